@@ -1,0 +1,62 @@
+"""The figure record every benchmark returns, and a median timer."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Figure", "median_time"]
+
+
+@dataclass
+class Figure:
+    """One measured number, with the baseline it is compared to (DESIGN's JSON shape)."""
+
+    bench: str
+    name: str
+    value: float
+    unit: str
+    baseline: str | None = None
+    baseline_value: float | None = None
+
+    @property
+    def ratio(self) -> float | None:
+        """``value / baseline_value`` when both exist."""
+        if self.baseline_value in (None, 0) or self.value is None:
+            return None
+        return float(self.value) / float(self.baseline_value)  # type: ignore[arg-type]
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON object of ``bench --json``."""
+        d = asdict(self)
+        d["ratio"] = self.ratio
+        return d
+
+    def line(self) -> str:
+        """One human-readable line: value, baseline and ratio."""
+        s = f"{self.bench:>14}  {self.name:<34} {self.value:>12.4g} {self.unit:<6}"
+        if self.baseline is not None:
+            bv = "n/a" if self.baseline_value is None else f"{self.baseline_value:.4g}"
+            r = "" if self.ratio is None else f"  ratio {self.ratio:.3g}"
+            s += f"  vs {self.baseline}: {bv}{r}"
+        return s
+
+
+def median_time(fn: Callable[[], Any], repeats: int = 15, min_time: float = 0.05) -> float:
+    """Median seconds per call of ``fn`` over ``repeats`` samples, each at least ``min_time`` long."""
+    fn()  # warm caches and lazy imports
+    t0 = time.perf_counter()
+    fn()
+    one = max(time.perf_counter() - t0, 1e-7)
+    inner = max(1, int(min_time / one))
+    samples = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for _ in range(inner):
+            fn()
+        samples.append((time.perf_counter() - t0) / inner)
+    return float(np.median(samples))

@@ -1,0 +1,47 @@
+"""``puppetphone bench [NAME…] [--json FILE]``: run benchmarks, print figures with baselines."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+
+from engine.atomic import atomic_write_bytes
+
+__all__ = ["configure", "run"]
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the bench arguments."""
+    from bench import BENCHES
+
+    parser.add_argument("names", nargs="*", metavar="NAME", help=f"benches to run (default all): {', '.join(BENCHES)}")
+    parser.add_argument("--json", metavar="FILE", help="write the figures as a JSON list")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the chosen benches in order and report every figure."""
+    from bench import BENCHES
+
+    names = args.names or list(BENCHES)
+    unknown = [n for n in names if n not in BENCHES]
+    if unknown:
+        print(f"unknown bench {', '.join(unknown)}; known: {', '.join(BENCHES)}", file=sys.stderr)
+        return 2
+    figures = []
+    failed = []
+    for name in names:
+        try:
+            module = importlib.import_module(BENCHES[name])
+        except ModuleNotFoundError as exc:
+            print(f"{name}: not available ({exc})", file=sys.stderr)
+            failed.append(name)
+            continue
+        print(f"# {name}", flush=True)
+        for fig in module.run():
+            print(fig.line(), flush=True)
+            figures.append(fig)
+    if args.json:
+        atomic_write_bytes(args.json, json.dumps([f.as_dict() for f in figures], indent=2).encode())
+    return 1 if failed else 0
