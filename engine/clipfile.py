@@ -72,11 +72,10 @@ def save_clip(clip: Clip, path: str | Path) -> Path:
 def load_clip(path: str | Path) -> Clip:
     """Read a clip, checking format, version and checksum; raises :class:`ClipFileError`."""
     path = Path(path)
+    raw = path.read_bytes()
     try:
-        with np.load(path, allow_pickle=False) as data:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
-    except FileNotFoundError:
-        raise
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
         raise ClipFileError(f"{path}: not a readable clip file ({exc})") from exc
     if "header" not in arrays:

@@ -1,0 +1,150 @@
+"""What crosses the input boundary: pose samples, per-step input frames, source status.
+
+A :class:`PoseSample` is one reading of one controller, already in engine units
+(metres, Y up, quaternions ``(w,x,y,z)``) but *not* yet calibrated or turned into a
+stick: that happens in the simulation (``input/motionstick.py``) so that a replay
+reproduces it. An :class:`InputFrame` is everything the hub drained for one fixed
+step; it is the only non-deterministic thing the simulation reads, and exactly
+what a recording stores (DESIGN: input is the one non-deterministic boundary).
+
+Two position modes exist because controllers differ in what they know:
+
+- ``"world"``: the sample's ``position`` is the stick's pivot in world space and
+  its orientation points the stick (the mouse: a stick held at the camera eye).
+- ``"device"``: orientation (and, for 6-DoF phones, ``position``) are in the
+  device's own tracking space; the MotionStick applies the calibration yaw and
+  puts the pivot at a virtual phone position.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS"]
+
+CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP = "connect", "disconnect", "touch_down", "touch_up"
+EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP)
+
+F = NDArray[np.float64]
+
+
+def _vec(v: object, n: int, name: str) -> F | None:
+    if v is None:
+        return None
+    a = np.array(v, dtype=np.float64).reshape(-1)
+    if a.shape != (n,):
+        raise ValueError(f"{name} needs {n} values, got {a.shape[0]}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} is not finite: {a.tolist()}")
+    return a
+
+
+@dataclass(eq=False)
+class PoseSample:
+    """One controller reading.
+
+    Args:
+        time: seconds on the source's clock when it was received (informative only:
+            the simulation steps on its own fixed clock).
+        source: id of the sending controller (``"osc:127.0.0.1:5000"``, ``"mouse"``).
+        orientation: unit quaternion (w,x,y,z); for ``"device"`` samples the stick
+            points along the rotated +Z axis once calibrated.
+        position: pivot (``"world"``) or tracked device position (``"device"``), or ``None``.
+        angular_velocity: rad/s in the device frame, if the device reports it.
+        acceleration: m/s² in the device frame, if the device reports it.
+        touch: ``True`` pressed, ``False`` released, ``None`` unknown/unchanged.
+        mode: ``"world"`` or ``"device"`` (see the module docs).
+        plane_normal: keep the grab depth along this axis while held (mouse dragging
+            in the plane at the grab depth); ``None`` keeps the stick length.
+        depth_delta: metres to add to the grab depth (mouse wheel).
+        flick: the source itself saw a flick gesture (mouse); phones flick by velocity.
+        calibrate: "this is forward now" (tap-to-calibrate, a calibrate message).
+
+    Raises:
+        ValueError: on wrong sizes, non-finite values or a non-unit quaternion.
+    """
+
+    time: float
+    source: str
+    orientation: F
+    position: F | None = None
+    angular_velocity: F | None = None
+    acceleration: F | None = None
+    touch: bool | None = None
+    mode: str = "device"
+    plane_normal: F | None = None
+    depth_delta: float = 0.0
+    flick: bool = False
+    calibrate: bool = False
+
+    def __post_init__(self) -> None:
+        q = _vec(self.orientation, 4, "orientation")
+        assert q is not None
+        n = float(np.linalg.norm(q))
+        if abs(n - 1.0) > 1e-3:
+            raise ValueError(f"orientation is not a unit quaternion (norm {n:.4g})")
+        self.orientation = q / n
+        self.position = _vec(self.position, 3, "position")
+        self.angular_velocity = _vec(self.angular_velocity, 3, "angular_velocity")
+        self.acceleration = _vec(self.acceleration, 3, "acceleration")
+        self.plane_normal = _vec(self.plane_normal, 3, "plane_normal")
+        if self.mode not in ("world", "device"):
+            raise ValueError(f"mode must be 'world' or 'device', not {self.mode!r}")
+        if not np.isfinite(self.depth_delta) or not np.isfinite(self.time):
+            raise ValueError("time and depth_delta must be finite")
+        if not self.source or len(self.source.encode()) > 255:
+            raise ValueError("source id must be 1..255 bytes")
+        self.time = float(self.time)
+        self.depth_delta = float(self.depth_delta)
+
+
+@dataclass(eq=False)
+class InputFrame:
+    """Everything the hub drained for one step: samples in arrival order and events.
+
+    ``events`` is a tuple of ``(kind, source)`` with kind one of :data:`EVENT_KINDS`.
+    It is a simulation resource (``SIM_STATE``): its content is hashed, so a replay
+    that fed different input would be caught at the first differing frame.
+    """
+
+    frame: int = 0
+    samples: tuple[PoseSample, ...] = ()
+    events: tuple[tuple[str, str], ...] = ()
+
+    SIM_STATE = True
+
+    def latest(self, source: str | None = None) -> PoseSample | None:
+        """The last sample of ``source`` (any source if ``None``) this step."""
+        for s in reversed(self.samples):
+            if source is None or s.source == source:
+                return s
+        return None
+
+    def sources(self) -> list[str]:
+        """Distinct source ids in this frame, in first-seen order."""
+        seen: dict[str, None] = {}
+        for s in self.samples:
+            seen.setdefault(s.source)
+        for _, src in self.events:
+            seen.setdefault(src)
+        return list(seen)
+
+    def has_event(self, kind: str, source: str | None = None) -> bool:
+        """Whether an event of ``kind`` (for ``source``, or any) happened this step."""
+        return any(k == kind and (source is None or s == source) for k, s in self.events)
+
+
+@dataclass
+class SourceStatus:
+    """A source's health, for the overlay and ``puppetphone devices`` (not simulation state)."""
+
+    name: str
+    connected: bool = False
+    packets: int = 0
+    packets_per_s: float = 0.0
+    dropped: int = 0
+    last_error: str = ""
+    drop_reasons: dict[str, int] = field(default_factory=dict)

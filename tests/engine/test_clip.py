@@ -1,0 +1,138 @@
+"""Clip sampling, looping and root motion; the clip file round trip and its refusals."""
+
+import zipfile
+
+import numpy as np
+import pytest
+
+from engine import quat
+from engine.clip import Clip
+from engine.clipfile import ClipFileError, load_clip, save_clip
+from engine.humanoid import humanoid_skeleton
+
+UP = np.array([0.0, 1.0, 0.0])
+
+
+def walking_clip(frames=30, fps=30.0, speed=1.5, turn=0.0):
+    """A root that walks along +Z (and turns by ``turn`` rad per second) with a knee swinging."""
+    sk = humanoid_skeleton()
+    t = np.arange(frames) / fps
+    heading = turn * t
+    root = np.zeros((frames, 3))
+    root[:, 2] = speed * t
+    root[:, 1] = 0.95 + 0.02 * np.sin(2 * np.pi * t * fps / frames)
+    rot = quat.identity(frames, sk.num_joints)
+    rot[:, 0] = quat.from_axis_angle(UP, heading)
+    rot[:, sk.index("l_lower_leg")] = quat.from_axis_angle([1, 0, 0], 0.5 + 0.4 * np.sin(2 * np.pi * t * fps / frames))
+    return Clip("walk", sk, fps, root, rot, loop=True)
+
+
+def test_sampling_interpolates_between_frames():
+    clip = walking_clip()
+    a, b = clip.sample(0.0), clip.sample(1 / 30)
+    mid = clip.sample(0.5 / 30)
+    np.testing.assert_allclose(mid.root, (a.root + b.root) / 2, atol=1e-12)
+    np.testing.assert_allclose(mid.rotations, quat.slerp(a.rotations, b.rotations, 0.5), atol=1e-12)
+
+
+def test_vector_sampling_matches_scalar():
+    clip = walking_clip()
+    ts = np.array([0.0, 0.13, 0.77])
+    many = clip.sample(ts)
+    for k, t in enumerate(ts):
+        np.testing.assert_allclose(many.rotations[k], clip.sample(t).rotations, atol=1e-12)
+
+
+def test_loop_wraps_time_and_non_loop_clamps():
+    clip = walking_clip()
+    np.testing.assert_allclose(clip.sample(0.2).rotations, clip.sample(0.2 + clip.duration).rotations, atol=1e-12)
+    one_shot = Clip("x", clip.skeleton, clip.fps, clip.root, clip.rotations, loop=False)
+    np.testing.assert_allclose(one_shot.sample(99.0).root, clip.root[-1])
+    np.testing.assert_allclose(one_shot.sample(-1.0).root, clip.root[0])
+
+
+def test_root_motion_extraction_removes_travel_and_accumulates_over_loops():
+    clip = walking_clip(speed=1.5).extract_root_motion()
+    assert np.allclose(clip.root[:, [0, 2]], 0.0)
+    assert np.allclose(clip.root[:, 1], walking_clip().root[:, 1])
+    assert clip.average_speed() == pytest.approx(1.5, rel=1e-6)
+    t1, _ = clip.sample_root_motion(0.5)
+    t2, _ = clip.sample_root_motion(0.5 + 2 * clip.duration)
+    np.testing.assert_allclose(t2 - t1, [0, 0, 2 * 1.5 * clip.duration], atol=1e-9)
+    # Root motion is continuous across the loop seam.
+    eps = 1e-4
+    before, _ = clip.sample_root_motion(clip.duration - eps)
+    after, _ = clip.sample_root_motion(clip.duration + eps)
+    assert np.linalg.norm(after - before) < 1.5 * 3 * eps
+
+
+def test_root_motion_heading():
+    clip = walking_clip(turn=0.5).extract_root_motion()
+    _, h = clip.sample_root_motion(0.5)
+    assert h == pytest.approx(0.25, abs=1e-6)
+    assert np.allclose(quat.rotate(clip.rotations[:, 0], [0, 0, 1.0])[:, 0], 0.0, atol=1e-12)
+
+
+def test_nan_clip_refused():
+    clip = walking_clip()
+    root = clip.root.copy()
+    root[3, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        Clip("bad", clip.skeleton, 30, root, clip.rotations)
+
+
+def test_clip_file_round_trip(tmp_path):
+    clip = walking_clip().extract_root_motion()
+    clip = Clip(clip.name, clip.skeleton, clip.fps, clip.root, clip.rotations, True, clip.root_motion, {"left_down": 0.0})
+    path = save_clip(clip, tmp_path / "walk.ppclip")
+    back = load_clip(path)
+    assert back.name == "walk" and back.loop and back.markers == {"left_down": 0.0}
+    np.testing.assert_array_equal(back.rotations, clip.rotations)
+    np.testing.assert_array_equal(back.root_motion.translation, clip.root_motion.translation)
+    assert back.skeleton.names == clip.skeleton.names
+    assert not list(tmp_path.glob(".*tmp"))  # no temporary left behind
+
+
+def test_truncated_clip_file_refused(tmp_path):
+    path = save_clip(walking_clip(), tmp_path / "walk.ppclip")
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ClipFileError, match="walk.ppclip"):
+        load_clip(path)
+
+
+def test_garbage_file_refused(tmp_path):
+    path = tmp_path / "x.ppclip"
+    path.write_bytes(b"not a clip at all")
+    with pytest.raises(ClipFileError):
+        load_clip(path)
+
+
+def _rewrite_header(path, change):
+    import json
+
+    with np.load(path) as data:
+        arrays = {k: data[k] for k in data.files}
+    header = json.loads(arrays.pop("header").tobytes())
+    change(header, arrays)
+    with open(path, "wb") as f:  # a file object: np.savez would append ".npz" to the name
+        np.savez(f, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8), **arrays)
+
+
+def test_wrong_version_refused(tmp_path):
+    path = save_clip(walking_clip(), tmp_path / "walk.ppclip")
+    _rewrite_header(path, lambda h, a: h.update(version=99))
+    with pytest.raises(ClipFileError, match="version 99"):
+        load_clip(path)
+
+
+def test_altered_data_fails_checksum(tmp_path):
+    path = save_clip(walking_clip(), tmp_path / "walk.ppclip")
+
+    def alter(h, a):
+        a["root"] = a["root"] + 1.0
+
+    _rewrite_header(path, alter)
+    with pytest.raises(ClipFileError, match="checksum"):
+        load_clip(path)
+    assert zipfile.is_zipfile(path)
