@@ -1,0 +1,200 @@
+"""A generic state machine: states and transitions as data, per-entity runtime state.
+
+The definition (:class:`StateMachine`) is an immutable asset shared by every puppet
+that uses it; what changes per step lives in the :class:`Brain` component (active
+state, time in it, the cross-fade in progress, the trace of transitions).
+
+Each step :func:`step_machine`:
+
+1. collects the events raised since the last step (``Brain.raise_event``);
+2. evaluates the transitions that leave the active state (and the ``"*"`` ones that
+   leave any state) in priority order, highest first; a transition fires when its
+   event (if it names one) was raised and its guard (if any) is true;
+3. if none fires and the active state's ``fits`` guard says the state no longer fits
+   the input, the machine falls back to the *default state* (thesis §6.2.2: the
+   ragdoll, "activated when such a situation arises");
+4. runs ``exit`` / ``enter`` on a change, then ``update`` of the active state.
+
+Guards and callbacks take ``(world, entity, brain)``; they read the context
+(stick, ground, nearby objects) from the world and write the animation request.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from engine.ecs import Entity, World
+
+__all__ = ["State", "Transition", "StateMachine", "Brain", "TraceEntry", "step_machine", "ANY"]
+
+ANY = "*"
+Callback = Callable[[World, Entity, "Brain"], None]
+Guard = Callable[[World, Entity, "Brain"], bool]
+
+
+def _nothing(world: World, entity: Entity, brain: Brain) -> None:
+    return None
+
+
+def _always(world: World, entity: Entity, brain: Brain) -> bool:
+    return True
+
+
+@dataclass(frozen=True)
+class State:
+    """A state's behaviour: ``enter``/``update``/``exit`` callbacks and a ``fits`` guard."""
+
+    name: str
+    enter: Callback = _nothing
+    update: Callback = _nothing
+    exit: Callback = _nothing
+    fits: Guard = _always
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Transition:
+    """An edge: from ``source`` (or ``ANY``) to ``target`` on ``event`` and/or when ``guard`` holds."""
+
+    source: str
+    target: str
+    event: str | None = None
+    guard: Guard | None = None
+    priority: int = 0
+    crossfade: float = 0.2
+    label: str = ""
+
+    def fires(self, world: World, entity: Entity, brain: Brain, events: Sequence[str]) -> bool:
+        """Whether this transition should be taken now."""
+        if self.event is not None and self.event not in events:
+            return False
+        if self.guard is not None and not self.guard(world, entity, brain):
+            return False
+        return self.event is not None or self.guard is not None
+
+
+@dataclass
+class TraceEntry:
+    """One transition taken: when, from where, to where, and why."""
+
+    frame: int
+    source: str
+    target: str
+    reason: str
+
+
+@dataclass
+class Brain:
+    """Per-entity runtime state of a state machine (a component)."""
+
+    machine: StateMachine = field(metadata={"hash": False})
+    active: str = ""
+    time_in_state: float = 0.0
+    crossfade: float = 0.0
+    crossfade_total: float = 0.0
+    previous: str = ""
+    pending_events: list[str] = field(default_factory=list)
+    last_events: list[str] = field(default_factory=list)
+    trace: list[TraceEntry] = field(default_factory=list)
+    memory: dict[str, Any] = field(default_factory=dict)
+    max_trace: int = 256
+
+    def raise_event(self, name: str) -> None:
+        """Queue an event for the next evaluation."""
+        self.pending_events.append(name)
+
+    @property
+    def fade_weight(self) -> float:
+        """0 just after a transition, rising to 1 when its cross-fade is over."""
+        if self.crossfade_total <= 0:
+            return 1.0
+        return 1.0 - self.crossfade / self.crossfade_total
+
+
+class StateMachine:
+    """An immutable graph of states and transitions with a default state."""
+
+    def __init__(self, name: str, states: Sequence[State], transitions: Sequence[Transition], default: str, initial: str | None = None) -> None:
+        self.name = name
+        self.states = {s.name: s for s in states}
+        if len(self.states) != len(states):
+            raise ValueError(f"{name}: state names must be unique")
+        for t in transitions:
+            for end in (t.source, t.target):
+                if end != ANY and end not in self.states:
+                    raise ValueError(f"{name}: transition {t.source}->{t.target} names unknown state {end!r}")
+            if t.event is None and t.guard is None:
+                raise ValueError(f"{name}: transition {t.source}->{t.target} needs an event or a guard")
+        if default not in self.states:
+            raise ValueError(f"{name}: default state {default!r} is not a state")
+        self.default = default
+        self.initial = initial or default
+        if self.initial not in self.states:
+            raise ValueError(f"{name}: initial state {self.initial!r} is not a state")
+        self.transitions = tuple(transitions)
+        self._outgoing: dict[str, list[Transition]] = {}
+        for s in self.states:
+            out = [t for t in transitions if t.source in (s, ANY) and t.target != s]
+            # Highest priority first; among equals, specific before ANY, then declaration order.
+            out.sort(key=lambda t: (-t.priority, t.source == ANY))
+            self._outgoing[s] = out
+
+    def new_brain(self) -> Brain:
+        """A component starting in the initial state (``enter`` runs on the first step)."""
+        return Brain(machine=self, active="")
+
+    def outgoing(self, state: str) -> list[Transition]:
+        """Transitions leaving ``state``, in evaluation order."""
+        return self._outgoing[state]
+
+    def to_dot(self) -> str:
+        """The graph in Graphviz DOT: the default state double-circled, edges labelled."""
+        lines = [f'digraph "{self.name}" {{', "  rankdir=LR;", '  node [shape=ellipse, fontname="Helvetica"];']
+        for s in self.states:
+            shape = "doublecircle" if s == self.default else "ellipse"
+            lines.append(f'  "{s}" [shape={shape}];')
+        for t in self.transitions:
+            label = t.label or t.event or (t.guard.__name__ if t.guard else "")
+            sources = list(self.states) if t.source == ANY else [t.source]
+            for src in sources:
+                if src != t.target:
+                    style = ", style=dashed" if t.source == ANY else ""
+                    lines.append(f'  "{src}" -> "{t.target}" [label="{label}"{style}];')
+        lines.append("}")
+        return "\n".join(lines)
+
+
+def _switch(world: World, entity: Entity, brain: Brain, target: str, reason: str, crossfade: float) -> None:
+    machine = brain.machine
+    if brain.active:
+        machine.states[brain.active].exit(world, entity, brain)
+    brain.trace.append(TraceEntry(world.frame, brain.active or "-", target, reason))
+    if len(brain.trace) > brain.max_trace:
+        del brain.trace[: len(brain.trace) - brain.max_trace]
+    brain.previous, brain.active = brain.active, target
+    brain.time_in_state = 0.0
+    brain.crossfade = brain.crossfade_total = crossfade
+    machine.states[target].enter(world, entity, brain)
+
+
+def step_machine(world: World, entity: Entity, brain: Brain) -> None:
+    """Advance one entity's machine by one fixed step (see the module docstring)."""
+    machine = brain.machine
+    events, brain.pending_events = brain.pending_events, []
+    if events:
+        brain.last_events = (brain.last_events + events)[-8:]
+    if not brain.active:
+        _switch(world, entity, brain, machine.initial, "start", 0.0)
+    else:
+        for t in machine.outgoing(brain.active):
+            if t.fires(world, entity, brain, events):
+                _switch(world, entity, brain, t.target, t.label or t.event or "guard", t.crossfade)
+                break
+        else:
+            if brain.active != machine.default and not machine.states[brain.active].fits(world, entity, brain):
+                _switch(world, entity, brain, machine.default, "no state fits", 0.2)
+    machine.states[brain.active].update(world, entity, brain)
+    brain.time_in_state += world.dt
+    brain.crossfade = max(0.0, brain.crossfade - world.dt)

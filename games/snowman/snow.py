@@ -1,0 +1,95 @@
+"""Snow physics of the game rules: how a rolled ball grows, and the marks it leaves.
+
+A ball rolled over fresh snow of depth ``d`` sinks into it and peels up the strip
+under it. The strip's cross-section is the circular segment the ball cuts into
+the snow layer, ``A = r²·acos((r−d)/r) − (r−d)·√(2rd − d²)``; rolling ``ds`` adds
+``A·ds`` of snow to the ball, so ``r`` grows by volume, ``(4/3)π·r³ += A·ds``. The
+strip is then bare: rolling again over a mark picks up nothing, which is why the
+field remembers its marks (a coarse grid of snow depth).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["segment_area", "grow_radius", "SnowField"]
+
+
+def segment_area(radius: float, depth: float) -> float:
+    """Cross-section of snow a ball of ``radius`` peels from a layer ``depth`` deep."""
+    d = min(max(depth, 0.0), radius)
+    if d <= 0.0:
+        return 0.0
+    h = radius - d
+    return float(radius**2 * np.arccos(h / radius) - h * np.sqrt(max(2 * radius * d - d * d, 0.0)))
+
+
+def grow_radius(radius: float, distance: float, depth: float) -> float:
+    """Radius after rolling ``distance`` metres over snow ``depth`` deep (volume conserved)."""
+    volume = 4.0 / 3.0 * np.pi * radius**3 + segment_area(radius, depth) * max(distance, 0.0)
+    return float(np.cbrt(volume * 3.0 / (4.0 * np.pi)))
+
+
+@dataclass
+class SnowField:
+    """Snow depth on a square grid centred on the origin; rolled strips are cleared.
+
+    Attributes:
+        size: side length of the field in metres.
+        cell: grid cell size in metres.
+        depth: ``[N,N]`` snow depth per cell in metres.
+    """
+
+    size: float = 24.0
+    cell: float = 0.1
+    initial_depth: float = 0.04
+    depth: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
+
+    SIM_STATE = True
+
+    def __post_init__(self) -> None:
+        n = int(round(self.size / self.cell))
+        if self.depth is None:
+            self.depth = np.full((n, n), self.initial_depth)
+
+    def _cells(self, center: NDArray[np.float64], half_width: float) -> tuple[slice, slice]:
+        n = self.depth.shape[0]
+        lo = np.floor((center[[0, 2]] - half_width + self.size / 2) / self.cell).astype(int)
+        hi = np.ceil((center[[0, 2]] + half_width + self.size / 2) / self.cell).astype(int)
+        lo, hi = np.clip(lo, 0, n), np.clip(hi, 0, n)
+        return slice(lo[0], hi[0]), slice(lo[1], hi[1])
+
+    def depth_at(self, position: NDArray[np.float64]) -> float:
+        """Snow depth under a point (0 off the field)."""
+        n = self.depth.shape[0]
+        i, k = np.floor((np.asarray(position)[[0, 2]] + self.size / 2) / self.cell).astype(int)
+        return float(self.depth[i, k]) if 0 <= i < n and 0 <= k < n else 0.0
+
+    def roll(self, start: NDArray[np.float64], end: NDArray[np.float64], radius: float) -> float:
+        """Roll a ball from ``start`` to ``end``: clear its strip and return its new radius."""
+        start, end = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64)
+        distance = float(np.linalg.norm((end - start)[[0, 2]]))
+        if distance <= 0.0:
+            return radius
+        # Sample the strip densely enough that no cell is skipped.
+        steps = max(1, int(np.ceil(distance / (0.5 * self.cell))))
+        points = [start + (end - start) * (k + 0.5) / steps for k in range(steps)]
+        # Read the snow along the whole path before clearing, so the strip the ball
+        # is about to reach is not mistaken for one it already peeled.
+        depths = [self.depth_at(p) for p in points]
+        r = radius
+        for p, d in zip(points, depths):
+            if d > 0.0:
+                half = np.sqrt(max(2 * r * min(d, r) - min(d, r) ** 2, 0.0))
+                self.depth[self._cells(p, max(half, 0.5 * self.cell))] = 0.0
+            r = grow_radius(r, distance / steps, d)
+        return r
+
+    def marks(self) -> NDArray[np.float64]:
+        """World ``[M,3]`` centres of cells rolled bare (for drawing the tracks)."""
+        idx = np.argwhere(self.depth <= 0.0)
+        xz = (idx + 0.5) * self.cell - self.size / 2
+        return np.column_stack([xz[:, 0], np.zeros(len(xz)), xz[:, 1]])

@@ -1,0 +1,102 @@
+"""The generic state machine: events, guards, priority, default state, trace, DOT."""
+
+import pytest
+
+from engine.ecs import World
+from engine.hashing import state_hash
+from engine.statemachine import ANY, State, StateMachine, Transition, step_machine
+
+
+def make_machine(log):
+    def enter(name):
+        return lambda w, e, b: log.append(("enter", name))
+
+    def exit_(name):
+        return lambda w, e, b: log.append(("exit", name))
+
+    def high_speed(w, e, b):
+        return b.memory.get("speed", 0.0) > 2.0
+
+    states = [
+        State("ragdoll", enter("ragdoll"), exit=exit_("ragdoll")),
+        State("idle", enter("idle"), exit=exit_("idle")),
+        State("run", enter("run"), exit=exit_("run"), fits=lambda w, e, b: b.memory.get("speed", 0) < 10),
+        State("jump", enter("jump")),
+    ]
+    transitions = [
+        Transition("ragdoll", "idle", event="landed", crossfade=0.5),
+        Transition("idle", "run", guard=high_speed, crossfade=0.25),
+        Transition("idle", "jump", event="flick", priority=5),
+        Transition(ANY, "ragdoll", event="hit", priority=10, label="hit"),
+    ]
+    return StateMachine("test", states, transitions, default="ragdoll", initial="idle")
+
+
+def test_starts_in_initial_state_and_follows_guard():
+    log = []
+    m = make_machine(log)
+    w = World()
+    e = w.spawn()
+    b = m.new_brain()
+    step_machine(w, e, b)
+    assert b.active == "idle" and log == [("enter", "idle")]
+    b.memory["speed"] = 3.0
+    step_machine(w, e, b)
+    assert b.active == "run"
+    assert b.crossfade_total == 0.25 and b.fade_weight < 0.5
+    assert [(t.source, t.target) for t in b.trace] == [("-", "idle"), ("idle", "run")]
+
+
+def test_priority_event_beats_guard():
+    m = make_machine([])
+    w = World()
+    b = m.new_brain()
+    step_machine(w, 1, b)
+    b.memory["speed"] = 3.0
+    b.raise_event("flick")
+    step_machine(w, 1, b)
+    assert b.active == "jump"
+
+
+def test_any_transition_and_default_state_when_nothing_fits():
+    m = make_machine([])
+    w = World()
+    b = m.new_brain()
+    step_machine(w, 1, b)
+    b.memory["speed"] = 3.0
+    step_machine(w, 1, b)
+    b.memory["speed"] = 50.0  # run no longer fits and no transition applies
+    step_machine(w, 1, b)
+    assert b.active == "ragdoll" and b.trace[-1].reason == "no state fits"
+    b.raise_event("landed")
+    step_machine(w, 1, b)
+    assert b.active == "idle"
+    b.raise_event("hit")
+    step_machine(w, 1, b)
+    assert b.active == "ragdoll" and b.trace[-1].reason == "hit"
+    assert b.last_events[-2:] == ["landed", "hit"]
+
+
+def test_bad_definitions_refused():
+    with pytest.raises(ValueError, match="unknown state"):
+        StateMachine("x", [State("a")], [Transition("a", "b", event="e")], default="a")
+    with pytest.raises(ValueError, match="event or a guard"):
+        StateMachine("x", [State("a"), State("b")], [Transition("a", "b")], default="a")
+    with pytest.raises(ValueError, match="default"):
+        StateMachine("x", [State("a")], [], default="z")
+
+
+def test_dot_export_lists_states_and_edges():
+    dot = make_machine([]).to_dot()
+    assert '"ragdoll" [shape=doublecircle]' in dot
+    assert '"idle" -> "jump" [label="flick"]' in dot
+    assert '"run" -> "ragdoll" [label="hit", style=dashed]' in dot
+
+
+def test_brain_is_hashable_state():
+    m = make_machine([])
+    w = World()
+    e = w.spawn(m.new_brain())
+    h0 = state_hash(w)
+    step_machine(w, e, w.get(e, type(m.new_brain())))
+    assert state_hash(w) != h0
