@@ -1,0 +1,39 @@
+"""The games the launcher knows, and how an app is assembled for one of them.
+
+A game module (``games/<name>/game.py``) exposes a :class:`games.base.Game`; the
+launcher builds the simulation from its plugins plus the input plugin, so
+``play``, ``replay --verify`` and the tests all assemble the same app.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from engine.app import App
+from games.base import Game
+from input.hub import InputHub
+from input.plugin import install_input
+
+__all__ = ["GAMES", "load_game", "make_app"]
+
+GAMES: dict[str, str] = {
+    "snowman": "games.snowman.game",
+    "tasbada": "games.tasbada.game",
+    "sandbox": "games.sandbox",
+}
+
+
+def load_game(name: str) -> Game:
+    """The game object of a registered game; ``ValueError`` lists the known ones."""
+    if name not in GAMES:
+        raise ValueError(f"unknown game {name!r}; games are {', '.join(g for g in GAMES if g != 'sandbox')}")
+    return importlib.import_module(GAMES[name]).GAME  # type: ignore[no-any-return]
+
+
+def make_app(game: str, seed: int, hub: InputHub) -> App:
+    """A headless simulation of ``game``: input first, then the game's plugins."""
+    g = load_game(game)
+    app = App(seed=seed)
+    install_input(app, hub)
+    g.install(app)
+    return app

@@ -1,0 +1,34 @@
+"""The on-screen overlay: fps, the game's status, each puppet's state, input sources.
+
+Only reads the world; drawn as text lines into the render scene.
+"""
+
+from __future__ import annotations
+
+from engine.ecs import World
+from engine.render.scene import RenderScene
+from engine.statemachine import Brain
+from games.base import Game
+from input.hub import InputHub
+
+__all__ = ["draw_overlay", "overlay_lines"]
+
+
+def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: bool) -> list[str]:
+    """The overlay's text, top to bottom."""
+    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}" + ("   PAUSED" if paused else "")]
+    lines += game.status(world)
+    for e, brain in world.query(Brain):
+        events = ", ".join(brain.last_events[-3:])
+        lines.append(f"#{e} {brain.active}" + (f"  ({events})" if events else ""))
+    for st in hub.statuses():
+        light = "●" if st.connected and st.packets_per_s > 0 else ("○" if st.connected else "×")
+        err = f"  {st.last_error}" if st.last_error else ""
+        lines.append(f"{light} {st.name}: {st.packets_per_s:5.1f} packets/s, dropped {st.dropped}{err}")
+    return lines
+
+
+def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fps: float, paused: bool) -> None:
+    """Add the overlay's lines to the scene."""
+    for line in overlay_lines(world, game, hub, fps, paused):
+        scene.add_text(line, size=16)
