@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from engine import quat
 from engine.skeleton import Skeleton
 
-__all__ = ["Transform", "Stick", "Puppet", "LocalPose", "WorldPose", "Grabbable", "Name"]
+__all__ = ["Transform", "Stick", "Puppet", "LocalPose", "WorldPose", "Grabbable", "Name", "Obstacle"]
 
 
 def _vec3() -> NDArray[np.float64]:
@@ -49,6 +49,14 @@ class Grabbable:
 
     radius: float = 0.5
     kind: str = "puppet"
+
+
+@dataclass
+class Obstacle:
+    """A vertical cylinder standing on the entity's ``Transform`` position (the MotionStick stops at it)."""
+
+    radius: float = 0.5
+    height: float = 2.0
 
 
 @dataclass

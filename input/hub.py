@@ -1,0 +1,121 @@
+"""The input hub: once per fixed step, every source's queue becomes one :class:`InputFrame`.
+
+The hub is where the non-deterministic world (threads, sockets, wall time) meets
+the deterministic one. It
+
+- drains each source in registration order, keeping samples in arrival order;
+- coalesces floods: per source at most ``max_samples`` samples per step survive
+  (the newest, plus any sample that changes touch or asks to calibrate), the rest
+  are counted as dropped, so a burst never costs the step more than a bounded time;
+- turns touch transitions into ``touch_down`` / ``touch_up`` events;
+- round-trips the frame through :mod:`input.codec`, so the live simulation reads
+  exactly the bits a recording stores and a replay will feed back.
+
+With a *frame source* (a :class:`input.replay.ReplaySource`) the hub returns the
+recorded frame for each index instead of draining live sources.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Protocol
+
+from input.codec import decode_frame, encode_frame
+from input.sample import TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus
+from input.source import PoseSource
+
+__all__ = ["InputHub", "FrameSource"]
+
+
+class FrameSource(Protocol):
+    """A source that supplies whole recorded frames by index (replay)."""
+
+    name: str
+
+    def frame_at(self, index: int) -> InputFrame | None: ...
+
+    def status(self) -> SourceStatus: ...
+
+
+class InputHub:
+    """Collects sources and produces one :class:`InputFrame` per step.
+
+    Args:
+        sources: live sources (started by :meth:`start`).
+        replay: a frame source; when given, live sources are ignored.
+        max_samples: per source and step, how many pose samples are kept.
+    """
+
+    def __init__(self, sources: Iterable[PoseSource] = (), replay: FrameSource | None = None,
+                 max_samples: int = 8) -> None:
+        self.sources: list[PoseSource] = list(sources)
+        self.replay = replay
+        self.max_samples = max_samples
+        self.coalesced = 0
+        self._touch: dict[str, bool] = {}
+        self.last_frame = InputFrame()
+
+    @property
+    def live(self) -> bool:
+        """Whether frames come from live devices (the game loop then paces to real time)."""
+        return self.replay is None and any(s.threaded for s in self.sources)
+
+    def add(self, source: PoseSource) -> PoseSource:
+        """Register another live source."""
+        self.sources.append(source)
+        return source
+
+    def start(self) -> InputHub:
+        """Start every live source's device thread."""
+        for s in self.sources:
+            s.start()
+        return self
+
+    def close(self) -> None:
+        """Stop every source."""
+        for s in self.sources:
+            s.stop()
+
+    def statuses(self) -> list[SourceStatus]:
+        """Status of every source, for the overlay."""
+        out = [s.status() for s in self.sources]
+        if self.replay is not None:
+            out.insert(0, self.replay.status())
+        return out
+
+    def drain(self, frame: int) -> InputFrame:
+        """The input for step ``frame``."""
+        if self.replay is not None:
+            recorded = self.replay.frame_at(frame)
+            self.last_frame = recorded if recorded is not None else InputFrame(frame=frame)
+            return self.last_frame
+        samples: list[PoseSample] = []
+        events: list[tuple[str, str]] = []
+        for source in self.sources:
+            items = source.drain()
+            pose = [i for i in items if isinstance(i, PoseSample)]
+            events += [i for i in items if not isinstance(i, PoseSample)]
+            samples += self._coalesce(pose)
+        for s in samples:
+            if s.touch is not None and s.touch != self._touch.get(s.source, False):
+                events.append((TOUCH_DOWN if s.touch else TOUCH_UP, s.source))
+                self._touch[s.source] = s.touch
+        for kind, src in events:
+            if kind == "disconnect" and self._touch.pop(src, False):
+                events.append((TOUCH_UP, src))
+        live = InputFrame(frame=frame, samples=tuple(samples), events=tuple(events))
+        self.last_frame = decode_frame(encode_frame(live))
+        return self.last_frame
+
+    def _coalesce(self, pose: list[PoseSample]) -> list[PoseSample]:
+        if len(pose) <= self.max_samples:
+            return pose
+        keep = set(range(len(pose) - self.max_samples, len(pose)))
+        last_touch: dict[str, bool | None] = {}
+        for i, s in enumerate(pose):
+            if s.calibrate or s.flick or (s.touch is not None and s.touch != last_touch.get(s.source)):
+                keep.add(i)
+            if s.touch is not None:
+                last_touch[s.source] = s.touch
+        self.coalesced += len(pose) - len(keep)
+        return [s for i, s in enumerate(pose) if i in keep]

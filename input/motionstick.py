@@ -1,0 +1,219 @@
+"""The MotionStick system (thesis §6.2.1): controller poses in, a ``Stick`` out.
+
+The puppet hangs at the end of an invisible stick fixed to the controller. Each
+step, for every controller entity (``Stick`` + :class:`StickState`):
+
+1. take the newest sample of the source it is bound to (the first source that
+   speaks, unless bound to one by name); a disconnect releases the puppet;
+2. build the stick: ``"world"`` samples give pivot and orientation directly (the
+   mouse: a stick held at the camera); ``"device"`` samples are turned by the
+   calibration heading and pivot at a virtual phone position (moved by the tracked
+   position for 6-DoF phones). "Point at the screen and tap" calibrates: the first
+   tap of an uncalibrated device, or a sample with ``calibrate``, makes the current
+   pointing direction the scene's forward;
+3. ray-pick the grabbable the stick points at (``focus``: the renderer outlines it);
+4. touch down grabs the focus, keeping the stick's length and the grabbed thing's
+   rotation relative to the tip; touch up releases;
+5. shorten the stick where the tip would go below the ground or into an
+   :class:`~engine.components.Obstacle`;
+6. filter the tip velocity (One Euro) and detect an upward flick.
+
+Everything here runs on the fixed ``dt`` with state in components, so a replay
+reproduces it bit for bit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine import quat
+from engine.components import Grabbable, Obstacle, Stick, Transform
+from engine.ecs import Entity, World
+from input.filters import OneEuro
+from input.sample import DISCONNECT, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample
+from input.stick_geometry import pick, shorten
+
+__all__ = ["StickState", "StickConfig", "motionstick_system", "spawn_stick"]
+
+F = NDArray[np.float64]
+_Z = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass
+class StickConfig:
+    """Scene-level stick settings (a resource; hashed because it shapes the simulation)."""
+
+    virtual_pivot: F = field(default_factory=lambda: np.array([0.0, 1.4, -3.0]))
+    forward: F = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    ground_y: float = 0.0
+    idle_length: float = 3.0
+    min_depth: float = 0.3
+    max_pick: float = 50.0
+    flick_speed: float = 2.5
+    filter: OneEuro = field(default_factory=OneEuro)
+
+    SIM_STATE = True
+
+
+@dataclass
+class StickState:
+    """Per-controller state behind a ``Stick``: binding, calibration, grab depth, filter."""
+
+    binding: str = "*"
+    source: str = ""
+    yaw: F = field(default_factory=quat.identity)
+    origin: F = field(default_factory=lambda: np.zeros(3))
+    calibrated: bool = False
+    held_length: float = 0.0
+    depth: float = 0.0
+    plane_normal: F | None = None
+    filt_x: F | None = None
+    raw_x: F = field(default_factory=lambda: np.zeros(3))
+    filt_dx: F = field(default_factory=lambda: np.zeros(3))
+    flick_armed: bool = True
+
+
+def spawn_stick(world: World, binding: str = "*") -> Entity:
+    """A controller entity driven by ``binding`` (a source id, or ``"*"`` for the first that speaks)."""
+    return world.spawn(Stick(source=binding), StickState(binding=binding))
+
+
+def _heading_yaw(direction: F, forward: F) -> F:
+    """Rotation about +Y taking ``direction``'s heading to ``forward``'s."""
+    a = np.arctan2(direction[0], direction[2])
+    b = np.arctan2(forward[0], forward[2])
+    if np.hypot(direction[0], direction[2]) < 1e-6:
+        return quat.identity()
+    return quat.from_axis_angle([0.0, 1.0, 0.0], b - a)
+
+
+def _apply_sample(st: StickState, stick: Stick, s: PoseSample, cfg: StickConfig) -> None:
+    if s.mode == "world":
+        stick.orientation = s.orientation.copy()
+        if s.position is not None:
+            stick.pivot = s.position.copy()
+    else:
+        if s.calibrate:
+            _calibrate(st, s, cfg)
+        stick.orientation = quat.normalize(quat.mul(st.yaw, s.orientation))
+        offset = np.zeros(3) if s.position is None else quat.rotate(st.yaw, s.position - st.origin)
+        stick.pivot = cfg.virtual_pivot + offset
+    stick.direction = quat.rotate(stick.orientation, _Z)
+    if s.plane_normal is not None:
+        st.plane_normal = s.plane_normal.copy()
+
+
+def _calibrate(st: StickState, s: PoseSample, cfg: StickConfig) -> None:
+    st.yaw = _heading_yaw(quat.rotate(s.orientation, _Z), cfg.forward)
+    st.origin = np.zeros(3) if s.position is None else s.position.copy()
+    st.calibrated = True
+
+
+def _grab(world: World, st: StickState, stick: Stick, target: Entity) -> None:
+    tr = world.try_get(target, Transform)
+    if tr is None:
+        return
+    rel = tr.position - stick.pivot
+    st.held_length = float(np.linalg.norm(rel))
+    st.depth = float(rel @ st.plane_normal) if st.plane_normal is not None else st.held_length
+    tip = stick.pivot + stick.direction * st.held_length
+    inv = quat.conjugate(stick.orientation)
+    stick.grab_offset = quat.rotate(inv, tr.position - tip)
+    stick.grab_rotation = quat.normalize(quat.mul(inv, tr.rotation))
+    stick.grabbed, stick.just_grabbed = target, True
+
+
+def _release(stick: Stick) -> None:
+    if stick.grabbed is not None:
+        stick.grabbed, stick.just_released = None, True
+
+
+def _length(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, focus_t: float | None) -> float:
+    if stick.grabbed is None:
+        return focus_t if focus_t is not None else cfg.idle_length
+    if s is not None and s.depth_delta:
+        st.depth = max(cfg.min_depth, st.depth + s.depth_delta)
+        if st.plane_normal is None:
+            st.held_length = st.depth
+    if st.plane_normal is not None:
+        cos = float(stick.direction @ st.plane_normal)
+        return st.depth / max(cos, 0.05)
+    return st.held_length
+
+
+def _obstacles(world: World, skip: Entity | None) -> tuple[F, F, F]:
+    rows = [(tr.position, ob.radius, ob.height) for e, ob, tr in world.query(Obstacle, Transform) if e != skip]
+    if not rows:
+        return np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+    return np.array([r[0] for r in rows]), np.array([r[1] for r in rows]), np.array([r[2] for r in rows])
+
+
+def motionstick_system(world: World) -> None:
+    """The ``stick`` stage: update every controller's ``Stick`` from this step's ``InputFrame``."""
+    frame = world.try_resource(InputFrame) or InputFrame(frame=world.frame)
+    cfg = world.try_resource(StickConfig) or StickConfig()
+    grabbables = world.query(Grabbable, Transform)
+    for e, stick, st in world.query(Stick, StickState):
+        stick.just_grabbed = stick.just_released = stick.flick = False
+        if st.source and frame.has_event(DISCONNECT, st.source):
+            _release(stick)
+            stick.touching, stick.connected = False, False
+            if st.binding == "*":
+                st.source = ""
+        if not st.source:
+            first = frame.samples[0].source if frame.samples else None
+            if st.binding != "*":
+                first = st.binding if frame.latest(st.binding) is not None else None
+            if first is None:
+                continue
+            st.source, stick.source, stick.connected = first, first, True
+        s = frame.latest(st.source)
+        if s is not None:
+            stick.connected = True
+            _apply_sample(st, stick, s, cfg)
+        if stick.grabbed is not None and not world.alive(stick.grabbed):
+            _release(stick)
+        # Ray pick: what would be grabbed now (the renderer outlines it).
+        others = [(g, gr.radius, tr.position) for g, gr, tr in grabbables if g != stick.grabbed]
+        hit = None
+        if others:
+            centers = np.array([c for _, _, c in others])
+            radii = np.array([r for _, r, _ in others])
+            hit = pick(stick.pivot, stick.direction, centers, radii, cfg.max_pick)
+        stick.focus = others[hit[0]][0] if hit is not None else None
+        for kind, src in frame.events:
+            if src != st.source:
+                continue
+            if kind == TOUCH_DOWN:
+                stick.touching = True
+                if s is not None and s.mode == "device" and not st.calibrated:
+                    _calibrate(st, s, cfg)  # "point at the screen and tap"
+                    _apply_sample(st, stick, s, cfg)
+                elif stick.focus is not None and stick.grabbed is None:
+                    _grab(world, st, stick, stick.focus)
+            elif kind == TOUCH_UP:
+                stick.touching = False
+                _release(stick)
+        wanted = _length(st, stick, s, cfg, None if hit is None else hit[1])
+        bases, radii_o, heights = _obstacles(world, stick.grabbed)
+        stick.length = shorten(stick.pivot, stick.direction, wanted, cfg.ground_y, bases, radii_o, heights)
+        stick.tip = stick.pivot + stick.direction * stick.length
+        stick.tip_rotation = stick.orientation.copy()
+        _filter_velocity(st, stick, s, cfg, world.dt)
+
+
+def _filter_velocity(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, dt: float) -> None:
+    if st.filt_x is None:
+        st.filt_x, st.filt_dx = stick.tip.copy(), np.zeros(3)
+    else:
+        st.filt_x, st.filt_dx = cfg.filter.step(stick.tip, st.raw_x, st.filt_x, st.filt_dx, dt)
+    st.raw_x = stick.tip.copy()
+    stick.velocity = st.filt_dx.copy()
+    up = float(stick.velocity[1])
+    if (s is not None and s.flick) or (st.flick_armed and stick.grabbed is not None and up > cfg.flick_speed):
+        stick.flick, st.flick_armed = True, False
+    elif up < 0.5 * cfg.flick_speed:
+        st.flick_armed = True

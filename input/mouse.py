@@ -1,0 +1,110 @@
+"""The mouse as a MotionStick held at the camera (the default source).
+
+The game loop hands pygame events to :meth:`MouseSource.handle_event` on the main
+thread (pygame delivers events there). Each event becomes a ``"world"`` sample
+whose pivot is the camera's eye and whose orientation points along the ray under
+the cursor, with the camera's forward as the drag plane's normal; so the
+simulation (and a replay) never needs the camera:
+
+- left press grabs what is under the cursor, drag moves it in the plane at the
+  grab depth, release lets go;
+- the wheel changes the grab depth (``wheel_step`` metres per notch);
+- a quick upward drag is a flick (jumps);
+- right-drag orbits the camera: camera-only, so it is left to the game loop
+  (``handle_event`` returns ``False`` for it).
+
+The camera is anything with ``forward`` and ``ray(px, py, width, height) ->
+(origin, direction)`` (``engine.camera.OrbitCamera``).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine import quat
+from input.sample import PoseSample
+from input.source import PoseSource
+
+__all__ = ["MouseSource", "RayCamera"]
+
+F = NDArray[np.float64]
+
+# pygame event type ids (pygame.locals), copied so this module needs no display.
+MOUSEMOTION, MOUSEBUTTONDOWN, MOUSEBUTTONUP, MOUSEWHEEL = 1024, 1025, 1026, 1027
+
+
+class RayCamera(Protocol):
+    """What the mouse needs from a camera."""
+
+    forward: Any
+
+    def ray(self, px: float, py: float, width: int, height: int) -> tuple[Any, Any]: ...
+
+
+class MouseSource(PoseSource):
+    """Mouse events → pose samples (fed from the main thread; no device thread).
+
+    Args:
+        wheel_step: metres of grab depth per wheel notch.
+        flick_speed: upward cursor speed, in screen heights per second, that counts as a flick.
+    """
+
+    threaded = False
+
+    def __init__(self, wheel_step: float = 0.25, flick_speed: float = 2.5) -> None:
+        super().__init__("mouse")
+        self.wheel_step = wheel_step
+        self.flick_speed = flick_speed
+        self.pressed = False
+        self._last: tuple[float, float, float] | None = None  # x, y, time
+        self._flicked = False
+        self._status.connected = True
+
+    def handle_event(self, event: Any, camera: RayCamera, size: tuple[int, int], now: float | None = None) -> bool:
+        """Turn one pygame event into a sample; ``True`` if the event was the stick's."""
+        now = time.monotonic() if now is None else now
+        kind = event.type
+        if kind == MOUSEWHEEL:
+            pos = self._last[:2] if self._last else (size[0] / 2, size[1] / 2)
+            self._emit(camera, size, pos, now, depth_delta=-float(event.y) * self.wheel_step)
+            return True
+        if kind in (MOUSEBUTTONDOWN, MOUSEBUTTONUP) and getattr(event, "button", 1) != 1:
+            return False  # right button: camera orbit (game loop); wheel buttons 4/5 come as MOUSEWHEEL
+        if kind == MOUSEBUTTONDOWN:
+            self.pressed, self._flicked = True, False
+            self._last = (*event.pos, now)
+            self._emit(camera, size, event.pos, now, touch=True)
+            return True
+        if kind == MOUSEBUTTONUP:
+            self.pressed = False
+            self._emit(camera, size, event.pos, now, touch=False)
+            self._last = (*event.pos, now)
+            return True
+        if kind == MOUSEMOTION:
+            if getattr(event, "buttons", (0, 0, 0))[2] and not self.pressed:
+                return False  # right-drag: orbiting
+            flick = False
+            if self.pressed and self._last is not None:
+                dt = max(now - self._last[2], 1e-3)
+                up_speed = (self._last[1] - event.pos[1]) / size[1] / dt
+                if up_speed > self.flick_speed and not self._flicked:
+                    flick, self._flicked = True, True
+                elif up_speed < 0.5 * self.flick_speed:
+                    self._flicked = False
+            self._last = (*event.pos, now)
+            self._emit(camera, size, event.pos, now, flick=flick)
+            return True
+        return False
+
+    def _emit(self, camera: RayCamera, size: tuple[int, int], pos: Any, now: float, touch: bool | None = None,
+              depth_delta: float = 0.0, flick: bool = False) -> None:
+        origin, direction = camera.ray(float(pos[0]), float(pos[1]), int(size[0]), int(size[1]))
+        d = np.asarray(direction, dtype=np.float64)
+        orientation = quat.between([0.0, 0.0, 1.0], d / np.linalg.norm(d))
+        self.push(PoseSample(time=now, source="mouse", orientation=orientation, position=np.asarray(origin, float),
+                             touch=touch, mode="world", plane_normal=np.asarray(camera.forward, float),
+                             depth_delta=depth_delta, flick=flick))

@@ -1,0 +1,65 @@
+import numpy as np
+
+from input.hub import InputHub
+from input.sample import DISCONNECT, TOUCH_DOWN, TOUCH_UP, PoseSample
+from input.source import PoseSource
+
+
+class Fed(PoseSource):
+    threaded = False
+
+
+def _s(i, touch=None, src="dev"):
+    return PoseSample(time=float(i), source=src, orientation=[1.0, 0, 0, 0], position=[float(i), 0, 0], touch=touch)
+
+
+def test_touch_transitions_become_events_once():
+    src = Fed("dev")
+    hub = InputHub([src])
+    src.push(_s(0, touch=True))
+    src.push(_s(1, touch=True))
+    f = hub.drain(0)
+    assert f.events == ((TOUCH_DOWN, "dev"),) and len(f.samples) == 2
+    src.push(_s(2, touch=False))
+    assert hub.drain(1).events == ((TOUCH_UP, "dev"),)
+    assert hub.drain(2).samples == () and hub.drain(2).events == ()
+
+
+def test_flood_is_coalesced_keeping_newest_and_touch_changes():
+    src = Fed("dev", capacity=100_000)
+    hub = InputHub([src], max_samples=8)
+    for i in range(10_000):
+        src.push(_s(i, touch=True if i == 5000 else None))
+    f = hub.drain(0)
+    xs = [s.position[0] for s in f.samples]
+    assert len(f.samples) == 9 and xs[0] == 5000 and xs[-8:] == [float(i) for i in range(9992, 10000)]
+    assert hub.coalesced == 10_000 - 9
+    assert f.has_event(TOUCH_DOWN, "dev")
+
+
+def test_bounded_queue_counts_drops():
+    src = Fed("dev", capacity=16)
+    for i in range(100):
+        src.push(_s(i))
+    st = src.status()
+    assert st.dropped == 84 and st.drop_reasons == {"queue full": 84} and st.packets == 100
+    assert len(src.drain()) == 16
+
+
+def test_disconnect_while_touching_adds_touch_up():
+    src = Fed("dev")
+    hub = InputHub([src])
+    src.push(_s(0, touch=True))
+    hub.drain(0)
+    src.disconnected("dev")
+    f = hub.drain(1)
+    assert f.events == ((DISCONNECT, "dev"), (TOUCH_UP, "dev"))
+
+
+def test_live_frame_is_codec_round_tripped():
+    src = Fed("dev")
+    hub = InputHub([src])
+    src.push(_s(0))
+    f = hub.drain(0)
+    assert isinstance(f.samples[0].position, np.ndarray) and f.samples[0].position.dtype == np.float64
+    assert not hub.live  # fed from the main thread only

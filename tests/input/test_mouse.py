@@ -1,0 +1,66 @@
+"""The mouse: a stick held at the camera; drag in the plane at the grab depth, wheel, flick."""
+
+import numpy as np
+import pygame
+
+from engine.components import Stick
+from input.hub import InputHub
+from input.mouse import MouseSource
+
+
+class PinholeCamera:
+    """A camera at (0,1.5,-4) looking along +Z with a 90° vertical field of view."""
+
+    eye = np.array([0.0, 1.5, -4.0])
+    forward = np.array([0.0, 0.0, 1.0])
+
+    def ray(self, px, py, width, height):
+        x = (2 * px / width - 1) * width / height
+        y = 1 - 2 * py / height
+        d = np.array([-x, y, 1.0])  # screen right is -X when looking along +Z
+        return self.eye.copy(), d / np.linalg.norm(d)
+
+
+def ev(kind, **kw):
+    return pygame.event.Event(kind, **kw)
+
+
+def test_event_types_match_pygame():
+    from input import mouse
+
+    assert (mouse.MOUSEMOTION, mouse.MOUSEBUTTONDOWN, mouse.MOUSEBUTTONUP, mouse.MOUSEWHEEL) == (
+        pygame.MOUSEMOTION, pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEWHEEL)
+
+
+def test_drag_in_the_plane_at_grab_depth_and_wheel(make_app):
+    cam, size = PinholeCamera(), (800, 600)
+    mouse = MouseSource()
+    app = make_app(InputHub([mouse]))
+    # The puppet stand-in is at (0,0.95,0): find its pixel (below the centre).
+    py = 300 + 300 * (0.55 / 4.0)
+    assert mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(400, py), button=1), cam, size, now=0.0)
+    app.step()
+    stick = app.world.query(Stick)[0][1]
+    assert stick.grabbed is not None and np.isclose(stick.tip[2] - cam.eye[2], 4.0)
+    mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(200, py), rel=(-200, 0), buttons=(1, 0, 0)), cam, size, now=0.5)
+    app.step()
+    assert np.isclose(stick.tip[2], 0.0) and stick.tip[0] > 1.0  # same depth, moved to screen-left (+X)
+    mouse.handle_event(ev(pygame.MOUSEWHEEL, x=0, y=-2), cam, size, now=0.6)
+    app.step()
+    assert np.isclose(stick.tip[2], 0.5)  # two notches pushed it 0.5 m further away
+    assert not mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(1, 1), button=3), cam, size)  # orbit: camera's
+    mouse.handle_event(ev(pygame.MOUSEBUTTONUP, pos=(200, py), button=1), cam, size, now=0.7)
+    app.step()
+    assert stick.grabbed is None and stick.just_released
+
+
+def test_quick_upward_drag_is_one_flick():
+    cam, size = PinholeCamera(), (800, 600)
+    mouse = MouseSource()
+    mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(400, 500), button=1), cam, size, now=0.0)
+    for i, y in enumerate((400, 300, 200)):
+        mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(400, y), rel=(0, -100), buttons=(1, 0, 0)), cam, size,
+                           now=0.03 * (i + 1))
+    mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(400, 199), rel=(0, -1), buttons=(1, 0, 0)), cam, size, now=1.0)
+    flicks = [s.flick for s in mouse.drain()]
+    assert flicks == [False, True, False, False, False]
