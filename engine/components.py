@@ -45,10 +45,20 @@ class Transform:
 
 @dataclass
 class Grabbable:
-    """Marks an entity the MotionStick may grab; ``radius`` is its pick sphere around ``Transform``."""
+    """Marks an entity the MotionStick may grab.
+
+    The pick sphere of ``radius`` sits at ``offset`` in the entity's ``Transform`` frame
+    (a puppet is held at its hips, not at its feet): that point is the *anchor* the
+    stick's tip holds.
+    """
 
     radius: float = 0.5
     kind: str = "puppet"
+    offset: NDArray[np.float64] = field(default_factory=_vec3)
+
+    def anchor(self, transform: Transform) -> NDArray[np.float64]:
+        """World position of the held point."""
+        return transform.position + quat.rotate(transform.rotation, self.offset)
 
 
 @dataclass

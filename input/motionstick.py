@@ -114,14 +114,16 @@ def _calibrate(st: StickState, s: PoseSample, cfg: StickConfig) -> None:
 
 def _grab(world: World, st: StickState, stick: Stick, target: Entity) -> None:
     tr = world.try_get(target, Transform)
+    gr = world.try_get(target, Grabbable)
     if tr is None:
         return
-    rel = tr.position - stick.pivot
+    anchor = tr.position if gr is None else gr.anchor(tr)
+    rel = anchor - stick.pivot
     st.held_length = float(np.linalg.norm(rel))
     st.depth = float(rel @ st.plane_normal) if st.plane_normal is not None else st.held_length
     tip = stick.pivot + stick.direction * st.held_length
     inv = quat.conjugate(stick.orientation)
-    stick.grab_offset = quat.rotate(inv, tr.position - tip)
+    stick.grab_offset = quat.rotate(inv, anchor - tip)
     stick.grab_rotation = quat.normalize(quat.mul(inv, tr.rotation))
     stick.grabbed, stick.just_grabbed = target, True
 
@@ -177,7 +179,7 @@ def motionstick_system(world: World) -> None:
         if stick.grabbed is not None and not world.alive(stick.grabbed):
             _release(stick)
         # Ray pick: what would be grabbed now (the renderer outlines it).
-        others = [(g, gr.radius, tr.position) for g, gr, tr in grabbables if g != stick.grabbed]
+        others = [(g, gr.radius, gr.anchor(tr)) for g, gr, tr in grabbables if g != stick.grabbed]
         hit = None
         if others:
             centers = np.array([c for _, _, c in others])

@@ -3,12 +3,16 @@
 The game loop hands pygame events to :meth:`MouseSource.handle_event` on the main
 thread (pygame delivers events there). Each event becomes a ``"world"`` sample
 whose pivot is the camera's eye and whose orientation points along the ray under
-the cursor, with the camera's forward as the drag plane's normal; so the
-simulation (and a replay) never needs the camera:
+the cursor, with the drag plane's normal; so the simulation (and a replay) never
+needs the camera:
 
 - left press grabs what is under the cursor, drag moves it in the plane at the
-  grab depth, release lets go;
-- the wheel changes the grab depth (``wheel_step`` metres per notch);
+  grab depth, release lets go. With ``plane="ground"`` (the default, what a game
+  wants) the plane is horizontal at the grab point, so dragging walks the puppet
+  over the ground and the grab depth is measured downwards from the camera; with
+  ``plane="view"`` it faces the camera (a modelling tool's drag);
+- the wheel changes the grab depth (``wheel_step`` metres per notch): in the ground
+  plane, wheel up lifts what is held and wheel down lowers it (a puppet crouches);
 - a quick upward drag is a flick (jumps);
 - right-drag orbits the camera: camera-only, so it is left to the game loop
   (``handle_event`` returns ``False`` for it).
@@ -55,8 +59,11 @@ class MouseSource(PoseSource):
 
     threaded = False
 
-    def __init__(self, wheel_step: float = 0.25, flick_speed: float = 2.5) -> None:
+    def __init__(self, wheel_step: float = 0.1, flick_speed: float = 2.5, plane: str = "ground") -> None:
         super().__init__("mouse")
+        if plane not in ("ground", "view"):
+            raise ValueError(f"plane must be 'ground' or 'view', not {plane!r}")
+        self.plane = plane
         self.wheel_step = wheel_step
         self.flick_speed = flick_speed
         self.pressed = False
@@ -100,11 +107,16 @@ class MouseSource(PoseSource):
             return True
         return False
 
+    def _plane_normal(self, camera: RayCamera) -> NDArray[np.float64]:
+        if self.plane == "ground":
+            return np.array([0.0, -1.0, 0.0])
+        return np.asarray(camera.forward, dtype=np.float64)
+
     def _emit(self, camera: RayCamera, size: tuple[int, int], pos: Any, now: float, touch: bool | None = None,
               depth_delta: float = 0.0, flick: bool = False) -> None:
         origin, direction = camera.ray(float(pos[0]), float(pos[1]), int(size[0]), int(size[1]))
         d = np.asarray(direction, dtype=np.float64)
         orientation = quat.between([0.0, 0.0, 1.0], d / np.linalg.norm(d))
         self.push(PoseSample(time=now, source="mouse", orientation=orientation, position=np.asarray(origin, float),
-                             touch=touch, mode="world", plane_normal=np.asarray(camera.forward, float),
+                             touch=touch, mode="world", plane_normal=self._plane_normal(camera),
                              depth_delta=depth_delta, flick=flick))

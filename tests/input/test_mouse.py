@@ -34,7 +34,7 @@ def test_event_types_match_pygame():
 
 def test_drag_in_the_plane_at_grab_depth_and_wheel(make_app):
     cam, size = PinholeCamera(), (800, 600)
-    mouse = MouseSource()
+    mouse = MouseSource(plane="view", wheel_step=0.25)
     app = make_app(InputHub([mouse]))
     # The puppet stand-in is at (0,0.95,0): find its pixel (below the centre).
     py = 300 + 300 * (0.55 / 4.0)
@@ -52,6 +52,25 @@ def test_drag_in_the_plane_at_grab_depth_and_wheel(make_app):
     mouse.handle_event(ev(pygame.MOUSEBUTTONUP, pos=(200, py), button=1), cam, size, now=0.7)
     app.step()
     assert stick.grabbed is None and stick.just_released
+
+
+def test_ground_plane_drag_keeps_height_and_wheel_lifts(make_app):
+    cam, size = PinholeCamera(), (800, 600)
+    mouse = MouseSource(plane="ground", wheel_step=0.1)
+    app = make_app(InputHub([mouse]))
+    py = 300 + 300 * (0.55 / 4.0)
+    mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(400, py), button=1), cam, size, now=0.0)
+    app.step()
+    stick = app.world.query(Stick)[0][1]
+    assert stick.grabbed is not None
+    height = stick.tip[1]
+    mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(300, py + 60), rel=(-100, 60), buttons=(1, 0, 0)), cam, size, now=0.5)
+    app.step()
+    assert np.isclose(stick.tip[1], height)  # dragging stays on the horizontal plane
+    assert stick.tip[2] < -0.5 or stick.tip[0] > 0.5  # and moved over the ground
+    mouse.handle_event(ev(pygame.MOUSEWHEEL, x=0, y=2), cam, size, now=0.6)
+    app.step()
+    assert np.isclose(stick.tip[1], height + 0.2)  # wheel up lifts by two notches
 
 
 def test_quick_upward_drag_is_one_flick():
