@@ -17,9 +17,9 @@ HIP_HEIGHT = 0.95
 
 # name, parent, offset from parent, tip (leaves only), radius
 _SPEC: tuple[tuple[str, str | None, tuple[float, float, float], tuple[float, float, float], float], ...] = (
-    ("hips", None, (0.0, HIP_HEIGHT, 0.0), (0, 0, 0), 0.12),
-    ("spine", "hips", (0.0, 0.10, 0.0), (0, 0, 0), 0.12),
-    ("chest", "spine", (0.0, 0.18, 0.0), (0, 0, 0), 0.14),
+    ("hips", None, (0.0, HIP_HEIGHT, 0.0), (0, 0, 0), 0.095),
+    ("spine", "hips", (0.0, 0.10, 0.0), (0, 0, 0), 0.11),
+    ("chest", "spine", (0.0, 0.18, 0.0), (0, 0, 0), 0.085),
     ("neck", "chest", (0.0, 0.22, 0.0), (0, 0, 0), 0.05),
     ("head", "neck", (0.0, 0.10, 0.0), (0.0, 0.20, 0.0), 0.10),
     ("l_upper_arm", "chest", (0.17, 0.17, 0.0), (0, 0, 0), 0.05),

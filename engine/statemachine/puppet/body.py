@@ -1,0 +1,96 @@
+"""What a puppet's brain keeps between steps, and the tuning it reads.
+
+:class:`PuppetBody` is the per-puppet component (hashed: it is simulation state);
+:class:`PuppetTuning` holds the thresholds of the behaviour — immutable data a game
+may replace (a snowman jumps lower, its crouch is shallower).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.pose import Pose
+from engine.statemachine.jump_arc import JumpTracker
+
+__all__ = ["PuppetBody", "PuppetTuning", "PoseOverride"]
+
+F = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class PuppetTuning:
+    """Thresholds and rates of the puppet behaviour (thesis §6.2.2, §6.3).
+
+    Heights are hips heights in metres; speeds in m/s.
+    """
+
+    stand_height: float = 0.95
+    crouch_height: float = 0.55
+    crouch_enter: float = 0.80
+    crouch_exit: float = 0.86
+    lift_limit: float = 0.25
+    max_speed: float = 3.4
+    catch_up_gain: float = 2.5
+    follow_deadband: float = 0.06
+    turn_rate: float = 5.0
+    drag_limit: float = 1.6
+    anticipation: float = 0.16
+    landing: float = 0.22
+    flick_launch_speed: float = 3.4
+    jump_ragdoll_fall: float = 0.0
+    reach: float = 0.55
+    carry_max_radius: float = 0.26
+    pickup_time: float = 0.35
+    still_speed: float = 0.2
+    still_time: float = 0.3
+    gravity: float = 9.81
+
+
+@dataclass
+class PoseOverride:
+    """A pose that replaces the animated one after the animation stage (get-up), with a weight."""
+
+    pose: Pose | None = field(default=None, metadata={"hash": False})
+    weight: float = 0.0
+    SIM_STATE = True
+
+
+@dataclass
+class PuppetBody:
+    """Per-puppet brain state.
+
+    Attributes:
+        tuning: behaviour thresholds (an asset).
+        held_by: the controller entity whose stick holds this puppet, if any.
+        target: where the stick wants the puppet's ground position.
+        target_height: hips height the stick asks for (its tip's height).
+        heading: facing angle about +Y (0 = +Z).
+        speed: smoothed stick ground speed.
+        air: height of the root above the ground during a jump.
+        air_velocity: the puppet's velocity while airborne (ballistic jumps).
+        jump: the arc tracker of the current jump.
+        jump_from_stick: whether the stick's own path drives the arc (phones) or a flick launched it (mouse).
+        object: the prop carried or rolled.
+        timer: seconds in the current phase of a multi-phase state.
+        phase: the phase name within a state (``"anticipation"``, ``"air"``…).
+        getup: the get-up blend in progress (an object; its frame is hashed through ``timer``).
+    """
+
+    tuning: PuppetTuning = field(default_factory=PuppetTuning, metadata={"hash": False})
+    held_by: int | None = None
+    target: F = field(default_factory=lambda: np.zeros(3))
+    target_height: float = 0.95
+    heading: float = 0.0
+    speed: float = 0.0
+    air: float = 0.0
+    air_velocity: F = field(default_factory=lambda: np.zeros(3))
+    jump: JumpTracker | None = None
+    jump_from_stick: bool = False
+    object: int | None = None
+    timer: float = 0.0
+    phase: str = ""
+    getup: Any = field(default=None, metadata={"hash": False})

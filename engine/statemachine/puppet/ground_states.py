@@ -1,0 +1,107 @@
+"""Locomotion and Crouch: the puppet walks, runs and crouches where the stick leads it.
+
+Both states drive the same blend space (thesis Fig. 6.3): the stick's ground speed
+becomes the requested root speed, resolved to blend parameters by the IDW lookup
+table; the stick's height becomes the hips height. The puppet follows the stick's
+ground point with the speed of the stick plus a catch-up term on the remaining
+distance, turning toward where it is led at a bounded rate, so the clip's root
+motion — not a teleport — carries it and its feet do not slide.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.blend.locomotion import LocomotionPlayer
+from engine.components import Transform
+from engine.ecs import Entity, World
+from engine.ik.system import IKRequest
+from engine.statemachine.machine import Brain
+from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
+
+__all__ = ["follow_stick", "update_locomotion", "update_crouch", "locomotion_fits", "wants_crouch", "wants_stand", "lifted"]
+
+
+def _wrap(angle: float) -> float:
+    return float((angle + np.pi) % (2 * np.pi) - np.pi)
+
+
+def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0) -> None:
+    """Steer toward the stick's ground point: set heading and requested speed."""
+    tr = world.get(entity, Transform)
+    t = body.tuning
+    if body.held_by is None:
+        player.speed = 0.0
+        return
+    err = body.target - tr.position
+    err[1] = 0.0
+    dist = float(np.linalg.norm(err))
+    chase = max(dist - t.follow_deadband, 0.0)
+    wanted = 0.0 if chase <= 0.0 and body.speed < t.still_speed else body.speed + t.catch_up_gain * chase
+    if dist > 0.12:
+        goal = float(np.arctan2(err[0], err[2]))
+        turn = _wrap(goal - body.heading)
+        body.heading = _wrap(body.heading + float(np.clip(turn, -t.turn_rate * world.dt, t.turn_rate * world.dt)))
+        # Walk only as fast as the facing allows; a puppet turns before it strides off.
+        facing = max(float(heading_vector(body.heading) @ (err / dist)), 0.0)
+        wanted *= facing
+    else:
+        wanted = min(wanted, t.catch_up_gain * dist)
+    tr.rotation = yaw_rotation(body.heading)
+    player.speed = float(np.clip(wanted * speed_scale, 0.0, t.max_speed))
+
+
+def lifted(body: PuppetBody) -> bool:
+    """Held clearly above standing height: no ground state fits (the ragdoll takes it)."""
+    return body.held_by is not None and body.target_height > body.tuning.stand_height + body.tuning.lift_limit
+
+
+def locomotion_fits(world: World, entity: Entity, brain: Brain) -> bool:
+    """Ground states fit unless the puppet is lifted or yanked far beyond its stride."""
+    body = world.get(entity, PuppetBody)
+    if body.held_by is None:
+        return True
+    tr = world.get(entity, Transform)
+    far = float(np.linalg.norm((body.target - tr.position)[[0, 2]])) > body.tuning.drag_limit
+    return not lifted(body) and not far
+
+
+def wants_crouch(world: World, entity: Entity, brain: Brain) -> bool:
+    """The stick holds the hips below the crouch threshold."""
+    body = world.get(entity, PuppetBody)
+    return body.held_by is not None and body.target_height < body.tuning.crouch_enter
+
+
+def wants_stand(world: World, entity: Entity, brain: Brain) -> bool:
+    """Released, or the stick is back above the crouch's exit height (hysteresis)."""
+    body = world.get(entity, PuppetBody)
+    return body.held_by is None or body.target_height > body.tuning.crouch_exit
+
+
+def _ground_ik(world: World, entity: Entity) -> None:
+    ik = world.try_get(entity, IKRequest)
+    if ik is not None:
+        ik.grounding = True
+        ik.sphere_centre, ik.sphere_radius = None, 0.0
+
+
+def update_locomotion(world: World, entity: Entity, brain: Brain) -> None:
+    """Idle / walk / run: stand tall (a slight dip allowed) and follow the stick."""
+    body = world.get(entity, PuppetBody)
+    player = world.get(entity, LocomotionPlayer)
+    t = body.tuning
+    standing = body.held_by is None or body.target_height >= t.crouch_exit
+    player.height = None if standing else float(np.clip(body.target_height, t.crouch_enter, t.stand_height))
+    follow_stick(world, entity, body, player)
+    _ground_ik(world, entity)
+
+
+def update_crouch(world: World, entity: Entity, brain: Brain) -> None:
+    """Crouch idle / crouch walk: the hips go as low as the stick holds them."""
+    body = world.get(entity, PuppetBody)
+    player = world.get(entity, LocomotionPlayer)
+    t = body.tuning
+    player.height = float(np.clip(body.target_height, t.crouch_height, t.crouch_exit))
+    follow_stick(world, entity, body, player)
+    _ground_ik(world, entity)

@@ -1,0 +1,216 @@
+"""Pick up / carry / put down, and rolling a snowball (thesis §6.2.2, §6.3).
+
+All of them are the crouch or walk animations adapted by IK: the hands are placed
+on the object's surface (``IKRequest.sphere_centre``), independent of the clip.
+
+- **PickUp**: crouched and still over a small ball, the hands reach it; after a
+  moment the ball is lifted (the prop becomes ``carried``: physics follows it).
+- **Carry**: walking with the ball held in front of the chest.
+- **PutDown**: crouching while carrying sets the ball down in front — on top of a
+  ball that is there, which is how snowmen are stacked.
+- **RollSnowball**: crouch-walking into a ball pushes it along the ground in front
+  of the puppet, rolling without slipping; the game decides how it grows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine import quat
+from engine.blend.locomotion import LocomotionPlayer
+from engine.components import Transform
+from engine.ecs import Entity, World
+from engine.ik.system import IKRequest
+from engine.ragdoll.components import Prop
+from engine.statemachine.machine import Brain
+from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.ground_states import follow_stick, wants_crouch
+from engine.statemachine.puppet.senses import heading_vector, prop_in_front
+
+__all__ = [
+    "can_pick_up", "enter_pickup", "update_pickup", "pickup_done",
+    "update_carry", "exit_carry", "enter_putdown", "update_putdown", "putdown_done", "exit_putdown",
+    "can_roll", "enter_roll", "update_roll", "exit_roll", "stop_rolling", "carry_position", "wants_putdown",
+]
+
+
+def _hands(world: World, entity: Entity, centre: np.ndarray, radius: float) -> None:
+    ik = world.try_get(entity, IKRequest)
+    if ik is not None:
+        ik.sphere_centre, ik.sphere_radius, ik.grounding = np.asarray(centre, dtype=np.float64), float(radius), True
+
+
+def carry_position(world: World, entity: Entity, body: PuppetBody, radius: float) -> np.ndarray:
+    """Where a carried ball sits: in front of the chest."""
+    tr = world.get(entity, Transform)
+    return tr.position + np.array([0.0, body.tuning.stand_height + 0.1, 0.0]) + heading_vector(body.heading) * (0.22 + radius)
+
+
+def can_pick_up(world: World, entity: Entity, brain: Brain) -> bool:
+    """Crouched, nearly still, a small free ball within reach in front."""
+    body = world.get(entity, PuppetBody)
+    t = body.tuning
+    if body.held_by is None or brain.time_in_state < t.still_time or body.speed > t.still_speed:
+        return False
+    return prop_in_front(world, entity, body, t.reach, t.carry_max_radius) is not None
+
+
+def enter_pickup(world: World, entity: Entity, brain: Brain) -> None:
+    """Choose the ball and start reaching."""
+    body = world.get(entity, PuppetBody)
+    body.object = prop_in_front(world, entity, body, body.tuning.reach, body.tuning.carry_max_radius)
+    body.phase, body.timer = "reach", 0.0
+
+
+def update_pickup(world: World, entity: Entity, brain: Brain) -> None:
+    """Hands to the ball; lift it once reached."""
+    body = world.get(entity, PuppetBody)
+    player = world.get(entity, LocomotionPlayer)
+    player.speed, player.height = 0.0, body.tuning.crouch_height
+    body.timer += world.dt
+    if body.object is None or not world.alive(body.object):
+        return
+    prop, ptr = world.get(body.object, Prop), world.get(body.object, Transform)
+    if body.timer >= body.tuning.pickup_time:
+        prop.carried = True
+        s = min((body.timer - body.tuning.pickup_time) / body.tuning.pickup_time, 1.0)
+        ptr.position = ptr.position + s * (carry_position(world, entity, body, prop.radius) - ptr.position)
+        prop.velocity = np.zeros(6)
+    _hands(world, entity, ptr.position, prop.radius)
+
+
+def pickup_done(world: World, entity: Entity, brain: Brain) -> bool:
+    """Reached and lifted (or the ball vanished)."""
+    body = world.get(entity, PuppetBody)
+    return body.object is None or not world.alive(body.object) or body.timer >= 2 * body.tuning.pickup_time
+
+
+def update_carry(world: World, entity: Entity, brain: Brain) -> None:
+    """Walk with the ball held in front of the chest."""
+    body = world.get(entity, PuppetBody)
+    player = world.get(entity, LocomotionPlayer)
+    player.height = None
+    follow_stick(world, entity, body, player, speed_scale=0.8)
+    if body.object is None or not world.alive(body.object):
+        return
+    prop, ptr = world.get(body.object, Prop), world.get(body.object, Transform)
+    ptr.position = carry_position(world, entity, body, prop.radius)
+    prop.carried = True
+    _hands(world, entity, ptr.position, prop.radius)
+
+
+def exit_carry(world: World, entity: Entity, brain: Brain) -> None:
+    """Whatever comes next, physics holds the ball until PutDown takes it again (a fall drops it)."""
+    body = world.get(entity, PuppetBody)
+    if body.object is not None and world.alive(body.object):
+        world.get(body.object, Prop).carried = False
+
+
+def enter_putdown(world: World, entity: Entity, brain: Brain) -> None:
+    """Start lowering the ball: onto a ball in front if there is one, else onto the ground."""
+    body = world.get(entity, PuppetBody)
+    body.phase, body.timer = "lower", 0.0
+    if body.object is None or not world.alive(body.object):
+        return
+    prop = world.get(body.object, Prop)
+    ahead = world.get(entity, Transform).position + heading_vector(body.heading) * (0.25 + prop.radius)
+    spot = np.array([ahead[0], prop.radius, ahead[2]])
+    for e, other, otr in world.query(Prop, Transform):
+        if e == body.object or other.carried:
+            continue
+        d = otr.position - ahead
+        if np.hypot(d[0], d[2]) < other.radius + 0.15 and other.radius > prop.radius:
+            spot = np.array([otr.position[0], otr.position[1] + other.radius + prop.radius + 0.01, otr.position[2]])
+            break
+    brain.memory["putdown_spot"] = spot
+
+
+def update_putdown(world: World, entity: Entity, brain: Brain) -> None:
+    """Lower the ball to its spot."""
+    body = world.get(entity, PuppetBody)
+    player = world.get(entity, LocomotionPlayer)
+    player.speed, player.height = 0.0, body.tuning.crouch_height + 0.1
+    body.timer += world.dt
+    if body.object is None or not world.alive(body.object):
+        return
+    prop, ptr = world.get(body.object, Prop), world.get(body.object, Transform)
+    prop.carried = True
+    spot = brain.memory["putdown_spot"]
+    s = min(body.timer / body.tuning.pickup_time, 1.0)
+    ptr.position = ptr.position + s * (spot - ptr.position)
+    _hands(world, entity, ptr.position, prop.radius)
+
+
+def putdown_done(world: World, entity: Entity, brain: Brain) -> bool:
+    """The ball is at its spot."""
+    body = world.get(entity, PuppetBody)
+    return body.timer >= body.tuning.pickup_time
+
+
+def exit_putdown(world: World, entity: Entity, brain: Brain) -> None:
+    """Let go: physics takes the ball again."""
+    body = world.get(entity, PuppetBody)
+    if body.object is not None and world.alive(body.object):
+        prop = world.get(body.object, Prop)
+        prop.carried, prop.velocity = False, np.zeros(6)
+    body.object = None
+    brain.memory.pop("putdown_spot", None)
+
+
+def can_roll(world: World, entity: Entity, brain: Brain) -> bool:
+    """Crouch-walking into a free ball."""
+    body = world.get(entity, PuppetBody)
+    return body.held_by is not None and body.speed > body.tuning.still_speed and prop_in_front(world, entity, body, body.tuning.reach) is not None
+
+
+def enter_roll(world: World, entity: Entity, brain: Brain) -> None:
+    """Take the ball in front."""
+    body = world.get(entity, PuppetBody)
+    body.object = prop_in_front(world, entity, body, body.tuning.reach)
+    body.phase, body.timer = "roll", 0.0
+
+
+def update_roll(world: World, entity: Entity, brain: Brain) -> None:
+    """Crouch-walk with both hands on the ball, pushing it ahead, rolling without slipping."""
+    body = world.get(entity, PuppetBody)
+    player = world.get(entity, LocomotionPlayer)
+    t = body.tuning
+    player.height = float(np.clip(body.target_height, t.crouch_height, t.crouch_exit))
+    follow_stick(world, entity, body, player, speed_scale=0.9)
+    if body.object is None or not world.alive(body.object):
+        return
+    prop, ptr = world.get(body.object, Prop), world.get(body.object, Transform)
+    tr = world.get(entity, Transform)
+    new = tr.position + heading_vector(body.heading) * (0.3 + prop.radius)
+    new = np.array([new[0], prop.radius, new[2]])
+    moved = new - ptr.position
+    moved[1] = 0.0
+    dist = float(np.linalg.norm(moved))
+    if dist > 1e-9:
+        axis = np.cross(np.array([0.0, 1.0, 0.0]), moved / dist)
+        ptr.rotation = quat.normalize(quat.mul(quat.from_axis_angle(axis, dist / prop.radius), ptr.rotation))
+    velocity = moved / world.dt
+    prop.velocity = np.concatenate([velocity, np.cross(np.array([0.0, 1.0, 0.0]), velocity) / prop.radius])
+    ptr.position = new
+    prop.carried = True
+    _hands(world, entity, new, prop.radius)
+
+
+def stop_rolling(world: World, entity: Entity, brain: Brain) -> bool:
+    """Stood up or let go."""
+    body = world.get(entity, PuppetBody)
+    return body.held_by is None or body.target_height > body.tuning.crouch_exit
+
+
+def exit_roll(world: World, entity: Entity, brain: Brain) -> None:
+    """Leave the ball where it is, at rest."""
+    body = world.get(entity, PuppetBody)
+    if body.object is not None and world.alive(body.object):
+        prop = world.get(body.object, Prop)
+        prop.carried, prop.velocity = False, np.zeros(6)
+    body.object = None
+
+
+def wants_putdown(world: World, entity: Entity, brain: Brain) -> bool:
+    """Crouching while carrying."""
+    return wants_crouch(world, entity, brain) and brain.time_in_state > 0.3

@@ -1,0 +1,107 @@
+"""The puppet plugin: everything a living puppet needs, and how to spawn one.
+
+``install_puppets(app)`` installs, in schedule order: the brain (``statemachine``
+stage), locomotion blending and the pose overrides (``animation``), IK (``ik``),
+the MuJoCo physics (``physics``) and batched FK (``fk``). ``spawn_puppet`` creates a
+puppet entity with every component those systems read.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from engine.app import App
+from engine.blend.locomotion import BlendLibrary, LocomotionPlayer
+from engine.blend.puppet import install_puppet_locomotion
+from engine.components import Grabbable, LocalPose, Name, Puppet, Transform
+from engine.ecs import Entity, World
+from engine.humanoid import humanoid_skeleton
+from engine.ik.system import IKRequest, install_ik
+from engine.posing import install_fk
+from engine.ragdoll.components import Ragdoll, RagdollMode
+from engine.ragdoll.profile import default_profile
+from engine.ragdoll.system import install_physics
+from engine.skeleton import Skeleton
+from engine.statemachine.machine import Brain, StateMachine, step_machine
+from engine.statemachine.puppet.body import PoseOverride, PuppetBody, PuppetTuning
+from engine.statemachine.puppet.machine import puppet_machine
+from engine.statemachine.puppet.senses import sense, yaw_rotation
+
+__all__ = ["install_puppets", "spawn_puppet", "brain_system", "apply_pose_overrides", "PuppetMachine"]
+
+
+class PuppetMachine:
+    """Resource: the one state-machine asset all puppets share."""
+
+    SIM_STATE = False
+
+    def __init__(self, machine: StateMachine | None = None) -> None:
+        self.machine = machine or puppet_machine()
+
+
+def brain_system(world: World) -> None:
+    """The ``statemachine`` stage: sense the stick, then step each puppet's machine (entity order)."""
+    for e, body, brain in world.query(PuppetBody, Brain):
+        sense(world, e, body)
+        step_machine(world, e, brain)
+
+
+def apply_pose_overrides(world: World) -> None:
+    """After blending: a state's pose override (get-up) replaces the animated pose."""
+    for _, override, pose in world.query(PoseOverride, LocalPose):
+        if override.weight > 0.0 and override.pose is not None:
+            pose.root = np.array(override.pose.root)
+            pose.rotations = np.array(override.pose.rotations)
+
+
+def install_puppets(app: App) -> None:
+    """Plugin: brain, blending, pose overrides, IK, physics and FK, in schedule order."""
+    world = app.world
+    if world.try_resource(PuppetMachine) is None:
+        world.insert_resource(PuppetMachine())
+    app.add_system("statemachine", brain_system)
+    install_puppet_locomotion(app)
+    app.add_system("animation", apply_pose_overrides)
+    install_ik(app)
+    install_physics(app)
+    install_fk(app)
+
+
+def spawn_puppet(
+    world: World,
+    position: ArrayLike = (0.0, 0.0, 0.0),
+    heading: float = 0.0,
+    *,
+    skeleton: Skeleton | None = None,
+    library_key: str = "humanoid",
+    tuning: PuppetTuning | None = None,
+    name: str = "puppet",
+    extra: tuple[object, ...] = (),
+) -> Entity:
+    """Create a puppet standing at ``position`` facing ``heading`` (radians about +Y, 0 = +Z)."""
+    sk = skeleton or humanoid_skeleton()
+    tuning = tuning or PuppetTuning(stand_height=float(sk.offsets[0][1]))
+    library = world.try_resource(BlendLibrary)
+    if library is not None and library_key not in library:
+        raise KeyError(f"no locomotion set {library_key!r}: install it before spawning")
+    pos = np.asarray(position, dtype=np.float64).reshape(3).copy()
+    machine = world.resource(PuppetMachine).machine
+    rest_root = pos + sk.offsets[0]
+    rotations = np.zeros((sk.num_joints, 4))
+    rotations[:, 0] = 1.0
+    rotations[0] = yaw_rotation(heading)
+    return world.spawn(
+        Name(name),
+        Transform(pos, yaw_rotation(heading)),
+        Puppet(sk),
+        LocalPose(rest_root, rotations),
+        LocomotionPlayer(library_key=library_key),
+        IKRequest(grounding=True),
+        Ragdoll(default_profile(sk), mode=RagdollMode.ANIMATED),
+        PoseOverride(),
+        PuppetBody(tuning=tuning, heading=float(heading), target=pos.copy(), target_height=tuning.stand_height),
+        Grabbable(radius=0.45 * tuning.stand_height, kind="puppet", offset=np.array([0.0, tuning.stand_height, 0.0])),
+        machine.new_brain(),
+        *extra,
+    )

@@ -1,0 +1,81 @@
+"""What a puppet perceives each step: who holds it, where the stick wants it, what is near.
+
+The context of the state machine (thesis §6.2.2) is the environment — the ground
+and the objects around the puppet — and the MotionStick. The stick holds a puppet
+by its anchor (the hips, ``Grabbable.offset``); the anchor the stick asks for is
+``tip + R_stick · grab_offset``. Its ground projection is where the puppet should
+stand, its height is the hips height asked for (lower: crouch; much higher: the
+puppet is held in the air).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine import quat
+from engine.components import Stick, Transform
+from engine.ecs import Entity, World
+from engine.ragdoll.components import Prop
+from engine.statemachine.puppet.body import PuppetBody
+
+__all__ = ["holder", "wanted_anchor", "sense", "heading_vector", "prop_in_front", "yaw_rotation"]
+
+F = NDArray[np.float64]
+_UP = np.array([0.0, 1.0, 0.0])
+
+
+def holder(world: World, entity: Entity) -> tuple[Entity, Stick] | None:
+    """The controller whose stick holds ``entity`` (the lowest id if several do)."""
+    for e, stick in world.query(Stick):
+        if stick.grabbed == entity:
+            return e, stick
+    return None
+
+
+def wanted_anchor(stick: Stick) -> F:
+    """Where the stick wants the held anchor: its tip plus the kept relative offset."""
+    return stick.tip + quat.rotate(stick.orientation, stick.grab_offset)
+
+
+def heading_vector(heading: float) -> F:
+    """Unit ground vector of a heading angle (0 = +Z, positive toward +X)."""
+    return np.array([np.sin(heading), 0.0, np.cos(heading)])
+
+
+def yaw_rotation(heading: float) -> F:
+    """The rotation about +Y of a heading angle."""
+    return quat.from_axis_angle(_UP, heading)
+
+
+def sense(world: World, entity: Entity, body: PuppetBody) -> Stick | None:
+    """Refresh ``body``'s view of the stick; returns the holding stick, if any."""
+    held = holder(world, entity)
+    if held is None:
+        body.held_by = None
+        body.speed = 0.0
+        return None
+    body.held_by, stick = held
+    anchor = wanted_anchor(stick)
+    body.target = np.array([anchor[0], 0.0, anchor[2]])
+    body.target_height = float(anchor[1])
+    body.speed = float(np.hypot(stick.velocity[0], stick.velocity[2]))
+    return stick
+
+
+def prop_in_front(world: World, entity: Entity, body: PuppetBody, reach: float, max_radius: float | None = None) -> Entity | None:
+    """The nearest free prop whose surface is within ``reach`` in front of the puppet."""
+    tr = world.get(entity, Transform)
+    forward = heading_vector(body.heading)
+    best, best_d = None, np.inf
+    for e, prop, ptr in world.query(Prop, Transform):
+        if prop.carried or (max_radius is not None and prop.radius > max_radius):
+            continue
+        d = ptr.position - tr.position
+        d[1] = 0.0
+        ahead = float(d @ forward)
+        side = float(np.linalg.norm(d - ahead * forward))
+        gap = float(np.linalg.norm(d)) - prop.radius
+        if ahead > 0.0 and side < max(prop.radius, 0.25) and gap < reach and gap < best_d:
+            best, best_d = e, gap
+    return best

@@ -1,0 +1,121 @@
+"""``puppetphone cycle INPUT -o OUTPUT [--json] [--plot PNG] [--items …]``: one clean loop from a performance.
+
+Input ``.bvh`` / ``.csv`` / ``.npz`` / ``.rec`` (a recording), output ``.bvh`` / ``.ppclip`` (skeletal
+input) or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output is::
+
+    {"period_frames", "period_seconds", "cycles", "dims", "closure_error", "seconds", ...}
+
+When no cycle can be found the command exits with status 3 and says why on standard
+error (and, with ``--json``, an ``{"error": …}`` line); nothing is written then.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+__all__ = ["configure", "run"]
+
+EXIT_NO_CYCLE = 3
+EXIT_BAD_INPUT = 2
+_PROGRESS_SAMPLES = 200_000  # values (T·N) from which a progress bar is worth showing
+
+
+def configure(parser: argparse.ArgumentParser) -> None:
+    """Add the cycle arguments."""
+    parser.add_argument("input", metavar="INPUT", help="performance: .bvh, .csv (time + columns), .npz or a recording (.rec)")
+    parser.add_argument("-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .csv or .npz")
+    parser.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
+    parser.add_argument("--plot", metavar="PNG", help="draw the performance, cuts, aligned cycles and the loop")
+    parser.add_argument("--items", metavar="NAME", nargs="+", help="only these joints (BVH), items (CSV/npz) or sources (recording)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the random probe points (default 0)")
+    parser.add_argument("--samples", type=int, help="samples in the output loop (default: the period at the input rate)")
+    parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+
+
+class _Bar:
+    """A one-line progress bar on standard error, only when it is a terminal or forced."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.enabled = enabled
+
+    def __call__(self, stage: str, done: float) -> None:
+        if not self.enabled:
+            return
+        width = 30
+        fill = int(round(done * width))
+        sys.stderr.write(f"\r[{'#' * fill}{'.' * (width - fill)}] {done:4.0%} {stage:<12}")
+        if done >= 1.0:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def run(args: argparse.Namespace) -> int:
+    """Read, extract, write; report what was found or why nothing was."""
+    import numpy as np
+
+    from authoring.cycles.extract import CycleError, CycleOptions, extract_cycle
+    from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
+    from authoring.cycles.trajectory import TrajectoryError
+
+    def fail(code: int, message: str) -> int:
+        print(f"cycle: {message}", file=sys.stderr)
+        if args.json:
+            print(json.dumps({"error": message}))
+        return code
+
+    out_suffix = "." + args.output.rsplit(".", 1)[-1].lower() if "." in args.output else ""
+    if out_suffix not in OUTPUT_SUFFIXES:
+        return fail(EXIT_BAD_INPUT, f"unknown output type {out_suffix or args.output!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
+    t0 = time.perf_counter()
+    try:
+        perf = load_performance(args.input, args.items)
+    except FileNotFoundError as exc:
+        return fail(EXIT_BAD_INPUT, str(exc))
+    except (TrajectoryError, ValueError) as exc:
+        return fail(EXIT_BAD_INPUT, f"cannot read {args.input}: {exc}")
+    if perf.clip is None and out_suffix in (".bvh", ".ppclip"):
+        return fail(EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH); write .csv or .npz for {args.input}")
+    traj = perf.trajectory
+    big = traj.num_samples * traj.dims >= _PROGRESS_SAMPLES
+    bar = _Bar(big and not args.no_progress and sys.stderr.isatty())
+    opts = CycleOptions(samples=args.samples)
+    t1 = time.perf_counter()
+    try:
+        result = extract_cycle(traj, np.random.default_rng(args.seed), opts, progress=bar)
+    except CycleError as exc:
+        bar.enabled = False
+        return fail(EXIT_NO_CYCLE, str(exc))
+    seconds = time.perf_counter() - t1
+    try:
+        save_loop(result, perf, args.output)
+    except (TrajectoryError, ValueError, OSError) as exc:
+        return fail(EXIT_BAD_INPUT, f"cannot write {args.output}: {exc}")
+    if args.plot:
+        from authoring.cycles.plot import plot_cycle
+
+        plot_cycle(traj, result, args.plot, perf.names)
+    summary = {
+        "period_frames": round(result.period_samples, 3),
+        "period_seconds": round(result.period, 6),
+        "cycles": result.cycles,
+        "dims": traj.dims,
+        "closure_error": result.closure_error,
+        "seconds": round(seconds, 4),
+        "total_seconds": round(time.perf_counter() - t0, 4),
+        "spread": round(result.spread, 4),
+        "samples": len(result.loop),
+        "skipped_frames": perf.skipped,
+        "bezier_segments": sum(c.segments for c in result.curves.values()),
+    }
+    if not args.json:
+        print(
+            f"{perf.source.name}: period {result.period:.4f} s = {result.period_samples:.2f} frames, "
+            f"{result.cycles} cycles averaged, {traj.dims} dims, spread {result.spread:.1%}, "
+            f"closure error {result.closure_error:.1e}, {seconds * 1000:.0f} ms -> {args.output}"
+        )
+    else:
+        print(json.dumps(summary))
+    return 0
