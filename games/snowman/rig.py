@@ -20,10 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.humanoid import HIP_HEIGHT as HUMAN_HIPS
 from engine.humanoid import humanoid_skeleton
 from engine.skeleton import Skeleton
 
-__all__ = ["SnowmanShape", "snowman_skeleton", "bezier_spine", "spine_control_point", "BEND"]
+__all__ = ["SnowmanShape", "snowman_skeleton", "bezier_spine", "spine_control_point", "leg_scale", "middle_ball_parameter", "BEND", "HUMAN_HIPS"]
 
 BEND = 0.3
 
@@ -50,45 +51,61 @@ class SnowmanShape:
 
 
 def snowman_skeleton(shape: SnowmanShape) -> Skeleton:
-    """The humanoid hierarchy with offsets, tips and radii sized from the balls."""
+    """The humanoid hierarchy with offsets, tips and radii sized from the balls.
+
+    The hips joint is the bottom ball's centre; the chest joint sits on top of the
+    middle ball (where the head rests and the twig arms attach); the middle ball's
+    centre lies on the Bézier spine between them (:func:`middle_ball_parameter`); the
+    head joint is the head ball's centre, so the neck is as long as the head is big.
+    The legs are the human legs scaled to the bottom ball (:func:`leg_scale`), so the
+    human clips, scaled by the same factor, keep their feet planted.
+    """
     base = humanoid_skeleton()
+    s = leg_scale(shape)
     off = np.array(base.offsets)
     tips = np.array(base.tips)
     radii = np.array(base.radii)
     j = base.index
     rb, rh = shape.bottom, shape.head
-    rm = shape.middle if shape.middle is not None else 0.0
-    leg = 0.9 * rb  # hips at the bottom ball's centre, feet just under it
-    off[j("hips")] = (0.0, leg, 0.0)
-    # Pelvis -> chest: the lower two balls touch; spine is the first half, chest the second.
-    torso = rb + rm if shape.middle is not None else rb * 0.8
-    off[j("spine")] = (0.0, 0.5 * torso, 0.0)
-    off[j("chest")] = (0.0, 0.5 * torso, 0.0)
-    # Neck length from the head size: the head ball sits on the chest ball.
-    neck = (rm if shape.middle is not None else 0.2 * rb) + rh
-    off[j("neck")] = (0.0, 0.5 * neck, 0.0)
-    off[j("head")] = (0.0, 0.5 * neck, 0.0)
+    rm = shape.middle or 0.0
+    off[j("hips")] = (0.0, HUMAN_HIPS * s, 0.0)
+    spine = rb + 2.0 * rm if shape.middle is not None else rb
+    off[j("spine")] = (0.0, 0.5 * spine, 0.0)
+    off[j("chest")] = (0.0, 0.5 * spine, 0.0)
+    off[j("neck")] = (0.0, 0.5 * rh, 0.0)
+    off[j("head")] = (0.0, 0.5 * rh, 0.0)
     tips[j("head")] = (0.0, rh, 0.0)
-    shoulder = 0.9 * (rm if shape.middle is not None else rb)
-    arm = 0.55 * shape.height * 0.5
+    body = rm if shape.middle is not None else rb
+    arm = 0.9 * body + 0.15
     for side, sx in (("l", 1.0), ("r", -1.0)):
-        off[j(f"{side}_upper_arm")] = (sx * shoulder, 0.1 * torso, 0.0)
+        off[j(f"{side}_upper_arm")] = (sx * 0.75 * body, -0.45 * body, 0.0)
         off[j(f"{side}_lower_arm")] = (0.0, -0.5 * arm, 0.0)
         off[j(f"{side}_hand")] = (0.0, -0.5 * arm, 0.0)
-        tips[j(f"{side}_hand")] = (0.0, -0.15 * arm, 0.0)
-        off[j(f"{side}_upper_leg")] = (sx * 0.35 * rb, -0.1 * leg, 0.0)
-        off[j(f"{side}_lower_leg")] = (0.0, -0.45 * leg, 0.0)
-        off[j(f"{side}_foot")] = (0.0, -0.45 * leg, 0.0)
-        tips[j(f"{side}_foot")] = (0.0, -0.05 * leg, 0.35 * rb)
+        tips[j(f"{side}_hand")] = (0.0, -0.12 * arm, 0.0)
+        for leg in ("upper_leg", "lower_leg", "foot"):
+            off[j(f"{side}_{leg}")] = base.offsets[j(f"{side}_{leg}")] * s
+        tips[j(f"{side}_foot")] = base.tips[j(f"{side}_foot")] * s
     radii[j("hips")] = rb
-    radii[j("chest")] = rm if shape.middle is not None else 0.5 * rb
+    radii[j("chest")] = 0.35 * body
     radii[j("head")] = rh
-    radii[[j("spine"), j("neck")]] = 0.5 * radii[j("chest")]
+    radii[[j("spine"), j("neck")]] = 0.35 * body
     for name in ("upper_arm", "lower_arm", "hand"):
-        radii[[j(f"l_{name}"), j(f"r_{name}")]] = 0.02 + 0.02 * rb
+        radii[[j(f"l_{name}"), j(f"r_{name}")]] = 0.018 + 0.01 * rb
     for name in ("upper_leg", "lower_leg", "foot"):
-        radii[[j(f"l_{name}"), j(f"r_{name}")]] = 0.25 * rb
+        radii[[j(f"l_{name}"), j(f"r_{name}")]] = base.radii[j(f"l_{name}")] * s * 1.3
     return Skeleton(base.names, base.parents, off, tips, radii)
+
+
+def leg_scale(shape: SnowmanShape) -> float:
+    """How much shorter than the human's a snowman's legs are: the bottom ball sits on them."""
+    return 0.8 * shape.bottom / HUMAN_HIPS + 0.12
+
+
+def middle_ball_parameter(shape: SnowmanShape) -> float:
+    """Where on the pelvis→chest Bézier the middle ball's centre lies (3-ball snowmen)."""
+    if shape.middle is None:
+        return 1.0
+    return (shape.bottom + shape.middle) / (shape.bottom + 2.0 * shape.middle)
 
 
 def spine_control_point(p_pelvis: NDArray[np.float64], p_chest: NDArray[np.float64], p_up: NDArray[np.float64], b: float = BEND) -> NDArray[np.float64]:

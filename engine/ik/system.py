@@ -1,0 +1,117 @@
+"""The IK stage: per-puppet requests, the system that serves them, and the plugin.
+
+A state writes an :class:`IKRequest` on its puppet (feet on the ground, hands on a
+snowball, any effector targets with pins); :func:`ik_system` runs in the ``ik``
+stage, after blending and before physics, and edits the puppet's
+:class:`~engine.components.LocalPose` in place. Order within a puppet: the
+optimisation IK's arbitrary targets first, then foot grounding (it moves the
+pelvis), then the hands (they follow the shoulders wherever the pelvis went).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.components import LocalPose, Puppet
+from engine.ecs import World
+from engine.humanoid import JOINTS
+from engine.ik.grounding import GroundQuery, PlaneGround, ground_feet
+from engine.ik.hands import hands_on_sphere
+from engine.ik.rig import IKRig, humanoid_rig
+from engine.ik.solver import Effector, IKSettings, Pin, solve_ik
+from engine.pose import Pose
+from engine.skeleton import Skeleton
+
+if TYPE_CHECKING:
+    from engine.app import App
+
+__all__ = ["IKRequest", "IKGround", "IKRigCache", "ik_system", "install_ik"]
+
+
+@dataclass
+class IKRequest:
+    """What a puppet's state asks of IK this step (all off by default).
+
+    ``effectors``/``pins`` feed the optimisation IK; ``sphere_centre`` with a positive
+    ``sphere_radius`` puts both hands on that sphere; ``grounding`` plants the feet.
+    ``reached`` and ``pelvis_shift`` are written back by :func:`ik_system`.
+    """
+
+    grounding: bool = False
+    grounding_weight: float = 1.0
+    sphere_centre: NDArray[np.float64] | None = None
+    sphere_radius: float = 0.0
+    effectors: tuple[Effector, ...] = ()
+    pins: tuple[Pin, ...] = ()
+    keep_closest: bool = True
+    reached: bool = True
+    pelvis_shift: float = 0.0
+
+
+@dataclass
+class IKGround:
+    """The ground the feet stand on: ``query(x, z) -> (height, normal)`` (static scene data)."""
+
+    SIM_STATE: ClassVar[bool] = False
+    query: GroundQuery = field(default_factory=PlaneGround)
+
+
+@dataclass
+class IKRigCache:
+    """IK rigs built per skeleton (the humanoid gets its limits and hinges), reused every step."""
+
+    SIM_STATE: ClassVar[bool] = False
+    settings: IKSettings = field(default_factory=IKSettings)
+    rigs: dict[int, IKRig] = field(default_factory=dict)
+
+    def rig(self, skeleton: Skeleton) -> IKRig:
+        """The rig of ``skeleton``: the humanoid preset for the default puppet, ball joints otherwise."""
+        key = id(skeleton)
+        cached = self.rigs.get(key)
+        if cached is None or cached.skeleton is not skeleton:
+            cached = humanoid_rig(skeleton) if skeleton.names == JOINTS else IKRig.build(skeleton)
+            self.rigs[key] = cached
+        return cached
+
+
+def ik_system(world: World) -> None:
+    """Serve every puppet's :class:`IKRequest` on its :class:`LocalPose` (the ``ik`` stage)."""
+    ground = world.try_resource(IKGround)
+    cache = world.try_resource(IKRigCache)
+    if cache is None:
+        cache = IKRigCache()
+        world.insert_resource(cache)
+    for _, puppet, local, req in world.query(Puppet, LocalPose, IKRequest):
+        sk = puppet.skeleton
+        offsets = puppet.offsets
+        pose = Pose(np.array(local.root, dtype=np.float64), np.array(local.rotations, dtype=np.float64))
+        if req.effectors:
+            res = solve_ik(cache.rig(sk), pose.root, pose.rotations, req.effectors, req.pins,
+                           offsets=offsets, settings=cache.settings)  # fmt: skip
+            req.reached = res.reached
+            if res.reached or req.keep_closest:
+                pose.root[:] = res.root if res.reached else res.closest_root
+                pose.rotations[:] = res.rotations if res.reached else res.closest_rotations
+        if req.grounding:
+            query = ground.query if ground is not None else PlaneGround()
+            req.pelvis_shift = float(ground_feet(sk, pose, query, offsets=offsets, weight=req.grounding_weight))
+        if req.sphere_centre is not None and req.sphere_radius > 0.0:
+            hands_on_sphere(sk, pose, req.sphere_centre, req.sphere_radius, offsets=offsets)
+        if pose.is_finite():
+            local.root = pose.root
+            local.rotations = pose.rotations
+        else:  # a bad target must not poison the puppet: keep the animated pose
+            req.reached = False
+
+
+def install_ik(app: App) -> None:
+    """Plugin: the rig cache, a flat default ground, and :func:`ik_system` in the ``ik`` stage."""
+    if app.world.try_resource(IKRigCache) is None:
+        app.world.insert_resource(IKRigCache())
+    if app.world.try_resource(IKGround) is None:
+        app.world.insert_resource(IKGround())
+    app.add_system("ik", ik_system)

@@ -1,0 +1,68 @@
+"""The snowman game (thesis §6.3): roll snowballs, stack them, and they come alive.
+
+One puppet stands in a snowy field among rocks and pine trees. Crouch-walk it to
+pack and roll a snowball (it grows with the snow it picks up and leaves a bare
+track); stack two or three balls, largest at the bottom — lift a ball onto
+another with the stick, or let the puppet carry a small one and put it down on a
+big one — and the stack comes alive as a snowman, a puppet like the first that
+can build more snowmen in turn.
+"""
+
+from __future__ import annotations
+
+
+from engine.app import App
+from engine.camera import OrbitCamera
+from engine.ecs import World
+from engine.render.components import Appearance
+from engine.statemachine.puppet import install_puppets, spawn_puppet
+from games.base import Game
+from games.snowman.components import Snowman, SnowmanStats, StackWatch
+from games.snowman.draw import draw_snowman_game
+from games.snowman.rules import assemble_snowmen, stick_stacked_balls, grow_snowballs, snowmen_standing, start_snowballs
+from games.snowman.scenery import build_scenery
+from games.snowman.snow import SnowField
+
+__all__ = ["GAME", "install", "CONTROLS"]
+
+CONTROLS = (
+    "mouse: press on the puppet (or a snowball) to grab it, drag to walk or run it, release to let go",
+    "mouse: wheel down while holding = crouch (crouch-walk to roll a snowball), wheel up = lift",
+    "mouse: a quick upward flick while holding = jump; right-drag orbits the camera",
+    "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
+    "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
+    "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive",
+)
+
+
+def install(app: App) -> None:
+    """The field, the first puppet, the snow and the rules."""
+    install_puppets(app)
+    world = app.world
+    world.insert_resource(SnowField(size=24.0, cell=0.15, initial_depth=0.12))
+    world.insert_resource(SnowmanStats())
+    world.insert_resource(StackWatch())
+    build_scenery(world)
+    spawn_puppet(world, (0.0, 0.0, 0.0), 0.0, name="puppet", extra=(Appearance(color=(0.85, 0.32, 0.24)),))
+    app.add_system("rules", stick_stacked_balls)
+    app.add_system("rules", grow_snowballs)
+    app.add_system("rules", start_snowballs)
+    app.add_system("rules", assemble_snowmen)
+
+
+def camera() -> OrbitCamera:
+    """Looking over the field from the south-east."""
+    return OrbitCamera(target=[0.0, 0.6, 0.0], yaw=0.35, pitch=0.5, distance=9.0)
+
+
+def status(world: World) -> list[str]:
+    """Counter of snowmen built, and the controls until the first grab."""
+    stats = world.resource(SnowmanStats)
+    lines = [f"snowmen built: {stats.built}   standing: {snowmen_standing(world)}   snowballs started: {stats.balls_started}"]
+    if stats.built == 0 and world.frame < 60 * 20 and not world.query(Snowman):
+        lines += list(CONTROLS)
+    return lines
+
+
+GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS)
+

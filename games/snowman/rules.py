@@ -1,0 +1,142 @@
+"""The snowman game's rules (the ``rules`` stage): snow, snowballs, snowmen.
+
+1. **Growing**: every snowball that rolls over fresh snow picks it up
+   (:class:`~games.snowman.snow.SnowField`) and its radius grows by volume.
+2. **Starting a ball**: a puppet crouch-walking on fresh snow with no ball in front
+   packs a new small ball in front of its hands; the brain then rolls it.
+3. **Building**: two or three balls stacked largest at the bottom that stand still
+   for half a second come alive as a snowman puppet (:mod:`~games.snowman.alive`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.components import Grabbable, Stick, Transform
+from engine.ecs import World
+from engine.ragdoll.components import Prop
+from engine.statemachine import Brain
+from engine.statemachine.puppet import PuppetBody
+from engine.statemachine.puppet.senses import heading_vector, prop_in_front
+from games.snowman.alive import bring_to_life
+from games.snowman.assembly import Ball, find_snowmen, resting_on
+from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
+from games.snowman.rig import SnowmanShape
+from games.snowman.snow import SnowField
+
+__all__ = ["stick_stacked_balls", "grow_snowballs", "start_snowballs", "assemble_snowmen", "spawn_ball", "MAX_RADIUS", "MAX_BALLS"]
+
+MAX_RADIUS = 0.6
+MAX_BALLS = 24
+START_RADIUS = 0.11
+STILL_FRAMES = 30
+
+
+def spawn_ball(world: World, position: np.ndarray, radius: float) -> int:
+    """A snowball entity: physical, grabbable, growing."""
+    pos = np.array([position[0], radius, position[2]], dtype=np.float64)
+    return world.spawn(Transform(pos), Prop(radius=radius), Snowball(last=pos.copy()), Grabbable(radius=radius + 0.05, kind="snowball"))
+
+
+def _held(world: World) -> set[int]:
+    return {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None} | {
+        b.object for _, b in world.query(PuppetBody) if b.object is not None
+    }
+
+
+def stick_stacked_balls(world: World) -> None:
+    """A ball that comes to rest on a bigger one packs onto it, centred, and stays there.
+
+    Real snowballs squash where they touch and hold; rigid spheres would roll off, so
+    the rule takes the upper ball out of the physics (``carried``) and keeps it on top
+    of the lower one, wherever that one goes.
+    """
+    held = _held(world)
+    balls = {e: (prop, tr) for e, _, prop, tr in world.query(Snowball, Prop, Transform)}
+    for e, stacked in list(world.query(Stacked)):
+        prop, tr = balls.get(e, (None, None))
+        if prop is None or e in held or stacked.on not in balls:
+            world.remove(e, Stacked)
+            if prop is not None and e not in held:
+                prop.carried = False
+            continue
+        lower_prop, lower_tr = balls[stacked.on]
+        tr.position = lower_tr.position + np.array([0.0, lower_prop.radius + prop.radius, 0.0])
+        prop.carried, prop.velocity = True, np.zeros(6)
+    for e, (prop, tr) in balls.items():
+        if e in held or world.has(e, Stacked) or prop.carried:
+            continue
+        upper = Ball(e, tr.position, prop.radius)
+        for o, (oprop, otr) in balls.items():
+            if o == e or oprop.radius <= prop.radius or o in held:
+                continue
+            if resting_on(upper, Ball(o, otr.position, oprop.radius), gap=0.1, off_axis=0.6) and prop.velocity[1] < 0.5:
+                world.add(e, Stacked(on=o))
+                tr.position = otr.position + np.array([0.0, oprop.radius + prop.radius, 0.0])
+                prop.carried, prop.velocity = True, np.zeros(6)
+                break
+
+
+def grow_snowballs(world: World) -> None:
+    """Balls touching the ground grow by the fresh snow they roll over."""
+    field = world.resource(SnowField)
+    for _, ball, prop, tr, grab in world.query(Snowball, Prop, Transform, Grabbable):
+        here = tr.position.copy()
+        if np.isfinite(ball.last).all() and here[1] - prop.radius < 0.03 and prop.radius < MAX_RADIUS:
+            if float(np.hypot(*(here - ball.last)[[0, 2]])) > 1e-4:
+                prop.radius = min(field.roll(ball.last, here, prop.radius), MAX_RADIUS)
+                grab.radius = prop.radius + 0.05
+        ball.last = here
+
+
+def start_snowballs(world: World) -> None:
+    """A crouch-walking puppet with nothing in front packs a new ball on fresh snow."""
+    field = world.resource(SnowField)
+    stats = world.resource(SnowmanStats)
+    count = len(world.query(Snowball))
+    for e, body, brain, tr in world.query(PuppetBody, Brain, Transform):
+        if brain.active != "Crouch" or body.held_by is None or body.speed < 0.3 or brain.time_in_state < 0.4:
+            continue
+        if count >= MAX_BALLS or prop_in_front(world, e, body, 1.0) is not None:
+            continue
+        spot = tr.position + heading_vector(body.heading) * (0.3 + START_RADIUS)
+        if field.depth_at(spot) <= 0.0:
+            continue
+        spawn_ball(world, spot, START_RADIUS)
+        stats.balls_started += 1
+        count += 1
+
+
+def assemble_snowmen(world: World) -> None:
+    """Stacks that stood still long enough come alive."""
+    watch = world.resource(StackWatch)
+    stats = world.resource(SnowmanStats)
+    held = _held(world)
+    balls = [
+        Ball(e, tr.position.copy(), prop.radius)
+        for e, _, prop, tr in world.query(Snowball, Prop, Transform)
+        if e not in held and (not prop.carried or world.has(e, Stacked))
+    ]
+    still = {b.entity for b in balls if float(np.linalg.norm(world.get(b.entity, Prop).velocity[:3])) < 0.2}
+    seen: dict[tuple[int, ...], int] = {}
+    for stack in find_snowmen([b for b in balls if b.entity in still]):
+        key = tuple(b.entity for b in stack)
+        seen[key] = watch.frames.get(key, 0) + 1
+        if seen[key] >= STILL_FRAMES:
+            radii = [b.radius for b in stack]
+            shape = SnowmanShape(radii[0], radii[1] if len(radii) == 3 else None, radii[-1])
+            stats.built += 1
+            bottom = stack[0].center
+            heading = float(np.arctan2(-bottom[0], -bottom[2])) if np.hypot(bottom[0], bottom[2]) > 0.5 else 0.0
+            snowman = bring_to_life(world, shape, bottom, heading, stats.built)
+            world.get(snowman, Grabbable).radius = shape.bottom + 0.1
+            for b in stack:
+                world.despawn(b.entity)
+            del seen[key]
+            print(f"snowman {stats.built} came alive ({len(stack)} balls: {', '.join(f'{r:.2f}' for r in radii)} m)")
+    watch.frames = seen
+
+
+def snowmen_standing(world: World) -> int:
+    """How many snowmen are alive and on their feet (not a ragdoll)."""
+    return sum(1 for _, _, brain in world.query(Snowman, Brain) if brain.active not in ("Ragdoll", "GetUp"))

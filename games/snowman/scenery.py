@@ -1,0 +1,56 @@
+"""The snowy field: obstacles (rocks and pine trees) and the falling snow.
+
+Obstacles are entities with an ``Obstacle`` (the MotionStick stops at them) and a
+render ``Shape``. The snowfall is drawn only — flakes are placed from a fixed seed
+and fall with the frame time — so it never touches the simulation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.components import Obstacle, Transform
+from engine.ecs import World
+from engine.render.components import Appearance, Shape
+from engine.render.scene import RenderScene
+
+__all__ = ["build_scenery", "draw_snowfall", "draw_trees", "TREES", "ROCKS"]
+
+TREES = ((-5.0, -4.5, 1.0), (6.0, -5.5, 1.2), (-7.5, 3.0, 0.9), (7.0, 4.5, 1.1), (-2.5, -8.0, 1.3), (3.5, 8.0, 1.0))
+ROCKS = ((3.2, -2.4, 0.45), (-3.8, 2.6, 0.35), (1.0, 5.5, 0.4))
+
+_FLAKES = np.random.default_rng(20171105).uniform([-12, 0, -12], [12, 9, 12], size=(900, 3))
+_DRIFT = np.random.default_rng(7).uniform(0, 2 * np.pi, size=900)
+
+
+def build_scenery(world: World) -> None:
+    """Spawn the rocks and trees."""
+    for x, z, s in TREES:
+        world.spawn(Transform(np.array([x, 0.0, z]), scale=s), Obstacle(radius=0.9 * s, height=3.2 * s))
+    for x, z, r in ROCKS:
+        world.spawn(
+            Transform(np.array([x, 0.6 * r, z])),
+            Obstacle(radius=r, height=1.2 * r),
+            Shape("sphere", np.array([r])),
+            Appearance(color=(0.48, 0.5, 0.54)),
+        )
+
+
+def draw_trees(world: World, scene: RenderScene) -> None:
+    """Pine trees: a trunk and three snowy tiers each."""
+    for x, z, s in TREES:
+        base = np.array([x, 0.0, z])
+        scene.add_capsule(base, base + [0, 1.2 * s, 0], 0.12 * s, color=(0.36, 0.25, 0.17))
+        for k, (h, r) in enumerate(((1.0, 1.0), (1.9, 0.75), (2.7, 0.5))):
+            c = base + [0, h * s, 0]
+            scene.add_capsule(c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, color=(0.16, 0.36 - 0.03 * k, 0.24))
+            scene.add_sphere(c + [0, 0.45 * s, 0], 0.35 * r * s, color=(0.95, 0.97, 1.0))
+
+
+def draw_snowfall(scene: RenderScene, time: float) -> None:
+    """Flakes drifting down; they wrap around the top when they reach the ground."""
+    p = _FLAKES.copy()
+    p[:, 1] = (p[:, 1] - 0.6 * time) % 9.0
+    p[:, 0] += 0.25 * np.sin(0.7 * time + _DRIFT)
+    p[:, 2] += 0.25 * np.cos(0.5 * time + _DRIFT)
+    scene.add_points(p, size=0.035, color=(1.0, 1.0, 1.0))
