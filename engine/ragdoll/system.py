@@ -1,0 +1,109 @@
+"""The ``physics`` stage: sync entities into MuJoCo, drive ragdolls, step, write poses back.
+
+Per step, for every puppet with a :class:`Ragdoll`, the ``LocalPose`` written by
+animation and IK is the *target*:
+
+- ``ANIMATED``: the bodies are placed on it (with its velocity) and the pose passes through;
+- otherwise the muscles and the root pin track it with the current weights, and the
+  pose written back is ``blend_poses(target, simulated, blend_weight)``.
+
+Props (:class:`Prop` + ``Transform``) are added, resized and removed to match their
+components; physics writes their ``Transform`` back unless the prop is ``carried``.
+Ragdolls and props that appear in the same step are added in one rebuild.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from engine import quat
+from engine.app import App
+from engine.components import LocalPose, Puppet, Transform
+from engine.ecs import Entity, World
+from engine.pose import Pose
+from engine.ragdoll.blend import blend_poses
+from engine.ragdoll.components import Prop, Ragdoll, RagdollMode
+from engine.ragdoll.getup import update_settle
+from engine.ragdoll.physics import PhysicsWorld
+
+__all__ = ["physics_step", "install_physics", "spawn_snowball"]
+
+
+def _sync(world: World, pw: PhysicsWorld) -> None:
+    rows = world.query(Ragdoll, Puppet, LocalPose)
+    present = {e for e, *_ in rows}
+    for key in pw.ragdoll_keys:
+        if key not in present:
+            pw.remove(key)
+    for e, rd, puppet, pose in rows:
+        if not pw.has_ragdoll(e):
+            pw.add_ragdoll(e, puppet.skeleton, rd.profile, pose.root, pose.rotations, puppet.joint_offsets())
+    props = world.query(Prop, Transform)
+    present = {e for e, *_ in props}
+    for key in pw.prop_keys:
+        if key not in present:
+            pw.remove(key)
+    for e, prop, tr in props:
+        if not pw.has_prop(e):
+            pw.add_prop(e, prop.radius, prop.current_mass(), tr.position, tr.rotation, prop.velocity, prop.friction)
+    pw.ensure_built()
+    for e, prop, _ in props:
+        if prop.radius != pw.prop_radius(e):
+            pw.set_prop_radius(e, prop.radius, prop.current_mass())
+
+
+def physics_step(world: World) -> None:
+    """The physics-stage system (needs the :class:`PhysicsWorld` resource)."""
+    pw = world.resource(PhysicsWorld)
+    if abs(pw.dt - world.dt) > 1e-9:
+        raise ValueError(f"physics steps {pw.dt:.6f} s but the world steps {world.dt:.6f} s: "
+                         "set PhysicsWorld(timestep=world.dt / substeps)")
+    _sync(world, pw)
+    rows = world.query(Ragdoll, Puppet, LocalPose)
+    targets: dict[Entity, Pose] = {}
+    for e, rd, _, pose in rows:
+        rd.ramp(world.dt)
+        target = Pose(np.array(pose.root, dtype=np.float64), quat.normalize(pose.rotations))
+        targets[e] = target
+        if rd.mode is RagdollMode.ANIMATED:
+            pw.drive(e, target.root, target.rotations, 1.0, 1.0, 1.0, kinematic=True)
+        else:
+            pw.drive(e, target.root, target.rotations, rd.muscle_weight, rd.pin_weight,
+                     rd.muscle_weight * rd.pin_weight)
+        pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
+    for e, prop, tr in world.query(Prop, Transform):
+        if prop.carried:
+            pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
+    pw.step()
+    for e, rd, _, pose in rows:
+        if rd.mode is RagdollMode.ANIMATED:
+            rd.kinetic_energy, rd.settled, rd.still_frames = pw.kinetic_energy(e), False, 0
+            continue
+        speed = float(np.linalg.norm(pw.root_velocity(e)[:3]))
+        update_settle(rd, pw.kinetic_energy(e), speed, float(rd.profile.masses.sum()))
+        out = blend_poses(targets[e], pw.pose(e), rd.blend_weight)
+        pose.root, pose.rotations = out.root, out.rotations
+    for e, prop, tr in world.query(Prop, Transform):
+        if not prop.carried:
+            pos, rot, vel = pw.prop_state(e)
+            tr.position, tr.rotation, prop.velocity = pos, rot, vel
+
+
+def install_physics(app: App, timestep: float | None = None, substeps: int = 8) -> None:
+    """Plugin: the :class:`PhysicsWorld` resource and :func:`physics_step` in the physics stage."""
+    if app.world.try_resource(PhysicsWorld) is None:
+        step = app.world.dt / substeps if timestep is None else timestep
+        app.world.insert_resource(PhysicsWorld(timestep=step, substeps=substeps))
+    if physics_step not in app.systems("physics"):
+        app.add_system("physics", physics_step)
+
+
+def spawn_snowball(world: World, position: ArrayLike, radius: float = 0.15, mass: float | None = None,
+                   velocity: ArrayLike | None = None) -> Entity:
+    """Spawn a snowball prop now (position of its centre; velocity linear ``[3]`` or full ``[6]``)."""
+    vel = np.zeros(6)
+    if velocity is not None:
+        v = np.asarray(velocity, dtype=np.float64).ravel()
+        vel[: len(v)] = v
+    return world.spawn(Transform(np.asarray(position, dtype=np.float64).copy()), Prop(radius, mass, velocity=vel))
