@@ -62,15 +62,12 @@ def mul(a: ArrayLike, b: ArrayLike) -> F:
     b = np.asarray(b, dtype=np.float64)
     aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
     bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=-1,
-    )
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = aw * bw - ax * bx - ay * by - az * bz
+    out[..., 1] = aw * bx + ax * bw + ay * bz - az * by
+    out[..., 2] = aw * by - ax * bz + ay * bw + az * bx
+    out[..., 3] = aw * bz + ax * by - ay * bx + az * bw
+    return out
 
 
 def conjugate(q: ArrayLike) -> F:
@@ -78,6 +75,15 @@ def conjugate(q: ArrayLike) -> F:
     q = np.array(q, dtype=np.float64)
     q[..., 1:] *= -1.0
     return q
+
+
+def _cross(a: F, b: F) -> F:
+    """``a × b`` over the last axis, written out: ``np.cross`` is slow on small arrays."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 def rotate(q: ArrayLike, v: ArrayLike) -> F:
@@ -89,8 +95,8 @@ def rotate(q: ArrayLike, v: ArrayLike) -> F:
     v = np.asarray(v, dtype=np.float64)
     u = q[..., 1:]
     w = q[..., :1]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    t = 2.0 * _cross(u, v)
+    return v + w * t + _cross(u, t)
 
 
 def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> F:

@@ -1,0 +1,118 @@
+"""Saving and exporting an edited cycle: atomic ``.ppclip`` + session side file, BVH, glTF.
+
+:func:`save_session` writes the edited clip with the engine's own format (versioned,
+checksummed, atomic) and, beside it, ``<name>.mocurves.json`` with what a clip cannot hold:
+the scale tracks and the pinned keypoints. The side file records the clip's SHA-256 so a
+pair that does not belong together is refused instead of silently mismatched. JSON floats
+round-trip exactly (``repr``), so a reload is bit-for-bit.
+
+:func:`export_clip` picks the format from the suffix. BVH and glTF have no root-motion
+track, so the travel is baked into the root there (other tools then see the character
+walk); ``.ppclip`` keeps it as root motion.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from authoring.mocurves.session import EditSession
+from engine import quat
+from engine.atomic import atomic_write_bytes
+from engine.clip import Clip
+from engine.clipfile import load_clip, save_clip
+from engine.io import clip_to_bvh, write_bvh, write_gltf
+
+__all__ = ["save_session", "load_session", "export_clip", "bake_root_motion", "SessionFileError", "EXPORT_SUFFIXES"]
+
+SIDE_FORMAT = "puppetphone-mocurves"
+SIDE_VERSION = 1
+EXPORT_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
+_UP = np.array([0.0, 1.0, 0.0])
+
+
+class SessionFileError(ValueError):
+    """A session side file that is unreadable, of a newer version, or not of this clip."""
+
+
+def _side_path(path: Path) -> Path:
+    return path.with_name(path.name.removesuffix(path.suffix) + ".mocurves.json")
+
+
+def _clip_digest(clip: Clip) -> str:
+    h = hashlib.sha256()
+    for a in (clip.root, clip.rotations):
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def save_session(session: EditSession, path: str | Path) -> Path:
+    """Write the shown state atomically: ``path`` (``.ppclip``) and its ``.mocurves.json``."""
+    p = Path(path)
+    if p.suffix != ".ppclip":
+        raise ValueError(f"{p}: a session is saved as .ppclip (use export_clip for BVH/glTF)")
+    st = session.state
+    side = {
+        "format": SIDE_FORMAT,
+        "version": SIDE_VERSION,
+        "clip_sha256": _clip_digest(st.clip),
+        "scales": [[float(x) for x in row] for row in st.scales],
+        "pins": {k: sorted(v) for k, v in st.pins.items()},
+        "tau": session.tau,
+        "sigma": session.sigma,
+    }
+    # Side file first: a crash between the two leaves the old clip with a side file that
+    # no longer matches it, which load refuses loudly, never a silently wrong pairing.
+    atomic_write_bytes(_side_path(p), json.dumps(side).encode())
+    return save_clip(st.clip, p)
+
+
+def load_session(path: str | Path) -> EditSession:
+    """An :class:`EditSession` from a ``.ppclip`` (and its side file when there is one)."""
+    p = Path(path)
+    clip = load_clip(p)
+    if not clip.loop:
+        raise ValueError(f"{p}: clip {clip.name!r} is not a loop; MoCurves edit cycles")
+    side_path = _side_path(p)
+    if not side_path.exists():
+        return EditSession(clip)
+    try:
+        side = json.loads(side_path.read_text())
+    except (OSError, ValueError) as exc:
+        raise SessionFileError(f"{side_path}: unreadable session file ({exc})") from exc
+    if side.get("format") != SIDE_FORMAT:
+        raise SessionFileError(f"{side_path}: not a MoCurves session file")
+    if int(side.get("version", 0)) > SIDE_VERSION:
+        raise SessionFileError(f"{side_path}: version {side['version']} is newer than this build reads ({SIDE_VERSION})")
+    if side.get("clip_sha256") != _clip_digest(clip):
+        raise SessionFileError(f"{side_path}: belongs to another version of {p.name}; move it away to open the clip alone")
+    return EditSession(clip, np.array(side["scales"], dtype=np.float64), tau=int(side.get("tau", 6)),
+                       sigma=float(side.get("sigma", 0.08)), pins=side.get("pins", {}))  # fmt: skip
+
+
+def bake_root_motion(clip: Clip) -> Clip:
+    """``clip`` with its root motion put back into the root track (for formats without it)."""
+    rm = clip.root_motion
+    if rm is None:
+        return clip
+    yaw = quat.from_axis_angle(_UP, rm.heading)
+    rot = clip.rotations.copy()
+    rot[:, 0] = quat.mul(yaw, rot[:, 0])
+    return replace(clip, root=quat.rotate(yaw, clip.root) + rm.translation, rotations=rot, root_motion=None)
+
+
+def export_clip(clip: Clip, path: str | Path) -> Path:
+    """Write ``clip`` as ``.ppclip``, ``.bvh`` or ``.glb``/``.gltf`` (by suffix), atomically."""
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix == ".ppclip":
+        return save_clip(clip, p)
+    if suffix == ".bvh":
+        return write_bvh(p, clip_to_bvh(bake_root_motion(clip)))
+    if suffix in (".glb", ".gltf"):
+        return write_gltf(p, bake_root_motion(clip))
+    raise ValueError(f"{p}: export to one of {', '.join(EXPORT_SUFFIXES)}")

@@ -1,0 +1,60 @@
+"""Save/load round trip (bit for bit), refusal of mismatched side files, exports."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from authoring.mocurves import EditSession, SessionFileError, bake_root_motion, export_clip, load_session, save_session
+from engine.io import read_bvh, read_gltf
+
+
+def test_save_load_round_trip_is_exact(walk, tmp_path):
+    s = EditSession(walk, tau=4, sigma=0.3)
+    s.retime("l_foot", {20: 0.4})
+    s.scale_arrow("l_foot", 20, 0.3)
+    path = save_session(s, tmp_path / "walk_edit.ppclip")
+    back = load_session(path)
+    assert back.clip.root.tobytes() == s.clip.root.tobytes()
+    assert back.clip.rotations.tobytes() == s.clip.rotations.tobytes()
+    assert back.scales.tobytes() == s.scales.tobytes()
+    assert back.clip.root_motion.translation.tobytes() == s.clip.root_motion.translation.tobytes()
+    assert back.pins("l_foot") == {20} and back.tau == 4 and back.sigma == 0.3
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["walk_edit.mocurves.json", "walk_edit.ppclip"]
+
+
+def test_mismatched_or_newer_side_file_is_refused(walk, tmp_path):
+    s = EditSession(walk)
+    path = save_session(s, tmp_path / "a.ppclip")
+    side = tmp_path / "a.mocurves.json"
+    data = json.loads(side.read_text())
+    s.retime("hips", {3: 0.1})
+    save_session(s, tmp_path / "b.ppclip")
+    (tmp_path / "b.mocurves.json").write_text(json.dumps(data))  # a's side file beside b
+    with pytest.raises(SessionFileError, match="another version"):
+        load_session(tmp_path / "b.ppclip")
+    data["version"] = 99
+    side.write_text(json.dumps(data))
+    with pytest.raises(SessionFileError, match="newer"):
+        load_session(path)
+    with pytest.raises(ValueError, match=".ppclip"):
+        save_session(s, tmp_path / "c.bvh")
+
+
+def test_exports_to_bvh_and_gltf_carry_the_travel(walk, tmp_path):
+    baked = bake_root_motion(walk)
+    assert baked.root_motion is None
+    assert baked.root[-1, 2] - baked.root[0, 2] == pytest.approx(walk.root_motion.translation[-1, 2], abs=1e-9)
+    bvh = read_bvh(export_clip(walk, tmp_path / "walk.bvh"))
+    assert bvh.data.shape[0] == walk.num_frames
+    # Root Z position (cm) runs forward with the travel: the BVH walks.
+    z = bvh.data[:, list(bvh.channels[0]).index("Zposition")]
+    assert z[-1] - z[0] == pytest.approx(100 * walk.root_motion.translation[-1, 2], rel=1e-6)
+    asset = read_gltf(export_clip(walk, tmp_path / "walk.glb"))
+    assert len(asset.animations) == 1
+    assert export_clip(walk, tmp_path / "w.ppclip").exists()
+    with pytest.raises(ValueError, match="export to one of"):
+        export_clip(walk, tmp_path / "walk.fbx")
+    assert not (tmp_path / "walk.fbx").exists()
