@@ -67,6 +67,7 @@ def draw_lookup(loco: Any, request: Any, path: str) -> None:
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(alpha=0.3)
     ax.autoscale_view()
+    ax.margins(x=0.08, y=0.05)
     import io
 
     buf = io.BytesIO()
@@ -87,6 +88,9 @@ def run(args: argparse.Namespace) -> int:
     if args.power <= 0:
         print("--power must be positive", file=sys.stderr)
         return 2
+    if args.query is not None and not (np.isfinite(args.query).all() and args.query[0] >= 0):
+        print("--query needs a non-negative speed and a finite height", file=sys.stderr)
+        return 2
     try:
         from engine.clips import default_clips
     except ImportError as exc:
@@ -101,9 +105,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"probes: {len(table.probes)}; speed {lo[0]:.2f}–{hi[0]:.2f} m/s; hips height {lo[1]:.3f}–{hi[1]:.3f} m")
     if args.query is not None:
         request = np.array(args.query, dtype=np.float64)
-        if not np.isfinite(request).all() or request[0] < 0:
-            print("--query needs a non-negative speed and a finite height", file=sys.stderr)
-            return 2
     else:
         request = np.array([1.3 * hi[0], 0.5 * (lo[1] + hi[1])])
     res = table.resolve(request)

@@ -136,7 +136,8 @@ class Prop:
 
     Change ``radius`` at run time to grow it; with ``mass=None`` the mass follows the
     volume at ``density``. ``carried`` makes physics follow the Transform (the stick holds it)
-    instead of writing it.
+    instead of writing it. ``placed`` hands a prop back to physics at its ``Transform`` with
+    ``velocity`` for one step (set it when letting go, so the last carried velocity is not kept).
     """
 
     radius: float = 0.15
@@ -145,6 +146,7 @@ class Prop:
     friction: float = 1.0
     carried: bool = False
     velocity: NDArray[np.float64] = field(default_factory=lambda: np.zeros(6))
+    placed: bool = False
 
     def current_mass(self) -> float:
         """The mass in use: the given one, or density × volume."""

@@ -73,8 +73,9 @@ def physics_step(world: World) -> None:
                      rd.muscle_weight * rd.pin_weight)
         pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
     for e, prop, tr in world.query(Prop, Transform):
-        if prop.carried:
+        if prop.carried or prop.placed:
             pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
+            prop.placed = False
     pw.step()
     for e, rd, _, pose in rows:
         if rd.mode is RagdollMode.ANIMATED:

@@ -58,7 +58,7 @@ def stick_stacked_balls(world: World) -> None:
         if prop is None or e in held or stacked.on not in balls:
             world.remove(e, Stacked)
             if prop is not None and e not in held:
-                prop.carried = False
+                prop.carried, prop.placed, prop.velocity = False, True, np.zeros(6)
             continue
         lower_prop, lower_tr = balls[stacked.on]
         tr.position = lower_tr.position + np.array([0.0, lower_prop.radius + prop.radius, 0.0])

@@ -4,8 +4,8 @@ A ball rolled over fresh snow of depth ``d`` sinks into it and peels up the stri
 under it. The strip's cross-section is the circular segment the ball cuts into
 the snow layer, ``A = r²·acos((r−d)/r) − (r−d)·√(2rd − d²)``; rolling ``ds`` adds
 ``A·ds`` of snow to the ball, so ``r`` grows by volume, ``(4/3)π·r³ += A·ds``. The
-strip is then bare: rolling again over a mark picks up nothing, which is why the
-field remembers its marks (a coarse grid of snow depth).
+snow taken comes out of the field (a coarse grid of snow depth): a strip rolled
+again gives less, and the bare strips are the marks drawn in the snow.
 """
 
 from __future__ import annotations
@@ -69,27 +69,40 @@ class SnowField:
         return float(self.depth[i, k]) if 0 <= i < n and 0 <= k < n else 0.0
 
     def roll(self, start: NDArray[np.float64], end: NDArray[np.float64], radius: float) -> float:
-        """Roll a ball from ``start`` to ``end``: clear its strip and return its new radius."""
+        """Roll a ball from ``start`` to ``end``: take the snow it peels up; return its new radius.
+
+        The snow taken, ``A·ds``, is removed from the cells under the strip in
+        proportion, so volume is conserved whatever the step size: a ball moved a
+        centimetre per step peels a cell as surely as one moved across it at once.
+        """
         start, end = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64)
         distance = float(np.linalg.norm((end - start)[[0, 2]]))
         if distance <= 0.0:
             return radius
-        # Sample the strip densely enough that no cell is skipped.
         steps = max(1, int(np.ceil(distance / (0.5 * self.cell))))
-        points = [start + (end - start) * (k + 0.5) / steps for k in range(steps)]
-        # Read the snow along the whole path before clearing, so the strip the ball
-        # is about to reach is not mistaken for one it already peeled.
-        depths = [self.depth_at(p) for p in points]
+        ds = distance / steps
         r = radius
-        for p, d in zip(points, depths):
-            if d > 0.0:
-                half = np.sqrt(max(2 * r * min(d, r) - min(d, r) ** 2, 0.0))
-                self.depth[self._cells(p, max(half, 0.5 * self.cell))] = 0.0
-            r = grow_radius(r, distance / steps, d)
+        for k in range(steps):
+            p = start + (end - start) * (k + 0.5) / steps
+            d_here = self.depth_at(p)
+            if d_here <= 0.0:
+                continue
+            sunk = min(d_here, r)
+            half = max(np.sqrt(max(2 * r * sunk - sunk * sunk, 0.0)), 0.5 * self.cell)
+            cells = self._cells(p, half)
+            patch = self.depth[cells]
+            if patch.size == 0:
+                continue
+            mean_depth = float(patch.mean())
+            taken = segment_area(r, mean_depth) * ds
+            patch -= min(taken / (patch.size * self.cell**2), mean_depth) * (patch > 0)
+            np.maximum(patch, 0.0, out=patch)
+            self.depth[cells] = patch
+            r = float(np.cbrt(r**3 + 3.0 * taken / (4.0 * np.pi)))
         return r
 
     def marks(self) -> NDArray[np.float64]:
-        """World ``[M,3]`` centres of cells rolled bare (for drawing the tracks)."""
-        idx = np.argwhere(self.depth <= 0.0)
+        """World ``[M,3]`` centres of cells that lost most of their snow (the tracks to draw)."""
+        idx = np.argwhere(self.depth < 0.7 * self.initial_depth)
         xz = (idx + 0.5) * self.cell - self.size / 2
         return np.column_stack([xz[:, 0], np.zeros(len(xz)), xz[:, 1]])

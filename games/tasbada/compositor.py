@@ -67,7 +67,7 @@ def build_sprites(photo: NDArray[np.uint8], marks: list[Mark]) -> Sprites:
     for m in marks:
         rgba, box = cutout(photo, m)
         sprites.append((Image.fromarray((rgba * 255).astype(np.uint8), "RGBA"), box))
-        hole = np.maximum(hole, np.clip(mark_mask(m, (w, h), 3.0) * 1.6, 0, 1))
+        hole = np.maximum(hole, np.clip(mark_mask(m, (w, h), 2.0) * 1.4, 0, 1))
     base = Image.fromarray(fill_holes(photo, hole)).convert("RGBA")
     sh = Image.new("L", (128, 48), 0)
     ImageDraw.Draw(sh).ellipse((16, 10, 112, 38), fill=170)
@@ -192,7 +192,7 @@ def _bubble(d: ImageDraw.ImageDraw, text: str, anchor: tuple[float, float], size
     bh = lh * len(lines) + 24
     ax, ay = anchor
     bx = float(np.clip(ax - bw * 0.3, 8, w - bw - 8))
-    by = float(np.clip(ay - bh - 40, 8, h - bh - 8))
+    by = float(np.clip(ay - bh - 40, 0.09 * h, h - bh - 8))
     tail = [(ax - 14, by + bh - 2), (ax + 14, by + bh - 2), (ax, min(ay - 6, by + bh + 34))]
     d.rounded_rectangle((bx, by, bx + bw, by + bh), radius=18, fill=PAPER + (250,), outline=INK + (255,), width=3)
     d.polygon(tail, fill=PAPER + (250,), outline=INK + (255,))
@@ -208,7 +208,7 @@ def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: flo
     d = ImageDraw.Draw(img, "RGBA")
     pw = int(w * 0.22)
     ph = int(pw * selfie.height / selfie.width)
-    x, y = w - pw - 16, 16
+    x, y = 16, h - ph - 70
     counting = q.script == "selfie" and q.line < 3
     if counting or q.stage == MIXED and now - q.stage_t < 6.0:
         img.paste(selfie.resize((pw, ph), Image.Resampling.BILINEAR), (x, y))
@@ -233,36 +233,41 @@ def _menu(img: Image.Image, q: Quest) -> None:
     d.text((w / 2, h * 0.12), "Tasbada — where shall we go?", font=font(int(h * 0.05)), fill=(255, 255, 255, 255),
            anchor="mm")
     reached = [s for s in STAGES if s in q.reached or s in q.saved_reached]
-    for b in marking.menu_buttons(reached):
+    for b in marking.menu_buttons(reached, q.stage == MENU):
         _button(d, b.rect, b.label, (w, h), b.contains(q.pointer))
     _pointer(d, q, (w, h))
 
 
 def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, selfie: Image.Image | None,
             color: tuple[float, float, float], gaze: float) -> NDArray[np.uint8]:
-    """This frame's background picture ``[H,W,3]`` uint8 (a new array every call)."""
+    """This frame's background picture ``[H,W,3]`` uint8 (a new array every call).
+
+    Sprites are blended on an RGBA canvas; the drawing after that happens on RGB,
+    where Pillow's ``"RGBA"`` draw mode blends translucent fills instead of replacing.
+    """
     if q.stage in (REAL, MENU) or sprites is None:
-        img = photo.convert("RGBA")
+        img = photo.convert("RGB")
         if q.stage == REAL and not q.menu_open:
             _draw_real(img, q)
     else:
-        img = sprites.base.copy()
-        d = ImageDraw.Draw(img, "RGBA")
-        t = now - q.reached_t(PROPS_ALIVE) if hasattr(q, "reached_t") else now - q.stage_t
+        canvas = sprites.base.copy()
+        t = now - q.alive_t
         talking_text = narrator.script_line(q.script, q.line)
-        narrator_box = None
+        boxes, motions = [], []
         for i in range(len(sprites.sprites)):
             if i == 0:
                 wake = q.stage == PROPS_ALIVE and q.script == "wake" and q.line == 0
                 m = narrator.prop_motion(t, 0.0, talking=bool(talking_text), energy=1.6 if wake else 1.0, gaze=gaze)
             else:
                 m = narrator.prop_motion(t - 0.4 * i, 0.31 * i, energy=0.6, gaze=gaze)
-            box = _prop(img, sprites, i, m)
-            if i == 0:
-                _face(d, box, m)
-                narrator_box = box
-        if talking_text and narrator_box is not None:
-            _bubble(d, talking_text, ((narrator_box[0] + narrator_box[2]) / 2, narrator_box[1]), img.size)
+            boxes.append(_prop(canvas, sprites, i, m))
+            motions.append(m)
+        img = canvas.convert("RGB")
+        d = ImageDraw.Draw(img, "RGBA")
+        if boxes:
+            _face(d, boxes[0], motions[0])
+            if talking_text:
+                _bubble(d, talking_text, ((boxes[0][0] + boxes[0][2]) / 2, boxes[0][1]), img.size)
         _selfie_pip(img, selfie, q, now, color)
     d = ImageDraw.Draw(img, "RGBA")
     if q.menu_open or q.stage == MENU:
@@ -270,4 +275,4 @@ def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, s
     else:
         _button(d, marking.MENU_BUTTON.rect, marking.MENU_BUTTON.label, img.size,
                 marking.MENU_BUTTON.contains(q.pointer))
-    return np.asarray(img.convert("RGB")).copy()
+    return np.asarray(img).copy()

@@ -66,6 +66,8 @@ def enter_stage(world: World, q: Quest, stage: str) -> None:
     q.stage, q.stage_t, q.menu_open = stage, now, False
     if stage in STAGES and stage not in q.reached:
         q.reached.append(stage)
+    if stage == PROPS_ALIVE or (stage in (MIXED, VIRTUAL) and q.alive_t < 0):
+        q.alive_t = now
     if stage == PROPS_ALIVE:
         _say(q, "wake", now)
     elif stage == MIXED:
@@ -90,7 +92,7 @@ def _spawn_mixed(world: World, q: Quest) -> None:
         world.despawn(q.avatar)
     objects.spawn_objects(world, q)
     look = world.try_resource(AvatarLook) or AvatarLook()
-    start = objects.layout(q.ground_v).start
+    start = objects.layout(q.ground_v, q.marks).start
     q.avatar = spawn_puppet(world, start, heading=np.pi, name="avatar", extra=(Appearance(color=look.color),))
 
 
@@ -103,6 +105,7 @@ def restart_from(world: World, q: Quest, stage: str) -> None:
         stage = REAL
     if stage == REAL:
         q.marks.clear()
+    q.alive_t = -1.0
     q.script, q.line, q.selfie_t = "", -1, -1.0
     q.gesture, q.path = "", []
     if stage in (REAL, PROPS_ALIVE):
@@ -140,12 +143,12 @@ def _menu(world: World, q: Quest, pressed: bool) -> None:
     reached = [s for s in STAGES if s in q.reached or s in q.saved_reached]
     if not pressed:
         return
-    b = marking.hit_button(marking.menu_buttons(reached), q.pointer)
+    b = marking.hit_button(marking.menu_buttons(reached, q.stage == MENU), q.pointer)
     if b is None:
         return
     if b.action == "close":
         if q.stage == MENU:
-            enter_stage(world, q, REAL)
+            restart_from(world, q, reached[-1] if reached else REAL)
         q.menu_open = False
     else:
         restart_from(world, q, b.action.split(":", 1)[1])
@@ -224,13 +227,13 @@ def quest_system(world: World) -> None:
     """The ``rules`` stage: pointer, menu, stage logic, narration, milestones."""
     q = world.resource(Quest)
     pressed, released = _pointer(world, q)
+    if not q.stage:
+        enter_stage(world, q, MENU if len(q.saved_reached) > 1 else REAL)
+        return
     if q.stage == MENU or q.menu_open:
         _menu(world, q, pressed)
         return
-    if pressed and q.stage != REAL and marking.MENU_BUTTON.contains(q.pointer):
-        q.menu_open = True
-        return
-    if pressed and q.stage == REAL and marking.MENU_BUTTON.contains(q.pointer) and q.saved_reached:
+    if pressed and marking.MENU_BUTTON.contains(q.pointer):
         q.menu_open = True
         return
     if q.stage == REAL:

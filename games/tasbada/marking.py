@@ -51,10 +51,15 @@ REAL_BUTTONS: tuple[Button, ...] = (
 MENU_BUTTON = Button("menu", "Menu", (0.88, 0.89, 0.985, 0.97))
 
 
-def menu_buttons(reached: list[str]) -> list[Button]:
-    """The restart menu: one button per reached stage, then a new journey and close."""
+def menu_buttons(reached: list[str], startup: bool = False) -> list[Button]:
+    """The restart menu: one button per reached stage, then a new journey and close.
+
+    At startup (saved progress found) "close" continues at the furthest stage reached.
+    """
     items = [(f"restart:{s}", f"Restart from: {s}") for s in reached]
-    items += [("restart:new", "New journey (forget the marks)"), ("close", "Back")]
+    last = reached[-1] if reached else "real"
+    items += [("restart:new", "New journey (forget the marks)"),
+              ("close", f"Continue: {last}" if startup else "Back")]
     top, h, gap = 0.2, 0.085, 0.02
     return [Button(a, label, (0.3, top + i * (h + gap), 0.7, top + i * (h + gap) + h))
             for i, (a, label) in enumerate(items)]

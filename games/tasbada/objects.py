@@ -22,8 +22,8 @@ from numpy.typing import NDArray
 
 from engine.components import Transform, WorldPose
 from engine.ecs import Entity, World
-from games.tasbada.quest import Quest
-from games.tasbada.view import floor_depth
+from games.tasbada.quest import Mark, Quest
+from games.tasbada.view import QUEST_HALF_WIDTH, floor_depth, floor_point, to_image
 
 __all__ = ["Creature", "Crystal", "Gate", "Layout", "layout", "spawn_objects", "despawn_objects",
            "avatar_position", "milestone_step", "follow_system", "CAGE_REACH", "CRYSTAL_REACH", "GATE_REACH",
@@ -67,8 +67,49 @@ class Layout:
     start: NDArray[np.float64]
 
 
-def layout(ground_v: float) -> Layout:
-    """The quest's layout on the floor in front of the floor line at image row ``ground_v``."""
+def real_spots(marks: list[Mark], ground_v: float) -> NDArray[np.float64]:
+    """Floor points ``[N,3]`` where marked real things stand (the bottom middle of each mark on the floor)."""
+    pts = []
+    for m in marks:
+        u0, _, u1, v1 = m.bbox
+        if v1 > ground_v:
+            p = floor_point((u0 + u1) / 2, v1)
+            if p is not None:
+                pts.append(p)
+    return np.array(pts).reshape(-1, 3)
+
+
+def _clear_of(points: NDArray[np.float64], spots: NDArray[np.float64], room: float = 1.0) -> NDArray[np.float64]:
+    """Push each point away from the real things (radially, in XZ) to at least ``room`` metres."""
+    out = points.copy()
+    for s in spots:
+        d = out - s
+        d[:, 1] = 0.0
+        r = np.linalg.norm(d, axis=1)
+        near = r < room
+        away = np.where(r[:, None] > 1e-6, d / np.maximum(r, 1e-6)[:, None], np.array([1.0, 0.0, 0.0]))
+        out[near] = s + away[near] * room
+        out[near, 1] = 0.0
+    out[:, 0] = np.clip(out[:, 0], -QUEST_HALF_WIDTH, QUEST_HALF_WIDTH)
+    return out
+
+
+def _overlap(gate: NDArray[np.float64], marks: list[Mark]) -> float:
+    """Image area the gate would cover of the marked things (they live in the photo, behind it)."""
+    corners = gate + np.array([[-1.0, 0.0, 0.0], [1.0, 1.75, 0.0]])
+    uv = to_image(corners)
+    gu0, gu1 = sorted(uv[:, 0])
+    gv0, gv1 = sorted(uv[:, 1])
+    total = 0.0
+    for m in marks:
+        u0, v0, u1, v1 = m.bbox
+        total += max(0.0, min(u1, gu1) - max(u0, gu0)) * max(0.0, min(v1, gv1) - max(v0, gv0))
+    return total
+
+
+def layout(ground_v: float, marks: list[Mark] | None = None) -> Layout:
+    """The quest's layout on the floor in front of the floor line at image row ``ground_v``,
+    kept clear of the real things marked on the floor (``marks``)."""
     z0 = max(floor_depth(ground_v) + 0.7, -5.0)
     z1 = min(z0 + 3.6, 2.6)
     span = z1 - z0
@@ -77,12 +118,16 @@ def layout(ground_v: float) -> Layout:
     rad = np.array([0.45, 0.42, 0.38, 0.4, 0.45])
     cx, cz = 0.3, z0 + 0.6 * span
     crystals = np.c_[cx + 2.3 * rad / 0.45 * np.cos(ang), np.zeros(5), cz + span * rad * np.sin(ang)]
-    return Layout(cages, crystals, np.array([0.0, 0.0, z0 - 0.15]), np.array([1.2, 0.0, z1 - 0.1 * span]))
+    spots = real_spots(marks or [], ground_v)
+    gates = np.array([[x, 0.0, z0 - 0.15] for x in (0.0, -1.3, 1.3, -2.2, 2.2)])
+    gate = gates[int(np.argmin([_overlap(g, marks or []) for g in gates]))]  # first least hidden-behind
+    start = np.array([[1.2, 0.0, z1 - 0.1 * span]])
+    return Layout(_clear_of(cages, spots), _clear_of(crystals, spots, 0.8), gate, _clear_of(start, spots)[0])
 
 
 def spawn_objects(world: World, q: Quest) -> None:
     """Spawn creatures, crystals and the gate for ``q``'s floor line; reset their milestones."""
-    lay = layout(q.ground_v)
+    lay = layout(q.ground_v, q.marks)
     for i, home in enumerate(lay.cages):
         world.spawn(Creature(i, home.copy()), Transform(home.copy()))
     for i, pos in enumerate(lay.crystals):

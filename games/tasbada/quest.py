@@ -79,9 +79,10 @@ class Quest:
 
     SIM_STATE: ClassVar[bool] = True
 
-    stage: str = REAL
+    stage: str = ""
+    """The current stage; empty until the first step enters ``real`` (or ``menu``)."""
     stage_t: float = 0.0
-    reached: list[str] = field(default_factory=lambda: [REAL])
+    reached: list[str] = field(default_factory=list)
     marks: list[Mark] = field(default_factory=list)
     ground_v: float = 0.555
     """The floor line: the image row where the floor meets the back wall."""
@@ -91,6 +92,8 @@ class Quest:
     gesture: str = ""
     """What the current press does: ``draw`` a mark, drag the ``ground`` line, a ``button``."""
     path: list[tuple[float, float]] = field(default_factory=list)
+    alive_t: float = -1.0
+    """When the props came alive (the narrator's clock), -1 before."""
     # Narration.
     line: int = -1
     line_t: float = 0.0

@@ -103,7 +103,8 @@ def exit_carry(world: World, entity: Entity, brain: Brain) -> None:
     """Whatever comes next, physics holds the ball until PutDown takes it again (a fall drops it)."""
     body = world.get(entity, PuppetBody)
     if body.object is not None and world.alive(body.object):
-        world.get(body.object, Prop).carried = False
+        prop = world.get(body.object, Prop)
+        prop.carried, prop.placed, prop.velocity = False, True, np.zeros(6)
 
 
 def enter_putdown(world: World, entity: Entity, brain: Brain) -> None:
@@ -152,7 +153,7 @@ def exit_putdown(world: World, entity: Entity, brain: Brain) -> None:
     body = world.get(entity, PuppetBody)
     if body.object is not None and world.alive(body.object):
         prop = world.get(body.object, Prop)
-        prop.carried, prop.velocity = False, np.zeros(6)
+        prop.carried, prop.placed, prop.velocity = False, True, np.zeros(6)
     body.object = None
     brain.memory.pop("putdown_spot", None)
 
@@ -207,7 +208,7 @@ def exit_roll(world: World, entity: Entity, brain: Brain) -> None:
     body = world.get(entity, PuppetBody)
     if body.object is not None and world.alive(body.object):
         prop = world.get(body.object, Prop)
-        prop.carried, prop.velocity = False, np.zeros(6)
+        prop.carried, prop.placed, prop.velocity = False, True, np.zeros(6)
     body.object = None
 
 

@@ -26,6 +26,7 @@ from engine.skeleton import Skeleton
 from engine.statemachine.machine import Brain, StateMachine, step_machine
 from engine.statemachine.puppet.body import PoseOverride, PuppetBody, PuppetTuning
 from engine.statemachine.puppet.machine import puppet_machine
+from engine.statemachine.puppet.props import held_props_system
 from engine.statemachine.puppet.senses import sense, yaw_rotation
 
 __all__ = ["install_puppets", "spawn_puppet", "brain_system", "apply_pose_overrides", "PuppetMachine"]
@@ -60,6 +61,7 @@ def install_puppets(app: App) -> None:
     world = app.world
     if world.try_resource(PuppetMachine) is None:
         world.insert_resource(PuppetMachine())
+    app.add_system("statemachine", held_props_system)
     app.add_system("statemachine", brain_system)
     install_puppet_locomotion(app)
     app.add_system("animation", apply_pose_overrides)

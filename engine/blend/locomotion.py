@@ -1,0 +1,272 @@
+"""The animation stage for locomotion: requests in user units in, local poses and root motion out.
+
+Per frame, for every puppet with a :class:`LocomotionPlayer` (written by the state
+machine: requested root speed in m/s and hips height in m):
+
+1. the request is resolved by the set's lookup table — projected onto the feasible
+   border when out of reach, with the playback speed-up ``u/u'`` (thesis §6.2.3);
+2. the blend point eases toward the answer (time constant ``smoothing``), so a state
+   switch never pops the pose;
+3. the shared phase advances by ``dt·rate / Σ wᵢTᵢ`` and the blended root motion over
+   that phase interval moves the puppet's ``Transform`` (turned into its heading);
+4. the blended pose (cross-faded with a one-shot or override clip, if one plays)
+   is written to ``LocalPose`` with the root in world space and the heading folded
+   into joint 0, ready for IK and FK.
+
+Puppets sharing a locomotion set are evaluated together, batched over puppets:
+one inside test and one k-d tree query for all their requests, one sample per
+active clip for all their phases. Answers are memoised per request (a puppet held
+still, or an idle crowd, asks the same thing every step).
+Assets (spaces, tables, clips) live in the :class:`BlendLibrary` resource; the
+component holds only what changes per frame. Time is ``world.dt`` steps only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine import quat
+from engine.app import App
+from engine.blend.lookup import LookupTable, Resolution
+from engine.blend.pose_blend import crossfade, fade_weight
+from engine.blend.space import BlendSpace
+from engine.clip import Clip
+from engine.components import LocalPose, Puppet, Transform
+from engine.ecs import World
+from engine.pose import Pose
+
+__all__ = ["LocomotionSet", "BlendLibrary", "LocomotionPlayer", "animate", "install_blend"]
+
+F = NDArray[np.float64]
+_UP = np.array([0.0, 1.0, 0.0])
+
+
+@dataclass(frozen=True)
+class LocomotionSet:
+    """One character's locomotion assets: the blend space, its measured lookup and extra clips.
+
+    Args:
+        space: the cyclic blend space.
+        table: its lookup table, properties ``(speed m/s, hips height m)``.
+        clips: clips a state may play over the blend by name (get-up, mid-jump…).
+        smoothing: time constant (s) of the blend point's easing toward each answer.
+    """
+
+    space: BlendSpace
+    table: LookupTable
+    clips: dict[str, Clip] = field(default_factory=dict)
+    smoothing: float = 0.08
+
+    def standing_heights(self, speeds: F) -> F:
+        """What ``height=None`` requests: the tallest blend at each speed (beyond the fastest, at the fastest)."""
+        s = np.minimum(np.asarray(speeds, dtype=np.float64), self.table.values[:, 0].max())
+        _, hi = self.table.extent_many(np.stack([s, np.full_like(s, self.table.values[0, 1])], axis=-1), 1)
+        return np.where(np.isnan(hi), self.table.values[:, 1].max(), hi)
+
+
+class BlendLibrary:
+    """Resource: locomotion sets by name (``"humanoid"``, ``"snowman"``…). An asset store, not sim state."""
+
+    SIM_STATE = False
+
+    def __init__(self) -> None:
+        self.sets: dict[str, LocomotionSet] = {}
+        self.memo: dict[tuple[str, float, float | None], Resolution] = {}
+
+    def add(self, name: str, locomotion: LocomotionSet) -> None:
+        """Register (or replace) a set."""
+        self.sets[name] = locomotion
+        self.memo.clear()
+
+    def __getitem__(self, name: str) -> LocomotionSet:
+        try:
+            return self.sets[name]
+        except KeyError:
+            raise KeyError(f"no locomotion set {name!r}; loaded: {sorted(self.sets)}") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.sets
+
+
+@dataclass
+class LocomotionPlayer:
+    """Per-puppet playback state. The state machine writes ``speed``/``height`` and calls :meth:`play`.
+
+    Attributes:
+        library_key: which :class:`LocomotionSet` drives this puppet.
+        speed: requested ground speed (m/s, ≥ 0) along the puppet's heading.
+        height: requested hips height (m); ``None`` stands tall.
+        point: the blend point in use (eased), ``None`` until the first step.
+        feasible: the request actually played (after projection).
+        inside: whether the last request was feasible.
+        rate: playback speed-up applied (1 inside the feasible set).
+        phase: shared normalised phase in ``[0, 1)``.
+        override: name of a clip playing over the blend, if any.
+        override_time: seconds into the override clip.
+        override_fade: cross-fade duration in and out (s).
+        override_weight: linear fade progress in ``[0, 1]``.
+        override_stopping: fading the override out.
+        override_hold: a non-looping override holds its last frame until :meth:`stop`.
+        finished: name of a one-shot that ended this step (cleared next step).
+    """
+
+    library_key: str = "humanoid"
+    speed: float = 0.0
+    height: float | None = None
+    point: F | None = None
+    feasible: F | None = None
+    inside: bool = True
+    rate: float = 1.0
+    phase: float = 0.0
+    override: str | None = None
+    override_time: float = 0.0
+    override_fade: float = 0.2
+    override_weight: float = 0.0
+    override_stopping: bool = False
+    override_hold: bool = False
+    finished: str | None = None
+
+    def play(self, clip: str, fade: float = 0.2, hold: bool = False) -> None:
+        """Cross-fade a named clip in over the blend.
+
+        A non-looping clip fades out by itself at its end, unless ``hold`` (a jump's
+        mid-air pose held until landing), which keeps its last frame until :meth:`stop`.
+        """
+        if fade < 0:
+            raise ValueError("fade time must be non-negative")
+        if self.override != clip:
+            self.override_time = 0.0
+            self.override_weight = 0.0 if self.override is None else self.override_weight
+        self.override, self.override_fade, self.override_stopping = clip, fade, False
+        self.override_hold = hold
+
+    def stop(self, fade: float = 0.2) -> None:
+        """Fade the override clip out, back to the blend."""
+        if self.override is not None:
+            self.override_fade, self.override_stopping = fade, True
+
+
+def _override(player: LocomotionPlayer, loco: LocomotionSet, dt: float) -> tuple[Clip | None, float, F]:
+    """Advance the override clip: (clip, eased weight, its root travel this step in clip frame)."""
+    if player.override is None:
+        return None, 0.0, np.zeros(3)
+    clip = loco.clips.get(player.override)
+    if clip is None:
+        raise KeyError(f"clip {player.override!r} is not in the locomotion set; available: {sorted(loco.clips)}")
+    t0, t1 = player.override_time, player.override_time + dt
+    fade = player.override_fade
+    if not clip.loop and not player.override_hold and not player.override_stopping and t1 >= clip.duration - fade:
+        player.override_stopping = True
+    step = dt / fade if fade > 0 else 1.0
+    step = -step if player.override_stopping else step
+    player.override_weight = float(np.clip(player.override_weight + step, 0.0, 1.0))
+    player.override_time = t1
+    travel = clip.sample_root_motion(t1)[0] - clip.sample_root_motion(t0)[0]
+    if player.override_stopping and player.override_weight <= 0.0:
+        player.finished = player.override
+        player.override, player.override_stopping, player.override_time = None, False, 0.0
+        return None, 0.0, np.zeros(3)
+    return clip, fade_weight(player.override_weight, 1.0), travel
+
+
+def _yaw(rotation: F) -> F:
+    """Heading angles ``[B]`` about +Y of rotations ``[B, 4]`` (their +Z axis in the ground plane)."""
+    w, x, y, z = rotation[:, 0], rotation[:, 1], rotation[:, 2], rotation[:, 3]
+    return np.arctan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
+
+
+_Row = tuple[int, Transform, Puppet, "LocomotionPlayer"]
+
+
+def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members: list[_Row]) -> list[Resolution]:
+    """The table's answers for a group's requests, batched; memoised, as a held stick repeats its request."""
+    out: list[Resolution | None] = []  # filled below for every miss
+    misses: list[int] = []
+    for i, (e, _tr, _pup, player) in enumerate(members):
+        speed, height = player.speed, player.height
+        if not (np.isfinite(speed) and speed >= 0.0 and (height is None or np.isfinite(height))):
+            raise ValueError(f"entity {e}: locomotion request speed={speed!r}, height={height!r} is invalid")
+        res = library.memo.get((key, float(speed), None if height is None else float(height)))
+        out.append(res)
+        if res is None:
+            misses.append(i)
+    if misses:
+        players = [members[i][3] for i in misses]
+        speeds = np.array([p.speed for p in players], dtype=np.float64)
+        heights = np.array([np.nan if p.height is None else p.height for p in players], dtype=np.float64)
+        standing = np.isnan(heights)
+        if standing.any():
+            heights[standing] = loco.standing_heights(speeds[standing])
+        points, feasible, inside, rates = loco.table.resolve_many(np.stack([speeds, heights], axis=-1))
+        if len(library.memo) + len(misses) > 4096:
+            library.memo.clear()
+        for j, i in enumerate(misses):
+            res = Resolution(points[j], feasible[j], bool(inside[j]), float(rates[j]))
+            p = players[j]
+            library.memo[(key, float(p.speed), None if p.height is None else float(p.height))] = res
+            out[i] = res
+    return out  # type: ignore[return-value]
+
+
+def animate(world: World) -> None:
+    """The animation-stage system: resolve, advance and pose every locomotion puppet (batched per set)."""
+    library = world.try_resource(BlendLibrary)
+    if library is None:
+        return
+    groups: dict[str, list[_Row]] = {}
+    for e, tr, pup, player in world.query(Transform, Puppet, LocomotionPlayer):
+        groups.setdefault(player.library_key, []).append((e, tr, pup, player))
+    dt = world.dt
+    for key, members in groups.items():
+        loco = library[key]
+        space = loco.space
+        alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
+        points, rates = [], []
+        for (_e, _, _, player), res in zip(members, _resolve_group(library, key, loco, members), strict=True):
+            player.finished = None
+            p = res.point if player.point is None else player.point + alpha * (res.point - player.point)
+            player.point, player.feasible, player.inside, player.rate = p, res.feasible, res.inside, res.rate
+            points.append(p)
+            rates.append(res.rate)
+        w = space.weights(np.array(points))
+        phase = np.array([m[3].phase for m in members])
+        new_phase, travel, turn = space.advance(phase, w, dt, np.array(rates))
+        # Scaling the phase step by the rate already scales the root travel: feet keep pace with the ground.
+        pose = space.sample(w, new_phase)
+        roots, rots = pose.root.copy(), pose.rotations.copy()
+        keep_turn = np.ones(len(members))
+        for i, (_e, _tr, _pup, player) in enumerate(members):
+            player.phase = float(new_phase[i] % 1.0)
+            clip, weight, clip_travel = _override(player, loco, dt)
+            if clip is not None:
+                local = crossfade(Pose(roots[i], rots[i]), clip.sample(player.override_time), weight)
+                roots[i], rots[i] = local.root, local.rotations
+                travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel
+                keep_turn[i] = 1.0 - weight
+        # Heading, travel and the world root for the whole group at once.
+        yaw = _yaw(np.array([m[1].rotation for m in members]))
+        hq = quat.from_axis_angle(_UP, yaw)
+        step = quat.rotate(hq, travel)
+        turn_q = quat.from_axis_angle(_UP, turn * keep_turn)
+        hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
+        rots[:, 0] = quat.mul(hq_new, rots[:, 0])
+        offsets = quat.rotate(hq_new, roots)
+        for i, (e, tr, _pup, _player) in enumerate(members):
+            tr.position = tr.position + step[i]
+            tr.rotation = quat.normalize(quat.mul(turn_q[i], tr.rotation))
+            root = tr.position + offsets[i]
+            existing = world.try_get(e, LocalPose)
+            if existing is None:
+                world.queue_add(e, LocalPose(root, rots[i]))
+            else:
+                existing.root, existing.rotations = root, rots[i]
+
+
+def install_blend(app: App) -> None:
+    """Plugin: the :class:`BlendLibrary` resource (if absent) and :func:`animate` in the animation stage."""
+    if app.world.try_resource(BlendLibrary) is None:
+        app.world.insert_resource(BlendLibrary())
+    app.add_system("animation", animate)

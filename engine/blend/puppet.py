@@ -1,0 +1,91 @@
+"""The puppet's blend space of thesis Fig. 6.3 and its measured lookup table.
+
+Axes ``(velocity, height)``: idle ``(0, 1)``, walk ``(0.5, 1)``, run ``(1, 1)``, crouch
+idle ``(0, 0)``, crouch walk ``(1, 0)``. The snowman game drives it with the phone's
+speed and height; the lookup table (a 31×31 probe grid by default, measured by
+playing each blend) turns those into the blend point that really moves at that
+speed. ``get_up`` and ``mid_jump`` ride along as one-shot clips.
+
+Building the table plays 961 blends for one cycle each, batched: about half a second,
+so the result is cached per process and per set of clips.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from functools import lru_cache
+
+from engine.app import App
+from engine.blend.locomotion import BlendLibrary, LocomotionSet, install_blend
+from engine.blend.lookup import LinearMapping, LookupTable
+from engine.blend.measure import LOCOMOTION_PROPERTIES, measure_locomotion
+from engine.blend.space import BlendSpace
+from engine.clip import Clip
+
+__all__ = [
+    "PUPPET_PLACEMENT",
+    "PUPPET_AXES",
+    "puppet_blend_space",
+    "build_locomotion",
+    "puppet_locomotion",
+    "height_mapping",
+    "install_puppet_locomotion",
+]
+
+PUPPET_AXES: tuple[str, ...] = ("velocity", "height")
+PUPPET_PLACEMENT: dict[str, tuple[float, float]] = {
+    "idle": (0.0, 1.0),
+    "walk": (0.5, 1.0),
+    "run": (1.0, 1.0),
+    "crouch_idle": (0.0, 0.0),
+    "crouch_walk": (1.0, 0.0),
+}
+
+
+def puppet_blend_space(clips: Mapping[str, Clip]) -> BlendSpace:
+    """The Fig. 6.3 space over the five locomotion clips of ``clips`` (e.g. ``default_clips()``)."""
+    return BlendSpace.from_named(dict(clips), PUPPET_PLACEMENT, PUPPET_AXES)
+
+
+def build_locomotion(
+    clips: Mapping[str, Clip],
+    density: int = 31,
+    dt: float = 1.0 / 60.0,
+    power: float = 7.0,
+    neighbours: int = 16,
+) -> LocomotionSet:
+    """Blend space + measured lookup table + the remaining clips as one-shots."""
+    space = puppet_blend_space(clips)
+    table = LookupTable.measure(
+        space.dims,
+        density,
+        lambda probes: measure_locomotion(space, probes, dt),
+        LOCOMOTION_PROPERTIES,
+        power=power,
+        neighbours=neighbours,
+        rate_property=0,
+    )
+    extra = {name: clip for name, clip in clips.items() if name not in PUPPET_PLACEMENT}
+    return LocomotionSet(space, table, extra)
+
+
+@lru_cache(maxsize=4)
+def puppet_locomotion(density: int = 31, dt: float = 1.0 / 60.0) -> LocomotionSet:
+    """The default puppet's locomotion set, built from ``engine.clips.default_clips()`` (cached)."""
+    from engine.clips import default_clips
+
+    return build_locomotion(default_clips(), density, dt)
+
+
+def height_mapping(table: LookupTable, low: float, high: float) -> LinearMapping:
+    """Phone height ``low..high`` (m) to hips height, crouched to standing, clamped (thesis §6.2.3)."""
+    heights = table.values[:, 1]
+    return LinearMapping(low, high, float(heights.min()), float(heights.max()))
+
+
+def install_puppet_locomotion(app: App) -> None:
+    """Plugin: :func:`install_blend` plus the default puppet's set under ``"humanoid"``."""
+    install_blend(app)
+    library = app.world.resource(BlendLibrary)
+    if "humanoid" not in library:
+        library.add("humanoid", puppet_locomotion())

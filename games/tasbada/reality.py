@@ -1,0 +1,94 @@
+"""The real-world pictures of a session: the backdrop photo (or webcam), the selfie, the cut-outs.
+
+:class:`Reality` is a world resource that is *not* simulation state: it is built once
+at setup from files (deterministic), may be fed by a webcam in a live session, and is
+only read by the view. It caches the expensive work — cutting out the marked objects
+and filling their holes — per set of marks, so that happens once per stage change,
+not per frame.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+from PIL import Image
+
+from games.tasbada.compositor import Sprites, build_sprites, compose
+from games.tasbada.images import PHOTO_SIZE, clothes_color, fit_photo, load_image
+from games.tasbada.quest import MIXED, REAL, Quest
+from games.tasbada.webcam import Webcam
+
+__all__ = ["Reality", "SHIPPED_PHOTO", "SHIPPED_SELFIE"]
+
+SHIPPED_PHOTO = Path(__file__).with_name("assets") / "room.jpg"
+SHIPPED_SELFIE = Path(__file__).with_name("assets") / "selfie.jpg"
+
+
+class Reality:
+    """Photo, selfie, avatar colour, optional webcam, and the cut-out cache.
+
+    Args:
+        photo: the backdrop picture file (16:9 crop is taken from its centre).
+        selfie: the selfie picture file.
+        webcam: a started webcam, or ``None`` to use the files only.
+        message: what to tell the person about the camera.
+    """
+
+    SIM_STATE = False
+
+    def __init__(self, photo: str | Path = SHIPPED_PHOTO, selfie: str | Path = SHIPPED_SELFIE,
+                 webcam: Webcam | None = None, message: str = "") -> None:
+        self.photo_path = str(photo)
+        self.photo = fit_photo(load_image(photo))
+        self.selfie_img = load_image(selfie)
+        self.color = clothes_color(self.selfie_img)
+        self.webcam = webcam
+        self.message = message
+        self.frozen = webcam is None
+        self.selfie_taken = webcam is None
+        self._sprites: tuple[bytes, Sprites] | None = None
+        self._photo_pil = Image.fromarray(self.photo)
+        self._selfie_pil = Image.fromarray(self.selfie_img)
+
+    def _live(self, q: Quest) -> None:
+        """Webcam: keep the backdrop live until marking starts; take the selfie when the count-down ends."""
+        if self.webcam is None:
+            return
+        if not self.frozen:
+            frame = self.webcam.frame()
+            if frame is not None:
+                self.photo = fit_photo(frame, PHOTO_SIZE)
+                self._photo_pil = Image.fromarray(self.photo)
+            if q.down or q.marks or q.stage != REAL:
+                self.frozen = True
+        if q.script == "selfie" and not self.selfie_taken:
+            frame = self.webcam.frame()
+            if frame is not None:
+                self._selfie_pil = Image.fromarray(frame)
+                if q.stage == MIXED or q.line >= 3:
+                    self.selfie_img = frame
+                    self.color = clothes_color(frame)
+                    self.selfie_taken = True
+
+    def sprites(self, q: Quest) -> Sprites | None:
+        """The cut-outs for ``q``'s marks (built on first use for a new set of marks)."""
+        if not q.marks:
+            return None
+        key = b"".join(m.kind.encode() + np.ascontiguousarray(m.points).tobytes() for m in q.marks)
+        if self._sprites is None or self._sprites[0] != key:
+            self._sprites = (key, build_sprites(self.photo, q.marks))
+        return self._sprites[1]
+
+    def frame(self, q: Quest, now: float, gaze: float) -> NDArray[np.uint8]:
+        """This frame's backdrop picture."""
+        self._live(q)
+        sprites = None if q.stage == REAL else self.sprites(q)
+        return compose(self._photo_pil, sprites, q, now, self._selfie_pil, self.color, gaze)
+
+    def close(self) -> None:
+        """Free the webcam."""
+        if self.webcam is not None:
+            self.webcam.close()
+            self.webcam = None
