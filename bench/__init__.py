@@ -18,4 +18,5 @@ BENCHES: dict[str, str] = {
     "mocurves": "bench.mocurves",
     "input-latency": "bench.input_latency",
     "snowman": "bench.snowman",
+    "render": "bench.render",
 }

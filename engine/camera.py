@@ -116,6 +116,8 @@ class Camera:
         """World ray ``(origin [3], unit direction [3])`` through pixel ``(px, py)`` (top-left origin)."""
         if width <= 0 or height <= 0:
             raise ValueError(f"viewport must be positive, got {width}x{height}")
+        if not (math.isfinite(px) and math.isfinite(py)):
+            raise ValueError(f"pixel must be finite, got ({px}, {py})")
         t = math.tan(math.radians(self.fov_y) / 2.0)
         nx = 2.0 * px / width - 1.0
         ny = 1.0 - 2.0 * py / height

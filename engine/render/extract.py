@@ -1,0 +1,111 @@
+"""From the world to a :class:`RenderScene`: what the render step reads each frame.
+
+Rendering runs between simulation steps and interpolates: every puppet is drawn at
+``WorldPose.interpolated(alpha)``, ``alpha`` being how far the wall clock is between the
+previous and the current step. Nothing here writes the world.
+
+- Puppets (``Puppet`` + ``WorldPose``): one capsule per bone, from each parent joint to
+  its child (the parent's radius along a chain, the child's on a side branch such as a
+  collar bone), and for leaf joints (those with a ``tips``
+  offset: head, hands, feet) from the joint towards its tip, ending at the tip.
+- Props (``Transform`` + ``Shape``): a sphere, capsule or box.
+
+Colours and outlines come from an optional ``Appearance``; entities whose appearance is
+not ``visible`` are skipped.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine import quat
+from engine.components import Puppet, Transform, WorldPose
+from engine.ecs import World
+from engine.render.components import Appearance, Shape
+from engine.render.scene import RenderScene
+from engine.skeleton import Skeleton
+
+__all__ = ["scene_from_world", "puppet_capsules"]
+
+_DEFAULT_PUPPET = Appearance()
+_DEFAULT_PROP = Appearance(color=(0.95, 0.96, 0.98))
+
+
+_Idx = NDArray[np.int64]
+
+
+@lru_cache(maxsize=64)
+def _bones(parents: bytes, tips: bytes) -> tuple[_Idx, _Idx, _Idx, _Idx]:
+    """Per bone: parent joint, child joint, the joint whose radius it takes; and the leaf joints."""
+    par = np.frombuffer(parents, dtype=np.int64)
+    tip = np.frombuffer(tips, dtype=np.float64).reshape(-1, 3)
+    child = np.arange(1, len(par))
+    # The first child continues the parent's chain (spine, neck, arm, leg) and takes the
+    # parent's thickness; side branches (collar bones, hip sockets) take the child's.
+    first = np.array([par[c] >= 0 and np.nonzero(par == par[c])[0][0] == c for c in child], dtype=bool)
+    owner = np.where(first, par[child], child)
+    leaves = np.nonzero(np.linalg.norm(tip, axis=1) > 1e-9)[0]
+    return par[child], child, owner, leaves
+
+
+def puppet_capsules(skeleton: Skeleton, positions: NDArray[np.float64], rotations: NDArray[np.float64]
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """Capsules ``(a [B,3], b [B,3], radius [B], joint [B])`` of one posed puppet.
+
+    ``joint`` is the joint whose radius (and per-joint colour) each capsule takes.
+    """
+    parent, child, bone_owner, leaves = _bones(skeleton.parents.tobytes(), skeleton.tips.tobytes())
+    pos = np.asarray(positions, dtype=np.float64)
+    a = [pos[parent]]
+    b = [pos[child]]
+    r = [skeleton.radii[bone_owner]]
+    owner = [bone_owner]
+    if len(leaves):
+        start = pos[leaves]
+        tip = quat.rotate(np.asarray(rotations, dtype=np.float64)[leaves], skeleton.tips[leaves])
+        length = np.linalg.norm(tip, axis=1, keepdims=True)
+        rad = skeleton.radii[leaves]
+        # End the capsule's surface at the tip rather than its core segment.
+        keep = np.maximum(length - rad[:, None], 0.0) / np.maximum(length, 1e-12)
+        a.append(start)
+        b.append(start + tip * keep)
+        r.append(rad)
+        owner.append(leaves)
+    return np.vstack(a), np.vstack(b), np.concatenate(r), np.concatenate(owner)
+
+
+def scene_from_world(world: World, alpha: float, scene: RenderScene | None = None) -> RenderScene:
+    """Append every visible puppet and prop of ``world`` to ``scene`` (a new one if ``None``).
+
+    Args:
+        world: the simulation world (read only).
+        alpha: interpolation in ``[0, 1]`` between the previous and the current step.
+        scene: the scene to append to; call ``scene.clear()`` first to reuse one per frame.
+    """
+    if not 0.0 <= alpha <= 1.0:
+        raise ValueError(f"alpha must be in [0, 1], got {alpha}")
+    scene = RenderScene() if scene is None else scene
+    for e, puppet, wpose in world.query(Puppet, WorldPose):
+        look = world.try_get(e, Appearance) or _DEFAULT_PUPPET
+        if not look.visible:
+            continue
+        pos, rot = wpose.interpolated(alpha)
+        a, b, r, owner = puppet_capsules(puppet.skeleton, pos, rot)
+        color = look.color if look.joint_colors is None else look.joint_colors[owner]
+        scene.add_capsules(a, b, r, color, look.outline)
+    for e, tf, shape in world.query(Transform, Shape):
+        look = world.try_get(e, Appearance) or _DEFAULT_PROP
+        if not look.visible:
+            continue
+        s = float(tf.scale)
+        if shape.kind == "sphere":
+            scene.add_sphere(tf.position, shape.size[0] * s, look.color, look.outline)
+        elif shape.kind == "capsule":
+            axis = quat.rotate(tf.rotation, np.array([0.0, shape.size[1] * s, 0.0]))
+            scene.add_capsule(tf.position - axis, tf.position + axis, shape.size[0] * s, look.color, look.outline)
+        else:
+            scene.add_box(tf.position, shape.size * s, tf.rotation, look.color, look.outline)
+    return scene

@@ -1,0 +1,50 @@
+"""Small moderngl helpers shared by the render passes."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import moderngl
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["Instances", "set_uniform", "mesh_buffers"]
+
+
+class Instances:
+    """A dynamic instance buffer that grows by orphaning, so VAO bindings stay valid."""
+
+    def __init__(self, ctx: moderngl.Context, stride_bytes: int) -> None:
+        self.buf = ctx.buffer(reserve=max(stride_bytes * 64, 1024), dynamic=True)
+        self.count = 0
+
+    def upload(self, data: NDArray[np.float32]) -> int:
+        """Write ``data`` rows (float32) and return how many instances that is."""
+        raw = np.ascontiguousarray(data, dtype=np.float32).tobytes()
+        if len(raw) > self.buf.size:
+            self.buf.orphan(2 * len(raw))
+        if raw:
+            self.buf.write(raw)
+        self.count = len(data)
+        return self.count
+
+
+def set_uniform(prog: moderngl.Program, name: str, value: Any) -> None:
+    """Set a uniform if the compiler kept it (unused uniforms are optimised away).
+
+    ``[4,4]`` numpy matrices (maths convention, column vectors) are uploaded transposed,
+    since GL reads them column-major.
+    """
+    if name not in prog:
+        return
+    u = prog[name]
+    if isinstance(value, np.ndarray) and value.shape == (4, 4):
+        u.write(np.ascontiguousarray(value.T, dtype=np.float32).tobytes())
+    else:
+        u.value = value
+
+
+def mesh_buffers(ctx: moderngl.Context,
+                 mesh: tuple[NDArray[Any], NDArray[Any]]) -> tuple[moderngl.Buffer, moderngl.Buffer]:
+    """Vertex and index buffers of a ``(vertices, triangles)`` mesh."""
+    return ctx.buffer(np.ascontiguousarray(mesh[0]).tobytes()), ctx.buffer(np.ascontiguousarray(mesh[1]).tobytes())

@@ -1,0 +1,283 @@
+"""The moderngl renderer: draws a :class:`RenderScene` through a camera into a framebuffer.
+
+Passes, in order (each kind of primitive is one instanced draw call):
+
+1. **shadows** — a sun depth map for objects and a blurred planar mask for the ground
+   (:mod:`engine.render.shadows`), both fitted around the casters each frame.
+2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
+   culling in a flat colour: only a rim around the silhouette stays visible.
+3. **objects** — capsules, spheres, boxes, lit by sun, sky ambient and shadow.
+4. **ground** — a large quad under the camera: procedural snow (drift shading, sparkle),
+   anti-aliased grid, soft shadows, distance fog.
+5. **sky** — a gradient with a sun glow (and the background photo, faded) on the pixels
+   nothing else covered (depth test at the far plane).
+6. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
+7. **text** — the overlay, in pixels.
+
+Opaque passes run nearest-first because on a software rasteriser (llvmpipe) fragment
+shading is the cost: the early depth test then skips ground and sky under the puppets.
+The renderer owns GPU objects only; it never writes the scene or the simulation.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import moderngl
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.camera import Camera
+from engine.render import meshes
+from engine.render import shaders as S
+from engine.render import shaders_env as E
+from engine.render.gpu import Instances, mesh_buffers, set_uniform
+from engine.render.noise import snow_noise
+from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
+from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
+from engine.render.text import TextCache
+
+__all__ = ["Renderer"]
+
+_LINE_FMT = ("3f 3f 3f 1f/i", "i_p0", "i_p1", "i_color", "i_width")
+_POINT_FMT = ("3f 1f 3f 1f", "i_pos", "i_size", "i_color", "i_pixels")
+_SOLIDS = ("capsules", "spheres", "boxes")
+
+
+def _linear(c: Any) -> tuple[float, float, float]:
+    a = np.clip(np.asarray(c, dtype=np.float64), 0.0, None) ** 2  # the shaders' gamma 2.0
+    return float(a[0]), float(a[1]), float(a[2])
+
+
+class Renderer:
+    """Draws scenes with one moderngl context (window or headless).
+
+    Args:
+        ctx: an OpenGL 3.3 core context.
+        shadow_size: side of the object shadow map in texels.
+        mask_size: side of the ground shadow mask in texels.
+    """
+
+    def __init__(self, ctx: moderngl.Context, shadow_size: int = 1024, mask_size: int = 256) -> None:
+        self.ctx = ctx
+        h, lit = S.HEADER, S.HEADER + S.LIGHTING
+        p = self._programs = {
+            "capsule": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=lit + S.LIT_FS),
+            "capsule_flat": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=h + S.FLAT_FS),
+            "box": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=lit + S.LIT_FS),
+            "box_flat": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.FLAT_FS),
+            "ground": ctx.program(vertex_shader=h + E.GROUND_VS, fragment_shader=lit + E.BACKGROUND + E.GROUND_FS),
+            "sky": ctx.program(vertex_shader=h + E.SKY_VS, fragment_shader=lit + E.BACKGROUND + E.SKY_FS),
+            "line": ctx.program(vertex_shader=h + S.LINE_VS, fragment_shader=h + S.LINE_FS),
+            "point": ctx.program(vertex_shader=h + S.POINT_VS, fragment_shader=h + S.POINT_FS),
+            "text": ctx.program(vertex_shader=h + S.TEXT_VS, fragment_shader=h + S.TEXT_FS),
+        }
+        strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
+                   "lines": LINE_STRIDE, "points": POINT_STRIDE}
+        self._inst = {k: Instances(ctx, 4 * n) for k, n in strides.items()}
+        # Outlined items get their own small buffers so the outline pass only touches them.
+        self._outline_inst = {k: Instances(ctx, 4 * strides[k]) for k in _SOLIDS}
+        self._buffers: list[moderngl.Buffer] = []
+        self._vaos: dict[str, moderngl.VertexArray] = {}
+        for kind, mesh in (("capsules", meshes.capsule_mesh()), ("spheres", meshes.sphere_mesh())):
+            vbo, ibo = self._keep(mesh_buffers(ctx, mesh))
+            for suffix, prog, inst in (("", "capsule", self._inst[kind]),
+                                       ("_flat", "capsule_flat", self._outline_inst[kind])):
+                self._vaos[kind + suffix] = ctx.vertex_array(
+                    p[prog], [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)], ibo, 4, skip_errors=True)
+        vbo, ibo = self._keep(mesh_buffers(ctx, meshes.box_mesh()))
+        for suffix, prog, inst in (("", "box", self._inst["boxes"]),
+                                   ("_flat", "box_flat", self._outline_inst["boxes"])):
+            self._vaos["boxes" + suffix] = ctx.vertex_array(
+                p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
+        quad, unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
+            [-1, -1, 1, -1, -1, 1, 1, 1], [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
+        self._vaos["ground"] = ctx.vertex_array(p["ground"], [(quad, "2f", "in_corner")])
+        self._vaos["text"] = ctx.vertex_array(p["text"], [(unit, "2f", "in_corner")])
+        self._vaos["lines"] = ctx.vertex_array(
+            p["line"], [(seg, "2f", "in_corner"), (self._inst["lines"].buf, *_LINE_FMT)], skip_errors=True)
+        self._vaos["points"] = ctx.vertex_array(p["point"], [(self._inst["points"].buf, *_POINT_FMT)], skip_errors=True)
+        self._vaos["sky"] = ctx.vertex_array(p["sky"], [])
+        self.shadows = Shadows(ctx, self._inst["capsules"], self._inst["spheres"], self._inst["boxes"],
+                               shadow_size, mask_size)
+        self._blank = ctx.texture((1, 1), 3, bytes([255, 255, 255]))
+        noise = snow_noise()
+        self._noise = ctx.texture(noise.shape[:2][::-1], 4, noise.tobytes())
+        self._noise.filter = (moderngl.LINEAR, moderngl.LINEAR)  # no mipmaps: trilinear costs double here
+        self._background: moderngl.Texture | None = None
+        self._background_src: np.ndarray | None = None
+        self.text = TextCache(ctx)
+        self.profile = False
+        """When true, each pass waits for the GPU and its time lands in :attr:`timings` (slow; benches only)."""
+        self.timings: dict[str, float] = {}
+        self._mark_t = 0.0
+
+    def _keep(self, bufs: tuple[moderngl.Buffer, ...]) -> tuple[moderngl.Buffer, ...]:
+        self._buffers += list(bufs)
+        return bufs
+
+    def _mark(self, name: str | None) -> None:
+        if not self.profile:
+            return
+        self.ctx.finish()
+        now = time.perf_counter()
+        if name is not None:
+            self.timings[name] = now - self._mark_t
+        self._mark_t = now
+
+    # -- frame ------------------------------------------------------------------------
+    def render(self, scene: RenderScene, camera: Camera, framebuffer: moderngl.Framebuffer) -> None:
+        """Draw ``scene`` seen by ``camera`` into ``framebuffer`` (cleared first)."""
+        ctx = self.ctx
+        w, h = framebuffer.size
+        vp = camera.view_projection(w / h)
+        self._mark(None)
+        counts = {k: inst.upload(getattr(scene, k).data) for k, inst in self._inst.items()}
+        outlined = {}
+        for k, inst in self._outline_inst.items():
+            d = getattr(scene, k).data
+            outlined[k] = inst.upload(d[d[:, -1] > 0.5])
+        light_vp = light_matrix(scene) if scene.sun.shadows else None
+        rect = ground_rect(scene) if light_vp is not None else None
+        if light_vp is not None and rect is not None:
+            self.shadows.render(scene, light_vp, rect)
+        self._mark("shadows")
+
+        framebuffer.use()
+        framebuffer.viewport = (0, 0, w, h)
+        framebuffer.clear(*scene.horizon_color, 1.0, depth=1.0)
+        self._set_frame_uniforms(scene, camera, vp, light_vp, rect, (w, h))
+        self.shadows.depth.use(location=1)
+        self._background_texture(scene).use(location=2)
+        self._noise.use(location=3)
+        self.shadows.mask.use(location=4)
+
+        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        ctx.front_face = "ccw"
+        ctx.cull_face = "front"
+        for kind in _SOLIDS:
+            if outlined[kind]:
+                self._vaos[kind + "_flat"].render(moderngl.TRIANGLES, instances=outlined[kind])
+        ctx.cull_face = "back"
+        for kind in _SOLIDS:
+            if counts[kind]:
+                self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
+        self._mark("objects")
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        if scene.ground.visible:
+            self._vaos["ground"].render(moderngl.TRIANGLE_STRIP)
+        self._mark("ground")
+        ctx.depth_func = "<="
+        self._vaos["sky"].render(moderngl.TRIANGLES, vertices=3)
+        ctx.depth_func = "<"
+        self._mark("sky")
+
+        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
+        framebuffer.depth_mask = False
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        if counts["lines"]:
+            self._vaos["lines"].render(moderngl.TRIANGLE_STRIP, vertices=4, instances=counts["lines"])
+        if counts["points"]:
+            self._vaos["points"].render(moderngl.POINTS, vertices=counts["points"])
+        self._mark("lines_points")
+        self._draw_text(scene, (w, h))
+        framebuffer.depth_mask = True
+        ctx.enable_only(moderngl.NOTHING)
+        self._mark("text")
+
+    def _set_frame_uniforms(self, scene: RenderScene, camera: Camera, vp: NDArray[np.float64],
+                            light_vp: NDArray[np.float64] | None, rect: tuple[float, float, float, float] | None,
+                            size: tuple[int, int]) -> None:
+        w, h = size
+        sun = scene.sun
+        L = np.asarray(sun.direction, dtype=np.float64)
+        L = tuple(float(x) for x in L / np.linalg.norm(L))
+        tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
+        eye = tuple(float(x) for x in camera.eye)
+        # World size of one shadow-map texel: the light frustum is 2/|row 0 of P@V| wide.
+        # Window depth per metre along the light: row 2 of P@V is 2/(far-near) long.
+        texel_world, depth_per_m = 0.01, 1.0
+        if light_vp is not None:
+            texel_world = 2.0 / float(np.linalg.norm(light_vp[0, :3])) / self.shadows.map_size
+            depth_per_m = float(np.linalg.norm(light_vp[2, :3])) / 2.0
+        bg = scene.background
+        bg_scale = (1.0, 1.0)
+        if bg is not None:
+            img_aspect, view_aspect = bg.shape[1] / bg.shape[0], w / h
+            bg_scale = (view_aspect / img_aspect, 1.0) if view_aspect < img_aspect else (1.0, img_aspect / view_aspect)
+        common = {
+            "u_view_proj": vp, "u_eye": eye, "u_cam": eye, "u_sun_dir": L,
+            "u_sun_color": tuple(c * sun.intensity for c in _linear(sun.color)),
+            "u_sky_lin": _linear(scene.sky_color), "u_horizon_lin": _linear(scene.horizon_color),
+            "u_ambient": float(sun.ambient), "u_light_vp": light_vp if light_vp is not None else np.eye(4),
+            "u_shadow_map": 1, "u_shadows_on": 0.0 if light_vp is None else 1.0,
+            "u_shadow_texel": 1.0 / self.shadows.map_size,
+            "u_softness": float(np.clip(sun.softness / texel_world, 0.5, 4.0)),
+            "u_normal_bias": max(3.0 * texel_world, 0.01), "u_depth_bias": 0.01 * depth_per_m,
+            "u_fog_density": 0.015, "u_px_scale": 2.0 * tan_half / h, "u_px_per_unit": h / (2.0 * tan_half),
+            "u_viewport": (float(w), float(h)), "u_background": 2,
+            "u_fade": 1.0 if bg is None else float(scene.background_fade), "u_bg_scale": bg_scale,
+            "u_inv_view_proj": np.linalg.inv(vp), "u_inflate_px": 0.0,
+        }
+        for prog in self._programs.values():
+            for name, value in common.items():
+                set_uniform(prog, name, value)
+        g = scene.ground
+        gp = self._programs["ground"]
+        for name, value in (("u_center", (eye[0], 0.0, eye[2])), ("u_extent", min(camera.far * 0.9, 150.0)),
+                            ("u_height", float(g.height)), ("u_ground_lin", _linear(g.color)),
+                            ("u_snow", float(g.snow)), ("u_grid_on", 1.0 if g.grid else 0.0),
+                            ("u_grid_spacing", float(g.grid_spacing)), ("u_grid_lin", _linear(g.grid_color)),
+                            ("u_grid_strength", float(g.grid_strength)), ("u_noise", 3), ("u_ground_mask", 4),
+                            ("u_rect", rect if rect is not None else (0.0, 0.0, 1.0, 1.0)),
+                            ("u_shadow_strength", 0.9)):
+            set_uniform(gp, name, value)
+        outline = tuple(float(c) for c in scene.outline_color)
+        for name in ("capsule_flat", "box_flat"):
+            set_uniform(self._programs[name], "u_color", outline)
+            set_uniform(self._programs[name], "u_inflate_px", float(scene.outline_width))
+
+    def _background_texture(self, scene: RenderScene) -> moderngl.Texture:
+        """The photo as a texture, uploaded again only when a different array is set."""
+        bg = scene.background
+        if bg is None:
+            return self._blank
+        if bg is not self._background_src or self._background is None:
+            if self._background is not None:
+                self._background.release()
+            self._background = self.ctx.texture((bg.shape[1], bg.shape[0]), 3, np.ascontiguousarray(bg).tobytes())
+            self._background.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            self._background_src = bg
+        return self._background
+
+    def _draw_text(self, scene: RenderScene, size: tuple[int, int]) -> None:
+        if not scene.texts:
+            return
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        prog = self._programs["text"]
+        set_uniform(prog, "u_tex", 0)
+        cursor_y = 8.0
+        for line in scene.texts:
+            tex = self.text.texture(line.text, line.size, line.color)
+            x = 10.0 if line.x is None else float(line.x)
+            y = cursor_y if line.y is None else float(line.y)
+            if line.y is None:
+                cursor_y += tex.size[1] + 2
+            tex.use(location=0)
+            set_uniform(prog, "u_rect", (x, y, float(tex.size[0]), float(tex.size[1])))
+            self._vaos["text"].render(moderngl.TRIANGLE_STRIP)
+
+    def release(self) -> None:
+        """Free every GPU object this renderer made."""
+        self.text.release()
+        self.shadows.release()
+        for v in self._vaos.values():
+            v.release()
+        for i in (*self._inst.values(), *self._outline_inst.values()):
+            i.buf.release()
+        for obj in (*self._buffers, *self._programs.values(), self._blank, self._noise):
+            obj.release()
+        if self._background is not None:
+            self._background.release()

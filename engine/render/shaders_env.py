@@ -1,0 +1,200 @@
+"""GLSL 3.30 core sources for the environment: snowy ground, sky, background photo, shadow mask.
+
+The fragment stages here are compiled after :data:`engine.render.shaders.LIGHTING`
+(and :data:`BACKGROUND` where a photo may show), whose helpers they use.
+"""
+
+from __future__ import annotations
+
+__all__ = ["GROUND_VS", "BACKGROUND", "GROUND_FS", "MASK_CAPSULE_VS", "MASK_BOX_VS", "MASK_FS", "BLUR_VS",
+           "BLUR_FS", "SKY_VS", "SKY_FS"]
+
+GROUND_VS = """
+uniform mat4 u_view_proj;
+uniform vec3 u_center;
+uniform float u_extent;
+uniform float u_height;
+in vec2 in_corner;
+out vec3 v_pos;
+void main() {
+    v_pos = vec3(u_center.x + in_corner.x * u_extent, u_height, u_center.z + in_corner.y * u_extent);
+    gl_Position = u_view_proj * vec4(v_pos, 1.0);
+}
+"""
+
+# Background photo helpers: sample the photo "cover"-fitted to the viewport.
+BACKGROUND = """
+uniform sampler2D u_background;
+uniform float u_fade;            // 1 = world only, 0 = photo only
+uniform vec2 u_viewport;
+uniform vec2 u_bg_scale;         // uv scale that crops the photo to the viewport aspect
+vec3 photo_linear() {
+    vec2 uv = gl_FragCoord.xy / u_viewport;
+    uv = (uv - 0.5) * u_bg_scale + 0.5;
+    return to_linear(texture(u_background, vec2(uv.x, 1.0 - uv.y)).rgb);
+}
+"""
+
+GROUND_FS = """
+uniform vec3 u_ground_lin;
+uniform vec3 u_grid_lin;
+uniform float u_snow;
+uniform float u_grid_on;
+uniform float u_grid_spacing;
+uniform float u_grid_strength;
+uniform sampler2D u_noise;       // tileable: r height, gb slope, a random per texel
+uniform sampler2D u_ground_mask; // blurred planar shadow of the casters
+uniform vec4 u_rect;             // where the mask lies on the ground: x0, z0, width, depth
+uniform float u_shadow_strength;
+in vec3 v_pos;
+out vec4 f_color;
+
+void main() {
+    vec2 xz = v_pos.xz;
+    vec3 to_eye = u_eye - v_pos;
+    float dist = length(to_eye);
+    // Drifts: one fetch of the precomputed tileable 1/f noise (height and its slope).
+    // The ground is nearly flat, so the sun term is linearised around the up normal:
+    // n.L ~ L.y - slope.L.xz. That saves a normalize and the general lighting per pixel,
+    // which matters because the ground is most of the screen.
+    // Far away the fog hides the drifts, and skipping the fetch there saves whole pixel blocks.
+    vec4 drift = dist < 45.0 ? texture(u_noise, xz * 0.08) : vec4(0.5);
+    vec2 slope = (drift.gb - 0.5) * (0.6 * u_snow) * clamp(1.5 - dist / 30.0, 0.0, 1.0);  // no shimmer far off
+    vec3 albedo = u_ground_lin * (1.0 - 0.08 * u_snow * (1.0 - drift.r));
+    vec2 muv = (xz - u_rect.xy) / u_rect.zw;
+    float sh = 1.0;
+    if (u_shadows_on > 0.5 && all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) {
+        sh = 1.0 - texture(u_ground_mask, muv).r * u_shadow_strength;
+    }
+    vec3 L = u_sun_dir;
+    float ndl = max(L.y - dot(slope, L.xz), 0.0);
+    vec3 c = albedo * (u_sky_lin * u_ambient + u_sun_color * (ndl * sh));
+    // Sparkle: a few random cells act as ice crystals that glint towards the viewer.
+    if (dist < 14.0) {
+        ivec2 cell = ivec2(floor(xz * 45.0));
+        vec4 rnd = texelFetch(u_noise, cell & 255, 0);
+        if (rnd.a > 0.97) {
+            vec3 cn = normalize(vec3(rnd.g - 0.5, 0.6, rnd.b - 0.5));
+            vec3 refl = reflect(-normalize(u_sun_dir), cn);
+            float g = max(dot(refl, to_eye / dist), 0.0);
+            g = g * g; g = g * g; g = g * g; g = g * g; g = g * g;   // ^32
+            c += u_sun_color * g * 1.5 * sh * (1.0 - dist / 14.0) * u_snow;
+        }
+    }
+    if (u_grid_on > 0.5 && dist < 60.0) {
+        vec2 gp = xz / u_grid_spacing;
+        vec2 w = fwidth(gp);
+        vec2 gl = abs(fract(gp - 0.5) - 0.5) / max(w, 1e-4);
+        float line = 1.0 - min(min(gl.x, gl.y), 1.0);
+        float fade = clamp(1.0 - max(w.x, w.y) * 3.0, 0.0, 1.0);
+        c = mix(c, u_grid_lin * (0.6 + 0.4 * sh), line * u_grid_strength * fade);
+    }
+    c = mix(c, u_horizon_lin * SKY_GAIN, fog_amount(dist));
+    if (u_fade < 1.0) {
+        // On a photo, keep the ground's shadows so puppets still sit on something.
+        vec3 photo = photo_linear() * mix(0.55, 1.0, sh);
+        c = mix(photo, c, u_fade);
+    }
+    f_color = vec4(finish(c), 1.0);
+}
+"""
+
+# Ground shadow mask: casters squashed onto the ground plane along the sun direction
+# (planar projected shadows), drawn top-down into a small texture and blurred. The
+# ground then reads its soft shadow with one bilinear fetch, far cheaper on llvmpipe
+# than a PCF kernel per ground pixel, and the penumbra is smooth rather than texel-stepped.
+MASK_CAPSULE_VS = """
+uniform vec3 u_sun_dir;
+uniform float u_height;
+uniform vec4 u_rect;            // x0, z0, width, depth of the mask on the ground
+in vec4 in_vert;
+in vec3 i_a;
+in vec3 i_b;
+in float i_r;
+void main() {
+    vec3 axis = i_b - i_a;
+    float len = length(axis);
+    vec3 y = len > 1e-6 ? axis / len : vec3(0.0, 1.0, 0.0);
+    vec3 helper = abs(y.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 x = normalize(cross(helper, y));
+    vec3 z = cross(x, y);
+    vec3 p = mix(i_a, i_b, in_vert.w) + (x * in_vert.x + y * in_vert.y + z * in_vert.z) * i_r;
+    vec3 L = normalize(u_sun_dir);
+    vec2 g = p.xz - L.xz * max(p.y - u_height, 0.0) / max(L.y, 0.05);
+    gl_Position = vec4((g - u_rect.xy) / u_rect.zw * 2.0 - 1.0, 0.0, 1.0);
+}
+"""
+
+MASK_BOX_VS = """
+uniform vec3 u_sun_dir;
+uniform float u_height;
+uniform vec4 u_rect;
+in vec3 in_pos;
+in vec3 i_center;
+in vec3 i_half;
+in vec4 i_rot;
+vec3 qrot(vec4 q, vec3 v) {
+    vec3 t = 2.0 * cross(q.yzw, v);
+    return v + q.x * t + cross(q.yzw, t);
+}
+void main() {
+    vec3 p = i_center + qrot(i_rot, in_pos * i_half);
+    vec3 L = normalize(u_sun_dir);
+    vec2 g = p.xz - L.xz * max(p.y - u_height, 0.0) / max(L.y, 0.05);
+    gl_Position = vec4((g - u_rect.xy) / u_rect.zw * 2.0 - 1.0, 0.0, 1.0);
+}
+"""
+
+MASK_FS = """
+out float f_mask;
+void main() { f_mask = 1.0; }
+"""
+
+# Separable Gaussian (9 texels in 5 bilinear fetches) for the ground mask.
+BLUR_VS = """
+out vec2 v_uv;
+void main() {
+    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2) * 2.0 - 1.0;
+    v_uv = p * 0.5 + 0.5;
+    gl_Position = vec4(p, 0.0, 1.0);
+}
+"""
+
+BLUR_FS = """
+uniform sampler2D u_src;
+uniform vec2 u_step;            // texel step (times the spread) along one axis
+in vec2 v_uv;
+out float f_mask;
+void main() {
+    float s = texture(u_src, v_uv).r * 0.2270270270;
+    vec2 o1 = u_step * 1.3846153846, o2 = u_step * 3.2307692308;
+    s += (texture(u_src, v_uv + o1).r + texture(u_src, v_uv - o1).r) * 0.3162162162;
+    s += (texture(u_src, v_uv + o2).r + texture(u_src, v_uv - o2).r) * 0.0702702703;
+    f_mask = s;
+}
+"""
+
+SKY_VS = """
+uniform mat4 u_inv_view_proj;
+noperspective out vec4 v_far;   // homogeneous far-plane point: linear in screen space, exact
+void main() {
+    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2) * 2.0 - 1.0;
+    v_far = u_inv_view_proj * vec4(p, 1.0, 1.0);
+    gl_Position = vec4(p, 0.99999, 1.0);
+}
+"""
+
+SKY_FS = """
+noperspective in vec4 v_far;
+out vec4 f_color;
+void main() {
+    vec3 dir = normalize(v_far.xyz / v_far.w - u_eye);
+    float t = clamp(dir.y, 0.0, 1.0);
+    vec3 c = mix(u_horizon_lin, u_sky_lin, sqrt(t)) * SKY_GAIN;
+    float s = max(dot(dir, u_sun_dir), 0.0);
+    c += u_sun_color * (exp2(900.0 * 1.4427 * (s - 1.0)) * 4.0 + exp2(12.0 * 1.4427 * (s - 1.0)) * 0.08);
+    if (dir.y < 0.0) c = u_horizon_lin * SKY_GAIN;
+    if (u_fade < 1.0) c = mix(photo_linear(), c, u_fade);
+    f_color = vec4(finish(c), 1.0);
+}
+"""

@@ -1,0 +1,188 @@
+"""Sun shadows: a depth map for shadows on objects, a blurred planar mask for the ground.
+
+Two techniques, because their costs differ on a software rasteriser. Objects cover few
+pixels, so they take a classic shadow map with a 4-tap PCF kernel. The ground covers most
+of the screen and a PCF kernel there cost more than all its other shading together, so
+the casters are instead squashed onto the ground plane along the sun direction (planar
+projected shadows), drawn top-down into a small mask, blurred with a separable Gaussian
+and read back with one bilinear fetch: soft, smooth penumbrae at a fixed low cost.
+
+Both fit themselves to the casters each frame (:func:`light_matrix`, :func:`ground_rect`)
+so their resolution goes where the puppets are.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.camera import look_at
+from engine.render import meshes
+from engine.render import shaders as S
+from engine.render import shaders_env as E
+from engine.render.gpu import Instances, mesh_buffers, set_uniform
+from engine.render.scene import RenderScene
+
+__all__ = ["Shadows", "light_matrix", "ground_rect"]
+
+CAPSULE_FMT = ("3f 3f 1f 3f 1f/i", "i_a", "i_b", "i_r", "i_color", "i_outline")
+BOX_FMT = ("3f 3f 4f 3f 1f/i", "i_center", "i_half", "i_rot", "i_color", "i_outline")
+
+
+def _ortho(half: float, near: float, far: float) -> NDArray[np.float64]:
+    m = np.eye(4)
+    m[0, 0] = m[1, 1] = 1.0 / half
+    m[2, 2] = -2.0 / (far - near)
+    m[2, 3] = -(far + near) / (far - near)
+    return m
+
+
+def _sun(scene: RenderScene) -> NDArray[np.float64]:
+    L = np.asarray(scene.sun.direction, dtype=np.float64)
+    n = float(np.linalg.norm(L))
+    if not n > 0:
+        raise ValueError("sun direction must be non-zero")
+    return L / n
+
+
+def _corners(lo: NDArray[np.float64], hi: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+def _on_ground(points: NDArray[np.float64], L: NDArray[np.float64], height: float) -> NDArray[np.float64]:
+    """Where each point's shadow lands on the plane ``y = height`` (points below stay put)."""
+    drop = np.maximum(points[:, 1] - height, 0.0) / max(L[1], 0.05)
+    return points - drop[:, None] * L
+
+
+def light_matrix(scene: RenderScene) -> NDArray[np.float64] | None:
+    """The sun's orthographic view-projection around every caster, ``None`` without casters.
+
+    The sides hug the casters' bounding sphere; the depth range runs from the nearest
+    caster to where their shadows land on the ground, tight for depth precision.
+    """
+    b = scene.bounds()
+    if b is None:
+        return None
+    lo, hi = b
+    center = (lo + hi) / 2.0
+    radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 0.25) * 1.05
+    L = _sun(scene)
+    up = np.array([0.0, 1.0, 0.0]) if abs(L[1]) < 0.99 else np.array([0.0, 0.0, 1.0])
+    view = look_at(center + L * radius, center, up)
+    corners = _corners(lo, hi)
+    pts = np.vstack([corners, _on_ground(corners, L, scene.ground.height)])
+    depth = -(pts @ view[:3, :3].T + view[:3, 3])[:, 2]
+    near, far = float(depth.min()) - 0.1, float(depth.max()) + 0.1  # orthographic: near may be negative
+    return _ortho(radius, near, far) @ view
+
+
+def ground_rect(scene: RenderScene, margin: float = 0.5) -> tuple[float, float, float, float] | None:
+    """``(x0, z0, width, depth)`` on the ground covering every caster's planar shadow."""
+    b = scene.bounds()
+    if b is None:
+        return None
+    g = _on_ground(_corners(*b), _sun(scene), scene.ground.height)
+    x0, z0 = g[:, 0].min() - margin, g[:, 2].min() - margin
+    x1, z1 = g[:, 0].max() + margin, g[:, 2].max() + margin
+    return float(x0), float(z0), float(x1 - x0), float(z1 - z0)
+
+
+class Shadows:
+    """GPU side of both shadow techniques for one context.
+
+    Args:
+        ctx: the context.
+        capsules, spheres, boxes: the renderer's instance buffers (shared, not copied).
+        map_size: side of the object shadow map; mask_size: side of the ground mask.
+    """
+
+    def __init__(self, ctx: moderngl.Context, capsules: Instances, spheres: Instances, boxes: Instances,
+                 map_size: int = 1024, mask_size: int = 512) -> None:
+        if map_size < 16 or mask_size < 16:
+            raise ValueError(f"shadow sizes must be at least 16, got {map_size} and {mask_size}")
+        self.ctx = ctx
+        self.map_size, self.mask_size = map_size, mask_size
+        h = S.HEADER
+        progs = self._programs = {
+            "capsule_depth": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=h + S.DEPTH_FS),
+            "box_depth": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.DEPTH_FS),
+            "capsule_mask": ctx.program(vertex_shader=h + E.MASK_CAPSULE_VS, fragment_shader=h + E.MASK_FS),
+            "box_mask": ctx.program(vertex_shader=h + E.MASK_BOX_VS, fragment_shader=h + E.MASK_FS),
+            "blur": ctx.program(vertex_shader=h + E.BLUR_VS, fragment_shader=h + E.BLUR_FS),
+        }
+        # Coarse meshes: llvmpipe runs vertex work on one thread, and a shadow cannot show the facets.
+        self._buffers: list[moderngl.Buffer] = []
+        self._vaos: list[tuple[str, moderngl.VertexArray, moderngl.VertexArray, Instances]] = []
+        for kind, mesh, inst in (("capsule", meshes.capsule_mesh(8, 2), capsules),
+                                 ("sphere", meshes.sphere_mesh(12, 4), spheres)):
+            vbo, ibo = mesh_buffers(ctx, mesh)
+            self._buffers += [vbo, ibo]
+            content = [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)]
+            self._vaos.append((kind,
+                               ctx.vertex_array(progs["capsule_depth"], content, ibo, 4, skip_errors=True),
+                               ctx.vertex_array(progs["capsule_mask"], content, ibo, 4, skip_errors=True), inst))
+        vbo, ibo = mesh_buffers(ctx, meshes.box_mesh())
+        self._buffers += [vbo, ibo]
+        content = [(vbo, "3f 3f", "in_pos", "in_normal"), (boxes.buf, *BOX_FMT)]
+        self._vaos.append(("box", ctx.vertex_array(progs["box_depth"], content, ibo, 4, skip_errors=True),
+                           ctx.vertex_array(progs["box_mask"], content, ibo, 4, skip_errors=True), boxes))
+        self._blur_vao = ctx.vertex_array(progs["blur"], [])
+        self.depth = ctx.depth_texture((map_size, map_size))
+        self.depth.compare_func = "<="
+        self.depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self.depth.repeat_x = self.depth.repeat_y = False
+        self._depth_fbo = ctx.framebuffer(depth_attachment=self.depth)
+        self.mask = ctx.texture((mask_size, mask_size), 1)
+        self._mask_tmp = ctx.texture((mask_size, mask_size), 1)
+        for tex in (self.mask, self._mask_tmp):
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+        self._mask_fbo = ctx.framebuffer([self.mask])
+        self._tmp_fbo = ctx.framebuffer([self._mask_tmp])
+
+    def render(self, scene: RenderScene, light_vp: NDArray[np.float64],
+               rect: tuple[float, float, float, float]) -> None:
+        """Draw the object shadow map and the blurred ground mask for this frame."""
+        ctx = self.ctx
+        self._depth_fbo.use()
+        self._depth_fbo.clear(depth=1.0)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        for kind, depth_vao, _, inst in self._vaos:
+            if inst.count:
+                prog = self._programs["box_depth" if kind == "box" else "capsule_depth"]
+                set_uniform(prog, "u_view_proj", light_vp)
+                set_uniform(prog, "u_inflate_px", 0.0)
+                depth_vao.render(moderngl.TRIANGLES, instances=inst.count)
+        self._mask_fbo.use()
+        self._mask_fbo.clear(0.0, 0.0, 0.0, 0.0)
+        ctx.enable_only(moderngl.NOTHING)
+        sun = tuple(float(x) for x in _sun(scene))
+        for kind, _, mask_vao, inst in self._vaos:
+            if inst.count:
+                prog = self._programs["box_mask" if kind == "box" else "capsule_mask"]
+                set_uniform(prog, "u_sun_dir", sun)
+                set_uniform(prog, "u_height", float(scene.ground.height))
+                set_uniform(prog, "u_rect", rect)
+                mask_vao.render(moderngl.TRIANGLES, instances=inst.count)
+        # The 9-texel kernel reaches 3.23 steps out: scale the step so it spans ``softness`` metres.
+        blur = self._programs["blur"]
+        set_uniform(blur, "u_src", 0)
+        spread = max(scene.sun.softness / 3.23, 1e-4)
+        for src, dst, step in ((self.mask, self._tmp_fbo, (spread / rect[2], 0.0)),
+                               (self._mask_tmp, self._mask_fbo, (0.0, spread / rect[3]))):
+            dst.use()
+            src.use(location=0)
+            set_uniform(blur, "u_step", (max(step[0], 0.0), max(step[1], 0.0)))
+            self._blur_vao.render(moderngl.TRIANGLES, vertices=3)
+
+    def release(self) -> None:
+        """Free the GPU objects."""
+        for _, a, b, _ in self._vaos:
+            a.release()
+            b.release()
+        self._blur_vao.release()
+        for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo,
+                    self._tmp_fbo, self.mask, self._mask_tmp):
+            obj.release()

@@ -1,0 +1,86 @@
+"""A pygame (SDL2) window with an OpenGL 3.3 core context, resizable, vsync if offered.
+
+SDL is asked for a 3.3 core profile before the window opens; moderngl then wraps the
+current context. ``poll_events`` hands the pygame events to the caller (the mouse input backend reads them) after handling the
+two the window itself must know: resize and quit. Frames are drawn off-screen
+(:class:`~engine.render.offscreen.OffscreenBuffers`) and blitted to the window in ``end()``,
+so screenshots read a defined buffer and anti-aliasing does not depend on the driver.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import moderngl
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.render.offscreen import OffscreenBuffers
+
+__all__ = ["WindowTarget"]
+
+
+class WindowTarget:
+    """An on-screen target; ``closed`` turns true when the user closes the window."""
+
+    def __init__(self, width: int, height: int, *, title: str = "PuppetPhone", samples: int | None = None,
+                 vsync: bool = True) -> None:
+        import pygame
+
+        pygame.display.init()
+        gl = pygame
+        pygame.display.gl_set_attribute(gl.GL_CONTEXT_MAJOR_VERSION, 3)
+        pygame.display.gl_set_attribute(gl.GL_CONTEXT_MINOR_VERSION, 3)
+        pygame.display.gl_set_attribute(gl.GL_CONTEXT_PROFILE_MASK, gl.GL_CONTEXT_PROFILE_CORE)
+        pygame.display.gl_set_attribute(gl.GL_DEPTH_SIZE, 24)
+        flags = pygame.OPENGL | pygame.DOUBLEBUF | pygame.RESIZABLE
+        try:
+            pygame.display.set_mode((width, height), flags, vsync=1 if vsync else 0)
+        except pygame.error:
+            # No vsync on this driver: a window without it beats no window.
+            pygame.display.set_mode((width, height), flags)
+        pygame.display.set_caption(title)
+        self._pg = pygame
+        self.ctx = moderngl.create_context(require=330)
+        self.buffers = OffscreenBuffers(self.ctx, width, height, samples)
+        self.closed = False
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.buffers.size
+
+    @property
+    def framebuffer(self) -> moderngl.Framebuffer:
+        return self.buffers.framebuffer
+
+    def begin(self) -> moderngl.Framebuffer:
+        return self.buffers.begin()
+
+    def end(self) -> None:
+        self.buffers.resolve()
+        screen = self.ctx.detect_framebuffer()
+        self.ctx.copy_framebuffer(screen, self.buffers.resolved)
+        self._pg.display.flip()
+
+    def read_pixels(self) -> NDArray[np.uint8]:
+        return self.buffers.read_pixels()
+
+    def screenshot(self, path: str | Path) -> Path:
+        return self.buffers.screenshot(path)
+
+    def poll_events(self) -> list[Any]:
+        events = self._pg.event.get()
+        for ev in events:
+            if ev.type == self._pg.QUIT:
+                self.closed = True
+            elif ev.type in (self._pg.VIDEORESIZE, self._pg.WINDOWSIZECHANGED):
+                w, h = self._pg.display.get_window_size()
+                self.buffers.resize(max(int(w), 1), max(int(h), 1))
+        return events
+
+    def close(self) -> None:
+        self.buffers.release()
+        self.ctx.release()
+        self._pg.display.quit()
+        self.closed = True
