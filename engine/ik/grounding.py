@@ -7,6 +7,9 @@ above the real ground, with the foot turned to the ground's slope (fully when
 planted, fading out as the foot lifts). The pelvis moves by the lowest foot's
 height change, so a foot stepping into a dip is reached by lowering the body
 rather than over-stretching a leg, and the other knee bends instead.
+
+One puppet's legs are a few dozen 3-vector operations, so they run on floats
+(:mod:`engine.ik._scalar`, :mod:`engine.ik._limb`); only the ground query sees numpy.
 """
 
 from __future__ import annotations
@@ -17,9 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from engine import quat
-from engine.ik._vec import path_fk, rotate
-from engine.ik.two_bone import two_bone_ik
+from engine.ik._limb import solve_limb
+from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
 from engine.pose import Pose
 from engine.skeleton import Skeleton
 
@@ -27,6 +29,7 @@ __all__ = ["GroundQuery", "PlaneGround", "HeightfieldGround", "Leg", "HUMANOID_L
 
 F = NDArray[np.float64]
 GroundQuery = Callable[[F, F], tuple[F, F]]
+_UP = (0.0, 1.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -116,29 +119,36 @@ def ground_feet(
     if not 0.0 <= weight <= 1.0:
         raise ValueError("weight must lie in 0..1")
     idx = [(skeleton.index(leg.upper), skeleton.index(leg.lower), skeleton.index(leg.foot)) for leg in legs]
-    sole_local = np.array([leg.sole for leg in legs], dtype=np.float64)
-    feet_pos, feet_rot = [], []
-    for _, _, f in idx:
-        wp, wr = path_fk(skeleton, pose.root, pose.rotations, f, offsets)
-        feet_pos.append(wp[f]), feet_rot.append(wr[f])
-    ankle, qfoot = np.array(feet_pos), np.array(feet_rot)
-    sole = ankle + rotate(qfoot, sole_local)
-    clip_height = sole[:, 1]  # authored on flat ground at y = 0
-    height, normal = ground(sole[:, 0], sole[:, 2])
+    par = skeleton.parents
+    off = (skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)).tolist()
+    rot = pose.rotations.tolist()
+    root = tuple(pose.root.tolist())
+    ankle, qfoot, sole = [], [], []
+    for (_, _, f), leg in zip(idx, legs, strict=True):
+        wp, wr = chain_fk(par, root, rot, off, f)
+        ankle.append(wp[f]), qfoot.append(wr[f])
+        sole.append(add(wp[f], qrot(wr[f], leg.sole)))
+    clip_height = [s[1] for s in sole]  # authored on flat ground at y = 0
+    height, normal = ground(np.array([s[0] for s in sole]), np.array([s[2] for s in sole]))
     height, normal = np.asarray(height, dtype=np.float64), np.asarray(normal, dtype=np.float64)
     if not (np.all(np.isfinite(height)) and np.all(np.isfinite(normal))):
         raise ValueError("ground query returned non-finite values")
-    # Turn each foot to the slope, fading out as it lifts.
-    planted = np.clip((align_height - clip_height) / (align_height - contact_height), 0.0, 1.0) * weight
-    tilt = quat.slerp(quat.identity(len(legs)), quat.between(np.array([0.0, 1.0, 0.0]), normal), planted)
-    new_rot = quat.mul(tilt, qfoot)
-    new_sole = np.stack([sole[:, 0], height * weight + clip_height, sole[:, 2]], axis=-1)
-    targets = new_sole - rotate(new_rot, sole_local)
+    height, normal = np.broadcast_to(height, (len(legs),)).tolist(), np.broadcast_to(normal, (len(legs), 3)).tolist()
+    # Turn each foot to the slope, fading out as it lifts; its sole keeps the clip's clearance.
+    targets, new_rot = [], []
+    for leg, q, s, ch, h, n in zip(legs, qfoot, sole, clip_height, height, normal, strict=True):
+        planted = min(max((align_height - ch) / (align_height - contact_height), 0.0), 1.0) * weight
+        r = qmul(slerp(Q_ID, between(_UP, n), planted), q)
+        new_rot.append(r)
+        targets.append(sub((s[0], h * weight + ch, s[2]), qrot(r, leg.sole)))
     # Pelvis: follow the lowest foot (negative into dips, positive onto steps).
-    shift = float(np.clip(np.min(targets[:, 1] - ankle[:, 1]), -max_pelvis_shift, max_pelvis_shift))
+    shift = min(max(min(t[1] - a[1] for t, a in zip(targets, ankle)), -max_pelvis_shift), max_pelvis_shift)
     pose.root[1] += shift
+    root = tuple(pose.root.tolist())
     for leg, (u, lo, f), tgt, frot in zip(legs, idx, targets, new_rot, strict=True):
-        wp, wr = path_fk(skeleton, pose.root, pose.rotations, lo, offsets)
-        pole = wp[lo] + rotate(wr[int(skeleton.parents[u])], np.asarray(leg.knee_forward, dtype=np.float64))
-        two_bone_ik(skeleton, pose, (u, lo, f), tgt, pole, end_rotation=frot, offsets=offsets)
+        wp, wr = chain_fk(par, root, rot, off, lo)
+        pole = add(wp[lo], qrot(wr[int(par[u])], leg.knee_forward))
+        solve_limb(par, root, rot, off, (u, lo, f), tgt, pole, qnormalize(frot))
+        for j in (u, lo, f):
+            pose.rotations[j] = rot[j]
     return np.float64(shift)

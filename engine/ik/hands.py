@@ -6,25 +6,48 @@ palms turn to the surface normal, fingers running on along the arm's direction.
 When the sphere is out of reach the spine leans towards it (up to ``max_lean``)
 before the arms are solved, so a small snowball near the feet is reached by
 bending, not by stretching the arms out of their sockets.
+
+One puppet's arms, re-measured after each lean, are a few hundred 3-vector
+operations: they run on floats (:mod:`engine.ik._scalar`, :mod:`engine.ik._limb`),
+since numpy's per-call cost made this stage 10 ms per puppet.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from engine import quat
-from engine.ik._vec import cross, path_fk, rotate
-from engine.ik.two_bone import two_bone_ik
+from engine.ik._limb import solve_limb
+from engine.ik._scalar import (
+    Q,
+    Q_ID,
+    V,
+    add,
+    chain_fk,
+    cross,
+    dot,
+    from_axis_angle,
+    from_frames,
+    norm,
+    qconj,
+    qmul,
+    qnormalize,
+    qrot,
+    scale,
+    sub,
+    unit,
+)
 from engine.pose import Pose
 from engine.skeleton import Skeleton
 
 __all__ = ["Arm", "HUMANOID_ARMS", "sphere_contacts", "hands_on_sphere"]
 
 F = NDArray[np.float64]
-_UP = np.array([0.0, 1.0, 0.0])
+_UP: V = (0.0, 1.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -51,15 +74,29 @@ HUMANOID_ARMS: tuple[Arm, ...] = (
 )
 
 
-def _unit(v: F) -> F:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+def _contacts(
+    centre: V, radius: float, facing_from: V, left: V, spread: float, elevation: float
+) -> tuple[list[V], list[V]]:
+    """:func:`sphere_contacts` on floats: contact points and normals, left then right."""
+    toward = (facing_from[0] - centre[0], 0.0, facing_from[2] - centre[2])
+    lft = unit((left[0], 0.0, left[2]), 1e-12)
+    if norm(toward) < 1e-6:
+        toward = cross(lft, _UP)  # standing on top: use the character's back direction
+    toward = unit(toward, 1e-12)
+    cs, sn = math.cos(spread), math.sin(spread)
+    ce, se = math.cos(elevation), math.sin(elevation)
+    points, normals = [], []
+    for side in (1.0, -1.0):
+        k = sn * side
+        horiz = unit(add(scale(cs, toward), scale(k, lft)), 1e-12)
+        n = add(scale(ce, horiz), scale(se, _UP))
+        normals.append(n)
+        points.append(add(centre, scale(radius, n)))
+    return points, normals
 
 
-def _frame(a: F, b: F) -> F:
-    """Rotation matrices whose columns are ``a``, ``b`` (orthogonalised) and ``a × b``."""
-    a = _unit(a)
-    b = _unit(b - np.sum(a * b, axis=-1, keepdims=True) * a)
-    return np.stack([a, b, cross(a, b)], axis=-1)
+def _vec3(v: ArrayLike) -> V:
+    return tuple(np.asarray(v, dtype=np.float64).reshape(3).tolist())
 
 
 def sphere_contacts(
@@ -75,19 +112,8 @@ def sphere_contacts(
 
     ``facing_from`` is a point of the character (its chest); ``left`` its left direction.
     """
-    c = np.asarray(centre, dtype=np.float64)
-    toward = np.asarray(facing_from, dtype=np.float64) - c
-    toward[1] = 0.0
-    lft = np.asarray(left, dtype=np.float64).copy()
-    lft[1] = 0.0
-    lft = _unit(lft)
-    if np.linalg.norm(toward) < 1e-6:
-        toward = cross(lft, _UP)  # standing on top: use the character's back direction
-    toward = _unit(toward)
-    sides = np.array([1.0, -1.0])[:, None]
-    horiz = _unit(np.cos(spread) * toward[None] + np.sin(spread) * sides * lft[None])
-    normals = np.cos(elevation) * horiz + np.sin(elevation) * _UP[None]
-    return c[None] + radius * normals, normals
+    points, normals = _contacts(_vec3(centre), float(radius), _vec3(facing_from), _vec3(left), spread, elevation)
+    return np.array(points), np.array(normals)
 
 
 def hands_on_sphere(
@@ -108,31 +134,30 @@ def hands_on_sphere(
         raise ValueError("sphere needs a finite centre and a positive radius")
     if len(arms) != 2:
         raise ValueError("hands_on_sphere places exactly two arms (left, right)")
-    centre = np.asarray(centre, dtype=np.float64)
+    cen = _vec3(centre)
     ids = [(skeleton.index(a.upper), skeleton.index(a.lower), skeleton.index(a.hand)) for a in arms]
-    off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
-    upper_len = np.array([np.linalg.norm(off[lo]) + np.linalg.norm(off[h]) for _, lo, h in ids])
+    par = skeleton.parents
+    off = (skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)).tolist()
+    upper_len = [norm(off[lo]) + norm(off[h]) for _, lo, h in ids]
+    root = tuple(pose.root.tolist())
+    rot = pose.rotations.tolist()
 
-    def targets() -> tuple[F, F, F, F]:
-        wp, wr = path_fk(skeleton, pose.root, pose.rotations, ids[0][0], offsets)
-        chest = wp[int(skeleton.parents[ids[0][0]])]
-        body_rot = pose.rotations[0]
-        left = rotate(body_rot, np.array([1.0, 0.0, 0.0]))
-        contacts, normals = sphere_contacts(centre, radius, chest, left, spread=spread, elevation=elevation)
-        fwd = rotate(body_rot, np.array([0.0, 0.0, 1.0]))
-        shoulders = np.array([path_fk(skeleton, pose.root, pose.rotations, u, offsets)[0][u] for u, _, _ in ids])
-        rots = []
+    def targets() -> tuple[list[V], list[Q], list[V], V]:
+        """Wrist targets, hand rotations, shoulders and the body's forward, from the current pose."""
+        shoulders = [chain_fk(par, root, rot, off, u)[0] for u, _, _ in ids]
+        chest = shoulders[0][int(par[ids[0][0]])]
+        shoulders = [wp[u] for wp, (u, _, _) in zip(shoulders, ids, strict=True)]
+        left, fwd = qrot(rot[0], (1.0, 0.0, 0.0)), qrot(rot[0], (0.0, 0.0, 1.0))
+        contacts, normals = _contacts(cen, radius, chest, left, spread, elevation)
+        wrists, hand_rot = [], []
         for arm, n, sh, ct in zip(arms, normals, shoulders, contacts, strict=True):
-            along = ct - sh
-            fingers = along - np.dot(along, n) * n
-            if np.linalg.norm(fingers) < 1e-6:
-                fingers = fwd - np.dot(fwd, n) * n
-            world = _frame(-n, fingers)
-            local = _frame(np.asarray(arm.palm_normal, dtype=np.float64), np.asarray(arm.fingers, dtype=np.float64))
-            rots.append(quat.from_matrix(world @ local.T))
-        hand_rot = np.array(rots)
-        palms = np.array([a.palm for a in arms], dtype=np.float64)
-        wrists = contacts - rotate(hand_rot, palms)
+            along = sub(ct, sh)
+            fingers = sub(along, scale(dot(along, n), n))
+            if norm(fingers) < 1e-6:
+                fingers = sub(fwd, scale(dot(fwd, n), n))
+            hr = from_frames(((-n[0], -n[1], -n[2]), fingers), (arm.palm_normal, arm.fingers))
+            hand_rot.append(hr)
+            wrists.append(sub(ct, qrot(hr, arm.palm)))
         return wrists, hand_rot, shoulders, fwd
 
     wrists, hand_rot, shoulders, fwd = targets()
@@ -140,28 +165,30 @@ def hands_on_sphere(
         lj = skeleton.index(lean_joint)
         leaned = 0.0
         for _ in range(6):  # lean, then re-measure: the shoulders move on an arc
-            short = np.max(np.linalg.norm(wrists - shoulders, axis=-1) - 0.97 * upper_len)
+            short = max(norm(sub(w, s)) - 0.97 * ln for w, s, ln in zip(wrists, shoulders, upper_len, strict=True))
             if short <= 1e-4:
                 break
-            wp, wr = path_fk(skeleton, pose.root, pose.rotations, lj, offsets)
-            torso = float(np.linalg.norm(shoulders.mean(axis=0) - wp[lj]))
-            toward = centre - wp[lj]
-            toward[1] = 0.0
-            axis = cross(_UP, _unit(toward) if np.linalg.norm(toward) > 1e-6 else fwd)
+            wp, wr = chain_fk(par, root, rot, off, lj)
+            mid = ((shoulders[0][0] + shoulders[1][0]) / 2, (shoulders[0][1] + shoulders[1][1]) / 2,
+                   (shoulders[0][2] + shoulders[1][2]) / 2)  # fmt: skip
+            torso = norm(sub(mid, wp[lj]))
+            toward = (cen[0] - wp[lj][0], 0.0, cen[2] - wp[lj][2])
+            axis = cross(_UP, unit(toward, 1e-12) if norm(toward) > 1e-6 else fwd)
             angle = min(short / max(torso, 1e-3), max_lean - leaned)
             if angle <= 1e-6:
                 break
             leaned += angle
-            p = int(skeleton.parents[lj])
-            parent_rot = wr[p] if p >= 0 else quat.identity()
-            turn = quat.from_axis_angle(axis, angle)
-            world = quat.mul(turn, wr[lj])
-            pose.rotations[lj] = quat.mul(quat.conjugate(parent_rot), world)
+            p = int(par[lj])
+            parent_rot = wr[p] if p >= 0 else Q_ID
+            rot[lj] = qmul(qconj(parent_rot), qmul(from_axis_angle(axis, angle), wr[lj]))
+            pose.rotations[lj] = rot[lj]
             wrists, hand_rot, shoulders, fwd = targets()
     reached = []
     for arm, (u, lo, h), tgt, hr, sh in zip(arms, ids, wrists, hand_rot, shoulders, strict=True):
-        out = rotate(pose.rotations[0], np.array([arm.side, 0.0, 0.0]))
-        pole = sh + 0.5 * out - 0.8 * fwd - 0.3 * _UP  # elbows bend back and out
-        wrist = two_bone_ik(skeleton, pose, (u, lo, h), tgt, pole, end_rotation=hr, offsets=offsets)
-        reached.append(wrist + rotate(hr, np.asarray(arm.palm, dtype=np.float64)))
+        out = qrot(rot[0], (arm.side, 0.0, 0.0))
+        pole = sub(sub(add(sh, scale(0.5, out)), scale(0.8, fwd)), scale(0.3, _UP))  # elbows bend back and out
+        wrist = solve_limb(par, root, rot, off, (u, lo, h), tgt, pole, qnormalize(hr))
+        for j in (u, lo, h):
+            pose.rotations[j] = rot[j]
+        reached.append(add(wrist, qrot(hr, arm.palm)))
     return np.array(reached)

@@ -14,6 +14,10 @@ Each is a world rotation applied at a joint, so positions are updated analytical
 and forward kinematics runs once. Targets out of reach stretch the limb straight
 towards them; targets closer than ``|ab − bc|`` fold it as far as it goes. The
 pose is changed in place, like the engine's other pose systems.
+
+One pose (the per-frame case) goes to the float version in :mod:`engine.ik._limb`,
+which is some thirty times cheaper than numpy on a single limb and agrees with the
+batched code below to rounding.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
+from engine.ik._limb import solve_limb
 from engine.ik._vec import cross, path_fk, rotate
 from engine.pose import Pose
 from engine.skeleton import Skeleton
@@ -43,6 +48,32 @@ def _angle(u: F, v: F) -> F:
 
 def _rotate_about(point: F, centre: F, q: F) -> F:
     return centre + rotate(q, point - centre)
+
+
+def _single(value: ArrayLike | None, size: int) -> bool:
+    return value is None or np.shape(value) == (size,)
+
+
+def _two_bone_one(
+    skeleton: Skeleton,
+    pose: Pose,
+    joints: tuple[int, int, int],
+    target: F,
+    pole: ArrayLike | None,
+    end_rotation: ArrayLike | None,
+    offsets: ArrayLike | None,
+    weight: float,
+) -> F:
+    """One pose, one limb: solve on floats and write the three joints back."""
+    off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
+    rot = pose.rotations.tolist()
+    end = None if end_rotation is None else tuple(quat.normalize(end_rotation).tolist())
+    pole_v = None if pole is None else tuple(np.asarray(pole, dtype=np.float64).tolist())
+    root = tuple(np.asarray(pose.root, dtype=np.float64).tolist())
+    c = solve_limb(skeleton.parents, root, rot, off.tolist(), joints, tuple(target.tolist()), pole_v, end, weight)
+    for j in joints:
+        pose.rotations[j] = rot[j]
+    return np.array(c)
 
 
 def two_bone_ik(
@@ -81,6 +112,9 @@ def two_bone_ik(
     if not np.all(np.isfinite(target)):
         raise ValueError("two_bone_ik target must be finite")
     rot = pose.rotations
+    one = rot.ndim == 2 and target.shape == (3,) and np.ndim(weight) == 0 and (offsets is None or np.ndim(offsets) == 2)
+    if one and _single(pole, 3) and _single(end_rotation, 4):
+        return _two_bone_one(skeleton, pose, (ia, ib, ic), target, pole, end_rotation, offsets, float(weight))
     wpos, wrot = path_fk(skeleton, pose.root, rot, ic, offsets)
     a, b, c = wpos[ia], wpos[ib], wpos[ic]
     qa, qb, qc = wrot[ia], wrot[ib], wrot[ic]

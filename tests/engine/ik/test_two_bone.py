@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from engine import quat
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
 from engine.ik import two_bone_ik
@@ -88,3 +89,29 @@ def test_end_rotation_is_applied_and_bad_input_rejected():
         two_bone_ik(sk, pose, ("l_upper_leg", "l_foot", "l_lower_leg"), [0, 0, 0])
     with pytest.raises(ValueError, match="finite"):
         two_bone_ik(sk, pose, LEG, [np.nan, 0, 0])
+
+
+@pytest.mark.parametrize("limb", [LEG, ARM])
+def test_one_pose_float_path_matches_the_batched_solver(limb):
+    """A single pose is solved on floats (engine.ik._limb); it must agree with the numpy batch row by row."""
+    sk = humanoid_skeleton()
+    rng = np.random.default_rng(11)
+    n = 12
+    batch = Pose.rest(sk, n)
+    batch.rotations[:] = quat.exp(rng.uniform(-0.6, 0.6, (n, 17, 3)))
+    batch.rotations[0, sk.index(limb[1])] = quat.identity()  # a straight limb: the bend plane comes from the pole
+    batch.root[:] = rng.uniform([-1, 0.8, -1], [1, 1.0, 1], (n, 3))
+    offsets = np.broadcast_to(sk.offsets * rng.uniform(0.8, 1.2), (n, 17, 3)).copy()
+    a = forward_kinematics(sk, batch.root, batch.rotations, offsets)[0][:, sk.index(limb[0])]
+    targets = a + rng.uniform(-0.9, 0.9, (n, 3))  # some out of reach, some folded
+    poles = a + rng.uniform(-1, 1, (n, 3))
+    ends = quat.normalize(rng.normal(size=(n, 4)))
+    for pole, end, weight in ((poles, None, 1.0), (None, ends, 1.0), (poles, ends, 0.4)):
+        solved = batch.copy()
+        reached = two_bone_ik(sk, solved, limb, targets, pole, end_rotation=end, offsets=offsets, weight=weight)
+        for i in range(n):
+            one = Pose(batch.root[i].copy(), batch.rotations[i].copy())
+            p, q = None if pole is None else pole[i], None if end is None else end[i]
+            got = two_bone_ik(sk, one, limb, targets[i], p, end_rotation=q, offsets=offsets[i], weight=weight)
+            assert np.allclose(got, reached[i], atol=1e-10)
+            assert np.allclose(one.rotations, solved.rotations[i], atol=1e-10)
