@@ -45,7 +45,7 @@ class _Bar:
         if not self.enabled:
             return
         width = 30
-        fill = int(round(done * width))
+        fill = round(done * width)
         sys.stderr.write(f"\r[{'#' * fill}{'.' * (width - fill)}] {done:4.0%} {stage:<12}")
         if done >= 1.0:
             sys.stderr.write("\n")

@@ -1,0 +1,258 @@
+"""Reading performances and writing loops: BVH, CSV, ``.npz``, input recordings, ``.ppclip``.
+
+A :class:`Performance` is a :class:`Trajectory` plus what is needed to write the loop
+back in kind: the column names, and for skeletal input (BVH) the source clip, whose
+skeleton the output clip or BVH reuses.
+
+* **BVH** — read with :mod:`engine.io.bvh`, the leading T-pose of CMU conversions
+  skipped, converted to a clip; items are the root position (allowed to travel) and
+  every joint's rotation as a quaternion (never raw Euler angles, which wrap). ``items``
+  selects joints by name.
+* **CSV** — a header row, first column ``time`` in seconds, one column per dimension.
+  Columns named ``NAME.qw NAME.qx NAME.qy NAME.qz`` form a rotation item, ``NAME.x NAME.y
+  NAME.z`` a position item; everything else is a scalar.
+* **npz** — ``values [T,N]`` with ``times [T]`` or ``fps``; optional ``names [N]``.
+* **recordings** (``.rec``, :mod:`input.recording`) — one controller's samples: its
+  position (the stick pivot) and orientation over the fixed-step clock.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from authoring.cycles.extract import CycleResult
+from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
+from engine.atomic import atomic_write_bytes
+from engine.clip import Clip
+
+__all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop"]
+
+INPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".rec")
+OUTPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".ppclip")
+
+
+@dataclass(frozen=True)
+class Performance:
+    """A performance read from a file.
+
+    Attributes:
+        trajectory: what the extractor analyses.
+        names: ``[N]`` column names.
+        source: the file it came from.
+        clip: for skeletal input, the (T-pose-free) clip the columns came from.
+        joints: for skeletal input, the joint index of each rotation item, in item order.
+        skipped: leading frames dropped (a T-pose lead-in).
+    """
+
+    trajectory: Trajectory
+    names: tuple[str, ...]
+    source: Path
+    clip: Clip | None = None
+    joints: tuple[int, ...] = ()
+    skipped: int = 0
+
+
+def _select(available: list[str], wanted: list[str] | None, what: str) -> list[str]:
+    if not wanted:
+        return available
+    missing = [w for w in wanted if w not in available]
+    if missing:
+        raise TrajectoryError(f"no {what} {', '.join(map(repr, missing))}; available: {', '.join(available[:40])}")
+    return [a for a in available if a in wanted]
+
+
+def _load_bvh(path: Path, items: list[str] | None) -> Performance:
+    from engine.io.bvh import read_bvh
+    from engine.io.bvh_convert import detect_tpose_frames
+
+    motion = read_bvh(path)
+    lead = detect_tpose_frames(motion)
+    clip = motion.to_clip(skip_frames=lead)
+    sk = clip.skeleton
+    chosen = _select(list(sk.names), items, "joint")
+    cols = [clip.root]
+    names = [f"{sk.names[0]}.x", f"{sk.names[0]}.y", f"{sk.names[0]}.z"]
+    its = [Item(f"{sk.names[0]}.position", "position", 0, 3, travel=True)]
+    joints = []
+    for name in chosen:
+        j = sk.index(name)
+        start = 3 + 4 * len(joints)
+        cols.append(clip.rotations[:, j])
+        names += [f"{name}.qw", f"{name}.qx", f"{name}.qy", f"{name}.qz"]
+        its.append(Item(f"{name}.rotation", "rotation", start, start + 4))
+        joints.append(j)
+    traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, its)
+    return Performance(traj, tuple(names), path, clip, tuple(joints), lead)
+
+
+def _items_from_names(names: list[str]) -> list[Item]:
+    """Group ``X.qw..X.qz`` into rotations and ``X.x..X.z`` into positions; the rest are scalars."""
+    out: list[Item] = []
+    c = 0
+    while c < len(names):
+        stem, _, suffix = names[c].rpartition(".")
+        if stem and suffix == "qw" and names[c : c + 4] == [f"{stem}.q{a}" for a in "wxyz"]:
+            out.append(Item(stem, "rotation", c, c + 4))
+            c += 4
+            continue
+        if stem and suffix == "x" and names[c : c + 3] == [f"{stem}.{a}" for a in "xyz"]:
+            out.append(Item(stem, "position", c, c + 3))
+            c += 3
+            continue
+        out.append(Item(names[c], "scalar", c, c + 1))
+        c += 1
+    return out
+
+
+def _load_csv(path: Path, items: list[str] | None) -> Performance:
+    text = path.read_text()
+    rows = list(csv.reader(io.StringIO(text)))
+    rows = [r for r in rows if r and any(x.strip() for x in r)]
+    if len(rows) < 2:
+        raise TrajectoryError(f"{path}: a CSV performance needs a header row and data rows")
+    header = [h.strip() for h in rows[0]]
+    if header[0].lower() != "time":
+        raise TrajectoryError(f"{path}: the first column must be 'time' (seconds), found {header[0]!r}")
+    try:
+        data = np.array([[float(x) for x in r] for r in rows[1:]], dtype=np.float64)
+    except ValueError as exc:
+        raise TrajectoryError(f"{path}: non-numeric value ({exc})") from None
+    if data.ndim != 2 or data.shape[1] != len(header):
+        raise TrajectoryError(f"{path}: every row needs {len(header)} values")
+    return _from_columns(path, data[:, 0], data[:, 1:], header[1:], items)
+
+
+def _from_columns(path: Path, times: NDArray[np.float64], values: NDArray[np.float64], names: list[str], items: list[str] | None) -> Performance:
+    its = _items_from_names(names)
+    chosen = _select([it.name for it in its], items, "item")
+    keep = [it for it in its if it.name in chosen]
+    cols = np.concatenate([np.arange(it.start, it.stop) for it in keep])
+    new_items, start = [], 0
+    for it in keep:
+        width = it.stop - it.start
+        new_items.append(Item(it.name, it.kind, start, start + width, it.travel))
+        start += width
+    traj = Trajectory(times, values[:, cols], tuple(new_items))
+    return Performance(traj, tuple(names[c] for c in cols), path)
+
+
+def _load_npz(path: Path, items: list[str] | None) -> Performance:
+    with np.load(path, allow_pickle=False) as z:
+        if "values" not in z.files:
+            raise TrajectoryError(f"{path}: an .npz performance needs a 'values' array [T,N] (has {z.files})")
+        values = np.asarray(z["values"], dtype=np.float64)
+        if values.ndim == 1:
+            values = values[:, None]
+        if "times" in z.files:
+            times = np.asarray(z["times"], dtype=np.float64)
+        elif "fps" in z.files:
+            times = np.arange(len(values)) / float(z["fps"])
+        else:
+            raise TrajectoryError(f"{path}: give 'times' [T] or 'fps' beside 'values'")
+        names = [str(n) for n in z["names"]] if "names" in z.files else [f"c{c}" for c in range(values.shape[1])]
+    if len(names) != values.shape[1]:
+        raise TrajectoryError(f"{path}: {len(names)} names for {values.shape[1]} columns")
+    return _from_columns(path, times, values, names, items)
+
+
+def _load_recording(path: Path, items: list[str] | None) -> Performance:
+    from input.recording import read_recording
+
+    rec = read_recording(path)
+    sources: list[str] = []
+    for fr in rec.frames:
+        for s in fr.sources():
+            if s not in sources:
+                sources.append(s)
+    chosen = _select(sources, items, "source")
+    if not chosen:
+        raise TrajectoryError(f"{path}: the recording holds no controller samples")
+    src = chosen[0]
+    t, pos, ori = [], [], []
+    for fr in rec.frames:
+        s = fr.latest(src)
+        if s is None:
+            continue
+        t.append(fr.frame * rec.header.dt)
+        ori.append(s.orientation)
+        pos.append(s.position if s.position is not None else np.full(3, np.nan))
+    if len(t) < 3:
+        raise TrajectoryError(f"{path}: source {src!r} has only {len(t)} samples")
+    p = np.asarray(pos)
+    cols, names, its = [], [], []
+    if np.isfinite(p).all() and np.ptp(p, axis=0).max() > 0:
+        cols.append(p)
+        names += [f"{src}.x", f"{src}.y", f"{src}.z"]
+        its.append(Item(f"{src}.position", "position", 0, 3))
+    start = 3 * len(cols)
+    cols.append(np.asarray(ori))
+    names += [f"{src}.q{a}" for a in "wxyz"]
+    its.append(Item(f"{src}.orientation", "rotation", start, start + 4))
+    traj = Trajectory(np.asarray(t), np.concatenate(cols, axis=1), tuple(its))
+    return Performance(traj, tuple(names), path)
+
+
+def load_performance(path: str | Path, items: list[str] | None = None) -> Performance:
+    """Read a performance; ``items`` restricts it to named joints / items / sources.
+
+    Raises:
+        TrajectoryError: unreadable or unsuitable content (the message says what).
+        FileNotFoundError: no such file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path}")
+    suffix = path.suffix.lower()
+    loaders = {".bvh": _load_bvh, ".csv": _load_csv, ".npz": _load_npz, ".rec": _load_recording}
+    if suffix not in loaders:
+        raise TrajectoryError(f"{path}: unknown input type {suffix!r}; use one of {', '.join(INPUT_SUFFIXES)}")
+    return loaders[suffix](path, items)
+
+
+def loop_clip(result: CycleResult, perf: Performance, name: str | None = None) -> Clip:
+    """The loop as a looping clip on the performance's skeleton (skeletal input only)."""
+    if perf.clip is None:
+        raise TrajectoryError("only skeletal input (BVH) can become a clip or BVH; write .csv or .npz instead")
+    src = perf.clip
+    s = len(result.loop)
+    root = result.loop[:, 0:3]
+    rots = np.broadcast_to(src.rotations.mean(axis=0), (s, *src.rotations.shape[1:])).copy()
+    # Joints that were not analysed keep their mean pose from the performance.
+    rots = rots / np.linalg.norm(rots, axis=-1, keepdims=True)
+    for k, j in enumerate(perf.joints):
+        rots[:, j] = result.loop[:, 3 + 4 * k : 7 + 4 * k]
+    return Clip(name or f"{src.name}_cycle", src.skeleton, s / result.period, root, rots, loop=True)
+
+
+def save_loop(result: CycleResult, perf: Performance, path: str | Path) -> Path:
+    """Write the loop as ``.bvh``, ``.ppclip`` (skeletal input), ``.csv`` or ``.npz``, atomically."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in OUTPUT_SUFFIXES:
+        raise TrajectoryError(f"{path}: unknown output type {suffix!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
+    if suffix == ".ppclip":
+        from engine.clipfile import save_clip
+
+        return save_clip(loop_clip(result, perf), path)
+    if suffix == ".bvh":
+        from engine.io.bvh import write_bvh
+        from engine.io.bvh_convert import clip_to_bvh
+
+        return write_bvh(path, clip_to_bvh(loop_clip(result, perf)))
+    if suffix == ".csv":
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["time", *perf.names])
+        for t, row in zip(result.loop_times, result.loop, strict=True):
+            w.writerow([repr(float(t)), *(repr(float(x)) for x in row)])
+        return atomic_write_bytes(path, buf.getvalue().encode())
+    out = io.BytesIO()
+    np.savez_compressed(out, times=result.loop_times, values=result.loop, names=np.array(perf.names),
+                        period=np.float64(result.period), travel=result.travel)
+    return atomic_write_bytes(path, out.getvalue())

@@ -1,0 +1,296 @@
+"""The recording scene (``puppetphone author record``): act a loop out, get a clean cycle (SCA 2017 §3–4).
+
+Workflow, as in the paper: pick a character, an item (a joint) and what to drive; a
+countdown; perform several loops while the layers already authored play back in
+sync; the loop is extracted at once (:func:`~authoring.cycles.extract_cycle`) and
+previewed — the performance in orange, the extracted cycle in green (Fig. 9) — then
+accepted (it stacks onto the motion cycle) or retried. The stacked cycle is a looping
+:class:`~engine.clip.Clip`, saved as ``.ppclip``.
+
+What can be driven: a joint's **rotation** (any joint), or the root's **translation**.
+Other joints' translations would need IK and clips carry no scale, so those are refused
+with the reason rather than silently ignored.
+
+Layers are synchronised by phase: the scene knows where the playing cycle was when
+each performed cycle started, so a new layer is placed at that phase (the performer
+acted it against what they saw) and time-scaled to the cycle's duration.
+
+Like the edit scene, this class does not know pygame: the command loop feeds it one
+performance value per step (:func:`mouse_point`, :func:`drag_rotation` or a device's
+orientation), key names, and asks it to draw into a :class:`RenderScene`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from authoring.cycles import CycleError, CycleResult, Item, Trajectory, extract_cycle
+from engine import quat
+from engine.camera import OrbitCamera
+from engine.clip import Clip
+from engine.fk import forward_kinematics
+from engine.render.extract import puppet_capsules
+from engine.render.scene import RenderScene
+from engine.skeleton import Skeleton
+
+__all__ = ["DRIVES", "RecordScene", "drag_rotation", "mouse_point"]
+
+F = NDArray[np.float64]
+DRIVES = ("translation", "rotation", "scale")
+PERFORMANCE = (0.95, 0.55, 0.1)  # orange: what was performed
+CYCLE = (0.1, 0.75, 0.25)  # green: the extracted cycle (paper Fig. 9)
+
+
+def mouse_point(camera: OrbitCamera, px: float, py: float, size: tuple[int, int], through: F) -> F:
+    """Where the cursor's ray meets the plane through ``through`` facing the camera."""
+    origin, direction = camera.ray(px, py, size[0], size[1])
+    normal = np.asarray(camera.forward, dtype=np.float64)
+    denom = float(np.dot(direction, normal))
+    if abs(denom) < 1e-9:
+        return np.asarray(through, dtype=np.float64).copy()
+    s = float(np.dot(np.asarray(through) - origin, normal)) / denom
+    return np.asarray(origin + s * np.asarray(direction), dtype=np.float64)
+
+
+def drag_rotation(dx: float, dy: float, height: int, gain: float = np.pi) -> F:
+    """A local rotation from a mouse drag (pixels from the press point): down pitches, right yaws."""
+    return quat.exp(np.array([dy / height * gain, dx / height * gain, 0.0]))
+
+
+@dataclass
+class _Take:
+    times: list[float]
+    values: list[F]
+    base_time: float  # playback time of the cycle when the take started
+
+
+class RecordScene:
+    """Record, extract, preview, accept or retry; layers stack into one looping clip.
+
+    Args:
+        skeleton: the character.
+        item: the joint to drive.
+        drive: ``"rotation"`` or ``"translation"`` (root only); ``"scale"`` is refused.
+        base: a looping clip already authored (its layers play back while performing).
+        countdown: seconds before the take starts.
+        take_seconds: the take stops by itself after this long (or on :meth:`stop`).
+        rng: seeded generator for the extractor's probe points.
+    """
+
+    def __init__(self, skeleton: Skeleton, item: str, drive: str = "rotation", base: Clip | None = None,
+                 countdown: float = 3.0, take_seconds: float = 8.0, rng: np.random.Generator | None = None) -> None:
+        if drive not in DRIVES:
+            raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
+        if drive == "scale":
+            raise ValueError("clips carry no scale channel; drive 'rotation' or the root's 'translation'")
+        if item not in skeleton.names:
+            raise ValueError(f"no joint {item!r}; the character has {', '.join(skeleton.names)}")
+        joint = skeleton.index(item)
+        if drive == "translation" and joint != 0:
+            raise ValueError(f"only the root ({skeleton.names[0]}) can be driven by translation; drive {item!r} by rotation")
+        if base is not None and (base.skeleton.names != skeleton.names or not base.loop):
+            raise ValueError("the base clip must be a looping clip of the same skeleton")
+        self.skeleton = skeleton
+        self.joint = joint
+        self.drive = drive
+        self.clip = base
+        self.countdown = float(countdown)
+        self.take_seconds = float(take_seconds)
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.camera = OrbitCamera(target=np.array([0.0, 1.0, 0.0]), distance=2.8, pitch=0.25, yaw=-0.6)
+        self.phase = "ready"
+        self.time = 0.0  # playback time of the cycle
+        self.timer = 0.0
+        self.message = "press R to record"
+        self.result: CycleResult | None = None
+        self.candidate: Clip | None = None
+        self._take: _Take | None = None
+        self._value: F | None = None
+        self._performed: F = np.zeros((0, 4))
+
+    # -- the performance ---------------------------------------------------------------
+    def rest_value(self) -> F:
+        """The driven channel at the current playback time (what the take starts from)."""
+        root, rot = self._pose(self.time, None)
+        return root.copy() if self.drive == "translation" else rot[self.joint].copy()
+
+    def item_position(self) -> F:
+        """World position of the driven joint now (where the mouse plane goes through)."""
+        root, rot = self._pose(self.time, self.candidate)
+        wpos, _ = forward_kinematics(self.skeleton, root, rot)
+        return wpos[self.joint]
+
+    def feed(self, value: F | None) -> None:
+        """The performed value for this step (a point, or a unit quaternion), or ``None`` if unchanged."""
+        if value is None:
+            return
+        v = np.asarray(value, dtype=np.float64).reshape(-1)
+        want = 3 if self.drive == "translation" else 4
+        if v.shape != (want,) or not np.isfinite(v).all():
+            raise ValueError(f"a {self.drive} performance value is {want} finite numbers, got {v.tolist()}")
+        self._value = quat.normalize(v) if want == 4 else v
+
+    # -- the workflow ------------------------------------------------------------------
+    def start(self) -> None:
+        """Start the countdown (from ready or preview)."""
+        self.phase, self.timer, self.result, self.candidate = "countdown", self.countdown, None, None
+        self.message = ""
+
+    def stop(self) -> None:
+        """End the take now and extract the loop."""
+        if self.phase == "recording":
+            self._extract()
+
+    def accept(self) -> Clip | None:
+        """Stack the previewed layer onto the cycle; returns the new clip."""
+        if self.phase != "preview" or self.candidate is None:
+            return None
+        self.clip, self.candidate, self.phase = self.candidate, None, "ready"
+        self.message = f"layer accepted: {self.skeleton.names[self.joint]} {self.drive}; R records another"
+        return self.clip
+
+    def retry(self) -> None:
+        """Drop the previewed take and count down again."""
+        self.start()
+
+    def key(self, name: str) -> None:
+        """Keyboard: R record, Space stop the take, Enter accept, Backspace retry."""
+        if name == "r" and self.phase in ("ready", "preview"):
+            self.start()
+        elif name == "space":
+            self.stop()
+        elif name in ("return", "enter"):
+            self.accept()
+        elif name == "backspace" and self.phase == "preview":
+            self.retry()
+
+    def step(self, dt: float) -> None:
+        """Advance playback, the countdown and the take by one fixed step."""
+        self.time += dt
+        if self.phase == "countdown":
+            self.timer -= dt
+            if self.timer <= 0.0:
+                self.phase = "recording"
+                self._take = _Take([], [], self.time)
+                self.timer = 0.0
+        elif self.phase == "recording" and self._take is not None:
+            self.timer += dt
+            self._take.times.append(self.timer)
+            self._take.values.append((self._value if self._value is not None else self.rest_value()).copy())
+            if self.timer >= self.take_seconds:
+                self._extract()
+
+    def _extract(self) -> None:
+        take = self._take
+        self._take = None
+        self.phase = "preview"
+        assert take is not None
+        values = np.asarray(take.values)
+        kind = "position" if self.drive == "translation" else "rotation"
+        name = f"{self.skeleton.names[self.joint]}.{self.drive}"
+        try:
+            traj = Trajectory(np.asarray(take.times), values, (Item(name, kind, 0, values.shape[1]),))
+            self.result = extract_cycle(traj, self.rng)
+        except (CycleError, ValueError) as exc:
+            self.result, self.candidate = None, None
+            self.message = f"no clean loop: {exc} — Backspace/R to retry"
+            return
+        self.candidate = self._stack(self.result, take)
+        self._performed = values
+        self.message = (f"loop of {self.result.period:.2f} s from {self.result.cycles} cycles "
+                        f"(spread {self.result.spread:.0%}) — Enter accepts, Backspace retries")
+
+    # -- layering ----------------------------------------------------------------------
+    def _stack(self, result: CycleResult, take: _Take) -> Clip:
+        """The cycle with this layer: the first layer sets the duration; later ones are phase-aligned to it."""
+        loop = result.closed()
+        if self.clip is None:
+            frames = len(result.loop)
+            fps = frames / result.period
+            base_rot = np.broadcast_to(quat.identity(self.skeleton.num_joints), (frames, self.skeleton.num_joints, 4)).copy()
+            base_root = np.broadcast_to(self.skeleton.offsets[0], (frames, 3)).copy()
+            shift = 0.0
+        else:
+            frames, fps = self.clip.num_frames, self.clip.fps
+            base_root, base_rot = np.array(self.clip.root), np.array(self.clip.rotations)
+            # Where the playing cycle was when each performed cycle began: the layer starts there.
+            starts = result.aligned.knots_time[:, 0] + take.base_time
+            ang = 2 * np.pi * np.mod(starts / self.clip.duration, 1.0)
+            shift = float(np.mod(np.arctan2(np.sin(ang).mean(), np.cos(ang).mean()) / (2 * np.pi), 1.0))
+        phase = np.mod(np.arange(frames) / frames - shift, 1.0)
+        values = _sample_loop(loop, phase, self.drive == "rotation")
+        if self.drive == "rotation":
+            base_rot[:, self.joint] = values
+        else:
+            base_root = values
+        name = self.clip.name if self.clip is not None else "performed_cycle"
+        return Clip(name, self.skeleton, fps, base_root, base_rot, loop=True)
+
+    def _pose(self, t: float, clip: Clip | None) -> tuple[F, F]:
+        c = clip if clip is not None else self.clip
+        if c is None:
+            return self.skeleton.offsets[0].copy(), quat.identity(self.skeleton.num_joints)
+        pose = c.sample(t)
+        return np.asarray(pose.root), np.asarray(pose.rotations)
+
+    # -- drawing -----------------------------------------------------------------------
+    def _joint_path(self, values: F, rotation: bool) -> F:
+        """World path of the driven joint's child (or the root) when the values drive it, over the base pose."""
+        n = len(values)
+        root, rot = self._pose(self.time, None)
+        roots = np.broadcast_to(root, (n, 3)).copy()
+        rots = np.broadcast_to(rot, (n, *rot.shape)).copy()
+        if rotation:
+            rots[:, self.joint] = values
+        else:
+            roots = values
+        wpos, wrot = forward_kinematics(self.skeleton, roots, rots)
+        kids = self.skeleton.children(self.joint)
+        if rotation and kids:
+            return wpos[:, kids[0]]
+        if rotation:
+            return wpos[:, self.joint] + quat.rotate(wrot[:, self.joint], self.skeleton.tips[self.joint])
+        return wpos[:, 0]
+
+    def draw(self, scene: RenderScene) -> None:
+        """The puppet (candidate layer applied in preview), the take in orange, the loop in green, the overlay."""
+        clip = self.candidate if self.phase == "preview" and self.candidate is not None else None
+        root, rot = self._pose(self.time, clip)
+        if self.phase == "recording" and self._value is not None:
+            if self.drive == "rotation":
+                rot = rot.copy()
+                rot[self.joint] = self._value
+            else:
+                root = self._value
+        wpos, wrot = forward_kinematics(self.skeleton, root, rot)
+        a, b, r, owner = puppet_capsules(self.skeleton, wpos, wrot)
+        colors = np.tile(np.array([0.82, 0.8, 0.76]), (len(a), 1))
+        colors[owner == self.joint] = PERFORMANCE
+        scene.add_capsules(a, b, r, colors)
+        rotation = self.drive == "rotation"
+        if self._take is not None and len(self._take.values) > 1:
+            scene.add_polyline(self._joint_path(np.asarray(self._take.values), rotation), PERFORMANCE, 2.0)
+        if self.phase == "preview" and self.result is not None:
+            scene.add_polyline(self._joint_path(np.asarray(self._performed), rotation), PERFORMANCE, 1.5)
+            scene.add_polyline(self._joint_path(self.result.loop, rotation), CYCLE, 4.0, closed=True)
+        title = {"ready": "ready", "countdown": f"get ready… {max(self.timer, 0.0):.0f}",
+                 "recording": f"recording {self.timer:4.1f} s — perform several loops, Space to stop",
+                 "preview": "preview"}[self.phase]
+        scene.add_text(f"{self.skeleton.names[self.joint]} · {self.drive} · {title}", size=22)
+        if self.message:
+            scene.add_text(self.message, size=16)
+
+
+def _sample_loop(loop: F, phase: F, rotation: bool) -> F:
+    """Values of a closed loop ``[S+1, d]`` (end = start) at phases in ``[0, 1)``, interpolated."""
+    s = len(loop) - 1
+    x = phase * s
+    i = np.minimum(np.floor(x).astype(np.int64), s - 1)
+    w = x - i
+    if rotation:
+        return quat.nlerp(loop[i], loop[i + 1], w)
+    return loop[i] * (1.0 - w)[:, None] + loop[i + 1] * w[:, None]
+
