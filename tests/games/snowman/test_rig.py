@@ -5,7 +5,7 @@ import pytest
 
 from engine import quat
 from engine.fk import forward_kinematics, world_points
-from games.snowman.rig import SnowmanShape, bezier_spine, snowman_skeleton, spine_control_point
+from games.snowman.rig import SnowmanShape, bezier_spine, middle_ball_parameter, snowman_skeleton, spine_control_point
 
 
 def standing(shape):
@@ -18,12 +18,17 @@ def test_balls_stack_on_each_other_and_head_size_sets_neck():
     shape = SnowmanShape(0.5, 0.35, 0.22)
     sk, pos, rot = standing(shape)
     hips, chest, head = pos[sk.index("hips")], pos[sk.index("chest")], pos[sk.index("head")]
-    assert np.linalg.norm(chest - hips) == pytest.approx(0.5 + 0.35)
-    assert np.linalg.norm(head - chest) == pytest.approx(0.35 + 0.22)
+    assert np.linalg.norm(chest - hips) == pytest.approx(0.5 + 2 * 0.35)  # chest on top of the middle ball
+    assert np.linalg.norm(head - chest) == pytest.approx(0.22)  # the head ball rests on it
+    t = middle_ball_parameter(shape)
+    up = chest  # standing upright: the Bézier is the straight spine
+    middle = bezier_spine(hips, chest, up, t)
+    assert np.linalg.norm(middle - hips) == pytest.approx(0.5 + 0.35)
     bigger_head = snowman_skeleton(SnowmanShape(0.5, 0.35, 0.3))
     assert np.linalg.norm(bigger_head.offsets[sk.index("neck")]) > np.linalg.norm(sk.offsets[sk.index("neck")])
     toes = world_points(sk, pos, rot)[sk.index("l_foot")]
-    assert abs(toes[1]) < 0.05 * shape.bottom  # feet on the ground
+    assert abs(toes[1]) < 0.02  # feet on the ground
+    assert pos[sk.index("hips")][1] - shape.bottom < 0.1  # the bottom ball sits on the snow
 
 
 def test_two_ball_snowman():

@@ -22,15 +22,36 @@ def test_ball_grows_by_volume_and_slower_when_big():
     assert grow_radius(0.5, 1.0, 0.04) - 0.5 < r1 - 0.1
 
 
-def test_rolling_clears_the_strip_and_bare_snow_adds_nothing():
+def test_rolling_takes_snow_from_the_field_and_conserves_volume():
     field = SnowField(size=4.0, cell=0.05)
+    before = field.depth.sum() * field.cell**2
     a, b = np.array([-1.0, 0, 0]), np.array([1.0, 0, 0])
     r = field.roll(a, b, 0.1)
     assert r > 0.13
+    gained = 4 / 3 * np.pi * (r**3 - 0.1**3)
+    taken = before - field.depth.sum() * field.cell**2
+    assert gained == pytest.approx(taken, rel=1e-9)
     assert len(field.marks()) > 0
-    assert field.depth_at([0.0, 0, 0]) == 0.0
-    assert field.roll(a, b, r) == pytest.approx(r, rel=1e-3)
-    assert field.depth_at([0.0, 0, 1.0]) == pytest.approx(0.04)
+    assert field.depth_at([0.0, 0, 0]) < 0.7 * 0.04  # a visible track
+    assert field.depth_at([0.0, 0, 1.0]) == pytest.approx(0.04)  # off the track: untouched
+
+
+def test_small_steps_grow_like_one_big_step():
+    one, many = SnowField(size=4.0, cell=0.15), SnowField(size=4.0, cell=0.15)
+    r_one = one.roll(np.array([-1.0, 0, 0]), np.array([1.0, 0, 0]), 0.1)
+    r_many = 0.1
+    xs = np.linspace(-1, 1, 171)
+    for x0, x1 in zip(xs[:-1], xs[1:]):
+        r_many = many.roll(np.array([x0, 0, 0]), np.array([x1, 0, 0]), r_many)
+    assert r_many == pytest.approx(r_one, rel=0.1)
+
+
+def test_rolling_the_same_strip_again_gives_less():
+    field = SnowField(size=4.0, cell=0.05)
+    a, b = np.array([-1.0, 0, 0]), np.array([1.0, 0, 0])
+    r1 = field.roll(a, b, 0.1)
+    r2 = field.roll(a, b, 0.1)
+    assert r2 - 0.1 < 0.8 * (r1 - 0.1)
 
 
 def test_three_stacked_balls_are_a_snowman_and_wrong_order_is_not():
