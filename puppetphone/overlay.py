@@ -21,10 +21,25 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
     for e, brain in world.query(Brain):
         events = ", ".join(brain.last_events[-3:])
         lines.append(f"#{e} {brain.active}" + (f"  ({events})" if events else ""))
+    for src in hub.sources:
+        if type(src).__name__ == "OscSource" and not any(st.packets > 0 for st in hub.statuses()):
+            lines += _pairing_lines(src)
     for st in hub.statuses():
-        light = "●" if st.connected and st.packets_per_s > 0 else ("○" if st.connected else "×")
+        light = "[live]" if st.connected and st.packets_per_s > 0 else ("[idle]" if st.connected else "[gone]")
         err = f"  {st.last_error}" if st.last_error else ""
         lines.append(f"{light} {st.name}: {st.packets_per_s:5.1f} packets/s, dropped {st.dropped}{err}")
+    return lines
+
+
+def _pairing_lines(source: object) -> list[str]:
+    """Where a phone should send, until the first packet arrives (the pairing overlay)."""
+    from input.pairing import pairing_info
+
+    host = getattr(source, "host", "0.0.0.0")
+    info = pairing_info(int(getattr(source, "port", 9000)), host)
+    lines = info.lines()[:4]
+    if host.startswith("127."):
+        lines.append("  listening on 127.0.0.1 only: phones on the LAN need --osc-host 0.0.0.0")
     return lines
 
 
