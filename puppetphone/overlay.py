@@ -46,4 +46,4 @@ def _pairing_lines(source: object) -> list[str]:
 def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fps: float, paused: bool) -> None:
     """Add the overlay's lines to the scene."""
     for line in overlay_lines(world, game, hub, fps, paused):
-        scene.add_text(line, size=16)
+        scene.add_text(line, size=16, color=(0.06, 0.08, 0.14))
