@@ -41,6 +41,7 @@ class PuppetTuning:
     anticipation: float = 0.16
     landing: float = 0.22
     flick_launch_speed: float = 3.4
+    flick_grace: float = 0.1
     jump_ragdoll_fall: float = 0.0
     reach: float = 0.55
     carry_max_radius: float = 0.26
@@ -72,6 +73,8 @@ class PuppetBody:
         speed: smoothed stick ground speed.
         air: height of the root above the ground during a jump.
         air_velocity: the puppet's velocity while airborne (ballistic jumps).
+        ground_velocity: the puppet's measured ground velocity over the last step (its momentum).
+        last_position: where it stood a step ago (for ``ground_velocity``).
         jump: the arc tracker of the current jump.
         jump_from_stick: whether the stick's own path drives the arc (phones) or a flick launched it (mouse).
         object: the prop carried or rolled.
@@ -88,6 +91,8 @@ class PuppetBody:
     speed: float = 0.0
     air: float = 0.0
     air_velocity: F = field(default_factory=lambda: np.zeros(3))
+    ground_velocity: F = field(default_factory=lambda: np.zeros(3))
+    last_position: F | None = None
     jump: JumpTracker | None = None
     jump_from_stick: bool = False
     object: int | None = None

@@ -46,6 +46,9 @@ def enter_jump(world: World, entity: Entity, brain: Brain) -> None:
     player = world.get(entity, LocomotionPlayer)
     body.phase, body.timer, body.air = "anticipation", 0.0, 0.0
     body.jump = None
+    # The puppet's own momentum, taken before the squat slows it: a mouse flick's
+    # stroke says "jump", never where to — the stick's velocity during it is a gesture.
+    body.air_velocity = body.ground_velocity.copy()
     player.height = body.tuning.crouch_height + 0.12
     player.speed *= 0.5
     brain.memory["jump_apex_height"] = 0.0
@@ -61,7 +64,7 @@ def _take_off(world: World, entity: Entity, body: PuppetBody, stick: Stick | Non
     if rising:
         velocity = stick.velocity.copy()
     else:
-        horizontal = np.zeros(3) if stick is None else np.array([stick.velocity[0], 0.0, stick.velocity[2]])
+        horizontal = np.array([body.air_velocity[0], 0.0, body.air_velocity[2]])
         n = float(np.linalg.norm(horizontal))
         if n > t.max_speed:
             horizontal *= t.max_speed / n
@@ -102,13 +105,24 @@ def update_jump(world: World, entity: Entity, brain: Brain) -> None:
         tr.position = tr.position + body.air_velocity * world.dt
         velocity = body.air_velocity
         point = tr.position + np.array([0.0, t.stand_height, 0.0])
-        if stick is not None:
-            # The mouse's stick stays in its plane: it can still turn or stop the jump.
-            velocity = np.array([stick.velocity[0], body.air_velocity[1], stick.velocity[2]])
-            if body.timer < 0.1:
-                velocity[[0, 2]] = body.air_velocity[[0, 2]]
+        lead = None if stick is None else np.array([stick.velocity[0], 0.0, stick.velocity[2]])
+        if lead is not None and body.timer >= t.flick_grace and float(np.linalg.norm(lead)) <= t.max_speed:
+            # The mouse's stick stays in its plane: leading sideways turns the jump and
+            # holding still stops it. Faster than any run is the flick stroke still
+            # fading from the filtered velocity, not a lead: ignored.
+            velocity = np.array([lead[0], body.air_velocity[1], lead[2]])
     body.air = float(tr.position[1])
+    predicted = body.jump.apex.copy()
     status = body.jump.update(point, velocity, world.dt, body.air)
+    if not body.jump_from_stick:
+        # Ballistic: the apex is exact (the tracker's refit would mix the stick's lead in);
+        # once past it, the last prediction stands.
+        vy = float(body.air_velocity[1])
+        if vy > 0.0:
+            rise = vy / t.gravity
+            along = float(body.jump.direction @ body.air_velocity[[0, 2]]) if np.any(body.jump.direction) else 0.0
+            predicted = np.array([body.jump.side_view(point)[0] + along * rise, point[1] + 0.5 * vy * rise])
+        body.jump.apex = predicted
     if np.isfinite(body.jump.apex).all():
         brain.memory["jump_apex_height"] = float(body.jump.apex[1])
     if status in (JumpStatus.ROSE_AGAIN, JumpStatus.TURNED, JumpStatus.STOPPED):

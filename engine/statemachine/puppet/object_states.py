@@ -90,6 +90,8 @@ def update_carry(world: World, entity: Entity, brain: Brain) -> None:
     body = world.get(entity, PuppetBody)
     player = world.get(entity, LocomotionPlayer)
     player.height = None
+    if body.target_height > body.tuning.crouch_exit:
+        body.phase = "raised"
     follow_stick(world, entity, body, player, speed_scale=0.8)
     if body.object is None or not world.alive(body.object):
         return
@@ -159,9 +161,15 @@ def exit_putdown(world: World, entity: Entity, brain: Brain) -> None:
 
 
 def can_roll(world: World, entity: Entity, brain: Brain) -> bool:
-    """Crouch-walking into a free ball."""
+    """Crouch-walking into a free ball.
+
+    The puppet's own stride decides, not the stick's speed: the stick jitters while it
+    is lowered (a wheel notch slides the held point), and a puppet crouched still over
+    a small ball is about to pick it up, not to push it away.
+    """
     body = world.get(entity, PuppetBody)
-    return body.held_by is not None and body.speed > body.tuning.still_speed and prop_in_front(world, entity, body, body.tuning.reach) is not None
+    walking = float(world.get(entity, LocomotionPlayer).speed) > body.tuning.still_speed
+    return body.held_by is not None and walking and prop_in_front(world, entity, body, body.tuning.reach) is not None
 
 
 def enter_roll(world: World, entity: Entity, brain: Brain) -> None:
@@ -213,5 +221,10 @@ def exit_roll(world: World, entity: Entity, brain: Brain) -> None:
 
 
 def wants_putdown(world: World, entity: Entity, brain: Brain) -> bool:
-    """Crouching while carrying."""
-    return wants_crouch(world, entity, brain) and brain.time_in_state > 0.3
+    """Crouching again while carrying.
+
+    The stick is still low when the ball has just been lifted (the player crouched to
+    pick it up); only a lowering *after* standing up with the ball puts it down.
+    """
+    body = world.get(entity, PuppetBody)
+    return body.phase == "raised" and wants_crouch(world, entity, brain) and brain.time_in_state > 0.3

@@ -49,7 +49,11 @@ def yaw_rotation(heading: float) -> F:
 
 
 def sense(world: World, entity: Entity, body: PuppetBody) -> Stick | None:
-    """Refresh ``body``'s view of the stick; returns the holding stick, if any."""
+    """Refresh ``body``'s view of the stick (and its own momentum); returns the holding stick, if any."""
+    pos = world.get(entity, Transform).position
+    if body.last_position is not None:
+        body.ground_velocity = (pos - body.last_position) * np.array([1.0, 0.0, 1.0]) / world.dt
+    body.last_position = np.array(pos, dtype=np.float64)
     held = holder(world, entity)
     if held is None:
         body.held_by = None
