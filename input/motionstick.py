@@ -74,6 +74,7 @@ class StickState:
     raw_x: F = field(default_factory=lambda: np.zeros(3))
     filt_dx: F = field(default_factory=lambda: np.zeros(3))
     flick_armed: bool = True
+    world_mode: bool = False
 
 
 def spawn_stick(world: World, binding: str = "*") -> Entity:
@@ -91,6 +92,7 @@ def _heading_yaw(direction: F, forward: F) -> F:
 
 
 def _apply_sample(st: StickState, stick: Stick, s: PoseSample, cfg: StickConfig) -> None:
+    st.world_mode = s.mode == "world"
     if s.mode == "world":
         stick.orientation = s.orientation.copy()
         if s.position is not None:
@@ -215,7 +217,10 @@ def _filter_velocity(st: StickState, stick: Stick, s: PoseSample | None, cfg: St
     st.raw_x = stick.tip.copy()
     stick.velocity = st.filt_dx.copy()
     up = float(stick.velocity[1])
-    if (s is not None and s.flick) or (st.flick_armed and stick.grabbed is not None and up > cfg.flick_speed):
+    # A "world" source (the mouse) says itself when it flicks: its tip jumps with wheel
+    # notches and cursor warps, so its velocity is not a gesture. Devices flick by velocity.
+    by_velocity = not st.world_mode and st.flick_armed and stick.grabbed is not None and up > cfg.flick_speed
+    if (s is not None and s.flick) or by_velocity:
         stick.flick, st.flick_armed = True, False
     elif up < 0.5 * cfg.flick_speed:
         st.flick_armed = True

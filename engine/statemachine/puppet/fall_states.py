@@ -31,8 +31,8 @@ _HELD_JOINT = "chest"
 
 
 def enter_ragdoll(world: World, entity: Entity, brain: Brain) -> None:
-    """Go limp; whatever the animation was doing stops."""
-    world.get(entity, Ragdoll).set_mode(RagdollMode.LIMP)
+    """Go limp at once: the bodies already stand in the animated pose, so nothing pops."""
+    world.get(entity, Ragdoll).set_mode(RagdollMode.LIMP, immediate=True)
     player = world.get(entity, LocomotionPlayer)
     player.speed, player.height = 0.0, None
     player.stop(0.1)
