@@ -14,9 +14,15 @@ __all__ = ["Snowball", "Snowman", "SnowmanStats", "StackWatch", "Stacked"]
 
 @dataclass
 class Snowball:
-    """A ball of snow; ``last`` is where it was last step (to measure rolling)."""
+    """A ball of snow; ``last`` is where it was last step (to measure rolling).
+
+    ``snow`` is the exact radius the snow it picked up gives it; the physical radius
+    (``Prop.radius``) follows in steps of ``GROWTH_STEP`` because every change of it
+    re-derives the physics model's constants (and perturbs its solver).
+    """
 
     last: NDArray[np.float64] = field(default_factory=lambda: np.full(3, np.nan))
+    snow: float = 0.0
 
 
 @dataclass

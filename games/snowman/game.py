@@ -19,7 +19,8 @@ from engine.statemachine.puppet import install_puppets, spawn_puppet
 from games.base import Game
 from games.snowman.components import Snowman, SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game
-from games.snowman.rules import assemble_snowmen, stick_stacked_balls, grow_snowballs, snowmen_standing, start_snowballs
+from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
+                                 start_snowballs, stick_stacked_balls)
 from games.snowman.scenery import build_scenery
 from games.snowman.snow import SnowField
 
@@ -44,7 +45,9 @@ def install(app: App) -> None:
     world.insert_resource(StackWatch())
     build_scenery(world)
     spawn_puppet(world, (0.0, 0.0, 0.0), 0.0, name="puppet", extra=(Appearance(color=(0.85, 0.32, 0.24)),))
+    app.add_system("rules", aim_putdown_on_stacks)
     app.add_system("rules", stick_stacked_balls)
+    app.add_system("rules", snow_drag)
     app.add_system("rules", grow_snowballs)
     app.add_system("rules", start_snowballs)
     app.add_system("rules", assemble_snowmen)

@@ -4,7 +4,9 @@
    (:class:`~games.snowman.snow.SnowField`) and its radius grows by volume.
 2. **Starting a ball**: a puppet crouch-walking on fresh snow with no ball in front
    packs a new small ball in front of its hands; the brain then rolls it.
-3. **Building**: two or three balls stacked largest at the bottom that stand still
+3. **Snow drag**: a free ball rolling on the ground ploughs through the snow and
+   slows down at ``SNOW_DRAG`` m/s² (rigid spheres on a plane would roll on for ever).
+4. **Building**: two or three balls stacked largest at the bottom that stand still
    for half a second come alive as a snowman puppet (:mod:`~games.snowman.alive`).
 """
 
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from engine.blend.locomotion import LocomotionPlayer
 from engine.components import Grabbable, Stick, Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
@@ -24,18 +27,22 @@ from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, S
 from games.snowman.rig import SnowmanShape
 from games.snowman.snow import SnowField
 
-__all__ = ["stick_stacked_balls", "grow_snowballs", "start_snowballs", "assemble_snowmen", "spawn_ball", "MAX_RADIUS", "MAX_BALLS"]
+__all__ = ["stick_stacked_balls", "grow_snowballs", "start_snowballs", "assemble_snowmen", "spawn_ball", "snow_drag", "aim_putdown_on_stacks",
+           "snowmen_standing", "MAX_RADIUS", "MAX_BALLS", "SNOW_DRAG"]
 
 MAX_RADIUS = 0.6
 MAX_BALLS = 24
 START_RADIUS = 0.11
+START_GAP = 0.4
+GROWTH_STEP = 0.01
 STILL_FRAMES = 30
+SNOW_DRAG = 5.0
 
 
 def spawn_ball(world: World, position: np.ndarray, radius: float) -> int:
     """A snowball entity: physical, grabbable, growing."""
     pos = np.array([position[0], radius, position[2]], dtype=np.float64)
-    return world.spawn(Transform(pos), Prop(radius=radius), Snowball(last=pos.copy()), Grabbable(radius=radius + 0.05, kind="snowball"))
+    return world.spawn(Transform(pos), Prop(radius=radius), Snowball(last=pos.copy(), snow=radius), Grabbable(radius=radius + 0.05, kind="snowball"))
 
 
 def _held(world: World) -> set[int]:
@@ -84,9 +91,60 @@ def grow_snowballs(world: World) -> None:
         here = tr.position.copy()
         if np.isfinite(ball.last).all() and here[1] - prop.radius < 0.03 and prop.radius < MAX_RADIUS:
             if float(np.hypot(*(here - ball.last)[[0, 2]])) > 1e-4:
-                prop.radius = min(field.roll(ball.last, here, prop.radius), MAX_RADIUS)
-                grab.radius = prop.radius + 0.05
+                ball.snow = min(field.roll(ball.last, here, max(ball.snow, prop.radius)), MAX_RADIUS)
+                if ball.snow - prop.radius >= GROWTH_STEP or ball.snow >= MAX_RADIUS:
+                    prop.radius = ball.snow
+                    grab.radius = prop.radius + 0.05
         ball.last = here
+
+
+def snow_drag(world: World) -> None:
+    """Free balls on the ground lose ``SNOW_DRAG`` m/s of speed per second to the snow.
+
+    The new velocity is handed to physics with ``Prop.placed`` (the pose stays the one
+    physics wrote), so a ball let go while moving rolls a short way and stops.
+    """
+    held = _held(world)
+    step = SNOW_DRAG * world.dt
+    for e, _, prop, tr in world.query(Snowball, Prop, Transform):
+        if prop.carried or e in held or tr.position[1] - prop.radius > 0.03:
+            continue
+        speed = float(np.linalg.norm(prop.velocity[:3]))
+        if speed < 1e-4:
+            continue
+        keep = max(0.0, 1.0 - step / speed)
+        prop.velocity = prop.velocity * keep
+        prop.placed = True
+
+
+def aim_putdown_on_stacks(world: World) -> None:
+    """A puppet putting a ball down onto a stack puts it on the stack's top ball.
+
+    The brain aims at the first free ball in front; balls already packed on it are
+    ``carried`` and invisible to it, so it would press the new ball into them. This
+    rule (after the brain's first PutDown step) climbs the stack to its top and aims
+    there when the top ball is still the bigger one.
+    """
+    on = {s.on: e for e, s in world.query(Stacked)}
+    for e, body, brain in world.query(PuppetBody, Brain):
+        spot = brain.memory.get("putdown_spot")
+        if brain.active != "PutDown" or spot is None or body.object is None or not world.alive(body.object):
+            continue
+        radius = world.get(body.object, Prop).radius
+        base = None
+        for o, _, prop, tr in world.query(Snowball, Prop, Transform):
+            aimed_at = abs(tr.position[1] + prop.radius + radius + 0.01 - spot[1]) < 1e-6
+            if o != body.object and aimed_at and float(np.hypot(*(tr.position - spot)[[0, 2]])) < 1e-6:
+                base = o
+                break
+        if base is None or base not in on:
+            continue
+        top = base
+        while top in on and on[top] != body.object:
+            top = on[top]
+        top_prop, top_tr = world.get(top, Prop), world.get(top, Transform)
+        if top_prop.radius > radius:
+            brain.memory["putdown_spot"] = np.array([top_tr.position[0], top_tr.position[1] + top_prop.radius + radius + 0.01, top_tr.position[2]])
 
 
 def start_snowballs(world: World) -> None:
@@ -94,12 +152,14 @@ def start_snowballs(world: World) -> None:
     field = world.resource(SnowField)
     stats = world.resource(SnowmanStats)
     count = len(world.query(Snowball))
-    for e, body, brain, tr in world.query(PuppetBody, Brain, Transform):
-        if brain.active != "Crouch" or body.held_by is None or body.speed < 0.3 or brain.time_in_state < 0.4:
+    for e, body, brain, tr, player in world.query(PuppetBody, Brain, Transform, LocomotionPlayer):
+        # The puppet itself must be under way (not only the stick): a ball packed at the
+        # feet of a puppet still crouching in place lands in its hands' collision shapes.
+        if brain.active != "Crouch" or body.held_by is None or body.speed < 0.3 or player.speed < 0.3 or brain.time_in_state < 0.4:
             continue
         if count >= MAX_BALLS or prop_in_front(world, e, body, 1.0) is not None:
             continue
-        spot = tr.position + heading_vector(body.heading) * (0.3 + START_RADIUS)
+        spot = tr.position + heading_vector(body.heading) * (START_GAP + START_RADIUS)
         if field.depth_at(spot) <= 0.0:
             continue
         spawn_ball(world, spot, START_RADIUS)
