@@ -92,7 +92,7 @@ class Stick:
     grab_offset: NDArray[np.float64] = field(default_factory=_vec3)
     grab_rotation: NDArray[np.float64] = field(default_factory=_quat)
     just_grabbed: bool = False
-    just_released: bool = False
+    released: int | None = None  # the entity let go this step
     flick: bool = False
     connected: bool = True
     source: str = "mouse"

@@ -132,7 +132,7 @@ def _grab(world: World, st: StickState, stick: Stick, target: Entity) -> None:
 
 def _release(stick: Stick) -> None:
     if stick.grabbed is not None:
-        stick.grabbed, stick.just_released = None, True
+        stick.grabbed, stick.released = None, stick.grabbed
 
 
 def _length(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, focus_t: float | None) -> float:
@@ -161,7 +161,8 @@ def motionstick_system(world: World) -> None:
     cfg = world.try_resource(StickConfig) or StickConfig()
     grabbables = world.query(Grabbable, Transform)
     for e, stick, st in world.query(Stick, StickState):
-        stick.just_grabbed = stick.just_released = stick.flick = False
+        stick.just_grabbed = stick.flick = False
+        stick.released = None
         if st.source and frame.has_event(DISCONNECT, st.source):
             _release(stick)
             stick.touching, stick.connected = False, False

@@ -70,11 +70,15 @@ class MouseBot:
         return tr.position.copy() if grab is None else grab.anchor(tr)
 
     def press_on(self, entity: Entity) -> None:
-        """Hover over ``entity`` and press the left button (grabs it if the stick focuses it)."""
+        """Hover over ``entity`` and press the left button; raises if something else was grabbed
+        (a script that goes on holding the wrong thing records nonsense)."""
         self.move_to_pixel(self.pixel(self.anchor(entity)), (0, 0, 0))
         self.step()
         self._send(pygame.MOUSEBUTTONDOWN, pos=self.pos, button=1)
         self.step()
+        grabbed = [stick.grabbed for _, stick, _ in self.app.world.query(Stick, StickState)]
+        if entity not in grabbed:
+            raise RuntimeError(f"pressed on entity {entity} but the stick holds {grabbed} (hidden behind something?)")
 
     def release(self) -> None:
         """Let go of the left button."""

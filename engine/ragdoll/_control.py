@@ -24,8 +24,10 @@ GRAVITY = 9.81
 _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
 _PIN_DAMPING = 100.0  # and damping (1/s): critically damped
 _MAX_LEAD = 0.5  # s: cap on the velocity lead at tiny weights
-_GROUND_BIT = 1  # contype/conaffinity bit of the ground
-_BODY_BITS = 2  # bit every ragdoll body and prop shares
+# contype/conaffinity bits (mjcf.py sets the simulated ones): 1 ground, 2 simulated
+# bodies and props, 4 animated bodies
+_SIMULATED_TYPE, _SIMULATED_AFFINITY = 3, 7
+_ANIMATED_TYPE, _ANIMATED_AFFINITY = 4, 2
 _F = NDArray[np.float64]
 
 
@@ -87,11 +89,12 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
     d.mocap_quat[L.pin_mocap] = quat.mul(quat.exp(w_root * pin_lead[:, None]), rot[r0])
     d.xfrc_applied[L.body] = 0.0
     d.xfrc_applied[L.body, 1] = m.body_mass[L.body] * GRAVITY * np.array([c.support for c in cmds])[L.body_owner]
-    # A kinematic body and the static ground cannot push each other: animated ragdolls
-    # leave the ground's contact bit and keep the one they share with props and bodies.
-    bits = np.where(kin[L.geom_owner], _BODY_BITS, _BODY_BITS | _GROUND_BIT)
-    m.geom_contype[L.geom] = bits
-    m.geom_conaffinity[L.geom] = bits
+    # An animated (kinematic) ragdoll touches only simulated bodies and props: not the
+    # ground (neither can give way), not other animated bodies and not itself -- a
+    # crouching pose lays the arms into the legs, and the contact impulses inside the
+    # substeps would spin the arms and fling the ball in their hands.
+    m.geom_contype[L.geom] = np.where(kin[L.geom_owner], _ANIMATED_TYPE, _SIMULATED_TYPE)
+    m.geom_conaffinity[L.geom] = np.where(kin[L.geom_owner], _ANIMATED_AFFINITY, _SIMULATED_AFFINITY)
     for p, c in enumerate(cmds):
         for name, eq in L.hold_eq[p].items():
             d.eq_active[eq] = name == c.hold

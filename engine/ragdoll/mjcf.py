@@ -209,8 +209,9 @@ def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequenc
         '<mujoco model="puppetphone">',
         '  <compiler angle="radian" autolimits="true"/>',
         # stiff contacts (5 ms, critically damped): snowballs and bodies barely sink into anything
-        # contype/conaffinity: bit 1 ground, bit 2 bodies and props (physics.py toggles bit 1)
-        '  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="3" conaffinity="3"/></default>',
+        # contype/conaffinity: bit 1 ground, bit 2 simulated bodies and props, bit 4 animated
+        # (kinematic) bodies, which _control.py switches to contype 4 / conaffinity 2
+        '  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="3" conaffinity="7"/></default>',
         f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"/>',
         "  <worldbody>",
         f'    <geom name="ground" type="plane" size="0 0 1" zaxis="0 1 0" contype="1" conaffinity="1" friction="{_f(ground_friction)} 0.005 0.002"/>',

@@ -53,6 +53,7 @@ def snowman_tuning(shape: SnowmanShape) -> PuppetTuning:
         max_speed=base.max_speed * s,
         flick_launch_speed=base.flick_launch_speed * np.sqrt(s),
         reach=base.reach + shape.bottom * 0.5,
+        front=shape.bottom + 0.05,
         carry_max_radius=max(base.carry_max_radius, 0.8 * shape.bottom),
     )
 

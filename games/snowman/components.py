@@ -35,10 +35,12 @@ class Snowman:
 
 @dataclass
 class StackWatch:
-    """Resource: how long each candidate stack (by its ball ids) has stood still."""
+    """Resource: how long each candidate stack (by its ball ids) has stood still, and how
+    many two-ball stacks stand waiting for a head."""
 
     SIM_STATE = True
     frames: dict[tuple[int, ...], int] = field(default_factory=dict)
+    headless: int = 0
 
 
 @dataclass

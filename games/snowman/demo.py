@@ -62,6 +62,10 @@ class Director:
     def pos(self, e: Entity) -> np.ndarray:
         return self.world.get(e, Transform).position.copy()
 
+    def where(self, e: Entity) -> str:
+        """Position for the log, or what became of it (the balls of a snowman are gone)."""
+        return str(self.pos(e).round(2)) if self.world.alive(e) else "(part of a snowman now)"
+
     def state(self, e: Entity) -> str:
         return self.world.get(e, Brain).active
 
@@ -126,7 +130,15 @@ class Director:
         self.bot.wait(0.6)
         self.bot.release()
         self.bot.wait(0.8)
-        self.say(f"ball {ball} at {self.pos(ball).round(2)}, on ball {lower} at {self.pos(lower).round(2)}")
+        self.say(f"ball {ball} at {self.where(ball)}, on ball {lower} at {self.where(lower)}")
+
+    def approach(self, who: Entity, ball: Entity, side: np.ndarray, gap: float = 0.3) -> None:
+        """Walk ``who`` up to ``ball`` from direction ``side`` and stop facing it, ``gap`` from its surface."""
+        centre = self.pos(ball)
+        centre[1] = 0.0
+        side = np.asarray(side, dtype=np.float64) / np.linalg.norm(side)
+        r = self.world.get(ball, Prop).radius
+        self.walk(who, [centre + side * (r + gap + 0.8), centre + side * (r + gap)], speed=0.9)
 
     def carry_onto(self, who: Entity, ball: Entity, lower: Entity, notches: int = 4) -> None:
         """``who`` stands behind ``ball`` facing it: pick it up, carry it to ``lower``, put it on top."""
@@ -139,13 +151,13 @@ class Director:
         here, goal = self.pos(who), self.pos(lower)
         away = here - goal
         away[1] = 0.0
-        stand = goal + away / np.linalg.norm(away) * (self.world.get(lower, Prop).radius + 0.55)
+        stand = goal + away / np.linalg.norm(away) * (self.world.get(lower, Prop).radius + 0.45)
         self.bot.drag_path([stand], 0.9)
         self.bot.wait(0.8)
         self.say(f"carrying to {stand.round(2)}: {self.state(who)} at {self.pos(who).round(2)}")
         self.wheel(-notches)
         self.bot.wait(1.2)
-        self.say(f"putting down: {self.state(who)}; ball {ball} at {self.pos(ball).round(2)}")
+        self.say(f"putting down: {self.state(who)}; ball {ball} at {self.where(ball)}")
         self.wheel(notches)
         self.bot.wait(0.5)
         self.bot.release()
@@ -186,17 +198,20 @@ def play(d: Director) -> None:
     # 4. The stick lifts the middle ball onto the bottom one.
     d.mark("stacking")
     d.lift_onto(middle, bottom, 10)
-    # 5. The puppet carries the head ball up and puts it on top.
+    # 5. The puppet walks up to the head ball, carries it up and puts it on top.
+    d.approach(puppet, head, _xz(1.0, 0.0))
     d.carry_onto(puppet, head, bottom)
     first = d.wait_for_snowman(1)
     d.mark("alive")
     d.bot.wait(0.5)
+    # The puppet steps aside (it stands between the camera and the snowman).
+    d.walk(puppet, [d.pos(puppet) + _xz(0.6, -0.6), _xz(-1.0, -2.6)])
     # 6. The snowman builds another snowman: a bottom ball and a head ball, stacked with the stick.
     here = d.pos(first)
-    d.walk(first, [here + _xz(0.6, 0.3), _xz(0.8, -0.6)])
-    bottom2 = d.roll(first, [_xz(1.6, -0.7), _xz(2.4, -0.4), _xz(2.8, 0.4)])
-    d.walk(first, [_xz(2.0, 0.5), _xz(1.6, 1.4), _xz(1.3, 1.7)])
-    head2 = d.roll(first, [_xz(0.6, 2.0)])
+    d.walk(first, [here + _xz(0.6, 0.3), _xz(0.2, -1.2), _xz(0.8, -1.2)])
+    bottom2 = d.roll(first, _arc((2.0, 0.3), 1.5, -0.5 * np.pi, 0.5 * np.pi, 10))
+    d.walk(first, [d.pos(first) + _xz(0.0, 0.6), _xz(3.0, 1.6), _xz(3.6, -0.4), _xz(3.6, -1.6), _xz(3.1, -1.6)])
+    head2 = d.roll(first, [_xz(1.9, -1.6)])
     d.mark("second")
     d.lift_onto(head2, bottom2, 8)
     d.wait_for_snowman(2)

@@ -32,7 +32,7 @@ CONTROLS = (
     "mouse: a quick upward flick while holding = jump; right-drag orbits the camera",
     "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
     "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
-    "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive",
+    "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
 )
 
 
@@ -62,6 +62,8 @@ def status(world: World) -> list[str]:
     """Counter of snowmen built, and the controls until the first grab."""
     stats = world.resource(SnowmanStats)
     lines = [f"snowmen built: {stats.built}   standing: {snowmen_standing(world)}   snowballs started: {stats.balls_started}"]
+    if world.resource(StackWatch).headless:
+        lines.append("a snowman body is waiting for its head: put a smaller ball on top")
     if stats.built == 0 and world.frame < 60 * 20 and not world.query(Snowman):
         lines += list(CONTROLS)
     return lines

@@ -8,6 +8,8 @@
    slows down at ``SNOW_DRAG`` m/s² (rigid spheres on a plane would roll on for ever).
 4. **Building**: two or three balls stacked largest at the bottom that stand still
    for half a second come alive as a snowman puppet (:mod:`~games.snowman.alive`).
+   The top of a two-ball stack must be head-sized (at most ``HEAD_RATIO`` of the ball
+   under it); a bigger one is a middle and the stack waits for its head.
 """
 
 from __future__ import annotations
@@ -28,15 +30,16 @@ from games.snowman.rig import SnowmanShape
 from games.snowman.snow import SnowField
 
 __all__ = ["stick_stacked_balls", "grow_snowballs", "start_snowballs", "assemble_snowmen", "spawn_ball", "snow_drag", "aim_putdown_on_stacks",
-           "snowmen_standing", "MAX_RADIUS", "MAX_BALLS", "SNOW_DRAG"]
+           "snowmen_standing", "MAX_RADIUS", "MAX_BALLS", "SNOW_DRAG", "HEAD_RATIO"]
 
 MAX_RADIUS = 0.6
 MAX_BALLS = 24
 START_RADIUS = 0.11
-START_GAP = 0.4
+START_GAP = 0.18  # beyond the body's front
 GROWTH_STEP = 0.01
 STILL_FRAMES = 30
 SNOW_DRAG = 5.0
+HEAD_RATIO = 0.6
 
 
 def spawn_ball(world: World, position: np.ndarray, radius: float) -> int:
@@ -120,31 +123,21 @@ def snow_drag(world: World) -> None:
 def aim_putdown_on_stacks(world: World) -> None:
     """A puppet putting a ball down onto a stack puts it on the stack's top ball.
 
-    The brain aims at the first free ball in front; balls already packed on it are
-    ``carried`` and invisible to it, so it would press the new ball into them. This
-    rule (after the brain's first PutDown step) climbs the stack to its top and aims
-    there when the top ball is still the bigger one.
+    The brain aims at the first free ball in front (``putdown_on``); balls already
+    packed on it are ``carried`` and invisible to it, so it would press the new ball
+    into them. This rule climbs the stack to its top and aims there while the top ball
+    is still the bigger one.
     """
     on = {s.on: e for e, s in world.query(Stacked)}
-    for e, body, brain in world.query(PuppetBody, Brain):
-        spot = brain.memory.get("putdown_spot")
-        if brain.active != "PutDown" or spot is None or body.object is None or not world.alive(body.object):
-            continue
-        radius = world.get(body.object, Prop).radius
-        base = None
-        for o, _, prop, tr in world.query(Snowball, Prop, Transform):
-            aimed_at = abs(tr.position[1] + prop.radius + radius + 0.01 - spot[1]) < 1e-6
-            if o != body.object and aimed_at and float(np.hypot(*(tr.position - spot)[[0, 2]])) < 1e-6:
-                base = o
-                break
-        if base is None or base not in on:
+    for _, body, brain in world.query(PuppetBody, Brain):
+        base = brain.memory.get("putdown_on")
+        if brain.active != "PutDown" or base not in on or body.object is None or not world.alive(body.object):
             continue
         top = base
         while top in on and on[top] != body.object:
             top = on[top]
-        top_prop, top_tr = world.get(top, Prop), world.get(top, Transform)
-        if top_prop.radius > radius:
-            brain.memory["putdown_spot"] = np.array([top_tr.position[0], top_tr.position[1] + top_prop.radius + radius + 0.01, top_tr.position[2]])
+        if world.get(top, Prop).radius > world.get(body.object, Prop).radius:
+            brain.memory["putdown_on"] = top
 
 
 def start_snowballs(world: World) -> None:
@@ -159,7 +152,7 @@ def start_snowballs(world: World) -> None:
             continue
         if count >= MAX_BALLS or prop_in_front(world, e, body, 1.0) is not None:
             continue
-        spot = tr.position + heading_vector(body.heading) * (START_GAP + START_RADIUS)
+        spot = tr.position + heading_vector(body.heading) * (body.tuning.front + START_GAP + START_RADIUS)
         if field.depth_at(spot) <= 0.0:
             continue
         spawn_ball(world, spot, START_RADIUS)
@@ -179,7 +172,11 @@ def assemble_snowmen(world: World) -> None:
     ]
     still = {b.entity for b in balls if float(np.linalg.norm(world.get(b.entity, Prop).velocity[:3])) < 0.2}
     seen: dict[tuple[int, ...], int] = {}
+    watch.headless = 0
     for stack in find_snowmen([b for b in balls if b.entity in still]):
+        if len(stack) == 2 and stack[1].radius > HEAD_RATIO * stack[0].radius:
+            watch.headless += 1
+            continue
         key = tuple(b.entity for b in stack)
         seen[key] = watch.frames.get(key, 0) + 1
         if seen[key] >= STILL_FRAMES:

@@ -62,7 +62,7 @@ def test_grab_keeps_length_and_relative_rotation_then_release(make_app):
     assert np.allclose(stick.grab_rotation, rel)
     src.push(world_sample(target, touch=False))
     app.step()
-    assert stick.grabbed is None and stick.just_released and not stick.touching
+    assert stick.grabbed is None and stick.released == puppet and not stick.touching
 
 
 def test_tip_stops_at_the_ground_and_at_obstacles(make_app):
@@ -85,16 +85,19 @@ def test_disconnect_releases_and_despawned_target_releases(make_app):
     src.push(world_sample([0, 0.95 - 1.5, 4.0], touch=True))
     app.step()
     stick = app.world.get(e, Stick)
-    assert stick.grabbed is not None
+    held = stick.grabbed
+    assert held is not None
     src.disconnected("m")
     app.step()
-    assert stick.grabbed is None and stick.just_released and not stick.connected
+    assert stick.grabbed is None and stick.released == held and not stick.connected
     src.push(world_sample([0, 0.95 - 1.5, 4.0], touch=True))
     app.step()
     assert stick.connected and stick.grabbed is not None
     app.world.despawn(stick.grabbed)
     app.step()
-    assert stick.grabbed is None and stick.just_released
+    assert stick.grabbed is None and stick.released is not None
+    app.step()
+    assert stick.released is None  # for one step only
 
 
 def test_device_calibration_makes_the_pointing_direction_forward(make_app):

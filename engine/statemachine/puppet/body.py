@@ -25,7 +25,9 @@ F = NDArray[np.float64]
 class PuppetTuning:
     """Thresholds and rates of the puppet behaviour (thesis §6.2.2, §6.3).
 
-    Heights are hips heights in metres; speeds in m/s.
+    Heights are hips heights in metres; speeds in m/s. ``front`` is how far the body
+    reaches in front of its root: balls are carried, rolled and put down beyond it, so
+    a bulky puppet (a snowman's bottom ball) never holds a ball inside itself.
     """
 
     stand_height: float = 0.95
@@ -44,6 +46,7 @@ class PuppetTuning:
     flick_grace: float = 0.1
     jump_ragdoll_fall: float = 0.0
     reach: float = 0.55
+    front: float = 0.22
     carry_max_radius: float = 0.26
     pickup_time: float = 0.35
     still_speed: float = 0.2

@@ -92,6 +92,8 @@ def update_locomotion(world: World, entity: Entity, brain: Brain) -> None:
     player = world.get(entity, LocomotionPlayer)
     t = body.tuning
     standing = body.held_by is None or body.target_height >= t.crouch_exit
+    if standing:  # standing up ends the "leave it there" of a put-down (object_states)
+        brain.memory.pop("put_down", None)
     player.height = None if standing else float(np.clip(body.target_height, t.crouch_enter, t.stand_height))
     follow_stick(world, entity, body, player)
     _ground_ik(world, entity)

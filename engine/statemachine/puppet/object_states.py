@@ -30,7 +30,7 @@ from engine.statemachine.puppet.senses import heading_vector, prop_in_front
 __all__ = [
     "can_pick_up", "enter_pickup", "update_pickup", "pickup_done",
     "update_carry", "exit_carry", "enter_putdown", "update_putdown", "putdown_done", "exit_putdown",
-    "can_roll", "enter_roll", "update_roll", "exit_roll", "stop_rolling", "carry_position", "wants_putdown",
+    "putdown_spot", "can_roll", "enter_roll", "update_roll", "exit_roll", "stop_rolling", "carry_position", "wants_putdown",
 ]
 
 
@@ -43,16 +43,18 @@ def _hands(world: World, entity: Entity, centre: np.ndarray, radius: float) -> N
 def carry_position(world: World, entity: Entity, body: PuppetBody, radius: float) -> np.ndarray:
     """Where a carried ball sits: in front of the chest."""
     tr = world.get(entity, Transform)
-    return tr.position + np.array([0.0, body.tuning.stand_height + 0.1, 0.0]) + heading_vector(body.heading) * (0.22 + radius)
+    return tr.position + np.array([0.0, body.tuning.stand_height + 0.1, 0.0]) + heading_vector(body.heading) * (body.tuning.front + radius)
 
 
 def can_pick_up(world: World, entity: Entity, brain: Brain) -> bool:
-    """Crouched, nearly still, a small free ball within reach in front."""
+    """Crouched, nearly still, a small free ball within reach in front -- not the one
+    just put down, which stays put until the puppet has stood up again."""
     body = world.get(entity, PuppetBody)
     t = body.tuning
     if body.held_by is None or brain.time_in_state < t.still_time or body.speed > t.still_speed:
         return False
-    return prop_in_front(world, entity, body, t.reach, t.carry_max_radius) is not None
+    ball = prop_in_front(world, entity, body, t.reach, t.carry_max_radius)
+    return ball is not None and ball != brain.memory.get("put_down")
 
 
 def enter_pickup(world: World, entity: Entity, brain: Brain) -> None:
@@ -110,22 +112,35 @@ def exit_carry(world: World, entity: Entity, brain: Brain) -> None:
 
 
 def enter_putdown(world: World, entity: Entity, brain: Brain) -> None:
-    """Start lowering the ball: onto a ball in front if there is one, else onto the ground."""
+    """Start lowering the ball: onto a bigger ball its ground spot would overlap, else onto the ground.
+
+    The ball under it is remembered (``putdown_on``), not its position: it may still be
+    moving, and a game may re-aim to the top of a stack standing on it.
+    """
     body = world.get(entity, PuppetBody)
     body.phase, body.timer = "lower", 0.0
+    brain.memory.pop("putdown_on", None)
     if body.object is None or not world.alive(body.object):
         return
     prop = world.get(body.object, Prop)
-    ahead = world.get(entity, Transform).position + heading_vector(body.heading) * (0.25 + prop.radius)
-    spot = np.array([ahead[0], prop.radius, ahead[2]])
+    ahead = world.get(entity, Transform).position + heading_vector(body.heading) * (body.tuning.front + 0.03 + prop.radius)
+    brain.memory["putdown_spot"] = np.array([ahead[0], prop.radius, ahead[2]])
+    nearest = np.inf
     for e, other, otr in world.query(Prop, Transform):
-        if e == body.object or other.carried:
+        if e == body.object or other.carried or other.radius <= prop.radius:
             continue
-        d = otr.position - ahead
-        if np.hypot(d[0], d[2]) < other.radius + 0.15 and other.radius > prop.radius:
-            spot = np.array([otr.position[0], otr.position[1] + other.radius + prop.radius + 0.01, otr.position[2]])
-            break
-    brain.memory["putdown_spot"] = spot
+        gap = float(np.hypot(*(otr.position - ahead)[[0, 2]]))
+        if gap < other.radius + prop.radius and gap < nearest:
+            brain.memory["putdown_on"], nearest = e, gap
+
+
+def putdown_spot(world: World, brain: Brain, radius: float) -> np.ndarray:
+    """Where the lowered ball goes now: on top of ``putdown_on`` if it is still there, else the ground spot."""
+    under = brain.memory.get("putdown_on")
+    if under is not None and world.alive(under):
+        top = world.get(under, Transform).position
+        return top + np.array([0.0, world.get(under, Prop).radius + radius + 0.01, 0.0])
+    return brain.memory["putdown_spot"]
 
 
 def update_putdown(world: World, entity: Entity, brain: Brain) -> None:
@@ -138,9 +153,8 @@ def update_putdown(world: World, entity: Entity, brain: Brain) -> None:
         return
     prop, ptr = world.get(body.object, Prop), world.get(body.object, Transform)
     prop.carried = True
-    spot = brain.memory["putdown_spot"]
     s = min(body.timer / body.tuning.pickup_time, 1.0)
-    ptr.position = ptr.position + s * (spot - ptr.position)
+    ptr.position = ptr.position + s * (putdown_spot(world, brain, prop.radius) - ptr.position)
     _hands(world, entity, ptr.position, prop.radius)
 
 
@@ -156,8 +170,10 @@ def exit_putdown(world: World, entity: Entity, brain: Brain) -> None:
     if body.object is not None and world.alive(body.object):
         prop = world.get(body.object, Prop)
         prop.carried, prop.placed, prop.velocity = False, True, np.zeros(6)
+        brain.memory["put_down"] = body.object
     body.object = None
     brain.memory.pop("putdown_spot", None)
+    brain.memory.pop("putdown_on", None)
 
 
 def can_roll(world: World, entity: Entity, brain: Brain) -> bool:
@@ -190,7 +206,7 @@ def update_roll(world: World, entity: Entity, brain: Brain) -> None:
         return
     prop, ptr = world.get(body.object, Prop), world.get(body.object, Transform)
     tr = world.get(entity, Transform)
-    new = tr.position + heading_vector(body.heading) * (0.3 + prop.radius)
+    new = tr.position + heading_vector(body.heading) * (body.tuning.front + 0.08 + prop.radius)
     new = np.array([new[0], prop.radius, new[2]])
     moved = new - ptr.position
     moved[1] = 0.0

@@ -42,7 +42,7 @@ def _clear_of_others(point: np.ndarray, entity: int, radius: float, props: list)
 def held_props_system(world: World) -> None:
     """The ``statemachine`` stage: move held props with their sticks; let go on release."""
     holders = {s.grabbed: s for _, s in world.query(Stick) if s.grabbed is not None}
-    released = {s.grabbed for _, s in world.query(Stick) if s.just_released}
+    released = {s.released for _, s in world.query(Stick) if s.released is not None}
     props = world.query(Prop, Transform)
     for e, prop, tr, grab in world.query(Prop, Transform, Grabbable):
         stick = holders.get(e)
