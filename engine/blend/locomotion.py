@@ -97,10 +97,14 @@ class LocomotionPlayer:
 
     Attributes:
         library_key: which :class:`LocomotionSet` drives this puppet.
+        scale: the puppet's size relative to the set's clips. Requests are divided by it
+            and the root's height and travel multiplied by it (rotations are kept), so a
+            snowman with legs 0.6 as long plays the puppet's set at 0.6 with planted feet,
+            and every puppet of a set is posed in one batch whatever its size.
         speed: requested ground speed (m/s, ≥ 0) along the puppet's heading.
         height: requested hips height (m); ``None`` stands tall.
         point: the blend point in use (eased), ``None`` until the first step.
-        feasible: the request actually played (after projection).
+        feasible: the request actually played (after projection), in the puppet's units.
         inside: whether the last request was feasible.
         rate: playback speed-up applied (1 inside the feasible set).
         phase: shared normalised phase in ``[0, 1)``.
@@ -114,6 +118,7 @@ class LocomotionPlayer:
     """
 
     library_key: str = "humanoid"
+    scale: float = 1.0
     speed: float = 0.0
     height: float | None = None
     point: F | None = None
@@ -189,14 +194,17 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
         speed, height = player.speed, player.height
         if not (np.isfinite(speed) and speed >= 0.0 and (height is None or np.isfinite(height))):
             raise ValueError(f"entity {e}: locomotion request speed={speed!r}, height={height!r} is invalid")
+        if not (np.isfinite(player.scale) and player.scale > 0.0):
+            raise ValueError(f"entity {e}: locomotion scale {player.scale!r} must be positive")
+        speed, height = speed / player.scale, None if height is None else height / player.scale
         res = library.memo.get((key, float(speed), None if height is None else float(height)))
         out.append(res)
         if res is None:
             misses.append(i)
     if misses:
         players = [members[i][3] for i in misses]
-        speeds = np.array([p.speed for p in players], dtype=np.float64)
-        heights = np.array([np.nan if p.height is None else p.height for p in players], dtype=np.float64)
+        speeds = np.array([p.speed / p.scale for p in players], dtype=np.float64)
+        heights = np.array([np.nan if p.height is None else p.height / p.scale for p in players], dtype=np.float64)
         standing = np.isnan(heights)
         if standing.any():
             heights[standing] = loco.standing_heights(speeds[standing])
@@ -205,8 +213,8 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
             library.memo.clear()
         for j, i in enumerate(misses):
             res = Resolution(points[j], feasible[j], bool(inside[j]), float(rates[j]))
-            p = players[j]
-            library.memo[(key, float(p.speed), None if p.height is None else float(p.height))] = res
+            h = heights[j]
+            library.memo[(key, float(speeds[j]), None if players[j].height is None else float(h))] = res
             out[i] = res
     return out  # type: ignore[return-value]
 
@@ -228,7 +236,7 @@ def animate(world: World) -> None:
         for (_e, _, _, player), res in zip(members, _resolve_group(library, key, loco, members), strict=True):
             player.finished = None
             p = res.point if player.point is None else player.point + alpha * (res.point - player.point)
-            player.point, player.feasible, player.inside, player.rate = p, res.feasible, res.inside, res.rate
+            player.point, player.feasible, player.inside, player.rate = p, res.feasible * player.scale, res.inside, res.rate
             points.append(p)
             rates.append(res.rate)
         w = space.weights(np.array(points))
@@ -236,15 +244,18 @@ def animate(world: World) -> None:
         new_phase, travel, turn = space.advance(phase, w, dt, np.array(rates))
         # Scaling the phase step by the rate already scales the root travel: feet keep pace with the ground.
         pose = space.sample(w, new_phase)
-        roots, rots = pose.root.copy(), pose.rotations.copy()
+        scale = np.array([m[3].scale for m in members])
+        roots, rots = pose.root * scale[:, None], pose.rotations.copy()
+        travel = travel * scale[:, None]
         keep_turn = np.ones(len(members))
         for i, (_e, _tr, _pup, player) in enumerate(members):
             player.phase = float(new_phase[i] % 1.0)
             clip, weight, clip_travel = _override(player, loco, dt)
             if clip is not None:
-                local = crossfade(Pose(roots[i], rots[i]), clip.sample(player.override_time), weight)
+                over = clip.sample(player.override_time)
+                local = crossfade(Pose(roots[i], rots[i]), Pose(over.root * scale[i], over.rotations), weight)
                 roots[i], rots[i] = local.root, local.rotations
-                travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel
+                travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
                 keep_turn[i] = 1.0 - weight
         # Heading, travel and the world root for the whole group at once.
         yaw = _yaw(np.array([m[1].rotation for m in members]))

@@ -128,14 +128,14 @@ class BlendSpace:
     def sample(self, weights: ArrayLike, phase: ArrayLike) -> Pose:
         """The blended in-place pose (batch ``[...]``) at group ``phase [...]`` with ``weights [..., K]``."""
         w = np.asarray(weights, dtype=np.float64)
-        times = self.sync.clip_times(phase)
         # Only clips with weight somewhere in the batch are sampled (gradient bands are local:
         # two or three of the five puppet clips at a time).
         active = np.flatnonzero(np.any(w.reshape(-1, len(self.clips)) > 0.0, axis=0))
+        times = self.sync.clip_times(phase, active)
         roots = []
         rots = []
-        for k in active:
-            pose = self.clips[k].sample(times[..., k])
+        for i, k in enumerate(active):
+            pose = self.clips[k].sample(times[..., i])
             roots.append(pose.root)
             rots.append(pose.rotations)
         root = np.stack(roots, axis=-2)  # [..., K', 3]

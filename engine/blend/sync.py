@@ -111,16 +111,19 @@ class SyncGroup:
         """Seconds of one blended cycle, ``Σ wᵢTᵢ`` for weights ``[..., K]`` summing to one."""
         return np.asarray(weights, dtype=np.float64) @ self.durations
 
-    def clip_times(self, phase: ArrayLike) -> F:
-        """Each clip's unwrapped local time in seconds at group phase ``phase [...]``: ``[..., K]``."""
+    def clip_times(self, phase: ArrayLike, active: ArrayLike | None = None) -> F:
+        """Each clip's unwrapped local time in seconds at group phase ``phase [...]``: ``[..., K]``,
+        or ``[..., K']`` for the clip indices ``active`` only (the ones with weight)."""
         phase = np.asarray(phase, dtype=np.float64)
         cycles = np.floor(phase)
         frac = phase - cycles
-        out = np.empty(phase.shape + (len(self.clips),))
-        for k, (xp, fp) in enumerate(self._knots):
+        ks = range(len(self.clips)) if active is None else [int(k) for k in np.asarray(active).reshape(-1)]
+        out = np.empty(phase.shape + (len(ks),))
+        for i, k in enumerate(ks):
+            xp, fp = self._knots[k]
             # Normalised clip time, shifted so the first marker lands on phase 0.
             local = np.interp(frac, xp, fp)
-            out[..., k] = (cycles + local) * self.durations[k]
+            out[..., i] = (cycles + local) * self.durations[k]
         return out
 
     def advance(self, phase: ArrayLike, weights: ArrayLike, dt: float, rate: ArrayLike = 1.0) -> F:
@@ -129,30 +132,35 @@ class SyncGroup:
             weights
         )
 
-    def root_motion(self, phase: ArrayLike) -> tuple[F, F]:
-        """Accumulated root travel ``[..., K, 3]`` and heading ``[..., K]`` of every clip at ``phase``.
+    def root_motion(self, phase: ArrayLike, active: ArrayLike | None = None) -> tuple[F, F]:
+        """Accumulated root travel ``[..., K, 3]`` and heading ``[..., K]`` of every clip at ``phase``
+        (``K'`` of them with ``active``).
 
         Vectorised equivalent of :meth:`Clip.sample_root_motion` over a batch of times.
         """
-        times = self.clip_times(phase)
+        ks = range(len(self.clips)) if active is None else [int(k) for k in np.asarray(active).reshape(-1)]
+        times = self.clip_times(phase, active)
         trans = np.empty(times.shape + (3,))
         head = np.empty(times.shape)
-        for k, (table, cycle) in enumerate(self._root_tables):
+        for i, k in enumerate(ks):
+            table, cycle = self._root_tables[k]
             n = len(table) - 1
-            f = times[..., k] * self.clips[k].fps
+            f = times[..., i] * self.clips[k].fps
             cycles = np.floor(f / n)
             local = f - cycles * n
             i0 = np.minimum(np.floor(local).astype(np.int64), n - 1)
             a = (local - i0)[..., None]
             row = table[i0] + a * (table[i0 + 1] - table[i0]) + cycles[..., None] * cycle
-            trans[..., k, :] = row[..., :3]
-            head[..., k] = row[..., 3]
+            trans[..., i, :] = row[..., :3]
+            head[..., i] = row[..., 3]
         return trans, head
 
     def root_delta(self, phase0: ArrayLike, phase1: ArrayLike, weights: ArrayLike) -> tuple[F, F]:
         """Blended root travel ``[..., 3]`` (clip frame) and heading change ``[...]`` from ``phase0`` to ``phase1``."""
         p0, p1 = np.broadcast_arrays(np.asarray(phase0, dtype=np.float64), np.asarray(phase1, dtype=np.float64))
-        trans, head = self.root_motion(np.stack([p0, p1]))  # one pass over the clips for both ends
-        t0, t1, h0, h1 = trans[0], trans[1], head[0], head[1]
         w = np.asarray(weights, dtype=np.float64)
+        active = np.flatnonzero(np.any(w.reshape(-1, len(self.clips)) > 0.0, axis=0))  # clips without weight add nothing
+        trans, head = self.root_motion(np.stack([p0, p1]), active)  # one pass over the clips for both ends
+        t0, t1, h0, h1 = trans[0], trans[1], head[0], head[1]
+        w = w[..., active]
         return np.sum(w[..., None] * (t1 - t0), axis=-2), np.sum(w * (h1 - h0), axis=-1)

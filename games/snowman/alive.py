@@ -1,11 +1,12 @@
-"""Bringing a snowman to life: its rig, its locomotion set, and the puppet entity.
+"""Bringing a snowman to life: its rig, its locomotion, and the puppet entity.
 
 Every snowman is a puppet: the same state machine and blend space as the default
-puppet, with clips scaled to its proportions — the clips' local rotations are
-kept, the root's height and travel are scaled by the snowman's leg scale, so its
-feet stay planted on its shorter legs — and its lookup table measured anew on
-those clips (thesis §6.3: "adapted to different environments and character
-dimensions").
+puppet, played at the snowman's leg scale (:attr:`LocomotionPlayer.scale`) — the
+clips' local rotations are kept and the root's height and travel are scaled, so its
+feet stay planted on its shorter legs, and requests (speed, hips height) are read in
+the clips' units, which is the lookup table measured on scaled clips (thesis §6.3:
+"adapted to different environments and character dimensions"). Sharing the set also
+poses every puppet and snowman in one batch.
 """
 
 from __future__ import annotations
@@ -14,29 +15,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from engine.blend.locomotion import BlendLibrary
-from engine.blend.puppet import build_locomotion
-from engine.clip import Clip, RootMotion
-from engine.clips import default_clips
 from engine.ecs import Entity, World
 from engine.render.components import Appearance
-from engine.skeleton import Skeleton
 from engine.statemachine.puppet import PuppetTuning, spawn_puppet
 from games.snowman.components import Snowman
 from games.snowman.rig import SnowmanShape, leg_scale, snowman_skeleton
 
-__all__ = ["scaled_clips", "bring_to_life", "snowman_tuning"]
-
-
-def scaled_clips(skeleton: Skeleton, scale: float) -> dict[str, Clip]:
-    """The default clips on ``skeleton`` with root height and travel scaled by ``scale``."""
-    out = {}
-    for name, clip in default_clips().items():
-        rm = clip.root_motion
-        if rm is not None:
-            rm = RootMotion(rm.translation * scale, rm.heading)
-        out[name] = replace(clip, skeleton=skeleton, root=clip.root * scale, root_motion=rm)
-    return out
+__all__ = ["bring_to_life", "snowman_tuning"]
 
 
 def snowman_tuning(shape: SnowmanShape) -> PuppetTuning:
@@ -60,18 +45,14 @@ def snowman_tuning(shape: SnowmanShape) -> PuppetTuning:
 
 def bring_to_life(world: World, shape: SnowmanShape, position: np.ndarray, heading: float, number: int) -> Entity:
     """Spawn a snowman puppet standing where its bottom ball was."""
-    skeleton = snowman_skeleton(shape)
-    key = f"snowman-{number}"
-    library = world.resource(BlendLibrary)
-    if key not in library:
-        library.add(key, build_locomotion(scaled_clips(skeleton, leg_scale(shape)), density=15, dt=world.dt))
     ground = np.array([position[0], 0.0, position[2]])
     return spawn_puppet(
         world,
         ground,
         heading,
-        skeleton=skeleton,
-        library_key=key,
+        skeleton=snowman_skeleton(shape),
+        library_key="humanoid",
+        scale=leg_scale(shape),
         tuning=snowman_tuning(shape),
         name=f"snowman {number}",
         extra=(Snowman(shape, number), Appearance(color=(0.97, 0.98, 1.0), visible=False)),

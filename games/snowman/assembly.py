@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Ball", "find_snowmen", "resting_on"]
+__all__ = ["Ball", "find_snowmen", "resting_on", "resting_matrix"]
 
 
 @dataclass(frozen=True)
@@ -25,30 +25,48 @@ class Ball:
     radius: float
 
 
+def resting_matrix(centers: NDArray[np.float64], radii: NDArray[np.float64], gap: float = 0.06,
+                   off_axis: float = 0.45) -> NDArray[np.bool_]:
+    """``[N, N]`` booleans: entry ``[u, l]`` says ball ``u`` sits on top of ball ``l``.
+
+    On top means: centre above, horizontally within ``off_axis`` of the lower radius, and
+    the distance between centres within ``gap`` (a fraction of the radii sum) of touching.
+    All pairs at once: the rules ask every step, for every ball.
+    """
+    c = np.asarray(centers, dtype=np.float64).reshape(-1, 3)
+    r = np.asarray(radii, dtype=np.float64).reshape(-1)
+    d = c[:, None, :] - c[None, :, :]
+    horizontal = np.hypot(d[..., 0], d[..., 2])
+    touch = r[:, None] + r[None, :]
+    return (d[..., 1] > 0) & (horizontal <= off_axis * r[None, :]) & (np.abs(np.linalg.norm(d, axis=-1) - touch) <= gap * touch)
+
+
 def resting_on(upper: Ball, lower: Ball, gap: float = 0.06, off_axis: float = 0.45) -> bool:
-    """Whether ``upper`` sits on top of ``lower``."""
-    d = np.asarray(upper.center) - np.asarray(lower.center)
-    horizontal = float(np.hypot(d[0], d[2]))
-    if d[1] <= 0 or horizontal > off_axis * lower.radius:
-        return False
-    return abs(float(np.linalg.norm(d)) - (upper.radius + lower.radius)) <= gap * (upper.radius + lower.radius)
+    """Whether ``upper`` sits on top of ``lower`` (one pair of :func:`resting_matrix`)."""
+    m = resting_matrix(np.array([upper.center, lower.center]), np.array([upper.radius, lower.radius]), gap, off_axis)
+    return bool(m[0, 1])
 
 
 def find_snowmen(balls: list[Ball], on_ground: float = 0.1) -> list[list[Ball]]:
     """Stacks of 2–3 balls, bottom first, radii decreasing upwards; each ball in one stack at most."""
-    order = sorted(balls, key=lambda b: (float(b.center[1]), b.entity))
+    if len(balls) < 2:
+        return []
+    centers = np.array([b.center for b in balls], dtype=np.float64)
+    radii = np.array([b.radius for b in balls], dtype=np.float64)
+    on = resting_matrix(centers, radii) & (radii[:, None] < radii[None, :])
+    order = sorted(range(len(balls)), key=lambda i: (float(centers[i, 1]), balls[i].entity))
     used: set[int] = set()
     stacks: list[list[Ball]] = []
     for base in order:
-        if base.entity in used or base.center[1] - base.radius > on_ground:
+        if base in used or centers[base, 1] - radii[base] > on_ground:
             continue
         stack = [base]
         while len(stack) < 3:
-            above = [b for b in order if b.entity not in used and b not in stack and resting_on(b, stack[-1]) and b.radius < stack[-1].radius]
+            above = [i for i in np.nonzero(on[:, stack[-1]])[0] if i not in used and i not in stack]
             if not above:
                 break
-            stack.append(min(above, key=lambda b: b.entity))
+            stack.append(min(above, key=lambda i: balls[i].entity))
         if len(stack) >= 2:
-            stacks.append(stack)
-            used.update(b.entity for b in stack)
+            stacks.append([balls[i] for i in stack])
+            used.update(stack)
     return stacks

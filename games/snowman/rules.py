@@ -24,7 +24,7 @@ from engine.statemachine import Brain
 from engine.statemachine.puppet import PuppetBody
 from engine.statemachine.puppet.senses import heading_vector, prop_in_front
 from games.snowman.alive import bring_to_life
-from games.snowman.assembly import Ball, find_snowmen, resting_on
+from games.snowman.assembly import Ball, find_snowmen, resting_matrix
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
 from games.snowman.rig import SnowmanShape
 from games.snowman.snow import SnowField
@@ -73,18 +73,24 @@ def stick_stacked_balls(world: World) -> None:
         lower_prop, lower_tr = balls[stacked.on]
         tr.position = lower_tr.position + np.array([0.0, lower_prop.radius + prop.radius, 0.0])
         prop.carried, prop.velocity = True, np.zeros(6)
-    for e, (prop, tr) in balls.items():
-        if e in held or world.has(e, Stacked) or prop.carried:
+    keys = list(balls)
+    if len(keys) < 2:
+        return
+    centers = np.array([balls[k][1].position for k in keys])
+    radii = np.array([balls[k][0].radius for k in keys])
+    on = resting_matrix(centers, radii, gap=0.1, off_axis=0.6) & (radii[:, None] < radii[None, :])
+    for i, e in enumerate(keys):
+        prop, tr = balls[e]
+        if e in held or world.has(e, Stacked) or prop.carried or prop.velocity[1] >= 0.5:
             continue
-        upper = Ball(e, tr.position, prop.radius)
-        for o, (oprop, otr) in balls.items():
-            if o == e or oprop.radius <= prop.radius or o in held:
+        for j in np.nonzero(on[i])[0]:
+            o = keys[j]
+            if o in held:
                 continue
-            if resting_on(upper, Ball(o, otr.position, oprop.radius), gap=0.1, off_axis=0.6) and prop.velocity[1] < 0.5:
-                world.add(e, Stacked(on=o))
-                tr.position = otr.position + np.array([0.0, oprop.radius + prop.radius, 0.0])
-                prop.carried, prop.velocity = True, np.zeros(6)
-                break
+            tr.position = balls[o][1].position + np.array([0.0, balls[o][0].radius + prop.radius, 0.0])
+            world.add(e, Stacked(on=o))
+            prop.carried, prop.velocity = True, np.zeros(6)
+            break
 
 
 def grow_snowballs(world: World) -> None:

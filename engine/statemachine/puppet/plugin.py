@@ -77,11 +77,13 @@ def spawn_puppet(
     *,
     skeleton: Skeleton | None = None,
     library_key: str = "humanoid",
+    scale: float = 1.0,
     tuning: PuppetTuning | None = None,
     name: str = "puppet",
     extra: tuple[object, ...] = (),
 ) -> Entity:
-    """Create a puppet standing at ``position`` facing ``heading`` (radians about +Y, 0 = +Z)."""
+    """Create a puppet standing at ``position`` facing ``heading`` (radians about +Y, 0 = +Z),
+    playing the locomotion set ``library_key`` at ``scale`` (see :class:`LocomotionPlayer`)."""
     sk = skeleton or humanoid_skeleton()
     tuning = tuning or PuppetTuning(stand_height=float(sk.offsets[0][1]))
     library = world.try_resource(BlendLibrary)
@@ -98,7 +100,7 @@ def spawn_puppet(
         Transform(pos, yaw_rotation(heading)),
         Puppet(sk),
         LocalPose(rest_root, rotations),
-        LocomotionPlayer(library_key=library_key),
+        LocomotionPlayer(library_key=library_key, scale=scale),
         IKRequest(grounding=True),
         Ragdoll(default_profile(sk), mode=RagdollMode.ANIMATED),
         PoseOverride(),

@@ -22,11 +22,12 @@ def loco(clips: dict[str, Clip]) -> LocomotionSet:
     return build_locomotion({**clips, "wave": one_shot}, density=21)
 
 
-def _app(loco: LocomotionSet, speed: float, heading: float = 0.0, height: float | None = None) -> tuple[App, int]:
+def _app(loco: LocomotionSet, speed: float, heading: float = 0.0, height: float | None = None,
+         scale: float = 1.0) -> tuple[App, int]:
     app = App(seed=1, plugins=[install_blend])
     app.world.resource(BlendLibrary).add("humanoid", loco)
     tr = Transform(rotation=quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), heading))
-    e = app.world.spawn(tr, Puppet(humanoid_skeleton()), LocomotionPlayer(speed=speed, height=height))
+    e = app.world.spawn(tr, Puppet(humanoid_skeleton()), LocomotionPlayer(speed=speed, height=height, scale=scale))
     return app, e
 
 
@@ -63,6 +64,27 @@ def test_crouch_request_lowers_the_hips(loco: LocomotionSet) -> None:
         app.step()
         heights.append(app.world.get(e, LocalPose).root[1])
     assert np.mean(heights) == pytest.approx(0.85, abs=0.01)
+
+
+def test_a_smaller_puppet_plays_the_set_scaled_same_rotations_shorter_root(loco: LocomotionSet) -> None:
+    """A snowman with legs 0.6 as long asks for 0.6 m/s: it plays the clips the full-size
+    puppet plays at 1 m/s, with the root 0.6 as high and 0.6 as far per step."""
+    big, e_big = _app(loco, 1.0)
+    small, e_small = _app(loco, 0.6, scale=0.6)
+    for _ in range(90):
+        big.step()
+        small.step()
+        a, b = big.world.get(e_big, LocalPose), small.world.get(e_small, LocalPose)
+        assert np.allclose(a.rotations, b.rotations, atol=1e-12)
+        assert b.root[1] == pytest.approx(0.6 * a.root[1], abs=1e-12)
+    travel_big = big.world.get(e_big, Transform).position
+    travel_small = small.world.get(e_small, Transform).position
+    assert np.allclose(travel_small, 0.6 * travel_big, atol=1e-12)
+    player = small.world.get(e_small, LocomotionPlayer)
+    assert player.feasible[0] == pytest.approx(0.6)  # reported in the puppet's own units
+    small.world.get(e_small, LocomotionPlayer).scale = 0.0
+    with pytest.raises(ValueError, match="scale"):
+        small.step()
 
 
 def test_too_fast_is_sped_up_and_still_keeps_pace(loco: LocomotionSet) -> None:
