@@ -21,7 +21,7 @@ import numpy as np
 
 from bench.figures import Figure, median_time
 
-__all__ = ["run", "demo_scene"]
+__all__ = ["run", "demo_scene", "unloaded_frame_time"]
 
 WIDTH, HEIGHT = 1280, 720
 COLORS = ((0.85, 0.3, 0.25), (0.25, 0.5, 0.85), (0.3, 0.7, 0.35), (0.9, 0.7, 0.2), (0.6, 0.35, 0.75),
@@ -76,7 +76,7 @@ def _thread_cpu() -> dict[str, float]:
     return out
 
 
-def _unloaded_frame_time(frame, frames: int = 40) -> float | None:  # type: ignore[no-untyped-def]
+def unloaded_frame_time(frame, frames: int = 40) -> float | None:  # type: ignore[no-untyped-def]
     """Seconds per frame if the cores were free: main thread + busiest other thread CPU."""
     before = _thread_cpu()
     for _ in range(frames):
@@ -106,7 +106,7 @@ def run() -> list[Figure]:
 
         t_scene = median_time(lambda: frame(scene), repeats=15, min_time=0.0)
         t_empty = median_time(lambda: frame(empty), repeats=15, min_time=0.0)
-        t_free = _unloaded_frame_time(lambda: frame(scene))
+        t_free = unloaded_frame_time(lambda: frame(scene))
     finally:
         viewer.close()
     figures = [

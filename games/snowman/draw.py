@@ -38,7 +38,6 @@ def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[i
         hips, chest, head = pos[j("hips")], pos[j("chest")], pos[j("head")]
         spine_len = float(np.linalg.norm(sk.offsets[j("spine")]) + np.linalg.norm(sk.offsets[j("chest")]))
         up = hips + quat.rotate(rot[j("hips")], np.array([0.0, spine_len, 0.0]))
-        up = np.array([chest[0] if False else up[0], up[1], up[2]])
         balls = [(hips, shape.bottom)]
         if shape.middle is not None:
             balls.append((bezier_spine(hips, chest, up, middle_ball_parameter(shape)), shape.middle))
