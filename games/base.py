@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 from engine.app import App
 from engine.camera import OrbitCamera
@@ -23,6 +24,10 @@ def _no_lines(world: World) -> list[str]:
     return []
 
 
+def _no_extra(world: World) -> dict[str, Any]:
+    return {}
+
+
 @dataclass(frozen=True)
 class Game:
     """A playable game.
@@ -34,6 +39,8 @@ class Game:
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
         controls: the start screen's help lines.
+        recording_extra: what a recording's header must carry to rebuild this start
+            (read back by the game's install when it is replayed).
     """
 
     name: str
@@ -42,3 +49,4 @@ class Game:
     camera: Callable[[], OrbitCamera]
     status: Callable[[World], list[str]] = _no_lines
     controls: tuple[str, ...] = field(default_factory=tuple)
+    recording_extra: Callable[[World], dict[str, Any]] = _no_extra

@@ -21,7 +21,7 @@ from collections.abc import Iterable
 from typing import Protocol
 
 from input.codec import decode_frame, encode_frame
-from input.sample import TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus
+from input.sample import COMMANDS, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus
 from input.source import PoseSource
 
 __all__ = ["InputHub", "FrameSource"]
@@ -53,7 +53,16 @@ class InputHub:
         self.max_samples = max_samples
         self.coalesced = 0
         self._touch: dict[str, bool] = {}
+        self._commands: list[str] = []
         self.last_frame = InputFrame()
+
+    def command(self, kind: str) -> None:
+        """Queue a keyboard command (:data:`~input.sample.COMMANDS`) for the next step's frame,
+        where it is recorded like any input. Ignored while replaying: the recording has its own."""
+        if kind not in COMMANDS:
+            raise ValueError(f"unknown command {kind!r}; commands are {', '.join(COMMANDS)}")
+        if self.replay is None:
+            self._commands.append(kind)
 
     @property
     def live(self) -> bool:
@@ -103,6 +112,8 @@ class InputHub:
         for kind, src in events:
             if kind == "disconnect" and self._touch.pop(src, False):
                 events.append((TOUCH_UP, src))
+        events += [(kind, "keys") for kind in self._commands]
+        self._commands.clear()
         live = InputFrame(frame=frame, samples=tuple(samples), events=tuple(events))
         self.last_frame = decode_frame(encode_frame(live))
         return self.last_frame

@@ -23,10 +23,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS"]
+__all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS",
+           "RESET", "SAVE", "RESTORE", "COMMANDS"]
 
 CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP = "connect", "disconnect", "touch_down", "touch_up"
-EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP)
+# Commands from the keyboard (the launcher's keys), recorded like any input so a
+# replay resets, saves and restores where the player did.
+RESET, SAVE, RESTORE = "reset", "save", "restore"
+COMMANDS: tuple[str, ...] = (RESET, SAVE, RESTORE)
+# Recordings store the index: new kinds go at the end.
+EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP, *COMMANDS)
 
 F = NDArray[np.float64]
 

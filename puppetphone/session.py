@@ -9,8 +9,9 @@ Two ways to run:
   are paced to real time so a phone can drive it; with a replay or no source it
   runs as fast as it can. Only the last frame is rendered, for ``--screenshot``.
 
-Keys (windowed): Esc quits, P pauses, ``.`` single-steps while paused, Tab switches
-between the orbit camera and the phone view.
+Keys (windowed): Esc quits, P pauses, ``.`` single-steps while paused; R resets the
+game, F5 saves and F9 restores it (games that keep a field: snowman). The last three
+go through the hub as recorded input events, so replays repeat them.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from engine.render.scene import RenderScene
 from games.base import Game
 from input.hub import InputHub
 from input.recording import Recorder, RecordingHeader
+from input.sample import RESET, RESTORE, SAVE
 from puppetphone.overlay import draw_overlay
 from puppetphone.games import load_game, make_app
 
@@ -60,7 +62,8 @@ class Session:
         self.scene = RenderScene()
         self.recorder: Recorder | None = None
         if options.record is not None:
-            header = RecordingHeader(game=options.game, seed=options.seed, dt=self.app.world.dt, sources=[options.source_label])
+            header = RecordingHeader(game=options.game, seed=options.seed, dt=self.app.world.dt, sources=[options.source_label],
+                                     extra=self.game.recording_extra(self.app.world))
             self.recorder = Recorder(options.record, header).attach(self.app)
         self._target = None
         self._renderer = None
@@ -153,10 +156,13 @@ class Session:
         import pygame
 
         clock = self.app.clock
+        commands = {pygame.K_r: RESET, pygame.K_F5: SAVE, pygame.K_F9: RESTORE}
         if key == pygame.K_p:
             clock.resume() if clock.paused else clock.pause()
         elif key == pygame.K_PERIOD:
             clock.request_step()
+        elif key in commands:
+            self.hub.command(commands[key])
 
     def run(self) -> int:
         """Run to the end; write the screenshot; close everything. Returns the exit code."""

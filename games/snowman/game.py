@@ -14,11 +14,11 @@ from __future__ import annotations
 from engine.app import App
 from engine.camera import OrbitCamera
 from engine.ecs import World
-from engine.render.components import Appearance
-from engine.statemachine.puppet import install_puppets, spawn_puppet
+from engine.statemachine.puppet import install_puppets
 from games.base import Game
 from games.snowman.components import Snowman, SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game
+from games.snowman.field_save import field_commands, install_field_slot, recording_extra, spawn_first_puppet
 from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
                                  start_snowballs, stick_stacked_balls)
 from games.snowman.scenery import build_scenery
@@ -33,6 +33,7 @@ CONTROLS = (
     "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
     "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
+    "keys: R new field, F5 save the field, F9 restore it, P pause, Esc quit",
 )
 
 
@@ -44,7 +45,9 @@ def install(app: App) -> None:
     world.insert_resource(SnowmanStats())
     world.insert_resource(StackWatch())
     build_scenery(world)
-    spawn_puppet(world, (0.0, 0.0, 0.0), 0.0, name="puppet", extra=(Appearance(color=(0.85, 0.32, 0.24)),))
+    spawn_first_puppet(world)
+    install_field_slot(app)
+    app.add_system("rules", field_commands)
     app.add_system("rules", aim_putdown_on_stacks)
     app.add_system("rules", stick_stacked_balls)
     app.add_system("rules", snow_drag)
@@ -69,5 +72,6 @@ def status(world: World) -> list[str]:
     return lines
 
 
-GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS)
+GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
+            recording_extra=recording_extra)
 

@@ -8,7 +8,7 @@ leads where, with which priority and cross-fade.
 
 from __future__ import annotations
 
-from engine.statemachine.machine import ANY, State, StateMachine, Transition
+from engine.statemachine.machine import State, StateMachine, Transition
 from engine.statemachine.puppet import fall_states as fall
 from engine.statemachine.puppet import ground_states as ground
 from engine.statemachine.puppet import jump_state as jump

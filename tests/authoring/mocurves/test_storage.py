@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 
 from authoring.mocurves import EditSession, SessionFileError, bake_root_motion, export_clip, load_session, save_session

@@ -11,7 +11,7 @@ from engine.statemachine.puppet.props import held_props_system
 def _scene() -> tuple[World, int, int]:
     world = World(seed=1)
     ball = world.spawn(Transform(np.array([0.0, 0.2, 0.0])), Prop(radius=0.2), Grabbable(radius=0.25))
-    other = world.spawn(Transform(np.array([1.0, 0.4, 0.0])), Prop(radius=0.4), Grabbable(radius=0.45))
+    world.spawn(Transform(np.array([1.0, 0.4, 0.0])), Prop(radius=0.4), Grabbable(radius=0.45))
     stick_entity = world.spawn(Stick())
     world.flush()
     world.get(stick_entity, Stick).grabbed = ball

@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.blend.locomotion import LocomotionPlayer
 from engine.components import LocalPose, Stick, Transform
 from engine.ragdoll.components import Prop, Ragdoll
 from engine.statemachine import Brain

@@ -1,0 +1,260 @@
+"""Saving, restoring and resetting the snowman field.
+
+What a field is: the snow left (the depth grid, tracks included), every snowball
+(where, how big, which ball it is packed onto), every snowman (its balls, where it
+stands, its number), the first puppet, and the counters. :func:`snapshot` turns it
+into a small JSON-safe dict, :func:`restore` rebuilds the world from one.
+
+Keys in the window (``F5`` save, ``F9`` restore, ``R`` reset) reach the simulation
+as recorded input events (:data:`input.sample.SAVE` …), so a replay does exactly
+what the player did. A save is kept in the :class:`FieldSlot` (the simulation
+restores from there) and written to disk atomically: ``$SNOWMAN_FIELD`` if set, else
+``$XDG_DATA_HOME/puppetphone/snowman_field.json``. A live session starts with the
+file's field in the slot (``F9`` brings it back) and puts it into its recording's
+header, so replays restore the same field without reading anyone's disk; replays
+never write the default file.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import os
+import sys
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from engine.app import App
+from engine.atomic import atomic_write_bytes
+from engine.components import Transform
+from engine.ecs import World
+from engine.ragdoll.components import Prop
+from engine.render.components import Appearance
+from engine.statemachine.puppet import PuppetBody, spawn_puppet
+from games.snowman.alive import bring_to_life
+from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
+from games.snowman.rig import SnowmanShape
+from games.snowman.snow import SnowField
+from input.sample import InputFrame, RESET, RESTORE, SAVE
+
+__all__ = ["FIELD_VERSION", "FieldError", "FieldSlot", "snapshot", "restore", "spawn_first_puppet", "field_commands",
+           "default_field_path", "load_field", "install_field_slot", "recording_extra", "EXTRA_KEY"]
+
+FIELD_VERSION = 1
+EXTRA_KEY = "snowman_field"
+PUPPET_COLOR = (0.85, 0.32, 0.24)
+
+
+class FieldError(ValueError):
+    """A saved field that cannot be read back."""
+
+
+@dataclass
+class FieldSlot:
+    """Resource: the last saved field and where saves go on disk (``None``: nowhere)."""
+
+    path: Path | None = None
+    saved: dict[str, Any] | None = None
+    loaded_from_disk: dict[str, Any] | None = None
+
+
+def spawn_first_puppet(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
+                       heading: float = 0.0) -> int:
+    """The player's puppet (red), as at the start of a game."""
+    return spawn_puppet(world, position, heading, name="puppet", extra=(Appearance(color=PUPPET_COLOR),))
+
+
+def _encode_depth(depth: np.ndarray) -> dict[str, Any]:
+    raw = np.ascontiguousarray(depth, dtype="<f8").tobytes()
+    return {"shape": list(depth.shape), "zlib_f8": base64.b64encode(zlib.compress(raw, 6)).decode("ascii")}
+
+
+def _decode_depth(data: dict[str, Any], shape: tuple[int, ...]) -> np.ndarray:
+    try:
+        if tuple(data["shape"]) != shape:
+            raise FieldError(f"snow grid is {data['shape']}, this field's is {list(shape)}")
+        depth = np.frombuffer(zlib.decompress(base64.b64decode(data["zlib_f8"])), dtype="<f8").reshape(shape).copy()
+    except (KeyError, TypeError, ValueError, zlib.error) as exc:
+        raise FieldError(f"snow grid unreadable: {exc}") from None
+    if not np.isfinite(depth).all() or (depth < 0).any():
+        raise FieldError("snow grid has negative or non-finite depths")
+    return depth
+
+
+def _heading(tr: Transform) -> float:
+    w, x, y, z = tr.rotation
+    return float(np.arctan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y)))
+
+
+def snapshot(world: World) -> dict[str, Any]:
+    """The field as a JSON-safe dict (see the module docstring)."""
+    balls = [(e, prop, tr, sb) for e, sb, prop, tr in world.query(Snowball, Prop, Transform)]
+    index = {e: i for i, (e, *_rest) in enumerate(balls)}
+    stats = world.resource(SnowmanStats)
+    return {
+        "version": FIELD_VERSION,
+        "balls": [{"position": tr.position.tolist(), "radius": float(prop.radius), "snow": float(sb.snow),
+                   "on": index.get(world.get(e, Stacked).on) if world.has(e, Stacked) else None}
+                  for e, prop, tr, sb in balls],
+        "snowmen": [{"number": s.number, "bottom": s.shape.bottom, "middle": s.shape.middle, "head": s.shape.head,
+                     "position": world.get(e, Transform).position.tolist(), "heading": _heading(world.get(e, Transform))}
+                    for e, s in world.query(Snowman)],
+        "puppets": [{"position": world.get(e, Transform).position.tolist(), "heading": float(body.heading)}
+                    for e, body in world.query(PuppetBody) if not world.has(e, Snowman)],
+        "snow": _encode_depth(world.resource(SnowField).depth),
+        "stats": {"built": stats.built, "balls_started": stats.balls_started},
+    }
+
+
+def _vec(value: Any, what: str) -> np.ndarray:
+    v = np.asarray(value, dtype=np.float64)
+    if v.shape != (3,) or not np.isfinite(v).all():
+        raise FieldError(f"{what} must be three finite numbers, got {value!r}")
+    return v
+
+
+def _check(snap: dict[str, Any], field_shape: tuple[int, ...]) -> np.ndarray | None:
+    """Validate the whole snapshot before touching the world; returns the decoded snow grid."""
+    if not isinstance(snap, dict) or snap.get("version") != FIELD_VERSION:
+        raise FieldError(f"not a snowman field of version {FIELD_VERSION}")
+    try:
+        for b in snap["balls"]:
+            _vec(b["position"], "ball position")
+            if not (0 < float(b["radius"]) < 5):
+                raise FieldError(f"ball radius {b['radius']!r} out of range")
+            if b["on"] is not None and not 0 <= int(b["on"]) < len(snap["balls"]):
+                raise FieldError(f"ball packed onto missing ball {b['on']!r}")
+        for s in snap["snowmen"]:
+            _vec(s["position"], "snowman position")
+            SnowmanShape(float(s["bottom"]), None if s["middle"] is None else float(s["middle"]), float(s["head"]))
+        for p in snap["puppets"]:
+            _vec(p["position"], "puppet position")
+            float(p["heading"])
+        int(snap["stats"]["built"]), int(snap["stats"]["balls_started"])
+    except (KeyError, TypeError) as exc:
+        raise FieldError(f"field is missing or mistypes {exc}") from None
+    return None if snap.get("snow") is None else _decode_depth(snap["snow"], field_shape)
+
+
+def restore(world: World, snap: dict[str, Any]) -> None:
+    """Replace the field by ``snap``: every ball, snowman and puppet is rebuilt; nothing is
+    changed if the snapshot is damaged (:class:`FieldError`)."""
+    snow = world.resource(SnowField)
+    depth = _check(snap, snow.depth.shape)
+    for e, _ in world.query(Snowball):
+        world.despawn(e)
+    for e, _ in world.query(PuppetBody):
+        world.despawn(e)
+    snow.depth = np.full_like(snow.depth, snow.initial_depth) if depth is None else depth
+    stats = world.resource(SnowmanStats)
+    stats.built, stats.balls_started = int(snap["stats"]["built"]), int(snap["stats"]["balls_started"])
+    world.resource(StackWatch).frames.clear()
+    for p in snap["puppets"]:
+        spawn_first_puppet(world, _vec(p["position"], "puppet"), float(p["heading"]))
+    for s in snap["snowmen"]:
+        shape = SnowmanShape(float(s["bottom"]), None if s["middle"] is None else float(s["middle"]), float(s["head"]))
+        bring_to_life(world, shape, _vec(s["position"], "snowman"), float(s["heading"]), int(s["number"]))
+    from games.snowman.rules import spawn_ball
+
+    spawned = []
+    for b in snap["balls"]:
+        e = spawn_ball(world, _vec(b["position"], "ball"), float(b["radius"]))
+        spawned.append(e)
+    for e, b in zip(spawned, snap["balls"], strict=True):
+        if b["on"] is not None:
+            world.add(e, Stacked(on=spawned[int(b["on"])]))
+    world.flush()
+    for e, b in zip(spawned, snap["balls"], strict=True):
+        world.get(e, Transform).position = _vec(b["position"], "ball")
+        world.get(e, Snowball).snow = float(b["snow"])
+        world.get(e, Prop).carried = b["on"] is not None
+
+
+def start_snapshot() -> dict[str, Any]:
+    """A new game: untouched snow, the puppet at the centre, no balls, nothing built."""
+    return {"version": FIELD_VERSION, "balls": [], "snowmen": [], "snow": None,
+            "puppets": [{"position": [0.0, 0.0, 0.0], "heading": 0.0}], "stats": {"built": 0, "balls_started": 0}}
+
+
+def default_field_path() -> Path:
+    """``$SNOWMAN_FIELD``, else ``$XDG_DATA_HOME/puppetphone/snowman_field.json``."""
+    explicit = os.environ.get("SNOWMAN_FIELD")
+    if explicit:
+        return Path(explicit)
+    base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    return base / "puppetphone" / "snowman_field.json"
+
+
+def load_field(path: Path) -> dict[str, Any] | None:
+    """The field saved at ``path`` (``None`` if there is none); :class:`FieldError` if it is damaged."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise FieldError(f"{path}: {exc.strerror}") from None
+    try:
+        snap = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FieldError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
+    if not isinstance(snap, dict) or snap.get("version") != FIELD_VERSION:
+        raise FieldError(f"{path}: not a snowman field of version {FIELD_VERSION}")
+    return snap
+
+
+def install_field_slot(app: App) -> None:
+    """The slot: a replay takes the field its recording carries; a live game reads the file."""
+    from input.plugin import HubResource
+
+    hub = app.world.try_resource(HubResource)
+    replay = getattr(hub.hub, "replay", None) if hub is not None else None
+    slot = FieldSlot()
+    if replay is not None:
+        slot.saved = replay.recording.header.extra.get(EXTRA_KEY)
+        if os.environ.get("SNOWMAN_FIELD"):
+            slot.path = default_field_path()
+    else:
+        slot.path = default_field_path()
+        try:
+            slot.saved = slot.loaded_from_disk = load_field(slot.path)
+        except FieldError as exc:
+            bad = Path(str(slot.path) + ".bad")
+            os.replace(slot.path, bad)
+            print(f"snowman: {exc}; set aside as {bad}", file=sys.stderr)
+    app.world.insert_resource(slot)
+
+
+def recording_extra(world: World) -> dict[str, Any]:
+    """What a recording's header must carry: the field a live game found on disk."""
+    slot = world.try_resource(FieldSlot)
+    return {EXTRA_KEY: slot.loaded_from_disk} if slot is not None and slot.loaded_from_disk is not None else {}
+
+
+def field_commands(world: World) -> None:
+    """The ``rules`` stage, first: reset, save and restore from this step's input events."""
+    frame = world.try_resource(InputFrame)
+    if frame is None or not frame.events:
+        return
+    slot = world.resource(FieldSlot)
+    for kind, _source in frame.events:
+        if kind == RESET:
+            restore(world, start_snapshot())
+            print("snowman: field reset")
+        elif kind == SAVE:
+            slot.saved = snapshot(world)
+            if slot.path is not None:
+                atomic_write_bytes(slot.path, json.dumps(slot.saved).encode("utf-8"))
+            print(f"snowman: field saved{f' to {slot.path}' if slot.path is not None else ''}")
+        elif kind == RESTORE:
+            if slot.saved is None:
+                print("snowman: nothing saved to restore (F5 saves the field)")
+                continue
+            try:
+                restore(world, slot.saved)
+                print("snowman: field restored")
+            except FieldError as exc:
+                print(f"snowman: cannot restore the saved field: {exc}")

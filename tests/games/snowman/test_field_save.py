@@ -1,0 +1,140 @@
+"""Reset, save and restore of the snowman field: round trips, damaged saves, recorded commands."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from engine.components import Transform
+from engine.ragdoll.components import Prop
+from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked
+from games.snowman.field_save import EXTRA_KEY, FieldError, FieldSlot, restore, snapshot
+from games.snowman.rig import SnowmanShape
+from games.snowman.rules import spawn_ball
+from games.snowman.snow import SnowField
+from input.hub import InputHub
+from input.recording import Recorder, RecordingHeader, read_recording
+from input.replay import verify
+from input.sample import RESET, RESTORE, SAVE
+from puppetphone.games import load_game, make_app
+
+
+@pytest.fixture(autouse=True)
+def field_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    path = tmp_path / "field.json"
+    monkeypatch.setenv("SNOWMAN_FIELD", str(path))
+    return path
+
+
+def _built_field(hub: InputHub | None = None):  # type: ignore[no-untyped-def]
+    """A field with a rolled track, a stack of two balls, a loose ball and a snowman."""
+    from games.snowman.alive import bring_to_life
+
+    app = make_app("snowman", 3, hub or InputHub())
+    world = app.world
+    world.resource(SnowField).roll(np.array([-2.0, 0.2, 0.0]), np.array([1.0, 0.2, 0.5]), 0.2)
+    bottom = spawn_ball(world, np.array([2.0, 0.0, 1.0]), 0.4)
+    top = spawn_ball(world, np.array([2.0, 0.0, 1.0]), 0.18)
+    spawn_ball(world, np.array([-1.0, 0.0, -2.0]), 0.25)
+    world.flush()
+    world.add(top, Stacked(on=bottom))
+    world.get(top, Prop).carried = True
+    bring_to_life(world, SnowmanShape(0.4, 0.3, 0.2), np.array([-3.0, 0.0, 2.0]), 0.5, 1)
+    world.resource(SnowmanStats).built = 1
+    app.run_steps(30)
+    return app
+
+
+def _same(a: dict, b: dict) -> None:
+    assert a["stats"] == b["stats"] and a["snow"] == b["snow"]
+    assert [(x["radius"], x["on"]) for x in a["balls"]] == [(x["radius"], x["on"]) for x in b["balls"]]
+    assert np.allclose([x["position"] for x in a["balls"]], [x["position"] for x in b["balls"]], atol=1e-9)
+    assert [(s["number"], s["bottom"], s["middle"], s["head"]) for s in a["snowmen"]] == \
+        [(s["number"], s["bottom"], s["middle"], s["head"]) for s in b["snowmen"]]
+    assert np.allclose([s["position"] for s in a["snowmen"]], [s["position"] for s in b["snowmen"]], atol=1e-9)
+
+
+def test_snapshot_survives_json_and_restores_the_same_field() -> None:
+    app = _built_field()
+    saved = json.loads(json.dumps(snapshot(app.world)))
+    assert len(saved["balls"]) == 3 and sum(b["on"] is not None for b in saved["balls"]) == 1
+    assert len(saved["snowmen"]) == 1 and len(saved["puppets"]) == 1
+    restore(app.world, {**saved, "balls": [], "snowmen": [], "snow": None})
+    app.world.flush()
+    assert not app.world.query(Snowball) and not app.world.query(Snowman)
+    restore(app.world, saved)
+    app.world.flush()
+    _same(snapshot(app.world), saved)
+    app.run_steps(30)  # the restored stack stays packed, the snowman stands
+    world = app.world
+    stacked = [e for e, _ in world.query(Stacked)]
+    assert len(stacked) == 1 and world.get(stacked[0], Prop).carried
+    assert len(world.query(Snowman)) == 1
+
+
+def test_a_damaged_save_changes_nothing() -> None:
+    app = _built_field()
+    before = snapshot(app.world)
+    bad = json.loads(json.dumps(before))
+    bad["balls"][0]["position"] = [0.0, float("nan"), 0.0]
+    with pytest.raises(FieldError, match="finite"):
+        restore(app.world, bad)
+    truncated = json.loads(json.dumps(before))
+    truncated["snow"]["zlib_f8"] = truncated["snow"]["zlib_f8"][:40]
+    with pytest.raises(FieldError, match="snow grid"):
+        restore(app.world, truncated)
+    app.world.flush()
+    _same(snapshot(app.world), before)
+
+
+def test_keys_save_reset_and_restore(tmp_path: Path, field_file: Path) -> None:
+    hub = InputHub()
+    app = _built_field(hub)
+    hub.command(SAVE)
+    app.run_steps(2)
+    saved = json.loads(field_file.read_text())
+    assert len(saved["balls"]) == 3 and not list(tmp_path.glob(".field.json.*.tmp"))
+    hub.command(RESET)
+    app.run_steps(2)
+    assert not app.world.query(Snowball) and app.world.resource(SnowmanStats).built == 0
+    assert float(app.world.resource(SnowField).depth.min()) == app.world.resource(SnowField).initial_depth
+    hub.command(RESTORE)
+    app.run_steps(2)
+    assert len(app.world.query(Snowball)) == 3 and len(app.world.query(Snowman)) == 1
+    with pytest.raises(ValueError, match="unknown command"):
+        hub.command("explode")
+
+
+def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file(tmp_path: Path, field_file: Path) -> None:
+    field_file.write_text(json.dumps(snapshot(_built_field().world)))
+    hub = InputHub()
+    app = make_app("snowman", 3, hub)
+    header = RecordingHeader(game="snowman", seed=3, dt=app.world.dt, extra=load_game("snowman").recording_extra(app.world))
+    rec_path = tmp_path / "session.rec"
+    recorder = Recorder(rec_path, header).attach(app)
+    app.run_steps(5)
+    for command in (RESTORE, RESET, RESTORE):
+        hub.command(command)
+        app.run_steps(20)
+    assert len(app.world.query(Snowball)) == 3
+    recorder.close()
+    field_file.unlink()  # the replay must not need it: the recording carries the field
+    rec = read_recording(rec_path)
+    assert EXTRA_KEY in rec.header.extra
+    seen = []
+    result = verify(lambda h: make_app("snowman", 3, h), rec, on_step=lambda a, i: seen.append(len(a.world.query(Snowball))))
+    assert result.ok, result.message
+    assert seen[-1] == 3 and 0 in seen and not field_file.exists()  # restored, reset, restored; nothing written
+
+
+def test_a_corrupt_save_file_is_set_aside_with_a_message(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    field_file.write_text("{ not json")
+    app = make_app("snowman", 3, InputHub())
+    assert app.world.resource(FieldSlot).saved is None
+    assert Path(str(field_file) + ".bad").read_text() == "{ not json" and not field_file.exists()
+    assert "set aside" in capsys.readouterr().err
+    app.run_steps(3)
+    assert app.world.query(Transform)
