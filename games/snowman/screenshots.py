@@ -19,16 +19,21 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from engine.app import App
 from engine.components import Stick, Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
+from engine.render.renderer import Renderer
+from engine.render.scene import RenderScene
+from engine.render.target import RenderTarget, make_target
 from engine.statemachine import Brain
 from games.snowman.components import Snowman
 from games.snowman.demo import DEMO_PATH
+from games.snowman.game import GAME
 from input.hub import InputHub
+from input.plugin import install_input
 from input.recording import read_recording
 from input.replay import ReplaySource
-from puppetphone.session import Session, SessionOptions
 
 __all__ = ["STAGES", "take_screenshots"]
 
@@ -71,37 +76,46 @@ STAGES: dict[str, Callable[[World], bool]] = {
 }
 
 
-def _save_jpeg(session: Session, path: Path) -> None:
+def _save_jpeg(app: App, target: RenderTarget, renderer: Renderer, path: Path) -> None:
+    """The game's view with its status lines (the counter), as a JPEG."""
     from PIL import Image
 
+    scene = RenderScene()
+    GAME.draw(app.world, scene, 1.0)
+    for line in GAME.status(app.world)[:1]:
+        scene.add_text(line, color=(0.1, 0.12, 0.18))
+    renderer.render(scene, GAME.camera(), target.begin())
+    target.end()
     with tempfile.TemporaryDirectory() as tmp:
-        png = session.screenshot(Path(tmp) / "frame.png")
+        png = target.screenshot(Path(tmp) / "frame.png")
         Image.open(png).convert("RGB").save(path, quality=82, optimize=True)
-    print(f"{path.name}: frame {session.app.world.frame}")
+    print(f"{path.name}: frame {app.world.frame}")
 
 
 def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> list[Path]:
     """Replay the demo and write one JPEG per stage plus the last frame; returns the paths."""
     out.mkdir(parents=True, exist_ok=True)
     rec = read_recording(DEMO_PATH)
-    hub = InputHub(replay=ReplaySource(rec))
-    session = Session(SessionOptions(game="snowman", seed=rec.header.seed, headless=True, width=width, height=height), hub)
+    app = App(seed=rec.header.seed)
+    install_input(app, InputHub(replay=ReplaySource(rec)))
+    GAME.install(app)
+    target = make_target(True, width, height)
+    renderer = Renderer(target.ctx)
     seen: dict[str, int] = {}
     written = []
     try:
         for _ in rec.frames:
-            session.app.step()
-            world = session.app.world
+            app.step()
             for name, test in STAGES.items():
-                if name not in seen and test(world):
-                    seen[name] = world.frame
-                if seen.get(name) == world.frame - DELAY:
+                if name not in seen and test(app.world):
+                    seen[name] = app.world.frame
+                if seen.get(name) == app.world.frame - DELAY:
                     written.append(out / f"snowman_{name}.jpg")
-                    _save_jpeg(session, written[-1])
+                    _save_jpeg(app, target, renderer, written[-1])
         written.append(out / "snowman_second.jpg")
-        _save_jpeg(session, written[-1])
+        _save_jpeg(app, target, renderer, written[-1])
     finally:
-        session.close()
+        target.close()
     missing = sorted(set(STAGES) - set(seen))
     if missing:
         raise RuntimeError(f"the demo never showed: {', '.join(missing)}")
