@@ -46,6 +46,21 @@ _POINT_FMT = ("3f 1f 3f 1f", "i_pos", "i_size", "i_color", "i_pixels")
 _SOLIDS = ("capsules", "spheres", "boxes")
 
 
+def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArray[np.float32]:
+    """Instances sorted by the distance of their centre to the eye, nearest first.
+
+    On llvmpipe a fragment is shaded unless the depth buffer already holds something
+    nearer; drawing near shapes first lets the early depth test skip what they hide
+    (tree tiers, balls behind puppets) instead of shading it and painting over it. The
+    first six numbers of every row are two points (capsule ends; a box's centre and
+    half sizes, where the first three are the centre too).
+    """
+    if len(rows) < 2:
+        return rows
+    centre = 0.5 * (rows[:, 0:3] + rows[:, 3:6]) if rows.shape[1] != BOX_STRIDE else rows[:, 0:3]
+    return rows[np.argsort(np.sum((centre - eye) ** 2, axis=1), kind="stable")]
+
+
 def _linear(c: Any) -> tuple[float, float, float]:
     a = np.clip(np.asarray(c, dtype=np.float64), 0.0, None) ** 2  # the shaders' gamma 2.0
     return float(a[0]), float(a[1]), float(a[2])
@@ -134,7 +149,9 @@ class Renderer:
         w, h = framebuffer.size
         vp = camera.view_projection(w / h)
         self._mark(None)
-        counts = {k: inst.upload(getattr(scene, k).data) for k, inst in self._inst.items()}
+        eye = np.asarray(camera.eye, dtype=np.float64)
+        counts = {k: inst.upload(_nearest_first(getattr(scene, k).data, eye) if k in _SOLIDS else getattr(scene, k).data)
+                  for k, inst in self._inst.items()}
         outlined = {}
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data

@@ -188,3 +188,23 @@ def test_target_sizes_and_bad_input():
         assert t.size == (48, 40) and t.read_pixels().shape == (40, 48, 3)
     finally:
         t.close()
+
+
+def test_solids_are_drawn_nearest_first_and_the_picture_does_not_depend_on_it(gl):
+    from engine.render.renderer import _nearest_first
+
+    eye = np.array([0.0, 1.0, 5.0])
+    far, near = [0.0, 0.5, -3.0, 0.0, 1.5, -3.0], [0.0, 0.5, 2.0, 0.0, 1.5, 2.0]
+    rows = np.array([far + [0.3, 1, 0, 0, 0], near + [0.3, 0, 1, 0, 0]], dtype=np.float32)
+    assert np.array_equal(_nearest_first(rows, eye)[:, 2], [2.0, -3.0])
+    # Two overlapping balls added in either order render the same picture.
+    camera = OrbitCamera(target=np.array([0.0, 0.5, 0.0]), yaw=0.0, pitch=0.2, distance=4.0)
+    balls = [(np.array([0.0, 0.5, 0.0]), (0.9, 0.2, 0.1)), (np.array([0.3, 0.5, 0.6]), (0.1, 0.2, 0.9))]
+    images = []
+    for order in (balls, balls[::-1]):
+        s = RenderScene()
+        for centre, color in order:
+            s.add_sphere(centre, 0.5, color=color)
+        images.append(draw(gl, s, camera))
+    assert np.array_equal(images[0], images[1])
+    assert (images[0][..., 2] > images[0][..., 0] + 100).sum() > 500  # the nearer blue ball shows
