@@ -30,6 +30,7 @@ WIDTH, HEIGHT = 1280, 720
 def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1):  # type: ignore[no-untyped-def]
     """The snowman game with its puppet, ``snowmen`` snowmen and ``snowballs`` balls (0, 0 and
     no puppet: the empty field), stepped for one second so every model is built."""
+    from engine.ragdoll.components import Prop
     from engine.statemachine.puppet import PuppetBody
     from games.snowman.alive import bring_to_life
     from games.snowman.components import SnowmanStats
@@ -56,8 +57,6 @@ def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1
         r = float(rng.uniform(0.12, 0.35))
         ball = spawn_ball(world, np.array([rng.uniform(-6, 6), 0.0, rng.uniform(-5, 2)]), r)
         if i % 2:  # half of them rolling, into each other and the snowmen
-            from engine.ragdoll.components import Prop
-
             v = rng.normal(size=3) * [1.5, 0.0, 1.5]
             world.get(ball, Prop).velocity = np.concatenate([v, np.cross([0.0, 1.0, 0.0], v) / r])
     world.flush()

@@ -190,21 +190,22 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
     """The table's answers for a group's requests, batched; memoised, as a held stick repeats its request."""
     out: list[Resolution | None] = []  # filled below for every miss
     misses: list[int] = []
+    missed: list[tuple[float, float | None]] = []  # their requests in the set's units
     for i, (e, _tr, _pup, player) in enumerate(members):
         speed, height = player.speed, player.height
         if not (np.isfinite(speed) and speed >= 0.0 and (height is None or np.isfinite(height))):
             raise ValueError(f"entity {e}: locomotion request speed={speed!r}, height={height!r} is invalid")
         if not (np.isfinite(player.scale) and player.scale > 0.0):
             raise ValueError(f"entity {e}: locomotion scale {player.scale!r} must be positive")
-        speed, height = speed / player.scale, None if height is None else height / player.scale
-        res = library.memo.get((key, float(speed), None if height is None else float(height)))
+        request = (float(speed / player.scale), None if height is None else float(height / player.scale))
+        res = library.memo.get((key, *request))
         out.append(res)
         if res is None:
             misses.append(i)
+            missed.append(request)
     if misses:
-        players = [members[i][3] for i in misses]
-        speeds = np.array([p.speed / p.scale for p in players], dtype=np.float64)
-        heights = np.array([np.nan if p.height is None else p.height / p.scale for p in players], dtype=np.float64)
+        speeds = np.array([s for s, _ in missed], dtype=np.float64)
+        heights = np.array([np.nan if h is None else h for _, h in missed], dtype=np.float64)
         standing = np.isnan(heights)
         if standing.any():
             heights[standing] = loco.standing_heights(speeds[standing])
@@ -213,8 +214,7 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
             library.memo.clear()
         for j, i in enumerate(misses):
             res = Resolution(points[j], feasible[j], bool(inside[j]), float(rates[j]))
-            h = heights[j]
-            library.memo[(key, float(speeds[j]), None if players[j].height is None else float(h))] = res
+            library.memo[(key, *missed[j])] = res
             out[i] = res
     return out  # type: ignore[return-value]
 

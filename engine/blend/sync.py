@@ -111,13 +111,17 @@ class SyncGroup:
         """Seconds of one blended cycle, ``Σ wᵢTᵢ`` for weights ``[..., K]`` summing to one."""
         return np.asarray(weights, dtype=np.float64) @ self.durations
 
+    def _indices(self, active: ArrayLike | None) -> list[int]:
+        """Clip indices to evaluate: ``active`` (those with weight), or every clip."""
+        return list(range(len(self.clips))) if active is None else [int(k) for k in np.asarray(active).reshape(-1)]
+
     def clip_times(self, phase: ArrayLike, active: ArrayLike | None = None) -> F:
         """Each clip's unwrapped local time in seconds at group phase ``phase [...]``: ``[..., K]``,
         or ``[..., K']`` for the clip indices ``active`` only (the ones with weight)."""
         phase = np.asarray(phase, dtype=np.float64)
         cycles = np.floor(phase)
         frac = phase - cycles
-        ks = range(len(self.clips)) if active is None else [int(k) for k in np.asarray(active).reshape(-1)]
+        ks = self._indices(active)
         out = np.empty(phase.shape + (len(ks),))
         for i, k in enumerate(ks):
             xp, fp = self._knots[k]
@@ -138,7 +142,7 @@ class SyncGroup:
 
         Vectorised equivalent of :meth:`Clip.sample_root_motion` over a batch of times.
         """
-        ks = range(len(self.clips)) if active is None else [int(k) for k in np.asarray(active).reshape(-1)]
+        ks = self._indices(active)
         times = self.clip_times(phase, active)
         trans = np.empty(times.shape + (3,))
         head = np.empty(times.shape)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Ball", "find_snowmen", "resting_on", "resting_matrix"]
+__all__ = ["Ball", "find_snowmen", "resting_matrix"]
 
 
 @dataclass(frozen=True)
@@ -39,12 +39,6 @@ def resting_matrix(centers: NDArray[np.float64], radii: NDArray[np.float64], gap
     horizontal = np.hypot(d[..., 0], d[..., 2])
     touch = r[:, None] + r[None, :]
     return (d[..., 1] > 0) & (horizontal <= off_axis * r[None, :]) & (np.abs(np.linalg.norm(d, axis=-1) - touch) <= gap * touch)
-
-
-def resting_on(upper: Ball, lower: Ball, gap: float = 0.06, off_axis: float = 0.45) -> bool:
-    """Whether ``upper`` sits on top of ``lower`` (one pair of :func:`resting_matrix`)."""
-    m = resting_matrix(np.array([upper.center, lower.center]), np.array([upper.radius, lower.radius]), gap, off_axis)
-    return bool(m[0, 1])
 
 
 def find_snowmen(balls: list[Ball], on_ground: float = 0.1) -> list[list[Ball]]:

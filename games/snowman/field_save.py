@@ -38,6 +38,7 @@ from engine.statemachine.puppet import PuppetBody, spawn_puppet
 from games.snowman.alive import bring_to_life
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
 from games.snowman.rig import SnowmanShape
+from games.snowman.rules import spawn_ball
 from games.snowman.snow import SnowField
 from input.sample import InputFrame, RESET, RESTORE, SAVE
 
@@ -85,11 +86,6 @@ def _decode_depth(data: dict[str, Any], shape: tuple[int, ...]) -> np.ndarray:
     return depth
 
 
-def _heading(tr: Transform) -> float:
-    w, x, y, z = tr.rotation
-    return float(np.arctan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y)))
-
-
 def snapshot(world: World) -> dict[str, Any]:
     """The field as a JSON-safe dict (see the module docstring)."""
     balls = [(e, prop, tr, sb) for e, sb, prop, tr in world.query(Snowball, Prop, Transform)]
@@ -101,7 +97,7 @@ def snapshot(world: World) -> dict[str, Any]:
                    "on": index.get(world.get(e, Stacked).on) if world.has(e, Stacked) else None}
                   for e, prop, tr, sb in balls],
         "snowmen": [{"number": s.number, "bottom": s.shape.bottom, "middle": s.shape.middle, "head": s.shape.head,
-                     "position": world.get(e, Transform).position.tolist(), "heading": _heading(world.get(e, Transform))}
+                     "position": world.get(e, Transform).position.tolist(), "heading": float(world.get(e, PuppetBody).heading)}
                     for e, s in world.query(Snowman)],
         "puppets": [{"position": world.get(e, Transform).position.tolist(), "heading": float(body.heading)}
                     for e, body in world.query(PuppetBody) if not world.has(e, Snowman)],
@@ -135,7 +131,9 @@ def _check(snap: dict[str, Any], field_shape: tuple[int, ...]) -> np.ndarray | N
             _vec(p["position"], "puppet position")
             float(p["heading"])
         int(snap["stats"]["built"]), int(snap["stats"]["balls_started"])
-    except (KeyError, TypeError) as exc:
+    except (KeyError, TypeError, ValueError) as exc:
+        if isinstance(exc, FieldError):
+            raise
         raise FieldError(f"field is missing or mistypes {exc}") from None
     return None if snap.get("snow") is None else _decode_depth(snap["snow"], field_shape)
 
@@ -158,20 +156,14 @@ def restore(world: World, snap: dict[str, Any]) -> None:
     for s in snap["snowmen"]:
         shape = SnowmanShape(float(s["bottom"]), None if s["middle"] is None else float(s["middle"]), float(s["head"]))
         bring_to_life(world, shape, _vec(s["position"], "snowman"), float(s["heading"]), int(s["number"]))
-    from games.snowman.rules import spawn_ball
-
-    spawned = []
-    for b in snap["balls"]:
-        e = spawn_ball(world, _vec(b["position"], "ball"), float(b["radius"]))
-        spawned.append(e)
-    for e, b in zip(spawned, snap["balls"], strict=True):
-        if b["on"] is not None:
-            world.add(e, Stacked(on=spawned[int(b["on"])]))
+    spawned = [spawn_ball(world, _vec(b["position"], "ball"), float(b["radius"])) for b in snap["balls"]]
     world.flush()
     for e, b in zip(spawned, snap["balls"], strict=True):
-        world.get(e, Transform).position = _vec(b["position"], "ball")
+        world.get(e, Transform).position = _vec(b["position"], "ball")  # spawn_ball puts it on the ground
         world.get(e, Snowball).snow = float(b["snow"])
-        world.get(e, Prop).carried = b["on"] is not None
+        if b["on"] is not None:
+            world.add(e, Stacked(on=spawned[int(b["on"])]))
+            world.get(e, Prop).carried = True
 
 
 def start_snapshot() -> dict[str, Any]:

@@ -86,6 +86,10 @@ def test_a_damaged_save_changes_nothing() -> None:
     truncated["snow"]["zlib_f8"] = truncated["snow"]["zlib_f8"][:40]
     with pytest.raises(FieldError, match="snow grid"):
         restore(app.world, truncated)
+    mistyped = json.loads(json.dumps(before))
+    mistyped["snowmen"][0]["bottom"] = "big"
+    with pytest.raises(FieldError, match="mistypes"):
+        restore(app.world, mistyped)
     app.world.flush()
     _same(snapshot(app.world), before)
 
