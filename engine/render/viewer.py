@@ -45,10 +45,16 @@ class Viewer:
         return self.target.size
 
     def draw(self, scene: RenderScene) -> None:
-        """Render one frame of ``scene`` and present (or resolve) it."""
-        fb = self.target.begin()
-        self.renderer.render(scene, self.camera, fb)
-        self.target.end()
+        """Render one frame of ``scene`` and present (or resolve) it.
+
+        The target's context is made current first: another context created (and
+        released) since, by a second viewer or a probe, would otherwise receive the
+        GL calls, or none would, and the frame would be garbage.
+        """
+        with self.target.ctx:
+            fb = self.target.begin()
+            self.renderer.render(scene, self.camera, fb)
+            self.target.end()
 
     def poll_events(self) -> list[Any]:
         """Window events since the last call (empty when headless)."""
@@ -56,11 +62,13 @@ class Viewer:
 
     def read_pixels(self) -> NDArray[np.uint8]:
         """The last drawn frame, ``[H,W,3]`` uint8."""
-        return self.target.read_pixels()
+        with self.target.ctx:
+            return self.target.read_pixels()
 
     def screenshot(self, path: str | Path) -> Path:
         """Save the last drawn frame as PNG."""
-        return self.target.screenshot(path)
+        with self.target.ctx:
+            return self.target.screenshot(path)
 
     def close(self) -> None:
         """Free the renderer and the target."""

@@ -208,3 +208,17 @@ def test_solids_are_drawn_nearest_first_and_the_picture_does_not_depend_on_it(gl
         images.append(draw(gl, s, camera))
     assert np.array_equal(images[0], images[1])
     assert (images[0][..., 2] > images[0][..., 0] + 100).sum() > 500  # the nearer blue ball shows
+
+
+def test_a_viewer_draws_into_its_own_context_after_another_was_made(gl):
+    import moderngl
+
+    scene, _, _ = puppet_scene()
+    camera = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), yaw=0.3, pitch=0.25, distance=3.2)
+    before = draw(gl, scene, camera)
+    other = moderngl.create_standalone_context(backend="egl", require=330)  # now current
+    try:
+        assert np.array_equal(draw(gl, scene, camera), before)
+    finally:
+        other.release()
+    assert np.array_equal(draw(gl, scene, camera), before)
