@@ -84,7 +84,11 @@ class Renderer:
             "box": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=lit + S.LIT_FS),
             "box_flat": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.FLAT_FS),
             "ground": ctx.program(vertex_shader=h + E.GROUND_VS, fragment_shader=lit + E.BACKGROUND + E.GROUND_FS),
+            "ground_photo": ctx.program(vertex_shader=h + E.GROUND_VS,
+                                        fragment_shader=h + E.PHOTO_DEFINE + S.LIGHTING + E.BACKGROUND + E.GROUND_FS),
             "sky": ctx.program(vertex_shader=h + E.SKY_VS, fragment_shader=lit + E.BACKGROUND + E.SKY_FS),
+            "sky_photo": ctx.program(vertex_shader=h + E.SKY_VS,
+                                     fragment_shader=h + E.PHOTO_DEFINE + S.LIGHTING + E.BACKGROUND + E.SKY_FS),
             "line": ctx.program(vertex_shader=h + S.LINE_VS, fragment_shader=h + S.LINE_FS),
             "point": ctx.program(vertex_shader=h + S.POINT_VS, fragment_shader=h + S.POINT_FS),
             "text": ctx.program(vertex_shader=h + S.TEXT_VS, fragment_shader=h + S.TEXT_FS),
@@ -109,12 +113,14 @@ class Renderer:
                 p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
         quad, unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
             [-1, -1, 1, -1, -1, 1, 1, 1], [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
-        self._vaos["ground"] = ctx.vertex_array(p["ground"], [(quad, "2f", "in_corner")])
+        for name in ("ground", "ground_photo"):
+            self._vaos[name] = ctx.vertex_array(p[name], [(quad, "2f", "in_corner")])
         self._vaos["text"] = ctx.vertex_array(p["text"], [(unit, "2f", "in_corner")])
         self._vaos["lines"] = ctx.vertex_array(
             p["line"], [(seg, "2f", "in_corner"), (self._inst["lines"].buf, *_LINE_FMT)], skip_errors=True)
         self._vaos["points"] = ctx.vertex_array(p["point"], [(self._inst["points"].buf, *_POINT_FMT)], skip_errors=True)
-        self._vaos["sky"] = ctx.vertex_array(p["sky"], [])
+        for name in ("sky", "sky_photo"):
+            self._vaos[name] = ctx.vertex_array(p[name], [])
         self.shadows = Shadows(ctx, self._inst["capsules"], self._inst["spheres"], self._inst["boxes"],
                                shadow_size, mask_size)
         self._blank = ctx.texture((1, 1), 3, bytes([255, 255, 255]))
@@ -183,11 +189,12 @@ class Renderer:
                 self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
         self._mark("objects")
         ctx.enable_only(moderngl.DEPTH_TEST)
+        photo = "_photo" if scene.background is not None and scene.background_fade < 1.0 else ""
         if scene.ground.visible:
-            self._vaos["ground"].render(moderngl.TRIANGLE_STRIP)
+            self._vaos["ground" + photo].render(moderngl.TRIANGLE_STRIP)
         self._mark("ground")
         ctx.depth_func = "<="
-        self._vaos["sky"].render(moderngl.TRIANGLES, vertices=3)
+        self._vaos["sky" + photo].render(moderngl.TRIANGLES, vertices=3)
         ctx.depth_func = "<"
         self._mark("sky")
 
@@ -242,7 +249,6 @@ class Renderer:
             for name, value in common.items():
                 set_uniform(prog, name, value)
         g = scene.ground
-        gp = self._programs["ground"]
         for name, value in (("u_center", (eye[0], 0.0, eye[2])), ("u_extent", min(camera.far * 0.9, 150.0)),
                             ("u_height", float(g.height)), ("u_ground_lin", _linear(g.color)),
                             ("u_snow", float(g.snow)), ("u_grid_on", 1.0 if g.grid else 0.0),
@@ -250,7 +256,8 @@ class Renderer:
                             ("u_grid_strength", float(g.grid_strength)), ("u_noise", 3), ("u_ground_mask", 4),
                             ("u_rect", rect if rect is not None else (0.0, 0.0, 1.0, 1.0)),
                             ("u_shadow_strength", 0.9)):
-            set_uniform(gp, name, value)
+            set_uniform(self._programs["ground"], name, value)
+            set_uniform(self._programs["ground_photo"], name, value)
         outline = tuple(float(c) for c in scene.outline_color)
         for name in ("capsule_flat", "box_flat"):
             set_uniform(self._programs[name], "u_color", outline)
