@@ -28,45 +28,84 @@ _CARROT = (0.95, 0.45, 0.1)
 _SNOW = (0.97, 0.98, 1.0)
 
 
+_LEG = ("upper_leg", "lower_leg", "foot")
+_ARM = ("upper_arm", "lower_arm", "hand")
+# Capsule rows per snowman, in the order _snowman_rows fills them: two legs (thigh,
+# shin, foot), two twig arms (three segments each), the nose.
+_CAPSULE_COLORS = np.array([_SNOW] * 6 + [_TWIG] * 6 + [_CARROT])
+_EYES = np.array([[0.35, 0.25, 0.88], [-0.35, 0.25, 0.88]])
+_NOSE = np.array([[0.0, 0.0, 0.9], [0.0, -0.05, 1.6]])
+_BUTTONS = np.array([[0.0, 0.45 * k, 0.95] for k in (-0.6, 0.0, 0.6)])
+
+
+def _joint_indices(sk) -> dict[str, list[int]]:  # type: ignore[no-untyped-def]
+    """The joints a snowman is drawn from, looked up once per rig."""
+    j = sk.index
+    return {"legs": [j(f"{side}_{bone}") for side in "lr" for bone in _LEG],
+            "arms": [j(f"{side}_{bone}") for side in "lr" for bone in _ARM],
+            "body": [j("hips"), j("spine"), j("chest"), j("head")]}
+
+
+def _snowman_rows(snowman: Snowman, sk, pos: np.ndarray, rot: np.ndarray,  # type: ignore[no-untyped-def]
+                  joints: dict[str, list[int]]) -> tuple[np.ndarray, ...]:
+    """One snowman's capsules (a, b, radius) and spheres (centre, radius, is-a-ball)."""
+    shape = snowman.shape
+    hips_i, spine_i, chest_i, head_i = joints["body"]
+    legs, arms = joints["legs"], joints["arms"]
+    hips, chest, head = pos[hips_i], pos[chest_i], pos[head_i]
+    rh = shape.head
+    spine_len = float(np.linalg.norm(sk.offsets[spine_i]) + np.linalg.norm(sk.offsets[chest_i]))
+    feet, hands = [legs[2], legs[5]], [arms[2], arms[5]]
+    # Every offset that turns with a bone, rotated in one call: foot and hand tips, the
+    # spine's "up" (Eq. 6.4's p_up), eyes and nose on the head, buttons on the chest.
+    local = np.vstack([sk.tips[feet], sk.tips[hands], [[0.0, spine_len, 0.0]], _EYES * rh, _NOSE * rh,
+                       _BUTTONS * (shape.middle or 0.0)])
+    turn = rot[feet + hands + [hips_i] + [head_i] * 4 + [chest_i] * 3]
+    moved = quat.rotate(turn, local)
+    foot_tips, hand_tips, up = pos[feet] + moved[0:2], pos[hands] + moved[2:4], hips + moved[4]
+    eyes, nose = head + moved[5:7], head + moved[7:9]
+    leg_a = np.vstack([pos[legs[0:3]], pos[legs[3:6]]])
+    leg_b = np.vstack([pos[legs[1:3]], foot_tips[0:1], pos[legs[4:6]], foot_tips[1:2]])
+    arm_pts = [np.vstack([pos[arms[k:k + 3]], hand_tips[k // 3]]) for k in (0, 3)]
+    cap_a = np.vstack([leg_a, arm_pts[0][:-1], arm_pts[1][:-1], nose[0:1]])
+    cap_b = np.vstack([leg_b, arm_pts[0][1:], arm_pts[1][1:], nose[1:2]])
+    cap_r = np.concatenate([sk.radii[legs], np.full(6, sk.radii[arms[0]]), [0.07 * rh]])
+    centres, radii = [hips], [shape.bottom]
+    if shape.middle is not None:
+        centres.append(bezier_spine(hips, chest, up, middle_ball_parameter(shape)))
+        radii.append(shape.middle)
+    centres.append(head)
+    radii.append(rh)
+    n_balls = len(centres)
+    centres += list(eyes)
+    radii += [0.1 * rh] * 2
+    if shape.middle is not None:
+        centres += list(centres[1] + moved[9:12])
+        radii += [0.08 * shape.middle] * 3
+    is_ball = np.arange(len(radii)) < n_balls
+    return cap_a, cap_b, cap_r, np.array(centres), np.array(radii), is_ball
+
+
 def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[int]) -> None:
-    """Every living snowman, from its joints."""
+    """Every living snowman, from its joints, added to the scene in one call per primitive.
+
+    Gathering the rows first matters: a snowman is ~20 primitives, and adding them one
+    call at a time cost more than a millisecond a frame with six snowmen on the field.
+    """
+    caps: list[tuple[np.ndarray, ...]] = []
+    spheres: list[tuple[np.ndarray, ...]] = []
     for e, snowman, puppet, wp in world.query(Snowman, Puppet, WorldPose):
         sk = puppet.skeleton
         pos, rot = wp.interpolated(alpha)
-        j = sk.index
-        shape = snowman.shape
-        hips, chest, head = pos[j("hips")], pos[j("chest")], pos[j("head")]
-        spine_len = float(np.linalg.norm(sk.offsets[j("spine")]) + np.linalg.norm(sk.offsets[j("chest")]))
-        up = hips + quat.rotate(rot[j("hips")], np.array([0.0, spine_len, 0.0]))
-        balls = [(hips, shape.bottom)]
-        if shape.middle is not None:
-            balls.append((bezier_spine(hips, chest, up, middle_ball_parameter(shape)), shape.middle))
-        balls.append((head, shape.head))
-        centers = np.array([b[0] for b in balls])
-        radii = np.array([b[1] for b in balls])
-        scene.add_spheres(centers, radii, color=_SNOW, outline=e in outlined)
-        # Legs peek out under the bottom ball.
-        for side in ("l", "r"):
-            chain = [j(f"{side}_upper_leg"), j(f"{side}_lower_leg"), j(f"{side}_foot")]
-            scene.add_capsules(pos[chain[:-1]], pos[chain[1:]], sk.radii[chain[:-1]], color=_SNOW)
-            foot_tip = pos[chain[-1]] + quat.rotate(rot[chain[-1]], sk.tips[chain[-1]])
-            scene.add_capsule(pos[chain[-1]], foot_tip, float(sk.radii[chain[-1]]), color=_SNOW)
-            arm = [j(f"{side}_upper_arm"), j(f"{side}_lower_arm"), j(f"{side}_hand")]
-            hand_tip = pos[arm[-1]] + quat.rotate(rot[arm[-1]], sk.tips[arm[-1]])
-            pts = np.vstack([pos[arm], hand_tip[None]])
-            scene.add_capsules(pts[:-1], pts[1:], np.full(3, sk.radii[arm[0]]), color=_TWIG)
-        hr = rot[j("head")]
-        rh = shape.head
-        eyes = head + quat.rotate(np.broadcast_to(hr, (2, 4)), np.array([[0.35 * rh, 0.25 * rh, 0.88 * rh], [-0.35 * rh, 0.25 * rh, 0.88 * rh]]))
-        scene.add_spheres(eyes, np.full(2, 0.1 * rh), color=_COAL)
-        nose_base = head + quat.rotate(hr, np.array([0.0, 0.0, 0.9 * rh]))
-        nose_tip = head + quat.rotate(hr, np.array([0.0, -0.05 * rh, 1.6 * rh]))
-        scene.add_capsule(nose_base, nose_tip, 0.07 * rh, color=_CARROT)
-        if shape.middle is not None:
-            mid = centers[1]
-            fr = rot[j("chest")]
-            buttons = mid + quat.rotate(np.broadcast_to(fr, (3, 4)), np.array([[0.0, 0.45 * k, 0.95] for k in (-0.6, 0.0, 0.6)]) * shape.middle)
-            scene.add_spheres(buttons, np.full(3, 0.08 * shape.middle), color=_COAL)
+        cap_a, cap_b, cap_r, centres, radii, is_ball = _snowman_rows(snowman, sk, pos, rot, _joint_indices(sk))
+        caps.append((cap_a, cap_b, cap_r, _CAPSULE_COLORS))
+        colors = np.where(is_ball[:, None], _SNOW, _COAL)
+        spheres.append((centres, radii, colors, is_ball & (e in outlined)))
+    if caps:
+        a, b, r, col = (np.concatenate(x) for x in zip(*caps))
+        scene.add_capsules(a, b, r, color=col)
+        c, r, col, out = (np.concatenate(x) for x in zip(*spheres))
+        scene.add_spheres(c, r, color=col, outline=out)
 
 
 def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
@@ -77,7 +116,7 @@ def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
     outlined = {s.focus for _, s in world.query(Stick) if s.focus is not None and s.grabbed is None}
     outlined |= {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None}
     draw_snowmen(world, scene, alpha, outlined)
-    draw_trees(world, scene)
+    draw_trees(scene)
     field = world.try_resource(SnowField)
     if field is not None:
         marks = field.marks()

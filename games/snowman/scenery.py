@@ -36,15 +36,30 @@ def build_scenery(world: World) -> None:
         )
 
 
-def draw_trees(world: World, scene: RenderScene) -> None:
-    """Pine trees: a trunk and three snowy tiers each."""
+def _tree_primitives() -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """Every tree's trunk and three snowy tiers as capsule rows (a, b, radius, colour) and
+    their snow caps as sphere rows (centre, radius). Trees never move: built once."""
+    caps, snow = [], []
     for x, z, s in TREES:
         base = np.array([x, 0.0, z])
-        scene.add_capsule(base, base + [0, 1.2 * s, 0], 0.12 * s, color=(0.36, 0.25, 0.17))
+        caps.append((base, base + [0, 1.2 * s, 0], 0.12 * s, (0.36, 0.25, 0.17)))
         for k, (h, r) in enumerate(((1.0, 1.0), (1.9, 0.75), (2.7, 0.5))):
             c = base + [0, h * s, 0]
-            scene.add_capsule(c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, color=(0.16, 0.36 - 0.03 * k, 0.24))
-            scene.add_sphere(c + [0, 0.45 * s, 0], 0.35 * r * s, color=(0.95, 0.97, 1.0))
+            caps.append((c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, (0.16, 0.36 - 0.03 * k, 0.24)))
+            snow.append((c + [0, 0.45 * s, 0], 0.35 * r * s))
+    a, b, r, col = (np.array(v) for v in zip(*caps))
+    centre, radius = (np.array(v) for v in zip(*snow))
+    return (a, b, r, col), (centre, radius)
+
+
+_TREE_CAPSULES, _TREE_SNOW = _tree_primitives()
+
+
+def draw_trees(scene: RenderScene) -> None:
+    """Pine trees: a trunk and three snowy tiers each."""
+    a, b, r, col = _TREE_CAPSULES
+    scene.add_capsules(a, b, r, color=col)
+    scene.add_spheres(_TREE_SNOW[0], _TREE_SNOW[1], color=(0.95, 0.97, 1.0))
 
 
 def draw_snowfall(scene: RenderScene, time: float) -> None:

@@ -1,0 +1,67 @@
+"""Drawing snowmen and trees: every part where the rig puts it, outlines on the balls only."""
+
+import numpy as np
+import pytest
+
+from engine import quat
+from engine.components import Puppet, WorldPose
+from engine.ecs import World
+from engine.fk import forward_kinematics
+from engine.render.scene import RenderScene
+from games.snowman.components import Snowman
+from games.snowman.draw import draw_snowmen
+from games.snowman.rig import SnowmanShape, snowman_skeleton
+from games.snowman.scenery import TREES, draw_trees
+
+
+def spawn_standing(world, shape, heading, at):
+    sk = snowman_skeleton(shape)
+    rot = quat.identity(sk.num_joints)
+    rot[0] = quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), heading)
+    pos, rot = forward_kinematics(sk, sk.offsets[0] + at, rot)
+    e = world.spawn(Snowman(shape), Puppet(sk), WorldPose(pos, rot, pos.copy(), rot.copy()))
+    world.flush()
+    return e, sk, pos
+
+
+def rows_with_color(rows, color):
+    return rows[np.all(np.abs(rows[:, 7:10] - color) < 1e-6, axis=1)]
+
+
+@pytest.mark.parametrize("shape", [SnowmanShape(0.5, 0.35, 0.22), SnowmanShape(0.4, None, 0.2)])
+def test_a_snowman_is_drawn_on_its_joints(shape):
+    world = World()
+    e, sk, pos = spawn_standing(world, shape, np.pi / 2, np.array([2.0, 0.0, -1.0]))
+    other, _, _ = spawn_standing(world, SnowmanShape(0.3, None, 0.15), 0.0, np.array([-3.0, 0.0, 0.0]))
+    scene = RenderScene()
+    draw_snowmen(world, scene, 1.0, {e})
+    spheres, capsules = scene.spheres.data, scene.capsules.data
+    snow = rows_with_color(spheres, (0.97, 0.98, 1.0))
+    balls = 3 if shape.middle else 2
+    assert len(snow) == balls + 2  # the other snowman's two balls
+    mine = snow[snow[:, 10] > 0.5]  # outlined: only the grabbed snowman's balls
+    assert len(mine) == balls
+    assert np.allclose(mine[0, 0:3], pos[sk.index("hips")]) and mine[0, 6] == pytest.approx(shape.bottom)
+    assert np.allclose(mine[-1, 0:3], pos[sk.index("head")], atol=1e-6) and mine[-1, 6] == pytest.approx(shape.head)
+    if shape.middle:
+        assert mine[1, 6] == pytest.approx(shape.middle)
+        # Standing straight, the middle ball rests on the bottom one.
+        assert np.linalg.norm(mine[1, 0:3] - mine[0, 0:3]) == pytest.approx(shape.bottom + shape.middle, rel=1e-3)
+    coal = rows_with_color(spheres, (0.08, 0.08, 0.09))
+    assert len(coal) == 2 + (3 if shape.middle else 0) + 2 and not np.any(coal[:, 10])
+    # The carrot points the way the snowman faces (+x after a quarter turn about y).
+    (nose,) = [r for r in rows_with_color(capsules, (0.95, 0.45, 0.1)) if np.linalg.norm(r[0:3] - pos[sk.index("head")]) < 1.0]
+    assert nose[3] - nose[0] > 0.5 * shape.head
+    # Twig arms end beyond the hands; legs start at the thighs.
+    twigs = rows_with_color(capsules, (0.35, 0.22, 0.12))
+    assert len(twigs) == 12
+    assert any(np.allclose(r[0:3], pos[sk.index("l_upper_arm")]) for r in twigs)
+    assert any(np.allclose(r[0:3], pos[sk.index("r_upper_leg")]) for r in capsules)
+
+
+def test_trees_are_a_trunk_and_three_tiers_each():
+    scene = RenderScene()
+    draw_trees(scene)
+    assert len(scene.capsules) == 4 * len(TREES) and len(scene.spheres) == 3 * len(TREES)
+    trunks = scene.capsules.data[::4]
+    assert np.allclose(trunks[:, [0, 2]], [(x, z) for x, z, _ in TREES])
