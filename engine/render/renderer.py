@@ -6,7 +6,8 @@ Passes, in order (each kind of primitive is one instanced draw call):
    (:mod:`engine.render.shadows`), both fitted around the casters each frame.
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.
-3. **objects** — capsules, spheres, boxes, lit by sun, sky ambient and shadow.
+3. **objects** — capsules, spheres, boxes, lit by sun, sky ambient and shadow; capsules
+   and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`).
 4. **ground** — a large quad under the camera: procedural snow (drift shading, sparkle),
    anti-aliased grid, soft shadows, distance fog.
 5. **sky** — a gradient with a sun glow (and the background photo, faded) on the pixels
@@ -34,6 +35,7 @@ from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.gpu import Instances, mesh_buffers, set_uniform
+from engine.render.lod import CAPSULE_LEVELS, SPHERE_LEVELS, choose_levels, level_limits
 from engine.render.noise import snow_noise
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
@@ -100,17 +102,28 @@ class Renderer:
         self._outline_inst = {k: Instances(ctx, 4 * strides[k]) for k in _SOLIDS}
         self._buffers: list[moderngl.Buffer] = []
         self._vaos: dict[str, moderngl.VertexArray] = {}
+        # Lit solids: (vao, instances) per level of detail; boxes have one level.
+        self._lit: dict[str, list[tuple[moderngl.VertexArray, Instances]]] = {}
+        self._lod_limits = {"capsules": level_limits(CAPSULE_LEVELS), "spheres": level_limits(SPHERE_LEVELS)}
+        for kind, levels in (("capsules", CAPSULE_LEVELS), ("spheres", SPHERE_LEVELS)):
+            self._lit[kind] = []
+            for segments, rings in levels:
+                vbo, ibo = self._keep(mesh_buffers(ctx, meshes.capsule_mesh(segments, rings, band=kind == "capsules")))
+                inst = Instances(ctx, 4 * CAPSULE_STRIDE)
+                self._lit[kind].append((ctx.vertex_array(p["capsule"], [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)],
+                                                         ibo, 4, skip_errors=True), inst))
+        # Outlines (a few focused items) take the default meshes.
         for kind, mesh in (("capsules", meshes.capsule_mesh()), ("spheres", meshes.sphere_mesh())):
             vbo, ibo = self._keep(mesh_buffers(ctx, mesh))
-            for suffix, prog, inst in (("", "capsule", self._inst[kind]),
-                                       ("_flat", "capsule_flat", self._outline_inst[kind])):
-                self._vaos[kind + suffix] = ctx.vertex_array(
-                    p[prog], [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)], ibo, 4, skip_errors=True)
+            self._vaos[kind + "_flat"] = ctx.vertex_array(
+                p["capsule_flat"], [(vbo, "4f", "in_vert"), (self._outline_inst[kind].buf, *CAPSULE_FMT)], ibo, 4,
+                skip_errors=True)
         vbo, ibo = self._keep(mesh_buffers(ctx, meshes.box_mesh()))
         for suffix, prog, inst in (("", "box", self._inst["boxes"]),
                                    ("_flat", "box_flat", self._outline_inst["boxes"])):
             self._vaos["boxes" + suffix] = ctx.vertex_array(
                 p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
+        self._lit["boxes"] = [(self._vaos["boxes"], self._inst["boxes"])]
         quad, unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
             [-1, -1, 1, -1, -1, 1, 1, 1], [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
         for name in ("ground", "ground_photo"):
@@ -156,8 +169,14 @@ class Renderer:
         vp = camera.view_projection(w / h)
         self._mark(None)
         eye = np.asarray(camera.eye, dtype=np.float64)
-        counts = {k: inst.upload(_nearest_first(getattr(scene, k).data, eye) if k in _SOLIDS else getattr(scene, k).data)
-                  for k, inst in self._inst.items()}
+        rows = {k: _nearest_first(getattr(scene, k).data, eye) if k in _SOLIDS else getattr(scene, k).data
+                for k in self._inst}
+        counts = {k: inst.upload(rows[k]) for k, inst in self._inst.items()}  # every solid casts shadows
+        px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0))
+        for kind, limits in self._lod_limits.items():
+            level = choose_levels(rows[kind], eye, px_per_metre, limits)
+            for i, (_, inst) in enumerate(self._lit[kind]):
+                inst.upload(rows[kind][level == i])
         outlined = {}
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data
@@ -185,8 +204,9 @@ class Renderer:
                 self._vaos[kind + "_flat"].render(moderngl.TRIANGLES, instances=outlined[kind])
         ctx.cull_face = "back"
         for kind in _SOLIDS:
-            if counts[kind]:
-                self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
+            for vao, inst in self._lit[kind]:
+                if inst.count:
+                    vao.render(moderngl.TRIANGLES, instances=inst.count)
         self._mark("objects")
         ctx.enable_only(moderngl.DEPTH_TEST)
         photo = "_photo" if scene.background is not None and scene.background_fade < 1.0 else ""
@@ -297,9 +317,10 @@ class Renderer:
         """Free every GPU object this renderer made."""
         self.text.release()
         self.shadows.release()
-        for v in self._vaos.values():
+        lod = [pair for kind in ("capsules", "spheres") for pair in self._lit[kind]]
+        for v in (*self._vaos.values(), *(vao for vao, _ in lod)):
             v.release()
-        for i in (*self._inst.values(), *self._outline_inst.values()):
+        for i in (*self._inst.values(), *self._outline_inst.values(), *(inst for _, inst in lod)):
             i.buf.release()
         for obj in (*self._buffers, *self._programs.values(), self._blank, self._noise):
             obj.release()
