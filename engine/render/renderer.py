@@ -2,7 +2,7 @@
 
 Passes, in order (each kind of primitive is one instanced draw call):
 
-1. **shadows** — a sun depth map for objects and a blurred planar mask for the ground
+1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
    (:mod:`engine.render.shadows`), both fitted around the casters each frame.
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.

@@ -6,7 +6,7 @@ The fragment stages here are compiled after :data:`engine.render.shaders.LIGHTIN
 
 from __future__ import annotations
 
-__all__ = ["GROUND_VS", "PHOTO_DEFINE", "BACKGROUND", "GROUND_FS", "MASK_CAPSULE_VS", "MASK_BOX_VS", "MASK_FS", "BLUR_VS",
+__all__ = ["GROUND_VS", "PHOTO_DEFINE", "BACKGROUND", "GROUND_FS", "MASK_FS", "BLUR_VS",
            "BLUR_FS", "SKY_VS", "SKY_FS"]
 
 GROUND_VS = """
@@ -103,55 +103,25 @@ void main() {
 }
 """
 
-# Ground shadow mask: casters squashed onto the ground plane along the sun direction
-# (planar projected shadows), drawn top-down into a small texture and blurred. The
-# ground then reads its soft shadow with one bilinear fetch, far cheaper on llvmpipe
-# than a PCF kernel per ground pixel, and the penumbra is smooth rather than texel-stepped.
-MASK_CAPSULE_VS = """
-uniform vec3 u_sun_dir;
-uniform float u_height;
-uniform vec4 u_rect;            // x0, z0, width, depth of the mask on the ground
-in vec4 in_vert;
-in vec3 i_a;
-in vec3 i_b;
-in float i_r;
-void main() {
-    vec3 axis = i_b - i_a;
-    float len = length(axis);
-    vec3 y = len > 1e-6 ? axis / len : vec3(0.0, 1.0, 0.0);
-    vec3 helper = abs(y.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    vec3 x = normalize(cross(helper, y));
-    vec3 z = cross(x, y);
-    vec3 p = mix(i_a, i_b, in_vert.w) + (x * in_vert.x + y * in_vert.y + z * in_vert.z) * i_r;
-    vec3 L = normalize(u_sun_dir);
-    vec2 g = p.xz - L.xz * max(p.y - u_height, 0.0) / max(L.y, 0.05);
-    gl_Position = vec4((g - u_rect.xy) / u_rect.zw * 2.0 - 1.0, 0.0, 1.0);
-}
-"""
-
-MASK_BOX_VS = """
-uniform vec3 u_sun_dir;
-uniform float u_height;
-uniform vec4 u_rect;
-in vec3 in_pos;
-in vec3 i_center;
-in vec3 i_half;
-in vec4 i_rot;
-vec3 qrot(vec4 q, vec3 v) {
-    vec3 t = 2.0 * cross(q.yzw, v);
-    return v + q.x * t + cross(q.yzw, t);
-}
-void main() {
-    vec3 p = i_center + qrot(i_rot, in_pos * i_half);
-    vec3 L = normalize(u_sun_dir);
-    vec2 g = p.xz - L.xz * max(p.y - u_height, 0.0) / max(L.y, 0.05);
-    gl_Position = vec4((g - u_rect.xy) / u_rect.zw * 2.0 - 1.0, 0.0, 1.0);
-}
-"""
-
+# Ground shadow mask: each mask texel is a point on the ground under the casters; one
+# hardware 2x2 PCF fetch of the sun's depth map says whether a caster hides it from the
+# sun. The mask is then blurred and the ground reads its soft shadow with one bilinear
+# fetch, far cheaper on llvmpipe than a PCF kernel per ground pixel. (Drawing the casters
+# a second time, squashed onto the ground, cost twice as much: their vertices again.)
 MASK_FS = """
+uniform sampler2DShadow u_shadow_map;
+uniform mat4 u_light_vp;
+uniform vec4 u_rect;            // x0, z0, width, depth of the mask on the ground
+uniform float u_height;
+uniform float u_depth_bias;
+in vec2 v_uv;
 out float f_mask;
-void main() { f_mask = 1.0; }
+void main() {
+    vec2 xz = u_rect.xy + v_uv * u_rect.zw;
+    vec3 l = (u_light_vp * vec4(xz.x, u_height, xz.y, 1.0)).xyz * 0.5 + 0.5;
+    bool inside = all(greaterThan(l.xy, vec2(0.0))) && all(lessThan(l, vec3(1.0)));
+    f_mask = inside ? 1.0 - texture(u_shadow_map, vec3(l.xy, l.z - u_depth_bias)) : 0.0;
+}
 """
 
 # Separable Gaussian (9 texels in 5 bilinear fetches) for the ground mask.

@@ -1,11 +1,11 @@
-"""Sun shadows: a depth map for shadows on objects, a blurred planar mask for the ground.
+"""Sun shadows: a depth map for shadows on objects, a blurred mask for the ground.
 
-Two techniques, because their costs differ on a software rasteriser. Objects cover few
-pixels, so they take a classic shadow map with a 4-tap PCF kernel. The ground covers most
-of the screen and a PCF kernel there cost more than all its other shading together, so
-the casters are instead squashed onto the ground plane along the sun direction (planar
-projected shadows), drawn top-down into a small mask, blurred with a separable Gaussian
-and read back with one bilinear fetch: soft, smooth penumbrae at a fixed low cost.
+One depth map, read two ways, because the costs differ on a software rasteriser. Objects
+cover few pixels, so they read the map with a 4-tap PCF kernel. The ground covers most of
+the screen and a PCF kernel there cost more than all its other shading together, so the
+map is instead read once per texel of a small top-down mask of the ground under the
+casters, which is blurred with a separable Gaussian and read back with one bilinear
+fetch: soft, smooth penumbrae at a fixed low cost.
 
 Both fit themselves to the casters each frame (:func:`light_matrix`, :func:`ground_rect`)
 so their resolution goes where the puppets are.
@@ -108,26 +108,24 @@ class Shadows:
         progs = self._programs = {
             "capsule_depth": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=h + S.DEPTH_FS),
             "box_depth": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.DEPTH_FS),
-            "capsule_mask": ctx.program(vertex_shader=h + E.MASK_CAPSULE_VS, fragment_shader=h + E.MASK_FS),
-            "box_mask": ctx.program(vertex_shader=h + E.MASK_BOX_VS, fragment_shader=h + E.MASK_FS),
+            "mask": ctx.program(vertex_shader=h + E.BLUR_VS, fragment_shader=h + E.MASK_FS),
             "blur": ctx.program(vertex_shader=h + E.BLUR_VS, fragment_shader=h + E.BLUR_FS),
         }
         # Coarse meshes: llvmpipe runs vertex work on one thread, and a shadow cannot show the facets.
         self._buffers: list[moderngl.Buffer] = []
-        self._vaos: list[tuple[str, moderngl.VertexArray, moderngl.VertexArray, Instances]] = []
-        for kind, mesh, inst in (("capsule", meshes.capsule_mesh(8, 2), capsules),
-                                 ("sphere", meshes.sphere_mesh(12, 4), spheres)):
+        self._vaos: list[tuple[moderngl.Program, moderngl.VertexArray, Instances]] = []
+        for mesh, inst in ((meshes.capsule_mesh(8, 2), capsules), (meshes.sphere_mesh(12, 4), spheres)):
             vbo, ibo = mesh_buffers(ctx, mesh)
             self._buffers += [vbo, ibo]
             content = [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)]
-            self._vaos.append((kind,
-                               ctx.vertex_array(progs["capsule_depth"], content, ibo, 4, skip_errors=True),
-                               ctx.vertex_array(progs["capsule_mask"], content, ibo, 4, skip_errors=True), inst))
+            self._vaos.append((progs["capsule_depth"],
+                               ctx.vertex_array(progs["capsule_depth"], content, ibo, 4, skip_errors=True), inst))
         vbo, ibo = mesh_buffers(ctx, meshes.box_mesh())
         self._buffers += [vbo, ibo]
         content = [(vbo, "3f 3f", "in_pos", "in_normal"), (boxes.buf, *BOX_FMT)]
-        self._vaos.append(("box", ctx.vertex_array(progs["box_depth"], content, ibo, 4, skip_errors=True),
-                           ctx.vertex_array(progs["box_mask"], content, ibo, 4, skip_errors=True), boxes))
+        self._vaos.append((progs["box_depth"],
+                           ctx.vertex_array(progs["box_depth"], content, ibo, 4, skip_errors=True), boxes))
+        self._mask_vao = ctx.vertex_array(progs["mask"], [])
         self._blur_vao = ctx.vertex_array(progs["blur"], [])
         self.depth = ctx.depth_texture((map_size, map_size))
         self.depth.compare_func = "<="
@@ -149,23 +147,21 @@ class Shadows:
         self._depth_fbo.use()
         self._depth_fbo.clear(depth=1.0)
         ctx.enable_only(moderngl.DEPTH_TEST)
-        for kind, depth_vao, _, inst in self._vaos:
+        for prog, vao, inst in self._vaos:
             if inst.count:
-                prog = self._programs["box_depth" if kind == "box" else "capsule_depth"]
                 set_uniform(prog, "u_view_proj", light_vp)
                 set_uniform(prog, "u_inflate_px", 0.0)
-                depth_vao.render(moderngl.TRIANGLES, instances=inst.count)
+                vao.render(moderngl.TRIANGLES, instances=inst.count)
         self._mask_fbo.use()
-        self._mask_fbo.clear(0.0, 0.0, 0.0, 0.0)
         ctx.enable_only(moderngl.NOTHING)
-        sun = tuple(float(x) for x in _sun(scene))
-        for kind, _, mask_vao, inst in self._vaos:
-            if inst.count:
-                prog = self._programs["box_mask" if kind == "box" else "capsule_mask"]
-                set_uniform(prog, "u_sun_dir", sun)
-                set_uniform(prog, "u_height", float(scene.ground.height))
-                set_uniform(prog, "u_rect", rect)
-                mask_vao.render(moderngl.TRIANGLES, instances=inst.count)
+        mask = self._programs["mask"]
+        self.depth.use(location=0)
+        # Ground points a centimetre below the casters' surface along the light are still lit.
+        for name, value in (("u_shadow_map", 0), ("u_light_vp", light_vp), ("u_rect", rect),
+                            ("u_height", float(scene.ground.height)),
+                            ("u_depth_bias", 0.01 * float(np.linalg.norm(light_vp[2, :3])) / 2.0)):
+            set_uniform(mask, name, value)
+        self._mask_vao.render(moderngl.TRIANGLES, vertices=3)
         # The 9-texel kernel reaches 3.23 steps out: scale the step so it spans ``softness`` metres.
         blur = self._programs["blur"]
         set_uniform(blur, "u_src", 0)
@@ -179,9 +175,9 @@ class Shadows:
 
     def release(self) -> None:
         """Free the GPU objects."""
-        for _, a, b, _ in self._vaos:
-            a.release()
-            b.release()
+        for _, vao, _ in self._vaos:
+            vao.release()
+        self._mask_vao.release()
         self._blur_vao.release()
         for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo,
                     self._tmp_fbo, self.mask, self._mask_tmp):
