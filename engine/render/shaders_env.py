@@ -6,8 +6,8 @@ The fragment stages here are compiled after :data:`engine.render.shaders.LIGHTIN
 
 from __future__ import annotations
 
-__all__ = ["GROUND_VS", "PHOTO_DEFINE", "BACKGROUND", "GROUND_FS", "MASK_FS", "BLUR_VS",
-           "BLUR_FS", "SKY_VS", "SKY_FS"]
+__all__ = ["GROUND_VS", "PHOTO_DEFINE", "BACKGROUND", "GROUND_FS", "MASK_FS", "FULLSCREEN_VS",
+           "SKY_VS", "SKY_FS"]
 
 GROUND_VS = """
 uniform mat4 u_view_proj;
@@ -103,48 +103,41 @@ void main() {
 }
 """
 
-# Ground shadow mask: each mask texel is a point on the ground under the casters; one
-# hardware 2x2 PCF fetch of the sun's depth map says whether a caster hides it from the
-# sun. The mask is then blurred and the ground reads its soft shadow with one bilinear
-# fetch, far cheaper on llvmpipe than a PCF kernel per ground pixel. (Drawing the casters
-# a second time, squashed onto the ground, cost twice as much: their vertices again.)
+# Ground shadow mask: each mask texel is a point on the ground under the casters, lit
+# where four hardware 2x2 PCF taps of the sun's depth map on a disc of the penumbra's
+# radius see no caster. The ground then reads its soft shadow with one bilinear fetch,
+# far cheaper on llvmpipe than a PCF kernel per ground pixel. (Drawing the casters a
+# second time, squashed onto the ground, cost twice as much: their vertices again; and a
+# separable blur of the mask cost more than the taps.)
 MASK_FS = """
 uniform sampler2DShadow u_shadow_map;
 uniform mat4 u_light_vp;
 uniform vec4 u_rect;            // x0, z0, width, depth of the mask on the ground
 uniform float u_height;
 uniform float u_depth_bias;
+uniform float u_spread;         // penumbra radius in shadow-map uv
 in vec2 v_uv;
 out float f_mask;
+const vec2 DISC[4] = vec2[](vec2(-0.94, -0.40), vec2(0.95, 0.40), vec2(-0.40, 0.91), vec2(0.40, -0.91));
 void main() {
     vec2 xz = u_rect.xy + v_uv * u_rect.zw;
     vec3 l = (u_light_vp * vec4(xz.x, u_height, xz.y, 1.0)).xyz * 0.5 + 0.5;
+    float lit = 0.0;
+    for (int i = 0; i < 4; i++) {
+        lit += texture(u_shadow_map, vec3(l.xy + DISC[i] * u_spread, l.z - u_depth_bias));
+    }
     bool inside = all(greaterThan(l.xy, vec2(0.0))) && all(lessThan(l, vec3(1.0)));
-    f_mask = inside ? 1.0 - texture(u_shadow_map, vec3(l.xy, l.z - u_depth_bias)) : 0.0;
+    f_mask = inside ? 1.0 - 0.25 * lit : 0.0;
 }
 """
 
-# Separable Gaussian (9 texels in 5 bilinear fetches) for the ground mask.
-BLUR_VS = """
+# A full-screen triangle (no vertex buffer) with uv over the target.
+FULLSCREEN_VS = """
 out vec2 v_uv;
 void main() {
     vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2) * 2.0 - 1.0;
     v_uv = p * 0.5 + 0.5;
     gl_Position = vec4(p, 0.0, 1.0);
-}
-"""
-
-BLUR_FS = """
-uniform sampler2D u_src;
-uniform vec2 u_step;            // texel step (times the spread) along one axis
-in vec2 v_uv;
-out float f_mask;
-void main() {
-    float s = texture(u_src, v_uv).r * 0.2270270270;
-    vec2 o1 = u_step * 1.3846153846, o2 = u_step * 3.2307692308;
-    s += (texture(u_src, v_uv + o1).r + texture(u_src, v_uv - o1).r) * 0.3162162162;
-    s += (texture(u_src, v_uv + o2).r + texture(u_src, v_uv - o2).r) * 0.0702702703;
-    f_mask = s;
 }
 """
 

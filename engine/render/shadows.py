@@ -3,9 +3,9 @@
 One depth map, read two ways, because the costs differ on a software rasteriser. Objects
 cover few pixels, so they read the map with a 4-tap PCF kernel. The ground covers most of
 the screen and a PCF kernel there cost more than all its other shading together, so the
-map is instead read once per texel of a small top-down mask of the ground under the
-casters, which is blurred with a separable Gaussian and read back with one bilinear
-fetch: soft, smooth penumbrae at a fixed low cost.
+map is instead read with that kernel once per texel of a small top-down mask of the
+ground under the casters, and the ground reads the mask back with one bilinear fetch:
+soft, smooth penumbrae at a fixed low cost.
 
 Both fit themselves to the casters each frame (:func:`light_matrix`, :func:`ground_rect`)
 so their resolution goes where the puppets are.
@@ -108,8 +108,7 @@ class Shadows:
         progs = self._programs = {
             "capsule_depth": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=h + S.DEPTH_FS),
             "box_depth": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.DEPTH_FS),
-            "mask": ctx.program(vertex_shader=h + E.BLUR_VS, fragment_shader=h + E.MASK_FS),
-            "blur": ctx.program(vertex_shader=h + E.BLUR_VS, fragment_shader=h + E.BLUR_FS),
+            "mask": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + E.MASK_FS),
         }
         # Coarse meshes: llvmpipe runs vertex work on one thread, and a shadow cannot show the facets.
         self._buffers: list[moderngl.Buffer] = []
@@ -126,23 +125,19 @@ class Shadows:
         self._vaos.append((progs["box_depth"],
                            ctx.vertex_array(progs["box_depth"], content, ibo, 4, skip_errors=True), boxes))
         self._mask_vao = ctx.vertex_array(progs["mask"], [])
-        self._blur_vao = ctx.vertex_array(progs["blur"], [])
         self.depth = ctx.depth_texture((map_size, map_size))
         self.depth.compare_func = "<="
         self.depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.depth.repeat_x = self.depth.repeat_y = False
         self._depth_fbo = ctx.framebuffer(depth_attachment=self.depth)
         self.mask = ctx.texture((mask_size, mask_size), 1)
-        self._mask_tmp = ctx.texture((mask_size, mask_size), 1)
-        for tex in (self.mask, self._mask_tmp):
-            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            tex.repeat_x = tex.repeat_y = False
+        self.mask.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self.mask.repeat_x = self.mask.repeat_y = False
         self._mask_fbo = ctx.framebuffer([self.mask])
-        self._tmp_fbo = ctx.framebuffer([self._mask_tmp])
 
     def render(self, scene: RenderScene, light_vp: NDArray[np.float64],
                rect: tuple[float, float, float, float]) -> None:
-        """Draw the object shadow map and the blurred ground mask for this frame."""
+        """Draw the object shadow map and the ground mask for this frame."""
         ctx = self.ctx
         self._depth_fbo.use()
         self._depth_fbo.clear(depth=1.0)
@@ -156,29 +151,23 @@ class Shadows:
         ctx.enable_only(moderngl.NOTHING)
         mask = self._programs["mask"]
         self.depth.use(location=0)
-        # Ground points a centimetre below the casters' surface along the light are still lit.
+        # Ground points a centimetre below the casters' surface along the light are still
+        # lit. The taps spread over half the penumbra (the spread of the Gaussian the
+        # ground's penumbra once was), and at least over a mask texel's footprint, so a
+        # caster thinner than a texel (a twig arm across a wide field) still darkens the
+        # texels it crosses wherever it falls between their centres, rather than flicker.
+        uv_per_metre = float(np.linalg.norm(light_vp[0, :3])) / 2.0
+        spread = max(0.5 * scene.sun.softness, 0.5 * max(rect[2], rect[3]) / self.mask_size)
         for name, value in (("u_shadow_map", 0), ("u_light_vp", light_vp), ("u_rect", rect),
-                            ("u_height", float(scene.ground.height)),
+                            ("u_height", float(scene.ground.height)), ("u_spread", spread * uv_per_metre),
                             ("u_depth_bias", 0.01 * float(np.linalg.norm(light_vp[2, :3])) / 2.0)):
             set_uniform(mask, name, value)
         self._mask_vao.render(moderngl.TRIANGLES, vertices=3)
-        # The 9-texel kernel reaches 3.23 steps out: scale the step so it spans ``softness`` metres.
-        blur = self._programs["blur"]
-        set_uniform(blur, "u_src", 0)
-        spread = max(scene.sun.softness / 3.23, 1e-4)
-        for src, dst, step in ((self.mask, self._tmp_fbo, (spread / rect[2], 0.0)),
-                               (self._mask_tmp, self._mask_fbo, (0.0, spread / rect[3]))):
-            dst.use()
-            src.use(location=0)
-            set_uniform(blur, "u_step", (max(step[0], 0.0), max(step[1], 0.0)))
-            self._blur_vao.render(moderngl.TRIANGLES, vertices=3)
 
     def release(self) -> None:
         """Free the GPU objects."""
         for _, vao, _ in self._vaos:
             vao.release()
         self._mask_vao.release()
-        self._blur_vao.release()
-        for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo,
-                    self._tmp_fbo, self.mask, self._mask_tmp):
+        for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo, self.mask):
             obj.release()

@@ -222,3 +222,27 @@ def test_a_viewer_draws_into_its_own_context_after_another_was_made(gl):
     finally:
         other.release()
     assert np.array_equal(draw(gl, scene, camera), before)
+
+
+def test_a_thin_caster_shades_the_ground_steadily_even_when_the_shadow_mask_is_coarse(gl):
+    # Casters 20 m apart stretch the ground mask to ~8.6 cm texels; an 8 cm forearm moved
+    # across one texel darkens the ground under it at every position (no flicker), and
+    # with the casters close together (1.6 cm texels) its shadow is dark.
+    cam = OrbitCamera(target=np.array([0.0, 0.0, 0.0]), yaw=0.0, pitch=1.2, distance=2.5)
+
+    def ground_under_forearm(spread, x):
+        scene = RenderScene()
+        scene.sun.direction = (0.0, 1.0, 0.0001)
+        scene.ground.grid = False
+        scene.add_sphere([-spread, 0.5, 0.0], 0.5)
+        scene.add_sphere([spread, 0.5, 0.0], 0.5)
+        if x is not None:
+            scene.add_capsule([x, 0.6, -0.3], [x, 0.6, 0.3], 0.04)
+        (px, py), = np.round(cam.project([[0.0 if x is None else x, 0.0, 0.2]], W, H)).astype(int)
+        return draw(gl, scene, cam)[py - 2:py + 3, px - 2:px + 3].sum(axis=2).mean()
+
+    for spread, least in ((10.0, 0.05), (1.0, 0.25)):
+        plain = ground_under_forearm(spread, None)
+        darkening = np.array([1.0 - ground_under_forearm(spread, x) / plain for x in np.linspace(0.0, 0.086, 6)])
+        assert darkening.min() > least, (spread, darkening)
+        assert darkening.max() < 1.6 * darkening.min(), (spread, darkening)
