@@ -35,9 +35,9 @@ def set_uniform(prog: moderngl.Program, name: str, value: Any) -> None:
     ``[4,4]`` numpy matrices (maths convention, column vectors) are uploaded transposed,
     since GL reads them column-major.
     """
-    if name not in prog:
+    u = prog.get(name, None)  # not ``name in prog``: Program has no __contains__, that scans its members
+    if u is None:
         return
-    u = prog[name]
     if isinstance(value, np.ndarray) and value.shape == (4, 4):
         u.write(np.ascontiguousarray(value.T, dtype=np.float32).tobytes())
     else:
