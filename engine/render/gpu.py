@@ -8,7 +8,7 @@ import moderngl
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Instances", "set_uniform", "mesh_buffers"]
+__all__ = ["Instances", "LodBatches", "set_uniform", "mesh_buffers"]
 
 
 class Instances:
@@ -48,3 +48,50 @@ def mesh_buffers(ctx: moderngl.Context,
                  mesh: tuple[NDArray[Any], NDArray[Any]]) -> tuple[moderngl.Buffer, moderngl.Buffer]:
     """Vertex and index buffers of a ``(vertices, triangles)`` mesh."""
     return ctx.buffer(np.ascontiguousarray(mesh[0]).tobytes()), ctx.buffer(np.ascontiguousarray(mesh[1]).tobytes())
+
+
+class LodBatches:
+    """Capsules (or spheres) drawn with one instanced call per level of detail.
+
+    Args:
+        ctx: the context.
+        program: the program every level draws with (its vertex stage reads ``in_vert``
+            and the capsule instance attributes ``fmt``).
+        meshes: one ``(vertices, triangles)`` unit mesh per level, coarse to fine.
+        fmt: the instance layout, e.g. ``("3f 3f 1f 3f 1f/i", "i_a", ...)``, of rows
+            ``stride_bytes`` long.
+    """
+
+    def __init__(self, ctx: moderngl.Context, program: moderngl.Program,
+                 meshes: list[tuple[NDArray[Any], NDArray[Any]]], fmt: tuple[str, ...], stride_bytes: int) -> None:
+        self._levels: list[tuple[moderngl.VertexArray, Instances]] = []
+        self._buffers: list[moderngl.Buffer] = []
+        for mesh in meshes:
+            vbo, ibo = mesh_buffers(ctx, mesh)
+            inst = Instances(ctx, stride_bytes)
+            self._buffers += [vbo, ibo, inst.buf]
+            self._levels.append((ctx.vertex_array(program, [(vbo, "4f", "in_vert"), (inst.buf, *fmt)], ibo, 4,
+                                                  skip_errors=True), inst))
+
+    @property
+    def counts(self) -> list[int]:
+        """Instances uploaded at each level."""
+        return [inst.count for _, inst in self._levels]
+
+    def upload(self, rows: NDArray[np.float32], level: NDArray[np.intp]) -> None:
+        """Give each level the rows whose ``level`` index names it (order kept)."""
+        for i, (_, inst) in enumerate(self._levels):
+            inst.upload(rows[level == i])
+
+    def render(self) -> None:
+        """One instanced draw per level that has rows."""
+        for vao, inst in self._levels:
+            if inst.count:
+                vao.render(moderngl.TRIANGLES, instances=inst.count)
+
+    def release(self) -> None:
+        """Free the vertex arrays and buffers."""
+        for vao, _ in self._levels:
+            vao.release()
+        for buf in self._buffers:
+            buf.release()

@@ -17,7 +17,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CAPSULE_LEVELS", "SPHERE_LEVELS", "SILHOUETTE_ERROR_PX", "level_limits", "choose_levels"]
+from engine.render.meshes import capsule_mesh
+
+__all__ = ["CAPSULE_LEVELS", "SPHERE_LEVELS", "SILHOUETTE_ERROR_PX", "level_limits", "choose_levels",
+           "choose_levels_orthographic", "level_meshes"]
 
 CAPSULE_LEVELS: tuple[tuple[int, int], ...] = ((8, 2), (12, 3), (16, 4), (24, 6))
 """(segments around, rings per end cap) from coarse to fine."""
@@ -29,6 +32,12 @@ _NEAREST_M = 0.05  # a camera inside a shape takes the finest level, not a divis
 def level_limits(levels: tuple[tuple[int, int], ...], error_px: float = SILHOUETTE_ERROR_PX) -> NDArray[np.float64]:
     """Largest on-screen radius in pixels each level but the finest may draw."""
     return np.array([error_px / (1.0 - math.cos(math.pi / segments)) for segments, _ in levels[:-1]])
+
+
+def level_meshes(levels: tuple[tuple[int, int], ...], *,
+                 band: bool = True) -> list[tuple[NDArray[np.float32], NDArray[np.int32]]]:
+    """The unit mesh of each level (``band=False``: spheres)."""
+    return [capsule_mesh(segments, rings, band=band) for segments, rings in levels]
 
 
 def choose_levels(rows: NDArray[np.float32], eye: NDArray[np.float64], px_per_metre: float,
@@ -45,3 +54,10 @@ def choose_levels(rows: NDArray[np.float32], eye: NDArray[np.float64], px_per_me
     distance = np.linalg.norm(a + t[:, None] * axis - eye, axis=1) - r
     radius_px = r * px_per_metre / np.maximum(distance, _NEAREST_M)
     return np.searchsorted(limits, radius_px)
+
+
+def choose_levels_orthographic(rows: NDArray[np.float32], px_per_metre: float,
+                               limits: NDArray[np.float64]) -> NDArray[np.intp]:
+    """The level index for each capsule row seen through an orthographic projection (the
+    sun's shadow map), where the size on screen does not depend on distance."""
+    return np.searchsorted(limits, rows[:, 6].astype(np.float64) * px_per_metre)

@@ -34,8 +34,8 @@ from engine.camera import Camera
 from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
-from engine.render.gpu import Instances, mesh_buffers, set_uniform
-from engine.render.lod import CAPSULE_LEVELS, SPHERE_LEVELS, choose_levels, level_limits
+from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
+from engine.render.lod import CAPSULE_LEVELS, SPHERE_LEVELS, choose_levels, level_limits, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
@@ -46,6 +46,7 @@ __all__ = ["Renderer"]
 _LINE_FMT = ("3f 3f 3f 1f/i", "i_p0", "i_p1", "i_color", "i_width")
 _POINT_FMT = ("3f 1f 3f 1f", "i_pos", "i_size", "i_color", "i_pixels")
 _SOLIDS = ("capsules", "spheres", "boxes")
+_KINDS = (*_SOLIDS, "lines", "points")
 
 
 def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArray[np.float32]:
@@ -97,21 +98,16 @@ class Renderer:
         }
         strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
                    "lines": LINE_STRIDE, "points": POINT_STRIDE}
-        self._inst = {k: Instances(ctx, 4 * n) for k, n in strides.items()}
-        # Outlined items get their own small buffers so the outline pass only touches them.
+        # Capsules and spheres have one buffer per level of detail (self._lod, below).
+        self._inst = {k: Instances(ctx, 4 * strides[k]) for k in ("boxes", "lines", "points")}
         self._outline_inst = {k: Instances(ctx, 4 * strides[k]) for k in _SOLIDS}
         self._buffers: list[moderngl.Buffer] = []
         self._vaos: dict[str, moderngl.VertexArray] = {}
-        # Lit solids: (vao, instances) per level of detail; boxes have one level.
-        self._lit: dict[str, list[tuple[moderngl.VertexArray, Instances]]] = {}
+        # Lit capsules and spheres: one batch per level of detail.
+        self._lod = {kind: LodBatches(ctx, p["capsule"], level_meshes(levels, band=kind == "capsules"), CAPSULE_FMT,
+                                      4 * CAPSULE_STRIDE)
+                     for kind, levels in (("capsules", CAPSULE_LEVELS), ("spheres", SPHERE_LEVELS))}
         self._lod_limits = {"capsules": level_limits(CAPSULE_LEVELS), "spheres": level_limits(SPHERE_LEVELS)}
-        for kind, levels in (("capsules", CAPSULE_LEVELS), ("spheres", SPHERE_LEVELS)):
-            self._lit[kind] = []
-            for segments, rings in levels:
-                vbo, ibo = self._keep(mesh_buffers(ctx, meshes.capsule_mesh(segments, rings, band=kind == "capsules")))
-                inst = Instances(ctx, 4 * CAPSULE_STRIDE)
-                self._lit[kind].append((ctx.vertex_array(p["capsule"], [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)],
-                                                         ibo, 4, skip_errors=True), inst))
         # Outlines (a few focused items) take the default meshes.
         for kind, mesh in (("capsules", meshes.capsule_mesh()), ("spheres", meshes.sphere_mesh())):
             vbo, ibo = self._keep(mesh_buffers(ctx, mesh))
@@ -123,7 +119,6 @@ class Renderer:
                                    ("_flat", "box_flat", self._outline_inst["boxes"])):
             self._vaos["boxes" + suffix] = ctx.vertex_array(
                 p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
-        self._lit["boxes"] = [(self._vaos["boxes"], self._inst["boxes"])]
         quad, unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
             [-1, -1, 1, -1, -1, 1, 1, 1], [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
         for name in ("ground", "ground_photo"):
@@ -134,8 +129,7 @@ class Renderer:
         self._vaos["points"] = ctx.vertex_array(p["point"], [(self._inst["points"].buf, *_POINT_FMT)], skip_errors=True)
         for name in ("sky", "sky_photo"):
             self._vaos[name] = ctx.vertex_array(p[name], [])
-        self.shadows = Shadows(ctx, self._inst["capsules"], self._inst["spheres"], self._inst["boxes"],
-                               shadow_size, mask_size)
+        self.shadows = Shadows(ctx, self._inst["boxes"], shadow_size, mask_size)
         self._blank = ctx.texture((1, 1), 3, bytes([255, 255, 255]))
         noise = snow_noise()
         self._noise = ctx.texture(noise.shape[:2][::-1], 4, noise.tobytes())
@@ -170,13 +164,12 @@ class Renderer:
         self._mark(None)
         eye = np.asarray(camera.eye, dtype=np.float64)
         rows = {k: _nearest_first(getattr(scene, k).data, eye) if k in _SOLIDS else getattr(scene, k).data
-                for k in self._inst}
-        counts = {k: inst.upload(rows[k]) for k, inst in self._inst.items()}  # every solid casts shadows
+                for k in _KINDS}
+        counts = {k: self._inst[k].upload(rows[k]) for k in ("boxes", "lines", "points")}
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0))
-        for kind, limits in self._lod_limits.items():
-            level = choose_levels(rows[kind], eye, px_per_metre, limits)
-            for i, (_, inst) in enumerate(self._lit[kind]):
-                inst.upload(rows[kind][level == i])
+        levels = {kind: choose_levels(rows[kind], eye, px_per_metre, self._lod_limits[kind]) for kind in self._lod}
+        for kind, batches in self._lod.items():
+            batches.upload(rows[kind], levels[kind])
         outlined = {}
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data
@@ -184,7 +177,7 @@ class Renderer:
         light_vp = light_matrix(scene) if scene.sun.shadows else None
         rect = ground_rect(scene) if light_vp is not None else None
         if light_vp is not None and rect is not None:
-            self.shadows.render(scene, light_vp, rect)
+            self.shadows.render(scene, {kind: (rows[kind], levels[kind]) for kind in self._lod}, light_vp, rect)
         self._mark("shadows")
 
         framebuffer.use()
@@ -203,10 +196,10 @@ class Renderer:
             if outlined[kind]:
                 self._vaos[kind + "_flat"].render(moderngl.TRIANGLES, instances=outlined[kind])
         ctx.cull_face = "back"
-        for kind in _SOLIDS:
-            for vao, inst in self._lit[kind]:
-                if inst.count:
-                    vao.render(moderngl.TRIANGLES, instances=inst.count)
+        for batches in self._lod.values():
+            batches.render()
+        if counts["boxes"]:
+            self._vaos["boxes"].render(moderngl.TRIANGLES, instances=counts["boxes"])
         self._mark("objects")
         ctx.enable_only(moderngl.DEPTH_TEST)
         photo = "_photo" if scene.background is not None and scene.background_fade < 1.0 else ""
@@ -317,10 +310,11 @@ class Renderer:
         """Free every GPU object this renderer made."""
         self.text.release()
         self.shadows.release()
-        lod = [pair for kind in ("capsules", "spheres") for pair in self._lit[kind]]
-        for v in (*self._vaos.values(), *(vao for vao, _ in lod)):
+        for batches in self._lod.values():
+            batches.release()
+        for v in self._vaos.values():
             v.release()
-        for i in (*self._inst.values(), *self._outline_inst.values(), *(inst for _, inst in lod)):
+        for i in (*self._inst.values(), *self._outline_inst.values()):
             i.buf.release()
         for obj in (*self._buffers, *self._programs.values(), self._blank, self._noise):
             obj.release()

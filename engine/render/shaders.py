@@ -54,7 +54,10 @@ const vec2 POISSON[4] = vec2[](vec2(-0.94, -0.40), vec2(0.95, 0.40), vec2(-0.40,
 
 float shadow_factor(vec3 p, vec3 n) {
     if (u_shadows_on < 0.5) return 1.0;
-    vec4 ls = u_light_vp * vec4(p + n * u_normal_bias, 1.0);
+    // Normal offset grows as the surface turns from the sun (slope-scaled): there the
+    // PCF taps reach furthest across the curved surface towards its sunlit side.
+    float turned = 1.0 - clamp(dot(n, u_sun_dir), 0.0, 1.0);
+    vec4 ls = u_light_vp * vec4(p + n * (u_normal_bias * (1.0 + 2.0 * turned)), 1.0);
     vec3 uvz = ls.xyz / ls.w * 0.5 + 0.5;
     if (uvz.x <= 0.0 || uvz.y <= 0.0 || uvz.x >= 1.0 || uvz.y >= 1.0 || uvz.z >= 1.0) return 1.0;
     vec2 scale = vec2(u_softness * u_shadow_texel);

@@ -21,8 +21,9 @@ from engine.camera import look_at
 from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
-from engine.render.gpu import Instances, mesh_buffers, set_uniform
-from engine.render.scene import RenderScene
+from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
+from engine.render.lod import CAPSULE_LEVELS, SPHERE_LEVELS, choose_levels_orthographic, level_limits, level_meshes
+from engine.render.scene import CAPSULE_STRIDE, RenderScene
 
 __all__ = ["Shadows", "light_matrix", "ground_rect"]
 
@@ -94,12 +95,13 @@ class Shadows:
 
     Args:
         ctx: the context.
-        capsules, spheres, boxes: the renderer's instance buffers (shared, not copied).
+        boxes: the renderer's box instance buffer (shared, not copied). Capsules and
+            spheres come with each frame, since their level of detail in the shadow
+            map depends on its texels as well as on the camera's.
         map_size: side of the object shadow map; mask_size: side of the ground mask.
     """
 
-    def __init__(self, ctx: moderngl.Context, capsules: Instances, spheres: Instances, boxes: Instances,
-                 map_size: int = 1024, mask_size: int = 512) -> None:
+    def __init__(self, ctx: moderngl.Context, boxes: Instances, map_size: int = 1024, mask_size: int = 512) -> None:
         if map_size < 16 or mask_size < 16:
             raise ValueError(f"shadow sizes must be at least 16, got {map_size} and {mask_size}")
         self.ctx = ctx
@@ -110,20 +112,16 @@ class Shadows:
             "box_depth": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.DEPTH_FS),
             "mask": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + E.MASK_FS),
         }
-        # Coarse meshes: llvmpipe runs vertex work on one thread, and a shadow cannot show the facets.
-        self._buffers: list[moderngl.Buffer] = []
-        self._vaos: list[tuple[moderngl.Program, moderngl.VertexArray, Instances]] = []
-        for mesh, inst in ((meshes.capsule_mesh(8, 2), capsules), (meshes.sphere_mesh(12, 4), spheres)):
-            vbo, ibo = mesh_buffers(ctx, mesh)
-            self._buffers += [vbo, ibo]
-            content = [(vbo, "4f", "in_vert"), (inst.buf, *CAPSULE_FMT)]
-            self._vaos.append((progs["capsule_depth"],
-                               ctx.vertex_array(progs["capsule_depth"], content, ibo, 4, skip_errors=True), inst))
-        vbo, ibo = mesh_buffers(ctx, meshes.box_mesh())
-        self._buffers += [vbo, ibo]
-        content = [(vbo, "3f 3f", "in_pos", "in_normal"), (boxes.buf, *BOX_FMT)]
-        self._vaos.append((progs["box_depth"],
-                           ctx.vertex_array(progs["box_depth"], content, ibo, 4, skip_errors=True), boxes))
+        # Casters at the coarsest level whose outline stays within a shadow-map texel.
+        self._lod = {kind: LodBatches(ctx, progs["capsule_depth"], level_meshes(levels, band=kind == "capsules"),
+                                      CAPSULE_FMT, 4 * CAPSULE_STRIDE)
+                     for kind, levels in (("capsules", CAPSULE_LEVELS), ("spheres", SPHERE_LEVELS))}
+        self._lod_limits = {"capsules": level_limits(CAPSULE_LEVELS), "spheres": level_limits(SPHERE_LEVELS)}
+        self._boxes = boxes
+        self._buffers = list(mesh_buffers(ctx, meshes.box_mesh()))
+        self._box_vao = ctx.vertex_array(progs["box_depth"], [(self._buffers[0], "3f 3f", "in_pos", "in_normal"),
+                                                             (boxes.buf, *BOX_FMT)], self._buffers[1], 4,
+                                         skip_errors=True)
         self._mask_vao = ctx.vertex_array(progs["mask"], [])
         self.depth = ctx.depth_texture((map_size, map_size))
         self.depth.compare_func = "<="
@@ -135,18 +133,30 @@ class Shadows:
         self.mask.repeat_x = self.mask.repeat_y = False
         self._mask_fbo = ctx.framebuffer([self.mask])
 
-    def render(self, scene: RenderScene, light_vp: NDArray[np.float64],
-               rect: tuple[float, float, float, float]) -> None:
-        """Draw the object shadow map and the ground mask for this frame."""
+    def render(self, scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+               light_vp: NDArray[np.float64], rect: tuple[float, float, float, float]) -> None:
+        """Draw the object shadow map and the ground mask for this frame.
+
+        ``casters`` maps "capsules" and "spheres" to the scene's rows and the level each
+        is drawn at for the camera. In the shadow map a caster is one level coarser than
+        on screen (or coarser still if its texels allow): a coarser caster's faces lie
+        inside the surface drawn, which keeps the PCF taps on curved, sun-facing surfaces
+        from shadowing the surface itself in blotches (acne); a finer one stands outside it.
+        """
         ctx = self.ctx
         self._depth_fbo.use()
         self._depth_fbo.clear(depth=1.0)
         ctx.enable_only(moderngl.DEPTH_TEST)
-        for prog, vao, inst in self._vaos:
-            if inst.count:
-                set_uniform(prog, "u_view_proj", light_vp)
-                set_uniform(prog, "u_inflate_px", 0.0)
-                vao.render(moderngl.TRIANGLES, instances=inst.count)
+        texels_per_metre = self.map_size * float(np.linalg.norm(light_vp[0, :3])) / 2.0
+        for prog in (self._programs["capsule_depth"], self._programs["box_depth"]):
+            set_uniform(prog, "u_view_proj", light_vp)
+            set_uniform(prog, "u_inflate_px", 0.0)
+        for kind, (rows, on_screen) in casters.items():
+            in_map = choose_levels_orthographic(rows, texels_per_metre, self._lod_limits[kind])
+            self._lod[kind].upload(rows, np.minimum(in_map, np.maximum(on_screen - 1, 0)))
+            self._lod[kind].render()
+        if self._boxes.count:
+            self._box_vao.render(moderngl.TRIANGLES, instances=self._boxes.count)
         self._mask_fbo.use()
         ctx.enable_only(moderngl.NOTHING)
         mask = self._programs["mask"]
@@ -166,8 +176,9 @@ class Shadows:
 
     def release(self) -> None:
         """Free the GPU objects."""
-        for _, vao, _ in self._vaos:
-            vao.release()
+        for batches in self._lod.values():
+            batches.release()
+        self._box_vao.release()
         self._mask_vao.release()
         for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo, self.mask):
             obj.release()

@@ -246,3 +246,25 @@ def test_a_thin_caster_shades_the_ground_steadily_even_when_the_shadow_mask_is_c
         darkening = np.array([1.0 - ground_under_forearm(spread, x) / plain for x in np.linspace(0.0, 0.086, 6)])
         assert darkening.min() > least, (spread, darkening)
         assert darkening.max() < 1.6 * darkening.min(), (spread, darkening)
+
+
+@pytest.mark.parametrize("distance", [2.5, 6.0, 15.0])
+def test_a_ball_does_not_shadow_its_own_sunlit_side(gl, distance):
+    # Seen from the sun's side at any level of detail, the lit half looks the same with
+    # shadows on and off: the shadow map's caster is never finer than the ball drawn.
+    sun = np.array([0.6, 0.75, -0.1])
+    cam = OrbitCamera(target=np.array([0.0, 0.6, 0.0]), yaw=np.arctan2(sun[0], sun[2]), pitch=0.5, distance=distance)
+    images = []
+    for shadows in (True, False):
+        scene = RenderScene()
+        scene.sun.direction, scene.sun.shadows = tuple(sun), shadows
+        scene.ground.visible = False
+        scene.add_sphere([0.0, 0.6, 0.0], 0.5)
+        scene.add_sphere([-2.0, 0.3, 3.0], 0.3)  # a second caster widens the shadow map
+        images.append(draw(gl, scene, cam))
+    (cx, cy), = np.round(cam.project([[0.0, 0.6, 0.0]], W, H)).astype(int)
+    radius_px = 0.5 * H / (2 * np.tan(np.radians(cam.fov_y) / 2)) / distance
+    yy, xx = np.mgrid[0:H, 0:W]
+    inner = np.hypot(xx - cx, yy - cy) < 0.6 * radius_px
+    diff = np.abs(images[0] - images[1]).sum(axis=2)[inner]
+    assert inner.sum() > 20 and diff.max() <= 6, (distance, diff.max())
