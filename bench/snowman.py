@@ -2,7 +2,7 @@
 
 The loaded scene is the one the issue names: the game's own field (rocks, trees,
 snow), its puppet, six snowmen of different proportions (each with its own rig,
-clips and lookup table) and twenty snowballs, some resting and some rolling
+playing the shared locomotion set at its leg scale) and twenty snowballs, some resting and some rolling
 through each other. The baseline is the same game with nothing in the field (no
 puppet, no snowman, no ball), measured in the same run: the fixed cost of the
 schedule, the snow and the scenery.
