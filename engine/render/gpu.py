@@ -73,11 +73,6 @@ class LodBatches:
             self._levels.append((ctx.vertex_array(program, [(vbo, "4f", "in_vert"), (inst.buf, *fmt)], ibo, 4,
                                                   skip_errors=True), inst))
 
-    @property
-    def counts(self) -> list[int]:
-        """Instances uploaded at each level."""
-        return [inst.count for _, inst in self._levels]
-
     def upload(self, rows: NDArray[np.float32], level: NDArray[np.intp]) -> None:
         """Give each level the rows whose ``level`` index names it (order kept)."""
         for i, (_, inst) in enumerate(self._levels):

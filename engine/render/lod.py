@@ -19,8 +19,8 @@ from numpy.typing import NDArray
 
 from engine.render.meshes import capsule_mesh
 
-__all__ = ["CAPSULE_LEVELS", "SPHERE_LEVELS", "SILHOUETTE_ERROR_PX", "level_limits", "choose_levels",
-           "choose_levels_orthographic", "level_meshes"]
+__all__ = ["CAPSULE_LEVELS", "SPHERE_LEVELS", "LEVELS", "LIMITS", "SILHOUETTE_ERROR_PX", "level_limits",
+           "choose_levels", "choose_levels_orthographic", "level_meshes"]
 
 CAPSULE_LEVELS: tuple[tuple[int, int], ...] = ((8, 2), (12, 3), (16, 4), (24, 6))
 """(segments around, rings per end cap) from coarse to fine."""
@@ -34,10 +34,15 @@ def level_limits(levels: tuple[tuple[int, int], ...], error_px: float = SILHOUET
     return np.array([error_px / (1.0 - math.cos(math.pi / segments)) for segments, _ in levels[:-1]])
 
 
-def level_meshes(levels: tuple[tuple[int, int], ...], *,
-                 band: bool = True) -> list[tuple[NDArray[np.float32], NDArray[np.int32]]]:
-    """The unit mesh of each level (``band=False``: spheres)."""
-    return [capsule_mesh(segments, rings, band=band) for segments, rings in levels]
+LEVELS = {"capsules": CAPSULE_LEVELS, "spheres": SPHERE_LEVELS}
+"""The levels of each kind of round solid, by its RenderScene name."""
+LIMITS = {kind: level_limits(levels) for kind, levels in LEVELS.items()}
+"""Each kind's :func:`level_limits`, computed once."""
+
+
+def level_meshes(kind: str) -> list[tuple[NDArray[np.float32], NDArray[np.int32]]]:
+    """The unit mesh of each level of ``kind`` ("capsules" or "spheres": no cylinder band)."""
+    return [capsule_mesh(segments, rings, band=kind == "capsules") for segments, rings in LEVELS[kind]]
 
 
 def choose_levels(rows: NDArray[np.float32], eye: NDArray[np.float64], px_per_metre: float,

@@ -35,7 +35,7 @@ from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
-from engine.render.lod import CAPSULE_LEVELS, SPHERE_LEVELS, choose_levels, level_limits, level_meshes
+from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
@@ -104,10 +104,8 @@ class Renderer:
         self._buffers: list[moderngl.Buffer] = []
         self._vaos: dict[str, moderngl.VertexArray] = {}
         # Lit capsules and spheres: one batch per level of detail.
-        self._lod = {kind: LodBatches(ctx, p["capsule"], level_meshes(levels, band=kind == "capsules"), CAPSULE_FMT,
-                                      4 * CAPSULE_STRIDE)
-                     for kind, levels in (("capsules", CAPSULE_LEVELS), ("spheres", SPHERE_LEVELS))}
-        self._lod_limits = {"capsules": level_limits(CAPSULE_LEVELS), "spheres": level_limits(SPHERE_LEVELS)}
+        self._lod = {kind: LodBatches(ctx, p["capsule"], level_meshes(kind), CAPSULE_FMT, 4 * CAPSULE_STRIDE)
+                     for kind in LEVELS}
         # Outlines (a few focused items) take the default meshes.
         for kind, mesh in (("capsules", meshes.capsule_mesh()), ("spheres", meshes.sphere_mesh())):
             vbo, ibo = self._keep(mesh_buffers(ctx, mesh))
@@ -167,7 +165,7 @@ class Renderer:
                 for k in _KINDS}
         counts = {k: self._inst[k].upload(rows[k]) for k in ("boxes", "lines", "points")}
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0))
-        levels = {kind: choose_levels(rows[kind], eye, px_per_metre, self._lod_limits[kind]) for kind in self._lod}
+        levels = {kind: choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind]) for kind in self._lod}
         for kind, batches in self._lod.items():
             batches.upload(rows[kind], levels[kind])
         outlined = {}

@@ -22,7 +22,7 @@ from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
-from engine.render.lod import CAPSULE_LEVELS, SPHERE_LEVELS, choose_levels_orthographic, level_limits, level_meshes
+from engine.render.lod import LEVELS, LIMITS, choose_levels_orthographic, level_meshes
 from engine.render.scene import CAPSULE_STRIDE, RenderScene
 
 __all__ = ["Shadows", "light_matrix", "ground_rect"]
@@ -113,10 +113,8 @@ class Shadows:
             "mask": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + E.MASK_FS),
         }
         # Casters at the coarsest level whose outline stays within a shadow-map texel.
-        self._lod = {kind: LodBatches(ctx, progs["capsule_depth"], level_meshes(levels, band=kind == "capsules"),
-                                      CAPSULE_FMT, 4 * CAPSULE_STRIDE)
-                     for kind, levels in (("capsules", CAPSULE_LEVELS), ("spheres", SPHERE_LEVELS))}
-        self._lod_limits = {"capsules": level_limits(CAPSULE_LEVELS), "spheres": level_limits(SPHERE_LEVELS)}
+        self._lod = {kind: LodBatches(ctx, progs["capsule_depth"], level_meshes(kind), CAPSULE_FMT, 4 * CAPSULE_STRIDE)
+                     for kind in LEVELS}
         self._boxes = boxes
         self._buffers = list(mesh_buffers(ctx, meshes.box_mesh()))
         self._box_vao = ctx.vertex_array(progs["box_depth"], [(self._buffers[0], "3f 3f", "in_pos", "in_normal"),
@@ -152,7 +150,7 @@ class Shadows:
             set_uniform(prog, "u_view_proj", light_vp)
             set_uniform(prog, "u_inflate_px", 0.0)
         for kind, (rows, on_screen) in casters.items():
-            in_map = choose_levels_orthographic(rows, texels_per_metre, self._lod_limits[kind])
+            in_map = choose_levels_orthographic(rows, texels_per_metre, LIMITS[kind])
             self._lod[kind].upload(rows, np.minimum(in_map, np.maximum(on_screen - 1, 0)))
             self._lod[kind].render()
         if self._boxes.count:
