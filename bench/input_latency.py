@@ -28,7 +28,7 @@ def measure(steps: int = 240, dt: float = 1.0 / 60.0) -> np.ndarray:
     from engine.components import Stick
     from input.hub import InputHub
     from input.osc import OscSource
-    from input.pacing import RealTimePacer
+    from engine.pacing import RealTimePacer
     from input.plugin import install_input
     from input.sample import InputFrame
 

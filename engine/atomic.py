@@ -1,18 +1,34 @@
 """Atomic file writes: write a temporary file beside the target, fsync, then rename.
 
 A crash or a full disk mid-write leaves the old file intact, never a half-written
-one: authored cycles, saved fields and quest progress must not be lost.
+one: authored cycles, saved fields and quest progress must not be lost. The new file
+gets the mode a plain ``open`` would give it (the old file's mode, or 0666 less the
+umask), not the private 0600 of a temporary file.
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import BinaryIO
 
 __all__ = ["atomic_write", "atomic_write_bytes"]
+
+_UMASK_LOCK = threading.Lock()
+
+
+def _file_mode(target: Path) -> int:
+    """The mode ``target`` would have if written in place."""
+    try:
+        return target.stat().st_mode & 0o7777
+    except FileNotFoundError:
+        with _UMASK_LOCK:  # os.umask can only be read by setting it
+            umask = os.umask(0o022)
+            os.umask(umask)
+        return 0o666 & ~umask
 
 
 def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]) -> Path:
@@ -25,6 +41,7 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]
             write(f)
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, _file_mode(target))
         os.replace(tmp, target)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -1,9 +1,19 @@
-"""What a game gives the launcher: its simulation plugin, its view, its keys.
+"""What a game gives the launcher: its options, its simulation plugin, its view.
 
-The simulation part (:meth:`Game.install`) must be deterministic and headless;
-everything else here only reads the world (drawing, the camera, the overlay) or
-acts on it between steps in ways the recording captures (keys that reset are
-turned into input by the launcher, never applied behind the recorder's back).
+Set-up is split in two so a recording can rebuild any session:
+
+- :attr:`Game.prepare` reads everything from outside the program — the options typed
+  on the command line, save files, photos, the user's data folder — into one explicit
+  :class:`GameSetup` of plain JSON values. It runs only for a live session, and what
+  it returns is written into the recording's header.
+- :attr:`Game.install` is then a pure function of that setup and the world's seed: it
+  reads :class:`GameSetup` from the world and nothing else (no files, no environment),
+  so ``puppetphone replay FILE`` rebuilds the very session that was recorded from the
+  file alone.
+
+Everything else here only reads the world (drawing, the camera, the overlay) or acts on
+it between steps in ways the recording captures (keys that reset are turned into input
+by the launcher, never applied behind the recorder's back).
 """
 
 from __future__ import annotations
@@ -17,15 +27,49 @@ from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.render.scene import RenderScene
 
-__all__ = ["Game"]
+__all__ = ["Game", "GameSetup", "GameOptionError", "parse_settings"]
+
+
+class GameOptionError(ValueError):
+    """A game option that does not exist or has a value the game cannot use."""
+
+
+class GameSetup:
+    """The explicit inputs of a game's install (a world resource; see the module docstring).
+
+    Not hashed: it is fixed for the whole session and carried by the recording's header.
+    """
+
+    SIM_STATE = False
+
+    def __init__(self, values: dict[str, Any] | None = None) -> None:
+        self.values: dict[str, Any] = dict(values or {})
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """One value of the setup."""
+        return self.values.get(key, default)
 
 
 def _no_lines(world: World) -> list[str]:
     return []
 
 
-def _no_extra(world: World) -> dict[str, Any]:
-    return {}
+def _options_as_setup(options: dict[str, str]) -> dict[str, Any]:
+    return dict(options)
+
+
+def parse_settings(pairs: list[str], declared: dict[str, str], game: str) -> dict[str, str]:
+    """``["key=value", ...]`` from ``--set`` over the game's declared defaults."""
+    options = dict(declared)
+    for pair in pairs:
+        key, eq, value = pair.partition("=")
+        if not eq:
+            raise GameOptionError(f"--set takes key=value, not {pair!r}")
+        if key not in declared:
+            known = ", ".join(declared) or "none"
+            raise GameOptionError(f"{game} has no option {key!r} (options: {known})")
+        options[key] = value
+    return options
 
 
 @dataclass(frozen=True)
@@ -39,8 +83,11 @@ class Game:
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
         controls: the start screen's help lines.
-        recording_extra: what a recording's header must carry to rebuild this start
-            (read back by the game's install when it is replayed).
+        options: the options ``--set key=value`` may give, with their defaults.
+        prepare: reads the outside world for a live session: options in, the
+            :class:`GameSetup` values out (plain JSON; raises :class:`GameOptionError`).
+        replay_setup: the setup a replay uses, from the one recorded (for instance
+            without the paths a live game saves to: replays never write a user's files).
     """
 
     name: str
@@ -49,4 +96,6 @@ class Game:
     camera: Callable[[], OrbitCamera]
     status: Callable[[World], list[str]] = _no_lines
     controls: tuple[str, ...] = field(default_factory=tuple)
-    recording_extra: Callable[[World], dict[str, Any]] = _no_extra
+    options: dict[str, str] = field(default_factory=dict)
+    prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup
+    replay_setup: Callable[[dict[str, Any]], dict[str, Any]] = dict

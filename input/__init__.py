@@ -15,7 +15,6 @@ Submodules with device specifics are imported lazily by :func:`make_hub`:
 from input.factory import add_source_arguments, make_hub
 from input.hub import InputHub
 from input.motionstick import StickConfig, StickState, motionstick_system, spawn_stick
-from input.pacing import RealTimePacer
 from input.plugin import input_plugin, install_input
 from input.recording import Recorder, Recording, RecordingError, RecordingHeader, read_recording
 from input.replay import ReplayResult, ReplaySource, replay_hub, verify
@@ -25,7 +24,7 @@ from input.source import PoseSource
 __all__ = [
     "PoseSample", "InputFrame", "SourceStatus", "PoseSource", "InputHub",
     "StickConfig", "StickState", "motionstick_system", "spawn_stick",
-    "install_input", "input_plugin", "RealTimePacer",
+    "install_input", "input_plugin",
     "Recorder", "RecordingHeader", "Recording", "RecordingError", "read_recording",
     "ReplaySource", "ReplayResult", "replay_hub", "verify",
     "add_source_arguments", "make_hub",

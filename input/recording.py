@@ -7,7 +7,8 @@ File layout (little-endian)::
     payload  =  16-byte state hash  +  input/codec.py frame
 
 The header holds ``format`` (this module's :data:`FORMAT_VERSION`), ``engine_version``,
-``game``, ``seed``, ``dt`` and ``sources``. The file is append-only and flushed after
+``game``, ``seed``, ``dt``, ``sources`` and ``setup`` — the game's explicit set-up (options,
+a save's contents: see :mod:`games.base`), so a replay needs nothing but the file. The file is append-only and flushed after
 every step, so a crash or a cut at any byte loses at most the frame being written:
 :func:`read_recording` returns every complete, checksummed record before the cut
 and says why it stopped (the replay prints that as a warning).
@@ -41,7 +42,7 @@ from input.sample import InputFrame
 
 __all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording"]
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 MAGIC = b"PPREC\n"
 _LEN = struct.Struct("<II")
 
@@ -67,6 +68,7 @@ class RecordingHeader:
     seed: int
     dt: float
     sources: list[str] = field(default_factory=list)
+    setup: dict[str, Any] = field(default_factory=dict)
     format: int = FORMAT_VERSION
     engine_version: str = field(default_factory=_engine_version)
     extra: dict[str, Any] = field(default_factory=dict)

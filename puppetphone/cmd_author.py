@@ -29,8 +29,11 @@ __all__ = ["configure", "run"]
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add ``record`` and ``edit`` sub-commands."""
+    from puppetphone.runargs import add_run_arguments
+
     sub = parser.add_subparsers(dest="scene", metavar="SCENE")
-    rec = sub.add_parser("record", help="act a cycle out with the mouse or a device; layers stack into a clip")
+    record_help = "act a cycle out with the mouse or a device; layers stack into a clip"
+    rec = sub.add_parser("record", help=record_help, description=record_help)
     rec.add_argument("--item", default="r_upper_arm", help="joint to drive (default r_upper_arm)")
     rec.add_argument("--drive", default="rotation", choices=("rotation", "translation", "scale"), help="what to drive")
     rec.add_argument("--base", type=Path, default=None, help="a looping .ppclip whose layers play back while performing")
@@ -38,10 +41,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     rec.add_argument("--countdown", type=float, default=3.0, help="seconds of countdown (default 3)")
     rec.add_argument("--seconds", type=float, default=8.0, help="length of a take (default 8)")
     rec.add_argument("--script", choices=("loops",), default=None, help="a scripted performer instead of a hand")
-    rec.add_argument("--headless", action="store_true", help="no window (EGL), for tests and screenshots")
-    rec.add_argument("--frames", type=int, default=None, help="stop after N frames")
-    rec.add_argument("--screenshot", type=Path, default=None, help="write the last frame as PNG")
-    rec.add_argument("--size", default="1280x720", help="window size WxH")
+    add_run_arguments(rec)
     rec.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points")
     from input.factory import add_source_arguments
 
@@ -50,7 +50,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
         from puppetphone.cmd_author_edit import configure_edit
     except ModuleNotFoundError:  # the MoCurves scene is optional
         return
-    configure_edit(sub.add_parser("edit", help="refine a cycle with MoCurves while it plays"))
+    edit_help = "refine a cycle with MoCurves while it plays"
+    configure_edit(sub.add_parser("edit", help=edit_help, description=edit_help))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -84,82 +85,122 @@ def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre,
     return quat.mul(rest, q)
 
 
+class RecordActivity:
+    """The record scene as the runner's activity: one step feeds the performer's value.
+
+    The performer is the scripted loops, a device (its orientation relative to where it
+    pointed when the take began) or the mouse (a drag from the press point); the runner
+    calls :meth:`step` at the fixed 60 Hz whatever the frame rate, so the countdown and
+    the performer's tempo are real time.
+    """
+
+    dt = 1.0 / 60.0
+
+    def __init__(self, scene, args: argparse.Namespace, hub) -> None:  # type: ignore[no-untyped-def]
+        self.scene, self.args, self.hub = scene, args, hub
+        self.camera = scene.camera
+        self.frame, self.previewing = 0, 0
+        self.press: tuple[int, int, object] | None = None
+        self.phase_acc = [0.0]
+        self.reference = None
+        self.rest = scene.rest_value()
+        self.size = args.size
+        if args.script:
+            scene.start()
+
+    def finished(self) -> bool:
+        return False
+
+    def _value(self):  # type: ignore[no-untyped-def]
+        from authoring.record_scene import drag_rotation, mouse_point
+        from engine import quat
+
+        scene, fps = self.scene, 1.0 / self.dt
+        if self.args.script:
+            return _scripted(self.frame, fps, self.phase_acc, self.args.drive, scene.item_position(), self.rest)
+        if self.hub is not None:
+            sample = self.hub.drain(self.frame).latest()
+            if sample is None or scene.drive != "rotation":
+                return None
+            if scene.phase != "recording" or self.reference is None:
+                self.reference, self.rest = sample.orientation, scene.rest_value()
+            return quat.mul(quat.mul(sample.orientation, quat.conjugate(self.reference)), self.rest)
+        if self.press is None:
+            return None
+        import pygame
+
+        px, py = pygame.mouse.get_pos()
+        if scene.drive == "rotation":
+            return quat.mul(self.rest, drag_rotation(px - self.press[0], py - self.press[1], self.size[1]))
+        return mouse_point(scene.camera, px, py, self.size, self.press[2])
+
+    def step(self) -> None:
+        from engine.clipfile import save_clip
+
+        scene = self.scene
+        scene.feed(self._value())
+        scene.step(self.dt)
+        self.previewing = self.previewing + 1 if scene.phase == "preview" else 0
+        # The scripted performer looks at the preview for 2 s, then accepts.
+        if self.args.script and self.previewing == int(2 / self.dt) and scene.accept() is not None:
+            save_clip(scene.clip, self.args.output)  # type: ignore[arg-type]
+            print(f"saved {self.args.output}")
+        self.frame += 1
+
+    def draw(self, render, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
+        self.size = size
+        self.scene.draw(render)
+
+    def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
+        from engine.clipfile import save_clip
+
+        self.press, self.rest = _mouse(ev, self.scene, self.press, self.rest, self.args.output, save_clip)
+        return False
+
+
 def _record(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from authoring.record_scene import RecordScene, drag_rotation, mouse_point
-    from engine import quat
-    from engine.clipfile import ClipFileError, load_clip, save_clip
+    from authoring.record_scene import RecordScene
+    from engine.clipfile import ClipFileError, load_clip
     from engine.humanoid import humanoid_skeleton
-    from engine.render import RenderScene, Viewer
+    from engine.render.window import NoDisplayError
+    from engine.runner import Runner
+    from puppetphone.runargs import run_options
 
     try:
-        width, height = (int(v) for v in args.size.lower().split("x"))
         base = load_clip(args.base) if args.base is not None else None
         skeleton = base.skeleton if base is not None else humanoid_skeleton()
         scene = RecordScene(skeleton, args.item, args.drive, base, args.countdown, args.seconds, np.random.default_rng(args.seed))
     except (ValueError, OSError, ClipFileError) as exc:
         print(f"author record: {exc}", file=sys.stderr)
         return 2
+    live = args.source != "mouse" and args.script is None
+    runner = Runner(run_options(args, "PuppetPhone — record a cycle", pace=live and args.headless))
+    try:
+        runner.open()
+    except NoDisplayError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     hub = None
-    if args.source != "mouse" and args.script is None:
+    if live:
         from input.factory import make_hub
 
         try:
             hub = make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud).start()
         except (ValueError, OSError) as exc:
+            runner.close()
             print(f"author record: cannot open {args.source}: {exc}", file=sys.stderr)
             return 2
-    viewer = Viewer.create(headless=args.headless, width=width, height=height, title="PuppetPhone — record a cycle")
-    viewer.camera = scene.camera
-    render = RenderScene()
-    clock = None if args.headless else __import__("pygame").time.Clock()
-    fps = 60.0
-    frame, press, phase_acc, reference, previewing = 0, None, [0.0], None, 0
-    rest = scene.rest_value()
-    if args.script:
-        scene.start()
+    activity = RecordActivity(scene, args, hub)
+    runner.push_handlers(activity)
     try:
-        while args.frames is None or frame < args.frames:
-            value = None
-            for ev in viewer.poll_events():
-                press, rest = _mouse(ev, scene, press, rest, args.output, save_clip)
-            if getattr(viewer.target, "closed", False):
-                break
-            if args.script:
-                value = _scripted(frame, fps, phase_acc, args.drive, scene.item_position(), rest)
-            elif hub is not None:
-                sample = hub.drain(frame).latest()
-                if sample is not None and scene.drive == "rotation":
-                    if scene.phase != "recording" or reference is None:
-                        reference, rest = sample.orientation, scene.rest_value()
-                    value = quat.mul(quat.mul(sample.orientation, quat.conjugate(reference)), rest)
-            elif press is not None:
-                import pygame
-
-                px, py = pygame.mouse.get_pos()
-                if scene.drive == "rotation":
-                    value = quat.mul(rest, drag_rotation(px - press[0], py - press[1], height))
-                else:
-                    value = mouse_point(scene.camera, px, py, viewer.size, press[2])
-            scene.feed(value)
-            scene.step(1.0 / fps)
-            previewing = previewing + 1 if scene.phase == "preview" else 0
-            # The scripted performer looks at the preview for 2 s, then accepts.
-            if args.script and previewing == int(2 * fps) and scene.accept() is not None:
-                save_clip(scene.clip, args.output)  # type: ignore[arg-type]
-                print(f"saved {args.output}")
-            render.clear()
-            scene.draw(render)
-            viewer.draw(render)
-            if clock is not None:
-                clock.tick(fps)
-            frame += 1
-        if args.screenshot is not None:
-            viewer.screenshot(args.screenshot)
+        result = runner.run(activity)
+        if result.screenshot is not None:
+            print(f"screenshot: {result.screenshot}")
         print(scene.message)
     finally:
-        viewer.close()
+        runner.close()
         if hub is not None:
             hub.close()
     return 0

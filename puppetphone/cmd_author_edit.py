@@ -19,14 +19,13 @@ __all__ = ["configure_edit", "run_edit"]
 
 def configure_edit(parser: argparse.ArgumentParser) -> None:
     """Add the ``author edit`` arguments."""
+    from puppetphone.runargs import add_run_arguments
+
     parser.add_argument("clip", help="a .ppclip cycle, or a default clip name (walk, run, crouch_walk, idle…)")
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
-    parser.add_argument("--headless", action="store_true", help="no window (EGL), for tests and screenshots")
-    parser.add_argument("--frames", type=int, default=None, help="stop after N frames")
-    parser.add_argument("--screenshot", type=Path, default=None, help="write the last frame as PNG")
-    parser.add_argument("--size", default="1280x720", help="window size WxH (default 1280x720)")
+    add_run_arguments(parser)
 
 
 def _open(spec: str):  # type: ignore[no-untyped-def]
@@ -42,46 +41,61 @@ def _open(spec: str):  # type: ignore[no-untyped-def]
     return EditSession(clips[spec]), Path(f"{spec}_edited.ppclip")
 
 
+class EditActivity:
+    """The MoCurves scene as the runner's activity: the loop plays at the fixed 60 Hz step."""
+
+    dt = 1.0 / 60.0
+
+    def __init__(self, edit, session, output: Path) -> None:  # type: ignore[no-untyped-def]
+        self.edit, self.session, self.output = edit, session, output
+        self.camera = edit.camera
+        self._orbiting = [False]
+
+    def finished(self) -> bool:
+        return False
+
+    def step(self) -> None:
+        self.edit.step(self.dt)
+
+    def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
+        self.edit.size = size
+        self.edit.draw(scene)
+
+    def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
+        return _handle(ev, self.edit, self.session, self.output, self._orbiting)
+
+
 def run_edit(args: argparse.Namespace) -> int:
     """Open the clip, run the scene until the window closes (or ``--frames``), save/export."""
     from authoring.edit_scene import EditScene
     from authoring.mocurves import export_clip
-    from engine.render import RenderScene, Viewer
+    from engine.render.window import NoDisplayError
+    from engine.runner import Runner
+    from puppetphone.runargs import run_options
 
     try:
-        width, height = (int(v) for v in args.size.lower().split("x"))
         session, default_out = _open(args.clip)
     except (ValueError, OSError) as exc:
         print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)
         return 2
     output = args.output or default_out
-    viewer = Viewer.create(headless=args.headless, width=width, height=height, title="PuppetPhone — MoCurves")
-    edit = EditScene(session, viewer.size)
-    viewer.camera = edit.camera
-    scene = RenderScene()
-    clock = None if args.headless else __import__("pygame").time.Clock()
-    frame, orbiting = 0, [False]
+    runner = Runner(run_options(args, "PuppetPhone — MoCurves"))
     try:
-        while args.frames is None or frame < args.frames:
-            for ev in viewer.poll_events():
-                _handle(ev, edit, session, output, orbiting)
-            if getattr(viewer.target, "closed", False):
-                break
-            edit.size = viewer.size
-            edit.step(1.0 / 60.0)
-            scene.clear()
-            edit.draw(scene)
-            viewer.draw(scene)
-            if clock is not None:
-                clock.tick(60)
-            frame += 1
-        if args.screenshot is not None:
-            viewer.screenshot(args.screenshot)
+        runner.open()
+    except NoDisplayError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    activity = EditActivity(EditScene(session, runner.size), session, output)
+    runner.push_handlers(activity)
+    try:
+        result = runner.run(activity)
+        if result.screenshot is not None:
+            print(f"screenshot: {result.screenshot}")
         for path in args.export:
             export_clip(session.clip, path)
             print(f"exported {path}")
     finally:
-        viewer.close()
+        runner.close()
     return 0
 
 

@@ -1,4 +1,9 @@
-"""``puppetphone play GAME``: play a game with a MotionStick source; record; screenshot."""
+"""``puppetphone play GAME``: play a game with a MotionStick source; record; screenshot.
+
+A window needs a display; ``--headless`` runs without one (paced to real time with a
+live source, as fast as it can with a replay). Game options: ``--set key=value``
+(``puppetphone play GAME --set help`` lists them).
+"""
 
 from __future__ import annotations
 
@@ -6,21 +11,22 @@ import argparse
 import sys
 from pathlib import Path
 
-__all__ = ["configure", "run"]
+__all__ = ["configure", "run", "run_activity"]
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the play arguments."""
     from input.factory import add_source_arguments
+    from puppetphone.runargs import add_run_arguments
 
-    parser.add_argument("game", help="snowman or tasbada")
+    parser.add_argument("game", help="snowman, tasbada or sandbox")
     add_source_arguments(parser)
-    parser.add_argument("--headless", action="store_true", help="no window: EGL rendering, for servers and tests")
-    parser.add_argument("--frames", type=int, default=None, help="stop after N simulation steps")
-    parser.add_argument("--screenshot", type=Path, default=None, help="write the last frame as PNG")
+    add_run_arguments(parser)
     parser.add_argument("--record", type=Path, default=None, help="record the session's input and state hashes")
     parser.add_argument("--seed", type=int, default=0, help="the world's random seed (default 0)")
-    parser.add_argument("--size", default="1280x720", help="window size WxH (default 1280x720)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
+                        help="a game option (snowman: field=PATH; tasbada: save, photo, selfie, webcam; "
+                             "sandbox: scene); repeatable")
 
 
 def resolve_source(source: str, game: str) -> str:
@@ -34,39 +40,78 @@ def resolve_source(source: str, game: str) -> str:
     return source
 
 
+def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-untyped-def]
+    """Run a game activity through the runner; ``(exit code, run result)``."""
+    from engine.render.window import NoDisplayError
+    from engine.runner import Runner
+
+    runner = Runner(options, clock=activity.app.clock)
+    runner.push_handlers(activity)
+    activity.runner = runner
+    activity.hub.start()
+    try:
+        result = runner.run(activity)
+    except NoDisplayError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2, None
+    finally:
+        activity.close()
+        runner.close()
+    if result.screenshot is not None:
+        print(f"screenshot: {result.screenshot}")
+    if activity.recorder is not None:
+        print(f"recorded {activity.recorder.frames} frames to {activity.recorder.path}", file=sys.stderr)
+    return 0, result
+
+
 def run(args: argparse.Namespace) -> int:
     """Build the session and run it."""
+    from games.base import GameOptionError, parse_settings
     from input.factory import make_hub
     from input.recording import RecordingError
-    from puppetphone.session import Session, SessionOptions
+    from puppetphone.games import load_game
+    from puppetphone.runargs import run_options
+    from puppetphone.session import build_activity
 
     try:
-        width, height = (int(v) for v in args.size.lower().split("x"))
-    except ValueError:
-        print(f"--size must look like 1280x720, not {args.size!r}", file=sys.stderr)
+        game = load_game(args.game)
+        options = parse_settings(args.settings, game.options, game.name)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
         return 2
+    if not args.headless:
+        from engine.render.window import NoDisplayError
+        from engine.runner import check_display
+
+        try:
+            check_display()
+        except NoDisplayError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
     source = resolve_source(args.source, args.game)
     try:
         hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud)
     except (ValueError, OSError, RecordingError) as exc:
         print(f"cannot open input {source!r}: {exc}", file=sys.stderr)
         return 2
-    seed = args.seed
+    seed, setup = args.seed, None
     if hub.replay is not None:
-        header = hub.replay.recording.header  # type: ignore[attr-defined]
-        if header.game != args.game:
-            print(f"the recording is of {header.game!r}, not {args.game!r}", file=sys.stderr)
+        recording = hub.replay.recording  # type: ignore[attr-defined]
+        if recording.header.game != args.game:
+            hub.close()
+            print(f"the recording is of {recording.header.game!r}, not {args.game!r}", file=sys.stderr)
             return 2
-        seed = header.seed
-        if not hub.replay.recording.complete:  # type: ignore[attr-defined]
-            print(f"warning: {hub.replay.recording.problem}", file=sys.stderr)  # type: ignore[attr-defined]
-    options = SessionOptions(game=args.game, seed=seed, headless=args.headless, frames=args.frames,
-                             screenshot=args.screenshot, record=args.record, width=width, height=height,
-                             source_label=source)
+        seed, setup = recording.header.seed, game.replay_setup(recording.header.setup)
+        if not recording.complete:
+            print(f"warning: {recording.problem}", file=sys.stderr)
     try:
-        session = Session(options, hub)
-    except ValueError as exc:
+        activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
+                                  source_label=source)
+    except (GameOptionError, OSError) as exc:
         hub.close()
-        print(str(exc), file=sys.stderr)
+        print(f"error: {exc}", file=sys.stderr)
         return 2
-    return session.run()
+    code, result = run_activity(activity, run_options(args, f"PuppetPhone — {args.game}", pace=hub.live))
+    if result is not None:
+        print(f"ran {result.steps} steps of {args.game}")  # type: ignore[attr-defined]
+    return code

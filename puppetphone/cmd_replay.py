@@ -1,79 +1,88 @@
-"""``puppetphone replay FILE [--verify] [--headless] [--screenshot PNG] [--frames N]``.
+"""``puppetphone replay FILE [--verify] [--headless] [--screenshot IMAGE [--screenshot-at N]] [--frames N]``.
 
-Rebuilds the recorded game's app from the header (``puppetphone.games.make_app``
-with the recorded game and seed) around a replay hub, steps it once per recorded
-frame as fast as it can, and with ``--verify`` compares every state hash: it prints
-``replayed N frames, all N state hashes match`` or names the first frame that
-differs and exits 1. A recording cut short replays up to its last complete frame,
-with a warning.
+Rebuilds the recorded session from the file alone — the game, the seed and the game's
+setup (scene, saved field, saved progress) are in its header — and plays it through the
+same runner as ``play``: in a window at the recorded speed, or ``--headless`` as fast as
+it can. With ``--verify`` every step's state hash is compared with the recorded one; the
+first frame that differs is named — with or without ``--verify``, a replay that does not
+reproduce its recording is a failure. Exit codes: 0 every step replayed and matched;
+1 a state hash differs, or the file is damaged or cut short after its header; 2 the file
+cannot be replayed at all (not a regular file, not a recording, damaged header, unknown
+game, no display). A recording cut short (a session killed mid-write) replays up to its
+last complete frame with a warning and exit 0 only under ``--allow-truncated``.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 __all__ = ["configure", "run"]
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the replay arguments."""
+    from puppetphone.runargs import add_run_arguments
+
     parser.add_argument("file", metavar="FILE", help="a recording made with play --record")
-    parser.add_argument("--verify", action="store_true", help="compare every step's state hash with the recording")
-    parser.add_argument("--headless", action="store_true", help="no window (replays always simulate headless here)")
-    parser.add_argument("--screenshot", metavar="PNG", help="render the final state to a PNG")
-    parser.add_argument("--frames", type=int, default=None, help="stop after N frames")
+    parser.add_argument("--verify", action="store_true",
+                        help="print the verification line (every step's state hash is always compared)")
+    parser.add_argument("--allow-truncated", action="store_true",
+                        help="a recording cut short (killed mid-write) replays its complete frames with exit 0")
+    add_run_arguments(parser, screenshot_at=True)
+    parser.epilog = "exit codes: 0 replayed and matched; 1 a hash differs or the file is damaged/cut; 2 cannot replay"
 
 
 def run(args: argparse.Namespace) -> int:
     """Replay (and optionally verify) a recording; returns the exit code."""
+    from games.base import GameOptionError
     from input.recording import RecordingError, read_recording
-    from input.replay import verify
+    from input.replay import ReplaySource
+    from input.hub import InputHub
+    from puppetphone.cmd_play import run_activity
+    from puppetphone.games import load_game
+    from puppetphone.runargs import run_options
+    from puppetphone.session import build_activity
 
+    path = Path(args.file)
+    if path.exists() and not path.is_file():
+        print(f"error: {path} is not a regular file (a device, pipe or folder cannot be replayed)", file=sys.stderr)
+        return 2
     try:
-        rec = read_recording(args.file)
+        rec = read_recording(path)
     except (OSError, RecordingError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    cut_short = not rec.complete and rec.problem.startswith("cut inside")
     if not rec.complete:
-        print(f"warning: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)
-    if args.frames is not None:
-        rec.frames, rec.hashes = rec.frames[: args.frames], rec.hashes[: args.frames]
+        level = "warning" if cut_short and args.allow_truncated else "error"
+        print(f"{level}: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)
     h = rec.header
     try:
-        from puppetphone.games import make_app
-    except ImportError as exc:
-        print(f"error: cannot rebuild game {h.game!r}: {exc}", file=sys.stderr)
+        game = load_game(h.game)
+        activity = build_activity(h.game, h.seed, InputHub(replay=ReplaySource(rec)), setup=game.replay_setup(h.setup),
+                                  verify=rec)
+    except (GameOptionError, ValueError, KeyError, OSError) as exc:
+        print(f"error: cannot rebuild the recorded {h.game!r} session: {exc}", file=sys.stderr)
         return 2
-
-    def build(hub):  # type: ignore[no-untyped-def]
-        app = make_app(h.game, h.seed, hub)
-        if abs(app.world.dt - h.dt) > 1e-12:
-            raise ValueError(f"recording steps at dt={h.dt}, game {h.game!r} at dt={app.world.dt}")
-        return app
-
-    apps = []
-    try:
-        result = verify(build, rec, on_step=lambda app, i: apps.append(app) if i == 0 else None)
-    except (KeyError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    if abs(activity.dt - h.dt) > 1e-12:
+        print(f"error: the recording steps at dt={h.dt}, game {h.game!r} at dt={activity.dt}", file=sys.stderr)
         return 2
-    if args.screenshot and apps:
-        code = _screenshot(apps[0], args.screenshot)
-        if code:
-            return code
+    code, result = run_activity(activity, run_options(args, f"PuppetPhone — replay of {args.file}"))
+    if code:
+        return code
+    check = activity.check
+    assert check is not None and result is not None
+    steps = result.steps  # type: ignore[attr-defined]
+    if not check.ok:
+        print(f"state hash differs at frame {check.first_mismatch} (after {check.matched} matching): "
+              f"expected {check.expected}, got {check.got}")
+        return 1
     if args.verify:
-        print(result.message())
-        return 0 if result.ok else 1
-    print(f"replayed {result.frames} frames")
-    return 0
-
-
-def _screenshot(app, path: str) -> int:  # type: ignore[no-untyped-def]
-    try:
-        from puppetphone.games import screenshot
-    except ImportError:
-        print("error: --screenshot needs the renderer (puppetphone.games.screenshot), not available", file=sys.stderr)
-        return 2
-    screenshot(app, path)
+        print(f"replayed {steps} frames, all {check.matched} state hashes match")
+    else:
+        print(f"replayed {steps} frames")
+    if not rec.complete and not (cut_short and args.allow_truncated):
+        return 1
     return 0

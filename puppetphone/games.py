@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import importlib
 
+from typing import Any
+
 from engine.app import App
-from games.base import Game
+from games.base import Game, GameSetup
 from input.hub import InputHub
 from input.plugin import install_input
 
@@ -30,10 +32,15 @@ def load_game(name: str) -> Game:
     return importlib.import_module(GAMES[name]).GAME  # type: ignore[no-any-return]
 
 
-def make_app(game: str, seed: int, hub: InputHub) -> App:
-    """A headless simulation of ``game``: input first, then the game's plugins."""
+def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None = None) -> App:
+    """A headless simulation of ``game``: the setup, input first, then the game's plugins.
+
+    ``setup`` is what the game's ``prepare`` returned (live) or what a recording's header
+    carries (replay); ``None`` means the game's declared default options.
+    """
     g = load_game(game)
     app = App(seed=seed)
+    app.world.insert_resource(GameSetup(dict(g.options) if setup is None else setup))
     install_input(app, hub)
     g.install(app)
     return app

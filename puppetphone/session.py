@@ -1,190 +1,146 @@
-"""A play session: the game's app, its input, an optional recorder, and the frame loop.
+"""A game session as the runner's activity: the app, its input, recording and verification.
 
-Two ways to run:
+:class:`GameActivity` is what ``play`` and ``replay`` hand to :class:`engine.runner.Runner`:
+one step is ``App.step``; drawing is the game's view plus the overlay; its event layer
+feeds the mouse source, orbits the camera (right-drag) and turns R / F5 / F9 into
+recorded input commands (reset, save, restore), so replays repeat them.
 
-- **windowed** — a pygame window; real elapsed time goes through the fixed-step
-  clock (``App.tick``), the scene is drawn every display frame and interpolated with
-  the clock's ``alpha``; mouse events feed the mouse source; right-drag orbits.
-- **headless** — no display. With a live source (mouse, osc, hid, serial) steps
-  are paced to real time so a phone can drive it; with a replay or no source it
-  runs as fast as it can. Only the last frame is rendered, for ``--screenshot``.
-
-Keys (windowed): Esc quits, P pauses, ``.`` single-steps while paused; R resets the
-game, F5 saves and F9 restores it (games that keep a field: snowman). The last three
-go through the hub as recorded input events, so replays repeat them.
+A replay is the same activity built from a recording's header (game, seed, setup) with
+a replay hub; :class:`HashCheck` compares every step's state hash with the recorded one
+and ends the activity at the first difference.
 """
 
 from __future__ import annotations
 
-import sys
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from engine.app import App
 from engine.camera import OrbitCamera
+from engine.ecs import World
+from engine.hashing import state_hash
 from engine.render.scene import RenderScene
+from engine.runner import Runner
 from games.base import Game
 from input.hub import InputHub
-from input.recording import Recorder, RecordingHeader
+from input.recording import Recorder, Recording, RecordingHeader
 from input.sample import RESET, RESTORE, SAVE
-from puppetphone.overlay import draw_overlay
 from puppetphone.games import load_game, make_app
+from puppetphone.overlay import draw_overlay
 
-__all__ = ["SessionOptions", "Session"]
+__all__ = ["GameActivity", "HashCheck", "build_activity"]
 
 
 @dataclass
-class SessionOptions:
-    """What the command line chose for a session."""
+class HashCheck:
+    """Compares each finished step's state hash with a recording's (``App.on_step_end``)."""
 
-    game: str
-    seed: int = 0
-    headless: bool = False
-    frames: int | None = None
-    screenshot: Path | None = None
-    record: Path | None = None
-    width: int = 1280
-    height: int = 720
-    source_label: str = "mouse"
-    extra: dict[str, object] = field(default_factory=dict)
+    recording: Recording
+    matched: int = 0
+    first_mismatch: int | None = None
+    expected: str = ""
+    got: str = ""
+
+    def __call__(self, world: World) -> None:
+        index = world.frame - 1
+        if self.first_mismatch is not None or index >= len(self.recording.hashes):
+            return
+        digest = state_hash(world)
+        if digest == self.recording.hashes[index]:
+            self.matched += 1
+        else:
+            self.first_mismatch, self.expected, self.got = index, self.recording.hashes[index], digest
+
+    @property
+    def ok(self) -> bool:
+        """Whether every hash checked so far matched."""
+        return self.first_mismatch is None
 
 
-class Session:
-    """Owns the app, hub, recorder, render target and camera of one run."""
+@dataclass
+class GameActivity:
+    """One game session (see the module docstring)."""
 
-    def __init__(self, options: SessionOptions, hub: InputHub) -> None:
-        self.options = options
-        self.hub = hub
-        self.game: Game = load_game(options.game)
-        self.app: App = make_app(options.game, options.seed, hub)
-        self.camera: OrbitCamera = self.game.camera()
-        self.scene = RenderScene()
-        self.recorder: Recorder | None = None
-        if options.record is not None:
-            header = RecordingHeader(game=options.game, seed=options.seed, dt=self.app.world.dt, sources=[options.source_label],
-                                     extra=self.game.recording_extra(self.app.world))
-            self.recorder = Recorder(options.record, header).attach(self.app)
-        self._target = None
-        self._renderer = None
-        self.fps = 0.0
+    game: Game
+    app: App
+    hub: InputHub
+    camera: OrbitCamera
+    recorder: Recorder | None = None
+    check: HashCheck | None = None
+    runner: Runner | None = None
+    _orbiting: bool = field(default=False, repr=False)
 
-    # -- rendering ----------------------------------------------------------------------
-    def _ensure_renderer(self) -> None:
-        if self._target is None:
-            from engine.render.renderer import Renderer
-            from engine.render.target import make_target
+    @property
+    def dt(self) -> float:
+        """The game's fixed step."""
+        return self.app.world.dt
 
-            self._target = make_target(self.options.headless, self.options.width, self.options.height)
-            self._renderer = Renderer(self._target.ctx)
+    def step(self) -> None:
+        """One simulation step."""
+        self.app.step()
 
-    def draw(self) -> None:
-        """Draw the current world state (interpolated) into the target."""
-        self._ensure_renderer()
-        assert self._target is not None and self._renderer is not None
-        self.scene.clear()
-        alpha = self.app.clock.alpha
-        self.game.draw(self.app.world, self.scene, alpha)
-        draw_overlay(self.scene, self.app.world, self.game, self.hub, self.fps, self.app.clock.paused)
-        fb = self._target.begin()
-        self._renderer.render(self.scene, self.camera, fb)
-        self._target.end()
-
-    def screenshot(self, path: Path) -> Path:
-        """Render the current state and write it as PNG."""
-        self.draw()
-        assert self._target is not None
-        return self._target.screenshot(path)
-
-    # -- running ------------------------------------------------------------------------
-    def _done(self, steps: int) -> bool:
-        if self.options.frames is not None and steps >= self.options.frames:
+    def finished(self) -> bool:
+        """A replay ends after its last recorded frame or at the first hash that differs."""
+        if self.check is not None and not self.check.ok:
             return True
         replay = self.hub.replay
-        return replay is not None and self.options.frames is None and self.app.world.frame > replay.last_frame  # type: ignore[attr-defined]
+        return replay is not None and self.app.world.frame > replay.last_frame  # type: ignore[attr-defined]
 
-    def run_headless(self) -> int:
-        """Step as fast as allowed (paced for live sources) until done; returns steps run."""
-        pacer = None
-        if self.hub.live:
-            from input.pacing import RealTimePacer
+    def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
+        """The game's view and the overlay."""
+        self.game.draw(self.app.world, scene, alpha)
+        fps = self.runner.fps if self.runner is not None else 0.0
+        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused)
 
-            pacer = RealTimePacer(self.app.world.dt)
-        steps = 0
-        while not self._done(steps):
-            if pacer is not None:
-                pacer.wait()
-            self.app.step()
-            steps += 1
-        return steps
-
-    def run_window(self) -> int:
-        """The interactive loop; returns steps run."""
+    def on_event(self, event: Any, runner: Runner) -> bool:
+        """Mouse to the mouse source, right-drag orbits, R / F5 / F9 become recorded commands."""
         import pygame
 
-        self._ensure_renderer()
-        assert self._target is not None
-        mouse = next((s for s in self.hub.sources if hasattr(s, "handle_event")), None)
-        last = time.perf_counter()
-        steps = 0
-        orbiting = False
-        fps_frames, fps_t0 = 0, last
-        while not self._done(steps):
-            for ev in self._target.poll_events():
-                if ev.type == pygame.QUIT or (ev.type == pygame.KEYDOWN and ev.key == pygame.K_ESCAPE):
-                    return steps
-                if ev.type == pygame.KEYDOWN:
-                    self._key(ev.key)
-                if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 3:
-                    orbiting = True
-                elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 3:
-                    orbiting = False
-                elif ev.type == pygame.MOUSEMOTION and orbiting:
-                    self.camera.orbit(-0.005 * ev.rel[0], -0.005 * ev.rel[1])
-                if mouse is not None:
-                    mouse.handle_event(ev, self.camera, self._target.size)
-            now = time.perf_counter()
-            steps += self.app.tick(min(now - last, 0.25))
-            last = now
-            self.draw()
-            fps_frames += 1
-            if now - fps_t0 >= 0.5:
-                self.fps, fps_frames, fps_t0 = fps_frames / (now - fps_t0), 0, now
-        return steps
-
-    def _key(self, key: int) -> None:
-        import pygame
-
-        clock = self.app.clock
         commands = {pygame.K_r: RESET, pygame.K_F5: SAVE, pygame.K_F9: RESTORE}
-        if key == pygame.K_p:
-            clock.resume() if clock.paused else clock.pause()
-        elif key == pygame.K_PERIOD:
-            clock.request_step()
-        elif key in commands:
-            self.hub.command(commands[key])
-
-    def run(self) -> int:
-        """Run to the end; write the screenshot; close everything. Returns the exit code."""
-        self.hub.start()
-        try:
-            steps = self.run_headless() if self.options.headless else self.run_window()
-            if self.options.screenshot is not None:
-                path = self.screenshot(self.options.screenshot)
-                print(f"screenshot: {path}")
-            print(f"ran {steps} steps of {self.options.game}")
-            return 0
-        finally:
-            self.close()
+        if event.type == pygame.KEYDOWN and event.key in commands:
+            self.hub.command(commands[event.key])
+            return True
+        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 3:
+            self._orbiting = True
+        elif event.type == pygame.MOUSEBUTTONUP and event.button == 3:
+            self._orbiting = False
+        elif event.type == pygame.MOUSEMOTION and self._orbiting:
+            self.camera.orbit(-0.005 * event.rel[0], -0.005 * event.rel[1])
+        for source in self.hub.sources:
+            handle = getattr(source, "handle_event", None)
+            if handle is not None:
+                handle(event, self.camera, runner.size)
+        return False
 
     def close(self) -> None:
-        """Stop devices, close the recording (everything written is already flushed)."""
+        """Stop the devices and close the recording (everything written is already flushed)."""
         self.hub.close()
         if self.recorder is not None:
             self.recorder.close()
-            print(f"recorded {self.recorder.frames} frames to {self.recorder.path}", file=sys.stderr)
-        if self._target is not None:
-            if self._renderer is not None:
-                self._renderer.release()
-            self._target.close()
-            self._target = None
+
+
+def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str, Any] | None = None,
+                   options: dict[str, str] | None = None, record: Path | None = None, source_label: str = "",
+                   verify: Recording | None = None) -> GameActivity:
+    """The session of ``game_name``.
+
+    Args:
+        setup: a recorded setup (replays); otherwise ``options`` go through the game's
+            ``prepare``, which reads save files and pictures.
+        record: write the session (its setup in the header) to this file.
+        verify: compare every step's state hash with this recording's.
+    """
+    game = load_game(game_name)
+    if setup is None:
+        setup = game.prepare(dict(game.options) if options is None else options)
+    app = make_app(game_name, seed, hub, setup)
+    recorder = None
+    if record is not None:
+        header = RecordingHeader(game=game_name, seed=seed, dt=app.world.dt, sources=[source_label], setup=setup)
+        recorder = Recorder(record, header).attach(app)
+    check = None
+    if verify is not None:
+        check = HashCheck(verify)
+        app.on_step_end.append(check)
+    return GameActivity(game, app, hub, game.camera(), recorder, check)

@@ -41,7 +41,7 @@ __all__ = [
     "HeadlessTarget",
     "WindowTarget",
     "egl_available",
-    "save_png",
+    "save_image",
 ]
 
 _LAZY = {
@@ -49,7 +49,7 @@ _LAZY = {
     "Viewer": "engine.render.viewer",
     "make_target": "engine.render.target",
     "RenderTarget": "engine.render.target",
-    "save_png": "engine.render.target",
+    "save_image": "engine.render.target",
     "HeadlessTarget": "engine.render.headless",
     "egl_available": "engine.render.headless",
     "WindowTarget": "engine.render.window",

@@ -15,7 +15,7 @@ import moderngl
 import numpy as np
 from numpy.typing import NDArray
 
-from engine.render.target import save_png
+from engine.render.target import save_image
 
 __all__ = ["OffscreenBuffers", "is_software"]
 
@@ -46,6 +46,9 @@ class OffscreenBuffers:
         ctx = self.ctx
         self.resolved = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)],
                                         depth_attachment=ctx.depth_renderbuffer(size))
+        # The same colour renderbuffer without depth: what a window presents (a blit to
+        # the default framebuffer must not include depth, whose format may differ).
+        self.colour_only = ctx.framebuffer(color_attachments=[self.resolved.color_attachments[0]])
         self._msaa = None
         if self.samples:
             self._msaa = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4, samples=self.samples)],
@@ -84,11 +87,12 @@ class OffscreenBuffers:
         return np.frombuffer(raw, dtype=np.uint8).reshape(h, w, 3)[::-1].copy()
 
     def screenshot(self, path: str | Path) -> Path:
-        """Save the resolved image as PNG."""
-        return save_png(self.read_pixels(), path)
+        """Save the resolved image (PNG or JPEG by suffix)."""
+        return save_image(self.read_pixels(), path)
 
     def release(self) -> None:
         """Free the GPU buffers."""
+        self.colour_only.release()
         for fb in (self.resolved, self._msaa):
             if fb is not None:
                 for att in (*fb.color_attachments, fb.depth_attachment):

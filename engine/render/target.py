@@ -17,7 +17,10 @@ import moderngl
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["RenderTarget", "make_target", "save_png"]
+__all__ = ["RenderTarget", "make_target", "image_format", "save_image", "IMAGE_FORMATS"]
+
+#: Image formats a screenshot or plot can be written as, by file suffix.
+IMAGE_FORMATS: dict[str, str] = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG"}
 
 
 class RenderTarget(Protocol):
@@ -48,7 +51,7 @@ class RenderTarget(Protocol):
         ...
 
     def screenshot(self, path: str | Path) -> Path:
-        """Save the last finished frame as a PNG."""
+        """Save the last finished frame (PNG or JPEG by suffix)."""
         ...
 
     def poll_events(self) -> list[Any]:
@@ -60,19 +63,28 @@ class RenderTarget(Protocol):
         ...
 
 
-def save_png(pixels: NDArray[np.uint8], path: str | Path) -> Path:
-    """Write ``[H,W,3]`` uint8 pixels to ``path`` as PNG (atomically), creating folders."""
+def image_format(path: str | Path) -> str:
+    """The format for ``path``'s suffix; ``ValueError`` names the ones offered."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in IMAGE_FORMATS:
+        raise ValueError(f"{path}: cannot write a {suffix or 'suffix-less'} image; use .png or .jpg")
+    return IMAGE_FORMATS[suffix]
+
+
+def save_image(pixels: NDArray[np.uint8], path: str | Path) -> Path:
+    """Write ``[H,W,3]`` uint8 pixels to ``path`` (PNG or JPEG by suffix) atomically, creating folders."""
+    import io
+
     from PIL import Image
 
     from engine.atomic import atomic_write_bytes
 
+    fmt = image_format(path)
     arr = np.asarray(pixels)
     if arr.ndim != 3 or arr.shape[2] != 3 or arr.dtype != np.uint8:
         raise ValueError(f"pixels must be uint8 [H,W,3], got {arr.dtype} {arr.shape}")
-    import io
-
     buf = io.BytesIO()
-    Image.fromarray(arr, "RGB").save(buf, format="PNG")
+    Image.fromarray(arr, "RGB").save(buf, format=fmt, **({"quality": 92} if fmt == "JPEG" else {}))
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(p, buf.getvalue())

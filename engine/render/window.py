@@ -18,7 +18,14 @@ from numpy.typing import NDArray
 
 from engine.render.offscreen import OffscreenBuffers
 
-__all__ = ["WindowTarget"]
+__all__ = ["WindowTarget", "NoDisplayError"]
+
+#: SDL video drivers that open no visible window.
+INVISIBLE_DRIVERS = ("dummy", "offscreen", "evdev")
+
+
+class NoDisplayError(RuntimeError):
+    """A window was asked for where there is no display to show it."""
 
 
 class WindowTarget:
@@ -29,6 +36,11 @@ class WindowTarget:
         import pygame
 
         pygame.display.init()
+        driver = pygame.display.get_driver()
+        if driver in INVISIBLE_DRIVERS:
+            pygame.display.quit()
+            raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver): a window cannot be shown "
+                                 "here; use --headless to run without one")
         gl = pygame
         pygame.display.gl_set_attribute(gl.GL_CONTEXT_MAJOR_VERSION, 3)
         pygame.display.gl_set_attribute(gl.GL_CONTEXT_MINOR_VERSION, 3)
@@ -44,6 +56,7 @@ class WindowTarget:
         self._pg = pygame
         self.ctx = moderngl.create_context(require=330)
         self.buffers = OffscreenBuffers(self.ctx, width, height, samples)
+        self._screen = self.ctx.detect_framebuffer(0)
         self.closed = False
 
     @property
@@ -58,9 +71,16 @@ class WindowTarget:
         return self.buffers.begin()
 
     def end(self) -> None:
+        """Resolve the frame, copy its colour to the window's framebuffer 0 and flip.
+
+        Only colour is copied: a blit that includes depth fails with
+        ``GL_INVALID_OPERATION`` when the window's depth format differs from ours (Mesa
+        under X does), and the window never showed a pixel. The destination is named
+        explicitly: ``detect_framebuffer()`` returns whatever is bound, which after
+        drawing is our own buffer, so the frame was copied onto itself.
+        """
         self.buffers.resolve()
-        screen = self.ctx.detect_framebuffer()
-        self.ctx.copy_framebuffer(screen, self.buffers.resolved)
+        self.ctx.copy_framebuffer(self._screen, self.buffers.colour_only)
         self._pg.display.flip()
 
     def read_pixels(self) -> NDArray[np.uint8]:

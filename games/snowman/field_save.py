@@ -8,11 +8,11 @@ into a small JSON-safe dict, :func:`restore` rebuilds the world from one.
 Keys in the window (``F5`` save, ``F9`` restore, ``R`` reset) reach the simulation
 as recorded input events (:data:`input.sample.SAVE` …), so a replay does exactly
 what the player did. A save is kept in the :class:`FieldSlot` (the simulation
-restores from there) and written to disk atomically: ``$SNOWMAN_FIELD`` if set, else
-``$XDG_DATA_HOME/puppetphone/snowman_field.json``. A live session starts with the
-file's field in the slot (``F9`` brings it back) and puts it into its recording's
-header, so replays restore the same field without reading anyone's disk; replays
-never write the default file.
+restores from there) and written to disk atomically: the game option ``field``
+(``--set field=PATH``) if given, else ``$XDG_DATA_HOME/puppetphone/snowman_field.json``.
+:func:`prepare` reads that file before the game is built; the field it holds goes into
+the game's setup (``F9`` brings it back), which the recording's header carries, so
+replays restore the same field without reading anyone's disk; replays never write it.
 """
 
 from __future__ import annotations
@@ -43,10 +43,9 @@ from games.snowman.snow import SnowField
 from input.sample import InputFrame, RESET, RESTORE, SAVE
 
 __all__ = ["FIELD_VERSION", "FieldError", "FieldSlot", "snapshot", "restore", "spawn_first_puppet", "field_commands",
-           "default_field_path", "load_field", "install_field_slot", "recording_extra", "EXTRA_KEY"]
+           "default_field_path", "load_field", "install_field_slot", "prepare", "replay_setup"]
 
 FIELD_VERSION = 1
-EXTRA_KEY = "snowman_field"
 PUPPET_COLOR = (0.85, 0.32, 0.24)
 
 
@@ -60,7 +59,6 @@ class FieldSlot:
 
     path: Path | None = None
     saved: dict[str, Any] | None = None
-    loaded_from_disk: dict[str, Any] | None = None
 
 
 def spawn_first_puppet(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
@@ -198,32 +196,34 @@ def load_field(path: Path) -> dict[str, Any] | None:
     return snap
 
 
-def install_field_slot(app: App) -> None:
-    """The slot: a replay takes the field its recording carries; a live game reads the file."""
-    from input.plugin import HubResource
-
-    hub = app.world.try_resource(HubResource)
-    replay = getattr(hub.hub, "replay", None) if hub is not None else None
-    slot = FieldSlot()
-    if replay is not None:
-        slot.saved = replay.recording.header.extra.get(EXTRA_KEY)
-        if os.environ.get("SNOWMAN_FIELD"):
-            slot.path = default_field_path()
-    else:
-        slot.path = default_field_path()
+def prepare(options: dict[str, str]) -> dict[str, Any]:
+    """Read the saved field (a damaged file is set aside as ``.bad``) into the game's setup."""
+    path = Path(options["field"]).expanduser() if options["field"] else default_field_path()
+    try:
+        saved = load_field(path)
+    except FieldError as exc:
+        bad = Path(str(path) + ".bad")
         try:
-            slot.saved = slot.loaded_from_disk = load_field(slot.path)
-        except FieldError as exc:
-            bad = Path(str(slot.path) + ".bad")
-            os.replace(slot.path, bad)
-            print(f"snowman: {exc}; set aside as {bad}", file=sys.stderr)
-    app.world.insert_resource(slot)
+            os.replace(path, bad)
+            print(f"snowman: {exc}; set aside as {bad}, starting on a fresh field", file=sys.stderr)
+        except OSError as move:
+            print(f"snowman: {exc}; cannot set it aside ({move.strerror}), starting on a fresh field", file=sys.stderr)
+        saved = None
+    return {"field": saved, "save_to": str(path)}
 
 
-def recording_extra(world: World) -> dict[str, Any]:
-    """What a recording's header must carry: the field a live game found on disk."""
-    slot = world.try_resource(FieldSlot)
-    return {EXTRA_KEY: slot.loaded_from_disk} if slot is not None and slot.loaded_from_disk is not None else {}
+def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
+    """A replay restores the recorded field but saves nowhere."""
+    return {**recorded, "save_to": ""}
+
+
+def install_field_slot(app: App) -> None:
+    """The slot, from the game's setup: the field found on disk, and where saves go."""
+    from games.base import GameSetup
+
+    setup = app.world.try_resource(GameSetup) or GameSetup()
+    save_to = setup.get("save_to", "")
+    app.world.insert_resource(FieldSlot(saved=setup.get("field"), path=Path(save_to) if save_to else None))
 
 
 def field_commands(world: World) -> None:

@@ -18,7 +18,7 @@ from engine.statemachine.puppet import install_puppets
 from games.base import Game
 from games.snowman.components import Snowman, SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game
-from games.snowman.field_save import field_commands, install_field_slot, recording_extra, spawn_first_puppet
+from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
 from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
                                  start_snowballs, stick_stacked_balls)
 from games.snowman.scenery import build_scenery
@@ -73,5 +73,5 @@ def status(world: World) -> list[str]:
 
 
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            recording_extra=recording_extra)
+            options={"field": ""}, prepare=prepare, replay_setup=replay_setup)
 

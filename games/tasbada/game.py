@@ -7,9 +7,17 @@ line) → **props alive** (a marked thing wakes up and tells the quest) → **mi
 gate among virtual things over the photo) → **virtual** (the photo dissolves into
 Tasbada). See ``games/tasbada/README.md``.
 
-Setup (once, deterministic): the backdrop photo is ``$TASBADA_PHOTO`` or a webcam or
-the shipped ``assets/room.jpg``; the selfie is ``$TASBADA_SELFIE`` or the webcam or
-``assets/selfie.jpg``. Replays always use the files, never a camera or the save.
+Options (``--set key=value``; the ``$TASBADA_*`` variables are read as defaults):
+``save`` — the progress file (default ``$TASBADA_SAVE`` or the user's data folder);
+``photo`` — the backdrop (``$TASBADA_PHOTO``, else the save's photo, else a webcam, else
+the shipped ``assets/room.jpg``); ``selfie`` (``$TASBADA_SELFIE`` or the shipped one);
+``webcam`` — ``auto`` or ``off``.
+
+:func:`prepare` reads the save file and picks the pictures; :func:`install` builds the
+quest from that setup alone, so a recording replays from its header. The pictures and
+the webcam are display only (no simulation state depends on them): a replay shows the
+recorded photo files, and the frames of a webcam are not recorded — a replay of a
+webcam session shows the shipped photo instead, and says so.
 """
 
 from __future__ import annotations
@@ -17,21 +25,22 @@ from __future__ import annotations
 import os
 import sys
 from pathlib import Path
+from typing import Any
 
 from engine.app import App
 from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.statemachine.puppet import install_puppets
-from games.base import Game
+from games.base import Game, GameOptionError, GameSetup
 from games.tasbada import draw as draw_mod
 from games.tasbada.flow import AvatarLook, SaveSlot, quest_system, save_system
 from games.tasbada.objects import follow_system
-from games.tasbada.quest import MIXED, STAGES, VIRTUAL, Quest
+from games.tasbada.quest import MIXED, STAGES, VIRTUAL, Mark, Quest
 from games.tasbada.reality import SHIPPED_PHOTO, SHIPPED_SELFIE, Reality
 from games.tasbada.save import SaveError, default_save_path, load_progress
 from games.tasbada.view import game_camera
 
-__all__ = ["GAME", "install", "status", "CONTROLS"]
+__all__ = ["GAME", "install", "prepare", "replay_setup", "status", "CONTROLS"]
 
 CONTROLS = (
     "Stage 1: drag a box or draw a lasso around things in the photo; drag the dashed floor line; Done.",
@@ -41,45 +50,68 @@ CONTROLS = (
 )
 
 
-def _is_replay(app: App) -> bool:
-    from input.plugin import HubResource
+def prepare(options: dict[str, str]) -> dict[str, Any]:
+    """Read the save file (a damaged one is set aside) and choose the pictures."""
+    for key in ("webcam",):
+        if options[key] not in ("auto", "off"):
+            raise GameOptionError(f"tasbada webcam must be auto or off, not {options[key]!r}")
+    save = Path(options["save"] or os.environ.get("TASBADA_SAVE") or default_save_path()).expanduser()
+    progress = None
+    try:
+        progress = load_progress(save)
+    except SaveError as exc:
+        bad = Path(str(save) + ".bad")
+        os.replace(str(save), bad)
+        print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
+    photo = options["photo"] or os.environ.get("TASBADA_PHOTO", "")
+    if not photo and progress is not None and progress.photo and Path(progress.photo).is_file():
+        photo = progress.photo
+    selfie = options["selfie"] or os.environ.get("TASBADA_SELFIE", "") or str(SHIPPED_SELFIE)
+    for label, path in (("photo", photo), ("selfie", selfie)):
+        if path and not Path(path).is_file():
+            raise GameOptionError(f"tasbada {label} {path!r} is not a file")
+    return {
+        "save_to": str(save),
+        "reached": list(progress.reached) if progress else [],
+        "marks": [m.to_json() for m in progress.marks] if progress else [],
+        "ground_v": progress.ground_v if progress else None,
+        "photo": photo,
+        "selfie": selfie,
+        "webcam": not photo and options["webcam"] == "auto",
+    }
 
-    hub = app.world.try_resource(HubResource)
-    return hub is not None and getattr(hub.hub, "replay", None) is not None
+
+def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
+    """A replay saves nowhere and opens no camera; missing picture files fall back to the shipped ones."""
+    setup = {**recorded, "save_to": "", "webcam": False}
+    for key in ("photo", "selfie"):
+        if setup.get(key) and not Path(setup[key]).is_file():
+            setup[key] = ""
+    return setup
 
 
 def install(app: App) -> None:
-    """The Tasbada plugin: puppets, the quest resources and rules, the photo, saved progress."""
+    """The Tasbada plugin: puppets, the quest (with the saved progress) and its rules, the photo."""
     install_puppets(app)
     world = app.world
-    replay = _is_replay(app)
+    setup = world.try_resource(GameSetup) or GameSetup()
     q = Quest()
-    explicit_save = bool(os.environ.get("TASBADA_SAVE"))
-    slot = SaveSlot(default_save_path() if (explicit_save or not replay) else None)
-    progress = None
-    if slot.path is not None:
-        try:
-            progress = load_progress(slot.path)  # type: ignore[arg-type]
-        except SaveError as exc:
-            bad = Path(str(slot.path) + ".bad")
-            os.replace(str(slot.path), bad)
-            print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
-    photo = os.environ.get("TASBADA_PHOTO", "")
-    if progress is not None:
-        q.saved_reached = list(progress.reached)
-        q.marks, q.ground_v = list(progress.marks), progress.ground_v
-        if not photo and progress.photo and Path(progress.photo).is_file():
-            photo = progress.photo
-    selfie = os.environ.get("TASBADA_SELFIE", "") or SHIPPED_SELFIE
+    q.saved_reached = list(setup.get("reached", []))
+    q.marks = [Mark.from_json(m) for m in setup.get("marks", [])]
+    if setup.get("ground_v") is not None:
+        q.ground_v = float(setup.get("ground_v"))
+    photo = setup.get("photo", "")
     webcam, message = None, ""
-    if replay:
-        message = "replay: using the photo files"
-    elif not photo:
+    if setup.get("webcam", False):
         from games.tasbada.webcam import open_camera
 
         webcam, message = open_camera(SHIPPED_PHOTO.name)
         print(f"tasbada: {message}", file=sys.stderr)
-    reality = Reality(photo or SHIPPED_PHOTO, selfie, webcam, message)
+    elif not photo:
+        message = f"using the photo {SHIPPED_PHOTO.name}"
+    reality = Reality(photo or SHIPPED_PHOTO, setup.get("selfie", "") or SHIPPED_SELFIE, webcam, message)
+    save_to = setup.get("save_to", "")
+    slot = SaveSlot(Path(save_to) if save_to else None)
     slot.photo = reality.photo_path if webcam is None else ""
     world.insert_resource(q)
     world.insert_resource(reality)
@@ -111,4 +143,6 @@ def _camera() -> OrbitCamera:
     return game_camera()
 
 
-GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS)
+GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
+            options={"save": "", "photo": "", "selfie": "", "webcam": "auto"}, prepare=prepare,
+            replay_setup=replay_setup)

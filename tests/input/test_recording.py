@@ -7,7 +7,7 @@ import pytest
 
 from engine import quat
 from input.hub import InputHub
-from input.recording import MAGIC, Recorder, RecordingError, RecordingHeader, read_recording
+from input.recording import FORMAT_VERSION, MAGIC, Recorder, RecordingError, RecordingHeader, read_recording
 from input.replay import ReplaySource, verify
 from input.sample import PoseSample
 from input.source import PoseSource
@@ -38,7 +38,7 @@ def test_record_then_replay_every_hash_matches(make_app, tmp_path):
     app, rec = record_session(make_app, path)
     r = read_recording(path)
     assert r.complete and len(r) == 120 and r.header.game == "test" and r.header.seed == 7
-    assert r.header.format == 1 and r.header.sources == ["phone"] and r.header.engine_version
+    assert r.header.format == FORMAT_VERSION and r.header.sources == ["phone"] and r.header.engine_version
     res = verify(make_app, r)
     assert res.ok and res.message() == "replayed 120 frames, all 120 state hashes match"
 

@@ -2,55 +2,33 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
-import types
+from pathlib import Path
 
-import numpy as np
 import pytest
 
 from engine import quat
-from engine.app import App
-from engine.components import Grabbable, Stick, Transform
 from input.hub import InputHub
-from input.plugin import install_input
 from input.recording import Recorder, RecordingHeader
 from input.sample import PoseSample
 from input.source import PoseSource
 from puppetphone.cli import main
+from puppetphone.games import make_app
 
-
-def make_app(game: str, seed: int, hub: InputHub) -> App:
-    """Stand-in for puppetphone.games.make_app: a field with one grabbable thing."""
-    assert game == "sandbox"
-    app = App(seed=seed)
-    install_input(app, hub)
-    app.world.spawn(Transform(position=np.array([0.0, 0.95, 0.0])), Grabbable(0.6))
-
-    def carry(world) -> None:
-        for _, stick in world.query(Stick):
-            if stick.grabbed is not None:
-                world.get(stick.grabbed, Transform).position = stick.tip + world.rng.normal(0, 1e-3, 3)
-
-    app.add_system("rules", carry)
-    return app
-
-
-@pytest.fixture
-def games(monkeypatch):
-    """The command is tested against ``make_app``'s signature with the stand-in above, so the
-    test does not depend on which games are ready (the end-to-end test runs the real ones)."""
-    stand_in = types.SimpleNamespace(make_app=make_app)
-    monkeypatch.setitem(sys.modules, "puppetphone.games", stand_in)
-    return stand_in
+REPO = Path(__file__).resolve().parents[2]
+SHIPPED = sorted([*(REPO / "tests" / "data").glob("*.rec"), *(REPO / "games").glob("*/demo.rec")])
 
 
 class Fed(PoseSource):
     threaded = False
 
 
-def record(path, games, steps=90):
+def record(path, steps=90):
+    """A phone grabbing and swinging the sandbox puppet, recorded as ``play --record`` does."""
     src = Fed("phone")
-    app = games.make_app("sandbox", 11, InputHub([src]))
+    app = make_app("sandbox", 11, InputHub([src]))
     rec = Recorder(path, RecordingHeader("sandbox", 11, app.world.dt, ["phone"])).attach(app)
     for i in range(steps):
         q = quat.from_axis_angle([1, 0, 0], -0.4 + 0.01 * i)
@@ -59,16 +37,16 @@ def record(path, games, steps=90):
     rec.close()
 
 
-def test_verify_reports_all_hashes_match(tmp_path, games, capsys):
+def test_verify_reports_all_hashes_match(tmp_path, capsys):
     path = tmp_path / "s.rec"
-    record(path, games)
+    record(path)
     assert main(["replay", str(path), "--verify", "--headless"]) == 0
     assert capsys.readouterr().out.strip() == "replayed 90 frames, all 90 state hashes match"
 
 
-def test_first_differing_frame_is_named(tmp_path, games, capsys):
+def test_first_differing_frame_is_named(tmp_path, capsys):
     path = tmp_path / "s.rec"
-    record(path, games)
+    record(path)
     data = bytearray(path.read_bytes())
     # Corrupt the stored hash of frame 40 and fix its checksum, as a diverging build would produce.
     import zlib
@@ -86,14 +64,41 @@ def test_first_differing_frame_is_named(tmp_path, games, capsys):
     assert "differs at frame 40" in capsys.readouterr().out
 
 
-def test_truncated_recording_replays_with_a_warning(tmp_path, games, capsys):
+def test_a_cut_recording_fails_unless_allowed(tmp_path, capsys):
     path = tmp_path / "s.rec"
-    record(path, games)
+    record(path)
     path.write_bytes(path.read_bytes()[:-10])
-    assert main(["replay", str(path), "--verify", "--headless"]) == 0
+    assert main(["replay", str(path), "--verify", "--headless"]) == 1
+    assert "cut inside the record of frame 89" in capsys.readouterr().err
+    assert main(["replay", str(path), "--verify", "--headless", "--allow-truncated"]) == 0
     out = capsys.readouterr()
     assert "warning" in out.err and "89 complete frames" in out.err
     assert "replayed 89 frames, all 89 state hashes match" in out.out
+
+
+def test_plain_replay_also_fails_on_a_differing_hash(tmp_path, capsys):
+    path = tmp_path / "s.rec"
+    record(path)
+    data = bytearray(path.read_bytes())
+    data[-20] ^= 0x55  # the last record's payload: its checksum no longer matches
+    path.write_bytes(bytes(data))
+    assert main(["replay", str(path), "--headless"]) == 1
+    assert "damaged record at frame 89" in capsys.readouterr().err
+
+
+def test_a_device_or_pipe_is_refused(capsys):
+    assert main(["replay", "/dev/zero", "--headless"]) == 2
+    assert "not a regular file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: str(p.relative_to(REPO)))
+def test_every_shipped_recording_verifies_through_the_command(path):
+    """As a user types it: a subprocess, the console script, the shipped file."""
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
+    done = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(path), "--verify", "--headless"],
+                          capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "state hashes match" in done.stdout
 
 
 def test_not_a_recording_is_a_clear_error(tmp_path, capsys):

@@ -11,7 +11,7 @@ import pytest
 from engine.components import Transform
 from engine.ragdoll.components import Prop
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked
-from games.snowman.field_save import EXTRA_KEY, FieldError, FieldSlot, restore, snapshot
+from games.snowman.field_save import FieldError, FieldSlot, restore, snapshot
 from games.snowman.rig import SnowmanShape
 from games.snowman.rules import spawn_ball
 from games.snowman.snow import SnowField
@@ -29,11 +29,16 @@ def field_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return path
 
 
+def _live_app(hub: InputHub):  # type: ignore[no-untyped-def]
+    """The snowman as ``play`` builds it: the game's prepare reads the field file first."""
+    return make_app("snowman", 3, hub, load_game("snowman").prepare({"field": ""}))
+
+
 def _built_field(hub: InputHub | None = None):  # type: ignore[no-untyped-def]
     """A field with a rolled track, a stack of two balls, a loose ball and a snowman."""
     from games.snowman.alive import bring_to_life
 
-    app = make_app("snowman", 3, hub or InputHub())
+    app = _live_app(hub or InputHub())
     world = app.world
     world.resource(SnowField).roll(np.array([-2.0, 0.2, 0.0]), np.array([1.0, 0.2, 0.5]), 0.2)
     bottom = spawn_ball(world, np.array([2.0, 0.0, 1.0]), 0.4)
@@ -115,8 +120,9 @@ def test_keys_save_reset_and_restore(tmp_path: Path, field_file: Path) -> None:
 def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file(tmp_path: Path, field_file: Path) -> None:
     field_file.write_text(json.dumps(snapshot(_built_field().world)))
     hub = InputHub()
-    app = make_app("snowman", 3, hub)
-    header = RecordingHeader(game="snowman", seed=3, dt=app.world.dt, extra=load_game("snowman").recording_extra(app.world))
+    setup = load_game("snowman").prepare({"field": ""})
+    app = make_app("snowman", 3, hub, setup)
+    header = RecordingHeader(game="snowman", seed=3, dt=app.world.dt, setup=setup)
     rec_path = tmp_path / "session.rec"
     recorder = Recorder(rec_path, header).attach(app)
     app.run_steps(5)
@@ -127,16 +133,17 @@ def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file
     recorder.close()
     field_file.unlink()  # the replay must not need it: the recording carries the field
     rec = read_recording(rec_path)
-    assert EXTRA_KEY in rec.header.extra
+    assert rec.header.setup["field"] is not None
+    replayed = load_game("snowman").replay_setup(rec.header.setup)
     seen = []
-    result = verify(lambda h: make_app("snowman", 3, h), rec, on_step=lambda a, i: seen.append(len(a.world.query(Snowball))))
+    result = verify(lambda h: make_app("snowman", 3, h, replayed), rec, on_step=lambda a, i: seen.append(len(a.world.query(Snowball))))
     assert result.ok, result.message
     assert seen[-1] == 3 and 0 in seen and not field_file.exists()  # restored, reset, restored; nothing written
 
 
 def test_a_corrupt_save_file_is_set_aside_with_a_message(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
     field_file.write_text("{ not json")
-    app = make_app("snowman", 3, InputHub())
+    app = _live_app(InputHub())
     assert app.world.resource(FieldSlot).saved is None
     assert Path(str(field_file) + ".bad").read_text() == "{ not json" and not field_file.exists()
     assert "set aside" in capsys.readouterr().err

@@ -12,14 +12,15 @@ from input.replay import verify
 DEMO = Path(__file__).resolve().parents[3] / "games" / "tasbada" / "demo.rec"
 
 
-def test_demo_replays_every_stage_in_order_with_matching_hashes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+def test_demo_replays_every_stage_in_order_with_matching_hashes(tmp_path: Path,
                                                                  capsys: pytest.CaptureFixture[str]) -> None:
     from puppetphone.games import make_app
 
-    monkeypatch.setenv("TASBADA_SAVE", str(tmp_path / "save.json"))
     rec = read_recording(DEMO)
     assert rec.complete and rec.header.game == "tasbada"
-    result = verify(lambda hub: make_app("tasbada", rec.header.seed, hub), rec)
+    # The recorded setup, saving to a file of the test's (a replay itself saves nowhere).
+    setup = {**rec.header.setup, "save_to": str(tmp_path / "save.json")}
+    result = verify(lambda hub: make_app("tasbada", rec.header.seed, hub, setup), rec)
     assert result.ok, result.message
     lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("stage: ")]
     assert lines == ["stage: real", "stage: props alive", "stage: mixed", "stage: virtual"]

@@ -10,7 +10,7 @@ writes ``tests/data/<name>.rec``; the tests replay those files through
 the brain did.
 
 This module is loaded by file path (it is test code, not an installed package), so
-it imports only the engine, the input layer and the sandbox game.
+it imports only the engine, the input layer, the sandbox game and the launcher's ``make_app``.
 """
 
 from __future__ import annotations
@@ -25,14 +25,13 @@ from engine import quat
 from engine.app import App
 from engine.components import Grabbable, Stick, Transform
 from engine.ecs import Entity
-from engine.ragdoll.system import spawn_snowball
 from engine.statemachine import Brain
 from games.sandbox import GAME
+from puppetphone.games import make_app as games_make_app
 from input.hub import InputHub
 from input.motionstick import StickConfig
 from input.mouse import MouseSource
 from input.mousebot import MouseBot
-from input.plugin import install_input
 from input.recording import Recorder, RecordingHeader
 from input.sample import PoseSample
 from input.source import PoseSource
@@ -41,34 +40,11 @@ __all__ = ["SEED", "SESSIONS", "Session", "make_app", "record", "puppet_of", "Ph
 
 SEED = 63
 DATA_DIR = Path(__file__).resolve().parents[4] / "tests" / "data"
-SMALL_BALL = np.array([0.0, 0.14, 1.05])
-BIG_BALL = np.array([0.0, 0.3, 1.35])
-
-
-# -- worlds ---------------------------------------------------------------------------
-def _small_ball(app: App) -> None:
-    """A small grabbable ball one stride in front of the puppet (to pick up)."""
-    e = spawn_snowball(app.world, SMALL_BALL, radius=0.14)
-    app.world.add(e, Grabbable(radius=0.19, kind="snowball"))
-
-
-def _big_ball(app: App) -> None:
-    """A ball too big to carry in front of the puppet (to roll)."""
-    e = spawn_snowball(app.world, BIG_BALL, radius=0.3)
-    app.world.add(e, Grabbable(radius=0.35, kind="snowball"))
-
-
-SCENES: dict[str, Callable[[App], None]] = {"empty": lambda app: None, "small_ball": _small_ball, "big_ball": _big_ball}
 
 
 def make_app(scene: str, hub: InputHub, seed: int = SEED) -> App:
-    """The sandbox (input plugin, then the game) plus the scene's props — as ``games.make_app`` builds it."""
-    app = App(seed=seed)
-    install_input(app, hub)
-    GAME.install(app)
-    SCENES[scene](app)
-    app.world.flush()
-    return app
+    """The sandbox with its ``scene`` option, built as ``puppetphone replay`` rebuilds it."""
+    return games_make_app("sandbox", seed, hub, {"scene": scene})
 
 
 def puppet_of(app: App) -> Entity:
@@ -322,7 +298,7 @@ def record(session: Session, path: Path | None = None) -> App:
     hub = InputHub([src])
     app = make_app(session.scene, hub)
     header = RecordingHeader(game="sandbox", seed=SEED, dt=app.world.dt, sources=[session.source],
-                             extra={"scene": session.scene, "session": session.name})
+                             setup={"scene": session.scene}, extra={"session": session.name})
     with Recorder(path, header).attach(app):
         if session.source == "mouse":
             session.script(app, MouseBot(app, src, GAME.camera()))  # type: ignore[arg-type]

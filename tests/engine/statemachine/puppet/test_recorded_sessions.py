@@ -25,6 +25,7 @@ from engine.components import LocalPose, Stick, Transform
 from engine.ragdoll.components import Prop, Ragdoll
 from engine.statemachine import Brain
 from engine.statemachine.puppet import PuppetBody
+from games.sandbox import BIG_BALL
 from input.recording import read_recording
 from input.replay import verify
 
@@ -263,7 +264,7 @@ def test_crouch_walking_into_a_big_ball_rolls_it() -> None:
     ball, rot = w.arr("ball"), w.arr("ball_rot")
     start = w.first("state", "RollSnowball")
     stop = start + w.state[start:].index("Locomotion")
-    assert np.allclose(ball[:start, [0, 2]], S.BIG_BALL[[0, 2]], atol=0.02)  # at rest until pushed
+    assert np.allclose(ball[:start, [0, 2]], BIG_BALL[[0, 2]], atol=0.02)  # at rest until pushed
     travelled = float(np.linalg.norm((ball[stop] - ball[start])[[0, 2]]))
     assert travelled > 0.5
     assert np.allclose(ball[start:stop, 1], 0.3, atol=1e-9)  # on the ground

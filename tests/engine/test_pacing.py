@@ -1,6 +1,6 @@
 import pytest
 
-from input.pacing import RealTimePacer
+from engine.pacing import RealTimePacer
 
 
 class FakeClock:

@@ -1,0 +1,286 @@
+"""The one frame loop: every session — play, replay, the authoring scenes, demos — runs here.
+
+A session hands the runner an :class:`Activity`: something that steps at a fixed ``dt``
+and draws itself. The runner owns everything around it:
+
+- the **render target** (a window, or an EGL off-screen buffer with ``headless``);
+- the **clock**: in a window, real elapsed time goes through a
+  :class:`~engine.clock.FixedStepClock` (the scene is drawn every display frame,
+  interpolated with its ``alpha``); headless, steps run back to back, or paced to wall
+  time (:class:`~engine.pacing.RealTimePacer`) when a live device drives the session.
+  Either way the activity's own time is ``steps × dt``: at 8 rendered frames a second a
+  3 s countdown still takes 3 s, and a performer's tempo is kept;
+- the **event stack**: window events go to the handlers pushed last first (tools and
+  overlays before the game, as in pyglet's handler stack); a handler that returns true
+  consumes the event. The runner's own handler sits at the bottom: Esc and closing the
+  window quit, ``P`` pauses, ``.`` single-steps while paused;
+- the **common options**: ``--headless --frames --screenshot --screenshot-at``, window
+  size and title.
+
+``--frames N`` means N simulation steps, in a window too (catch-up never overshoots).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from engine.camera import Camera
+from engine.clock import FixedStepClock
+from engine.pacing import RealTimePacer
+from engine.render.scene import RenderScene
+from engine.render.window import INVISIBLE_DRIVERS, NoDisplayError
+
+__all__ = ["Activity", "EventHandler", "NoDisplayError", "RunOptions", "RunResult", "Runner", "check_display"]
+
+#: Real time a window frame may add at most (a stall drops time beyond this).
+MAX_FRAME_TIME = 0.25
+
+
+class Activity(Protocol):
+    """What the runner runs: fixed steps of ``dt`` and a drawing of the current state."""
+
+    dt: float
+    camera: Camera
+
+    def step(self) -> None:
+        """Advance one fixed step."""
+        ...
+
+    def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
+        """Fill ``scene`` with the current state (``alpha``: fraction of the next step)."""
+        ...
+
+    def finished(self) -> bool:
+        """Whether the activity has ended on its own (a replay ran out, a verify failed)."""
+        ...
+
+
+class EventHandler(Protocol):
+    """A layer of the event stack."""
+
+    def on_event(self, event: Any, runner: Runner) -> bool:
+        """Handle a pygame event; return true to stop it reaching the layers below."""
+        ...
+
+
+def check_display() -> None:
+    """Refuse to open an invisible window: no ``DISPLAY``/``WAYLAND_DISPLAY``, or a dummy driver.
+
+    Without a display SDL falls back to its offscreen or dummy driver and the session
+    would run, unseen, until killed.
+    """
+    driver = os.environ.get("SDL_VIDEODRIVER", "").lower()
+    if driver in INVISIBLE_DRIVERS:
+        raise NoDisplayError(f"no display (SDL_VIDEODRIVER={driver}): a window cannot be shown here; "
+                             "use --headless to run without one")
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise NoDisplayError("no display (DISPLAY and WAYLAND_DISPLAY are unset): a window cannot be shown here; "
+                             "use --headless to run without one")
+
+
+@dataclass
+class RunOptions:
+    """The options every session shares.
+
+    Attributes:
+        headless: render off-screen (EGL); no window, no events.
+        frames: stop after this many simulation steps (``None``: until the activity
+            finishes or the window closes).
+        screenshot: write the final frame here (PNG or JPEG by suffix).
+        screenshot_at: write ``screenshot`` after this step instead of at the end.
+        pace: headless only — hold each step to wall time (a live device drives it).
+    """
+
+    headless: bool = False
+    frames: int | None = None
+    screenshot: Path | None = None
+    screenshot_at: int | None = None
+    width: int = 1280
+    height: int = 720
+    title: str = "PuppetPhone"
+    pace: bool = False
+
+    def __post_init__(self) -> None:
+        if self.frames is not None and self.frames < 0:
+            raise ValueError(f"frames must be zero or more, not {self.frames}")
+        if self.screenshot_at is not None and self.screenshot_at < 0:
+            raise ValueError(f"screenshot step must be zero or more, not {self.screenshot_at}")
+        if self.screenshot_at is not None and self.screenshot is None:
+            raise ValueError("a screenshot step needs a screenshot file")
+
+
+@dataclass
+class RunResult:
+    """How a run ended."""
+
+    steps: int
+    quit: bool = False
+    screenshot: Path | None = None
+
+
+class _BaseKeys:
+    """The bottom of the event stack: quit, pause and single step."""
+
+    def on_event(self, event: Any, runner: Runner) -> bool:
+        import pygame
+
+        if event.type == pygame.QUIT or (event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE):
+            runner.stop()
+            return True
+        if event.type == pygame.KEYDOWN and event.key == pygame.K_p:
+            runner.clock.resume() if runner.clock.paused else runner.clock.pause()
+            return True
+        if event.type == pygame.KEYDOWN and event.key == pygame.K_PERIOD and runner.clock.paused:
+            runner.clock.request_step()
+            return True
+        return False
+
+
+class Runner:
+    """Runs an :class:`Activity` in a window or headless; see the module docstring.
+
+    Args:
+        options: the shared options.
+        clock: the fixed-step clock (an app's, so its pause state is what the overlay
+            shows); a new one at the activity's ``dt`` when omitted.
+        wall: the wall clock (injectable for tests of the tempo).
+    """
+
+    def __init__(self, options: RunOptions, clock: FixedStepClock | None = None,
+                 wall: Callable[[], float] = time.perf_counter) -> None:
+        self.options = options
+        self.clock = clock
+        self.handlers: list[EventHandler] = [_BaseKeys()]
+        self.fps = 0.0
+        self.viewer: Any = None
+        self._wall = wall
+        self._stopped = False
+        self._shot: Path | None = None
+
+    # -- event stack ---------------------------------------------------------------------
+    def push_handlers(self, handler: EventHandler) -> None:
+        """Put a layer on top of the stack: it sees events before every layer below."""
+        self.handlers.append(handler)
+
+    def pop_handlers(self, handler: EventHandler) -> None:
+        """Remove a layer."""
+        self.handlers.remove(handler)
+
+    def dispatch(self, event: Any) -> bool:
+        """Offer ``event`` to the layers, top first; true if one consumed it."""
+        return any(handler.on_event(event, self) for handler in reversed(self.handlers))
+
+    def stop(self) -> None:
+        """End the run after the current frame."""
+        self._stopped = True
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """The target's size in pixels."""
+        return self.viewer.size if self.viewer is not None else (self.options.width, self.options.height)
+
+    # -- running -------------------------------------------------------------------------
+    def open(self) -> None:
+        """Open the render target (a window needs a display: :class:`NoDisplayError`)."""
+        if self.viewer is not None:
+            return
+        from engine.render.viewer import Viewer
+
+        if not self.options.headless:
+            check_display()
+        o = self.options
+        self.viewer = Viewer.create(headless=o.headless, width=o.width, height=o.height,
+                                    **({} if o.headless else {"title": o.title}))
+
+    def run(self, activity: Activity) -> RunResult:
+        """Run ``activity`` until it finishes, ``frames`` steps ran, or the user quits."""
+        if self.clock is None:
+            self.clock = FixedStepClock(dt=activity.dt)
+        self.clock.max_steps = max(self.clock.max_steps, math.ceil(MAX_FRAME_TIME / activity.dt))
+        self._stopped = False
+        if self.options.headless:
+            steps = self._run_headless(activity)
+        else:
+            self.open()
+            steps = self._run_window(activity)
+        if self.options.screenshot is not None and self._shot is None:
+            self._take_screenshot(activity)
+        return RunResult(steps=steps, quit=self._stopped, screenshot=self._shot)
+
+    def _limit(self, steps: int) -> int:
+        """Steps still allowed by ``frames`` (a large number without it)."""
+        frames = self.options.frames
+        return sys.maxsize if frames is None else max(frames - steps, 0)
+
+    def _after_step(self, activity: Activity, steps: int) -> None:
+        if self.options.screenshot_at is not None and steps == self.options.screenshot_at:
+            self._take_screenshot(activity)
+
+    def _run_headless(self, activity: Activity) -> int:
+        pacer = RealTimePacer(activity.dt, clock=self._wall) if self.options.pace else None
+        steps = 0
+        if self.options.screenshot_at == 0:
+            self._take_screenshot(activity)
+        while self._limit(steps) > 0 and not activity.finished() and not self._stopped:
+            if pacer is not None:
+                pacer.wait()
+            activity.step()
+            steps += 1
+            self._after_step(activity, steps)
+        return steps
+
+    def _run_window(self, activity: Activity) -> int:
+        assert self.clock is not None
+        last = self._wall()
+        steps = 0
+        fps_frames, fps_t0 = 0, last
+        while not self._stopped and self._limit(steps) > 0 and not activity.finished():
+            for event in self.viewer.poll_events():
+                self.dispatch(event)
+            if getattr(self.viewer.target, "closed", False):
+                self._stopped = True
+            if self._stopped:
+                break
+            now = self._wall()
+            due = self.clock.advance(min(now - last, MAX_FRAME_TIME))
+            last = now
+            for _ in range(min(due, self._limit(steps))):
+                if activity.finished():
+                    break
+                activity.step()
+                steps += 1
+                self._after_step(activity, steps)
+            self.draw(activity)
+            fps_frames += 1
+            if now - fps_t0 >= 0.5:
+                self.fps, fps_frames, fps_t0 = fps_frames / (now - fps_t0), 0, now
+        return steps
+
+    def draw(self, activity: Activity) -> None:
+        """Draw the activity's current state into the target (and show it in a window)."""
+        self.open()
+        scene = RenderScene()
+        alpha = self.clock.alpha if self.clock is not None else 0.0
+        activity.draw(scene, alpha, self.viewer.size)
+        self.viewer.camera = activity.camera
+        self.viewer.draw(scene)
+
+    def _take_screenshot(self, activity: Activity) -> None:
+        from engine.render.target import save_image
+
+        self.draw(activity)
+        assert self.options.screenshot is not None
+        self._shot = save_image(self.viewer.read_pixels(), self.options.screenshot)
+
+    def close(self) -> None:
+        """Release the window or off-screen target."""
+        if self.viewer is not None:
+            self.viewer.close()
+            self.viewer = None
