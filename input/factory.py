@@ -13,15 +13,17 @@ import argparse
 from input.hub import InputHub
 from input.osc import DEFAULT_PORT
 
-__all__ = ["add_source_arguments", "make_hub", "SOURCE_KINDS"]
+__all__ = ["add_source_arguments", "make_hub", "SOURCE_KINDS", "DEFAULT_HOST"]
 
 SOURCE_KINDS = ("mouse", "osc", "hid", "serial", "replay:FILE")
+#: Where OSC listens unless told otherwise: this machine only (a LAN phone needs 0.0.0.0).
+DEFAULT_HOST = "127.0.0.1"
 
 
 def add_source_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``--source`` and the device options to a sub-command's parser."""
     parser.add_argument("--source", default="mouse", help=f"input source: {'|'.join(SOURCE_KINDS)} (default mouse)")
-    parser.add_argument("--osc-host", default="127.0.0.1",
+    parser.add_argument("--osc-host", default=DEFAULT_HOST,
                         help="OSC bind address; phones on the LAN need 0.0.0.0 (default 127.0.0.1)")
     parser.add_argument("--osc-port", type=int, default=DEFAULT_PORT, help=f"OSC UDP port (default {DEFAULT_PORT})")
     parser.add_argument("--osc-senders", type=int, default=1, help="how many phones may drive sticks (default 1)")
@@ -29,7 +31,7 @@ def add_source_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--baud", type=int, default=115200, help="serial baud rate (default 115200)")
 
 
-def make_hub(source: str = "mouse", osc_host: str = "127.0.0.1", osc_port: int = DEFAULT_PORT,
+def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int = DEFAULT_PORT,
              osc_senders: int = 1, serial_port: str | None = None, baud: int = 115200) -> InputHub:
     """The hub for one ``--source`` value (sources not yet started).
 

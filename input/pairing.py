@@ -44,6 +44,11 @@ class PairingInfo:
         return (f"OSC listens on {self.bind_host} only: a phone on the LAN cannot reach it; "
                 "start with --osc-host 0.0.0.0")
 
+    @property
+    def play_command(self) -> str:
+        """The ``play`` command line that listens where these addresses (and the QR code) point."""
+        return f"puppetphone play snowman --source osc --osc-host {self.bind_host or '0.0.0.0'} --osc-port {self.port}"
+
     def lines(self) -> list[str]:
         """The human-readable listing (``puppetphone devices`` and the overlay)."""
         out = [f"Phone (OSC over UDP): send to port {self.port} at"]

@@ -34,6 +34,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     sub = parser.add_subparsers(dest="scene", metavar="SCENE")
     record_help = "act a cycle out with the mouse or a device; layers stack into a clip"
     rec = sub.add_parser("record", help=record_help, description=record_help)
+    rec.set_defaults(_parser=rec)
     rec.add_argument("--item", default="r_upper_arm", help="joint to drive (default r_upper_arm)")
     rec.add_argument("--drive", default="rotation", choices=("rotation", "translation", "scale"), help="what to drive")
     rec.add_argument("--base", type=Path, default=None, help="a looping .ppclip whose layers play back while performing")
@@ -51,7 +52,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     except ModuleNotFoundError:  # the MoCurves scene is optional
         return
     edit_help = "refine a cycle with MoCurves while it plays"
-    configure_edit(sub.add_parser("edit", help=edit_help, description=edit_help))
+    edit = sub.add_parser("edit", help=edit_help, description=edit_help)
+    edit.set_defaults(_parser=edit)
+    configure_edit(edit)
 
 
 def run(args: argparse.Namespace) -> int:

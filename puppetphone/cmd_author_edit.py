@@ -33,7 +33,10 @@ def _open(spec: str):  # type: ignore[no-untyped-def]
     from engine.clips import default_clips
 
     path = Path(spec)
-    if path.suffix == ".ppclip" or path.exists():
+    if path.exists() and path.suffix.lower() != ".ppclip":
+        raise ValueError(f"{path} is not a clip file: author edit opens a .ppclip cycle or a default clip "
+                         f"({', '.join(default_clips())})")
+    if path.suffix.lower() == ".ppclip":
         return load_session(path), path.with_name(path.stem + "_edited.ppclip")
     clips = default_clips()
     if spec not in clips:
@@ -73,6 +76,12 @@ def run_edit(args: argparse.Namespace) -> int:
     from engine.runner import Runner
     from puppetphone.runargs import run_options
 
+    from authoring.mocurves.storage import EXPORT_SUFFIXES
+
+    for path in args.export:
+        if path.suffix.lower() not in EXPORT_SUFFIXES:
+            print(f"error: cannot export {path}: use one of {', '.join(EXPORT_SUFFIXES)}", file=sys.stderr)
+            return 2
     try:
         session, default_out = _open(args.clip)
     except (ValueError, OSError) as exc:

@@ -28,7 +28,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="INPUT", help="performance: .bvh, .csv (time + columns), .npz or a recording (.rec)")
     parser.add_argument("-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .csv or .npz")
     parser.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
-    parser.add_argument("--plot", metavar="PNG", help="draw the performance, cuts, aligned cycles and the loop")
+    from puppetphone.runargs import image_path
+
+    parser.add_argument("--plot", metavar="IMAGE", type=image_path,
+                        help="draw the performance, cuts, aligned cycles and the loop (.png or .jpg; needs "
+                             "matplotlib: the 'plot' extra)")
     parser.add_argument("--items", metavar="NAME", nargs="+", help="only these joints (BVH), items (CSV/npz) or sources (recording)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random probe points (default 0)")
     parser.add_argument("--samples", type=int, help="samples in the output loop (default: the period at the input rate)")
@@ -69,6 +73,11 @@ def run(args: argparse.Namespace) -> int:
     out_suffix = "." + args.output.rsplit(".", 1)[-1].lower() if "." in args.output else ""
     if out_suffix not in OUTPUT_SUFFIXES:
         return fail(EXIT_BAD_INPUT, f"unknown output type {out_suffix or args.output!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
+    if args.plot:
+        import importlib.util
+
+        if importlib.util.find_spec("matplotlib") is None:
+            return fail(EXIT_BAD_INPUT, "--plot needs matplotlib: pip install 'puppetphone[plot]'")
     t0 = time.perf_counter()
     try:
         perf = load_performance(args.input, args.items)
@@ -97,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
         from authoring.cycles.plot import plot_cycle
 
         plot_cycle(traj, result, args.plot, perf.names)
+        if not args.json:
+            print(f"wrote {args.plot}")
     summary = {
         "period_frames": round(result.period_samples, 3),
         "period_seconds": round(result.period, 6),

@@ -16,11 +16,15 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print recognised HID devices, serial ports, OSC addresses and a QR code."""
+    from input.factory import DEFAULT_HOST
     from input.osc import DEFAULT_PORT
     from input.pairing import pairing_info, qr_ascii
 
     info = pairing_info(port=args.osc_port or DEFAULT_PORT, bind_host=args.osc_host)
     print("\n".join(info.lines()))
+    print(f"\nTo play with the phone, start:\n  {info.play_command}")
+    print(f"(by default play --source osc listens on {DEFAULT_HOST} only, this machine; a phone on the LAN "
+          "needs --osc-host 0.0.0.0 as above)")
     if info.urls and not args.no_qr:
         print(f"\nScan to pair ({info.urls[0]}):")
         print(qr_ascii(info.urls[0]))

@@ -12,3 +12,48 @@ def test_devices_lists_where_to_send_and_draws_a_qr(capsys):
 def test_devices_warns_about_a_loopback_bind(capsys):
     assert main(["devices", "--osc-host", "127.0.0.1", "--no-qr"]) == 0
     assert "--osc-host 0.0.0.0" in capsys.readouterr().out
+
+
+def test_the_play_command_devices_prints_listens_where_the_qr_code_points(tmp_path):
+    """Pairing as a user does it: run the printed command, send to the printed LAN address."""
+    import os
+    import shlex
+    import shutil
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    import pytest
+
+    from input.recording import read_recording
+
+    if shutil.which("oscsend") is None:
+        pytest.skip("needs oscsend (Debian liblo-tools)")
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path)}
+    shown = subprocess.run([sys.executable, "-m", "puppetphone", "devices", "--osc-port", str(port), "--no-qr"],
+                           capture_output=True, text=True, env=env, timeout=60).stdout
+    urls = [w for w in shown.split() if w.startswith("(osc.udp://")]
+    if not urls:
+        pytest.skip("this machine has no LAN address to pair with")
+    address = urls[0][len("(osc.udp://"):].split(":")[0]
+    command = next(line.strip() for line in shown.splitlines() if line.strip().startswith("puppetphone play"))
+    assert "127.0.0.1 only" in shown
+    args = shlex.split(command)[1:] + ["--headless", "--frames", "900", "--record", "paired.rec"]
+    game = subprocess.Popen([sys.executable, "-m", "puppetphone", *args], cwd=tmp_path, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(2.0)
+        for i in range(40):
+            subprocess.run(["oscsend", address, str(port), "/ZIGSIM/pair/quaternion", "ffff", "0", "0",
+                            str(0.1 * (i % 3)), "1"], check=True, timeout=10)
+            time.sleep(0.03)
+        out, err = game.communicate(timeout=120)
+    finally:
+        game.kill()
+    assert game.returncode == 0, err
+    frames = read_recording(tmp_path / "paired.rec").frames
+    assert sum(len(f.samples) for f in frames) >= 10, "the phone's packets never reached the game"

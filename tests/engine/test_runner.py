@@ -1,0 +1,146 @@
+"""The runner: tempo against wall time, exact --frames, the event stack, screenshots.
+
+The window loop is driven here with a scripted wall clock and an off-screen viewer in
+place of the window, so a slow frame rate can be imposed exactly.
+"""
+
+from __future__ import annotations
+
+import types
+from pathlib import Path
+
+import pytest
+
+from engine.camera import OrbitCamera
+from engine.render.scene import RenderScene
+from engine.runner import RunOptions, Runner
+
+
+class Counter:
+    """An activity that counts its steps and draws a grey floor-less sky."""
+
+    dt = 1.0 / 60.0
+
+    def __init__(self, limit: int | None = None) -> None:
+        self.steps = 0
+        self.limit = limit
+        self.camera = OrbitCamera()
+        self.drawn: list[int] = []
+
+    def step(self) -> None:
+        self.steps += 1
+
+    def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
+        self.drawn.append(self.steps)
+
+    def finished(self) -> bool:
+        return self.limit is not None and self.steps >= self.limit
+
+
+class FakeWindow:
+    """Stands where the window's viewer would: no events, a fixed frame time per draw."""
+
+    def __init__(self, wall: list[float], frame_time: float, events: list | None = None) -> None:
+        self.wall, self.frame_time = wall, frame_time
+        self.size = (64, 48)
+        self.events = events or []
+        self.target = types.SimpleNamespace(closed=False)
+        self.camera = None
+
+    def poll_events(self) -> list:
+        out, self.events = self.events, []
+        return out
+
+    def draw(self, scene: RenderScene) -> None:
+        self.wall[0] += self.frame_time  # drawing is what takes the time
+
+    def close(self) -> None:
+        pass
+
+
+def _window_runner(options: RunOptions, frame_time: float, events: list | None = None) -> tuple[Runner, list[float]]:
+    wall = [100.0]
+    runner = Runner(options, wall=lambda: wall[0])
+    runner.viewer = FakeWindow(wall, frame_time, events)
+    return runner, wall
+
+
+@pytest.mark.parametrize("fps", [8.0, 30.0, 60.0, 144.0])
+def test_a_window_at_any_frame_rate_steps_at_sixty_per_second_of_wall_time(fps: float) -> None:
+    runner, wall = _window_runner(RunOptions(), 1.0 / fps)
+    activity = Counter()
+    start = wall[0]
+    # Three seconds of wall time, as the record scene's countdown.
+    original = activity.step
+
+    def step() -> None:
+        original()
+        if wall[0] - start >= 3.0:
+            runner.stop()
+
+    activity.step = step  # type: ignore[method-assign]
+    runner.run(activity)
+    assert abs(activity.steps - 180) <= 60 / fps + 1
+
+
+def test_frames_counts_steps_exactly_in_a_window_even_with_catch_up() -> None:
+    runner, _ = _window_runner(RunOptions(frames=180), 1.0 / 7.0)
+    activity = Counter()
+    result = runner.run(activity)
+    assert result.steps == activity.steps == 180
+
+
+def test_handlers_pushed_last_see_events_first_and_can_consume_them() -> None:
+    import pygame
+
+    seen: list[str] = []
+
+    class Layer:
+        def __init__(self, name: str, consume: bool) -> None:
+            self.name, self.consume = name, consume
+
+        def on_event(self, event, runner) -> bool:  # type: ignore[no-untyped-def]
+            seen.append(self.name)
+            return self.consume
+
+    runner = Runner(RunOptions(headless=True))
+    runner.push_handlers(Layer("game", False))
+    runner.push_handlers(Layer("tool", True))
+    escape = pygame.event.Event(pygame.KEYDOWN, key=pygame.K_ESCAPE)
+    assert runner.dispatch(escape) and seen == ["tool"]
+    assert not runner._stopped  # the tool took Esc: the base layer never saw it
+    runner.pop_handlers(runner.handlers[-1])
+    seen.clear()
+    runner.dispatch(escape)
+    assert seen == ["game"] and runner._stopped
+
+
+def test_escape_quits_a_window_run() -> None:
+    import pygame
+
+    runner, _ = _window_runner(RunOptions(), 1.0 / 30.0, [pygame.event.Event(pygame.KEYDOWN, key=pygame.K_ESCAPE)])
+    result = runner.run(Counter())
+    assert result.quit and result.steps == 0
+
+
+def test_headless_stops_when_the_activity_finishes_and_screenshots_the_chosen_step(tmp_path: Path) -> None:
+    from engine.render.headless import egl_available
+
+    if egl_available() is not None:
+        pytest.skip(f"no EGL: {egl_available()}")
+    shot = tmp_path / "at5.jpg"
+    runner = Runner(RunOptions(headless=True, screenshot=shot, screenshot_at=5, width=64, height=48))
+    activity = Counter(limit=12)
+    try:
+        result = runner.run(activity)
+    finally:
+        runner.close()
+    assert result.steps == 12 and activity.drawn == [5] and result.screenshot == shot
+    assert shot.read_bytes()[:3] == b"\xff\xd8\xff"  # a JPEG, as the suffix asks
+
+
+def test_absurd_options_are_refused() -> None:
+    with pytest.raises(ValueError, match="zero or more"):
+        RunOptions(frames=-1)
+    with pytest.raises(ValueError, match="needs a screenshot file"):
+        RunOptions(screenshot_at=3)
