@@ -36,11 +36,12 @@ def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None =
     """A headless simulation of ``game``: the setup, input first, then the game's plugins.
 
     ``setup`` is what the game's ``prepare`` returned (live) or what a recording's header
-    carries (replay); ``None`` means the game's declared default options.
+    carries (replay); ``None`` is the empty setup: the game's pure defaults (no save file,
+    the shipped pictures, no camera).
     """
     g = load_game(game)
     app = App(seed=seed)
-    app.world.insert_resource(GameSetup(dict(g.options) if setup is None else setup))
+    app.world.insert_resource(GameSetup(setup))
     install_input(app, hub)
     g.install(app)
     return app

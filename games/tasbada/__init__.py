@@ -13,7 +13,7 @@ Modules, each one job:
 - :mod:`~games.tasbada.compositor`, :mod:`~games.tasbada.reality`, :mod:`~games.tasbada.draw` — the view;
 - :mod:`~games.tasbada.webcam` — the optional live camera;
 - :mod:`~games.tasbada.save` — atomic progress files;
-- :mod:`~games.tasbada.demo_script` — rebuilds ``demo.rec``.
+- ``puppetphone regen demos`` (:mod:`tools.tasbada_demo`) rebuilds ``demo.rec``.
 """
 
 from games.tasbada.quest import MIXED, PROPS_ALIVE, REAL, STAGES, VIRTUAL, Mark, Quest

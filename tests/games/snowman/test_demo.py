@@ -1,6 +1,6 @@
 """The shipped snowman demo replays headless to the end of the arc with every hash matching.
 
-The recording (``games/snowman/demo.rec``, rewritten by ``python -m games.snowman.demo``)
+The recording (``games/snowman/demo.rec``, rewritten by ``puppetphone regen demos``)
 holds only mouse input: three balls rolled, the middle lifted onto the bottom with the
 stick, the head carried up and put on top; the snowman comes alive and itself rolls
 two balls and stacks them into a second snowman.
@@ -19,7 +19,7 @@ from PIL import Image
 from engine.app import App
 from engine.statemachine import Brain
 from games.snowman.components import Snowman, SnowmanStats
-from games.snowman.demo import DEMO_PATH
+from tools.snowman_demo import DEMO_PATH
 from games.snowman.rules import snowmen_standing
 from input.recording import read_recording
 from input.replay import verify

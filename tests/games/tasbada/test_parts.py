@@ -53,7 +53,7 @@ def test_image_and_floor_mapping_agree() -> None:
 
 
 def test_clothes_colour_is_the_sweater_and_cutouts_lift_the_object() -> None:
-    from games.tasbada.assets_gen import draw_selfie
+    from tools.tasbada_assets import draw_selfie
 
     color = clothes_color(np.asarray(draw_selfie(sweater=(200, 40, 60))))
     assert color == pytest.approx((200 / 255, 40 / 255, 60 / 255), abs=0.08)

@@ -2,13 +2,13 @@
 
 Each ``tests/data/puppet_*.rec`` is a real session through the real input path
 (mouse events or phone samples → hub → MotionStick → brain), recorded by
-``tests/data/make_recordings.py``. Every test replays its file through
+``puppetphone regen recordings``. Every test replays its file through
 :func:`input.replay.verify` — which rebuilds the world and checks every step's
 state hash — while watching the puppet, then asserts the state sequence from the
 brain's trace and the quantities that make each behaviour what it is.
 
 When an engine change legitimately alters the simulation the hashes stop matching:
-re-record with ``python tests/data/make_recordings.py`` and re-run.
+re-record with ``puppetphone regen recordings`` and re-run.
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ def replay(name: str) -> Watch:
         return _CACHE[name]
     session = S.SESSIONS[name]
     if not session.path.exists():
-        pytest.fail(f"{session.path} is missing: run python tests/data/make_recordings.py")
+        pytest.fail(f"{session.path} is missing: run puppetphone regen recordings")
     rec = read_recording(session.path)
     assert rec.complete, rec.problem
     assert rec.header.extra["session"] == name and rec.header.sources == [session.source]

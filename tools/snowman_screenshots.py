@@ -1,6 +1,6 @@
 """Screenshots of each stage of the shipped demo, for the README.
 
-``python -m games.snowman.screenshots [DIR]`` replays ``demo.rec`` once and writes a
+``puppetphone regen screenshots`` replays ``demo.rec`` once and writes a
 JPEG the moment each stage is first seen in the world (not at fixed frame numbers,
 so a re-recorded demo still gives the right pictures):
 
@@ -28,7 +28,8 @@ from engine.render.scene import RenderScene
 from engine.render.target import RenderTarget, make_target
 from engine.statemachine import Brain
 from games.snowman.components import Snowman
-from games.snowman.demo import DEMO_PATH
+from tools import REPO
+from tools.snowman_demo import DEMO_PATH
 from games.snowman.game import GAME
 from input.hub import InputHub
 from input.plugin import install_input
@@ -37,7 +38,7 @@ from input.replay import ReplaySource
 
 __all__ = ["STAGES", "take_screenshots"]
 
-OUT = Path(__file__).resolve().parents[2] / "docs" / "screenshots"
+OUT = REPO / "docs" / "screenshots"
 DELAY = 45  # frames after a stage is first seen: let it show
 
 

@@ -1,6 +1,6 @@
 """Rebuild ``games/tasbada/demo.rec``: the whole journey, played through the real input path.
 
-Run ``python -m games.tasbada.demo_script [--screenshots DIR]``. Mouse events are
+Run ``puppetphone regen demos`` (or ``python -m tools.tasbada_demo [--screenshots DIR]``). Mouse events are
 synthesised as pygame would deliver them for a 1280x720 window, handed to
 :class:`input.mouse.MouseSource` with the game's camera, and each step is recorded by
 :class:`input.recording.Recorder` — exactly what ``puppetphone play tasbada --record``
@@ -17,17 +17,17 @@ crystals and through the gate; then wander in Tasbada.
 from __future__ import annotations
 
 import argparse
-import os
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 
+import games.tasbada
+
 __all__ = ["DEMO", "SIZE", "make_demo"]
 
-DEMO = Path(__file__).with_name("demo.rec")
+DEMO = Path(games.tasbada.__file__).with_name("demo.rec")
 SIZE = (1280, 720)
 MOTION, DOWN, UP = 1024, 1025, 1026
 
@@ -236,42 +236,31 @@ def journey(d: _Driver) -> Iterator[str]:
 
 
 def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> list[str]:
-    """Play the journey and record it to ``path``; returns the stages in the order reached."""
+    """Play the journey and record it to ``path``; returns the stages in the order reached.
+
+    The game is built with the empty setup: a new journey, the shipped photo, no camera,
+    saving nowhere — so the demo depends on nothing outside the repository.
+    """
     from games.tasbada.view import game_camera
     from input.hub import InputHub
     from input.mouse import MouseSource
     from input.recording import Recorder, RecordingHeader
-    from engine.app import App
-    from games.tasbada.game import GAME
-    from input.plugin import install_input
+    from puppetphone.games import make_app
 
-    with tempfile.TemporaryDirectory() as tmp:
-        old = {k: os.environ.get(k) for k in ("TASBADA_SAVE", "TASBADA_CAMERA", "TASBADA_PHOTO")}
-        os.environ.update(TASBADA_SAVE=str(Path(tmp) / "save.json"), TASBADA_CAMERA="none")
-        os.environ.pop("TASBADA_PHOTO", None)
-        try:
-            mouse = MouseSource()
-            hub = InputHub([mouse]).start()
-            app = App(seed=seed)  # assembled as puppetphone.games.make_app does (games may not import the launcher)
-            install_input(app, hub)
-            GAME.install(app)
-            header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"])
-            recorder = Recorder(path, header).attach(app)
-            d = _Driver(app, mouse, game_camera(), shots)
-            try:
-                stages = list(journey(d))
-            finally:
-                d.close()
-                recorder.close()
-                hub.close()
-            print(f"recorded {recorder.frames} frames to {path}")
-            return stages
-        finally:
-            for k, v in old.items():
-                if v is None:
-                    os.environ.pop(k, None)
-                else:
-                    os.environ[k] = v
+    mouse = MouseSource()
+    hub = InputHub([mouse]).start()
+    app = make_app("tasbada", seed, hub, {})
+    header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"], setup={})
+    recorder = Recorder(path, header).attach(app)
+    d = _Driver(app, mouse, game_camera(), shots)
+    try:
+        stages = list(journey(d))
+    finally:
+        d.close()
+        recorder.close()
+        hub.close()
+    print(f"recorded {recorder.frames} frames to {path}")
+    return stages
 
 
 def main() -> None:

@@ -3,7 +3,7 @@
 Roll three balls, lift the middle one onto the biggest with the stick, let the
 puppet carry the head on top: the first snowman comes alive. Then the snowman
 itself rolls two balls and lifts the smaller onto the bigger with the stick, and a
-second snowman comes alive. ``python -m games.snowman.demo`` rewrites
+second snowman comes alive. ``puppetphone regen demos`` rewrites
 ``games/snowman/demo.rec``; ``puppetphone play snowman --source replay:demo``
 plays it.
 
@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+import games.snowman
+
 from engine.app import App
 from engine.components import Transform
 from engine.ecs import Entity, World
@@ -31,12 +33,12 @@ from games.snowman.components import Snowball, Snowman, SnowmanStats
 from input.hub import InputHub
 from input.mouse import MouseSource
 from input.mousebot import MouseBot
-from input.plugin import install_input
 from input.recording import Recorder, RecordingHeader
+from puppetphone.games import make_app
 
 __all__ = ["build_demo", "Director", "DEMO_PATH", "DEMO_SEED", "STAGES"]
 
-DEMO_PATH = Path(__file__).with_name("demo.rec")
+DEMO_PATH = Path(games.snowman.__file__).with_name("demo.rec")
 DEMO_SEED = 2017
 #: Named moments of the arc (filled with frame numbers by :func:`build_demo`), for screenshots.
 STAGES = ("rolling", "stacking", "alive", "second")
@@ -227,11 +229,10 @@ def build_demo(path: Path = DEMO_PATH, log: Log = print) -> tuple[App, dict[str,
 
     mouse = MouseSource()
     hub = InputHub([mouse])
-    app = App(seed=DEMO_SEED)
-    install_input(app, hub)
-    GAME.install(app)
+    app = make_app("snowman", DEMO_SEED, hub, {})  # a fresh field, saving nowhere
     bot = MouseBot(app, mouse, GAME.camera())
-    recorder = Recorder(path, RecordingHeader(game="snowman", seed=DEMO_SEED, dt=app.world.dt, sources=["mouse"])).attach(app)
+    header = RecordingHeader(game="snowman", seed=DEMO_SEED, dt=app.world.dt, sources=["mouse"], setup={})
+    recorder = Recorder(path, header).attach(app)
     director = Director(app, bot, log)
     try:
         play(director)

@@ -1,4 +1,4 @@
-"""Regenerate the puppet-brain recordings in this folder: ``python tests/data/make_recordings.py [NAME...]``.
+"""Regenerate the puppet-brain recordings in ``tests/data``: ``puppetphone regen recordings``.
 
 Each recording is a short scripted session of the sandbox puppet driven through the
 real input path (see ``tests/engine/statemachine/puppet/sessions.py``); engine changes
@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import importlib.util
 import sys
-from pathlib import Path
 
-_SESSIONS = Path(__file__).resolve().parents[1] / "engine" / "statemachine" / "puppet" / "sessions.py"
+from tools import REPO
+
+_SESSIONS = REPO / "tests" / "engine" / "statemachine" / "puppet" / "sessions.py"
 
 
 def load_sessions():  # type: ignore[no-untyped-def]

@@ -4,7 +4,7 @@
 living-room corner (back wall, window, picture, wooden floor, rug) with three things
 worth marking — an orange clay pot, a potted plant and a floor lamp. ``selfie.jpg`` is
 a person in a teal sweater against a wall, for the clothes-colour step. Both are drawn
-with a fixed seed, so running ``python -m games.tasbada.assets_gen`` again rebuilds the
+with a fixed seed, so running ``puppetphone regen assets`` again rebuilds the
 very same files.
 """
 
@@ -16,9 +16,11 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image, ImageDraw, ImageFilter
 
+import games.tasbada
+
 __all__ = ["ASSETS", "ROOM_SIZE", "draw_room", "draw_selfie", "main"]
 
-ASSETS = Path(__file__).with_name("assets")
+ASSETS = Path(games.tasbada.__file__).with_name("assets")
 ROOM_SIZE = (960, 540)
 
 
