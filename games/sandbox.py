@@ -14,7 +14,7 @@ __all__ = ["GAME"]
 
 def install(app: App) -> None:
     """One puppet at the origin facing the camera side (+Z)."""
-    install_puppets(app)
+    app.add_plugin(install_puppets)
     spawn_puppet(app.world, (0.0, 0.0, 0.0), 0.0, extra=(Appearance(color=(0.85, 0.35, 0.25)),))
 
 

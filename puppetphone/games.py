@@ -12,7 +12,7 @@ import importlib
 from engine.app import App
 from games.base import Game
 from input.hub import InputHub
-from input.plugin import install_input
+from input.plugin import input_plugin
 
 __all__ = ["GAMES", "load_game", "make_app"]
 
@@ -33,7 +33,4 @@ def load_game(name: str) -> Game:
 def make_app(game: str, seed: int, hub: InputHub) -> App:
     """A headless simulation of ``game``: input first, then the game's plugins."""
     g = load_game(game)
-    app = App(seed=seed)
-    install_input(app, hub)
-    g.install(app)
-    return app
+    return App(seed=seed, plugins=[input_plugin(hub), g.install])

@@ -31,7 +31,7 @@ from games.snowman.components import Snowball, Snowman, SnowmanStats
 from input.hub import InputHub
 from input.mouse import MouseSource
 from input.mousebot import MouseBot
-from input.plugin import install_input
+from input.plugin import input_plugin
 from input.recording import Recorder, RecordingHeader
 
 __all__ = ["build_demo", "Director", "DEMO_PATH", "DEMO_SEED", "STAGES"]
@@ -228,8 +228,8 @@ def build_demo(path: Path = DEMO_PATH, log: Log = print) -> tuple[App, dict[str,
     mouse = MouseSource()
     hub = InputHub([mouse])
     app = App(seed=DEMO_SEED)
-    install_input(app, hub)
-    GAME.install(app)
+    app.add_plugin(input_plugin(hub))
+    app.add_plugin(GAME.install)
     bot = MouseBot(app, mouse, GAME.camera())
     recorder = Recorder(path, RecordingHeader(game="snowman", seed=DEMO_SEED, dt=app.world.dt, sources=["mouse"])).attach(app)
     director = Director(app, bot, log)

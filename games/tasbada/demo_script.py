@@ -243,7 +243,7 @@ def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> li
     from input.recording import Recorder, RecordingHeader
     from engine.app import App
     from games.tasbada.game import GAME
-    from input.plugin import install_input
+    from input.plugin import input_plugin
 
     with tempfile.TemporaryDirectory() as tmp:
         old = {k: os.environ.get(k) for k in ("TASBADA_SAVE", "TASBADA_CAMERA", "TASBADA_PHOTO")}
@@ -253,8 +253,8 @@ def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> li
             mouse = MouseSource()
             hub = InputHub([mouse]).start()
             app = App(seed=seed)  # assembled as puppetphone.games.make_app does (games may not import the launcher)
-            install_input(app, hub)
-            GAME.install(app)
+            app.add_plugin(input_plugin(hub))
+            app.add_plugin(GAME.install)
             header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"])
             recorder = Recorder(path, header).attach(app)
             d = _Driver(app, mouse, game_camera(), shots)

@@ -50,7 +50,7 @@ def _is_replay(app: App) -> bool:
 
 def install(app: App) -> None:
     """The Tasbada plugin: puppets, the quest resources and rules, the photo, saved progress."""
-    install_puppets(app)
+    app.add_plugin(install_puppets)
     world = app.world
     replay = _is_replay(app)
     q = Quest()

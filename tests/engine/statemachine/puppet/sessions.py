@@ -32,7 +32,7 @@ from input.hub import InputHub
 from input.motionstick import StickConfig
 from input.mouse import MouseSource
 from input.mousebot import MouseBot
-from input.plugin import install_input
+from input.plugin import input_plugin
 from input.recording import Recorder, RecordingHeader
 from input.sample import PoseSample
 from input.source import PoseSource
@@ -64,8 +64,8 @@ SCENES: dict[str, Callable[[App], None]] = {"empty": lambda app: None, "small_ba
 def make_app(scene: str, hub: InputHub, seed: int = SEED) -> App:
     """The sandbox (input plugin, then the game) plus the scene's props — as ``games.make_app`` builds it."""
     app = App(seed=seed)
-    install_input(app, hub)
-    GAME.install(app)
+    app.add_plugin(input_plugin(hub))
+    app.add_plugin(GAME.install)
     SCENES[scene](app)
     app.world.flush()
     return app
