@@ -20,28 +20,84 @@ applied (``World.flush``) between stages:
                       track the animated pose; animated and simulated poses blend.
 7. ``fk``           — world transforms for every joint, batched over puppets.
 8. ``rules``        — game rules: snowball growth, snowman assembly, quest milestones.
-9. ``hash``         — observers of the finished step (the recorder writes the frame
-                      and ``state_hash``).
+9. ``hash``         — systems that observe the finished step before the frame counter
+                      moves on (a game's save of its progress, say).
+
+After the last stage ``world.frame`` is incremented, then the ``on_step_end``
+callbacks run: the recorder (:meth:`input.recording.Recorder.attach`) writes the
+step's ``InputFrame`` and its ``state_hash`` there, so a recorded hash covers the
+whole step including the new frame number.
 
 Rendering is not a stage: it runs as often as the window allows, reads the last two
 simulated states and interpolates between them with the clock's ``alpha``; it never
-writes simulation state. Plugins are plain callables ``install(app)`` that add
-resources and systems (STYLE: a feature is a plugin).
+writes simulation state.
+
+Plugins
+=======
+A plugin is a callable ``install(app)`` that adds resources and systems (STYLE: a
+feature is a plugin). A plugin that needs another one asks for it with
+:meth:`App.add_plugin`, never by calling it: each plugin is installed once, known by
+its name (:func:`plugin_name`), so plugins nest and a system is never registered
+twice. A plugin that takes parameters is wrapped with :func:`configured`; its name
+is its install function's, so a dependency on the bare function is met by any
+configuration of it, while two different configurations of one plugin conflict.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any
 
 from engine.clock import FixedStepClock
 from engine.ecs import World
 
-__all__ = ["App", "Plugin", "System", "STAGES"]
+__all__ = ["App", "Configured", "Plugin", "System", "STAGES", "configured", "plugin_name", "system_name"]
 
 STAGES: tuple[str, ...] = ("input", "stick", "statemachine", "animation", "ik", "physics", "fk", "rules", "hash")
 
 System = Callable[[World], None]
 Plugin = Callable[["App"], None]
+
+
+def _qualified(obj: Any) -> str:
+    return f"{getattr(obj, '__module__', type(obj).__module__)}.{getattr(obj, '__qualname__', type(obj).__qualname__)}"
+
+
+def plugin_name(plugin: Plugin) -> str:
+    """A plugin's identity: its ``name`` if it has one (:class:`Configured`), else its qualified name."""
+    name = getattr(plugin, "name", None)
+    return name if isinstance(name, str) else _qualified(plugin)
+
+
+def system_name(system: System) -> str:
+    """A system's qualified name (``module.function``), as ``puppetphone schedule`` prints it."""
+    return _qualified(system)
+
+
+@dataclass(frozen=True)
+class Configured:
+    """A plugin with parameters: calls ``install(app, **params)``.
+
+    Its name is ``install``'s, so a plugin that only needs the feature (asks for the
+    bare function) is satisfied by whichever configuration came first.
+    """
+
+    install: Callable[..., None]
+    params: tuple[tuple[str, Any], ...]
+
+    @property
+    def name(self) -> str:
+        """The install function's qualified name."""
+        return _qualified(self.install)
+
+    def __call__(self, app: App) -> None:
+        self.install(app, **dict(self.params))
+
+
+def configured(install: Callable[..., None], **params: Any) -> Configured:
+    """``install`` bound to keyword parameters, as a plugin (``configured(install_physics, substeps=4)``)."""
+    return Configured(install, tuple(sorted(params.items())))
 
 
 class App:
@@ -58,24 +114,42 @@ class App:
         self.clock = FixedStepClock(dt=dt)
         self.world.insert_resource(self.clock)
         self._systems: dict[str, list[System]] = {s: [] for s in STAGES}
-        self._installed: list[str] = []
+        self._installed: dict[str, Plugin] = {}
         self.on_step_end: list[Callable[[World], None]] = []
         for plugin in plugins:
             self.add_plugin(plugin)
 
     def add_plugin(self, plugin: Plugin) -> App:
-        """Install a plugin once (a second install of the same one is ignored)."""
-        name = f"{plugin.__module__}.{getattr(plugin, '__qualname__', repr(plugin))}"
-        if name not in self._installed:
-            self._installed.append(name)
+        """Install a plugin unless one of that name is installed (or being installed).
+
+        Plugins nest: an install may call ``app.add_plugin`` for what it depends on.
+        Asking again for an installed plugin, or for the bare function of an installed
+        :class:`Configured` one, does nothing.
+
+        Raises:
+            ValueError: a :class:`Configured` plugin whose name is installed with other parameters.
+        """
+        name = plugin_name(plugin)
+        installed = self._installed.get(name)
+        if installed is None:
+            self._installed[name] = plugin  # before installing, so a cycle stops here
             plugin(self)
             self.world.flush()
+        elif isinstance(plugin, Configured) and plugin != installed:
+            raise ValueError(f"plugin {name} is already installed as {installed!r}, not {plugin!r}")
         return self
 
     def add_system(self, stage: str, system: System, *, before: System | None = None) -> App:
-        """Register a system in a named stage (optionally ahead of another one there)."""
+        """Register a system in a named stage (optionally ahead of another one there).
+
+        Raises:
+            ValueError: an unknown stage, or a system already in the schedule (it would run twice a step).
+        """
         if stage not in self._systems:
             raise ValueError(f"unknown stage {stage!r}; stages are {', '.join(STAGES)}")
+        for other, registered in self._systems.items():
+            if system in registered:
+                raise ValueError(f"system {system_name(system)} is already in stage {other!r}")
         systems = self._systems[stage]
         if before is not None and before in systems:
             systems.insert(systems.index(before), system)
@@ -89,7 +163,7 @@ class App:
 
     @property
     def plugins(self) -> list[str]:
-        """Installed plugin names, in install order."""
+        """Installed plugin names, in the order their installs began (a plugin before its dependencies)."""
         return list(self._installed)
 
     def step(self) -> None:

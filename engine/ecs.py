@@ -124,6 +124,10 @@ class World:
         types = sorted(self._entities.get(entity, ()), key=lambda t: (t.__module__, t.__qualname__))
         return [self._components[t][entity] for t in types]
 
+    def component_types(self) -> list[type]:
+        """The component types at least one entity has, ordered by type name (stable for hashing)."""
+        return sorted((t for t, store in self._components.items() if store), key=lambda t: (t.__module__, t.__qualname__))
+
     # -- queries ----------------------------------------------------------------------
     @overload
     def query(self, a: type[A], /) -> list[tuple[Entity, A]]: ...

@@ -1,10 +1,21 @@
 """``state_hash(world)``: one digest over the whole simulation state, for replays.
 
-What is hashed: the frame number, the RNG state, every component of every entity
-(in entity-id order, components by type name), and the resources that declare
-``SIM_STATE = True``. Components that are only for display declare
-``SIM_STATE = False`` and are skipped. An object with a ``state_bytes()`` method
-(the physics world, say) supplies its own bytes.
+What is hashed: the frame number, the RNG state, the live entity ids, every
+component of every entity, and the resources that declare ``SIM_STATE = True``.
+Component types that are only for display declare ``SIM_STATE = False`` (a class
+attribute) and are skipped, as are dataclass fields with ``metadata={"hash": False}``.
+An object with a ``state_bytes()`` method (the physics world, say) supplies its own
+bytes.
+
+Components are hashed as packed columns, not one by one: per component type (by
+type name), the ids of the entities that have it, then each field gathered across
+those entities in entity-id order into one array — every ``position`` of every
+``Transform`` stacked into one ``[N, 3]`` block — and fed to the digest in one
+update. A recorded step of 100 puppets hashes in a fraction of a millisecond
+instead of the ~15 ms a field-by-field walk in Python took (``puppetphone bench
+state-hash``). A column whose values are not all of one packable kind (floats,
+ints, bools, strings, ``None``, arrays of one dtype and shape) falls back to
+:func:`feed`, value by value, into one buffer.
 
 Floats are hashed by their exact bits: a replay on the same machine and library
 versions must agree to the last bit, and a hash that rounded would hide the
@@ -15,8 +26,11 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import functools
 import hashlib
+import operator
 import struct
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -24,6 +38,20 @@ import numpy as np
 from engine.ecs import World
 
 __all__ = ["state_hash", "feed"]
+
+_COUNT = struct.Struct("<q")
+
+
+class _Buffer:
+    """A hashlib-like sink that collects bytes, so a column of mixed values is one digest update."""
+
+    __slots__ = ("data",)
+
+    def __init__(self) -> None:
+        self.data = bytearray()
+
+    def update(self, data: bytes) -> None:
+        self.data += data
 
 
 def feed(h: Any, value: Any) -> None:
@@ -71,16 +99,106 @@ def feed(h: Any, value: Any) -> None:
         raise TypeError(f"cannot hash {type(value).__name__}: make it a dataclass or give it state_bytes()")
 
 
+def _lengths(values: list[Any]) -> bytes:
+    return np.array([len(v) for v in values], dtype=np.int64).tobytes()
+
+
+def _column(values: list[Any]) -> bytes:
+    """The bytes of one column: packed when every value is of one kind, else value by value.
+
+    The number of values is known to the reader (the entity ids, or the lengths of
+    the enclosing lists), so every encoding below is self-delimiting. Lists, tuples,
+    dicts and dataclasses are packed recursively: the lengths, then their flattened
+    items as one column (every trace entry of every brain is one column per field).
+    """
+    if not values:
+        return b""
+    first = values[0]
+    kind = type(first)
+    if len(set(map(type, values))) > 1:
+        if any(v is None for v in values):
+            present = [v for v in values if v is not None]
+            mask = np.array([v is not None for v in values], dtype=np.bool_)
+            return b"?" + mask.tobytes() + _column(present)
+        return _fed(values)
+    if kind is float:
+        return b"f" + np.array(values, dtype=np.float64).tobytes()
+    if kind is bool:
+        return b"b" + np.array(values, dtype=np.bool_).tobytes()
+    if kind is int:
+        try:
+            return b"i" + np.array(values, dtype=np.int64).tobytes()
+        except OverflowError:
+            return _fed(values)
+    if kind is str:
+        encoded = [v.encode() for v in values]
+        return b"s" + _lengths(encoded) + b"".join(encoded)
+    if first is None:
+        return b"N"
+    if kind is np.ndarray and first.dtype != object:
+        dtype, shape = first.dtype, first.shape
+        if all(v.dtype == dtype and v.shape == shape for v in values):
+            return b"a" + dtype.str.encode() + str(shape).encode() + b"".join([v.tobytes() for v in values])
+        return _fed(values)
+    if kind is list or kind is tuple:
+        return b"L" + _lengths(values) + _column([item for v in values for item in v])
+    if kind is dict:
+        keys = [sorted(v, key=repr) for v in values]
+        return (b"M" + _lengths(values) + _column([k for ks in keys for k in ks])
+                + _column([v[k] for v, ks in zip(values, keys) for k in ks]))
+    if issubclass(kind, enum.Enum):
+        return b"E" + _column([str(v.value) for v in values])
+    if dataclasses.is_dataclass(kind) and not hasattr(kind, "state_bytes"):
+        return b"D" + kind.__qualname__.encode() + b"\0" + b"".join(
+            _column([getattr(v, f.name) for v in values]) for f in dataclasses.fields(kind) if f.metadata.get("hash", True))
+    return _fed(values)
+
+
+def _fed(values: list[Any]) -> bytes:
+    """The fallback: :func:`feed` value by value (mixed kinds, sets, objects with ``state_bytes``)."""
+    buf = _Buffer()
+    buf.update(b"F")
+    for v in values:
+        feed(buf, v)
+    return bytes(buf.data)
+
+
+@functools.cache
+def _hashed_fields(ctype: type) -> Callable[[Any], tuple[Any, ...]] | None:
+    """For a dataclass component type: a getter of its hashed fields as a tuple (one C call per
+    component, transposed into columns by ``zip``); ``None`` for other types (hashed whole)."""
+    if not dataclasses.is_dataclass(ctype) or hasattr(ctype, "state_bytes"):
+        return None
+    names = [f.name for f in dataclasses.fields(ctype) if f.metadata.get("hash", True)]
+    if len(names) == 1:
+        name = names[0]
+        return lambda c: (getattr(c, name),)
+    return operator.attrgetter(*names) if names else (lambda c: ())
+
+
+def _feed_components(h: Any, ctype: type, rows: list[tuple[Any, ...]]) -> None:
+    """One component type: its name, the entity ids that have it, then its fields as columns."""
+    ids = np.array([row[0] for row in rows], dtype=np.int64)
+    h.update(b"C" + f"{ctype.__module__}.{ctype.__qualname__}".encode() + b"\0" + _COUNT.pack(len(ids)) + ids.tobytes())
+    comps = [row[1] for row in rows]
+    getter = _hashed_fields(ctype)
+    if getter is None:
+        h.update(_column(comps))
+    else:
+        for column in zip(*map(getter, comps)):
+            h.update(_column(list(column)))
+
+
 def state_hash(world: World) -> str:
     """Hex digest (BLAKE2b, 16 bytes) of the world's simulation state."""
     h = hashlib.blake2b(digest_size=16)
     feed(h, world.frame)
     feed(h, world.rng.bit_generator.state)
-    for e in world.entities():
-        feed(h, e)
-        for comp in world.components_of(e):
-            if getattr(comp, "SIM_STATE", True):
-                feed(h, comp)
+    entities = world.entities()
+    h.update(b"e" + _COUNT.pack(len(entities)) + np.array(entities, dtype=np.int64).tobytes())
+    for ctype in world.component_types():
+        if getattr(ctype, "SIM_STATE", True):
+            _feed_components(h, ctype, world.query(ctype))
     for res in world.resources():
         if getattr(res, "SIM_STATE", False):
             feed(h, res)

@@ -49,7 +49,7 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
 
 def install(app: App) -> None:
     """One puppet at the origin facing the camera side (+Z), and the scene's prop."""
-    install_puppets(app)
+    app.add_plugin(install_puppets)
     spawn_puppet(app.world, (0.0, 0.0, 0.0), 0.0, extra=(Appearance(color=(0.85, 0.35, 0.25)),))
     setup = app.world.try_resource(GameSetup)
     SCENES[setup.get("scene", "empty") if setup is not None else "empty"](app.world)

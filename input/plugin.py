@@ -5,7 +5,7 @@ Usage::
     hub = InputHub([OscSource(port=9000)]).start()
     app = App(seed=1, plugins=[engine_plugins..., input_plugin(hub)])
 
-or ``install_input(app, hub)`` directly. It inserts the :class:`InputFrame`
+or ``app.add_plugin(input_plugin(hub))``. It inserts the :class:`InputFrame`
 resource (hashed: it is what recordings store), a :class:`StickConfig`, and one
 controller entity per stick (``sticks`` bindings, default one stick bound to the
 first source that speaks).
@@ -13,9 +13,9 @@ first source that speaks).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
-from engine.app import App
+from engine.app import App, Configured, configured
 from engine.ecs import World
 from input.hub import InputHub
 from input.motionstick import StickConfig, motionstick_system, spawn_stick
@@ -51,11 +51,9 @@ def install_input(app: App, hub: InputHub, sticks: Sequence[str] = ("*",),
     app.add_system("stick", motionstick_system)
 
 
-def input_plugin(hub: InputHub, sticks: Sequence[str] = ("*",), config: StickConfig | None = None) -> Callable[[App], None]:
-    """``install_input`` as a plugin callable for ``App(plugins=[...])``."""
+def input_plugin(hub: InputHub, sticks: Sequence[str] = ("*",), config: StickConfig | None = None) -> Configured:
+    """``install_input`` bound to its hub, as a plugin for ``App(plugins=[...])`` or ``app.add_plugin``.
 
-    def install(app: App) -> None:
-        install_input(app, hub, sticks, config)
-
-    install.__qualname__ = "input_plugin"
-    return install
+    Its name is ``input.plugin.install_input``: an app has one input hub.
+    """
+    return configured(install_input, hub=hub, sticks=tuple(sticks), config=config)

@@ -22,6 +22,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "bench": ("puppetphone.cmd_bench", "run benchmarks and print figures against baselines"),
     "blendspace": ("puppetphone.cmd_blendspace", "inspect the puppet's blend space and IDW lookup"),
     "regen": ("puppetphone.cmd_regen", "developers: regenerate shipped recordings, screenshots and assets"),
+    "schedule": ("puppetphone.cmd_schedule", "print a game's frame schedule: stages, systems, plugins"),
 }
 
 

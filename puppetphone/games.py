@@ -14,7 +14,7 @@ from typing import Any
 from engine.app import App
 from games.base import Game, GameSetup
 from input.hub import InputHub
-from input.plugin import install_input
+from input.plugin import input_plugin
 
 __all__ = ["GAMES", "load_game", "make_app"]
 
@@ -42,6 +42,6 @@ def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None =
     g = load_game(game)
     app = App(seed=seed)
     app.world.insert_resource(GameSetup(setup))
-    install_input(app, hub)
-    g.install(app)
+    app.add_plugin(input_plugin(hub))
+    app.add_plugin(g.install)
     return app

@@ -32,7 +32,7 @@ from tools import REPO
 from tools.snowman_demo import DEMO_PATH
 from games.snowman.game import GAME
 from input.hub import InputHub
-from input.plugin import install_input
+from input.plugin import input_plugin
 from input.recording import read_recording
 from input.replay import ReplaySource
 
@@ -98,8 +98,8 @@ def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> li
     out.mkdir(parents=True, exist_ok=True)
     rec = read_recording(DEMO_PATH)
     app = App(seed=rec.header.seed)
-    install_input(app, InputHub(replay=ReplaySource(rec)))
-    GAME.install(app)
+    app.add_plugin(input_plugin(InputHub(replay=ReplaySource(rec))))
+    app.add_plugin(GAME.install)
     target = make_target(True, width, height)
     renderer = Renderer(target.ctx)
     seen: dict[str, int] = {}

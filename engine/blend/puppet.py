@@ -85,7 +85,7 @@ def height_mapping(table: LookupTable, low: float, high: float) -> LinearMapping
 
 def install_puppet_locomotion(app: App) -> None:
     """Plugin: :func:`install_blend` plus the default puppet's set under ``"humanoid"``."""
-    install_blend(app)
+    app.add_plugin(install_blend)
     library = app.world.resource(BlendLibrary)
     if "humanoid" not in library:
         library.add("humanoid", puppet_locomotion())

@@ -92,12 +92,15 @@ def physics_step(world: World) -> None:
 
 
 def install_physics(app: App, timestep: float | None = None, substeps: int = 8) -> None:
-    """Plugin: the :class:`PhysicsWorld` resource and :func:`physics_step` in the physics stage."""
+    """Plugin: the :class:`PhysicsWorld` resource and :func:`physics_step` in the physics stage.
+
+    Other than the defaults, install it as ``app.add_plugin(configured(install_physics, substeps=4))``
+    (:func:`engine.app.configured`) before anything that depends on it.
+    """
     if app.world.try_resource(PhysicsWorld) is None:
         step = app.world.dt / substeps if timestep is None else timestep
         app.world.insert_resource(PhysicsWorld(timestep=step, substeps=substeps))
-    if physics_step not in app.systems("physics"):
-        app.add_system("physics", physics_step)
+    app.add_system("physics", physics_step)
 
 
 def spawn_snowball(world: World, position: ArrayLike, radius: float = 0.15, mass: float | None = None,

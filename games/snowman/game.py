@@ -39,14 +39,14 @@ CONTROLS = (
 
 def install(app: App) -> None:
     """The field, the first puppet, the snow and the rules."""
-    install_puppets(app)
+    app.add_plugin(install_puppets)
     world = app.world
     world.insert_resource(SnowField(size=24.0, cell=0.15, initial_depth=0.12))
     world.insert_resource(SnowmanStats())
     world.insert_resource(StackWatch())
     build_scenery(world)
     spawn_first_puppet(world)
-    install_field_slot(app)
+    app.add_plugin(install_field_slot)
     app.add_system("rules", field_commands)
     app.add_system("rules", aim_putdown_on_stacks)
     app.add_system("rules", stick_stacked_balls)

@@ -92,7 +92,7 @@ def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
 
 def install(app: App) -> None:
     """The Tasbada plugin: puppets, the quest (with the saved progress) and its rules, the photo."""
-    install_puppets(app)
+    app.add_plugin(install_puppets)
     world = app.world
     setup = world.try_resource(GameSetup) or GameSetup()
     q = Quest()

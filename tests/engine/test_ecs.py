@@ -100,3 +100,11 @@ def test_plugin_installed_once():
     app = App(plugins=[plugin])
     app.add_plugin(plugin)
     assert calls == [1]
+
+
+def test_component_types_are_the_ones_in_use_by_name():
+    w = World()
+    e = w.spawn(Vel(1), Pos(2))
+    assert w.component_types() == [Pos, Vel]
+    w.remove(e, Pos)
+    assert w.component_types() == [Vel]

@@ -4,7 +4,7 @@ from engine.app import App
 from games.sandbox import GAME
 from input.hub import InputHub
 from input.osc import OscSource
-from input.plugin import install_input
+from input.plugin import input_plugin
 from puppetphone.overlay import overlay_lines
 
 
@@ -13,8 +13,8 @@ def test_overlay_shows_state_and_pairing_until_a_packet_arrives():
     hub = InputHub([osc])
     try:
         app = App(seed=0)
-        install_input(app, hub)
-        GAME.install(app)
+        app.add_plugin(input_plugin(hub))
+        app.add_plugin(GAME.install)
         app.step()
         lines = overlay_lines(app.world, GAME, hub, 60.0, False)
         assert any("Locomotion" in line for line in lines)

@@ -63,11 +63,11 @@ def install_puppets(app: App) -> None:
         world.insert_resource(PuppetMachine())
     app.add_system("statemachine", held_props_system)
     app.add_system("statemachine", brain_system)
-    install_puppet_locomotion(app)
+    app.add_plugin(install_puppet_locomotion)
     app.add_system("animation", apply_pose_overrides)
-    install_ik(app)
-    install_physics(app)
-    install_fk(app)
+    app.add_plugin(install_ik)
+    app.add_plugin(install_physics)
+    app.add_plugin(install_fk)
 
 
 def spawn_puppet(
