@@ -13,7 +13,8 @@ stacked lines abut into one block.
 
 Never off the edge: :func:`layout_text` wraps each line at spaces to the room left
 between its start and the window's right margin (a word too long for a line is broken
-inside), and keeps centred lines (``TextLine.anchor``) inside the window.
+inside), leaves out what would fall below the bottom margin, and keeps centred lines
+(``TextLine.anchor``) inside the window.
 """
 
 from __future__ import annotations
@@ -57,9 +58,13 @@ class PlacedText:
 
 
 class TextCache:
-    """Textures for overlay strings, least-recently-used eviction past ``capacity``."""
+    """Textures for overlay strings, least-recently-used eviction past ``capacity``.
 
-    def __init__(self, ctx: moderngl.Context, capacity: int = 256) -> None:
+    Measuring and wrapping need only the font, so a cache made with ``ctx=None``
+    serves layout (and its tests) without a GL context.
+    """
+
+    def __init__(self, ctx: moderngl.Context | None, capacity: int = 256) -> None:
         import pygame.font
 
         if not pygame.font.get_init():
@@ -148,6 +153,8 @@ class TextCache:
         if tex is not None:
             self._tex.move_to_end(key)
             return tex
+        if self.ctx is None:
+            raise RuntimeError("this TextCache has no GL context: it can measure and wrap, not make textures")
         import pygame
 
         glyphs = self._font(size).render(text or " ", True, rgb)
@@ -175,8 +182,9 @@ def layout_text(lines: Sequence[TextLine], viewport: tuple[int, int], cache: Tex
     """Where every piece of every line goes in a ``viewport`` of (width, height) pixels.
 
     Lines without ``x``/``y`` stack down the left margin; a positioned line wraps
-    below its own position; an anchored line is centred on its anchor and shifted
-    inside the window if it would cross an edge.
+    below its own position; pieces of either that would cross the bottom edge are
+    left out. An anchored line is centred on its anchor and shifted inside the window
+    if it would cross an edge.
     """
     width, height = viewport
     cursor = float(MARGIN)
@@ -195,8 +203,10 @@ def layout_text(lines: Sequence[TextLine], viewport: tuple[int, int], cache: Tex
         x = float(MARGIN) if line.x is None else float(line.x)
         y = cursor if line.y is None else float(line.y)
         for piece in cache.wrap(line.text, line.size, int(max(width - MARGIN - x, line.size))):
-            placed.append(PlacedText(piece, x, y, line.size, line.color, line.alpha))
-            y += cache.measure(piece, line.size)[1]
+            h = cache.measure(piece, line.size)[1]
+            if y + h <= height - MARGIN:  # a piece that would cross the bottom edge is left out
+                placed.append(PlacedText(piece, x, y, line.size, line.color, line.alpha))
+            y += h
         if line.y is None:
             cursor = y
     return placed
