@@ -1,6 +1,8 @@
-"""Drawing and setup shared by the games: puppets, props, the stick, focus outlines."""
+"""Drawing and setup shared by the games: puppets, props, the stick, focus outlines, notices."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -12,7 +14,38 @@ from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
-__all__ = ["draw_world", "draw_sticks"]
+__all__ = ["draw_world", "draw_sticks", "Notice", "post_notice", "NOTICE_SECONDS"]
+
+NOTICE_SECONDS = 2.0
+"""How long a notice stays on screen (the last quarter of it fading out)."""
+
+
+@dataclass
+class Notice:
+    """Resource: a short message for the player ("field saved"), and the frame it was posted.
+
+    Display only, like a toast: not simulation state, so it is not hashed
+    (``SIM_STATE = False``) and a replay that shows it or not verifies the same. Its
+    age is counted in simulation frames, not wall time, so a paused game keeps it up
+    and a replay shows it for as long as the live game did.
+    """
+
+    text: str
+    frame: int
+    SIM_STATE = False
+
+    def opacity(self, frame: int, dt: float) -> float:
+        """1 while fresh, fading to 0 over the last quarter of :data:`NOTICE_SECONDS`; 0 once expired."""
+        shown = NOTICE_SECONDS / dt
+        left = shown - (frame - self.frame)
+        if frame < self.frame or left <= 0:
+            return 0.0
+        return float(min(1.0, left / (0.25 * shown)))
+
+
+def post_notice(world: World, text: str) -> None:
+    """Show ``text`` to the player from this frame on (a newer notice replaces an older one)."""
+    world.insert_resource(Notice(text, world.frame))
 
 
 def draw_sticks(world: World, scene: RenderScene) -> None:

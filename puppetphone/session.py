@@ -9,9 +9,10 @@ Two ways to run:
   are paced to real time so a phone can drive it; with a replay or no source it
   runs as fast as it can. Only the last frame is rendered, for ``--screenshot``.
 
-Keys (windowed): Esc quits, P pauses, ``.`` single-steps while paused; R resets the
-game, F5 saves and F9 restores it (games that keep a field: snowman). The last three
-go through the hub as recorded input events, so replays repeat them.
+Keys (windowed): Esc quits, P pauses, ``.`` single-steps while paused, H or F1 hides
+and shows the help; R resets the game, F5 saves and F9 restores it (games that keep a
+field: snowman). The last three go through the hub as recorded input events, so
+replays repeat them.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from games.base import Game
 from input.hub import InputHub
 from input.recording import Recorder, RecordingHeader
 from input.sample import RESET, RESTORE, SAVE
-from puppetphone.overlay import draw_overlay
+from puppetphone.overlay import OverlayState, draw_overlay
 from puppetphone.games import load_game, make_app
 
 __all__ = ["SessionOptions", "Session"]
@@ -60,6 +61,7 @@ class Session:
         self.app: App = make_app(options.game, options.seed, hub)
         self.camera: OrbitCamera = self.game.camera()
         self.scene = RenderScene()
+        self.overlay = OverlayState()
         self.recorder: Recorder | None = None
         if options.record is not None:
             header = RecordingHeader(game=options.game, seed=options.seed, dt=self.app.world.dt, sources=[options.source_label],
@@ -85,7 +87,7 @@ class Session:
         self.scene.clear()
         alpha = self.app.clock.alpha
         self.game.draw(self.app.world, self.scene, alpha)
-        draw_overlay(self.scene, self.app.world, self.game, self.hub, self.fps, self.app.clock.paused)
+        draw_overlay(self.scene, self.app.world, self.game, self.hub, self.fps, self.app.clock.paused, self.overlay)
         fb = self._target.begin()
         self._renderer.render(self.scene, self.camera, fb)
         self._target.end()
@@ -161,6 +163,8 @@ class Session:
             clock.resume() if clock.paused else clock.pause()
         elif key == pygame.K_PERIOD:
             clock.request_step()
+        elif key in (pygame.K_h, pygame.K_F1):
+            self.overlay.toggle_help()
         elif key in commands:
             self.hub.command(commands[key])
 
