@@ -5,8 +5,8 @@ Only reads the world; drawn as text lines into the render scene, light on the da
 panels the text renderer puts behind them (readable on snow and sky). The help is
 the game's ``controls``: shown at the start, hidden and shown again by
 :meth:`OverlayState.toggle_help` (H / F1 in the window). A notice a game posts
-(:class:`games.common.Notice`) is drawn large in the upper middle of the window and
-fades out after :data:`games.common.NOTICE_SECONDS`.
+(:class:`games.common.Notice`) is drawn large in the lower middle of the window, clear
+of the lines stacked at the top, and fades out after :data:`games.common.NOTICE_SECONDS`.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ _TEXT = (0.96, 0.97, 1.0)
 _HELP = (0.8, 0.88, 1.0)
 _NOTICE = (1.0, 0.86, 0.42)
 _SIZE, _NOTICE_SIZE = 20, 44
-_NOTICE_ANCHOR = (0.5, 0.3)
+_NOTICE_ANCHOR = (0.5, 0.8)
 
 
 @dataclass
