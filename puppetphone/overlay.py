@@ -22,12 +22,11 @@ from games.base import Game
 from games.common import Notice
 from input.hub import InputHub
 
-__all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "HELP_KEYS"]
+__all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "HELP_KEYS", "COLORS"]
 
 HELP_KEYS = "H / F1"
-_TEXT = (0.96, 0.97, 1.0)
-_HELP = (0.8, 0.88, 1.0)
-_NOTICE = (1.0, 0.86, 0.42)
+COLORS = {"text": (0.96, 0.97, 1.0), "help": (0.8, 0.88, 1.0), "notice": (1.0, 0.86, 0.42)}
+"""The overlay's text colours (sRGB), all light: the text renderer puts dark panels behind them."""
 _SIZE, _NOTICE_SIZE = 20, 44
 _NOTICE_ANCHOR = (0.5, 0.8)
 
@@ -67,7 +66,7 @@ def help_lines(game: Game, state: OverlayState) -> list[str]:
     """The game's controls while the help is shown, with how to hide them."""
     if not state.help_visible or not game.controls:
         return []
-    return [*game.controls, f"{HELP_KEYS} hides this help"]
+    return [f"{HELP_KEYS} hides this help:", *game.controls]  # the way out first: a small window cuts the end
 
 
 def notice(world: World) -> tuple[str, float] | None:
@@ -96,9 +95,9 @@ def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fp
     """Add the overlay's lines, the help (if shown) and the notice (if any) to the scene."""
     state = state or OverlayState()
     for line in overlay_lines(world, game, hub, fps, paused, state):
-        scene.add_text(line, size=_SIZE, color=_TEXT)
+        scene.add_text(line, size=_SIZE, color=COLORS["text"])
     for line in help_lines(game, state):
-        scene.add_text(line, size=_SIZE - 2, color=_HELP)
+        scene.add_text(line, size=_SIZE - 2, color=COLORS["help"])
     shown = notice(world)
     if shown is not None:
-        scene.add_text(shown[0], size=_NOTICE_SIZE, color=_NOTICE, anchor=_NOTICE_ANCHOR, alpha=shown[1])
+        scene.add_text(shown[0], size=_NOTICE_SIZE, color=COLORS["notice"], anchor=_NOTICE_ANCHOR, alpha=shown[1])

@@ -1,4 +1,5 @@
-"""Overlay text: wrapped to the window, centred lines kept inside, readable on snow and on sky.
+"""Overlay text: wrapped to the window, centred lines kept inside, readable on snow and on sky
+(the play overlay's own colours, and dark text as a tool might use).
 
 The wrapping tests need only pygame's font; the pixel tests render on the headless EGL
 context (skipped without one) and measure what a reader sees.
@@ -11,6 +12,7 @@ from engine.camera import OrbitCamera
 from engine.render.headless import egl_available
 from engine.render.scene import RenderScene, TextLine
 from engine.render.text import MARGIN, PAD_X, PAD_Y, TextCache, layout_text
+from puppetphone.overlay import COLORS
 
 W, H = 320, 240
 LONG = ("mouse: press on the puppet (or a snowball) to grab it, drag to walk or run it, release to let go; "
@@ -113,7 +115,7 @@ def glyph_masks(text, size):
 
 
 @needs_gl
-@pytest.mark.parametrize("color", [(0.96, 0.97, 1.0), (0.06, 0.08, 0.14), (1.0, 0.85, 0.4)], ids=["light", "dark", "amber"])
+@pytest.mark.parametrize("color", [*COLORS.values(), (0.06, 0.08, 0.14)], ids=[*COLORS, "dark"])
 @pytest.mark.parametrize("where", ["snow", "sky"])
 def test_text_contrast_with_its_surroundings_meets_wcag_aa(gl, color, where):
     text, size = "rolling a snowball  #12  field saved", 20
