@@ -147,7 +147,8 @@ class TextCache:
 
     def texture(self, text: str, size: int, color: tuple[float, float, float]) -> moderngl.Texture:
         """The texture of ``text`` on its panel (size in pixels, sRGB colour in [0,1]); width/height via ``.size``."""
-        rgb = tuple(int(round(255 * min(max(c, 0.0), 1.0))) for c in color)
+        r, g, b = (round(255 * min(max(c, 0.0), 1.0)) for c in color)
+        rgb = (r, g, b)
         key = (text, size, rgb)
         tex = self._tex.get(key)
         if tex is not None:
@@ -160,7 +161,7 @@ class TextCache:
         glyphs = self._font(size).render(text or " ", True, rgb)
         w, h = self.measure(text, size)
         surf = pygame.Surface((max(w, glyphs.get_width() + 2 * PAD_X), h), pygame.SRCALPHA)
-        surf.fill(panel_rgba(rgb))  # type: ignore[arg-type]
+        surf.fill(panel_rgba(rgb))
         surf.blit(glyphs, (PAD_X, PAD_Y))
         tex = self.ctx.texture(surf.get_size(), 4, pygame.image.tobytes(surf, "RGBA"))
         tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -182,9 +183,9 @@ def layout_text(lines: Sequence[TextLine], viewport: tuple[int, int], cache: Tex
     """Where every piece of every line goes in a ``viewport`` of (width, height) pixels.
 
     Lines without ``x``/``y`` stack down the left margin; a positioned line wraps
-    below its own position; pieces of either that would cross the bottom edge are
-    left out. An anchored line is centred on its anchor and shifted inside the window
-    if it would cross an edge.
+    below its own position. An anchored line is centred on its anchor and shifted
+    inside the window if it would cross an edge. Pieces that would still cross the
+    bottom edge (more text than the window has room for) are left out.
     """
     width, height = viewport
     cursor = float(MARGIN)
@@ -197,7 +198,8 @@ def layout_text(lines: Sequence[TextLine], viewport: tuple[int, int], cache: Tex
             y = min(max(line.anchor[1] * height - total / 2, MARGIN), max(height - MARGIN - total, MARGIN))
             for piece, (w, h) in zip(pieces, sizes, strict=True):
                 x = min(max(line.anchor[0] * width - w / 2, MARGIN), max(width - MARGIN - w, MARGIN))
-                placed.append(PlacedText(piece, x, y, line.size, line.color, line.alpha))
+                if y + h <= height - MARGIN:
+                    placed.append(PlacedText(piece, x, y, line.size, line.color, line.alpha))
                 y += h
             continue
         x = float(MARGIN) if line.x is None else float(line.x)

@@ -51,6 +51,7 @@ def test_layout_stacks_wraps_and_keeps_centred_lines_inside():
     for p in placed:
         w, h = cache.measure(p.text, p.size)
         assert MARGIN <= p.x and p.x + w <= W - MARGIN, p
+        assert MARGIN <= p.y and p.y + h <= H - MARGIN, p
     big = [p for p in placed if p.size == 40]
     assert len(big) > 1 and all(abs(p.x + cache.measure(p.text, 40)[0] / 2 - W / 2) <= 1 for p in big)
     (corner,) = [p for p in placed if p.text == "corner"]
