@@ -14,7 +14,8 @@ from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
-__all__ = ["draw_world", "draw_sticks", "draw_height_cues", "height_cues", "Notice", "post_notice", "NOTICE_SECONDS", "CUE_COLOR"]
+__all__ = ["draw_world", "draw_sticks", "draw_height_cues", "height_cues", "CUE_COLOR",
+           "Notice", "post_notice", "NOTICE_SECONDS"]
 
 NOTICE_SECONDS = 2.0
 """How long a notice stays on screen (the last quarter of it fading out)."""
@@ -114,7 +115,8 @@ def draw_height_cues(world: World, scene: RenderScene, alpha: float) -> None:
         foot = np.array([point[0], surface + 0.01, point[2]])
         scene.add_line(point, foot, CUE_COLOR, width=3.0)
         r = 0.6 * radius
-        scene.add_polyline(foot + np.c_[r * np.cos(_RING), np.zeros_like(_RING), r * np.sin(_RING)], CUE_COLOR, width=3.0)
+        ring = foot + np.c_[r * np.cos(_RING), np.zeros_like(_RING), r * np.sin(_RING)]
+        scene.add_polyline(ring, CUE_COLOR, width=3.0)
         scene.add_points(foot[None], size=0.08, color=CUE_COLOR)
 
 

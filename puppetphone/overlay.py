@@ -47,7 +47,8 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
     """The overlay's text, top to bottom (the notice apart: see :func:`draw_overlay`)."""
     state = state or OverlayState()
     hint = f"   {HELP_KEYS}: help" if game.controls and not state.help_visible else ""
-    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}" + ("   PAUSED" if paused else "") + hint]
+    pause = "   PAUSED" if paused else ""
+    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}{pause}{hint}"]
     lines += game.status(world)
     for e, brain in world.query(Brain):
         name = world.try_get(e, Name)

@@ -245,8 +245,8 @@ class RenderScene:
             raise ValueError(f"text alpha must be in [0, 1], got {alpha}")
         if anchor is not None:
             anchor = (float(anchor[0]), float(anchor[1]))
-        self.texts.append(TextLine(text, x, y, int(size), tuple(float(c) for c in color), anchor,  # type: ignore[arg-type]
-                                   float(alpha)))
+        rgb = (float(color[0]), float(color[1]), float(color[2]))
+        self.texts.append(TextLine(text, x, y, int(size), rgb, anchor, float(alpha)))
 
     def set_background(self, image: ArrayLike | None, fade: float | None = None) -> None:
         """Set (or with ``None`` remove) the ``[H,W,3]`` uint8 background photo and optionally its fade."""
