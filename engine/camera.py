@@ -148,6 +148,12 @@ class OrbitCamera(Camera):
     towards -Z, i.e. facing a puppet in its rest pose. ``pitch`` (radians) raises the
     eye above the target and is clamped to ``[pitch_min, pitch_max]`` so the view
     never flips over the pole.
+
+    The eye also stays at least ``clearance`` above ``ground`` (``None``: no floor), so
+    orbiting low never puts the camera under the snow looking up through the ground
+    plane: the pitch in use is never lower than the one that puts the eye there, and a
+    pan cannot sink the target below the floor. :attr:`eye` and :attr:`rotation` apply
+    the floor even when ``target`` or ``distance`` are assigned directly.
     """
 
     target: F = field(default_factory=lambda: np.array([0.0, 0.9, 0.0]))
@@ -158,41 +164,68 @@ class OrbitCamera(Camera):
     pitch_max: float = 1.5
     distance_min: float = 0.3
     distance_max: float = 150.0
+    ground: float | None = 0.0
+    clearance: float = 0.1
 
     def __post_init__(self) -> None:
         self.target = np.asarray(self.target, dtype=np.float64).reshape(3).copy()
         self.pitch = float(np.clip(self.pitch, self.pitch_min, self.pitch_max))
         self.distance = float(np.clip(self.distance, self.distance_min, self.distance_max))
+        self._keep_above_ground()
+
+    @property
+    def floor_pitch(self) -> float:
+        """The lowest pitch that keeps the eye ``clearance`` above ``ground`` (``-pi/2`` without a floor)."""
+        if self.ground is None:
+            return -math.pi / 2
+        s = (self.ground + self.clearance - float(self.target[1])) / self.distance
+        return math.asin(min(max(s, -1.0), 1.0))
+
+    @property
+    def effective_pitch(self) -> float:
+        """The pitch the view uses: ``pitch``, raised to :attr:`floor_pitch` if it is lower."""
+        return max(self.pitch, self.floor_pitch)
 
     @property
     def eye(self) -> F:
-        cp = math.cos(self.pitch)
-        offset = np.array([cp * math.sin(self.yaw), math.sin(self.pitch), cp * math.cos(self.yaw)])
+        pitch = self.effective_pitch
+        cp = math.cos(pitch)
+        offset = np.array([cp * math.sin(self.yaw), math.sin(pitch), cp * math.cos(self.yaw)])
         return self.target + self.distance * offset
 
     @property
     def rotation(self) -> F:
-        back = np.array([math.cos(self.pitch) * math.sin(self.yaw), math.sin(self.pitch),
-                         math.cos(self.pitch) * math.cos(self.yaw)])
+        pitch = self.effective_pitch
+        back = np.array([math.cos(pitch) * math.sin(self.yaw), math.sin(pitch), math.cos(pitch) * math.cos(self.yaw)])
         right = np.array([math.cos(self.yaw), 0.0, -math.sin(self.yaw)])
         up = np.cross(back, right)
         return np.stack([right, up, back], axis=1)
 
+    def _keep_above_ground(self) -> None:
+        """Lift the target onto the floor and the stored pitch to the floor's, so a drag
+        back up answers at once instead of first climbing out of an invisible dead zone."""
+        if self.ground is not None and self.target[1] < self.ground:
+            self.target = np.array([self.target[0], self.ground, self.target[2]])
+        self.pitch = self.effective_pitch
+
     def orbit(self, dyaw: float, dpitch: float) -> None:
-        """Turn the eye around the target by ``dyaw``/``dpitch`` radians (pitch clamped)."""
+        """Turn the eye around the target by ``dyaw``/``dpitch`` radians (pitch clamped, eye above the floor)."""
         self.yaw = float((self.yaw + dyaw + math.pi) % (2.0 * math.pi) - math.pi)
         self.pitch = float(np.clip(self.pitch + dpitch, self.pitch_min, self.pitch_max))
+        self._keep_above_ground()
 
     def zoom(self, factor: float) -> None:
-        """Multiply the distance by ``factor`` (> 1 moves away), clamped."""
+        """Multiply the distance by ``factor`` (> 1 moves away), clamped; the eye stays above the floor."""
         if not factor > 0:
             raise ValueError(f"zoom factor must be positive, got {factor}")
         self.distance = float(np.clip(self.distance * factor, self.distance_min, self.distance_max))
+        self._keep_above_ground()
 
     def pan(self, dx: float, dy: float) -> None:
-        """Move the target by ``dx`` along screen-right and ``dy`` along screen-up (metres)."""
+        """Move the target by ``dx`` along screen-right and ``dy`` along screen-up (metres), never below the floor."""
         r = self.rotation
         self.target = self.target + dx * r[:, 0] + dy * r[:, 1]
+        self._keep_above_ground()
 
 
 @dataclass

@@ -1,10 +1,12 @@
-"""Drawing and setup shared by the games: puppets, props, the stick, focus outlines."""
+"""Drawing and setup shared by the games: puppets, props, the stick, focus outlines, notices."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from engine.components import Stick, Transform
+from engine.components import Puppet, Stick, Transform, WorldPose
 from engine.ecs import World
 from engine.ragdoll.components import Prop
 from engine.render.components import Appearance
@@ -12,7 +14,39 @@ from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
-__all__ = ["draw_world", "draw_sticks"]
+__all__ = ["draw_world", "draw_sticks", "draw_height_cues", "height_cues", "CUE_COLOR",
+           "Notice", "post_notice", "NOTICE_SECONDS"]
+
+NOTICE_SECONDS = 2.0
+"""How long a notice stays on screen (the last quarter of it fading out)."""
+
+
+@dataclass
+class Notice:
+    """Resource: a short message for the player ("field saved"), and the frame it was posted.
+
+    Display only, like a toast: not simulation state, so it is not hashed
+    (``SIM_STATE = False``) and a replay that shows it or not verifies the same. Its
+    age is counted in simulation frames, not wall time, so a paused game keeps it up
+    and a replay shows it for as long as the live game did.
+    """
+
+    text: str
+    frame: int
+    SIM_STATE = False
+
+    def opacity(self, frame: int, dt: float) -> float:
+        """1 while fresh, fading to 0 over the last quarter of :data:`NOTICE_SECONDS`; 0 once expired."""
+        shown = NOTICE_SECONDS / dt
+        left = shown - (frame - self.frame)
+        if frame < self.frame or left <= 0:
+            return 0.0
+        return float(min(1.0, left / (0.25 * shown)))
+
+
+def post_notice(world: World, text: str) -> None:
+    """Show ``text`` to the player from this frame on (a newer notice replaces an older one)."""
+    world.insert_resource(Notice(text, world.frame))
 
 
 def draw_sticks(world: World, scene: RenderScene) -> None:
@@ -26,8 +60,68 @@ def draw_sticks(world: World, scene: RenderScene) -> None:
         scene.add_points(stick.tip[None], size=0.05, color=color)
 
 
+CUE_COLOR = (0.12, 0.16, 0.3)
+_PROP_LIFT = 0.05
+"""A ball whose bottom is this far (metres) above what is under it counts as lifted."""
+_PUPPET_LIFT = 0.2
+"""A puppet whose lowest joint is this high counts as lifted (an ankle stays below it while walking)."""
+_PUPPET_FOOTPRINT = 0.25
+_RING = np.linspace(0.0, 2.0 * np.pi, 33)
+
+
+def _surface_below(x: float, z: float, below: float, props: list[tuple[np.ndarray, float]]) -> float:
+    """Height of the first thing under ``(x, z)`` lower than ``below``: the top of a ball, else the ground (0)."""
+    top = 0.0
+    for centre, radius in props:
+        d2 = (x - centre[0]) ** 2 + (z - centre[2]) ** 2
+        if d2 < radius * radius:
+            h = float(centre[1] + np.sqrt(radius * radius - d2))
+            if h < below + 1e-6:
+                top = max(top, h)
+    return top
+
+
+def height_cues(world: World, alpha: float) -> list[tuple[np.ndarray, float, float]]:
+    """What is lifted: ``(lowest point [3], height of the surface under it, footprint radius)`` each.
+
+    A ball counts when its bottom is clear of whatever is under it (the ground, or the
+    top of another ball: a ball packed onto a stack does not), a puppet when even its
+    lowest joint is off the ground (held up by the stick, in the air).
+    """
+    props = [(tr.position, float(prop.radius)) for _, prop, tr in world.query(Prop, Transform)]
+    cues = []
+    for i, (centre, radius) in enumerate(props):
+        bottom = centre - np.array([0.0, radius, 0.0])
+        surface = _surface_below(bottom[0], bottom[2], bottom[1], props[:i] + props[i + 1:])
+        if bottom[1] - surface > _PROP_LIFT:
+            cues.append((bottom, surface, radius))
+    for _, _puppet, wp in world.query(Puppet, WorldPose):
+        pos, _ = wp.interpolated(alpha)
+        low = float(pos[:, 1].min())
+        if low > _PUPPET_LIFT:
+            point = np.array([pos[0, 0], low, pos[0, 2]])
+            cues.append((point, _surface_below(point[0], point[2], low, props), _PUPPET_FOOTPRINT))
+    return cues
+
+
+def draw_height_cues(world: World, scene: RenderScene, alpha: float) -> None:
+    """Under each lifted thing, a drop line to the surface below and a ring where it would land.
+
+    Without them a ball held in the air over a flat white field gives no clue how
+    high or where it is, and stacking one ball on another by hand is guesswork; the
+    ring lands on the top of a ball beneath when the held one is right above it.
+    """
+    for point, surface, radius in height_cues(world, alpha):
+        foot = np.array([point[0], surface + 0.01, point[2]])
+        scene.add_line(point, foot, CUE_COLOR, width=3.0)
+        r = 0.6 * radius
+        ring = foot + np.c_[r * np.cos(_RING), np.zeros_like(_RING), r * np.sin(_RING)]
+        scene.add_polyline(ring, CUE_COLOR, width=3.0)
+        scene.add_points(foot[None], size=0.08, color=CUE_COLOR)
+
+
 def draw_world(world: World, scene: RenderScene, alpha: float) -> None:
-    """Puppets as capsules, snowballs as spheres, the focused thing outlined, the stick."""
+    """Puppets as capsules, snowballs as spheres, the focused thing outlined, the stick, height cues."""
     focus = {s.focus for _, s in world.query(Stick) if s.focus is not None and s.grabbed is None}
     held = {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None}
     for e, app in world.query(Appearance):
@@ -42,3 +136,4 @@ def draw_world(world: World, scene: RenderScene, alpha: float) -> None:
         if outlined:
             scene.add_spheres(centers[outlined], radii[outlined] * 1.04, color=(1.0, 0.8, 0.2))
     draw_sticks(world, scene)
+    draw_height_cues(world, scene, alpha)

@@ -1,26 +1,58 @@
-"""The on-screen overlay: fps, the game's status, each puppet's state, input sources.
+"""The on-screen overlay: fps, the game's status, what each puppet is doing, input sources,
+the help, and the game's notices ("field saved").
 
-Only reads the world; drawn as text lines into the render scene.
+Only reads the world; drawn as text lines into the render scene, light on the dark
+panels the text renderer puts behind them (readable on snow and sky). The help is
+the game's ``controls``: shown at the start, hidden and shown again by
+:meth:`OverlayState.toggle_help` (H / F1 in the window). A notice a game posts
+(:class:`games.common.Notice`) is drawn large in the lower middle of the window, clear
+of the lines stacked at the top, and fades out after :data:`games.common.NOTICE_SECONDS`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+from engine.components import Name
 from engine.ecs import World
 from engine.render.scene import RenderScene
 from engine.statemachine import Brain
+from engine.statemachine.puppet.words import describe_puppet
 from games.base import Game
+from games.common import Notice
 from input.hub import InputHub
 
-__all__ = ["draw_overlay", "overlay_lines"]
+__all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "HELP_KEYS", "COLORS"]
+
+HELP_KEYS = "H / F1"
+COLORS = {"text": (0.96, 0.97, 1.0), "help": (0.8, 0.88, 1.0), "notice": (1.0, 0.86, 0.42)}
+"""The overlay's text colours (sRGB), all light: the text renderer puts dark panels behind them."""
+_SIZE, _NOTICE_SIZE = 20, 44
+_NOTICE_ANCHOR = (0.5, 0.8)
 
 
-def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: bool) -> list[str]:
-    """The overlay's text, top to bottom."""
-    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}" + ("   PAUSED" if paused else "")]
+@dataclass
+class OverlayState:
+    """What the player chose to see; the window's, not the world's (a replay does not repeat it)."""
+
+    help_visible: bool = True
+
+    def toggle_help(self) -> None:
+        """Hide the help if it is shown, show it if hidden."""
+        self.help_visible = not self.help_visible
+
+
+def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: bool,
+                  state: OverlayState | None = None) -> list[str]:
+    """The overlay's text, top to bottom (the notice apart: see :func:`draw_overlay`)."""
+    state = state or OverlayState()
+    hint = f"   {HELP_KEYS}: help" if game.controls and not state.help_visible else ""
+    pause = "   PAUSED" if paused else ""
+    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}{pause}{hint}"]
     lines += game.status(world)
     for e, brain in world.query(Brain):
-        events = ", ".join(brain.last_events[-3:])
-        lines.append(f"#{e} {brain.active}" + (f"  ({events})" if events else ""))
+        name = world.try_get(e, Name)
+        lines.append(f"{name.value if name is not None else f'#{e}'}: {describe_puppet(world, e, brain)}")
     for src in hub.sources:
         if type(src).__name__ == "OscSource" and not any(st.packets > 0 for st in hub.statuses()):
             lines += _pairing_lines(src)
@@ -29,6 +61,22 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
         err = f"  {st.last_error}" if st.last_error else ""
         lines.append(f"{light} {st.name}: {st.packets_per_s:5.1f} packets/s, dropped {st.dropped}{err}")
     return lines
+
+
+def help_lines(game: Game, state: OverlayState) -> list[str]:
+    """The game's controls while the help is shown, with how to hide them."""
+    if not state.help_visible or not game.controls:
+        return []
+    return [f"{HELP_KEYS} hides this help:", *game.controls]  # the way out first: a small window cuts the end
+
+
+def notice(world: World) -> tuple[str, float] | None:
+    """The game's current notice and its opacity, or ``None`` when there is none to show."""
+    posted = world.try_resource(Notice)
+    if posted is None:
+        return None
+    alpha = posted.opacity(world.frame, world.dt)
+    return (posted.text, alpha) if alpha > 0.0 else None
 
 
 def _pairing_lines(source: object) -> list[str]:
@@ -43,7 +91,14 @@ def _pairing_lines(source: object) -> list[str]:
     return lines
 
 
-def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fps: float, paused: bool) -> None:
-    """Add the overlay's lines to the scene."""
-    for line in overlay_lines(world, game, hub, fps, paused):
-        scene.add_text(line, size=16, color=(0.06, 0.08, 0.14))
+def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fps: float, paused: bool,
+                 state: OverlayState | None = None) -> None:
+    """Add the overlay's lines, the help (if shown) and the notice (if any) to the scene."""
+    state = state or OverlayState()
+    for line in overlay_lines(world, game, hub, fps, paused, state):
+        scene.add_text(line, size=_SIZE, color=COLORS["text"])
+    for line in help_lines(game, state):
+        scene.add_text(line, size=_SIZE - 2, color=COLORS["help"])
+    shown = notice(world)
+    if shown is not None:
+        scene.add_text(shown[0], size=_NOTICE_SIZE, color=COLORS["notice"], anchor=_NOTICE_ANCHOR, alpha=shown[1])

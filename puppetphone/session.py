@@ -3,7 +3,8 @@
 :class:`GameActivity` is what ``play`` and ``replay`` hand to :class:`engine.runner.Runner`:
 one step is ``App.step``; drawing is the game's view plus the overlay; its event layer
 feeds the mouse source, orbits the camera (right-drag) and turns R / F5 / F9 into
-recorded input commands (reset, save, restore), so replays repeat them.
+recorded input commands (reset, save, restore), so replays repeat them; H or F1 hides
+and shows the help.
 
 A replay is the same activity built from a recording's header (game, seed, setup) with
 a replay hub; :class:`HashCheck` compares every step's state hash with the recorded one
@@ -27,7 +28,7 @@ from input.hub import InputHub
 from input.recording import Recorder, Recording, RecordingHeader
 from input.sample import RESET, RESTORE, SAVE
 from puppetphone.games import load_game, make_app
-from puppetphone.overlay import draw_overlay
+from puppetphone.overlay import OverlayState, draw_overlay
 
 __all__ = ["GameActivity", "HashCheck", "build_activity"]
 
@@ -69,6 +70,7 @@ class GameActivity:
     recorder: Recorder | None = None
     check: HashCheck | None = None
     runner: Runner | None = None
+    overlay: OverlayState = field(default_factory=OverlayState)
     _orbiting: bool = field(default=False, repr=False)
 
     @property
@@ -91,7 +93,7 @@ class GameActivity:
         """The game's view and the overlay."""
         self.game.draw(self.app.world, scene, alpha)
         fps = self.runner.fps if self.runner is not None else 0.0
-        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused)
+        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay)
 
     def on_event(self, event: Any, runner: Runner) -> bool:
         """Mouse to the mouse source, right-drag orbits, R / F5 / F9 become recorded commands."""
@@ -100,6 +102,9 @@ class GameActivity:
         commands = {pygame.K_r: RESET, pygame.K_F5: SAVE, pygame.K_F9: RESTORE}
         if event.type == pygame.KEYDOWN and event.key in commands:
             self.hub.command(commands[event.key])
+            return True
+        if event.type == pygame.KEYDOWN and event.key in (pygame.K_h, pygame.K_F1):
+            self.overlay.toggle_help()
             return True
         if event.type == pygame.MOUSEBUTTONDOWN and event.button == 3:
             self._orbiting = True

@@ -39,7 +39,7 @@ from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
-from engine.render.text import TextCache
+from engine.render.text import TextCache, layout_text
 
 __all__ = ["Renderer"]
 
@@ -293,15 +293,11 @@ class Renderer:
         self.ctx.disable(moderngl.DEPTH_TEST)
         prog = self._programs["text"]
         set_uniform(prog, "u_tex", 0)
-        cursor_y = 8.0
-        for line in scene.texts:
-            tex = self.text.texture(line.text, line.size, line.color)
-            x = 10.0 if line.x is None else float(line.x)
-            y = cursor_y if line.y is None else float(line.y)
-            if line.y is None:
-                cursor_y += tex.size[1] + 2
+        for piece in layout_text(scene.texts, size, self.text):
+            tex = self.text.texture(piece.text, piece.size, piece.color)
             tex.use(location=0)
-            set_uniform(prog, "u_rect", (x, y, float(tex.size[0]), float(tex.size[1])))
+            set_uniform(prog, "u_rect", (piece.x, piece.y, float(tex.size[0]), float(tex.size[1])))
+            set_uniform(prog, "u_alpha", piece.alpha)
             self._vaos["text"].render(moderngl.TRIANGLE_STRIP)
 
     def release(self) -> None:

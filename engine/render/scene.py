@@ -110,13 +110,21 @@ class Sun:
 
 @dataclass
 class TextLine:
-    """One overlay string; ``x``/``y`` in pixels from the top-left, ``None`` to stack lines."""
+    """One overlay string; ``x``/``y`` in pixels from the top-left, ``None`` to stack lines.
+
+    ``anchor`` centres the line on a point given as fractions of the window
+    (``(0.5, 0.5)`` is its middle) instead, for messages that must stand out whatever
+    the window's size. ``alpha`` fades the line and its panel (1 opaque, 0 gone).
+    Lines are wrapped to the window's width when drawn (:mod:`engine.render.text`).
+    """
 
     text: str
     x: float | None = None
     y: float | None = None
     size: int = 18
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    anchor: tuple[float, float] | None = None
+    alpha: float = 1.0
 
 
 @dataclass
@@ -225,13 +233,20 @@ class RenderScene:
         rows[:, 0:3], rows[:, 3], rows[:, 4:7], rows[:, 7] = p, s, col, 1.0 if pixels else 0.0
 
     def add_text(self, text: str, x: float | None = None, y: float | None = None, size: int = 18,
-                 color: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> None:
-        """Append an overlay line; without ``x``/``y`` it stacks below the previous auto-placed line."""
+                 color: tuple[float, float, float] = (1.0, 1.0, 1.0), anchor: tuple[float, float] | None = None,
+                 alpha: float = 1.0) -> None:
+        """Append an overlay line; without ``x``/``y`` it stacks below the previous auto-placed line
+        (see :class:`TextLine` for ``anchor`` and ``alpha``)."""
         if not isinstance(text, str):
             raise TypeError(f"text must be a str, got {type(text).__name__}")
         if size <= 0:
             raise ValueError(f"text size must be positive, got {size}")
-        self.texts.append(TextLine(text, x, y, int(size), tuple(float(c) for c in color)))  # type: ignore[arg-type]
+        if not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"text alpha must be in [0, 1], got {alpha}")
+        if anchor is not None:
+            anchor = (float(anchor[0]), float(anchor[1]))
+        rgb = (float(color[0]), float(color[1]), float(color[2]))
+        self.texts.append(TextLine(text, x, y, int(size), rgb, anchor, float(alpha)))
 
     def set_background(self, image: ArrayLike | None, fade: float | None = None) -> None:
         """Set (or with ``None`` remove) the ``[H,W,3]`` uint8 background photo and optionally its fade."""

@@ -264,7 +264,8 @@ void main() {
 
 TEXT_FS = """
 uniform sampler2D u_tex;
+uniform float u_alpha;          // fades a whole line, panel included
 in vec2 v_uv;
 out vec4 f_color;
-void main() { f_color = texture(u_tex, v_uv); }
+void main() { vec4 c = texture(u_tex, v_uv); f_color = vec4(c.rgb, c.a * u_alpha); }
 """

@@ -7,7 +7,8 @@ into a small JSON-safe dict, :func:`restore` rebuilds the world from one.
 
 Keys in the window (``F5`` save, ``F9`` restore, ``R`` reset) reach the simulation
 as recorded input events (:data:`input.sample.SAVE` …), so a replay does exactly
-what the player did. A save is kept in the :class:`FieldSlot` (the simulation
+what the player did; each posts a :class:`~games.common.Notice` ("field saved") that
+the overlay shows for two seconds, besides the terminal line. A save is kept in the :class:`FieldSlot` (the simulation
 restores from there) and written to disk atomically: the game option ``field``
 (``--set field=PATH``) if given, else ``$XDG_DATA_HOME/puppetphone/snowman_field.json``.
 :func:`prepare` reads that file before the game is built; the field it holds goes into
@@ -35,6 +36,7 @@ from engine.ecs import World
 from engine.ragdoll.components import Prop
 from engine.render.components import Appearance
 from engine.statemachine.puppet import PuppetBody, spawn_puppet
+from games.common import post_notice
 from games.snowman.alive import bring_to_life
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
 from games.snowman.rig import SnowmanShape
@@ -235,18 +237,24 @@ def field_commands(world: World) -> None:
     for kind, _source in frame.events:
         if kind == RESET:
             restore(world, start_snapshot())
-            print("snowman: field reset")
+            _tell(world, "new field")
         elif kind == SAVE:
             slot.saved = snapshot(world)
             if slot.path is not None:
                 atomic_write_bytes(slot.path, json.dumps(slot.saved).encode("utf-8"))
-            print(f"snowman: field saved{f' to {slot.path}' if slot.path is not None else ''}")
+            _tell(world, "field saved", f" to {slot.path}" if slot.path is not None else "")
         elif kind == RESTORE:
             if slot.saved is None:
-                print("snowman: nothing saved to restore (F5 saves the field)")
+                _tell(world, "nothing saved to restore (F5 saves the field)")
                 continue
             try:
                 restore(world, slot.saved)
-                print("snowman: field restored")
+                _tell(world, "field restored")
             except FieldError as exc:
-                print(f"snowman: cannot restore the saved field: {exc}")
+                _tell(world, "cannot restore the saved field", f": {exc}")
+
+
+def _tell(world: World, message: str, detail: str = "") -> None:
+    """On screen for the player (a :class:`~games.common.Notice`), and with its detail on the terminal."""
+    post_notice(world, message)
+    print(f"snowman: {message}{detail}")

@@ -16,7 +16,7 @@ from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.statemachine.puppet import install_puppets
 from games.base import Game
-from games.snowman.components import Snowman, SnowmanStats, StackWatch
+from games.snowman.components import SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
 from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
@@ -33,7 +33,7 @@ CONTROLS = (
     "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
     "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
-    "keys: R new field, F5 save the field, F9 restore it, P pause, Esc quit",
+    "keys: R new field, F5 save the field, F9 restore it, P pause, H or F1 help, Esc quit",
 )
 
 
@@ -62,13 +62,11 @@ def camera() -> OrbitCamera:
 
 
 def status(world: World) -> list[str]:
-    """Counter of snowmen built, and the controls until the first grab."""
+    """Counter of snowmen built, and a hint while a stack waits for its head (the overlay shows the controls)."""
     stats = world.resource(SnowmanStats)
     lines = [f"snowmen built: {stats.built}   standing: {snowmen_standing(world)}   snowballs started: {stats.balls_started}"]
     if world.resource(StackWatch).headless:
         lines.append("a snowman body is waiting for its head: put a smaller ball on top")
-    if stats.built == 0 and world.frame < 60 * 20 and not world.query(Snowman):
-        lines += list(CONTROLS)
     return lines
 
 

@@ -1,10 +1,11 @@
 """The view of Tasbada: the composed photo behind, the virtual things in front, the dissolve.
 
 Reads the world only. The photo layer comes from :class:`~games.tasbada.reality.Reality`;
-the 3-D layer is the avatar (in the selfie's clothes colour), the cages and creatures,
-crystals and the gate, all standing on the invisible floor whose contact shadows the
-renderer draws over the photo. In the virtual stage the photo fades out over
-:data:`DISSOLVE` seconds while the ground, sky and the crystal forest of Tasbada grow in.
+the 3-D layer is the avatar (in the selfie's clothes colour, with a drop line and a
+ring under it while it is lifted), the cages and creatures, crystals and the gate, all
+standing on the invisible floor whose contact shadows the renderer draws over the photo.
+In the virtual stage the photo fades out over :data:`DISSOLVE` seconds while the
+ground, sky and the crystal forest of Tasbada grow in.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from engine.components import Puppet, Stick, Transform, WorldPose
 from engine.ecs import World
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
+from games.common import draw_height_cues
 from games.tasbada.objects import CREATURE_COLORS, Creature, Crystal, Gate, avatar_position
 from games.tasbada.quest import MENU, MIXED, PROPS_ALIVE, REAL, VIRTUAL, Quest
 from games.tasbada.reality import Reality
@@ -173,6 +175,7 @@ def draw(world: World, scene: RenderScene, alpha: float) -> None:
         pos, rot = wpose.interpolated(alpha)
         a, b, r, _ = puppet_capsules(puppet.skeleton, pos, rot)
         scene.add_capsules(a, b, r, reality.color, outline=e == focus)
+    draw_height_cues(world, scene, alpha)
     gate_pos = None
     for _, _g, tf in world.query(Gate, Transform):
         gate_pos = tf.position

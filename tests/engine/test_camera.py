@@ -33,7 +33,7 @@ def test_projection_matches_glm_perspective():
 
 
 def test_yaw_zero_looks_down_minus_z_at_the_target():
-    cam = OrbitCamera(target=np.zeros(3), yaw=0.0, pitch=0.0, distance=4.0)
+    cam = OrbitCamera(target=np.zeros(3), yaw=0.0, pitch=0.0, distance=4.0, ground=None)
     assert np.allclose(cam.eye, [0, 0, 4])
     assert np.allclose(cam.forward, [0, 0, -1])
     assert np.allclose(cam.right, [1, 0, 0])
@@ -83,7 +83,7 @@ def test_point_behind_camera_projects_to_nan():
 
 
 def test_orbit_pitch_and_zoom_are_clamped():
-    cam = OrbitCamera(pitch=0.2, distance=5.0)
+    cam = OrbitCamera(pitch=0.2, distance=5.0, ground=None)
     cam.orbit(0.0, 10.0)
     assert cam.pitch == cam.pitch_max
     cam.orbit(0.0, -10.0)
@@ -106,3 +106,39 @@ def test_phone_camera_identity_and_looking_at():
     assert np.allclose(cam2.forward, expect)
     assert np.allclose(cam2.project([[0.0, 1.0, 0.0]], 200, 100), [[100, 50]])
     assert abs(cam2.right[1]) < 1e-9  # no roll
+
+
+def test_orbit_eye_never_goes_below_the_ground():
+    rng = np.random.default_rng(3)
+    cam = OrbitCamera(target=np.array([0.0, 0.6, 0.0]), pitch=0.5, distance=9.0)
+    lowest = np.inf
+    for _ in range(400):
+        move = rng.integers(3)
+        if move == 0:
+            cam.orbit(rng.normal(0.0, 0.5), rng.normal(-0.1, 0.4))  # drags mostly downward
+        elif move == 1:
+            cam.zoom(float(np.exp(rng.normal(0.0, 0.6))))
+        else:
+            cam.pan(rng.normal(0.0, 1.0), rng.normal(-0.5, 1.0))
+        eye = cam.eye
+        lowest = min(lowest, eye[1])
+        assert eye[1] >= cam.ground + cam.clearance - 1e-9
+        assert cam.target[1] >= cam.ground
+        # The view stays consistent: the eye looks at the target along its forward axis.
+        to_target = cam.target - eye
+        assert np.allclose(to_target / np.linalg.norm(to_target), cam.forward)
+        assert np.allclose(cam.view_matrix(), look_at(eye, cam.target), atol=1e-9)
+    assert lowest == pytest.approx(cam.ground + cam.clearance)  # the floor was reached, not avoided
+
+
+def test_orbit_floor_applies_to_a_target_assigned_directly_and_lets_go_at_once():
+    cam = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), pitch=0.3, distance=5.0)
+    cam.orbit(0.0, -10.0)
+    floor = cam.pitch
+    assert floor > cam.pitch_min and cam.eye[1] == pytest.approx(0.1)
+    cam.orbit(0.0, 0.05)  # dragging back up moves the eye at once: no dead zone below the floor
+    assert cam.pitch == pytest.approx(floor + 0.05) and cam.eye[1] > 0.1 + 0.1
+    cam.target = np.array([0.0, 0.0, 0.0])  # a follow camera writing its target
+    cam.distance = 2.0
+    cam.pitch = -0.2
+    assert cam.eye[1] >= 0.1 - 1e-12

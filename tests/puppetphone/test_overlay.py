@@ -1,11 +1,17 @@
-"""The overlay: state of each puppet, the source light, pairing lines for a waiting phone."""
+"""The overlay: what each puppet is doing, the source light, pairing lines for a waiting phone,
+the help that H / F1 hides and brings back, and the notices the game posts."""
 
 from engine.app import App
+from engine.render.scene import RenderScene
+from games.common import NOTICE_SECONDS
 from games.sandbox import GAME
 from input.hub import InputHub
 from input.osc import OscSource
 from input.plugin import input_plugin
-from puppetphone.overlay import overlay_lines
+from input.sample import SAVE
+from puppetphone.games import load_game, make_app
+from puppetphone.overlay import OverlayState, draw_overlay, overlay_lines
+from puppetphone.session import build_activity
 
 
 def test_overlay_shows_state_and_pairing_until_a_packet_arrives():
@@ -17,9 +23,66 @@ def test_overlay_shows_state_and_pairing_until_a_packet_arrives():
         app.add_plugin(GAME.install)
         app.step()
         lines = overlay_lines(app.world, GAME, hub, 60.0, False)
-        assert any("Locomotion" in line for line in lines)
+        assert "puppet: standing" in lines
+        assert not any("Locomotion" in line for line in lines)  # words, not state names
         assert any(f"port {osc.port}" in line for line in lines)
         assert any("--osc-host 0.0.0.0" in line for line in lines)
         assert any("[idle]" in line or "[gone]" in line for line in lines)
     finally:
         hub.close()
+
+
+def texts(scene: RenderScene) -> list[str]:
+    return [t.text for t in scene.texts]
+
+
+def test_h_and_f1_hide_and_bring_back_the_help():
+    import pygame
+
+    session = build_activity("snowman", 0, InputHub(), setup={})  # a fresh field that saves nowhere
+    controls = list(session.game.controls)
+    assert controls and session.overlay.help_visible  # shown at the start
+
+    def drawn() -> list[str]:
+        scene = RenderScene()
+        draw_overlay(scene, session.app.world, session.game, session.hub, 60.0, False, session.overlay)
+        return texts(scene)
+
+    assert all(line in drawn() for line in controls)
+    press = lambda key: session.on_event(pygame.event.Event(pygame.KEYDOWN, key=key), None)  # noqa: E731
+    assert press(pygame.K_h)
+    hidden = drawn()
+    assert not any(line in hidden for line in controls)
+    assert "H / F1: help" in hidden[0]  # how to get it back stays on screen
+    assert press(pygame.K_F1)
+    assert all(line in drawn() for line in controls)
+    state = OverlayState()
+    state.toggle_help()
+    state.toggle_help()
+    assert state.help_visible
+
+
+def test_a_notice_is_drawn_large_and_fades_after_two_seconds_of_simulation():
+    hub = InputHub()
+    app = make_app("snowman", 0, hub)
+    game = load_game("snowman")
+    hub.command(SAVE)
+    app.step()
+
+    def notice_line():
+        scene = RenderScene()
+        draw_overlay(scene, app.world, game, hub, 60.0, False)
+        found = [t for t in scene.texts if t.text == "field saved"]
+        others = [t for t in scene.texts if t.text != "field saved"]
+        return (found[0] if found else None), others
+
+    line, others = notice_line()
+    assert line is not None and line.alpha == 1.0
+    assert line.anchor is not None and line.size > max(t.size for t in others)  # centred and larger
+    shown = round(NOTICE_SECONDS / app.world.dt)
+    app.run_steps(int(0.7 * shown))
+    assert notice_line()[0].alpha == 1.0
+    app.run_steps(int(0.2 * shown))
+    assert 0.0 < notice_line()[0].alpha < 1.0  # fading
+    app.run_steps(int(0.1 * shown) + 1)
+    assert notice_line()[0] is None  # gone after two simulated seconds, however long they took

@@ -53,7 +53,7 @@ def test_a_sphere_drawn_at_each_level_keeps_its_true_outline():
     try:
         limits = level_limits(SPHERE_LEVELS)
         distance = 6.0
-        viewer.camera = OrbitCamera(target=np.zeros(3), yaw=0.0, pitch=0.0, distance=distance)
+        viewer.camera = OrbitCamera(target=np.zeros(3), yaw=0.0, pitch=0.0, distance=distance, ground=None)
         f = H / (2.0 * math.tan(math.radians(viewer.camera.fov_y) / 2.0))
         empty = RenderScene()
         empty.ground.visible = False

@@ -149,3 +149,22 @@ def test_a_corrupt_save_file_is_set_aside_with_a_message(field_file: Path, capsy
     assert "set aside" in capsys.readouterr().err
     app.run_steps(3)
     assert app.world.query(Transform)
+
+
+def test_each_command_tells_the_player_on_screen_without_touching_the_hash() -> None:
+    from engine.hashing import state_hash
+    from games.common import Notice
+
+    hub = InputHub()
+    app = make_app("snowman", 3, hub)
+    app.run_steps(3)
+    assert app.world.try_resource(Notice) is None
+    for kind, text in [(RESTORE, "nothing saved to restore (F5 saves the field)"), (SAVE, "field saved"),
+                       (RESTORE, "field restored"), (RESET, "new field")]:
+        hub.command(kind)
+        app.step()
+        notice = app.world.resource(Notice)
+        assert (notice.text, notice.frame) == (text, app.world.frame - 1)
+    before = state_hash(app.world)
+    app.world.insert_resource(Notice("something else", 0))
+    assert state_hash(app.world) == before  # display only: a replay verifies with or without it

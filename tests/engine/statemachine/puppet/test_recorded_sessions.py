@@ -5,7 +5,8 @@ Each ``tests/data/puppet_*.rec`` is a real session through the real input path
 ``puppetphone regen recordings``. Every test replays its file through
 :func:`input.replay.verify` — which rebuilds the world and checks every step's
 state hash — while watching the puppet, then asserts the state sequence from the
-brain's trace and the quantities that make each behaviour what it is.
+brain's trace and the quantities that make each behaviour what it is, and what the
+overlay says the puppet is doing (:mod:`engine.statemachine.puppet.words`).
 
 When an engine change legitimately alters the simulation the hashes stop matching:
 re-record with ``puppetphone regen recordings`` and re-run.
@@ -16,6 +17,7 @@ from __future__ import annotations
 import importlib.util
 import sys
 from dataclasses import dataclass, field
+from itertools import groupby
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +27,11 @@ from engine.components import LocalPose, Stick, Transform
 from engine.ragdoll.components import Prop, Ragdoll
 from engine.statemachine import Brain
 from engine.statemachine.puppet import PuppetBody
+from engine.statemachine.puppet.words import describe_puppet
+from games.sandbox import GAME
+from input.hub import InputHub
+from input.mouse import MouseSource
+from input.mousebot import MouseBot
 from games.sandbox import BIG_BALL
 from input.recording import read_recording
 from input.replay import verify
@@ -54,6 +61,7 @@ class Watch:
     settled: list[bool] = field(default_factory=list)
     ball: list[np.ndarray] = field(default_factory=list)
     ball_rot: list[np.ndarray] = field(default_factory=list)
+    words: list[str] = field(default_factory=list)
     trace: list = field(default_factory=list)  # type: ignore[type-arg]
     memory: dict = field(default_factory=dict)  # type: ignore[type-arg]
     frames: int = 0
@@ -98,6 +106,7 @@ def replay(name: str) -> Watch:
         if balls:
             w.ball.append(balls[0][2].position.copy())
             w.ball_rot.append(balls[0][2].rotation.copy())
+        w.words.append(describe_puppet(world, p, brain))
         w.trace, w.memory = list(brain.trace), dict(brain.memory)
 
     result = verify(lambda hub: S.make_app(session.scene, hub), rec, on_step=on_step)
@@ -278,3 +287,56 @@ def test_crouch_walking_into_a_big_ball_rolls_it() -> None:
     assert np.all(ball[start + 1:stop, 2] > pos[start + 1:stop, 2] + 0.3)
     hips = w.arr("hips")
     assert float(np.median(hips[start:stop])) < 0.75
+
+
+# -- (10) what the overlay says ---------------------------------------------------------
+def words_along(name: str) -> list[str]:
+    """The puppet's words (:func:`describe_puppet`) per replayed step, repeats collapsed."""
+    return [w for w, _ in groupby(replay(name).words)]
+
+
+def in_order(words: list[str], expected: list[str]) -> bool:
+    """Whether ``expected`` occur in ``words`` in this order (others may come between)."""
+    it = iter(words)
+    return all(any(w == e for w in it) for e in expected)
+
+
+@pytest.mark.parametrize("name,expected", [
+    ("walk_run", ["standing", "walking", "running"]),
+    ("crouch_walk", ["crouching", "crouch-walking"]),
+    ("roll_snowball", ["rolling a snowball"]),
+    ("pick_up_carry", ["picking up a ball", "carrying a ball"]),
+    ("jump_valid", ["getting ready to jump", "in the air", "landing"]),
+    ("held_in_air", ["hanging from the stick", "fell over", "getting up", "standing"]),
+])
+def test_sessions_read_in_a_players_words(name: str, expected: list[str]) -> None:
+    words = words_along(name)
+    assert in_order(words, expected), words
+    assert not any(w[:1].isupper() for w in words)  # no state names ("Locomotion") leak through
+
+
+@pytest.mark.parametrize("name,why", [("jump_turn", "turned in the air"), ("jump_stop", "stopped in the air")])
+def test_an_invalid_jump_says_why(name: str, why: str) -> None:
+    words = words_along(name)
+    assert in_order(words, ["in the air", f"fell: invalid jump ({why})"]), words
+    assert words[-1] == f"fell: invalid jump ({why})"  # still held up by the stick: the reason stays
+
+
+def test_the_reason_of_a_fall_goes_once_the_puppet_is_up() -> None:
+    """Played live (the recording ends while the stick still holds the puppet): let go, watch it get up."""
+    hub = InputHub([mouse := MouseSource()])
+    app = S.make_app("empty", hub)
+    bot = MouseBot(app, mouse, GAME.camera())
+    S.SESSIONS["jump_turn"].script(app, bot)
+    p = S.puppet_of(app)
+    brain = app.world.get(p, Brain)
+    assert describe_puppet(app.world, p, brain) == "fell: invalid jump (turned in the air)"
+    bot.release()
+    seen = []
+    for _ in range(int(8.0 / app.world.dt)):
+        bot.step()
+        seen.append(describe_puppet(app.world, p, brain))
+    words = [w for w, _ in groupby(seen)]
+    assert in_order(words, ["getting up", "standing"]), words
+    assert not any("invalid" in w for w in words[words.index("getting up"):]), words
+    assert words[-1] == "standing"
