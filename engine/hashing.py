@@ -20,6 +20,12 @@ ints, bools, strings, ``None``, arrays of one dtype and shape) falls back to
 Floats are hashed by their exact bits: a replay on the same machine and library
 versions must agree to the last bit, and a hash that rounded would hide the
 first divergence until it grew visible.
+
+The state is hashed in named **parts** (:func:`state_parts`): ``frame``, ``rng``,
+``entities``, one per component type and one per hashed resource type, each with its own
+digest; :func:`state_hash` is the digest of those. Recordings keep a short digest of
+every part beside the hash, so a replay that diverges names the component type (and
+entity) that differs first, not only the frame.
 """
 
 from __future__ import annotations
@@ -37,7 +43,10 @@ import numpy as np
 
 from engine.ecs import World
 
-__all__ = ["state_hash", "feed"]
+__all__ = ["state_hash", "state_parts", "part_digests", "feed", "PART_DIGEST_SIZE"]
+
+#: Bytes of each part's digest (recordings store these per step).
+PART_DIGEST_SIZE = 2
 
 _COUNT = struct.Struct("<q")
 
@@ -189,17 +198,57 @@ def _feed_components(h: Any, ctype: type, rows: list[tuple[Any, ...]]) -> None:
             h.update(_column(list(column)))
 
 
-def state_hash(world: World) -> str:
-    """Hex digest (BLAKE2b, 16 bytes) of the world's simulation state."""
-    h = hashlib.blake2b(digest_size=16)
+def _part(name: str) -> Any:
+    return hashlib.blake2b(name.encode(), digest_size=16)
+
+
+def _type_name(t: type) -> str:
+    return f"{t.__module__}.{t.__qualname__}"
+
+
+def state_parts(world: World) -> list[tuple[str, Any]]:
+    """The state in named parts, each a finished BLAKE2b object (see the module docstring)."""
+    parts = []
+    h = _part("frame")
     feed(h, world.frame)
+    parts.append(("frame", h))
+    h = _part("rng")
     feed(h, world.rng.bit_generator.state)
+    parts.append(("rng", h))
     entities = world.entities()
+    h = _part("entities")
     h.update(b"e" + _COUNT.pack(len(entities)) + np.array(entities, dtype=np.int64).tobytes())
+    parts.append(("entities", h))
     for ctype in world.component_types():
         if getattr(ctype, "SIM_STATE", True):
+            name = _type_name(ctype)
+            h = _part(name)
             _feed_components(h, ctype, world.query(ctype))
+            parts.append((name, h))
     for res in world.resources():
         if getattr(res, "SIM_STATE", False):
+            name = "resource " + _type_name(type(res))
+            h = _part(name)
             feed(h, res)
-    return h.hexdigest()
+            parts.append((name, h))
+    return parts
+
+
+def _combine(parts: list[tuple[str, Any]]) -> tuple[str, dict[str, bytes]]:
+    total = hashlib.blake2b(digest_size=16)
+    digests = {}
+    for name, h in parts:
+        d = h.digest()
+        total.update(name.encode() + b"\0" + d)
+        digests[name] = d[:PART_DIGEST_SIZE]
+    return total.hexdigest(), digests
+
+
+def state_hash(world: World) -> str:
+    """Hex digest (BLAKE2b, 16 bytes) of the world's simulation state."""
+    return _combine(state_parts(world))[0]
+
+
+def part_digests(world: World) -> tuple[str, dict[str, bytes]]:
+    """The state hash and a short digest per part, computed once (what a recorder stores)."""
+    return _combine(state_parts(world))

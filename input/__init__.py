@@ -17,7 +17,7 @@ from input.hub import InputHub
 from input.motionstick import StickConfig, StickState, motionstick_system, spawn_stick
 from input.plugin import input_plugin, install_input
 from input.recording import Recorder, Recording, RecordingError, RecordingHeader, read_recording
-from input.replay import ReplayResult, ReplaySource, replay_hub, verify
+from input.replay import HashCheck, ReplaySource, replay_hub, verify
 from input.sample import InputFrame, PoseSample, SourceStatus
 from input.source import PoseSource
 
@@ -26,6 +26,6 @@ __all__ = [
     "StickConfig", "StickState", "motionstick_system", "spawn_stick",
     "install_input", "input_plugin",
     "Recorder", "RecordingHeader", "Recording", "RecordingError", "read_recording",
-    "ReplaySource", "ReplayResult", "replay_hub", "verify",
+    "ReplaySource", "HashCheck", "replay_hub", "verify",
     "add_source_arguments", "make_hub",
 ]

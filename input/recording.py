@@ -4,7 +4,15 @@ File layout (little-endian)::
 
     b"PPREC\\n"  u32 header_len  u32 crc32(header)  header (UTF-8 JSON)
     record*  =  u32 payload_len  u32 crc32(payload)  payload
-    payload  =  16-byte state hash  +  input/codec.py frame
+    payload  =  16-byte state hash  +  parts  +  input/codec.py frame
+    parts    =  u8 flags  [u16 n  names (UTF-8, newline-separated) if flags & 1]
+                u8 count  count × 2-byte part digest
+
+``parts`` (format 3) holds a short digest of each named part of the state — a component
+type, a resource, the RNG (:func:`engine.hashing.state_parts`) — so a replay that
+diverges names what differs first; the part names are written only when they change
+from the record before (a type appears or goes). Two bytes name a differing part well
+enough (the 16-byte hash decides whether a step matches).
 
 The header holds ``format`` (this module's :data:`FORMAT_VERSION`), ``engine_version``,
 ``game``, ``seed``, ``dt``, ``sources`` and ``setup`` — the game's explicit set-up (options,
@@ -16,7 +24,9 @@ and says why it stopped (the replay prints that as a warning).
 Size per minute of play (60 steps/s; measured by ``tests/input/test_recording.py``
 and the figures in the closing report):
 
-- idle frames (no input): 31 bytes each, **≈ 112 KB/min**;
+- the part digests: 2 bytes per state part (26 in a snowman game): ≈ 54 bytes per frame,
+  **≈ 190 KB/min**, on top of what follows;
+- input, idle frames (no input): 31 bytes each, **≈ 112 KB/min**;
 - mouse dragging (one world-mode sample with pivot and plane normal every step):
   about 127 bytes per frame, **≈ 460 KB/min** (less when the mouse is still);
 - a 60 Hz phone (orientation + gyro + accel, one sample per step, a
@@ -36,13 +46,15 @@ from typing import Any, BinaryIO
 
 from engine.app import App
 from engine.ecs import World
-from engine.hashing import state_hash
+from engine.hashing import PART_DIGEST_SIZE, part_digests
 from input.codec import CodecError, decode_frame, encode_frame
 from input.sample import InputFrame
 
 __all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording"]
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
+#: The first format whose records carry per-part digests.
+PARTS_FORMAT = 3
 MAGIC = b"PPREC\n"
 _LEN = struct.Struct("<II")
 
@@ -76,13 +88,18 @@ class RecordingHeader:
 
 @dataclass
 class Recording:
-    """A read recording: every complete frame, its hash, and whether the file was cut."""
+    """A read recording: every complete frame, its hash, and whether the file was cut.
+
+    ``parts[i]`` maps each part name of step ``i`` to its short digest (empty for
+    recordings older than format 3).
+    """
 
     header: RecordingHeader
     frames: list[InputFrame]
     hashes: list[str]
     complete: bool = True
     problem: str = ""
+    parts: list[dict[str, bytes]] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -105,6 +122,7 @@ class Recorder:
         self._file.flush()
         self.frames = 0
         self.bytes = self._file.tell()
+        self._names: tuple[str, ...] = ()
 
     def attach(self, app: App) -> Recorder:
         """Write a record at the end of every step of ``app`` (``app.on_step_end``)."""
@@ -112,18 +130,33 @@ class Recorder:
         return self
 
     def on_step_end(self, world: World) -> None:
-        """Record the step that just ran: its ``InputFrame`` and the resulting state hash."""
-        self.write(world.resource(InputFrame), state_hash(world))
+        """Record the step that just ran: its ``InputFrame``, the state hash and its parts."""
+        digest, parts = part_digests(world)
+        self.write(world.resource(InputFrame), digest, parts)
 
-    def write(self, frame: InputFrame, digest: str) -> None:
+    def write(self, frame: InputFrame, digest: str, parts: dict[str, bytes] | None = None) -> None:
         """Append one record and flush it to the OS."""
         if self._file is None:
             raise RecordingError(f"recording {self.path} is closed")
-        payload = bytes.fromhex(digest) + encode_frame(frame)
+        payload = bytes.fromhex(digest) + self._parts_block(parts or {}) + encode_frame(frame)
         self._file.write(_LEN.pack(len(payload), zlib.crc32(payload)) + payload)
         self._file.flush()
         self.frames += 1
         self.bytes += _LEN.size + len(payload)
+
+    def _parts_block(self, parts: dict[str, bytes]) -> bytes:
+        names = tuple(parts)
+        if len(names) > 255:
+            raise RecordingError(f"{len(names)} state parts; a record holds at most 255")
+        block = bytearray()
+        if names != self._names:
+            listed = "\n".join(names).encode()
+            block += b"\x01" + struct.pack("<H", len(listed)) + listed
+            self._names = names
+        else:
+            block += b"\x00"
+        block += bytes([len(names)]) + b"".join(parts.values())
+        return bytes(block)
 
     def close(self) -> None:
         """Flush and close (idempotent)."""
@@ -169,6 +202,8 @@ def read_recording(path: str | Path) -> Recording:
     header = _read_header(f, str(path))
     frames: list[InputFrame] = []
     hashes: list[str] = []
+    parts: list[dict[str, bytes]] = []
+    names: tuple[str, ...] = ()
     pos = f.tell()
     problem = ""
     while pos < len(data):
@@ -184,11 +219,44 @@ def read_recording(path: str | Path) -> Recording:
             problem = f"damaged record at frame {len(frames)} (byte {pos}, checksum mismatch)"
             break
         try:
-            frame = decode_frame(payload[16:])
+            start = 16
+            if header.format >= PARTS_FORMAT:
+                names, digests, start = _read_parts(payload, names)
+                parts.append(digests)
+            frame = decode_frame(payload[start:])
         except CodecError as exc:
             problem = f"undecodable record at frame {len(frames)}: {exc}"
             break
         frames.append(frame)
         hashes.append(payload[:16].hex())
         pos += _LEN.size + n
-    return Recording(header=header, frames=frames, hashes=hashes, complete=not problem, problem=problem)
+    return Recording(header=header, frames=frames, hashes=hashes, complete=not problem, problem=problem,
+                     parts=parts[: len(frames)])
+
+
+def _read_parts(payload: bytes, names: tuple[str, ...]) -> tuple[tuple[str, ...], dict[str, bytes], int]:
+    """The parts block at byte 16: (current names, digests by name, where the frame starts)."""
+    pos = 16
+    if len(payload) < pos + 2:
+        raise CodecError("record too short for its parts")
+    if payload[pos] & 1:
+        (n,) = struct.unpack_from("<H", payload, pos + 1)
+        listed = payload[pos + 3 : pos + 3 + n]
+        if len(listed) < n:
+            raise CodecError("part names cut short")
+        try:
+            names = tuple(listed.decode().split("\n")) if n else ()
+        except UnicodeDecodeError:
+            raise CodecError("part names are not UTF-8") from None
+        pos += 3 + n
+    else:
+        pos += 1
+    if pos >= len(payload):
+        raise CodecError("record too short for its parts")
+    count = payload[pos]
+    pos += 1
+    end = pos + count * PART_DIGEST_SIZE
+    if count != len(names) or end > len(payload):
+        raise CodecError(f"{count} part digests for {len(names)} part names")
+    digests = {name: payload[pos + i * PART_DIGEST_SIZE : pos + (i + 1) * PART_DIGEST_SIZE] for i, name in enumerate(names)}
+    return names, digests, end

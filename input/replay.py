@@ -9,16 +9,17 @@ the app through a factory, steps it once per recorded frame and compares every
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from engine.app import App
-from engine.hashing import state_hash
+from engine.ecs import World
+from engine.hashing import part_digests
 from input.hub import InputHub
 from input.recording import Recording, read_recording
 from input.sample import InputFrame, SourceStatus
 
-__all__ = ["ReplaySource", "ReplayResult", "verify", "replay_hub"]
+__all__ = ["ReplaySource", "HashCheck", "verify", "replay_hub", "differing_parts"]
 
 
 class ReplaySource:
@@ -54,32 +55,58 @@ def replay_hub(recording: Recording | str | Path) -> InputHub:
     return InputHub(replay=ReplaySource(recording))
 
 
-@dataclass
-class ReplayResult:
-    """Outcome of :func:`verify`."""
+def differing_parts(recorded: dict[str, bytes], replayed: dict[str, bytes]) -> list[str]:
+    """Names of the state parts whose digests differ (or exist on one side only), recorded order first."""
+    names = list(recorded) + [n for n in replayed if n not in recorded]
+    return [n for n in names if recorded.get(n) != replayed.get(n)]
 
-    frames: int
-    matched: int
+
+@dataclass
+class HashCheck:
+    """Compares each finished step's state hash with a recording's (an ``App.on_step_end`` observer).
+
+    At the first difference it keeps the frame, both hashes and the names of the state
+    parts (component types, resources) whose digests differ, and checks nothing more.
+    """
+
+    recording: Recording
+    frames: int = 0
+    matched: int = 0
     first_mismatch: int | None = None
     expected: str = ""
     got: str = ""
+    differing: list[str] = field(default_factory=list)
+
+    def __call__(self, world: World) -> None:
+        index = world.frame - 1
+        if self.first_mismatch is not None or index >= len(self.recording.hashes):
+            return
+        self.frames += 1
+        digest, parts = part_digests(world)
+        if digest == self.recording.hashes[index]:
+            self.matched += 1
+            return
+        self.first_mismatch, self.expected, self.got = index, self.recording.hashes[index], digest
+        if index < len(self.recording.parts):
+            self.differing = differing_parts(self.recording.parts[index], parts)
 
     @property
     def ok(self) -> bool:
-        """Whether every replayed hash matched."""
+        """Whether every hash checked so far matched."""
         return self.first_mismatch is None
 
     def message(self) -> str:
-        """The line the replay command prints."""
+        """The verification line: all matched, or the frame, what differs there and both hashes."""
         if self.ok:
             return f"replayed {self.frames} frames, all {self.matched} state hashes match"
-        return (f"state hash differs at frame {self.first_mismatch} (after {self.matched} matching): "
+        what = f" in {', '.join(self.differing)}" if self.differing else ""
+        return (f"state hash differs at frame {self.first_mismatch}{what} (after {self.matched} matching): "
                 f"expected {self.expected}, got {self.got}")
 
 
 def verify(make_app: Callable[[InputHub], App], recording: Recording,
-           on_step: Callable[[App, int], None] | None = None) -> ReplayResult:
-    """Rebuild the app with a replay hub and compare every step's state hash.
+           on_step: Callable[[App, int], None] | None = None) -> HashCheck:
+    """Rebuild the app with a replay hub, step it once per recorded frame, compare every hash.
 
     Args:
         make_app: builds the app from the hub (same game, seed and dt as recorded).
@@ -87,15 +114,16 @@ def verify(make_app: Callable[[InputHub], App], recording: Recording,
         on_step: called after each step (rendering a screenshot, progress).
     """
     app = make_app(InputHub(replay=ReplaySource(recording)))
-    matched = 0
-    for i, (frame, expected) in enumerate(zip(recording.frames, recording.hashes, strict=True)):
+    check = HashCheck(recording)
+    app.on_step_end.append(check)
+    for i, frame in enumerate(recording.frames):
         if app.world.frame != frame.frame:
-            return ReplayResult(i, matched, frame.frame, expected, f"world at frame {app.world.frame}")
+            check.first_mismatch, check.expected = frame.frame, recording.hashes[i]
+            check.got = f"world at frame {app.world.frame}"
+            break
         app.step()
         if on_step is not None:
             on_step(app, i)
-        got = state_hash(app.world)
-        if got != expected:
-            return ReplayResult(i + 1, matched, frame.frame, expected, got)
-        matched += 1
-    return ReplayResult(len(recording.frames), matched)
+        if not check.ok:
+            break
+    return check

@@ -76,8 +76,7 @@ def run(args: argparse.Namespace) -> int:
     assert check is not None and result is not None
     steps = result.steps  # type: ignore[attr-defined]
     if not check.ok:
-        print(f"state hash differs at frame {check.first_mismatch} (after {check.matched} matching): "
-              f"expected {check.expected}, got {check.got}")
+        print(check.message())
         return 1
     if args.verify:
         print(f"replayed {steps} frames, all {check.matched} state hashes match")

@@ -7,7 +7,7 @@ recorded input commands (reset, save, restore), so replays repeat them; H or F1 
 and shows the help.
 
 A replay is the same activity built from a recording's header (game, seed, setup) with
-a replay hub; :class:`HashCheck` compares every step's state hash with the recorded one
+a replay hub; :class:`input.replay.HashCheck` compares every step's state hash with the recorded one
 and ends the activity at the first difference.
 """
 
@@ -19,44 +19,17 @@ from typing import Any
 
 from engine.app import App
 from engine.camera import OrbitCamera
-from engine.ecs import World
-from engine.hashing import state_hash
 from engine.render.scene import RenderScene
 from engine.runner import Runner
 from games.base import Game
 from input.hub import InputHub
 from input.recording import Recorder, Recording, RecordingHeader
+from input.replay import HashCheck
 from input.sample import RESET, RESTORE, SAVE
 from puppetphone.games import load_game, make_app
 from puppetphone.overlay import OverlayState, draw_overlay
 
-__all__ = ["GameActivity", "HashCheck", "build_activity"]
-
-
-@dataclass
-class HashCheck:
-    """Compares each finished step's state hash with a recording's (``App.on_step_end``)."""
-
-    recording: Recording
-    matched: int = 0
-    first_mismatch: int | None = None
-    expected: str = ""
-    got: str = ""
-
-    def __call__(self, world: World) -> None:
-        index = world.frame - 1
-        if self.first_mismatch is not None or index >= len(self.recording.hashes):
-            return
-        digest = state_hash(world)
-        if digest == self.recording.hashes[index]:
-            self.matched += 1
-        else:
-            self.first_mismatch, self.expected, self.got = index, self.recording.hashes[index], digest
-
-    @property
-    def ok(self) -> bool:
-        """Whether every hash checked so far matched."""
-        return self.first_mismatch is None
+__all__ = ["GameActivity", "build_activity"]
 
 
 @dataclass

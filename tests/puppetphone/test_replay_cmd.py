@@ -106,3 +106,29 @@ def test_not_a_recording_is_a_clear_error(tmp_path, capsys):
     path.write_bytes(b"hello")
     assert main(["replay", str(path), "--verify"]) == 2
     assert "not a PuppetPhone recording" in capsys.readouterr().err
+
+
+def test_a_divergence_names_the_component_type_that_differs_first(tmp_path):
+    from engine.components import Transform
+    from engine.statemachine import Brain
+    from input.recording import read_recording
+    from input.replay import verify
+
+    path = tmp_path / "s.rec"
+    record(path)
+
+    def nudged(hub):  # the same session, with one puppet moved by a micrometre at step 40
+        app = make_app("sandbox", 11, hub)
+
+        def nudge(world):
+            if world.frame == 40:
+                puppet = next(e for e, _ in world.query(Brain))
+                world.get(puppet, Transform).position[0] += 1e-6
+
+        app.add_system("rules", nudge)
+        return app
+
+    check = verify(nudged, read_recording(path))
+    assert check.first_mismatch == 40 and check.matched == 40
+    assert check.differing[0] == "engine.components.Transform"
+    assert "differs at frame 40 in engine.components.Transform" in check.message()
