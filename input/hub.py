@@ -21,7 +21,7 @@ from collections.abc import Iterable
 from typing import Protocol
 
 from input.codec import decode_frame, encode_frame
-from input.sample import COMMANDS, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus
+from input.sample import COMMANDS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus
 from input.source import PoseSource
 
 __all__ = ["InputHub", "FrameSource"]
@@ -54,7 +54,17 @@ class InputHub:
         self.coalesced = 0
         self._touch: dict[str, bool] = {}
         self._commands: list[str] = []
+        self._tools: list[str] = []
         self.last_frame = InputFrame()
+
+    def tool(self, operation: str) -> None:
+        """Queue an authoring tool's operation (a short text) for the next step's frame.
+
+        Ignored while replaying: the recording has its own."""
+        if len(operation.encode()) > 255:
+            raise ValueError(f"tool operation too long to record: {operation[:40]!r}…")
+        if self.replay is None:
+            self._tools.append(operation)
 
     def command(self, kind: str) -> None:
         """Queue a keyboard command (:data:`~input.sample.COMMANDS`) for the next step's frame,
@@ -113,7 +123,9 @@ class InputHub:
             if kind == "disconnect" and self._touch.pop(src, False):
                 events.append((TOUCH_UP, src))
         events += [(kind, "keys") for kind in self._commands]
+        events += [(TOOL, operation) for operation in self._tools]
         self._commands.clear()
+        self._tools.clear()
         live = InputFrame(frame=frame, samples=tuple(samples), events=tuple(events))
         self.last_frame = decode_frame(encode_frame(live))
         return self.last_frame

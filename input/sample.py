@@ -24,15 +24,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS",
-           "RESET", "SAVE", "RESTORE", "COMMANDS"]
+           "RESET", "SAVE", "RESTORE", "COMMANDS", "TOOL"]
 
 CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP = "connect", "disconnect", "touch_down", "touch_up"
 # Commands from the keyboard (the launcher's keys), recorded like any input so a
 # replay resets, saves and restores where the player did.
 RESET, SAVE, RESTORE = "reset", "save", "restore"
 COMMANDS: tuple[str, ...] = (RESET, SAVE, RESTORE)
+# An authoring tool's operation (press, drag, key …) as a short text: the authoring
+# scenes take their pointer and keys through the hub so their sessions record too.
+TOOL = "tool"
 # Recordings store the index: new kinds go at the end.
-EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP, *COMMANDS)
+EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP, *COMMANDS, TOOL)
 
 F = NDArray[np.float64]
 
