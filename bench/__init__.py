@@ -19,4 +19,5 @@ BENCHES: dict[str, str] = {
     "input-latency": "bench.input_latency",
     "snowman": "bench.snowman",
     "render": "bench.render",
+    "crowd": "bench.crowd",
 }

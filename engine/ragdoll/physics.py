@@ -85,6 +85,7 @@ class PhysicsWorld:
         self._digest = b""
         self._ke: _F | None = None
         self._read: tuple[_F, _F] | None = None
+        self.simulate_animated = False
 
     @property
     def dt(self) -> float:
