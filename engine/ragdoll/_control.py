@@ -44,6 +44,7 @@ class Command:
     hold: str | None = None
     hold_target: _F = field(default_factory=lambda: np.zeros(3))
     last: tuple[_F, _F] | None = None
+    enter: bool = False  # just (re)joined the model: placed on its target with the target's velocity
 
 
 def hinge_angles(rot: _F, axes: _F) -> _F:
@@ -63,6 +64,7 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
     muscle = np.array([c.muscle for c in cmds])
     pin = np.array([c.pin for c in cmds])
     kin = np.array([c.kinematic for c in cmds])
+    place = kin | np.array([c.enter for c in cmds])
     r0 = L.starts[:-1]
     # target velocities from the previous target (zero after a placement)
     v_root = (root - last_root) / dt
@@ -99,14 +101,16 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
         for name, eq in L.hold_eq[p].items():
             d.eq_active[eq] = name == c.hold
         d.mocap_pos[L.hold_mocap[p]] = c.hold_target
-        c.last = (c.root, c.rot)
-    if kin.any():
-        k = np.nonzero(kin)[0]
+        c.last, c.enter = (c.root, c.rot), False
+    # animated bodies are placed on their targets, and so is a body that has just joined the
+    # model (it keeps the animation's momentum, as if it had been simulated all along)
+    if place.any():
+        k = np.nonzero(place)[0]
         d.qpos[L.root_q[k, None] + np.arange(3)] = root[k]
         d.qpos[L.root_q[k, None] + np.arange(3, 7)] = rot[r0[k]]
         d.qvel[L.root_d[k, None] + np.arange(3)] = v_root[k]
         d.qvel[L.root_d[k, None] + np.arange(3, 6)] = w_root[k]
-        b, h = kin[L.ball_owner], kin[L.hinge_owner]
+        b, h = place[L.ball_owner], place[L.hinge_owner]
         d.qpos[L.ball_q[b, None] + np.arange(4)] = ball[b]
         d.qvel[L.ball_d[b, None] + np.arange(3)] = w_ball[b]
         d.qpos[L.hinge_q[h]] = hinge[h]

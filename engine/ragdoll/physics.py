@@ -26,8 +26,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
+from engine.fk import forward_kinematics
 from engine.pose import Pose
 from engine.ragdoll._carry import restore, snapshot
+from engine.ragdoll._islands import LOOKAHEAD, near_simulated, reach
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist, read_poses
 from engine.ragdoll._layout import Layout, build_layout
 from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec, build_mjcf, prop_name, ragdoll_fragment
@@ -44,8 +46,11 @@ _F = NDArray[np.float64]
 class _RagdollSlot:
     spec: RagdollSpec
     cmd: Command
+    reach: float
     placed: bool = False
     fragment: RagdollFragment | None = None
+    in_model: bool = True
+    prev: tuple[_F, _F] | None = None  # out of the model: the target before the last step's
 
 
 @dataclass
@@ -102,7 +107,8 @@ class PhysicsWorld:
             raise ValueError(f"profile has {profile.num_joints} joints, skeleton {skeleton.num_joints}")
         off = np.array(skeleton.offsets if offsets is None else offsets, dtype=np.float64).reshape(-1, 3)
         r, q = self._checked(key, root, rotations, skeleton.num_joints)
-        self._ragdolls[key] = _RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q))
+        self._ragdolls[key] = _RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q),
+                                           reach(skeleton, profile, off))
         self._dirty = True
 
     def add_prop(self, key: int, radius: float, mass: float, position: ArrayLike,
@@ -149,12 +155,14 @@ class PhysicsWorld:
         self._dirty = False
         old = snapshot(self.model, self.data)
         self._ke = self._read = None
-        if not self._ragdolls and not self._props:
+        if not any(s.in_model for s in self._ragdolls.values()) and not self._props:
             self.model = self.data = self.layout = None
             return
         rd: list[RagdollFragment] = []
         for k in sorted(self._ragdolls):
             slot = self._ragdolls[k]
+            if not slot.in_model:
+                continue
             if slot.fragment is None:  # rendered once per ragdoll, reused by every rebuild
                 slot.fragment = ragdoll_fragment(slot.spec)
             rd.append(slot.fragment)
@@ -172,9 +180,10 @@ class PhysicsWorld:
             ps.geom, ps.body = m.geom(n).id, m.body(n).id
         restore(m, d, old)
         for key, slot in self._ragdolls.items():
-            if not slot.placed:
+            if slot.in_model and not slot.placed:
+                last = slot.cmd.last
                 self._place(key, slot.cmd.root, slot.cmd.rot)
-                slot.placed = True
+                slot.cmd.last, slot.cmd.enter, slot.placed = last, last is not None, True
         for ps in self._props.values():
             if ps.init is not None:
                 pos, rot, vel = ps.init
@@ -221,6 +230,26 @@ class PhysicsWorld:
         c.muscle, c.pin = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
         c.support = float(np.clip(gravity_support, 0, 1))
 
+    def drive_animated(self, keys: list[int], roots: list[_F], rotations: list[_F]) -> None:
+        """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
+        in one pass: a crowd of animated puppets is most of the physics stage's Python work)."""
+        if not keys:
+            return
+        slots = [self._slot(k) for k in keys]
+        sizes = [s.spec.skeleton.num_joints for s in slots]
+        r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
+        q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
+        if q.shape != (sum(sizes), 4):
+            raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes}")
+        if not (np.isfinite(r).all() and np.isfinite(q).all()):
+            bad = [k for k, ok in zip(keys, np.isfinite(r).all(axis=1), strict=True) if not ok] or keys
+            raise ValueError(f"ragdoll(s) {bad}: target pose has NaN or infinite values")
+        q = quat.normalize(q)
+        for slot, root, rot in zip(slots, r, np.split(q, np.cumsum(sizes)[:-1]), strict=True):
+            c = slot.cmd
+            c.root, c.rot, c.kinematic = root, rot, True
+            c.muscle = c.pin = c.support = 1.0
+
     def hold(self, key: int, joint: str | None, target: ArrayLike | None = None) -> None:
         """Hold one body of the ragdoll by a spring at ``target`` (``joint=None`` lets go)."""
         slot = self._slot(key)
@@ -239,6 +268,9 @@ class PhysicsWorld:
         slot = self._slot(key)
         r, q = self._checked(key, root, rotations, slot.spec.skeleton.num_joints)
         slot.cmd.root, slot.cmd.rot = r, q
+        if not slot.in_model:
+            slot.cmd.last = None
+            return
         self._place(key, r, q)
         assert self.model is not None and self.data is not None
         mujoco.mj_forward(self.model, self.data)
@@ -263,8 +295,13 @@ class PhysicsWorld:
     # -- stepping -----------------------------------------------------------------------
     def step(self) -> None:
         """Apply every command, advance one simulation step (``substeps`` MuJoCo steps) and
-        enforce the twist limits."""
+        enforce the twist limits. Animated ragdolls far from anything simulated are left out
+        of the model first (:mod:`engine.ragdoll._islands`)."""
+        self._update_islands()
         self.ensure_built()
+        for slot in self._ragdolls.values():
+            if not slot.in_model:  # it moves with its target: where it was is its last target
+                slot.prev, slot.cmd.last = slot.cmd.last, (slot.cmd.root, slot.cmd.rot)
         if self.model is None or self.data is None:
             return
         assert self.layout is not None
@@ -272,6 +309,46 @@ class PhysicsWorld:
         mujoco.mj_step(self.model, self.data, nstep=self.substeps)
         project_twist(self.layout, self.data)
         self._ke = self._read = None
+
+    def _update_islands(self) -> None:
+        """Put the ragdolls that need dynamics (or may touch what has them) in the model, and only those."""
+        slots = [self._ragdolls[k] for k in sorted(self._ragdolls)]
+        if self.simulate_animated:
+            wanted = np.ones(len(slots), dtype=bool)
+        else:
+            needs = np.array([not s.cmd.kinematic or s.cmd.hold is not None for s in slots], dtype=bool)
+            centres = np.array([self._centre(s) for s in slots]).reshape(-1, 3)
+            radii = np.array([s.reach for s in slots])
+            props = [self._prop_sphere(k) for k in sorted(self._props)]
+            sources = np.concatenate([centres[needs], np.array([c for c, _ in props]).reshape(-1, 3)])
+            source_radii = np.concatenate([radii[needs], [r for _, r in props]])
+            inside = np.array([s.in_model for s in slots], dtype=bool)
+            wanted = needs.copy()
+            wanted[~needs] = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+        for slot, want in zip(slots, wanted, strict=True):
+            if slot.in_model != bool(want):
+                slot.in_model, slot.placed = bool(want), False
+                self._dirty = True
+
+    def _centre(self, slot: _RagdollSlot) -> _F:
+        """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
+        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._dirty:
+            rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
+            return np.asarray(self.data.qpos[rq:rq + 3])
+        return slot.cmd.root
+
+    def _prop_sphere(self, key: int) -> tuple[_F, float]:
+        """A prop's bounding sphere over the next :data:`LOOKAHEAD` seconds."""
+        ps = self._props[key]
+        if ps.init is not None or self.data is None:
+            pos, vel = (ps.init[0], ps.init[2]) if ps.init is not None else (np.zeros(3), np.zeros(6))
+        else:
+            pos, vel = self.data.qpos[ps.qadr:ps.qadr + 3], self.data.qvel[ps.dadr:ps.dadr + 3]
+        return np.asarray(pos), ps.spec.radius + float(np.linalg.norm(vel[:3])) * LOOKAHEAD
+
+    def in_model(self, key: int) -> bool:
+        """Whether ragdoll ``key`` is simulated this step (animated ragdolls alone are not)."""
+        return self._slot(key).in_model
 
     # -- readback -----------------------------------------------------------------------
     def _readback(self) -> tuple[_F, _F]:
@@ -282,9 +359,16 @@ class PhysicsWorld:
             self._read = read_poses(self.layout, self.data)
         return self._read
 
+    def _outside(self, key: int) -> _RagdollSlot | None:
+        """The slot of a ragdoll left out of the model (it is exactly on its target), else ``None``."""
+        slot = self._slot(key)
+        self.ensure_built()
+        return None if slot.in_model else slot
+
     def pose(self, key: int) -> Pose:
         """The ragdoll's simulated pose as an engine :class:`Pose` (root + local rotations)."""
-        self._slot(key)
+        if (out := self._outside(key)) is not None:
+            return Pose(out.cmd.root.copy(), out.cmd.rot.copy())
         roots, rot = self._readback()
         L = self.layout
         assert L is not None
@@ -293,25 +377,30 @@ class PhysicsWorld:
 
     def body_positions(self, key: int) -> _F:
         """World positions ``[J,3]`` of the ragdoll's joint origins."""
-        self._slot(key)
-        self.ensure_built()
+        if (out := self._outside(key)) is not None:
+            return forward_kinematics(out.spec.skeleton, out.cmd.root, out.cmd.rot, out.spec.offsets)[0]
         L, d = self.layout, self.data
         assert L is not None and d is not None
         return d.xpos[L.body[L.body_owner == L.ordinal(key)]].copy()
 
     def root_velocity(self, key: int) -> _F:
         """The root's free-joint velocity ``[6]`` (linear world, angular local)."""
-        self._slot(key)
-        self.ensure_built()
+        if (out := self._outside(key)) is not None:  # its target's velocity over the last step
+            v, last, prev = np.zeros(6), out.cmd.last, out.prev
+            if last is not None and prev is not None:
+                v[:3] = (last[0] - prev[0]) / self.dt
+                v[3:] = quat.log(quat.mul(quat.conjugate(prev[1][0]), last[1][0])) / self.dt
+            return v
         L, d = self.layout, self.data
         assert L is not None and d is not None
         rd = int(L.root_d[L.ordinal(key)])
         return d.qvel[rd:rd + 6].copy()
 
     def kinetic_energy(self, key: int) -> float:
-        """Kinetic energy (J) of one ragdoll, ½ vᵀMv over its own degrees of freedom."""
-        self._slot(key)
-        self.ensure_built()
+        """Kinetic energy (J) of one ragdoll, ½ vᵀMv over its own degrees of freedom (0 for an
+        animated ragdoll left out of the model: nothing is simulated)."""
+        if self._outside(key) is not None:
+            return 0.0
         L, m, d = self.layout, self.model, self.data
         assert L is not None and m is not None and d is not None
         if self._ke is None:
@@ -322,8 +411,10 @@ class PhysicsWorld:
         return float(self._ke[L.ordinal(key)])
 
     def joint_limit_violation(self, key: int) -> float:
-        """Largest excess (rad) of any joint beyond its cone, twist or hinge range (0 when within)."""
-        self._slot(key)
+        """Largest excess (rad) of any simulated joint beyond its cone, twist or hinge range (0 when
+        within, and for an animated ragdoll left out of the model)."""
+        if self._outside(key) is not None:
+            return 0.0
         roots, rot = self._readback()
         L, d = self.layout, self.data
         assert L is not None and d is not None
