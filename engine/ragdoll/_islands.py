@@ -11,6 +11,11 @@ far it travels in :data:`LOOKAHEAD`) closer than :data:`ENTER`, kept until farth
 than :data:`LEAVE` (the hysteresis keeps a puppet walking beside a ball from
 recompiling the model every step). A crowd walking on an empty field is then no
 MuJoCo work at all; membership changes recompile the model, carrying every state.
+
+Puppets can also end up inside each other (two dropped on one spot, one walked into
+another as it falls): MuJoCo would push them apart at 10⁵ m/s. A simulated ragdoll whose
+root is that close to another's is a *ghost* (:func:`ghosts`): it touches only the
+ground and props until the two are apart again.
 """
 
 from __future__ import annotations
@@ -21,11 +26,13 @@ from numpy.typing import NDArray
 from engine.ragdoll.profile import RagdollProfile, bone_segments
 from engine.skeleton import Skeleton
 
-__all__ = ["reach", "near_simulated", "ENTER", "LEAVE", "LOOKAHEAD"]
+__all__ = ["reach", "near_simulated", "ghosts", "ENTER", "LEAVE", "LOOKAHEAD", "OVERLAP", "APART"]
 
 ENTER = 0.4  # m of clearance between bounding spheres under which an animated ragdoll joins
 LEAVE = 1.0  # m of clearance over which it leaves again
 LOOKAHEAD = 0.25  # s of a prop's travel added to its sphere
+OVERLAP = 0.35  # m between two roots under which a simulated ragdoll passes through ragdolls (a ghost)
+APART = 0.8  # m over which a ghost collides with ragdolls again
 
 _F = NDArray[np.float64]
 
@@ -50,3 +57,14 @@ def near_simulated(centres: _F, radii: _F, sources: _F, source_radii: _F, inside
     gap = np.linalg.norm(centres[:, None, :] - sources[None, :, :], axis=2) - radii[:, None] - source_radii[None, :]
     limit = np.where(inside, LEAVE, ENTER)
     return np.asarray((gap < limit[:, None]).any(axis=1))
+
+
+def ghosts(roots: _F, simulated: NDArray[np.bool_], ghost: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Which simulated ragdolls (roots ``[P,3]``) are deep inside another ragdoll: roots closer
+    than :data:`OVERLAP`; a ghost (``ghost [P]`` now) stays one until farther than :data:`APART`."""
+    if len(roots) < 2:
+        return np.zeros(len(roots), dtype=bool)
+    dist = np.linalg.norm(roots[:, None, :] - roots[None, :, :], axis=2)
+    np.fill_diagonal(dist, np.inf)
+    limit = np.where(ghost, APART, OVERLAP)
+    return np.asarray(simulated & (dist.min(axis=1) < limit))

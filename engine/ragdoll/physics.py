@@ -14,11 +14,14 @@ and :meth:`step` applies the commands of every ragdoll in one vectorised pass
 Adding a ragdoll or prop at run time regenerates the MJCF and recompiles; every body
 that existed keeps its exact state, carried over by name (:mod:`engine.ragdoll._carry`).
 Snowballs change radius in place (geom size, bounds, mass, inertia, ``mj_setConst``).
+Each step is guarded (:mod:`engine.ragdoll._guard`): velocities are bounded, and a step
+MuJoCo cannot take is undone and counted in :attr:`PhysicsWorld.recoveries`.
 """
 
 from __future__ import annotations
 
 import hashlib
+import warnings
 from dataclasses import dataclass
 
 import mujoco
@@ -29,7 +32,8 @@ from engine import quat
 from engine.fk import forward_kinematics
 from engine.pose import Pose
 from engine.ragdoll._carry import restore, snapshot
-from engine.ragdoll._islands import LOOKAHEAD, near_simulated, reach
+from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step, velocity_limits
+from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist, read_poses
 from engine.ragdoll._layout import Layout, build_layout
 from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec, build_mjcf, prop_name, ragdoll_fragment
@@ -51,6 +55,7 @@ class _RagdollSlot:
     fragment: RagdollFragment | None = None
     in_model: bool = True
     prev: tuple[_F, _F] | None = None  # out of the model: the target before the last step's
+    ghost: bool = False  # inside another ragdoll: touches only the ground and props
 
 
 @dataclass
@@ -91,6 +96,10 @@ class PhysicsWorld:
         self._ke: _F | None = None
         self._read: tuple[_F, _F] | None = None
         self.simulate_animated = False
+        self.recoveries = 0
+        self._limit = np.zeros(0)
+        self._owners = np.zeros(0, dtype=np.int64)
+        collect_warnings()
 
     @property
     def dt(self) -> float:
@@ -178,12 +187,23 @@ class PhysicsWorld:
             j = m.joint(n).id
             ps.qadr, ps.dadr = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
             ps.geom, ps.body = m.geom(n).id, m.body(n).id
+        self._limit = velocity_limits(m)
+        self._owners = np.full(m.nv, -1, dtype=np.int64)
+        for p, (a, b) in enumerate(self.layout.dofs):
+            self._owners[a:b] = p
+        for k, ps in enumerate(self._props.values()):
+            self._owners[ps.dadr:ps.dadr + 6] = len(self.layout.keys) + k
         restore(m, d, old)
         for key, slot in self._ragdolls.items():
             if slot.in_model and not slot.placed:
-                last = slot.cmd.last
-                self._place(key, slot.cmd.root, slot.cmd.rot)
-                slot.cmd.last, slot.cmd.enter, slot.placed = last, last is not None, True
+                # joining from outside: where its animation was a step ago, moving as it moved then
+                # (as if it had been simulated all along), so it keeps its momentum
+                last, prev = slot.cmd.last, slot.prev
+                if last is None:
+                    self._place(key, slot.cmd.root, slot.cmd.rot)
+                else:
+                    self._place(key, last[0], last[1], prev)
+                slot.cmd.last, slot.placed = last, True
         for ps in self._props.values():
             if ps.init is not None:
                 pos, rot, vel = ps.init
@@ -230,25 +250,39 @@ class PhysicsWorld:
         c.muscle, c.pin = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
         c.support = float(np.clip(gravity_support, 0, 1))
 
-    def drive_animated(self, keys: list[int], roots: list[_F], rotations: list[_F]) -> None:
+    def drive_animated(self, keys: list[int], roots: list[_F], rotations: list[_F]) -> list[int]:
         """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
-        in one pass: a crowd of animated puppets is most of the physics stage's Python work)."""
+        in one pass: a crowd of animated puppets is most of the physics stage's Python work).
+
+        A target with NaN or infinite values is not taken: that ragdoll keeps its previous
+        command (see :meth:`target`), so a bad pose never reaches MuJoCo.
+
+        Returns:
+            The keys whose targets were refused.
+        """
         if not keys:
-            return
+            return []
         slots = [self._slot(k) for k in keys]
         sizes = [s.spec.skeleton.num_joints for s in slots]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
         if q.shape != (sum(sizes), 4):
             raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes}")
-        if not (np.isfinite(r).all() and np.isfinite(q).all()):
-            bad = [k for k, ok in zip(keys, np.isfinite(r).all(axis=1), strict=True) if not ok] or keys
-            raise ValueError(f"ragdoll(s) {bad}: target pose has NaN or infinite values")
-        q = quat.normalize(q)
-        for slot, root, rot in zip(slots, r, np.split(q, np.cumsum(sizes)[:-1]), strict=True):
+        ends = np.cumsum(sizes)
+        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
+        q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
+        for slot, good, root, rot in zip(slots, ok, r, np.split(q, ends[:-1]), strict=True):
             c = slot.cmd
-            c.root, c.rot, c.kinematic = root, rot, True
+            if good:
+                c.root, c.rot = root, rot
+            c.kinematic = True
             c.muscle = c.pin = c.support = 1.0
+        return [k for k, good in zip(keys, ok, strict=True) if not good]
+
+    def target(self, key: int) -> Pose:
+        """The ragdoll's current command (its last accepted target pose)."""
+        c = self._slot(key).cmd
+        return Pose(c.root.copy(), c.rot.copy())
 
     def hold(self, key: int, joint: str | None, target: ArrayLike | None = None) -> None:
         """Hold one body of the ragdoll by a spring at ``target`` (``joint=None`` lets go)."""
@@ -275,18 +309,28 @@ class PhysicsWorld:
         assert self.model is not None and self.data is not None
         mujoco.mj_forward(self.model, self.data)
 
-    def _place(self, key: int, root: _F, rot: _F) -> None:
+    def _place(self, key: int, root: _F, rot: _F, before: tuple[_F, _F] | None = None) -> None:
+        """Put a ragdoll's bodies on a pose, at rest or moving as it moved from ``before`` in one step."""
         L, d = self.layout, self.data
         assert L is not None and d is not None
         p = L.ordinal(key)
-        rq = int(L.root_q[p])
+        rq, rd = int(L.root_q[p]), int(L.root_d[p])
         d.qpos[rq:rq + 3] = root
         d.qpos[rq + 3:rq + 7] = rot[0]
         b = L.ball_owner == p
-        d.qpos[L.ball_q[b][:, None] + np.arange(4)] = rot[L.ball_src[b] - L.starts[p]]
+        ball = rot[L.ball_src[b] - L.starts[p]]
+        d.qpos[L.ball_q[b][:, None] + np.arange(4)] = ball
         h = L.hinge_owner == p
-        d.qpos[L.hinge_q[h]] = hinge_angles(rot[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])
+        hinge = hinge_angles(rot[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])
+        d.qpos[L.hinge_q[h]] = hinge
         d.qvel[L.dofs[p, 0]:L.dofs[p, 1]] = 0.0
+        if before is not None:  # the same target velocities as an animated (kinematic) placement
+            r0, q0 = before
+            d.qvel[rd:rd + 3] = (root - r0) / self.dt
+            d.qvel[rd + 3:rd + 6] = quat.rotate(q0[0], quat.log(quat.mul(quat.conjugate(q0[0]), rot[0]))) / self.dt
+            d.qvel[L.ball_d[b][:, None] + np.arange(3)] = quat.log(
+                quat.mul(quat.conjugate(q0[L.ball_src[b] - L.starts[p]]), ball)) / self.dt
+            d.qvel[L.hinge_d[h]] = (hinge - hinge_angles(q0[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])) / self.dt
         d.mocap_pos[L.pin_mocap[p]] = root
         d.mocap_quat[L.pin_mocap[p]] = rot[0]
         self._slot(key).cmd.last = None
@@ -305,9 +349,20 @@ class PhysicsWorld:
         if self.model is None or self.data is None:
             return
         assert self.layout is not None
-        apply_commands(self.layout, self.model, self.data, [self._ragdolls[k].cmd for k in self.layout.keys], self.dt)
-        mujoco.mj_step(self.model, self.data, nstep=self.substeps)
-        project_twist(self.layout, self.data)
+        L, d = self.layout, self.data
+        slots = [self._ragdolls[k] for k in L.keys]
+        roots = d.qpos[L.root_q[:, None] + np.arange(3)]
+        simulated = np.array([not s.cmd.kinematic for s in slots], dtype=bool)
+        ghost = ghosts(roots, simulated, np.array([s.ghost for s in slots], dtype=bool))
+        for slot, g in zip(slots, ghost, strict=True):
+            slot.ghost = bool(g)
+        apply_commands(L, self.model, d, [s.cmd for s in slots], self.dt, ghost)
+        reason = guarded_step(self.model, self.data, self.substeps, self._limit, self._owners)
+        if reason is None:
+            project_twist(self.layout, self.data)
+        else:
+            self.recoveries += 1
+            warnings.warn(PhysicsRecovery(f"physics step undone, bodies reset: {reason}"), stacklevel=2)
         self._ke = self._read = None
 
     def _update_islands(self) -> None:

@@ -65,14 +65,22 @@ def physics_step(world: World) -> None:
     rows = world.query(Ragdoll, Puppet, LocalPose)
     animated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is RagdollMode.ANIMATED]
     simulated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is not RagdollMode.ANIMATED]
-    pw.drive_animated([e for e, _, _ in animated], [p.root for _, _, p in animated],
-                      [p.rotations for _, _, p in animated])
+    refused = pw.drive_animated([e for e, _, _ in animated], [p.root for _, _, p in animated],
+                                [p.rotations for _, _, p in animated])
     targets: dict[Entity, Pose] = {}
     for e, rd, pose in simulated:
         rd.ramp(world.dt)
-        target = Pose(np.array(pose.root, dtype=np.float64), quat.normalize(pose.rotations))
+        target = Pose(np.array(pose.root, dtype=np.float64), np.array(pose.rotations, dtype=np.float64))
+        if not target.is_finite():
+            refused.append(e)
+            target = pw.target(e)
+        target.rotations = quat.normalize(target.rotations)
         targets[e] = target
         pw.drive(e, target.root, target.rotations, rd.muscle_weight, rd.pin_weight, rd.muscle_weight * rd.pin_weight)
+    for e in refused:  # a NaN pose from upstream: count it, keep the last good target
+        pw.recoveries += 1
+        pose = world.get(e, LocalPose)
+        pose.root, pose.rotations = pw.target(e).root, pw.target(e).rotations
     for e, rd, _ in animated:
         rd.ramp(world.dt)
         # not simulated: the body is its animation (no energy of its own, nothing to settle)
