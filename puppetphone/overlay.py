@@ -1,4 +1,4 @@
-"""The on-screen overlay: fps, the game's status, each puppet's state, input sources.
+"""The on-screen overlay: fps, physics recoveries, the game's status, each puppet's state, input sources.
 
 Only reads the world; drawn as text lines into the render scene.
 """
@@ -6,6 +6,7 @@ Only reads the world; drawn as text lines into the render scene.
 from __future__ import annotations
 
 from engine.ecs import World
+from engine.ragdoll import PhysicsWorld
 from engine.render.scene import RenderScene
 from engine.statemachine import Brain
 from games.base import Game
@@ -16,7 +17,9 @@ __all__ = ["draw_overlay", "overlay_lines"]
 
 def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: bool) -> list[str]:
     """The overlay's text, top to bottom."""
-    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}" + ("   PAUSED" if paused else "")]
+    physics = world.try_resource(PhysicsWorld)
+    recoveries = "" if physics is None else f"   physics_recoveries {physics.recoveries}"
+    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}{recoveries}" + ("   PAUSED" if paused else "")]
     lines += game.status(world)
     for e, brain in world.query(Brain):
         events = ", ".join(brain.last_events[-3:])

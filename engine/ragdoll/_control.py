@@ -25,6 +25,7 @@ GRAVITY = 9.81
 _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
 _PIN_DAMPING = 100.0  # and damping (1/s): critically damped
 _MAX_LEAD = 0.5  # s: cap on the velocity lead at tiny weights
+_HOLD_REACH = 0.5  # m: farthest the hold spring's anchor is from the held body (a stick flicked into the sky)
 _F = NDArray[np.float64]
 
 
@@ -100,7 +101,14 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
     for p, c in enumerate(cmds):
         for name, eq in L.hold_eq[p].items():
             d.eq_active[eq] = name == c.hold
-        d.mocap_pos[L.hold_mocap[p]] = c.hold_target
+        target = c.hold_target
+        if c.hold is not None:  # the spring pulls from at most _HOLD_REACH away: a bounded force
+            held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][c.hold]]]
+            gap = target - held
+            dist = float(np.linalg.norm(gap))
+            if dist > _HOLD_REACH:
+                target = held + gap * (_HOLD_REACH / dist)
+        d.mocap_pos[L.hold_mocap[p]] = target
         c.last = (c.root, c.rot)
     if kin.any():
         k = np.nonzero(kin)[0]

@@ -30,6 +30,7 @@ __all__ = ["MAX_LINEAR", "MAX_ANGULAR", "velocity_limits", "guarded_step", "coll
 
 MAX_LINEAR = 30.0  # m/s: faster than any throw or fall in the field
 MAX_ANGULAR = 1000.0  # rad/s: a foot snapping back inside its joint limit on entry reaches ~550
+_BLOWUP = 10.0  # a substep that ends this many times over the bound has exploded
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 _PENDING: list[str] = []
 _HOOKED: list[bool] = []
@@ -80,6 +81,9 @@ def guarded_step(m: mujoco.MjModel, d: mujoco.MjData, substeps: int, limit: NDAr
     try:
         for _ in range(substeps):
             mujoco.mj_step(m, d)
+            if (np.abs(d.qvel) > _BLOWUP * limit).any():  # exploded inside the substep
+                reason = "velocity blow-up"
+                break
             np.clip(d.qvel, -limit, limit, out=d.qvel)
     except mujoco.FatalError as exc:
         reason = f"MuJoCo error: {exc}"
