@@ -7,7 +7,9 @@ play. Every figure is thread CPU time per simulation step (the machine is shared
 wall time would measure the neighbours), the median over :data:`STEPS` steps after a
 second of warm-up, against the 60 Hz frame budget. ``crowd_step_ms_100_old`` is the
 same crowd on the path from before animated puppets left the dynamics
-(:attr:`PhysicsWorld.simulate_animated`), measured in the same run so the ratio is fair.
+(:attr:`PhysicsWorld.simulate_animated`) and before crowds were grounded in one batch
+(:attr:`IKRigCache.batch_from`), measured in the same run so the ratio is fair; the other
+batching (animated drive, locomotion write-back) has no switch and is in both.
 ``crowd_system_ms_<stage>_100`` splits the 100-puppet step by schedule stage.
 """
 
@@ -19,6 +21,7 @@ import numpy as np
 
 from bench.figures import Figure
 from engine.app import STAGES, App
+from engine.ik.system import IKRigCache
 from engine.ragdoll.physics import PhysicsWorld
 
 __all__ = ["run", "crowd_app", "timed_steps", "STEPS", "BUDGET_MS"]
@@ -35,6 +38,8 @@ def crowd_app(puppets: int, *, old: bool = False, seed: int = 1) -> App:
     app = App(seed=seed)
     install(app, puppets=puppets)
     app.world.resource(PhysicsWorld).simulate_animated = old
+    if old:
+        app.world.resource(IKRigCache).batch_from = puppets + 1
     app.run_steps(60)
     return app
 

@@ -72,6 +72,7 @@ class IKRigCache:
     settings: IKSettings = field(default_factory=IKSettings)
     rigs: dict[int, IKRig] = field(default_factory=dict)
     canonical: dict[int, Skeleton] = field(default_factory=dict)
+    batch_from: int = BATCH  # alike puppets from which grounding is batched (benches raise it to compare)
 
     def rig(self, skeleton: Skeleton) -> IKRig:
         """The rig of ``skeleton``: the humanoid preset for the default puppet, ball joints otherwise."""
@@ -109,7 +110,7 @@ def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]
     query = ground.query if ground is not None else PlaneGround()
     done: set[int] = set()
     for group in groups.values():
-        if len(group) < BATCH:
+        if len(group) < cache.batch_from:
             continue
         sk = cache.same_as(group[0][0].skeleton)
         roots = np.array([local.root for _, local, _ in group], dtype=np.float64)

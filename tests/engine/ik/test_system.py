@@ -71,8 +71,9 @@ def test_a_crowd_is_grounded_in_one_batch_with_the_same_result(monkeypatch):
     roots = np.column_stack([rng.uniform(-3, 3, n), np.full(n, 0.95), rng.uniform(-3, 3, n)])
     rots = quat.normalize(quat.identity(n, 17) + rng.normal(0, 0.05, (n, 17, 4)))
 
-    def run():
+    def run(batch_from: int):
         app = App(seed=1, plugins=[install_ik])
+        app.world.insert_resource(system.IKRigCache(batch_from=batch_from))
         app.world.insert_resource(IKGround(PlaneGround(normal=(0.1, 1.0, -0.2))))
         ents = []
         for i in range(n):  # separately built skeletons, alike: one batch
@@ -86,10 +87,10 @@ def test_a_crowd_is_grounded_in_one_batch_with_the_same_result(monkeypatch):
     calls = []
     real = system.ground_feet_batch
     monkeypatch.setattr(system, "ground_feet_batch", lambda *a, **k: calls.append(1) or real(*a, **k))
-    batched = run()
+    batched = run(system.BATCH)
     assert calls == [1]
-    monkeypatch.setattr(system, "BATCH", 10**9)
-    single = run()
+    single = run(10**9)
+    assert calls == [1]
     for a, b in zip(batched, single, strict=True):
         np.testing.assert_allclose(a.root, b.root, atol=1e-12)
         np.testing.assert_allclose(a.rotations, b.rotations, atol=1e-12)
