@@ -214,9 +214,43 @@ def ground_feet_batch(
     targets = flat - quat.rotate(new_rot, soles)
     shift = np.clip(np.min(targets[..., 1] - ankles[..., 1], axis=1), -max_pelvis_shift, max_pelvis_shift)
     roots[:, 1] += shift
-    pose = Pose(roots, rotations)
-    for k, ((u, lo, f), leg) in enumerate(zip(idx, legs, strict=True)):
-        wp, wr = path_fk(skeleton, roots, rotations, lo, off)
-        pole = wp[lo] + quat.rotate(wr[int(skeleton.parents[u])], leg.knee_forward)
-        two_bone_ik(skeleton, pose, (u, lo, f), targets[:, k], pole, end_rotation=new_rot[:, k], offsets=off)
+    hips = {int(skeleton.parents[u]) for u, _, _ in idx}
+    if len(hips) != 1:  # legs hung from different joints: one solve per leg
+        pose = Pose(roots, rotations)
+        for k, ((u, lo, f), leg) in enumerate(zip(idx, legs, strict=True)):
+            wp, wr = path_fk(skeleton, roots, rotations, lo, off)
+            pole = wp[lo] + quat.rotate(wr[int(skeleton.parents[u])], leg.knee_forward)
+            two_bone_ik(skeleton, pose, (u, lo, f), targets[:, k], pole, end_rotation=new_rot[:, k], offsets=off)
+        return shift
+    _solve_legs(skeleton, roots, rotations, off, hips.pop(), idx, legs, targets, new_rot)
     return shift
+
+
+def _solve_legs(skeleton: Skeleton, roots: F, rotations: F, off: F, hip: int, idx: list[tuple[int, int, int]],
+                legs: tuple[Leg, ...], targets: F, new_rot: F) -> None:
+    """Every leg of every puppet in one batched two-bone solve.
+
+    The legs hang from one joint, so each is a chain ``hip → upper → lower → foot`` of its
+    own: a four-joint skeleton whose root is the hip's world transform, batched ``[L, P]``.
+    Its forward kinematics repeats the full skeleton's operations along the same path, so
+    the result is the one a solve per leg gives.
+    """
+    from engine.ik.two_bone import two_bone_ik
+
+    wp, wr = path_fk(skeleton, roots, rotations, hip, off)
+    chains = np.array(idx).T  # [3, L]
+    offs = np.broadcast_to(off, rotations.shape[:-2] + off.shape[-2:])
+    leg_off = np.zeros((len(legs),) + offs.shape[:-2] + (4, 3))
+    leg_off[..., 1:, :] = np.moveaxis(offs[..., chains, :], -2, 0)  # [L, P, 3, 3]
+    leg_rot = np.empty((len(legs),) + rotations.shape[:-2] + (4, 4))
+    leg_rot[..., 0, :] = wr[hip]
+    leg_rot[..., 1:, :] = np.moveaxis(rotations[..., chains, :], -2, 0)
+    chain = Skeleton(("hip", "upper", "lower", "foot"), np.array([-1, 0, 1, 2]), leg_off.reshape(-1, 4, 3)[0])
+    root = np.broadcast_to(wp[hip], leg_rot.shape[:-2] + (3,)).copy()
+    pose = Pose(root, leg_rot)
+    lp, lr = path_fk(chain, root, leg_rot, 2, leg_off)
+    knee = np.array([leg.knee_forward for leg in legs])[:, None, :]
+    pole = lp[2] + quat.rotate(lr[0], knee)
+    two_bone_ik(chain, pose, (1, 2, 3), np.moveaxis(targets, 1, 0), pole,
+                end_rotation=np.moveaxis(new_rot, 1, 0), offsets=leg_off)
+    rotations[..., chains, :] = np.moveaxis(leg_rot[..., 1:, :], 0, -2)
