@@ -22,20 +22,20 @@ from __future__ import annotations
 
 import hashlib
 import warnings
-from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
-from engine.fk import forward_kinematics
 from engine.pose import Pose
 from engine.ragdoll._carry import restore, snapshot
+from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step, velocity_limits
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
-from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist, read_poses
 from engine.ragdoll._layout import Layout, build_layout
+from engine.ragdoll._readback import Readback
+from engine.ragdoll._slots import PropSlot, RagdollSlot
 from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec, build_mjcf, prop_name, ragdoll_fragment
 from engine.ragdoll.profile import RagdollProfile
 from engine.skeleton import Skeleton
@@ -46,29 +46,7 @@ _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 _F = NDArray[np.float64]
 
 
-@dataclass
-class _RagdollSlot:
-    spec: RagdollSpec
-    cmd: Command
-    reach: float
-    placed: bool = False
-    fragment: RagdollFragment | None = None
-    in_model: bool = True
-    prev: tuple[_F, _F] | None = None  # out of the model: the target before the last step's
-    ghost: bool = False  # inside another ragdoll: touches only the ground and props
-
-
-@dataclass
-class _PropSlot:
-    spec: PropSpec
-    init: tuple[_F, _F, _F] | None = None
-    qadr: int = -1
-    dadr: int = -1
-    geom: int = -1
-    body: int = -1
-
-
-class PhysicsWorld:
+class PhysicsWorld(Readback):
     """The physics resource: ragdolls and props keyed by their entity id.
 
     Args:
@@ -89,8 +67,8 @@ class PhysicsWorld:
         self.data: mujoco.MjData | None = None
         self.layout: Layout | None = None
         self.rebuilds = 0
-        self._ragdolls: dict[int, _RagdollSlot] = {}
-        self._props: dict[int, _PropSlot] = {}
+        self._ragdolls: dict[int, RagdollSlot] = {}
+        self._props: dict[int, PropSlot] = {}
         self._dirty = False
         self._digest = b""
         self._ke: _F | None = None
@@ -116,7 +94,7 @@ class PhysicsWorld:
             raise ValueError(f"profile has {profile.num_joints} joints, skeleton {skeleton.num_joints}")
         off = np.array(skeleton.offsets if offsets is None else offsets, dtype=np.float64).reshape(-1, 3)
         r, q = self._checked(key, root, rotations, skeleton.num_joints)
-        self._ragdolls[key] = _RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q),
+        self._ragdolls[key] = RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q),
                                            reach(skeleton, profile, off))
         self._dirty = True
 
@@ -130,7 +108,7 @@ class PhysicsWorld:
         rot = quat.identity() if rotation is None else quat.normalize(np.asarray(rotation, dtype=np.float64))
         vel = np.zeros(6) if velocity is None else np.asarray(velocity, dtype=np.float64).reshape(6)
         init = (np.array(position, dtype=np.float64).reshape(3), rot, vel)
-        self._props[key] = _PropSlot(PropSpec(key, float(radius), float(mass), friction), init=init)
+        self._props[key] = PropSlot(PropSpec(key, float(radius), float(mass), friction), init=init)
         self._dirty = True
 
     def remove(self, key: int) -> None:
@@ -222,7 +200,7 @@ class PhysicsWorld:
             raise ValueError(f"ragdoll {key}: target pose has NaN or infinite values")
         return r, quat.normalize(q)
 
-    def _slot(self, key: int) -> _RagdollSlot:
+    def _slot(self, key: int) -> RagdollSlot:
         try:
             return self._ragdolls[key]
         except KeyError:
@@ -385,7 +363,7 @@ class PhysicsWorld:
                 slot.in_model, slot.placed = bool(want), False
                 self._dirty = True
 
-    def _centre(self, slot: _RagdollSlot) -> _F:
+    def _centre(self, slot: RagdollSlot) -> _F:
         """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
         if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._dirty:
             rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
@@ -405,87 +383,8 @@ class PhysicsWorld:
         """Whether ragdoll ``key`` is simulated this step (animated ragdolls alone are not)."""
         return self._slot(key).in_model
 
-    # -- readback -----------------------------------------------------------------------
-    def _readback(self) -> tuple[_F, _F]:
-        """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll (cached per step)."""
-        self.ensure_built()
-        if self._read is None:
-            assert self.layout is not None and self.data is not None
-            self._read = read_poses(self.layout, self.data)
-        return self._read
-
-    def _outside(self, key: int) -> _RagdollSlot | None:
-        """The slot of a ragdoll left out of the model (it is exactly on its target), else ``None``."""
-        slot = self._slot(key)
-        self.ensure_built()
-        return None if slot.in_model else slot
-
-    def pose(self, key: int) -> Pose:
-        """The ragdoll's simulated pose as an engine :class:`Pose` (root + local rotations)."""
-        if (out := self._outside(key)) is not None:
-            return Pose(out.cmd.root.copy(), out.cmd.rot.copy())
-        roots, rot = self._readback()
-        L = self.layout
-        assert L is not None
-        p = L.ordinal(key)
-        return Pose(roots[p].copy(), rot[L.starts[p]:L.starts[p + 1]].copy())
-
-    def body_positions(self, key: int) -> _F:
-        """World positions ``[J,3]`` of the ragdoll's joint origins."""
-        if (out := self._outside(key)) is not None:
-            return forward_kinematics(out.spec.skeleton, out.cmd.root, out.cmd.rot, out.spec.offsets)[0]
-        L, d = self.layout, self.data
-        assert L is not None and d is not None
-        return d.xpos[L.body[L.body_owner == L.ordinal(key)]].copy()
-
-    def root_velocity(self, key: int) -> _F:
-        """The root's free-joint velocity ``[6]`` (linear world, angular local)."""
-        if (out := self._outside(key)) is not None:  # its target's velocity over the last step
-            v, last, prev = np.zeros(6), out.cmd.last, out.prev
-            if last is not None and prev is not None:
-                v[:3] = (last[0] - prev[0]) / self.dt
-                v[3:] = quat.log(quat.mul(quat.conjugate(prev[1][0]), last[1][0])) / self.dt
-            return v
-        L, d = self.layout, self.data
-        assert L is not None and d is not None
-        rd = int(L.root_d[L.ordinal(key)])
-        return d.qvel[rd:rd + 6].copy()
-
-    def kinetic_energy(self, key: int) -> float:
-        """Kinetic energy (J) of one ragdoll, ½ vᵀMv over its own degrees of freedom (0 for an
-        animated ragdoll left out of the model: nothing is simulated)."""
-        if self._outside(key) is not None:
-            return 0.0
-        L, m, d = self.layout, self.model, self.data
-        assert L is not None and m is not None and d is not None
-        if self._ke is None:
-            res = np.zeros(m.nv)
-            mujoco.mj_mulM(m, d, res, d.qvel)
-            cum = np.concatenate([[0.0], np.cumsum(0.5 * d.qvel * res)])
-            self._ke = cum[L.dofs[:, 1]] - cum[L.dofs[:, 0]]
-        return float(self._ke[L.ordinal(key)])
-
-    def joint_limit_violation(self, key: int) -> float:
-        """Largest excess (rad) of any simulated joint beyond its cone, twist or hinge range (0 when
-        within, and for an animated ragdoll left out of the model)."""
-        if self._outside(key) is not None:
-            return 0.0
-        roots, rot = self._readback()
-        L, d = self.layout, self.data
-        assert L is not None and d is not None
-        p = L.ordinal(key)
-        b, h = L.ball_owner == p, L.hinge_owner == p
-        q = rot[L.ball_src[b]]
-        cone = np.max(quat.angle_between(quat.identity(len(q)), q) - L.ball_cone[b], initial=0.0)
-        _, tw = quat.swing_twist(quat.align_hemisphere(q), L.ball_axis[b])
-        tang = np.abs(2.0 * np.arctan2(np.sum(tw[:, 1:] * L.ball_axis[b], axis=1), tw[:, 0]))
-        twist = np.max(tang - L.ball_twist[b], initial=0.0)
-        a = d.qpos[L.hinge_q[h]]
-        hinge = np.max(np.maximum(L.hinge_range[h, 0] - a, a - L.hinge_range[h, 1]), initial=0.0)
-        return float(max(cone, twist, hinge, 0.0))
-
     # -- props ----------------------------------------------------------------------------
-    def _prop(self, key: int) -> _PropSlot:
+    def _prop(self, key: int) -> PropSlot:
         self.ensure_built()
         try:
             return self._props[key]
