@@ -20,4 +20,5 @@ BENCHES: dict[str, str] = {
     "snowman": "bench.snowman",
     "render": "bench.render",
     "state-hash": "bench.state_hash",
+    "crowd": "bench.crowd",
 }

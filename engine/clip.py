@@ -88,7 +88,8 @@ class Clip:
         """Length in seconds; a loop's last frame joins the first, so it spans ``F`` frames."""
         return (self.num_frames if self.loop else self.num_frames - 1) / self.fps
 
-    def _frame_pair(self, t: float | NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+    def frame_pair(self, t: float | NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+        """The two frames around time ``t`` (wrapped for loops, clamped otherwise) and the fraction between them."""
         f = np.asarray(t, dtype=np.float64) * self.fps
         n = self.num_frames
         if self.loop:
@@ -103,7 +104,7 @@ class Clip:
 
     def sample(self, t: float | NDArray[np.float64]) -> Pose:
         """The pose at time ``t`` seconds (wrapped for loops, clamped otherwise); ``t`` may be an array."""
-        i0, i1, a = self._frame_pair(t)
+        i0, i1, a = self.frame_pair(t)
         root = self.root[i0] + a[..., None] * (self.root[i1] - self.root[i0])
         rot = quat.slerp(self.rotations[i0], self.rotations[i1], np.asarray(a)[..., None])
         return Pose(root, rot)
@@ -113,7 +114,7 @@ class Clip:
         rm = self.root_motion
         if rm is None:
             return np.zeros(3), 0.0
-        i0, i1, a = self._frame_pair(t)
+        i0, i1, a = self.frame_pair(t)
         i0, i1, a = int(i0), int(i1), float(a)
         n = self.num_frames
         # The loop's closing segment runs from the last frame to the first frame of the

@@ -26,7 +26,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="the world's random seed (default 0)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
                         help="a game option (snowman: field=PATH; tasbada: save, photo, selfie, webcam; "
-                             "sandbox: scene); repeatable")
+                             "sandbox: scene, puppets); repeatable")
+    parser.add_argument("--puppets", type=int, default=None, metavar="N",
+                        help="sandbox: a crowd of N puppets wandering the field (same as --set puppets=N)")
 
 
 def resolve_source(source: str, game: str) -> str:
@@ -75,7 +77,8 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         game = load_game(args.game)
-        options = parse_settings(args.settings, game.options, game.name)
+        settings = args.settings + ([f"puppets={args.puppets}"] if args.puppets is not None else [])
+        options = parse_settings(settings, game.options, game.name)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -1,4 +1,4 @@
-"""The on-screen overlay: fps, the game's status, what each puppet is doing, input sources,
+"""The on-screen overlay: fps, physics recoveries, the game's status, what each puppet is doing, input sources,
 the help, and the game's notices ("field saved").
 
 Only reads the world; drawn as text lines into the render scene, light on the dark
@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from engine.components import Name
 from engine.ecs import World
+from engine.ragdoll import PhysicsWorld
 from engine.render.scene import RenderScene
 from engine.statemachine import Brain
 from engine.statemachine.puppet.words import describe_puppet
@@ -48,7 +49,9 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
     state = state or OverlayState()
     hint = f"   {HELP_KEYS}: help" if game.controls and not state.help_visible else ""
     pause = "   PAUSED" if paused else ""
-    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}{pause}{hint}"]
+    physics = world.try_resource(PhysicsWorld)
+    recoveries = "" if physics is None else f"   physics_recoveries {physics.recoveries}"
+    lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}{recoveries}{pause}{hint}"]
     lines += game.status(world)
     for e, brain in world.query(Brain):
         name = world.try_get(e, Name)

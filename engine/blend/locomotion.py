@@ -265,10 +265,11 @@ def animate(world: World) -> None:
         hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
         rots[:, 0] = quat.mul(hq_new, rots[:, 0])
         offsets = quat.rotate(hq_new, roots)
+        positions = np.array([m[1].position for m in members]) + step
+        headings = quat.normalize(quat.mul(turn_q, np.array([m[1].rotation for m in members])))
+        world_roots = positions + offsets
         for i, (e, tr, _pup, _player) in enumerate(members):
-            tr.position = tr.position + step[i]
-            tr.rotation = quat.normalize(quat.mul(turn_q[i], tr.rotation))
-            root = tr.position + offsets[i]
+            tr.position, tr.rotation, root = positions[i], headings[i], world_roots[i]
             existing = world.try_get(e, LocalPose)
             if existing is None:
                 world.queue_add(e, LocalPose(root, rots[i]))

@@ -10,6 +10,8 @@ rather than over-stretching a leg, and the other knee bends instead.
 
 One puppet's legs are a few dozen 3-vector operations, so they run on floats
 (:mod:`engine.ik._scalar`, :mod:`engine.ik._limb`); only the ground query sees numpy.
+A crowd of one skeleton goes through :func:`ground_feet_batch` instead: the same steps
+as arrays over the puppets.
 """
 
 from __future__ import annotations
@@ -20,12 +22,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from engine import quat
 from engine.ik._limb import solve_limb
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
+from engine.ik._vec import path_fk
 from engine.pose import Pose
 from engine.skeleton import Skeleton
 
-__all__ = ["GroundQuery", "PlaneGround", "HeightfieldGround", "Leg", "HUMANOID_LEGS", "ground_feet"]
+__all__ = ["GroundQuery", "PlaneGround", "HeightfieldGround", "Leg", "HUMANOID_LEGS", "ground_feet", "ground_feet_batch"]
 
 F = NDArray[np.float64]
 GroundQuery = Callable[[F, F], tuple[F, F]]
@@ -152,3 +156,101 @@ def ground_feet(
         for j in (u, lo, f):
             pose.rotations[j] = rot[j]
     return np.float64(shift)
+
+
+def ground_feet_batch(
+    skeleton: Skeleton,
+    roots: F,
+    rotations: F,
+    ground: GroundQuery,
+    legs: tuple[Leg, ...] = HUMANOID_LEGS,
+    *,
+    offsets: ArrayLike | None = None,
+    align_height: float = 0.25,
+    contact_height: float = 0.03,
+    max_pelvis_shift: float = 0.5,
+    weight: ArrayLike = 1.0,
+) -> F:
+    """:func:`ground_feet` for ``P`` puppets of one skeleton at once, in place.
+
+    The same steps as the one-puppet version, as arrays ``[P, …]``: leg FK, one ground
+    query for every sole, foot alignment, the pelvis shift and the batched
+    :func:`~engine.ik.two_bone.two_bone_ik` per leg; a crowd costs a few dozen numpy
+    calls instead of a Python loop of float maths per puppet.
+
+    Args:
+        roots: ``[P,3]`` world roots (the pelvis shift is added to them).
+        rotations: ``[P,J,4]`` local rotations (the legs are solved in them).
+        offsets: ``[J,3]`` or ``[P,J,3]`` bone offsets.
+        weight: ``[P]`` (or one) 0..1 blend of the whole effect.
+
+    Returns:
+        ``[P]`` pelvis height changes applied.
+    """
+    from engine.ik.two_bone import two_bone_ik
+
+    w = np.broadcast_to(np.asarray(weight, dtype=np.float64), (len(roots),))
+    if np.any((w < 0.0) | (w > 1.0)):
+        raise ValueError("weight must lie in 0..1")
+    off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
+    idx = [(skeleton.index(leg.upper), skeleton.index(leg.lower), skeleton.index(leg.foot)) for leg in legs]
+    soles = np.array([leg.sole for leg in legs])
+    ankle, qfoot = [], []
+    for _, _, f in idx:
+        wp, wr = path_fk(skeleton, roots, rotations, f, off)
+        ankle.append(wp[f]), qfoot.append(wr[f])
+    ankles, qfeet = np.stack(ankle, axis=1), np.stack(qfoot, axis=1)  # [P,L,3], [P,L,4]
+    sole = ankles + quat.rotate(qfeet, soles)
+    clip_height = sole[..., 1]  # authored on flat ground at y = 0
+    height, normal = ground(sole[..., 0], sole[..., 2])
+    height = np.broadcast_to(np.asarray(height, dtype=np.float64), clip_height.shape)
+    normal = np.broadcast_to(np.asarray(normal, dtype=np.float64), sole.shape)
+    if not (np.all(np.isfinite(height)) and np.all(np.isfinite(normal))):
+        raise ValueError("ground query returned non-finite values")
+    planted = np.clip((align_height - clip_height) / (align_height - contact_height), 0.0, 1.0) * w[:, None]
+    tilt = quat.between(np.broadcast_to(_UP, normal.shape), normal)
+    new_rot = quat.mul(quat.slerp(quat.identity(*planted.shape), tilt, planted), qfeet)
+    flat = np.stack([sole[..., 0], height * w[:, None] + clip_height, sole[..., 2]], axis=-1)
+    targets = flat - quat.rotate(new_rot, soles)
+    shift = np.clip(np.min(targets[..., 1] - ankles[..., 1], axis=1), -max_pelvis_shift, max_pelvis_shift)
+    roots[:, 1] += shift
+    hips = {int(skeleton.parents[u]) for u, _, _ in idx}
+    if len(hips) != 1:  # legs hung from different joints: one solve per leg
+        pose = Pose(roots, rotations)
+        for k, ((u, lo, f), leg) in enumerate(zip(idx, legs, strict=True)):
+            wp, wr = path_fk(skeleton, roots, rotations, lo, off)
+            pole = wp[lo] + quat.rotate(wr[int(skeleton.parents[u])], leg.knee_forward)
+            two_bone_ik(skeleton, pose, (u, lo, f), targets[:, k], pole, end_rotation=new_rot[:, k], offsets=off)
+        return shift
+    _solve_legs(skeleton, roots, rotations, off, hips.pop(), idx, legs, targets, new_rot)
+    return shift
+
+
+def _solve_legs(skeleton: Skeleton, roots: F, rotations: F, off: F, hip: int, idx: list[tuple[int, int, int]],
+                legs: tuple[Leg, ...], targets: F, new_rot: F) -> None:
+    """Every leg of every puppet in one batched two-bone solve.
+
+    The legs hang from one joint, so each is a chain ``hip → upper → lower → foot`` of its
+    own: a four-joint skeleton whose root is the hip's world transform, batched ``[L, P]``.
+    Its forward kinematics repeats the full skeleton's operations along the same path, so
+    the result is the one a solve per leg gives.
+    """
+    from engine.ik.two_bone import two_bone_ik
+
+    wp, wr = path_fk(skeleton, roots, rotations, hip, off)
+    chains = np.array(idx).T  # [3, L]
+    offs = np.broadcast_to(off, rotations.shape[:-2] + off.shape[-2:])
+    leg_off = np.zeros((len(legs),) + offs.shape[:-2] + (4, 3))
+    leg_off[..., 1:, :] = np.moveaxis(offs[..., chains, :], -2, 0)  # [L, P, 3, 3]
+    leg_rot = np.empty((len(legs),) + rotations.shape[:-2] + (4, 4))
+    leg_rot[..., 0, :] = wr[hip]
+    leg_rot[..., 1:, :] = np.moveaxis(rotations[..., chains, :], -2, 0)
+    chain = Skeleton(("hip", "upper", "lower", "foot"), np.array([-1, 0, 1, 2]), leg_off.reshape(-1, 4, 3)[0])
+    root = np.broadcast_to(wp[hip], leg_rot.shape[:-2] + (3,)).copy()
+    pose = Pose(root, leg_rot)
+    lp, lr = path_fk(chain, root, leg_rot, 2, leg_off)
+    knee = np.array([leg.knee_forward for leg in legs])[:, None, :]
+    pole = lp[2] + quat.rotate(lr[0], knee)
+    two_bone_ik(chain, pose, (1, 2, 3), np.moveaxis(targets, 1, 0), pole,
+                end_rotation=np.moveaxis(new_rot, 1, 0), offsets=leg_off)
+    rotations[..., chains, :] = np.moveaxis(leg_rot[..., 1:, :], 0, -2)

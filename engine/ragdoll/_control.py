@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.ragdoll._layout import Layout
+from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
 
 __all__ = ["Command", "apply_commands", "project_twist", "read_poses", "hinge_angles", "GRAVITY"]
 
@@ -24,10 +25,7 @@ GRAVITY = 9.81
 _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
 _PIN_DAMPING = 100.0  # and damping (1/s): critically damped
 _MAX_LEAD = 0.5  # s: cap on the velocity lead at tiny weights
-# contype/conaffinity bits (mjcf.py sets the simulated ones): 1 ground, 2 simulated
-# bodies and props, 4 animated bodies
-_SIMULATED_TYPE, _SIMULATED_AFFINITY = 3, 7
-_ANIMATED_TYPE, _ANIMATED_AFFINITY = 4, 2
+_HOLD_REACH = 0.5  # m: farthest the hold spring's anchor is from the held body (a stick flicked into the sky)
 _F = NDArray[np.float64]
 
 
@@ -52,8 +50,10 @@ def hinge_angles(rot: _F, axes: _F) -> _F:
     return 2.0 * np.arctan2(np.sum(h[..., 1:] * axes, axis=-1), h[..., 0])
 
 
-def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Command], dt: float) -> None:
-    """Turn every ragdoll's command into servo targets, gains, pins, holds and placements."""
+def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Command], dt: float,
+                   ghost: NDArray[np.bool_] | None = None) -> None:
+    """Turn every ragdoll's command into servo targets, gains, pins, holds and placements
+    (``ghost [P]``: which simulated ragdolls pass through other ragdolls this step)."""
     if not cmds:
         return
     root = np.stack([c.root for c in cmds])
@@ -63,6 +63,7 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
     muscle = np.array([c.muscle for c in cmds])
     pin = np.array([c.pin for c in cmds])
     kin = np.array([c.kinematic for c in cmds])
+    ghost = np.zeros(len(cmds), dtype=bool) if ghost is None else ghost
     r0 = L.starts[:-1]
     # target velocities from the previous target (zero after a placement)
     v_root = (root - last_root) / dt
@@ -92,13 +93,22 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
     # An animated (kinematic) ragdoll touches only simulated bodies and props: not the
     # ground (neither can give way), not other animated bodies and not itself -- a
     # crouching pose lays the arms into the legs, and the contact impulses inside the
-    # substeps would spin the arms and fling the ball in their hands.
-    m.geom_contype[L.geom] = np.where(kin[L.geom_owner], _ANIMATED_TYPE, _SIMULATED_TYPE)
-    m.geom_conaffinity[L.geom] = np.where(kin[L.geom_owner], _ANIMATED_AFFINITY, _SIMULATED_AFFINITY)
+    # substeps would spin the arms and fling the ball in their hands. A ghost (deep in another
+    # ragdoll) touches only the ground and props until it is out (mjcf.GHOST_BITS).
+    kind = np.where(kin, 1, np.where(ghost, 2, 0))[L.geom_owner]
+    bits = np.array([SIMULATED_BITS, ANIMATED_BITS, GHOST_BITS])[kind]
+    m.geom_contype[L.geom], m.geom_conaffinity[L.geom] = bits[:, 0], bits[:, 1]
     for p, c in enumerate(cmds):
         for name, eq in L.hold_eq[p].items():
             d.eq_active[eq] = name == c.hold
-        d.mocap_pos[L.hold_mocap[p]] = c.hold_target
+        target = c.hold_target
+        if c.hold is not None:  # the spring pulls from at most _HOLD_REACH away: a bounded force
+            held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][c.hold]]]
+            gap = target - held
+            dist = float(np.linalg.norm(gap))
+            if dist > _HOLD_REACH:
+                target = held + gap * (_HOLD_REACH / dist)
+        d.mocap_pos[L.hold_mocap[p]] = target
         c.last = (c.root, c.rot)
     if kin.any():
         k = np.nonzero(kin)[0]

@@ -61,6 +61,7 @@ class Layout:
     ball_lead: F  # kv/kp at full muscle: how far each servo trails a moving target (s)
     hinge_lead: F
     hold_eq: list[dict[str, int]]
+    hold_joint: list[dict[str, int]]  # holdable joint name -> its index in the ragdoll's skeleton
 
     def ordinal(self, key: int) -> int:
         """Position of ragdoll ``key`` in the flat layout."""
@@ -93,6 +94,7 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
 
     starts = [0]
     hold_eq = []
+    hold_joint = []
     for p, frag in enumerate(fragments):
         spec = frag.spec
         sk, pr, k = spec.skeleton, spec.profile, spec.key
@@ -138,6 +140,7 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         put("ball_lead", lead[ball])
         put("hinge_lead", lead[hinge])
         hold_eq.append({h: m.eq(rd_name(k, h) + "_hold").id for h in pr.holdable})
+        hold_joint.append({h: sk.index(h) for h in pr.holdable})
         starts.append(base + sk.num_joints)
 
     def cat(name: str, dtype: type, shape: tuple[int, ...] = ()) -> np.ndarray:
@@ -154,6 +157,6 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         keys=[f.spec.key for f in fragments], starts=np.array(starts, dtype=np.int64),
         dofs=cat("dofs", np.int64, (2,)), ball_axis=cat("ball_axis", np.float64, (3,)),
         hinge_axis=cat("hinge_axis", np.float64, (3,)), hinge_range=cat("hinge_range", np.float64, (2,)),
-        hold_eq=hold_eq,
+        hold_eq=hold_eq, hold_joint=hold_joint,
         **{n: cat(n, np.int64) for n in ints}, **{n: cat(n, np.float64) for n in floats},
     )

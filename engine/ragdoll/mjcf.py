@@ -26,7 +26,18 @@ from engine.fk import forward_kinematics
 from engine.ragdoll.profile import RagdollProfile, bone_segments, servo_gains
 from engine.skeleton import Skeleton
 
-__all__ = ["RagdollSpec", "PropSpec", "RagdollFragment", "ragdoll_fragment", "build_mjcf", "rd_name", "prop_name",
+# (contype, conaffinity) of each kind of geom; two geoms touch when either's type meets the
+# other's affinity. Simulated bodies touch everything; animated (kinematic) bodies touch only
+# simulated bodies and props (neither the ground nor each other can give way); ghosts -- ragdolls
+# that overlap another ragdoll deeply, until they are apart -- touch only the ground and props,
+# so two puppets dropped on one spot separate instead of exploding.
+GROUND_BITS = (16, 0)
+SIMULATED_BITS = (3, 23)
+PROP_BITS = (11, 31)
+ANIMATED_BITS = (4, 2)
+GHOST_BITS = (8, 16)
+
+__all__ = ["GROUND_BITS", "SIMULATED_BITS", "PROP_BITS", "ANIMATED_BITS", "GHOST_BITS", "RagdollSpec", "PropSpec", "RagdollFragment", "ragdoll_fragment", "build_mjcf", "rd_name", "prop_name",
            "self_collision_excludes"]
 
 
@@ -204,17 +215,19 @@ def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequenc
         # condim 6: rolling and torsional friction, so a snowball slows down as it rolls.
         body.append(f'    <body name="{n}" pos="0 {_f(p.radius)} 0"><freejoint name="{n}"/>'
                     f'<geom name="{n}" type="sphere" size="{_f(p.radius)}" mass="{_f(p.mass)}" condim="6" '
+                    f'contype="{PROP_BITS[0]}" conaffinity="{PROP_BITS[1]}" '
                     f'friction="{_f(p.friction)} 0.005 0.002"/></body>')
     sections = [
         '<mujoco model="puppetphone">',
         '  <compiler angle="radian" autolimits="true"/>',
         # stiff contacts (5 ms, critically damped): snowballs and bodies barely sink into anything
-        # contype/conaffinity: bit 1 ground, bit 2 simulated bodies and props, bit 4 animated
-        # (kinematic) bodies, which _control.py switches to contype 4 / conaffinity 2
-        '  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="3" conaffinity="7"/></default>',
+        # contype/conaffinity: see CONTACT_BITS; ragdoll bodies start simulated, _control.py
+        # switches them to animated or ghost
+        f'  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="{SIMULATED_BITS[0]}" '
+        f'conaffinity="{SIMULATED_BITS[1]}"/></default>',
         f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"/>',
         "  <worldbody>",
-        f'    <geom name="ground" type="plane" size="0 0 1" zaxis="0 1 0" contype="1" conaffinity="1" friction="{_f(ground_friction)} 0.005 0.002"/>',
+        f'    <geom name="ground" type="plane" size="0 0 1" zaxis="0 1 0" contype="{GROUND_BITS[0]}" conaffinity="{GROUND_BITS[1]}" friction="{_f(ground_friction)} 0.005 0.002"/>',
         *body,
         "  </worldbody>",
     ]

@@ -14,12 +14,14 @@ and :meth:`step` applies the commands of every ragdoll in one vectorised pass
 Adding a ragdoll or prop at run time regenerates the MJCF and recompiles; every body
 that existed keeps its exact state, carried over by name (:mod:`engine.ragdoll._carry`).
 Snowballs change radius in place (geom size, bounds, mass, inertia, ``mj_setConst``).
+Each step is guarded (:mod:`engine.ragdoll._guard`): velocities are bounded, and a step
+MuJoCo cannot take is undone and counted in :attr:`PhysicsWorld.recoveries`.
 """
 
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+import warnings
 
 import mujoco
 import numpy as np
@@ -28,8 +30,12 @@ from numpy.typing import ArrayLike, NDArray
 from engine import quat
 from engine.pose import Pose
 from engine.ragdoll._carry import restore, snapshot
-from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist, read_poses
+from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
+from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step, velocity_limits
+from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
 from engine.ragdoll._layout import Layout, build_layout
+from engine.ragdoll._readback import Readback
+from engine.ragdoll._slots import PropSlot, RagdollSlot
 from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec, build_mjcf, prop_name, ragdoll_fragment
 from engine.ragdoll.profile import RagdollProfile
 from engine.skeleton import Skeleton
@@ -40,25 +46,7 @@ _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 _F = NDArray[np.float64]
 
 
-@dataclass
-class _RagdollSlot:
-    spec: RagdollSpec
-    cmd: Command
-    placed: bool = False
-    fragment: RagdollFragment | None = None
-
-
-@dataclass
-class _PropSlot:
-    spec: PropSpec
-    init: tuple[_F, _F, _F] | None = None
-    qadr: int = -1
-    dadr: int = -1
-    geom: int = -1
-    body: int = -1
-
-
-class PhysicsWorld:
+class PhysicsWorld(Readback):
     """The physics resource: ragdolls and props keyed by their entity id.
 
     Args:
@@ -79,12 +67,17 @@ class PhysicsWorld:
         self.data: mujoco.MjData | None = None
         self.layout: Layout | None = None
         self.rebuilds = 0
-        self._ragdolls: dict[int, _RagdollSlot] = {}
-        self._props: dict[int, _PropSlot] = {}
+        self._ragdolls: dict[int, RagdollSlot] = {}
+        self._props: dict[int, PropSlot] = {}
         self._dirty = False
         self._digest = b""
         self._ke: _F | None = None
         self._read: tuple[_F, _F] | None = None
+        self.simulate_animated = False
+        self.recoveries = 0
+        self._limit = np.zeros(0)
+        self._owners = np.zeros(0, dtype=np.int64)
+        collect_warnings()
 
     @property
     def dt(self) -> float:
@@ -101,7 +94,8 @@ class PhysicsWorld:
             raise ValueError(f"profile has {profile.num_joints} joints, skeleton {skeleton.num_joints}")
         off = np.array(skeleton.offsets if offsets is None else offsets, dtype=np.float64).reshape(-1, 3)
         r, q = self._checked(key, root, rotations, skeleton.num_joints)
-        self._ragdolls[key] = _RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q))
+        self._ragdolls[key] = RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q),
+                                           reach(skeleton, profile, off))
         self._dirty = True
 
     def add_prop(self, key: int, radius: float, mass: float, position: ArrayLike,
@@ -114,7 +108,7 @@ class PhysicsWorld:
         rot = quat.identity() if rotation is None else quat.normalize(np.asarray(rotation, dtype=np.float64))
         vel = np.zeros(6) if velocity is None else np.asarray(velocity, dtype=np.float64).reshape(6)
         init = (np.array(position, dtype=np.float64).reshape(3), rot, vel)
-        self._props[key] = _PropSlot(PropSpec(key, float(radius), float(mass), friction), init=init)
+        self._props[key] = PropSlot(PropSpec(key, float(radius), float(mass), friction), init=init)
         self._dirty = True
 
     def remove(self, key: int) -> None:
@@ -148,12 +142,14 @@ class PhysicsWorld:
         self._dirty = False
         old = snapshot(self.model, self.data)
         self._ke = self._read = None
-        if not self._ragdolls and not self._props:
+        if not any(s.in_model for s in self._ragdolls.values()) and not self._props:
             self.model = self.data = self.layout = None
             return
         rd: list[RagdollFragment] = []
         for k in sorted(self._ragdolls):
             slot = self._ragdolls[k]
+            if not slot.in_model:
+                continue
             if slot.fragment is None:  # rendered once per ragdoll, reused by every rebuild
                 slot.fragment = ragdoll_fragment(slot.spec)
             rd.append(slot.fragment)
@@ -169,11 +165,23 @@ class PhysicsWorld:
             j = m.joint(n).id
             ps.qadr, ps.dadr = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
             ps.geom, ps.body = m.geom(n).id, m.body(n).id
+        self._limit = velocity_limits(m)
+        self._owners = np.full(m.nv, -1, dtype=np.int64)
+        for p, (a, b) in enumerate(self.layout.dofs):
+            self._owners[a:b] = p
+        for k, ps in enumerate(self._props.values()):
+            self._owners[ps.dadr:ps.dadr + 6] = len(self.layout.keys) + k
         restore(m, d, old)
         for key, slot in self._ragdolls.items():
-            if not slot.placed:
-                self._place(key, slot.cmd.root, slot.cmd.rot)
-                slot.placed = True
+            if slot.in_model and not slot.placed:
+                # joining from outside: where its animation was a step ago, moving as it moved then
+                # (as if it had been simulated all along), so it keeps its momentum
+                last, prev = slot.cmd.last, slot.prev
+                if last is None:
+                    self._place(key, slot.cmd.root, slot.cmd.rot)
+                else:
+                    self._place(key, last[0], last[1], prev)
+                slot.cmd.last, slot.placed = last, True
         for ps in self._props.values():
             if ps.init is not None:
                 pos, rot, vel = ps.init
@@ -192,7 +200,7 @@ class PhysicsWorld:
             raise ValueError(f"ragdoll {key}: target pose has NaN or infinite values")
         return r, quat.normalize(q)
 
-    def _slot(self, key: int) -> _RagdollSlot:
+    def _slot(self, key: int) -> RagdollSlot:
         try:
             return self._ragdolls[key]
         except KeyError:
@@ -220,6 +228,40 @@ class PhysicsWorld:
         c.muscle, c.pin = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
         c.support = float(np.clip(gravity_support, 0, 1))
 
+    def drive_animated(self, keys: list[int], roots: list[_F], rotations: list[_F]) -> list[int]:
+        """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
+        in one pass: a crowd of animated puppets is most of the physics stage's Python work).
+
+        A target with NaN or infinite values is not taken: that ragdoll keeps its previous
+        command (see :meth:`target`), so a bad pose never reaches MuJoCo.
+
+        Returns:
+            The keys whose targets were refused.
+        """
+        if not keys:
+            return []
+        slots = [self._slot(k) for k in keys]
+        sizes = [s.spec.skeleton.num_joints for s in slots]
+        r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
+        q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
+        if q.shape != (sum(sizes), 4):
+            raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes}")
+        ends = np.cumsum(sizes)
+        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
+        q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
+        for slot, good, root, rot in zip(slots, ok, r, np.split(q, ends[:-1]), strict=True):
+            c = slot.cmd
+            if good:
+                c.root, c.rot = root, rot
+            c.kinematic = True
+            c.muscle = c.pin = c.support = 1.0
+        return [k for k, good in zip(keys, ok, strict=True) if not good]
+
+    def target(self, key: int) -> Pose:
+        """The ragdoll's current command (its last accepted target pose)."""
+        c = self._slot(key).cmd
+        return Pose(c.root.copy(), c.rot.copy())
+
     def hold(self, key: int, joint: str | None, target: ArrayLike | None = None) -> None:
         """Hold one body of the ragdoll by a spring at ``target`` (``joint=None`` lets go)."""
         slot = self._slot(key)
@@ -238,22 +280,35 @@ class PhysicsWorld:
         slot = self._slot(key)
         r, q = self._checked(key, root, rotations, slot.spec.skeleton.num_joints)
         slot.cmd.root, slot.cmd.rot = r, q
+        if not slot.in_model:
+            slot.cmd.last = None
+            return
         self._place(key, r, q)
         assert self.model is not None and self.data is not None
         mujoco.mj_forward(self.model, self.data)
 
-    def _place(self, key: int, root: _F, rot: _F) -> None:
+    def _place(self, key: int, root: _F, rot: _F, before: tuple[_F, _F] | None = None) -> None:
+        """Put a ragdoll's bodies on a pose, at rest or moving as it moved from ``before`` in one step."""
         L, d = self.layout, self.data
         assert L is not None and d is not None
         p = L.ordinal(key)
-        rq = int(L.root_q[p])
+        rq, rd = int(L.root_q[p]), int(L.root_d[p])
         d.qpos[rq:rq + 3] = root
         d.qpos[rq + 3:rq + 7] = rot[0]
         b = L.ball_owner == p
-        d.qpos[L.ball_q[b][:, None] + np.arange(4)] = rot[L.ball_src[b] - L.starts[p]]
+        ball = rot[L.ball_src[b] - L.starts[p]]
+        d.qpos[L.ball_q[b][:, None] + np.arange(4)] = ball
         h = L.hinge_owner == p
-        d.qpos[L.hinge_q[h]] = hinge_angles(rot[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])
+        hinge = hinge_angles(rot[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])
+        d.qpos[L.hinge_q[h]] = hinge
         d.qvel[L.dofs[p, 0]:L.dofs[p, 1]] = 0.0
+        if before is not None:  # the same target velocities as an animated (kinematic) placement
+            r0, q0 = before
+            d.qvel[rd:rd + 3] = (root - r0) / self.dt
+            d.qvel[rd + 3:rd + 6] = quat.rotate(q0[0], quat.log(quat.mul(quat.conjugate(q0[0]), rot[0]))) / self.dt
+            d.qvel[L.ball_d[b][:, None] + np.arange(3)] = quat.log(
+                quat.mul(quat.conjugate(q0[L.ball_src[b] - L.starts[p]]), ball)) / self.dt
+            d.qvel[L.hinge_d[h]] = (hinge - hinge_angles(q0[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])) / self.dt
         d.mocap_pos[L.pin_mocap[p]] = root
         d.mocap_quat[L.pin_mocap[p]] = rot[0]
         self._slot(key).cmd.last = None
@@ -262,83 +317,74 @@ class PhysicsWorld:
     # -- stepping -----------------------------------------------------------------------
     def step(self) -> None:
         """Apply every command, advance one simulation step (``substeps`` MuJoCo steps) and
-        enforce the twist limits."""
+        enforce the twist limits. Animated ragdolls far from anything simulated are left out
+        of the model first (:mod:`engine.ragdoll._islands`)."""
+        self._update_islands()
         self.ensure_built()
+        for slot in self._ragdolls.values():
+            if not slot.in_model:  # it moves with its target: where it was is its last target
+                slot.prev, slot.cmd.last = slot.cmd.last, (slot.cmd.root, slot.cmd.rot)
         if self.model is None or self.data is None:
             return
         assert self.layout is not None
-        apply_commands(self.layout, self.model, self.data, [self._ragdolls[k].cmd for k in self.layout.keys], self.dt)
-        mujoco.mj_step(self.model, self.data, nstep=self.substeps)
-        project_twist(self.layout, self.data)
+        L, d = self.layout, self.data
+        slots = [self._ragdolls[k] for k in L.keys]
+        roots = d.qpos[L.root_q[:, None] + np.arange(3)]
+        simulated = np.array([not s.cmd.kinematic for s in slots], dtype=bool)
+        ghost = ghosts(roots, simulated, np.array([s.ghost for s in slots], dtype=bool))
+        for slot, g in zip(slots, ghost, strict=True):
+            slot.ghost = bool(g)
+        apply_commands(L, self.model, d, [s.cmd for s in slots], self.dt, ghost)
+        reason = guarded_step(self.model, self.data, self.substeps, self._limit, self._owners)
+        if reason is None:
+            project_twist(self.layout, self.data)
+        else:
+            self.recoveries += 1
+            warnings.warn(PhysicsRecovery(f"physics step undone, bodies reset: {reason}"), stacklevel=2)
         self._ke = self._read = None
 
-    # -- readback -----------------------------------------------------------------------
-    def _readback(self) -> tuple[_F, _F]:
-        """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll (cached per step)."""
-        self.ensure_built()
-        if self._read is None:
-            assert self.layout is not None and self.data is not None
-            self._read = read_poses(self.layout, self.data)
-        return self._read
+    def _update_islands(self) -> None:
+        """Put the ragdolls that need dynamics (or may touch what has them) in the model, and only those."""
+        slots = [self._ragdolls[k] for k in sorted(self._ragdolls)]
+        if self.simulate_animated:
+            wanted = np.ones(len(slots), dtype=bool)
+        else:
+            needs = np.array([not s.cmd.kinematic or s.cmd.hold is not None for s in slots], dtype=bool)
+            centres = np.array([self._centre(s) for s in slots]).reshape(-1, 3)
+            radii = np.array([s.reach for s in slots])
+            props = [self._prop_sphere(k) for k in sorted(self._props)]
+            sources = np.concatenate([centres[needs], np.array([c for c, _ in props]).reshape(-1, 3)])
+            source_radii = np.concatenate([radii[needs], [r for _, r in props]])
+            inside = np.array([s.in_model for s in slots], dtype=bool)
+            wanted = needs.copy()
+            wanted[~needs] = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+        for slot, want in zip(slots, wanted, strict=True):
+            if slot.in_model != bool(want):
+                slot.in_model, slot.placed = bool(want), False
+                self._dirty = True
 
-    def pose(self, key: int) -> Pose:
-        """The ragdoll's simulated pose as an engine :class:`Pose` (root + local rotations)."""
-        self._slot(key)
-        roots, rot = self._readback()
-        L = self.layout
-        assert L is not None
-        p = L.ordinal(key)
-        return Pose(roots[p].copy(), rot[L.starts[p]:L.starts[p + 1]].copy())
+    def _centre(self, slot: RagdollSlot) -> _F:
+        """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
+        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._dirty:
+            rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
+            return np.asarray(self.data.qpos[rq:rq + 3])
+        return slot.cmd.root
 
-    def body_positions(self, key: int) -> _F:
-        """World positions ``[J,3]`` of the ragdoll's joint origins."""
-        self._slot(key)
-        self.ensure_built()
-        L, d = self.layout, self.data
-        assert L is not None and d is not None
-        return d.xpos[L.body[L.body_owner == L.ordinal(key)]].copy()
+    def _prop_sphere(self, key: int) -> tuple[_F, float]:
+        """A prop's bounding sphere over the next :data:`LOOKAHEAD` seconds."""
+        ps = self._props[key]
+        if ps.init is not None or self.data is None:
+            pos, vel = (ps.init[0], ps.init[2]) if ps.init is not None else (np.zeros(3), np.zeros(6))
+        else:
+            pos, vel = self.data.qpos[ps.qadr:ps.qadr + 3], self.data.qvel[ps.dadr:ps.dadr + 3]
+        return np.asarray(pos), ps.spec.radius + float(np.linalg.norm(vel[:3])) * LOOKAHEAD
 
-    def root_velocity(self, key: int) -> _F:
-        """The root's free-joint velocity ``[6]`` (linear world, angular local)."""
-        self._slot(key)
-        self.ensure_built()
-        L, d = self.layout, self.data
-        assert L is not None and d is not None
-        rd = int(L.root_d[L.ordinal(key)])
-        return d.qvel[rd:rd + 6].copy()
-
-    def kinetic_energy(self, key: int) -> float:
-        """Kinetic energy (J) of one ragdoll, ½ vᵀMv over its own degrees of freedom."""
-        self._slot(key)
-        self.ensure_built()
-        L, m, d = self.layout, self.model, self.data
-        assert L is not None and m is not None and d is not None
-        if self._ke is None:
-            res = np.zeros(m.nv)
-            mujoco.mj_mulM(m, d, res, d.qvel)
-            cum = np.concatenate([[0.0], np.cumsum(0.5 * d.qvel * res)])
-            self._ke = cum[L.dofs[:, 1]] - cum[L.dofs[:, 0]]
-        return float(self._ke[L.ordinal(key)])
-
-    def joint_limit_violation(self, key: int) -> float:
-        """Largest excess (rad) of any joint beyond its cone, twist or hinge range (0 when within)."""
-        self._slot(key)
-        roots, rot = self._readback()
-        L, d = self.layout, self.data
-        assert L is not None and d is not None
-        p = L.ordinal(key)
-        b, h = L.ball_owner == p, L.hinge_owner == p
-        q = rot[L.ball_src[b]]
-        cone = np.max(quat.angle_between(quat.identity(len(q)), q) - L.ball_cone[b], initial=0.0)
-        _, tw = quat.swing_twist(quat.align_hemisphere(q), L.ball_axis[b])
-        tang = np.abs(2.0 * np.arctan2(np.sum(tw[:, 1:] * L.ball_axis[b], axis=1), tw[:, 0]))
-        twist = np.max(tang - L.ball_twist[b], initial=0.0)
-        a = d.qpos[L.hinge_q[h]]
-        hinge = np.max(np.maximum(L.hinge_range[h, 0] - a, a - L.hinge_range[h, 1]), initial=0.0)
-        return float(max(cone, twist, hinge, 0.0))
+    def in_model(self, key: int) -> bool:
+        """Whether ragdoll ``key`` is simulated this step (animated ragdolls alone are not)."""
+        return self._slot(key).in_model
 
     # -- props ----------------------------------------------------------------------------
-    def _prop(self, key: int) -> _PropSlot:
+    def _prop(self, key: int) -> PropSlot:
         self.ensure_built()
         try:
             return self._props[key]

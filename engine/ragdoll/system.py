@@ -3,7 +3,9 @@
 Per step, for every puppet with a :class:`Ragdoll`, the ``LocalPose`` written by
 animation and IK is the *target*:
 
-- ``ANIMATED``: the bodies are placed on it (with its velocity) and the pose passes through;
+- ``ANIMATED``: the pose passes through; the bodies are placed on it (with its velocity) only
+  while something simulated is near (:mod:`engine.ragdoll._islands`), and the whole crowd
+  of animated puppets is driven in one batched call;
 - otherwise the muscles and the root pin track it with the current weights, and the
   pose written back is ``blend_poses(target, simulated, blend_weight)``.
 
@@ -61,26 +63,36 @@ def physics_step(world: World) -> None:
                          "set PhysicsWorld(timestep=world.dt / substeps)")
     _sync(world, pw)
     rows = world.query(Ragdoll, Puppet, LocalPose)
+    animated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is RagdollMode.ANIMATED]
+    simulated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is not RagdollMode.ANIMATED]
+    refused = pw.drive_animated([e for e, _, _ in animated], [p.root for _, _, p in animated],
+                                [p.rotations for _, _, p in animated])
     targets: dict[Entity, Pose] = {}
-    for e, rd, _, pose in rows:
+    for e, rd, pose in simulated:
         rd.ramp(world.dt)
-        target = Pose(np.array(pose.root, dtype=np.float64), quat.normalize(pose.rotations))
+        target = Pose(np.array(pose.root, dtype=np.float64), np.array(pose.rotations, dtype=np.float64))
+        if not target.is_finite():
+            refused.append(e)
+            target = pw.target(e)
+        target.rotations = quat.normalize(target.rotations)
         targets[e] = target
-        if rd.mode is RagdollMode.ANIMATED:
-            pw.drive(e, target.root, target.rotations, 1.0, 1.0, 1.0, kinematic=True)
-        else:
-            pw.drive(e, target.root, target.rotations, rd.muscle_weight, rd.pin_weight,
-                     rd.muscle_weight * rd.pin_weight)
+        pw.drive(e, target.root, target.rotations, rd.muscle_weight, rd.pin_weight, rd.muscle_weight * rd.pin_weight)
+    for e in refused:  # a NaN pose from upstream: count it, keep the last good target
+        pw.recoveries += 1
+        pose = world.get(e, LocalPose)
+        pose.root, pose.rotations = pw.target(e).root, pw.target(e).rotations
+    for e, rd, _ in animated:
+        rd.ramp(world.dt)
+        # not simulated: the body is its animation (no energy of its own, nothing to settle)
+        rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
+    for e, rd, _, _ in rows:
         pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
     for e, prop, tr in world.query(Prop, Transform):
         if prop.carried or prop.placed:
             pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
             prop.placed = False
     pw.step()
-    for e, rd, _, pose in rows:
-        if rd.mode is RagdollMode.ANIMATED:
-            rd.kinetic_energy, rd.settled, rd.still_frames = pw.kinetic_energy(e), False, 0
-            continue
+    for e, rd, pose in simulated:
         speed = float(np.linalg.norm(pw.root_velocity(e)[:3]))
         update_settle(rd, pw.kinetic_energy(e), speed, float(rd.profile.masses.sum()))
         out = blend_poses(targets[e], pw.pose(e), rd.blend_weight)

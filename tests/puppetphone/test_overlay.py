@@ -25,6 +25,7 @@ def test_overlay_shows_state_and_pairing_until_a_packet_arrives():
         lines = overlay_lines(app.world, GAME, hub, 60.0, False)
         assert "puppet: standing" in lines
         assert not any("Locomotion" in line for line in lines)  # words, not state names
+        assert "physics_recoveries 0" in lines[0]
         assert any(f"port {osc.port}" in line for line in lines)
         assert any("--osc-host 0.0.0.0" in line for line in lines)
         assert any("[idle]" in line or "[gone]" in line for line in lines)

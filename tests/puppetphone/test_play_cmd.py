@@ -54,7 +54,7 @@ def test_a_sandbox_scene_is_a_game_option_and_replays(tmp_path: Path) -> None:
     done = puppetphone("play", "sandbox", "--headless", "--frames", "30", "--set", "scene=big_ball", "--record",
                        "s.rec", cwd=tmp_path, data=tmp_path)
     assert done.returncode == 0, done.stderr
-    assert read_recording(tmp_path / "s.rec").header.setup == {"scene": "big_ball"}
+    assert read_recording(tmp_path / "s.rec").header.setup == {"scene": "big_ball", "puppets": 1}
     assert puppetphone("replay", "s.rec", "--verify", "--headless", cwd=tmp_path, data=tmp_path).returncode == 0
     wrong = puppetphone("play", "sandbox", "--headless", "--set", "scene=moon", cwd=tmp_path, data=tmp_path)
     assert wrong.returncode == 2 and "scene 'moon' is not one of" in wrong.stderr

@@ -69,3 +69,23 @@ def test_lifted_foot_keeps_its_clearance_and_bad_ground_is_rejected():
     assert after[1] - 0.1 == pytest.approx(before[1], abs=2e-3)
     with pytest.raises(ValueError, match="non-finite"):
         ground_feet(sk, Pose.rest(sk), lambda x, z: (np.full(np.shape(x), np.nan), np.zeros(np.shape(x) + (3,))))
+
+
+def test_the_batched_grounding_agrees_with_one_puppet_at_a_time():
+    from engine.ik.grounding import HeightfieldGround, ground_feet_batch
+
+    sk = humanoid_skeleton()
+    rng = np.random.default_rng(4)
+    n = 6
+    rots = quat.normalize(np.tile(quat.identity(sk.num_joints), (n, 1, 1)) + rng.normal(0, 0.08, (n, sk.num_joints, 4)))
+    roots = np.column_stack([rng.uniform(-2, 2, n), np.full(n, 0.95), rng.uniform(-2, 2, n)])
+    offsets = sk.offsets * rng.uniform(0.8, 1.2, (n, 1, 1))
+    ground = HeightfieldGround(rng.uniform(-0.1, 0.1, (12, 12)), 0.5, -3.0, -3.0)
+    weights = rng.uniform(0, 1, n)
+    r, q = roots.copy(), rots.copy()
+    shift = ground_feet_batch(sk, r, q, ground, offsets=offsets, weight=weights)
+    for i in range(n):
+        pose = Pose(roots[i].copy(), rots[i].copy())
+        assert ground_feet(sk, pose, ground, offsets=offsets[i], weight=weights[i]) == pytest.approx(shift[i], abs=1e-12)
+        np.testing.assert_allclose(pose.root, r[i], atol=1e-12)
+        np.testing.assert_allclose(pose.rotations, q[i], atol=1e-12)

@@ -61,3 +61,36 @@ def test_public_surface_is_curated():
     for name in ik.__all__:
         assert hasattr(ik, name), name
     assert {"two_bone_ik", "solve_ik", "ground_feet", "hands_on_sphere", "install_ik", "IKRequest"} <= set(ik.__all__)
+
+
+def test_a_crowd_is_grounded_in_one_batch_with_the_same_result(monkeypatch):
+    import engine.ik.system as system
+
+    rng = np.random.default_rng(2)
+    n = system.BATCH + 2
+    roots = np.column_stack([rng.uniform(-3, 3, n), np.full(n, 0.95), rng.uniform(-3, 3, n)])
+    rots = quat.normalize(quat.identity(n, 17) + rng.normal(0, 0.05, (n, 17, 4)))
+
+    def run(batch_from: int):
+        app = App(seed=1, plugins=[install_ik])
+        app.world.insert_resource(system.IKRigCache(batch_from=batch_from))
+        app.world.insert_resource(IKGround(PlaneGround(normal=(0.1, 1.0, -0.2))))
+        ents = []
+        for i in range(n):  # separately built skeletons, alike: one batch
+            req = IKRequest(grounding=True)
+            if i == 0:
+                req.sphere_centre, req.sphere_radius = roots[0] + [0.0, -0.1, 0.45], 0.2
+            ents.append(app.world.spawn(Puppet(humanoid_skeleton()), LocalPose(roots[i].copy(), rots[i].copy()), req))
+        app.step()
+        return [app.world.get(e, LocalPose) for e in ents]
+
+    calls = []
+    real = system.ground_feet_batch
+    monkeypatch.setattr(system, "ground_feet_batch", lambda *a, **k: calls.append(1) or real(*a, **k))
+    batched = run(system.BATCH)
+    assert calls == [1]
+    single = run(10**9)
+    assert calls == [1]
+    for a, b in zip(batched, single, strict=True):
+        np.testing.assert_allclose(a.root, b.root, atol=1e-12)
+        np.testing.assert_allclose(a.rotations, b.rotations, atol=1e-12)

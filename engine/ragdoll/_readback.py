@@ -1,0 +1,112 @@
+"""Reading the physics world back: poses, joint positions, velocities, energies, limit excess.
+
+A mixin of :class:`~engine.ragdoll.physics.PhysicsWorld`, apart because it only reads.
+A ragdoll left out of the model (animated, nothing simulated near:
+:mod:`engine.ragdoll._islands`) is exactly on its target, so its answers come from its
+command instead of MuJoCo's state.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from engine import quat
+from engine.fk import forward_kinematics
+from engine.pose import Pose
+from engine.ragdoll._control import read_poses
+from engine.ragdoll._layout import Layout
+from engine.ragdoll._slots import RagdollSlot
+
+__all__ = ["Readback"]
+
+_F = NDArray[np.float64]
+
+
+class Readback:
+    """Read-only queries over the compiled model of a physics world."""
+
+    model: mujoco.MjModel | None
+    data: mujoco.MjData | None
+    layout: Layout | None
+    _ke: _F | None
+    _read: tuple[_F, _F] | None
+
+    def _readback(self) -> tuple[_F, _F]:
+        """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll (cached per step)."""
+        self.ensure_built()
+        if self._read is None:
+            assert self.layout is not None and self.data is not None
+            self._read = read_poses(self.layout, self.data)
+        return self._read
+
+    def _outside(self, key: int) -> RagdollSlot | None:
+        """The slot of a ragdoll left out of the model (it is exactly on its target), else ``None``."""
+        slot = self._slot(key)
+        self.ensure_built()
+        return None if slot.in_model else slot
+
+    def pose(self, key: int) -> Pose:
+        """The ragdoll's simulated pose as an engine :class:`Pose` (root + local rotations)."""
+        if (out := self._outside(key)) is not None:
+            return Pose(out.cmd.root.copy(), out.cmd.rot.copy())
+        roots, rot = self._readback()
+        L = self.layout
+        assert L is not None
+        p = L.ordinal(key)
+        return Pose(roots[p].copy(), rot[L.starts[p]:L.starts[p + 1]].copy())
+
+    def body_positions(self, key: int) -> _F:
+        """World positions ``[J,3]`` of the ragdoll's joint origins."""
+        if (out := self._outside(key)) is not None:
+            return forward_kinematics(out.spec.skeleton, out.cmd.root, out.cmd.rot, out.spec.offsets)[0]
+        L, d = self.layout, self.data
+        assert L is not None and d is not None
+        return d.xpos[L.body[L.body_owner == L.ordinal(key)]].copy()
+
+    def root_velocity(self, key: int) -> _F:
+        """The root's free-joint velocity ``[6]`` (linear world, angular local)."""
+        if (out := self._outside(key)) is not None:  # its target's velocity over the last step
+            v, last, prev = np.zeros(6), out.cmd.last, out.prev
+            if last is not None and prev is not None:
+                v[:3] = (last[0] - prev[0]) / self.dt
+                v[3:] = quat.log(quat.mul(quat.conjugate(prev[1][0]), last[1][0])) / self.dt
+            return v
+        L, d = self.layout, self.data
+        assert L is not None and d is not None
+        rd = int(L.root_d[L.ordinal(key)])
+        return d.qvel[rd:rd + 6].copy()
+
+    def kinetic_energy(self, key: int) -> float:
+        """Kinetic energy (J) of one ragdoll, ½ vᵀMv over its own degrees of freedom (0 for an
+        animated ragdoll left out of the model: nothing is simulated)."""
+        if self._outside(key) is not None:
+            return 0.0
+        L, m, d = self.layout, self.model, self.data
+        assert L is not None and m is not None and d is not None
+        if self._ke is None:
+            res = np.zeros(m.nv)
+            mujoco.mj_mulM(m, d, res, d.qvel)
+            cum = np.concatenate([[0.0], np.cumsum(0.5 * d.qvel * res)])
+            self._ke = cum[L.dofs[:, 1]] - cum[L.dofs[:, 0]]
+        return float(self._ke[L.ordinal(key)])
+
+    def joint_limit_violation(self, key: int) -> float:
+        """Largest excess (rad) of any simulated joint beyond its cone, twist or hinge range (0 when
+        within, and for an animated ragdoll left out of the model)."""
+        if self._outside(key) is not None:
+            return 0.0
+        roots, rot = self._readback()
+        L, d = self.layout, self.data
+        assert L is not None and d is not None
+        p = L.ordinal(key)
+        b, h = L.ball_owner == p, L.hinge_owner == p
+        q = rot[L.ball_src[b]]
+        cone = np.max(quat.angle_between(quat.identity(len(q)), q) - L.ball_cone[b], initial=0.0)
+        _, tw = quat.swing_twist(quat.align_hemisphere(q), L.ball_axis[b])
+        tang = np.abs(2.0 * np.arctan2(np.sum(tw[:, 1:] * L.ball_axis[b], axis=1), tw[:, 0]))
+        twist = np.max(tang - L.ball_twist[b], initial=0.0)
+        a = d.qpos[L.hinge_q[h]]
+        hinge = np.max(np.maximum(L.hinge_range[h, 0] - a, a - L.hinge_range[h, 1]), initial=0.0)
+        return float(max(cone, twist, hinge, 0.0))

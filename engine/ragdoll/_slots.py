@@ -1,0 +1,41 @@
+"""What the physics world keeps per ragdoll and per prop, beside MuJoCo's own state."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.ragdoll._control import Command
+from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec
+
+__all__ = ["RagdollSlot", "PropSlot"]
+
+_F = NDArray[np.float64]
+
+
+@dataclass
+class RagdollSlot:
+    """One ragdoll: how to build it, its command, and whether (and how) it is in the model now."""
+
+    spec: RagdollSpec
+    cmd: Command
+    reach: float
+    placed: bool = False
+    fragment: RagdollFragment | None = None
+    in_model: bool = True
+    prev: tuple[_F, _F] | None = None  # out of the model: the target before the last step's
+    ghost: bool = False  # inside another ragdoll: touches only the ground and props
+
+
+@dataclass
+class PropSlot:
+    """One prop: how to build it, its starting state until built, and its MuJoCo addresses."""
+
+    spec: PropSpec
+    init: tuple[_F, _F, _F] | None = None
+    qadr: int = -1
+    dadr: int = -1
+    geom: int = -1
+    body: int = -1
