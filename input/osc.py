@@ -104,11 +104,7 @@ class OscSource(PoseSource):
         if sender not in self._active:
             self._active.add(sender)
             self.connected(sender)
-        try:
-            sample = self.decoder.decode(data, sender, now)
-        except ValueError as exc:  # a sample that fails PoseSample's own checks
-            self.drop("invalid sample", str(exc))
-            return
+        sample = self.decoder.decode(data, sender, now)
         if sample is not None:
             self.push(sample)
 
