@@ -4,14 +4,21 @@ Binding: ``host`` defaults to ``127.0.0.1``; a phone on the LAN needs ``0.0.0.0`
 (``--osc-host 0.0.0.0``; the pairing overlay says so). Port 9000 by default (the
 Sensors2OSC default; point ZIG SIM, whose own default is 3333, at it).
 
-Per datagram the thread: checks the sender (locked to the first one unless
-``max_senders`` allows more), applies a per-sender rate limit (token bucket), then
-hands the bytes to :class:`input.osc_profiles.OscDecoder`. Garbage, truncated
-packets, wrong types, NaN/inf and non-unit quaternions are counted in the status
-with their reason and dropped; the thread never raises out.
+Per datagram the thread: checks the sender, applies a per-sender rate limit (token
+bucket), then hands the bytes to :class:`input.osc_profiles.OscDecoder`. Garbage,
+truncated packets, wrong types, NaN/inf and non-unit quaternions are counted in the
+status with their reason and dropped; the thread never raises out.
 
-A sender that goes quiet for ``timeout`` seconds is reported disconnected (its stick
-lets go); its next packet reconnects it.
+Sender policy: a new address is a *candidate* until it has sent ``admit_after`` valid
+pose samples; only then does it take one of the ``max_senders`` slots (the session
+then follows it, and the status reports it connected). So garbage, or a single stray
+datagram, from any host on the LAN cannot claim the phone's slot: only a real pose
+stream can. Once the slots are taken, other addresses are refused and listed in the
+status's ``locked_out`` (the overlay names them). At most :data:`MAX_CANDIDATES`
+addresses are candidates at once; a candidate quiet for ``timeout`` seconds is forgotten.
+
+An admitted sender that goes quiet for ``timeout`` seconds is reported disconnected
+(its stick lets go); its next packet reconnects it (the slot stays its own).
 """
 
 from __future__ import annotations
@@ -22,9 +29,11 @@ import time
 from input.osc_profiles import OscDecoder
 from input.source import PoseSource
 
-__all__ = ["OscSource", "DEFAULT_PORT"]
+__all__ = ["OscSource", "DEFAULT_PORT", "ADMIT_AFTER", "MAX_CANDIDATES"]
 
 DEFAULT_PORT = 9000
+ADMIT_AFTER = 3  # valid samples: 50 ms of a 60 Hz phone
+MAX_CANDIDATES = 16
 
 
 class OscSource(PoseSource):
@@ -33,22 +42,32 @@ class OscSource(PoseSource):
     Args:
         host: bind address (``0.0.0.0`` for phones on the LAN; tests use ``127.0.0.1``).
         port: UDP port; 0 picks a free one (read :attr:`port` after :meth:`start`).
-        max_senders: how many senders may drive sticks (1 = lock to the first).
+        max_senders: how many senders may drive sticks (1 = lock to the first valid stream).
         max_rate: packets per second accepted per sender (burst of one second).
         timeout: seconds of silence before a sender counts as disconnected.
         gyrosc_order: GyrOSC quaternion order.
+        admit_after: valid samples a new sender must send before it takes a slot.
+
+    Raises:
+        ValueError: ``max_senders`` or ``admit_after`` below 1.
+        OSError: the port cannot be bound.
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_senders: int = 1,
                  max_rate: float = 400.0, timeout: float = 2.0, gyrosc_order: str = "wxyz",
-                 capacity: int = 256) -> None:
+                 capacity: int = 256, admit_after: int = ADMIT_AFTER) -> None:
+        if max_senders < 1 or admit_after < 1:
+            raise ValueError(f"max_senders and admit_after must be at least 1, not {max_senders}, {admit_after}")
         super().__init__(f"osc {host}:{port}", capacity)
         self.host = host
         self.max_senders = max_senders
         self.max_rate = max_rate
         self.timeout = timeout
+        self.admit_after = admit_after
         self.decoder = OscDecoder(on_drop=self.drop, gyrosc_order=gyrosc_order)
         self._senders: dict[str, list[float]] = {}  # sender -> [tokens, last refill, last seen]
+        self._admitted: list[str] = []
+        self._valid: dict[str, int] = {}  # candidate -> valid samples so far
         self._active: set[str] = set()
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
@@ -90,10 +109,14 @@ class OscSource(PoseSource):
         """Validate and decode one datagram (the socket thread's work; callable from tests)."""
         state = self._senders.get(sender)
         if state is None:
-            if len(self._senders) >= self.max_senders:
-                self.drop("other sender", f"{sender} (locked to {', '.join(self._senders)})")
+            if len(self._admitted) >= self.max_senders:
+                self._lock_out(sender)
+                return
+            if len(self._valid) >= MAX_CANDIDATES:
+                self.drop("too many senders", sender)
                 return
             state = self._senders[sender] = [self.max_rate, now, now]
+            self._valid[sender] = 0
         tokens = min(self.max_rate, state[0] + (now - state[1]) * self.max_rate)
         state[1], state[2] = now, now
         if tokens < 1.0:
@@ -101,14 +124,45 @@ class OscSource(PoseSource):
             self.drop("rate limit", sender)
             return
         state[0] = tokens - 1.0
+        sample = self.decoder.decode(data, sender, now)
+        if sender in self._valid and not self._admit(sender, sample is not None):
+            return
         if sender not in self._active:
             self._active.add(sender)
             self.connected(sender)
-        sample = self.decoder.decode(data, sender, now)
         if sample is not None:
             self.push(sample)
 
+    def _admit(self, sender: str, valid: bool) -> bool:
+        """Count a candidate's valid sample; whether it now holds a slot."""
+        if not valid:
+            return False
+        self._valid[sender] += 1
+        if self._valid[sender] < self.admit_after:
+            self.drop("sender pending", sender)
+            return False
+        del self._valid[sender]
+        self._admitted.append(sender)
+        if len(self._admitted) >= self.max_senders:  # the slots are taken: the other candidates are out
+            for other in list(self._valid):
+                self._forget(other)
+        return True
+
+    def _forget(self, sender: str) -> None:
+        self._valid.pop(sender, None)
+        self._senders.pop(sender, None)
+        self.decoder.senders.pop(sender, None)
+
+    def _lock_out(self, sender: str) -> None:
+        self.drop("other sender", f"{sender} (locked to {', '.join(self._admitted)})")
+        with self._lock:
+            seen = self._status.locked_out
+            if sender not in seen:
+                seen[:] = [*seen[-3:], sender]  # the latest few, for the overlay
+
     def _expire(self, now: float) -> None:
+        for sender in [s for s in self._valid if now - self._senders[s][2] > self.timeout]:
+            self._forget(sender)
         for sender in [s for s in self._active if now - self._senders[s][2] > self.timeout]:
             self._active.discard(sender)
-            self.disconnected(sender)  # the lock stays: the first sender is the one that comes back
+            self.disconnected(sender)  # the slot stays: the admitted sender is the one that comes back

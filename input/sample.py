@@ -189,3 +189,4 @@ class SourceStatus:
     dropped: int = 0
     last_error: str = ""
     drop_reasons: dict[str, int] = field(default_factory=dict)
+    locked_out: list[str] = field(default_factory=list)  # senders refused because the slots are taken

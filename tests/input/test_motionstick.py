@@ -165,7 +165,7 @@ def test_a_huge_osc_double_is_dropped_and_the_stick_stays_finite(make_app):
             b.add_arg(v, "d")
         return b.build().dgram
 
-    osc = OscSource(port=0)
+    osc = OscSource(port=0, admit_after=1)
     try:
         app = make_app(InputHub([osc]))
         e = app.world.query(Stick)[0][0]

@@ -13,7 +13,7 @@ import pytest
 
 from engine.components import Stick
 from input.hub import InputHub
-from input.osc import OscSource
+from input.osc import ADMIT_AFTER, MAX_CANDIDATES, OscSource
 from input.sample import CONNECT, TOUCH_DOWN
 
 ZIG_SENDER = textwrap.dedent("""
@@ -80,7 +80,7 @@ def test_zigsim_bundles_from_another_process_move_the_stick(make_app):
 
 @pytest.mark.skipif(shutil.which("oscsend") is None, reason="liblo-tools' oscsend is not installed")
 def test_oscsend_messages_for_each_profile():
-    src = OscSource(host="127.0.0.1", port=0)
+    src = OscSource(host="127.0.0.1", port=0, admit_after=1)  # every message counts here, the first too
     hub = InputHub([src]).start()
     try:
         sends = [
@@ -145,11 +145,54 @@ def test_locked_to_first_sender_and_rate_limited(osc):
             src.handle_datagram(pkt, "osc:10.0.0.1", now=100.0)
         src.handle_datagram(pkt, "osc:10.0.0.2", now=100.0)
         st = src.status()
-        assert st.drop_reasons["rate limit"] == 20 and st.drop_reasons["other sender"] == 1
+        assert st.drop_reasons == {"rate limit": 20, "sender pending": 2, "other sender": 1}
+        assert st.locked_out == ["osc:10.0.0.2"]
         src.handle_datagram(message("/puppetphone/touch", 1), "osc:10.0.0.1", now=101.0)  # tokens refilled
         assert src.drain()[-1].touch is True
     finally:
         src.stop()
+
+
+def test_garbage_or_a_stray_datagram_cannot_claim_the_slot(osc):
+    message, _ = osc
+    src = OscSource(host="127.0.0.1", port=0)
+    pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+    try:
+        src.handle_datagram(b"\x00garbage", "osc:10.0.0.66", now=1.0)  # first on the wire: used to lock everyone out
+        src.handle_datagram(pose, "osc:10.0.0.77", now=1.0)  # one valid datagram is not a pose stream either
+        for i in range(5):
+            src.handle_datagram(pose, "osc:10.0.0.5", now=1.0 + i / 60)
+        for sender in ("osc:10.0.0.66", "osc:10.0.0.77"):
+            for _ in range(5):
+                src.handle_datagram(pose, sender, now=1.1)
+        items = src.drain()
+        assert items[0] == (CONNECT, "osc:10.0.0.5")
+        assert {i.source for i in items[1:]} == {"osc:10.0.0.5"} and len(items) == 1 + 5 - (ADMIT_AFTER - 1)
+        st = src.status()
+        assert st.locked_out == ["osc:10.0.0.66", "osc:10.0.0.77"] and st.drop_reasons["other sender"] == 10
+    finally:
+        src.stop()
+
+
+def test_candidates_are_bounded_and_forgotten_when_quiet(osc):
+    message, _ = osc
+    src = OscSource(host="127.0.0.1", port=0, timeout=2.0)
+    try:
+        for i in range(MAX_CANDIDATES + 5):
+            src.handle_datagram(b"junk", f"osc:10.1.0.{i}", now=1.0)
+        assert src.status().drop_reasons["too many senders"] == 5
+        src._expire(10.0)  # every candidate went quiet
+        pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+        for i in range(ADMIT_AFTER):
+            src.handle_datagram(pose, "osc:10.2.0.1", now=10.0 + i / 60)
+        assert src.drain()[0] == (CONNECT, "osc:10.2.0.1")
+    finally:
+        src.stop()
+
+
+def test_no_sender_slots_is_refused():
+    with pytest.raises(ValueError, match="max_senders"):
+        OscSource(host="127.0.0.1", port=0, max_senders=0)
 
 
 def test_bind_error_is_clear():
