@@ -17,6 +17,16 @@ stream can. Once the slots are taken, other addresses are refused and listed in 
 status's ``locked_out`` (the overlay names them). At most :data:`MAX_CANDIDATES`
 addresses are candidates at once; a candidate quiet for ``timeout`` seconds is forgotten.
 
+Bounded work: a datagram over :data:`MAX_DATAGRAM` bytes, a bundle nested deeper than
+:data:`MAX_BUNDLE_DEPTH` or holding more than :data:`MAX_MESSAGES` messages is dropped
+before python-osc parses it (the structure is walked iteratively first). Between two
+drains of the hub (one simulation step) each admitted sender may have
+:data:`STEP_BUDGET` datagrams, messages and bytes decoded, and each candidate
+:data:`CANDIDATE_BUDGET`; the excess is dropped and counted ("over budget"). Decoding runs on the
+socket thread, but it holds the interpreter lock the simulation needs: unbounded, a
+flood of 62 KB bundles held the game at 34 steps/s. Per sender, so a flood from one
+address does not spend the budget of the phone that plays.
+
 An admitted sender that goes quiet for ``timeout`` seconds is reported disconnected
 (its stick lets go); its next packet reconnects it (the slot stays its own).
 """
@@ -27,13 +37,55 @@ import socket
 import time
 
 from input.osc_profiles import OscDecoder
+from input.sample import PoseSample
 from input.source import PoseSource
 
-__all__ = ["OscSource", "DEFAULT_PORT", "ADMIT_AFTER", "MAX_CANDIDATES"]
+__all__ = ["OscSource", "DEFAULT_PORT", "ADMIT_AFTER", "MAX_CANDIDATES", "MAX_DATAGRAM", "MAX_BUNDLE_DEPTH",
+           "MAX_MESSAGES", "STEP_BUDGET", "CANDIDATE_BUDGET", "bundle_shape"]
 
 DEFAULT_PORT = 9000
 ADMIT_AFTER = 3  # valid samples: 50 ms of a 60 Hz phone
-MAX_CANDIDATES = 16
+MAX_CANDIDATES = 8
+# Phone apps send a few hundred bytes per tick (a ZIG SIM bundle with every sensor is ~1 KB).
+MAX_DATAGRAM = 8192
+MAX_BUNDLE_DEPTH = 2
+MAX_MESSAGES = 32
+# Per admitted sender and step: datagrams, messages, bytes. A 60 Hz phone needs one datagram
+# of a few messages per step (a ZIG SIM bundle holds about ten); Sensors2OSC sends one
+# datagram per sensor, up to the rate limit's 400/s; the rest is slack for Wi-Fi bunching.
+STEP_BUDGET = (8, 32, 8192)
+# Per candidate and step: enough for a phone to prove its pose stream (a whole ZIG SIM bundle),
+# and no more, as a candidate is anyone.
+CANDIDATE_BUDGET = (2, 16, 4096)
+_BUNDLE = b"#bundle\x00"
+
+
+def bundle_shape(data: bytes) -> tuple[int, str]:
+    """How many messages ``data`` holds, and why it is too big a bundle to parse (``""`` if it is not).
+
+    Walked without recursion and without parsing: only sizes are checked here; whatever
+    else is wrong, python-osc reports while parsing.
+    """
+    todo = [(0, len(data), 1)]
+    messages = 0
+    while todo:
+        start, end, depth = todo.pop()
+        if data[start:start + 8] != _BUNDLE:
+            messages += 1
+            continue
+        if depth > MAX_BUNDLE_DEPTH:
+            return messages, "bundle too deep"
+        pos = start + 16  # past the tag and the time tag
+        while pos + 4 <= end:
+            n = int.from_bytes(data[pos:pos + 4], "big")
+            pos += 4
+            if n <= 0 or pos + n > end:
+                break
+            if messages + len(todo) >= MAX_MESSAGES:
+                return messages, "bundle too large"
+            todo.append((pos, pos + n, depth + 1))
+            pos += n
+    return messages, ""
 
 
 class OscSource(PoseSource):
@@ -69,6 +121,7 @@ class OscSource(PoseSource):
         self._admitted: list[str] = []
         self._valid: dict[str, int] = {}  # candidate -> valid samples so far
         self._active: set[str] = set()
+        self._budget: dict[str, list[int]] = {}  # sender -> what is left to decode this step
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             self._sock.bind((host, port))
@@ -124,6 +177,8 @@ class OscSource(PoseSource):
             self.drop("rate limit", sender)
             return
         state[0] = tokens - 1.0
+        if not self._affordable(data, sender):
+            return
         sample = self.decoder.decode(data, sender, now)
         if sender in self._valid and not self._admit(sender, sample is not None):
             return
@@ -132,6 +187,29 @@ class OscSource(PoseSource):
             self.connected(sender)
         if sample is not None:
             self.push(sample)
+
+    def _affordable(self, data: bytes, sender: str) -> bool:
+        """Whether ``data`` is small enough, and this step's budget holds it (then spend it)."""
+        if len(data) > MAX_DATAGRAM:
+            self.drop("oversize packet", f"{sender}: {len(data)} bytes")
+            return False
+        messages, problem = bundle_shape(data)
+        if problem:
+            self.drop(problem, sender)
+            return False
+        left = self._budget.setdefault(sender, list(CANDIDATE_BUDGET if sender in self._valid else STEP_BUDGET))
+        if left[0] < 1 or left[1] < messages or left[2] < len(data):
+            self.drop("over budget", sender)
+            return False
+        left[0] -= 1
+        left[1] -= messages
+        left[2] -= len(data)
+        return True
+
+    def drain(self) -> list[PoseSample | tuple[str, str]]:
+        """What was queued since the last step; the decoding budgets start again for the next."""
+        self._budget = {}
+        return super().drain()
 
     def _admit(self, sender: str, valid: bool) -> bool:
         """Count a candidate's valid sample; whether it now holds a slot."""
@@ -143,6 +221,7 @@ class OscSource(PoseSource):
             return False
         del self._valid[sender]
         self._admitted.append(sender)
+        self._budget.pop(sender, None)  # from now on an admitted sender's budget
         if len(self._admitted) >= self.max_senders:  # the slots are taken: the other candidates are out
             for other in list(self._valid):
                 self._forget(other)

@@ -13,7 +13,8 @@ import pytest
 
 from engine.components import Stick
 from input.hub import InputHub
-from input.osc import ADMIT_AFTER, MAX_CANDIDATES, OscSource
+from input.osc import (ADMIT_AFTER, CANDIDATE_BUDGET, MAX_BUNDLE_DEPTH, MAX_CANDIDATES, MAX_DATAGRAM, MAX_MESSAGES, STEP_BUDGET, OscSource,
+                       bundle_shape)
 from input.sample import CONNECT, TOUCH_DOWN
 
 ZIG_SENDER = textwrap.dedent("""
@@ -130,9 +131,10 @@ def test_flood_of_ten_thousand_packets_keeps_the_step_cheap(make_app, osc):
         hub.close()
     st = src.status()
     assert worst <= hub.max_samples
-    # What the kernel's buffer kept is either a sample or a counted drop with its reason.
-    assert st.packets > 100 and st.dropped > 2 * 100
-    assert {"malformed packet", "non-finite value"} <= set(st.drop_reasons)
+    # What the kernel's buffer kept is either a sample or a counted drop with its reason; past
+    # the step's decoding budget, datagrams are dropped undecoded.
+    assert st.packets > 20 and st.dropped > 2 * 100
+    assert {"malformed packet", "non-finite value", "over budget"} <= set(st.drop_reasons)
     assert app.world.query(Stick)[0][1].connected
 
 
@@ -143,6 +145,8 @@ def test_locked_to_first_sender_and_rate_limited(osc):
         pkt = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
         for i in range(30):
             src.handle_datagram(pkt, "osc:10.0.0.1", now=100.0)
+            if i % 2:
+                src.drain()  # steps go by: the decoding budget is not what is tested here
         src.handle_datagram(pkt, "osc:10.0.0.2", now=100.0)
         st = src.status()
         assert st.drop_reasons == {"rate limit": 20, "sender pending": 2, "other sender": 1}
@@ -160,12 +164,14 @@ def test_garbage_or_a_stray_datagram_cannot_claim_the_slot(osc):
     try:
         src.handle_datagram(b"\x00garbage", "osc:10.0.0.66", now=1.0)  # first on the wire: used to lock everyone out
         src.handle_datagram(pose, "osc:10.0.0.77", now=1.0)  # one valid datagram is not a pose stream either
-        for i in range(5):
+        items = []
+        for i in range(5):  # a phone at 60 Hz, one datagram a step
             src.handle_datagram(pose, "osc:10.0.0.5", now=1.0 + i / 60)
+            items += src.drain()
         for sender in ("osc:10.0.0.66", "osc:10.0.0.77"):
             for _ in range(5):
                 src.handle_datagram(pose, sender, now=1.1)
-        items = src.drain()
+        items += src.drain()
         assert items[0] == (CONNECT, "osc:10.0.0.5")
         assert {i.source for i in items[1:]} == {"osc:10.0.0.5"} and len(items) == 1 + 5 - (ADMIT_AFTER - 1)
         st = src.status()
@@ -183,9 +189,11 @@ def test_candidates_are_bounded_and_forgotten_when_quiet(osc):
         assert src.status().drop_reasons["too many senders"] == 5
         src._expire(10.0)  # every candidate went quiet
         pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
-        for i in range(ADMIT_AFTER):
+        items = []
+        for i in range(ADMIT_AFTER):  # one datagram a step
             src.handle_datagram(pose, "osc:10.2.0.1", now=10.0 + i / 60)
-        assert src.drain()[0] == (CONNECT, "osc:10.2.0.1")
+            items += src.drain()
+        assert items[0] == (CONNECT, "osc:10.2.0.1")
     finally:
         src.stop()
 
@@ -202,3 +210,43 @@ def test_bind_error_is_clear():
             OscSource(host="127.0.0.1", port=a.port)
     finally:
         a.stop()
+
+
+def test_bundles_are_measured_without_parsing(osc):
+    message, bundle = osc
+    pose = ("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+    assert bundle_shape(message(*pose)) == (1, "")
+    assert bundle_shape(bundle(pose, pose, pose)) == (3, "")
+    assert bundle_shape(bundle(*[pose] * (MAX_MESSAGES + 1)))[1] == "bundle too large"
+    nested = bundle(pose)
+    for _ in range(MAX_BUNDLE_DEPTH):
+        nested = b"#bundle\x00" + bytes(8) + len(nested).to_bytes(4, "big") + nested
+    assert bundle_shape(nested)[1] == "bundle too deep"
+    assert bundle_shape(b"#bundle\x00" + bytes(8) + (10**9).to_bytes(4, "big")) == (0, "")  # lying sizes: python-osc's
+
+
+def test_decoding_is_budgeted_per_sender_and_step(osc):
+    message, bundle = osc
+    src = OscSource(host="127.0.0.1", port=0, max_senders=2, admit_after=1, max_rate=1e6)
+    try:
+        pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+        src.handle_datagram(pose, "osc:10.0.0.1", now=1.0)  # admitted, on the candidates' budget
+        src.drain()
+        for _ in range(STEP_BUDGET[0] + 5):
+            src.handle_datagram(pose, "osc:10.0.0.1", now=1.0)
+        src.handle_datagram(b"x" * (MAX_DATAGRAM + 1), "osc:10.0.0.1", now=1.0)
+        for _ in range(3):
+            src.handle_datagram(b"junk", "osc:10.0.0.9", now=1.0)  # a candidate: the candidates' budget
+        st = src.status()
+        assert st.packets == 1 + STEP_BUDGET[0] and st.drop_reasons["oversize packet"] == 1
+        assert st.drop_reasons["malformed packet"] == CANDIDATE_BUDGET[0]
+        assert st.drop_reasons["over budget"] == 5 + 3 - CANDIDATE_BUDGET[0]
+        src.drain()  # the next step: a fresh budget
+        src.handle_datagram(pose, "osc:10.0.0.1", now=1.0)
+        assert src.status().packets == STEP_BUDGET[0] + 2
+        many = bundle(*[("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)] * 30)
+        for _ in range(3):
+            src.handle_datagram(many, "osc:10.0.0.1", now=1.0)  # messages run out before datagrams do
+        assert src.status().drop_reasons["over budget"] == 5 + 3 - CANDIDATE_BUDGET[0] + 2
+    finally:
+        src.stop()
