@@ -101,15 +101,19 @@ class OscSource(PoseSource):
         admit_after: valid samples a new sender must send before it takes a slot.
 
     Raises:
-        ValueError: ``max_senders`` or ``admit_after`` below 1.
+        ValueError: ``max_senders`` or ``admit_after`` below 1, a port outside 0..65535.
         OSError: the port cannot be bound.
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_senders: int = 1,
                  max_rate: float = 400.0, timeout: float = 2.0, gyrosc_order: str = "wxyz",
                  capacity: int = 256, admit_after: int = ADMIT_AFTER) -> None:
-        if max_senders < 1 or admit_after < 1:
-            raise ValueError(f"max_senders and admit_after must be at least 1, not {max_senders}, {admit_after}")
+        if max_senders < 1:
+            raise ValueError(f"the number of OSC senders must be at least 1 (0 would refuse every phone), not {max_senders}")
+        if admit_after < 1:
+            raise ValueError(f"admit_after must be at least 1, not {admit_after}")
+        if not 0 <= port <= 65535:
+            raise ValueError(f"OSC port must be 0..65535, not {port}")
         super().__init__(f"osc {host}:{port}", capacity)
         self.host = host
         self.max_senders = max_senders

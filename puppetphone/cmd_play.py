@@ -12,15 +12,18 @@ __all__ = ["configure", "run"]
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the play arguments."""
     from input.factory import add_source_arguments
+    from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
 
     parser.add_argument("game", help="snowman or tasbada")
     add_source_arguments(parser)
     parser.add_argument("--headless", action="store_true", help="no window: EGL rendering, for servers and tests")
-    parser.add_argument("--frames", type=int, default=None, help="stop after N simulation steps")
-    parser.add_argument("--screenshot", type=Path, default=None, help="write the last frame as PNG")
-    parser.add_argument("--record", type=Path, default=None, help="record the session's input and state hashes")
-    parser.add_argument("--seed", type=int, default=0, help="the world's random seed (default 0)")
-    parser.add_argument("--size", default="1280x720", help="window size WxH (default 1280x720)")
+    parser.add_argument("--frames", type=int_range(0), default=None, help="stop after N simulation steps")
+    parser.add_argument("--screenshot", type=output_file, default=None, help="write the last frame as PNG")
+    parser.add_argument("--record", type=output_file, default=None,
+                        help="record the session's input and state hashes (an existing file is replaced)")
+    parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
+    parser.add_argument("--size", type=window_size, default=(1280, 720),
+                        help=f"window size WxH, sides up to {MAX_WINDOW} (default 1280x720)")
 
 
 def resolve_source(source: str, game: str) -> str:
@@ -40,11 +43,9 @@ def run(args: argparse.Namespace) -> int:
     from input.recording import RecordingError
     from puppetphone.session import Session, SessionOptions
 
-    try:
-        width, height = (int(v) for v in args.size.lower().split("x"))
-    except ValueError:
-        print(f"--size must look like 1280x720, not {args.size!r}", file=sys.stderr)
-        return 2
+    width, height = args.size
+    if args.record is not None and args.record.exists():
+        print(f"--record: replacing the existing {args.record}", file=sys.stderr)
     source = resolve_source(args.source, args.game)
     try:
         hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud)

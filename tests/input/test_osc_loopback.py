@@ -199,7 +199,7 @@ def test_candidates_are_bounded_and_forgotten_when_quiet(osc):
 
 
 def test_no_sender_slots_is_refused():
-    with pytest.raises(ValueError, match="max_senders"):
+    with pytest.raises(ValueError, match="OSC senders must be at least 1"):
         OscSource(host="127.0.0.1", port=0, max_senders=0)
 
 
