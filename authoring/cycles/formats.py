@@ -112,8 +112,11 @@ def _items_from_names(names: list[str]) -> list[Item]:
 
 
 def _load_csv(path: Path, items: list[str] | None) -> Performance:
-    text = path.read_text()
-    rows = list(csv.reader(io.StringIO(text)))
+    try:
+        text = read_bounded(path, MAX_NPZ_BYTES).decode("utf-8")
+        rows = list(csv.reader(io.StringIO(text)))
+    except (ValueError, csv.Error) as exc:  # not UTF-8 text, NUL bytes, not a regular file, too big
+        raise TrajectoryError(f"{path}: not a readable CSV file ({type(exc).__name__}: {exc})"[:300]) from None
     rows = [r for r in rows if r and any(x.strip() for x in r)]
     if len(rows) < 2:
         raise TrajectoryError(f"{path}: a CSV performance needs a header row and data rows")

@@ -269,12 +269,12 @@ def read_gltf(path: str | os.PathLike[str]) -> GltfAsset:
     """
     p = Path(path)
     source = str(p)
-    doc, buffers = _document(p)
     try:
+        doc, buffers = _document(p)
         return _asset(doc, buffers, source)
     except GltfError:
         raise
-    except _MALFORMED as exc:
+    except _MALFORMED as exc:  # binascii.Error of a bad data URI is a ValueError too
         raise GltfError(f"{source}: malformed document ({type(exc).__name__}: {exc})"[:300]) from None
 
 
@@ -338,6 +338,9 @@ def _asset(doc: dict[str, Any], buffers: list[bytes], source: str) -> GltfAsset:
                 raise GltfError(f"{source}: animation {a}: key times must increase and stay within ±{MAX_TIME:g} s")
             values = accessor(doc, buffers, sampler["output"], source)
             interp = sampler.get("interpolation", "LINEAR")
+            width = {"translation": 3, "scale": 3, "rotation": 4}.get(target["path"])
+            if width is not None and values.shape[1] != width:
+                raise GltfError(f"{source}: animation {a}: {target['path']} keys have {values.shape[1]} numbers, not {width}")
             if target["path"] == "rotation":
                 values = quat.from_xyzw(values)
             if interp not in ("LINEAR", "STEP", "CUBICSPLINE"):

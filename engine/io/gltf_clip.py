@@ -198,16 +198,22 @@ def gltf_clip(
                         f"{asset.num_nodes} nodes at {rate:g} fps; the limit is {MAX_SAMPLES} node-frames")
     n = int(round(anim.duration * rate)) + 1
     t = np.minimum(anim.start + np.arange(n) / rate, anim.end)
-    skeleton, root, rots = _build(asset, skin, anim, t, scale)
-    rest = gltf_skeleton(asset, skin, scale)
-    skeleton = Skeleton(skeleton.names, skeleton.parents, rest.offsets, rest.tips, rest.radii)
-    loop = bool(anim.extras.get("loop", False))
-    if loop and n > 1:
-        root, rots = root[:-1], rots[:-1]
-    markers = anim.extras.get("markers", {})
-    markers = {str(k): float(v) for k, v in markers.items()
-               if isinstance(v, (int, float)) and math.isfinite(v)} if isinstance(markers, dict) else {}
-    return Clip(anim.name, skeleton, rate, root, rots, loop=loop, markers=markers)
+    try:
+        skeleton, root, rots = _build(asset, skin, anim, t, scale)
+        rest = gltf_skeleton(asset, skin, scale)
+        skeleton = Skeleton(skeleton.names, skeleton.parents, rest.offsets, rest.tips, rest.radii)
+        loop = bool(anim.extras.get("loop", False))
+        if loop and n > 1:
+            root, rots = root[:-1], rots[:-1]
+        markers = anim.extras.get("markers", {})
+        markers = {str(k): float(v) for k, v in markers.items()
+                   if isinstance(v, (int, float)) and math.isfinite(v)} if isinstance(markers, dict) else {}
+        return Clip(str(anim.name), skeleton, rate, root, rots, loop=loop, markers=markers)
+    except GltfError:
+        raise
+    except (ValueError, IndexError, KeyError, TypeError) as exc:  # a skin or tracks that make no skeleton or clip
+        raise GltfError(f"{asset.source}: animation {anim.name!r} does not make a clip "
+                        f"({type(exc).__name__}: {exc})"[:300]) from None
 
 
 def load_gltf_clips(path: str | os.PathLike[str], fps: float | None = None, skin: int = 0, scale: float = 1.0) -> list[Clip]:

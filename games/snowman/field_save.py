@@ -229,14 +229,15 @@ def restore(world: World, snap: dict[str, Any]) -> None:
     for p in snap["puppets"]:
         spawn_first_puppet(world, _vec(p["position"], "puppet"), float(p["heading"]))
     for s in snap["snowmen"]:
-        shape = SnowmanShape(float(s["bottom"]), None if s["middle"] is None else float(s["middle"]), float(s["head"]))
+        middle = s.get("middle")  # absent or null: a two-ball snowman (as _check reads it)
+        shape = SnowmanShape(float(s["bottom"]), None if middle is None else float(middle), float(s["head"]))
         bring_to_life(world, shape, _vec(s["position"], "snowman"), float(s["heading"]), int(s["number"]))
     spawned = [spawn_ball(world, _vec(b["position"], "ball"), float(b["radius"])) for b in snap["balls"]]
     world.flush()
     for e, b in zip(spawned, snap["balls"], strict=True):
         world.get(e, Transform).position = _vec(b["position"], "ball")  # spawn_ball puts it on the ground
         world.get(e, Snowball).snow = float(b["snow"])
-        if b["on"] is not None:
+        if b.get("on") is not None:
             world.add(e, Stacked(on=spawned[int(b["on"])]))
             world.get(e, Prop).carried = True
 
