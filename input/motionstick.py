@@ -209,6 +209,9 @@ def motionstick_system(world: World) -> None:
         stick.tip = stick.pivot + stick.direction * stick.length
         stick.tip_rotation = stick.orientation.copy()
         _filter_velocity(st, stick, s, cfg, world.dt)
+        # Samples are range-checked where they enter (input.sample.LIMITS), so this never fires;
+        # if it does, a NaN was about to enter the world: stop here, not in a later stage.
+        assert np.isfinite(stick.tip).all() and np.isfinite(stick.velocity).all(), f"stick {e} is not finite"
 
 
 def _filter_velocity(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, dt: float) -> None:
