@@ -24,6 +24,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
     parser.add_argument("--size", type=window_size, default=(1280, 720),
                         help=f"window size WxH, sides up to {MAX_WINDOW} (default 1280x720)")
+    parser.epilog = ("exit codes: 0 the session ran; 2 a bad option value, an input that cannot be opened, "
+                     "or a recording of another game")
 
 
 def resolve_source(source: str, game: str) -> str:

@@ -66,3 +66,10 @@ def test_recording_over_an_existing_file_says_so(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "replacing the existing old.rec" in r.stderr
     assert (tmp_path / "old.rec").read_bytes().startswith(b"PPREC\n")
+
+
+def test_help_documents_the_exit_codes(tmp_path):
+    script = Path(sys.executable).with_name("puppetphone")
+    cmd = [str(script)] if script.exists() else [sys.executable, "-m", "puppetphone"]
+    r = subprocess.run([*cmd, "play", "--help"], capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    assert r.returncode == 0 and "exit codes: 0" in r.stdout and "WxH" in r.stdout
