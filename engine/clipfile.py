@@ -84,7 +84,8 @@ def _finite(name: str, a: np.ndarray, shape_tail: tuple[int, ...] = ()) -> np.nd
         raise ClipFileError(f"{name} is not numeric ({a.dtype})")
     if shape_tail and a.shape[1:] != shape_tail:
         raise ClipFileError(f"{name} has shape {a.shape}, expected [..., {', '.join(map(str, shape_tail))}]")
-    a = a.astype(np.float64)
+    with np.errstate(invalid="ignore"):  # a float32 signalling NaN warns as it widens; refused just below
+        a = a.astype(np.float64)
     if not np.isfinite(a).all() or (a.size and float(np.abs(a).max()) > MAX_COORDINATE):
         raise ClipFileError(f"{name} holds NaN, infinite or absurd values (beyond {MAX_COORDINATE:g})")
     return a

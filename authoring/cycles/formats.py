@@ -149,7 +149,8 @@ def _from_columns(path: Path, times: NDArray[np.float64], values: NDArray[np.flo
 def _numeric(path: Path, name: str, a: np.ndarray) -> NDArray[np.float64]:
     if a.dtype.kind not in "fiub":
         raise TrajectoryError(f"{path}: {name!r} is not numeric ({a.dtype})")
-    return np.asarray(a, dtype=np.float64)
+    with np.errstate(invalid="ignore"):  # a float32 signalling NaN warns as it widens; Trajectory refuses NaN
+        return np.asarray(a, dtype=np.float64)
 
 
 def _load_npz(path: Path, items: list[str] | None) -> Performance:

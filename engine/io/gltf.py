@@ -206,7 +206,8 @@ def accessor(doc: dict[str, Any], buffers: list[bytes], index: int, source: str 
             raise GltfError(f"{source}: accessor {index} reads past its bufferView")
         if count:
             rows = np.ndarray((count,), dtype=np.dtype((np.void, item)), buffer=raw, offset=offset, strides=(stride,))
-            out = np.frombuffer(rows.tobytes(), dtype=dtype).reshape(count, width).astype(np.float64)
+            with np.errstate(invalid="ignore"):  # a signalling NaN warns as it widens; it is refused below
+                out = np.frombuffer(rows.tobytes(), dtype=dtype).reshape(count, width).astype(np.float64)
     sparse = acc.get("sparse")
     if sparse:
         n = sparse["count"]
@@ -219,7 +220,8 @@ def accessor(doc: dict[str, Any], buffers: list[bytes], index: int, source: str 
             raise GltfError(f"{source}: accessor {index} has sparse indices outside 0..{count - 1}")
         vraw, _ = _view(doc, buffers, sparse["values"]["bufferView"], source)
         vals = np.frombuffer(vraw, dtype=dtype, count=n * width, offset=sparse["values"].get("byteOffset", 0))
-        out[idx] = vals.reshape(n, width)
+        with np.errstate(invalid="ignore"):
+            out[idx] = vals.reshape(n, width)
     if acc.get("normalized") and ctype in _NORM:
         out = np.maximum(out / _NORM[ctype], -1.0)
     if not np.isfinite(out).all() or (out.size and np.abs(out).max() > 1e12):

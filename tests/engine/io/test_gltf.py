@@ -221,3 +221,16 @@ def test_key_times_far_apart_do_not_allocate_frames(tmp_path: Path) -> None:
     path.write_text(json.dumps(doc))
     with pytest.raises(GltfError, match="node-frames"):
         load_gltf_clips(path)
+
+
+def test_a_signalling_nan_in_a_buffer_is_a_gltf_error(tmp_path: Path) -> None:
+    path, doc = _doc(tmp_path)
+    snan = b"\x01\x00\xa0\x7f" * 2  # float32 signalling NaNs: widening them raised a RuntimeWarning
+    doc["buffers"].append({"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(snan).decode()})
+    doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": 8})
+    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2,
+                             "type": "SCALAR"})
+    doc["animations"][0]["samplers"][0]["input"] = len(doc["accessors"]) - 1
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError, match="NaN"):
+        read_gltf(path)
