@@ -3,7 +3,7 @@
 A sender thread streams ``/puppetphone/pose`` over loopback UDP at about 60 Hz
 (slightly off the step rate, so every phase between packet and step occurs) and
 remembers each packet's send time; the simulation, paced to real time by
-:class:`input.pacing.RealTimePacer`, records when each packet's sample reaches the
+:class:`engine.pacing.RealTimePacer`, records when each packet's sample reaches the
 ``Stick`` (the end of the step whose ``InputFrame`` carried it). The goal is within
 one step: 16.7 ms.
 """

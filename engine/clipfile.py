@@ -4,7 +4,10 @@ A ``.ppclip`` is a zip (numpy ``.npz``) holding a JSON header and the arrays. Th
 header names the format and its version, the skeleton (names, parents, offsets,
 tips, radii), fps, loop flag, markers, and a SHA-256 of the array bytes, so a
 file that was truncated or altered is refused with a clear message rather than
-loaded as garbage. Readers refuse versions newer than they know.
+loaded as garbage. Readers refuse versions newer than they know, and check every
+value before building the clip (sizes before allocation through
+:mod:`engine.npz_safe`, then types, finiteness, fps, radii, unit rotations): whatever
+is wrong with a file, :func:`load_clip` raises :class:`ClipFileError` and nothing else.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-import zipfile
+import math
 from pathlib import Path
 from typing import Any
 
@@ -20,12 +23,19 @@ import numpy as np
 
 from engine.atomic import atomic_write
 from engine.clip import Clip, RootMotion
+from engine.npz_safe import read_bounded, read_npz
 from engine.skeleton import Skeleton
 
 __all__ = ["save_clip", "load_clip", "ClipFileError", "FORMAT", "VERSION"]
 
 FORMAT = "puppetphone-clip"
 VERSION = 1
+# Limits a real clip is far inside: an hour of 120 fps mocap on a 100-joint skeleton is ~170 MB.
+MAX_FILE = 256 << 20
+MAX_HEADER = 1 << 20
+MAX_JOINTS = 1024
+MAX_FPS = 1000.0
+MAX_COORDINATE = 1e6  # metres (and radians of heading)
 
 
 class ClipFileError(ValueError):
@@ -69,42 +79,103 @@ def save_clip(clip: Clip, path: str | Path) -> Path:
     return atomic_write(path, lambda f: f.write(buf.getvalue()))
 
 
-def load_clip(path: str | Path) -> Clip:
-    """Read a clip, checking format, version and checksum; raises :class:`ClipFileError`."""
-    path = Path(path)
-    raw = path.read_bytes()
+def _finite(name: str, a: np.ndarray, shape_tail: tuple[int, ...] = ()) -> np.ndarray:
+    if a.dtype.kind not in "fiu":
+        raise ClipFileError(f"{name} is not numeric ({a.dtype})")
+    if shape_tail and a.shape[1:] != shape_tail:
+        raise ClipFileError(f"{name} has shape {a.shape}, expected [..., {', '.join(map(str, shape_tail))}]")
+    with np.errstate(invalid="ignore"):  # a float32 signalling NaN warns as it widens; refused just below
+        a = a.astype(np.float64)
+    if not np.isfinite(a).all() or (a.size and float(np.abs(a).max()) > MAX_COORDINATE):
+        raise ClipFileError(f"{name} holds NaN, infinite or absurd values (beyond {MAX_COORDINATE:g})")
+    return a
+
+
+def _header(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
+    raw = arrays.pop("header")
+    if raw.dtype != np.uint8 or raw.ndim != 1 or raw.size > MAX_HEADER:
+        raise ClipFileError(f"header is not {MAX_HEADER} bytes or fewer of JSON")
     try:
-        with np.load(io.BytesIO(raw), allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
-        raise ClipFileError(f"{path}: not a readable clip file ({exc})") from exc
+        header = json.loads(raw.tobytes().decode())
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        raise ClipFileError(f"header is corrupt ({type(exc).__name__})") from None
+    if not isinstance(header, dict):
+        raise ClipFileError("header is not a JSON object")
+    return header
+
+
+def _check_header(header: dict[str, Any]) -> None:
+    if header.get("format") != FORMAT:
+        raise ClipFileError(f"format {repr(header.get('format'))[:40]}, expected {FORMAT!r}")
+    version = header.get("version")
+    if not isinstance(version, int) or isinstance(version, bool) or version > VERSION or version < 1:
+        raise ClipFileError(f"clip format version {repr(version)[:20]}; this build reads versions 1..{VERSION}")
+    fps = header.get("fps")
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0.0 < fps <= MAX_FPS:
+        raise ClipFileError(f"fps {repr(fps)[:20]} is not a number in (0, {MAX_FPS:g}]")
+    if not isinstance(header.get("name"), str) or not isinstance(header.get("loop"), bool):
+        raise ClipFileError("name must be a string and loop a boolean")
+    joints = header.get("joints")
+    if not isinstance(joints, list) or not 0 < len(joints) <= MAX_JOINTS or not all(isinstance(j, str) for j in joints):
+        raise ClipFileError(f"joints must be a list of 1..{MAX_JOINTS} names")
+    markers = header.get("markers", {})
+    if not isinstance(markers, dict) or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in markers.values()):
+        raise ClipFileError("markers must map names to finite times")
+
+
+def load_clip(path: str | Path) -> Clip:
+    """Read a clip, checking format, version, checksum and every value.
+
+    Raises:
+        ClipFileError: the file is not a readable clip: too big, damaged, of a newer version,
+            or with values no clip has (NaN or absurd coordinates, fps not in (0, 1000],
+            negative radii, rotations that are not unit quaternions, inconsistent shapes).
+        OSError: the file cannot be opened.
+    """
+    path = Path(path)
+    try:
+        arrays = read_npz(read_bounded(path, MAX_FILE))
+    except ValueError as exc:  # NpzError, or not a regular file / too big
+        raise ClipFileError(f"{path}: not a readable clip file ({exc})") from None
     if "header" not in arrays:
         raise ClipFileError(f"{path}: no header; not a {FORMAT} file")
     try:
-        header: dict[str, Any] = json.loads(arrays.pop("header").tobytes().decode())
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ClipFileError(f"{path}: header is corrupt ({exc})") from exc
-    if header.get("format") != FORMAT:
-        raise ClipFileError(f"{path}: format {header.get('format')!r}, expected {FORMAT!r}")
-    version = header.get("version")
-    if not isinstance(version, int) or version > VERSION or version < 1:
-        raise ClipFileError(f"{path}: clip format version {version!r}; this build reads versions 1..{VERSION}")
-    if _digest(arrays) != header.get("sha256"):
-        raise ClipFileError(f"{path}: checksum mismatch; the file is corrupt")
-    try:
-        sk = Skeleton(tuple(header["joints"]), arrays["parents"], arrays["offsets"], arrays["tips"], arrays["radii"])
+        header = _header(arrays)
+        _check_header(header)
+        if _digest(arrays) != header.get("sha256"):
+            raise ClipFileError("checksum mismatch; the file is corrupt")
+        rotations = _finite("rotations", arrays["rotations"])
+        if rotations.ndim != 3 or rotations.shape[-1] != 4:
+            raise ClipFileError(f"rotations have shape {rotations.shape}, expected [F,J,4]")
+        if rotations.size and float(np.abs(np.linalg.norm(rotations, axis=-1) - 1.0).max()) > 1e-3:
+            raise ClipFileError("rotations are not unit quaternions")
+        radii = _finite("radii", arrays["radii"])
+        if (radii < 0).any():
+            raise ClipFileError("radii must not be negative")
+        parents = arrays["parents"]
+        if parents.dtype.kind not in "iu":
+            raise ClipFileError("parents are not integers")
+        sk = Skeleton(tuple(header["joints"]), parents.astype(np.int64), _finite("offsets", arrays["offsets"]),
+                      _finite("tips", arrays["tips"]), radii)
+        root = _finite("root", arrays["root"], (3,))
         rm = None
         if "rm_translation" in arrays:
-            rm = RootMotion(arrays["rm_translation"], arrays["rm_heading"])
+            rm = RootMotion(_finite("rm_translation", arrays["rm_translation"], (3,)),
+                            _finite("rm_heading", arrays["rm_heading"]))
+            if rm.translation.shape != root.shape or rm.heading.shape != root.shape[:1]:
+                raise ClipFileError("root motion does not have one entry per frame")
         return Clip(
             name=header["name"],
             skeleton=sk,
             fps=float(header["fps"]),
-            root=arrays["root"],
-            rotations=arrays["rotations"],
-            loop=bool(header["loop"]),
+            root=root,
+            rotations=rotations,
+            loop=header["loop"],
             root_motion=rm,
             markers={str(k): float(v) for k, v in header.get("markers", {}).items()},
         )
+    except ClipFileError as exc:
+        raise ClipFileError(f"{path}: {exc}") from None
     except (KeyError, ValueError, TypeError) as exc:
-        raise ClipFileError(f"{path}: inconsistent clip data ({exc})") from exc
+        raise ClipFileError(f"{path}: inconsistent clip data ({type(exc).__name__}: {exc})"[:300]) from None

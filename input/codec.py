@@ -24,7 +24,7 @@ import struct
 
 import numpy as np
 
-from input.sample import EVENT_KINDS, InputFrame, PoseSample
+from input.sample import EVENT_KINDS, InputFrame, PoseSample, check_sample_ranges
 
 __all__ = ["encode_frame", "decode_frame", "CodecError"]
 
@@ -37,7 +37,7 @@ _D = struct.Struct("<d")
 
 
 class CodecError(ValueError):
-    """A frame's bytes do not decode (truncated or corrupt)."""
+    """A frame's bytes do not decode (truncated, corrupt, or a sample out of range)."""
 
 
 def _put_str(out: bytearray, s: str) -> None:
@@ -116,6 +116,12 @@ def decode_frame(data: bytes) -> InputFrame:
             mode="world" if flags & _F_WORLD else "device", plane_normal=vecs[_F_PLANE],
             depth_delta=depth, flick=bool(flags & _F_FLICK), calibrate=bool(flags & _F_CAL),
         )
+        try:
+            check_sample_ranges(sample)
+        except ValueError as exc:  # a damaged or hand-made file must not put NaN into the world
+            raise CodecError(f"sample {len(samples)} of {source!r}: {exc}") from None
+        if not source:
+            raise CodecError(f"sample {len(samples)} has an empty source id")
         samples.append(sample)
     events = []
     for _ in range(r.take(1)[0]):

@@ -32,7 +32,7 @@ from input.hid_reports import (DS4_DEFAULT, DUALSENSE_DEFAULT, SPACEMOUSE_COMBIN
                                ImuReport, ds4_calibration, dualsense_calibration, known_device, parse_ds4,
                                parse_dualsense, parse_spacemouse)
 from input.phone_frames import STICK_TO_ARKIT_CAMERA
-from input.sample import PoseSample
+from input.sample import LIMITS
 from input.source import PoseSource
 
 __all__ = ["SpaceMouseIntegrator", "ImuIntegrator", "HidSource", "enumerate_supported"]
@@ -66,7 +66,9 @@ class SpaceMouseIntegrator:
         if r.buttons is not None:
             self.buttons = r.buttons
         dt = min(max(dt, 0.0), 0.05)
-        self.position = self.position + self.translation * self.speed * dt
+        # Held long enough, a push would carry the pivot past what a sample may hold: stop at the edge.
+        limit = LIMITS["position"]
+        self.position = np.clip(self.position + self.translation * self.speed * dt, -limit, limit)
         # Turn about world axes (the cap's twist reads as "turn the stick this way").
         self.orientation = quat.normalize(quat.mul(quat.exp(self.rotation * self.turn_rate * dt), self.orientation))
 
@@ -207,8 +209,8 @@ class HidSource(PoseSource):
                     continue
                 last = now
                 if data[0] == 1 or not combined:
-                    self.push(PoseSample(time=now, source=self.source_id, orientation=sm.orientation,
-                                         position=sm.position, touch=bool(sm.buttons & 1)))
+                    self.offer(time=now, source=self.source_id, orientation=sm.orientation,
+                               position=sm.position, touch=bool(sm.buttons & 1))
             return
         imu = ImuIntegrator(self._calibration(dev))
         parse, wrap = (parse_ds4, 65536 * 16 / 3 * 1e-6) if self.kind == "ds4" else (parse_dualsense, 2**32 / 3 * 1e-6)
@@ -222,5 +224,5 @@ class HidSource(PoseSource):
                 self.drop("bad report", str(exc))
                 continue
             imu.update(r, wrap)
-            self.push(PoseSample(time=time.monotonic(), source=self.source_id, orientation=imu.stick_orientation(),
-                                 angular_velocity=imu.gyro, acceleration=imu.accel * 9.80665, touch=r.cross))
+            self.offer(time=time.monotonic(), source=self.source_id, orientation=imu.stick_orientation(),
+                       angular_velocity=imu.gyro, acceleration=imu.accel * 9.80665, touch=r.cross)

@@ -16,7 +16,8 @@ step, for every controller entity (``Stick`` + :class:`StickState`):
    rotation relative to the tip; touch up releases;
 5. shorten the stick where the tip would go below the ground or into an
    :class:`~engine.components.Obstacle`;
-6. filter the tip velocity (One Euro) and detect an upward flick.
+6. filter the tip velocity (One Euro) and detect an upward flick; a filter state that is
+   not finite starts again at rest.
 
 Everything here runs on the fixed ``dt`` with state in components, so a replay
 reproduces it bit for bit.
@@ -208,6 +209,9 @@ def motionstick_system(world: World) -> None:
         stick.tip = stick.pivot + stick.direction * stick.length
         stick.tip_rotation = stick.orientation.copy()
         _filter_velocity(st, stick, s, cfg, world.dt)
+        # Samples are range-checked where they enter (input.sample.LIMITS), so this never fires;
+        # if it does, a NaN was about to enter the world: stop here, not in a later stage.
+        assert np.isfinite(stick.tip).all() and np.isfinite(stick.velocity).all(), f"stick {e} is not finite"
 
 
 def _filter_velocity(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, dt: float) -> None:
@@ -215,6 +219,10 @@ def _filter_velocity(st: StickState, stick: Stick, s: PoseSample | None, cfg: St
         st.filt_x, st.filt_dx = stick.tip.copy(), np.zeros(3)
     else:
         st.filt_x, st.filt_dx = cfg.filter.step(stick.tip, st.raw_x, st.filt_x, st.filt_dx, dt)
+        if not (np.all(np.isfinite(st.filt_x)) and np.all(np.isfinite(st.filt_dx))):
+            # A filter keeps what it is fed for good: start again at rest rather than carry NaN
+            # into every later step (and into the puppet's locomotion request).
+            st.filt_x, st.filt_dx = stick.tip.copy(), np.zeros(3)
     st.raw_x = stick.tip.copy()
     stick.velocity = st.filt_dx.copy()
     up = float(stick.velocity[1])

@@ -4,14 +4,31 @@ Binding: ``host`` defaults to ``127.0.0.1``; a phone on the LAN needs ``0.0.0.0`
 (``--osc-host 0.0.0.0``; the pairing overlay says so). Port 9000 by default (the
 Sensors2OSC default; point ZIG SIM, whose own default is 3333, at it).
 
-Per datagram the thread: checks the sender (locked to the first one unless
-``max_senders`` allows more), applies a per-sender rate limit (token bucket), then
-hands the bytes to :class:`input.osc_profiles.OscDecoder`. Garbage, truncated
-packets, wrong types, NaN/inf and non-unit quaternions are counted in the status
-with their reason and dropped; the thread never raises out.
+Per datagram the thread: checks the sender, applies a per-sender rate limit (token
+bucket), then hands the bytes to :class:`input.osc_profiles.OscDecoder`. Garbage,
+truncated packets, wrong types, NaN/inf and non-unit quaternions are counted in the
+status with their reason and dropped; the thread never raises out.
 
-A sender that goes quiet for ``timeout`` seconds is reported disconnected (its stick
-lets go); its next packet reconnects it.
+Sender policy: a new address is a *candidate* until it has sent ``admit_after`` valid
+pose samples; only then does it take one of the ``max_senders`` slots (the session
+then follows it, and the status reports it connected). So garbage, or a single stray
+datagram, from any host on the LAN cannot claim the phone's slot: only a real pose
+stream can. Once the slots are taken, other addresses are refused and listed in the
+status's ``locked_out`` (the overlay names them). At most :data:`MAX_CANDIDATES`
+addresses are candidates at once; a candidate quiet for ``timeout`` seconds is forgotten.
+
+Bounded work: a datagram over :data:`MAX_DATAGRAM` bytes, a bundle nested deeper than
+:data:`MAX_BUNDLE_DEPTH` or holding more than :data:`MAX_MESSAGES` messages is dropped
+before python-osc parses it (the structure is walked iteratively first). Between two
+drains of the hub (one simulation step) each admitted sender may have
+:data:`STEP_BUDGET` datagrams, messages and bytes decoded, and each candidate
+:data:`CANDIDATE_BUDGET`; the excess is dropped and counted ("over budget"). Decoding runs on the
+socket thread, but it holds the interpreter lock the simulation needs: unbounded, a
+flood of 62 KB bundles held the game at 34 steps/s. Per sender, so a flood from one
+address does not spend the budget of the phone that plays.
+
+An admitted sender that goes quiet for ``timeout`` seconds is reported disconnected
+(its stick lets go); its next packet reconnects it (the slot stays its own).
 """
 
 from __future__ import annotations
@@ -20,11 +37,55 @@ import socket
 import time
 
 from input.osc_profiles import OscDecoder
+from input.sample import PoseSample
 from input.source import PoseSource
 
-__all__ = ["OscSource", "DEFAULT_PORT"]
+__all__ = ["OscSource", "DEFAULT_PORT", "ADMIT_AFTER", "MAX_CANDIDATES", "MAX_DATAGRAM", "MAX_BUNDLE_DEPTH",
+           "MAX_MESSAGES", "STEP_BUDGET", "CANDIDATE_BUDGET", "bundle_shape"]
 
 DEFAULT_PORT = 9000
+ADMIT_AFTER = 3  # valid samples: 50 ms of a 60 Hz phone
+MAX_CANDIDATES = 8
+# Phone apps send a few hundred bytes per tick (a ZIG SIM bundle with every sensor is ~1 KB).
+MAX_DATAGRAM = 8192
+MAX_BUNDLE_DEPTH = 2
+MAX_MESSAGES = 32
+# Per admitted sender and step: datagrams, messages, bytes. A 60 Hz phone needs one datagram
+# of a few messages per step (a ZIG SIM bundle holds about ten); Sensors2OSC sends one
+# datagram per sensor, up to the rate limit's 400/s; the rest is slack for Wi-Fi bunching.
+STEP_BUDGET = (8, 32, 8192)
+# Per candidate and step: enough for a phone to prove its pose stream (a whole ZIG SIM bundle),
+# and no more, as a candidate is anyone.
+CANDIDATE_BUDGET = (2, 16, 4096)
+_BUNDLE = b"#bundle\x00"
+
+
+def bundle_shape(data: bytes) -> tuple[int, str]:
+    """How many messages ``data`` holds, and why it is too big a bundle to parse (``""`` if it is not).
+
+    Walked without recursion and without parsing: only sizes are checked here; whatever
+    else is wrong, python-osc reports while parsing.
+    """
+    todo = [(0, len(data), 1)]
+    messages = 0
+    while todo:
+        start, end, depth = todo.pop()
+        if data[start:start + 8] != _BUNDLE:
+            messages += 1
+            continue
+        if depth > MAX_BUNDLE_DEPTH:
+            return messages, "bundle too deep"
+        pos = start + 16  # past the tag and the time tag
+        while pos + 4 <= end:
+            n = int.from_bytes(data[pos:pos + 4], "big")
+            pos += 4
+            if n <= 0 or pos + n > end:
+                break
+            if messages + len(todo) >= MAX_MESSAGES:
+                return messages, "bundle too large"
+            todo.append((pos, pos + n, depth + 1))
+            pos += n
+    return messages, ""
 
 
 class OscSource(PoseSource):
@@ -33,23 +94,38 @@ class OscSource(PoseSource):
     Args:
         host: bind address (``0.0.0.0`` for phones on the LAN; tests use ``127.0.0.1``).
         port: UDP port; 0 picks a free one (read :attr:`port` after :meth:`start`).
-        max_senders: how many senders may drive sticks (1 = lock to the first).
+        max_senders: how many senders may drive sticks (1 = lock to the first valid stream).
         max_rate: packets per second accepted per sender (burst of one second).
         timeout: seconds of silence before a sender counts as disconnected.
         gyrosc_order: GyrOSC quaternion order.
+        admit_after: valid samples a new sender must send before it takes a slot.
+
+    Raises:
+        ValueError: ``max_senders`` or ``admit_after`` below 1, a port outside 0..65535.
+        OSError: the port cannot be bound.
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_senders: int = 1,
                  max_rate: float = 400.0, timeout: float = 2.0, gyrosc_order: str = "wxyz",
-                 capacity: int = 256) -> None:
+                 capacity: int = 256, admit_after: int = ADMIT_AFTER) -> None:
+        if max_senders < 1:
+            raise ValueError(f"the number of OSC senders must be at least 1 (0 would refuse every phone), not {max_senders}")
+        if admit_after < 1:
+            raise ValueError(f"admit_after must be at least 1, not {admit_after}")
+        if not 0 <= port <= 65535:
+            raise ValueError(f"OSC port must be 0..65535, not {port}")
         super().__init__(f"osc {host}:{port}", capacity)
         self.host = host
         self.max_senders = max_senders
         self.max_rate = max_rate
         self.timeout = timeout
+        self.admit_after = admit_after
         self.decoder = OscDecoder(on_drop=self.drop, gyrosc_order=gyrosc_order)
         self._senders: dict[str, list[float]] = {}  # sender -> [tokens, last refill, last seen]
+        self._admitted: list[str] = []
+        self._valid: dict[str, int] = {}  # candidate -> valid samples so far
         self._active: set[str] = set()
+        self._budget: dict[str, list[int]] = {}  # sender -> what is left to decode this step
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             self._sock.bind((host, port))
@@ -90,10 +166,14 @@ class OscSource(PoseSource):
         """Validate and decode one datagram (the socket thread's work; callable from tests)."""
         state = self._senders.get(sender)
         if state is None:
-            if len(self._senders) >= self.max_senders:
-                self.drop("other sender", f"{sender} (locked to {', '.join(self._senders)})")
+            if len(self._admitted) >= self.max_senders:
+                self._lock_out(sender)
+                return
+            if len(self._valid) >= MAX_CANDIDATES:
+                self.drop("too many senders", sender)
                 return
             state = self._senders[sender] = [self.max_rate, now, now]
+            self._valid[sender] = 0
         tokens = min(self.max_rate, state[0] + (now - state[1]) * self.max_rate)
         state[1], state[2] = now, now
         if tokens < 1.0:
@@ -101,18 +181,71 @@ class OscSource(PoseSource):
             self.drop("rate limit", sender)
             return
         state[0] = tokens - 1.0
+        if not self._affordable(data, sender):
+            return
+        sample = self.decoder.decode(data, sender, now)
+        if sender in self._valid and not self._admit(sender, sample is not None):
+            return
         if sender not in self._active:
             self._active.add(sender)
             self.connected(sender)
-        try:
-            sample = self.decoder.decode(data, sender, now)
-        except ValueError as exc:  # a sample that fails PoseSample's own checks
-            self.drop("invalid sample", str(exc))
-            return
         if sample is not None:
             self.push(sample)
 
+    def _affordable(self, data: bytes, sender: str) -> bool:
+        """Whether ``data`` is small enough, and this step's budget holds it (then spend it)."""
+        if len(data) > MAX_DATAGRAM:
+            self.drop("oversize packet", f"{sender}: {len(data)} bytes")
+            return False
+        messages, problem = bundle_shape(data)
+        if problem:
+            self.drop(problem, sender)
+            return False
+        left = self._budget.setdefault(sender, list(CANDIDATE_BUDGET if sender in self._valid else STEP_BUDGET))
+        if left[0] < 1 or left[1] < messages or left[2] < len(data):
+            self.drop("over budget", sender)
+            return False
+        left[0] -= 1
+        left[1] -= messages
+        left[2] -= len(data)
+        return True
+
+    def drain(self) -> list[PoseSample | tuple[str, str]]:
+        """What was queued since the last step; the decoding budgets start again for the next."""
+        self._budget = {}
+        return super().drain()
+
+    def _admit(self, sender: str, valid: bool) -> bool:
+        """Count a candidate's valid sample; whether it now holds a slot."""
+        if not valid:
+            return False
+        self._valid[sender] += 1
+        if self._valid[sender] < self.admit_after:
+            self.drop("sender pending", sender)
+            return False
+        del self._valid[sender]
+        self._admitted.append(sender)
+        self._budget.pop(sender, None)  # from now on an admitted sender's budget
+        if len(self._admitted) >= self.max_senders:  # the slots are taken: the other candidates are out
+            for other in list(self._valid):
+                self._forget(other)
+        return True
+
+    def _forget(self, sender: str) -> None:
+        self._valid.pop(sender, None)
+        self._senders.pop(sender, None)
+        self.decoder.senders.pop(sender, None)
+
+    def _lock_out(self, sender: str) -> None:
+        self.drop("other sender", f"{sender} (locked to {', '.join(self._admitted)})")
+        with self._lock:
+            seen = self._status.locked_out
+            if sender not in seen:
+                seen[:] = [*seen[-3:], sender]  # the latest few, for the overlay
+
     def _expire(self, now: float) -> None:
+        for sender in [s for s in self._valid if now - self._senders[s][2] > self.timeout]:
+            self._forget(sender)
         for sender in [s for s in self._active if now - self._senders[s][2] > self.timeout]:
             self._active.discard(sender)
-            self.disconnected(sender)  # the lock stays: the first sender is the one that comes back
+            self.disconnected(sender)  # the slot stays: the admitted sender is the one that comes back

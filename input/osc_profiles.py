@@ -4,7 +4,8 @@
 returns at most one :class:`PoseSample` for that sender, so bundles (ZIG SIM sends
 one per tick) become one sample, and single messages (Sensors2OSC) one each. Every
 rejected packet or message is reported through ``on_drop(reason, detail)``; nothing
-raises. Profiles are detected from the address (input-protocols §1):
+raises. A packet whose values are finite but out of a sample's range (``input.sample.LIMITS``)
+is dropped whole and leaves its sender's state as it was before the packet. Profiles are detected from the address (input-protocols §1):
 
 ==================  ===========================================================
 our scheme          ``/puppetphone/pose x y z qw qx qy qz`` (engine axes, Y up),
@@ -25,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -43,6 +44,9 @@ __all__ = ["OscDecoder", "SenderState", "G"]
 F = NDArray[np.float64]
 G = 9.80665
 UNIT_TOLERANCE = 0.05  # phones send float32 quaternions; beyond this the packet is wrong
+# No phone app sends a number this large (metres, rad/s, m/s², g); a bigger one is an attack or
+# garbage, and rejecting it here keeps scaling arithmetic (g to m/s²) from overflowing.
+MAX_ARGUMENT = 1e6
 
 
 class Reject(Exception):
@@ -76,6 +80,8 @@ def _floats(args: tuple[Any, ...], n: int, n_max: int | None = None) -> F:
     v = np.array(args, dtype=np.float64)
     if not np.all(np.isfinite(v)):
         raise Reject("non-finite value")
+    if np.max(np.abs(v), initial=0.0) > MAX_ARGUMENT:
+        raise Reject(f"value out of range (beyond {MAX_ARGUMENT:g})")
     return v
 
 
@@ -134,6 +140,7 @@ class OscDecoder:
             return None
         st = self.senders.get(sender)
         fresh = st is None
+        before = None if st is None else replace(st)
         self._state = st = SenderState() if st is None else st
         st.touch_in_packet = False
         for timed in messages:
@@ -154,12 +161,19 @@ class OscDecoder:
             st.touch, st.dirty = st.touch_in_packet, True
         if not st.dirty:
             return None
-        if fresh:
-            self.senders[sender] = st
         st.dirty = False
         cal, st.calibrate = st.calibrate, False
-        return PoseSample(time=now, source=sender, orientation=st.orientation, position=st.position,
-                          angular_velocity=st.gyro, acceleration=st.accel, touch=st.touch, calibrate=cal)
+        try:
+            sample = PoseSample(time=now, source=sender, orientation=st.orientation, position=st.position,
+                                angular_velocity=st.gyro, acceleration=st.accel, touch=st.touch, calibrate=cal)
+        except ValueError as exc:  # finite but out of range (a 1e308 position): forget the whole packet
+            if before is not None:
+                self.senders[sender] = before
+            self.on_drop("invalid sample", f"{sender}: {exc}"[:200])
+            return None
+        if fresh:
+            self.senders[sender] = st
+        return sample
 
     # -- shared handlers ----------------------------------------------------------------
     def _set_orientation(self, o: F) -> None:

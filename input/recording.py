@@ -40,22 +40,28 @@ import io
 import json
 import struct
 import zlib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any, BinaryIO
 
 from engine.app import App
 from engine.ecs import World
 from engine.hashing import PART_DIGEST_SIZE, part_digests
+from engine.npz_safe import read_bounded
 from input.codec import CodecError, decode_frame, encode_frame
 from input.sample import InputFrame
 
-__all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording"]
+__all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording",
+           "MAX_RECORDING"]
 
 FORMAT_VERSION = 3
 #: The first format whose records carry per-part digests.
 PARTS_FORMAT = 3
 MAGIC = b"PPREC\n"
+# An hour of a 60 Hz phone is about 30 MB; a header holds a game's saved field (a few KB).
+MAX_RECORDING = 512 << 20
+MAX_HEADER = 16 << 20
+MIN_DT, MAX_DT = 1e-4, 1.0
 _LEN = struct.Struct("<II")
 
 
@@ -179,6 +185,8 @@ def _read_header(f: io.BufferedIOBase | BinaryIO, name: str) -> RecordingHeader:
     if len(raw) < _LEN.size:
         raise RecordingError(f"{name} is cut inside its header")
     n, crc = _LEN.unpack(raw)
+    if n > MAX_HEADER:
+        raise RecordingError(f"{name} claims a {n}-byte header; the limit is {MAX_HEADER}")
     head = f.read(n)
     if len(head) < n:
         raise RecordingError(f"{name} is cut inside its header")
@@ -186,18 +194,61 @@ def _read_header(f: io.BufferedIOBase | BinaryIO, name: str) -> RecordingHeader:
         raise RecordingError(f"{name} has a damaged header (checksum mismatch)")
     try:
         d = json.loads(head)
-        header = RecordingHeader(**d)
-    except (ValueError, TypeError) as exc:
-        raise RecordingError(f"{name} has an unreadable header: {exc}") from None
+    except (ValueError, RecursionError) as exc:
+        raise RecordingError(f"{name} has an unreadable header: {type(exc).__name__}") from None
+    problem = _header_problem(d)
+    if problem:
+        raise RecordingError(f"{name} has a bad header: {problem}")
+    header = RecordingHeader(**d)
     if header.format > FORMAT_VERSION:
         raise RecordingError(f"{name} is format {header.format}; this build reads up to {FORMAT_VERSION}")
     return header
 
 
+def _is_int(v: object) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _header_problem(d: object) -> str:
+    """What is wrong with a decoded header (``""`` if nothing): every field's type and range."""
+    if not isinstance(d, dict):
+        return "not a JSON object"
+    known = {f.name for f in fields(RecordingHeader)}
+    unknown = sorted(set(d) - known)
+    if unknown:
+        return f"unknown fields {', '.join(map(repr, unknown))[:100]}"
+    missing = sorted({"game", "seed", "dt"} - set(d))
+    if missing:
+        return f"missing {', '.join(missing)}"
+    game, seed, dt = d["game"], d["seed"], d["dt"]
+    if not isinstance(game, str) or not 0 < len(game) <= 64:
+        return "game must be a name of 1..64 characters"
+    if not _is_int(seed) or not 0 <= seed < 2**63:
+        return "seed must be a whole number in 0..2**63-1"
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not MIN_DT <= dt <= MAX_DT:
+        return f"dt must be a number of seconds in [{MIN_DT}, {MAX_DT}]"
+    if "format" in d and (not _is_int(d["format"]) or d["format"] < 1):
+        return "format must be a whole number from 1"
+    if not isinstance(d.get("sources", []), list) or not all(isinstance(x, str) for x in d.get("sources", [])):
+        return "sources must be a list of names"
+    if not isinstance(d.get("engine_version", ""), str) or not isinstance(d.get("extra", {}), dict):
+        return "engine_version must be a string and extra an object"
+    return ""
+
+
 def read_recording(path: str | Path) -> Recording:
-    """Read every complete frame; a cut or damaged tail ends the list with ``complete=False``."""
+    """Read every complete frame; a cut or damaged tail ends the list with ``complete=False``.
+
+    Raises:
+        RecordingError: not a regular file (``/dev/zero``, a pipe), over :data:`MAX_RECORDING`
+            bytes, not a recording, or a header that is damaged or has wrong types or ranges.
+        OSError: the file cannot be opened.
+    """
     path = Path(path)
-    data = path.read_bytes()
+    try:
+        data = read_bounded(path, MAX_RECORDING)
+    except ValueError as exc:  # a device, a pipe, a folder, or too big: never read without end
+        raise RecordingError(str(exc)) from None
     f = io.BytesIO(data)
     header = _read_header(f, str(path))
     frames: list[InputFrame] = []

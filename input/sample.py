@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS",
-           "RESET", "SAVE", "RESTORE", "COMMANDS", "TOOL"]
+           "RESET", "SAVE", "RESTORE", "COMMANDS", "TOOL", "LIMITS", "check_sample_ranges"]
 
 CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP = "connect", "disconnect", "touch_down", "touch_up"
 # Commands from the keyboard (the launcher's keys), recorded like any input so a
@@ -39,6 +39,19 @@ EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP, *COMM
 
 F = NDArray[np.float64]
 
+# Physical bounds of a sample (largest magnitude per component). A finite value can still
+# poison the simulation: 1e308 as a position makes the stick's velocity filter overflow to
+# NaN. Real controllers stay far inside these: phones and IMUs saturate near 35 rad/s
+# (2000 deg/s) and 16 g; positions are metres from the tracking origin or the camera.
+LIMITS: dict[str, float] = {
+    "position": 1000.0,  # m: a room, a stage, a field
+    "angular_velocity": 200.0,  # rad/s
+    "acceleration": 2000.0,  # m/s², about 200 g
+    "plane_normal": 1.0 + 1e-6,  # a direction
+    "depth_delta": 100.0,  # m per sample (a mouse wheel notch moves centimetres)
+}
+UNIT_NORM_TOLERANCE = 1e-3
+
 
 def _vec(v: object, n: int, name: str) -> F | None:
     if v is None:
@@ -46,9 +59,33 @@ def _vec(v: object, n: int, name: str) -> F | None:
     a = np.array(v, dtype=np.float64).reshape(-1)
     if a.shape != (n,):
         raise ValueError(f"{name} needs {n} values, got {a.shape[0]}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} is not finite: {a.tolist()}")
     return a
+
+
+def check_sample_ranges(s: PoseSample) -> None:
+    """Raise ``ValueError`` unless every value of ``s`` is finite and within :data:`LIMITS`.
+
+    The one range check of the input boundary: :class:`PoseSample` runs it on construction
+    and :func:`input.codec.decode_frame` on recorded samples (which bypass construction to
+    keep their bits), so neither a live device nor a recording can put NaN or an absurd
+    value into the world.
+    """
+    q = s.orientation
+    n = float(np.linalg.norm(q)) if np.all(np.isfinite(q)) and np.max(np.abs(q)) <= 2.0 else float("nan")
+    if not abs(n - 1.0) <= UNIT_NORM_TOLERANCE:
+        raise ValueError(f"orientation is not a unit quaternion (norm {n:.4g})")
+    for name in ("position", "angular_velocity", "acceleration", "plane_normal"):
+        v = getattr(s, name)
+        if v is None:
+            continue
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{name} is not finite: {v.tolist()}")
+        if float(np.max(np.abs(v))) > LIMITS[name]:
+            raise ValueError(f"{name} {v.tolist()} is out of range (limit {LIMITS[name]:g} per component)")
+    if not (np.isfinite(s.depth_delta) and np.isfinite(s.time)):
+        raise ValueError("time and depth_delta must be finite")
+    if abs(s.depth_delta) > LIMITS["depth_delta"]:
+        raise ValueError(f"depth_delta {s.depth_delta:g} is out of range (limit {LIMITS['depth_delta']:g})")
 
 
 @dataclass(eq=False)
@@ -73,7 +110,8 @@ class PoseSample:
         calibrate: "this is forward now" (tap-to-calibrate, a calibrate message).
 
     Raises:
-        ValueError: on wrong sizes, non-finite values or a non-unit quaternion.
+        ValueError: on wrong sizes, non-finite or out-of-range values (:data:`LIMITS`) or a
+            non-unit quaternion.
     """
 
     time: float
@@ -92,22 +130,19 @@ class PoseSample:
     def __post_init__(self) -> None:
         q = _vec(self.orientation, 4, "orientation")
         assert q is not None
-        n = float(np.linalg.norm(q))
-        if abs(n - 1.0) > 1e-3:
-            raise ValueError(f"orientation is not a unit quaternion (norm {n:.4g})")
-        self.orientation = q / n
+        self.orientation = q
         self.position = _vec(self.position, 3, "position")
         self.angular_velocity = _vec(self.angular_velocity, 3, "angular_velocity")
         self.acceleration = _vec(self.acceleration, 3, "acceleration")
         self.plane_normal = _vec(self.plane_normal, 3, "plane_normal")
         if self.mode not in ("world", "device"):
             raise ValueError(f"mode must be 'world' or 'device', not {self.mode!r}")
-        if not np.isfinite(self.depth_delta) or not np.isfinite(self.time):
-            raise ValueError("time and depth_delta must be finite")
-        if not self.source or len(self.source.encode()) > 255:
-            raise ValueError("source id must be 1..255 bytes")
         self.time = float(self.time)
         self.depth_delta = float(self.depth_delta)
+        check_sample_ranges(self)
+        self.orientation = q / np.linalg.norm(q)
+        if not self.source or len(self.source.encode()) > 255:
+            raise ValueError("source id must be 1..255 bytes")
 
 
 @dataclass(eq=False)
@@ -157,3 +192,4 @@ class SourceStatus:
     dropped: int = 0
     last_error: str = ""
     drop_reasons: dict[str, int] = field(default_factory=dict)
+    locked_out: list[str] = field(default_factory=list)  # senders refused because the slots are taken

@@ -9,8 +9,8 @@ example sketches print, all quaternions **w,x,y,z**:
 - plain CSV/whitespace: ``qw,qx,qy,qz[,x,y,z][,touch]``;
 - the 14-byte teapot packet ``'$' 0x02 qw qx qy qz (int16 big-endian, /16384) 0x00 counter '\\r' '\\n'``.
 
-Boot banners, garbage bytes, partial lines and non-unit quaternions are skipped and
-counted. :class:`SerialStreamParser` is fed arbitrary chunks (a read may end
+Boot banners, garbage bytes, partial lines, non-unit quaternions and positions beyond
+``input.sample.LIMITS`` are skipped and counted. :class:`SerialStreamParser` is fed arbitrary chunks (a read may end
 mid-line or mid-packet) and yields :class:`ImuReading` values.
 """
 
@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+
+from input.sample import LIMITS
 
 __all__ = ["ImuReading", "SerialStreamParser", "parse_line", "decode_teapot", "TEAPOT_LEN"]
 
@@ -77,6 +79,8 @@ def parse_line(line: str) -> ImuReading:
     if len(v) >= 7:
         if not all(math.isfinite(x) for x in v[4:7]):
             raise ParseSkip("non-finite value")
+        if max(abs(x) for x in v[4:7]) > LIMITS["position"]:
+            raise ParseSkip("position out of range")
         pos = (v[4], v[5], v[6])
     touch = bool(v[-1]) if len(v) in (5, 8) else None
     return ImuReading(q, pos, touch)

@@ -20,7 +20,6 @@ import numpy as np
 import serial
 
 from input.phone_frames import phone_to_stick, z_up_to_engine
-from input.sample import PoseSample
 from input.serial_parse import SerialStreamParser
 from input.source import PoseSource
 
@@ -90,10 +89,9 @@ class SerialSource(PoseSource):
                 continue
             before = dict(self.parser.skipped)
             for r in self.parser.feed(chunk):
-                self.push(PoseSample(
-                    time=time.monotonic(), source=self.source_id,
-                    orientation=phone_to_stick(np.array(r.quaternion)),
-                    position=None if r.position is None else z_up_to_engine(r.position), touch=r.touch))
+                self.offer(time=time.monotonic(), source=self.source_id,
+                           orientation=phone_to_stick(np.array(r.quaternion)),
+                           position=None if r.position is None else z_up_to_engine(r.position), touch=r.touch)
             for reason, n in self.parser.skipped.items():
                 for _ in range(n - before.get(reason, 0)):
                     self.drop(reason)

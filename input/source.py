@@ -113,6 +113,21 @@ class PoseSource:
         with self._lock:
             self._status.packets += 1
 
+    def offer(self, **fields: object) -> PoseSample | None:
+        """Build a :class:`PoseSample` from ``fields`` and queue it, or drop and count it.
+
+        Device threads use this instead of building samples themselves: a reading that
+        fails the sample's checks (out of range, not finite) is a bad packet to count,
+        never an exception that ends the thread.
+        """
+        try:
+            sample = PoseSample(**fields)  # type: ignore[arg-type]
+        except ValueError as exc:
+            self.drop("invalid sample", str(exc)[:200])
+            return None
+        self.push(sample)
+        return sample
+
     def connected(self, source_id: str | None = None) -> None:
         """Report that a device (or sender) appeared."""
         with self._lock:
@@ -159,6 +174,7 @@ class PoseSource:
     def status(self) -> SourceStatus:
         """A snapshot of the status for display."""
         with self._lock:
-            s = SourceStatus(**{**self._status.__dict__, "drop_reasons": dict(self._status.drop_reasons)})
+            s = SourceStatus(**{**self._status.__dict__, "drop_reasons": dict(self._status.drop_reasons),
+                                "locked_out": list(self._status.locked_out)})
         s.packets_per_s = self._meter.rate()
         return s

@@ -17,18 +17,22 @@ __all__ = ["configure", "run", "run_activity"]
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the play arguments."""
     from input.factory import add_source_arguments
+    from puppetphone.argtypes import int_range, output_file
     from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("game", help="snowman, tasbada or sandbox")
     add_source_arguments(parser)
     add_run_arguments(parser)
-    parser.add_argument("--record", type=Path, default=None, help="record the session's input and state hashes")
-    parser.add_argument("--seed", type=int, default=0, help="the world's random seed (default 0)")
+    parser.add_argument("--record", type=output_file, default=None,
+                        help="record the session's input and state hashes (an existing file is replaced)")
+    parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
                         help="a game option (snowman: field=PATH; tasbada: save, photo, selfie, webcam; "
                              "sandbox: scene, puppets); repeatable")
     parser.add_argument("--puppets", type=int, default=None, metavar="N",
                         help="sandbox: a crowd of N puppets wandering the field (same as --set puppets=N)")
+    parser.epilog = ("exit codes: 0 the session ran; 2 a bad option value, no display for a window, an input "
+                     "that cannot be opened, or a recording of another game")
 
 
 def resolve_source(source: str, game: str) -> str:
@@ -91,6 +95,8 @@ def run(args: argparse.Namespace) -> int:
         except NoDisplayError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
+    if args.record is not None and args.record.exists():
+        print(f"--record: replacing the existing {args.record}", file=sys.stderr)
     source = resolve_source(args.source, args.game)
     try:
         hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud)

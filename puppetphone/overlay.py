@@ -63,6 +63,8 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
         light = "[live]" if st.connected and st.packets_per_s > 0 else ("[idle]" if st.connected else "[gone]")
         err = f"  {st.last_error}" if st.last_error else ""
         lines.append(f"{light} {st.name}: {st.packets_per_s:5.1f} packets/s, dropped {st.dropped}{err}")
+        if st.locked_out:
+            lines.append(f"  locked out (another phone drives the stick): {', '.join(st.locked_out)}")
     return lines
 
 

@@ -11,42 +11,22 @@ from pathlib import Path
 
 from engine.render.target import image_format
 from engine.runner import RunOptions
+from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
 
-__all__ = ["add_run_arguments", "run_options", "steps", "window_size", "image_path", "MAX_SIZE"]
+__all__ = ["add_run_arguments", "run_options", "steps", "image_path"]
 
-#: The largest window or image side accepted (a 16k display is 15360 wide).
-MAX_SIZE = 16384
-
-
-def steps(text: str) -> int:
-    """A number of simulation steps: zero or more."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value} is negative; give zero or more steps")
-    return value
-
-
-def window_size(text: str) -> tuple[int, int]:
-    """``WxH`` in pixels, each side from 16 to :data:`MAX_SIZE`."""
-    try:
-        width, height = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} does not look like 1280x720") from None
-    if not (16 <= width <= MAX_SIZE and 16 <= height <= MAX_SIZE):
-        raise argparse.ArgumentTypeError(f"{width}x{height} is out of range: each side from 16 to {MAX_SIZE}")
-    return width, height
+#: Steps: zero or more.
+steps = int_range(0)
 
 
 def image_path(text: str) -> Path:
-    """A screenshot or plot file: ``.png`` or ``.jpg``, refused before the session starts."""
+    """A screenshot or plot file to write: ``.png`` or ``.jpg``, refused before the session starts."""
+    path = output_file(text)
     try:
-        image_format(text)
+        image_format(path)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
-    return Path(text)
+    return path
 
 
 def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = False) -> None:
@@ -60,7 +40,7 @@ def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = 
         parser.add_argument("--screenshot-at", type=steps, default=None, metavar="N",
                             help="take the screenshot after step N instead of at the end")
     parser.add_argument("--size", type=window_size, default=(1280, 720), metavar="WxH",
-                        help="window or image size (default 1280x720)")
+                        help=f"window or image size, sides up to {MAX_WINDOW} (default 1280x720)")
 
 
 def run_options(args: argparse.Namespace, title: str, *, pace: bool = False) -> RunOptions:

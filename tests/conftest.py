@@ -31,3 +31,142 @@ def mocap_dir() -> Path:
     if d is None:
         pytest.skip("real mocap data not found: set PUPPETPHONE_DATA or put shared/data beside the project")
     return d / "mocap"
+
+
+# -- fuzzing ------------------------------------------------------------------------------------
+# Every outside format is fuzzed (tests named test_fuzz_*): Hypothesis for structured inputs,
+# byte mutation of real files for the rest. The only allowed outcomes are success with finite
+# output or the format's own error; a case that takes longer than its time limit or allocates
+# more than its memory bound fails the test. CI runs a few thousand cases per format; tests
+# marked ``fuzz`` run a longer campaign locally (``pytest -m fuzz``; FUZZ_CASES, FUZZ_SEED).
+
+import signal  # noqa: E402 - grouped with the fuzzing helpers they serve
+import tracemalloc  # noqa: E402
+from collections import Counter  # noqa: E402
+from collections.abc import Callable, Iterator  # noqa: E402
+
+import numpy as np  # noqa: E402
+from hypothesis import HealthCheck, settings  # noqa: E402
+
+settings.register_profile("ci", max_examples=300, deadline=None, derandomize=True, database=None,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.register_profile("fuzz", max_examples=50_000, deadline=None, database=None,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """``pytest -m fuzz``: the fuzz tests only, each a long campaign (50,000 cases, a fresh seed)."""
+    if "fuzz" in (config.option.markexpr or "") and "not fuzz" not in config.option.markexpr:
+        settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "fuzz"))
+        os.environ.setdefault("FUZZ_CASES", "50000")
+        os.environ.setdefault("FUZZ_SEED", str(int.from_bytes(os.urandom(4), "little")))
+        print(f"fuzz campaign: {os.environ['FUZZ_CASES']} byte mutations per format, seed {os.environ['FUZZ_SEED']}")
+
+
+class CaseTimeout(BaseException):
+    """A fuzz case ran past its time limit (a BaseException, so no ``except Exception`` hides it)."""
+
+
+class Campaign:
+    """Runs the cases of one format, each under a time limit and a memory bound, and counts outcomes.
+
+    Args:
+        allowed: the format's own error type(s): the only exceptions a case may raise.
+        seconds: time limit per case.
+        max_bytes: peak of newly traced allocations per case.
+    """
+
+    def __init__(self, allowed: type[BaseException] | tuple[type[BaseException], ...], seconds: float = 2.0,
+                 max_bytes: int = 256 << 20) -> None:
+        self.allowed, self.seconds, self.max_bytes = allowed, seconds, max_bytes
+        self.outcomes: Counter[str] = Counter()
+
+    def run(self, fn: Callable[..., object], *args: object) -> object | None:
+        """``fn(*args)``'s result, or ``None`` when it raised an allowed error (counted either way)."""
+
+        def expire(signum: int, frame: object) -> None:
+            raise CaseTimeout(f"a case took over {self.seconds} s")
+
+        previous = signal.signal(signal.SIGALRM, expire)
+        tracemalloc.reset_peak()
+        base = tracemalloc.get_traced_memory()[0]
+        signal.setitimer(signal.ITIMER_REAL, self.seconds)
+        try:
+            out = fn(*args)
+            self.outcomes["ok"] += 1
+            return out
+        except self.allowed as exc:
+            self.outcomes[type(exc).__name__] += 1
+            return None
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, previous)
+            peak = tracemalloc.get_traced_memory()[1] - base
+            assert peak <= self.max_bytes, f"a case allocated {peak >> 20} MiB (bound {self.max_bytes >> 20} MiB)"
+
+    def report(self, name: str) -> str:
+        """One line for the log: cases and outcomes."""
+        return f"fuzz {name}: {sum(self.outcomes.values())} cases, " + ", ".join(
+            f"{k} {v}" for k, v in self.outcomes.most_common())
+
+
+@pytest.fixture
+def campaign() -> Iterator[Callable[..., Campaign]]:
+    """A factory of :class:`Campaign` with memory tracing on for the test's duration."""
+    tracemalloc.start()
+    try:
+        yield Campaign
+    finally:
+        tracemalloc.stop()
+
+
+_INTERESTING = [b"\x00", b"\xff", b"\x7f", b"\x80", b"\x00\x00\x00\x00", b"\xff\xff\xff\xff", b"\x7f\xff\xff\xff",
+                np.float64(np.nan).tobytes(), np.float64(np.inf).tobytes(), np.float64(1e308).tobytes(),
+                np.float32(np.nan).tobytes(), np.float32(3e38).tobytes(), b"nan", b"inf", b"1e308", b"-1",
+                b"999999999999", b"[[[[[[[[", b"{", b"}", b'"', b"\n", b",", b" "]
+
+
+def mutants(data: bytes, n: int, seed: int) -> Iterator[bytes]:
+    """``n`` mutations of ``data``: 1-4 edits each (bit flips, interesting values, cuts, deletions,
+    duplications, insertions), from a seeded generator so a failure can be replayed."""
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        b = bytearray(data)
+        for _ in range(int(rng.integers(1, 5))):
+            kind = int(rng.integers(0, 7))
+            pos = int(rng.integers(0, max(len(b), 1)))
+            if kind == 0 and b:
+                b[pos] ^= 1 << int(rng.integers(0, 8))
+            elif kind == 1:
+                v = _INTERESTING[int(rng.integers(0, len(_INTERESTING)))]
+                b[pos:pos + len(v)] = v
+            elif kind == 2:
+                del b[pos:]
+            elif kind == 3:
+                del b[pos:pos + int(rng.integers(1, 64))]
+            elif kind == 4:
+                end = min(len(b), pos + int(rng.integers(1, 256)))
+                b[pos:pos] = b[pos:end]
+            elif kind == 5:
+                b[pos:pos] = rng.integers(0, 256, int(rng.integers(1, 16)), dtype=np.uint8).tobytes()
+            elif b:
+                b[pos] = int(rng.integers(0, 256))
+        yield bytes(b)
+
+
+@pytest.fixture
+def mutations() -> Callable[[bytes, int, int], Iterator[bytes]]:
+    """:func:`mutants` as a fixture."""
+    return mutants
+
+
+def fuzz_cases(ci: int) -> tuple[int, int]:
+    """Cases and seed of a byte-mutation campaign: ``ci`` with seed 0, or ``$FUZZ_CASES``/``$FUZZ_SEED``."""
+    return int(os.environ.get("FUZZ_CASES", ci)), int(os.environ.get("FUZZ_SEED", 0))
+
+
+@pytest.fixture
+def fuzz_budget() -> Callable[[int], tuple[int, int]]:
+    """:func:`fuzz_cases` as a fixture."""
+    return fuzz_cases

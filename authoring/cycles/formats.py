@@ -30,6 +30,7 @@ from authoring.cycles.extract import CycleResult
 from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
+from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
 
 __all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop"]
 
@@ -111,8 +112,11 @@ def _items_from_names(names: list[str]) -> list[Item]:
 
 
 def _load_csv(path: Path, items: list[str] | None) -> Performance:
-    text = path.read_text()
-    rows = list(csv.reader(io.StringIO(text)))
+    try:
+        text = read_bounded(path, MAX_NPZ_BYTES).decode("utf-8")
+        rows = list(csv.reader(io.StringIO(text)))
+    except (ValueError, csv.Error) as exc:  # not UTF-8 text, NUL bytes, not a regular file, too big
+        raise TrajectoryError(f"{path}: not a readable CSV file ({type(exc).__name__}: {exc})"[:300]) from None
     rows = [r for r in rows if r and any(x.strip() for x in r)]
     if len(rows) < 2:
         raise TrajectoryError(f"{path}: a CSV performance needs a header row and data rows")
@@ -142,20 +146,38 @@ def _from_columns(path: Path, times: NDArray[np.float64], values: NDArray[np.flo
     return Performance(traj, tuple(names[c] for c in cols), path)
 
 
+def _numeric(path: Path, name: str, a: np.ndarray) -> NDArray[np.float64]:
+    if a.dtype.kind not in "fiub":
+        raise TrajectoryError(f"{path}: {name!r} is not numeric ({a.dtype})")
+    with np.errstate(invalid="ignore"):  # a float32 signalling NaN warns as it widens; Trajectory refuses NaN
+        return np.asarray(a, dtype=np.float64)
+
+
 def _load_npz(path: Path, items: list[str] | None) -> Performance:
-    with np.load(path, allow_pickle=False) as z:
-        if "values" not in z.files:
-            raise TrajectoryError(f"{path}: an .npz performance needs a 'values' array [T,N] (has {z.files})")
-        values = np.asarray(z["values"], dtype=np.float64)
-        if values.ndim == 1:
-            values = values[:, None]
-        if "times" in z.files:
-            times = np.asarray(z["times"], dtype=np.float64)
-        elif "fps" in z.files:
-            times = np.arange(len(values)) / float(z["fps"])
-        else:
-            raise TrajectoryError(f"{path}: give 'times' [T] or 'fps' beside 'values'")
-        names = [str(n) for n in z["names"]] if "names" in z.files else [f"c{c}" for c in range(values.shape[1])]
+    try:
+        z = read_npz(read_bounded(path, MAX_NPZ_BYTES))
+    except ValueError as exc:  # NpzError, or not a regular file / too big
+        raise TrajectoryError(f"{path}: {exc}") from None
+    if "values" not in z:
+        raise TrajectoryError(f"{path}: an .npz performance needs a 'values' array [T,N] (has {sorted(z)})")
+    values = _numeric(path, "values", z["values"])
+    if values.ndim == 1:
+        values = values[:, None]
+    if values.ndim != 2:
+        raise TrajectoryError(f"{path}: 'values' must be [T,N], not of shape {values.shape}")
+    if "times" in z:
+        times = _numeric(path, "times", z["times"]).reshape(-1)
+    elif "fps" in z:
+        fps = _numeric(path, "fps", z["fps"])
+        if fps.size != 1 or not 0.0 < float(fps.reshape(-1)[0]) <= 10_000.0:
+            raise TrajectoryError(f"{path}: 'fps' must be one number in (0, 10000]")
+        times = np.arange(len(values)) / float(fps.reshape(-1)[0])
+    else:
+        raise TrajectoryError(f"{path}: give 'times' [T] or 'fps' beside 'values'")
+    names_arr = z.get("names")
+    if names_arr is not None and (names_arr.dtype.kind not in "US" or names_arr.ndim != 1):
+        raise TrajectoryError(f"{path}: 'names' must be a list of strings")
+    names = [str(n) for n in names_arr] if names_arr is not None else [f"c{c}" for c in range(values.shape[1])]
     if len(names) != values.shape[1]:
         raise TrajectoryError(f"{path}: {len(names)} names for {values.shape[1]} columns")
     return _from_columns(path, times, values, names, items)

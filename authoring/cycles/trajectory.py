@@ -27,6 +27,10 @@ KINDS = ("position", "rotation", "scale", "scalar")
 _WIDTH = {"position": 3, "rotation": 4, "scale": 3}
 
 
+# No performance is measured in units this large (mocap in millimetres stays under 1e5).
+MAX_MAGNITUDE = 1e7
+
+
 class TrajectoryError(ValueError):
     """A performed trajectory that cannot be analysed (bad shape, NaN, times not increasing…)."""
 
@@ -95,6 +99,10 @@ class Trajectory:
             bad = np.argwhere(~np.isfinite(v))
             where = f" (first at frame {bad[0][0]}, column {bad[0][1]})" if len(bad) else ""
             raise TrajectoryError(f"the trajectory contains NaN or infinite values{where}")
+        big = max(float(np.abs(t).max(initial=0.0)), float(np.abs(v).max(initial=0.0)))
+        if big > MAX_MAGNITUDE:  # finite, but the fit's sums of squares would overflow to inf
+            raise TrajectoryError(f"the trajectory holds a value of {big:.3g}; values and times stay within "
+                                  f"±{MAX_MAGNITUDE:g}")
         if len(t) > 1 and not np.all(np.diff(t) > 0):
             i = int(np.argmin(np.diff(t)))
             raise TrajectoryError(f"times must increase strictly (frame {i + 1}: {t[i + 1]} after {t[i]})")

@@ -3,7 +3,9 @@
 :func:`save_session` writes the edited clip with the engine's own format (versioned,
 checksummed, atomic) and, beside it, ``<name>.mocurves.json`` with what a clip cannot hold:
 the scale tracks and the pinned keypoints. The side file records the clip's SHA-256 so a
-pair that does not belong together is refused instead of silently mismatched. JSON floats
+pair that does not belong together is refused instead of silently mismatched; every value
+in it is checked against the clip (shapes, ranges, types), and whatever is wrong with it
+is a :class:`SessionFileError`. JSON floats
 round-trip exactly (``repr``), so a reload is bit-for-bit.
 
 :func:`export_clip` picks the format from the suffix. BVH and glTF have no root-motion
@@ -17,6 +19,7 @@ import hashlib
 import json
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -26,11 +29,14 @@ from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
 from engine.clipfile import load_clip, save_clip
 from engine.io import clip_to_bvh, write_bvh, write_gltf
+from engine.npz_safe import read_bounded
 
 __all__ = ["save_session", "load_session", "export_clip", "bake_root_motion", "SessionFileError", "EXPORT_SUFFIXES"]
 
 SIDE_FORMAT = "puppetphone-mocurves"
 SIDE_VERSION = 1
+MAX_SIDE_FILE = 64 << 20
+MAX_SCALE = 100.0
 EXPORT_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
 _UP = np.array([0.0, 1.0, 0.0])
 
@@ -81,17 +87,48 @@ def load_session(path: str | Path) -> EditSession:
     if not side_path.exists():
         return EditSession(clip)
     try:
-        side = json.loads(side_path.read_text())
-    except (OSError, ValueError) as exc:
-        raise SessionFileError(f"{side_path}: unreadable session file ({exc})") from exc
-    if side.get("format") != SIDE_FORMAT:
-        raise SessionFileError(f"{side_path}: not a MoCurves session file")
-    if int(side.get("version", 0)) > SIDE_VERSION:
-        raise SessionFileError(f"{side_path}: version {side['version']} is newer than this build reads ({SIDE_VERSION})")
+        side = json.loads(read_bounded(side_path, MAX_SIDE_FILE).decode("utf-8"))
+    except (OSError, ValueError, RecursionError) as exc:
+        raise SessionFileError(f"{side_path}: unreadable session file ({type(exc).__name__}: {exc})"[:300]) from None
+    try:
+        scales, tau, sigma, pins = _side_values(side, clip)
+    except SessionFileError as exc:
+        raise SessionFileError(f"{side_path}: {exc}") from None
     if side.get("clip_sha256") != _clip_digest(clip):
         raise SessionFileError(f"{side_path}: belongs to another version of {p.name}; move it away to open the clip alone")
-    return EditSession(clip, np.array(side["scales"], dtype=np.float64), tau=int(side.get("tau", 6)),
-                       sigma=float(side.get("sigma", 0.08)), pins=side.get("pins", {}))  # fmt: skip
+    return EditSession(clip, scales, tau=tau, sigma=sigma, pins=pins)
+
+
+def _side_values(side: Any, clip: Clip) -> tuple[np.ndarray, int, float, dict[str, list[int]]]:
+    """Scales, τ, σ and pins of a decoded side file, every one checked against ``clip``."""
+    if not isinstance(side, dict) or side.get("format") != SIDE_FORMAT:
+        raise SessionFileError("not a MoCurves session file")
+    version = side.get("version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise SessionFileError(f"version {repr(version)[:20]} is not a version number")
+    if version > SIDE_VERSION:
+        raise SessionFileError(f"version {version} is newer than this build reads ({SIDE_VERSION})")
+    frames, joints = clip.num_frames, clip.skeleton.num_joints
+    rows = side.get("scales")
+    if (not isinstance(rows, list) or len(rows) != frames
+            or not all(isinstance(r, list) and len(r) == joints for r in rows)
+            or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for r in rows for x in r)):
+        raise SessionFileError(f"scales must be {frames} rows of {joints} numbers")
+    scales = np.array(rows, dtype=np.float64)
+    if not (np.isfinite(scales).all() and (scales > 0).all() and (scales <= MAX_SCALE).all()):
+        raise SessionFileError(f"scales must be in (0, {MAX_SCALE:g}]")
+    tau, sigma = side.get("tau", 6), side.get("sigma", 0.08)
+    if not isinstance(tau, int) or isinstance(tau, bool) or not 1 <= tau <= frames:
+        raise SessionFileError(f"tau must be a whole number of keypoints in 1..{frames}")
+    if isinstance(sigma, bool) or not isinstance(sigma, (int, float)) or not 0.0 < sigma <= 10.0:
+        raise SessionFileError("sigma must be a number in (0, 10]")
+    pins = side.get("pins", {})
+    if not isinstance(pins, dict) or not all(
+            isinstance(k, str) and isinstance(v, list)
+            and all(isinstance(i, int) and not isinstance(i, bool) and 0 <= i < frames for i in v)
+            for k, v in pins.items()):
+        raise SessionFileError(f"pins must map item names to keypoints in 0..{frames - 1}")
+    return scales, tau, float(sigma), pins
 
 
 def bake_root_motion(clip: Clip) -> Clip:

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.atomic import atomic_write_bytes
+from engine.npz_safe import read_bounded
 
 if TYPE_CHECKING:
     from engine.clip import Clip
@@ -32,6 +33,11 @@ if TYPE_CHECKING:
 __all__ = ["BvhError", "BvhMotion", "read_bvh", "write_bvh", "parse_bvh", "format_bvh", "CHANNEL_NAMES"]
 
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
+# Limits a real capture is far inside (CMU: 31 joints, 120 fps, centimetres and degrees).
+MAX_FILE = 512 << 20
+MAX_JOINTS = 1024
+MAX_VALUE = 1e7
+MAX_FRAME_TIME = 10.0
 _CANON = {c.lower(): c for c in CHANNEL_NAMES}
 
 
@@ -173,6 +179,8 @@ def parse_bvh(text: str, source: str = "<string>") -> BvhMotion:
                 raise BvhError(f"{where(i)}: duplicate joint name {name!r}")
             if stack and stack[-1] == -2:
                 raise BvhError(f"{where(i)}: a joint inside an End Site")
+            if len(names) >= MAX_JOINTS:
+                raise BvhError(f"{where(i)}: more than {MAX_JOINTS} joints")
             names.append(name)
             parents.append(stack[-1] if stack else -1)
             offsets.append(np.zeros(3))
@@ -195,6 +203,8 @@ def parse_bvh(text: str, source: str = "<string>") -> BvhMotion:
             if not stack or len(tok) != 4:
                 raise BvhError(f"{where(i)}: OFFSET needs 3 numbers inside a joint")
             value = _floats(tok[1:], where(i))
+            if not np.isfinite(value).all() or np.abs(value).max() > MAX_VALUE:
+                raise BvhError(f"{where(i)}: OFFSET must be finite and within ±{MAX_VALUE:g}")
             if stack[-1] == -2:
                 end_sites.setdefault(stack[-2], value)
             else:
@@ -243,10 +253,13 @@ def parse_bvh(text: str, source: str = "<string>") -> BvhMotion:
         frame_time = float(header["frame time"])
     except ValueError:
         raise BvhError(f"{where(i - 1)}: bad frame count or frame time") from None
-    if n_frames < 0 or not frame_time > 0:
-        raise BvhError(f"{where(i - 1)}: frame count must be >= 0 and frame time > 0")
+    if n_frames < 0 or not 0 < frame_time <= MAX_FRAME_TIME:
+        raise BvhError(f"{where(i - 1)}: frame count must be >= 0 and frame time in (0, {MAX_FRAME_TIME:g}] s")
     width = sum(len(c) for c in channels)
     data = _motion_block(lines, i, n_frames, width, source)
+    if not np.isfinite(data).all() or (data.size and np.abs(data).max() > MAX_VALUE):
+        bad = np.argwhere(~(np.abs(data) <= MAX_VALUE))[0]
+        raise BvhError(f"{source}: frame {bad[0]} holds a NaN, infinite or absurd value (beyond ±{MAX_VALUE:g})")
     return BvhMotion(
         tuple(names), np.array(parents, dtype=np.int64), np.array(offsets).reshape(-1, 3),
         end_sites, tuple(channels), frame_time, data, source,
@@ -298,12 +311,18 @@ def _motion_block(lines: list[str], start: int, n_frames: int, width: int, sourc
 
 
 def read_bvh(path: str | os.PathLike[str]) -> BvhMotion:
-    """Read a BVH file; raises :class:`BvhError` (with file and line) if it is malformed."""
+    """Read a BVH file; raises :class:`BvhError` (with file and line) if it is malformed, too big
+    (over :data:`MAX_FILE` bytes, :data:`MAX_JOINTS` joints), not a regular file, or holds NaN
+    or absurd numbers; ``OSError`` if it cannot be opened."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8", errors="strict")
+        raw = read_bounded(p, MAX_FILE)
+    except ValueError as exc:
+        raise BvhError(str(exc)) from None
+    try:
+        text = raw.decode("utf-8", errors="strict")
     except UnicodeDecodeError:
-        text = p.read_text(encoding="latin-1")
+        text = raw.decode("latin-1")
     return parse_bvh(text, str(p))
 
 
@@ -320,27 +339,29 @@ def format_bvh(motion: BvhMotion) -> str:
     for j, p in enumerate(motion.parents.tolist()):
         children.setdefault(p, []).append(j)
 
+    roots = children.get(-1, [])
+    if len(roots) != 1:
+        raise BvhError(f"{motion.source or 'BVH'}: need exactly one root joint, found {len(roots)}")
+    # Depth first with an explicit stack, not recursion: a hierarchy may be deeper than Python's stack.
     visited: list[int] = []
-
-    def emit(j: int, depth: int) -> None:
-        visited.append(j)
+    todo: list[tuple[int, int, bool]] = [(roots[0], 0, False)]  # joint, depth, closing its brace
+    while todo:
+        j, depth, closing = todo.pop()
         pad = "  " * depth
+        if closing:
+            if j in motion.end_sites:
+                out.extend([f"{pad}  End Site", f"{pad}  {{",
+                            f"{pad}    OFFSET {' '.join(_num(v) for v in motion.end_sites[j].tolist())}", f"{pad}  }}"])
+            out.append(pad + "}")
+            continue
+        visited.append(j)
         out.append(f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {motion.names[j]}")
         out.append(pad + "{")
         out.append(f"{pad}  OFFSET {' '.join(_num(v) for v in motion.offsets[j].tolist())}")
         chans = motion.channels[j]
         out.append(f"{pad}  CHANNELS {len(chans)}{' ' if chans else ''}{' '.join(chans)}")
-        for c in children.get(j, []):
-            emit(c, depth + 1)
-        if j in motion.end_sites:
-            out.extend([f"{pad}  End Site", f"{pad}  {{",
-                        f"{pad}    OFFSET {' '.join(_num(v) for v in motion.end_sites[j].tolist())}", f"{pad}  }}"])
-        out.append(pad + "}")
-
-    roots = children.get(-1, [])
-    if len(roots) != 1:
-        raise BvhError(f"{motion.source or 'BVH'}: need exactly one root joint, found {len(roots)}")
-    emit(roots[0], 0)
+        todo.append((j, depth, True))
+        todo.extend((c, depth + 1, False) for c in reversed(children.get(j, [])))
     if visited != list(range(motion.num_joints)):
         raise BvhError(f"{motion.source or 'BVH'}: joints must be in depth-first file order to match the data columns")
     out += ["MOTION", f"Frames: {motion.num_frames}", f"Frame Time: {_num(float(motion.frame_time))}"]

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.npz_safe import read_bounded
 
 __all__ = ["GltfError", "GltfAsset", "GltfSkin", "GltfChannel", "GltfAnimation", "read_gltf", "parse_glb", "accessor"]
 
@@ -31,6 +32,13 @@ _COMPONENT = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 51
 _NORM = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
 _GLB_MAGIC, _JSON_CHUNK, _BIN_CHUNK = b"glTF", 0x4E4F534A, 0x004E4942
+# Limits a character file is far inside; checked before anything is allocated.
+MAX_FILE = 512 << 20
+MAX_NODES = 65536
+MAX_ELEMENTS = 1 << 24  # numbers in one accessor (128 MB as float64)
+MAX_TIME = 1e5  # seconds of animation
+# Anything a malformed document (wrong types, missing keys) makes the walk below raise.
+_MALFORMED = (KeyError, TypeError, IndexError, AttributeError, ValueError, OverflowError)
 
 
 class GltfError(ValueError):
@@ -130,8 +138,8 @@ def parse_glb(data: bytes, source: str = "<glb>") -> tuple[dict[str, Any], bytes
         if kind == _JSON_CHUNK and doc is None:
             try:
                 doc = json.loads(chunk.decode("utf-8"))
-            except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-                raise GltfError(f"{source}: bad JSON chunk: {exc}") from None
+            except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+                raise GltfError(f"{source}: bad JSON chunk: {type(exc).__name__}") from None
         elif kind == _BIN_CHUNK and binary is None:
             binary = chunk
         pos += 8 + size
@@ -154,9 +162,11 @@ def _buffers(doc: dict[str, Any], glb_bin: bytes | None, base: Path, source: str
         else:
             path = base / urllib.parse.unquote(uri)
             try:
-                data = path.read_bytes()
+                data = read_bounded(path, MAX_FILE)
             except OSError as exc:
                 raise GltfError(f"{source}: buffer {i}: cannot read {path}: {exc.strerror}") from None
+            except ValueError as exc:
+                raise GltfError(f"{source}: buffer {i}: {exc}") from None
         if len(data) < buf.get("byteLength", 0):
             raise GltfError(f"{source}: buffer {i} holds {len(data)} bytes, byteLength says {buf['byteLength']}")
         out.append(data)
@@ -184,6 +194,8 @@ def accessor(doc: dict[str, Any], buffers: list[bytes], index: int, source: str 
         dtype = np.dtype(_COMPONENT[ctype]).newbyteorder("<")
     except (KeyError, IndexError, TypeError):
         raise GltfError(f"{source}: accessor {index} is missing or malformed") from None
+    if not isinstance(count, int) or isinstance(count, bool) or not 0 <= count * width <= MAX_ELEMENTS:
+        raise GltfError(f"{source}: accessor {index} count {repr(count)[:20]} is not 0..{MAX_ELEMENTS // width}")
     out = np.zeros((count, width))
     if "bufferView" in acc:
         raw, stride = _view(doc, buffers, acc["bufferView"], source)
@@ -194,18 +206,26 @@ def accessor(doc: dict[str, Any], buffers: list[bytes], index: int, source: str 
             raise GltfError(f"{source}: accessor {index} reads past its bufferView")
         if count:
             rows = np.ndarray((count,), dtype=np.dtype((np.void, item)), buffer=raw, offset=offset, strides=(stride,))
-            out = np.frombuffer(rows.tobytes(), dtype=dtype).reshape(count, width).astype(np.float64)
+            with np.errstate(invalid="ignore"):  # a signalling NaN warns as it widens; it is refused below
+                out = np.frombuffer(rows.tobytes(), dtype=dtype).reshape(count, width).astype(np.float64)
     sparse = acc.get("sparse")
     if sparse:
         n = sparse["count"]
+        if not isinstance(n, int) or not 0 < n <= count:
+            raise GltfError(f"{source}: accessor {index} has a sparse count outside 1..{count}")
         iraw, _ = _view(doc, buffers, sparse["indices"]["bufferView"], source)
         idt = np.dtype(_COMPONENT[sparse["indices"]["componentType"]]).newbyteorder("<")
-        idx = np.frombuffer(iraw, dtype=idt, count=n, offset=sparse["indices"].get("byteOffset", 0))
+        idx = np.frombuffer(iraw, dtype=idt, count=n, offset=sparse["indices"].get("byteOffset", 0)).astype(np.int64)
+        if (idx < 0).any() or (idx >= count).any():
+            raise GltfError(f"{source}: accessor {index} has sparse indices outside 0..{count - 1}")
         vraw, _ = _view(doc, buffers, sparse["values"]["bufferView"], source)
         vals = np.frombuffer(vraw, dtype=dtype, count=n * width, offset=sparse["values"].get("byteOffset", 0))
-        out[idx.astype(np.int64)] = vals.reshape(n, width)
+        with np.errstate(invalid="ignore"):
+            out[idx] = vals.reshape(n, width)
     if acc.get("normalized") and ctype in _NORM:
         out = np.maximum(out / _NORM[ctype], -1.0)
+    if not np.isfinite(out).all() or (out.size and np.abs(out).max() > 1e12):
+        raise GltfError(f"{source}: accessor {index} holds NaN, infinite or absurd values")
     return out
 
 
@@ -223,28 +243,61 @@ def _decompose(m: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.
 def _document(path: Path) -> tuple[dict[str, Any], list[bytes]]:
     source = str(path)
     try:
-        data = path.read_bytes()
+        data = read_bounded(path, MAX_FILE)
     except OSError as exc:
         raise GltfError(f"{source}: cannot read: {exc.strerror}") from None
+    except ValueError as exc:
+        raise GltfError(str(exc)) from None
     if data[:4] == _GLB_MAGIC:
         doc, glb_bin = parse_glb(data, source)
     else:
         try:
             doc, glb_bin = json.loads(data.decode("utf-8")), None
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise GltfError(f"{source}: neither GLB nor glTF JSON: {exc}") from None
+        except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+            raise GltfError(f"{source}: neither GLB nor glTF JSON: {type(exc).__name__}") from None
     if not isinstance(doc, dict) or not str(doc.get("asset", {}).get("version", "")).startswith("2"):
         raise GltfError(f"{source}: not a glTF 2.0 document (asset.version)")
     return doc, _buffers(doc, glb_bin, path.parent, source)
 
 
 def read_gltf(path: str | os.PathLike[str]) -> GltfAsset:
-    """Read nodes, skins and animations of a ``.glb`` or ``.gltf`` file."""
+    """Read nodes, skins and animations of a ``.glb`` or ``.gltf`` file.
+
+    Raises:
+        GltfError: whatever is wrong with the file: not glTF 2.0, truncated, too big (sizes
+            and counts are checked before allocation), a node hierarchy with a cycle, NaN
+            or absurd numbers, key times that are not finite and increasing, or a document
+            whose parts have the wrong types.
+    """
     p = Path(path)
     source = str(p)
-    doc, buffers = _document(p)
+    try:
+        doc, buffers = _document(p)
+        return _asset(doc, buffers, source)
+    except GltfError:
+        raise
+    except _MALFORMED as exc:  # binascii.Error of a bad data URI is a ValueError too
+        raise GltfError(f"{source}: malformed document ({type(exc).__name__}: {exc})"[:300]) from None
+
+
+def _check_tree(parents: NDArray[np.int64], source: str) -> None:
+    """Every node must hang from a scene root: a node that is its own (grand)child never does."""
+    children: dict[int, list[int]] = {}
+    for c, p in enumerate(parents.tolist()):
+        children.setdefault(p, []).append(c)
+    reached, todo = 0, list(children.get(-1, []))
+    while todo:
+        reached += 1
+        todo.extend(children.get(todo.pop(), []))
+    if reached != len(parents):
+        raise GltfError(f"{source}: the node hierarchy has a cycle (a node is its own ancestor)")
+
+
+def _asset(doc: dict[str, Any], buffers: list[bytes], source: str) -> GltfAsset:
     nodes = doc.get("nodes", [])
     n = len(nodes)
+    if n > MAX_NODES:
+        raise GltfError(f"{source}: {n} nodes; the limit is {MAX_NODES}")
     parents = np.full(n, -1, dtype=np.int64)
     trans, rot, scale = np.zeros((n, 3)), quat.identity(n), np.ones((n, 3))
     for i, node in enumerate(nodes):
@@ -258,6 +311,9 @@ def read_gltf(path: str | os.PathLike[str]) -> GltfAsset:
             trans[i] = node.get("translation", (0.0, 0.0, 0.0))
             rot[i] = quat.normalize(quat.from_xyzw(node.get("rotation", (0.0, 0.0, 0.0, 1.0))))
             scale[i] = node.get("scale", (1.0, 1.0, 1.0))
+    _check_tree(parents, source)
+    if not (np.isfinite(trans).all() and np.isfinite(rot).all() and np.isfinite(scale).all()):
+        raise GltfError(f"{source}: a node's translation, rotation or scale is not finite")
     skins = []
     for k, sk in enumerate(doc.get("skins", [])):
         joints = tuple(int(j) for j in sk.get("joints", []))
@@ -280,8 +336,13 @@ def read_gltf(path: str | os.PathLike[str]) -> GltfAsset:
             except (KeyError, IndexError):
                 raise GltfError(f"{source}: animation {a} channel names a missing sampler") from None
             times = accessor(doc, buffers, sampler["input"], source)[:, 0]
+            if len(times) and (np.abs(times).max() > MAX_TIME or (np.diff(times) < 0).any()):
+                raise GltfError(f"{source}: animation {a}: key times must increase and stay within ±{MAX_TIME:g} s")
             values = accessor(doc, buffers, sampler["output"], source)
             interp = sampler.get("interpolation", "LINEAR")
+            width = {"translation": 3, "scale": 3, "rotation": 4}.get(target["path"])
+            if width is not None and values.shape[1] != width:
+                raise GltfError(f"{source}: animation {a}: {target['path']} keys have {values.shape[1]} numbers, not {width}")
             if target["path"] == "rotation":
                 values = quat.from_xyzw(values)
             if interp not in ("LINEAR", "STEP", "CUBICSPLINE"):

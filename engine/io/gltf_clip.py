@@ -11,6 +11,7 @@ CUBICSPLINE by Hermite) at a fixed frame rate; a static root above moving hips (
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -23,6 +24,9 @@ from engine.io.gltf import GltfAnimation, GltfAsset, GltfChannel, GltfError, rea
 from engine.skeleton import Skeleton
 
 __all__ = ["sample_channel", "skin_nodes", "gltf_skeleton", "gltf_clip", "load_gltf_clips"]
+
+MAX_FPS = 1000.0
+MAX_SAMPLES = 4_000_000  # frames x nodes: an hour at 60 fps of an 18-node skeleton
 
 F64 = NDArray[np.float64]
 
@@ -184,20 +188,32 @@ def gltf_clip(
         anim = asset.animations[names.index(animation) if isinstance(animation, str) else animation]
     except (ValueError, IndexError):
         raise GltfError(f"{asset.source}: no animation {animation!r}; it has {names}") from None
-    rate = float(fps if fps is not None else anim.extras.get("fps", 30.0))
-    if not rate > 0:
-        raise ValueError(f"fps must be positive, got {rate}")
+    given = fps if fps is not None else anim.extras.get("fps", 30.0)
+    if isinstance(given, bool) or not isinstance(given, (int, float)) or not 0 < given <= MAX_FPS:
+        raise GltfError(f"{asset.source}: fps must be a number in (0, {MAX_FPS:g}], got {repr(given)[:20]}")
+    rate = float(given)
+    frames = anim.duration * rate
+    if frames * max(asset.num_nodes, 1) > MAX_SAMPLES:  # key times far apart must not allocate gigabytes
+        raise GltfError(f"{asset.source}: animation {anim.name!r} would be {frames:.3g} frames of "
+                        f"{asset.num_nodes} nodes at {rate:g} fps; the limit is {MAX_SAMPLES} node-frames")
     n = int(round(anim.duration * rate)) + 1
     t = np.minimum(anim.start + np.arange(n) / rate, anim.end)
-    skeleton, root, rots = _build(asset, skin, anim, t, scale)
-    rest = gltf_skeleton(asset, skin, scale)
-    skeleton = Skeleton(skeleton.names, skeleton.parents, rest.offsets, rest.tips, rest.radii)
-    loop = bool(anim.extras.get("loop", False))
-    if loop and n > 1:
-        root, rots = root[:-1], rots[:-1]
-    markers = anim.extras.get("markers", {})
-    markers = {str(k): float(v) for k, v in markers.items()} if isinstance(markers, dict) else {}
-    return Clip(anim.name, skeleton, rate, root, rots, loop=loop, markers=markers)
+    try:
+        skeleton, root, rots = _build(asset, skin, anim, t, scale)
+        rest = gltf_skeleton(asset, skin, scale)
+        skeleton = Skeleton(skeleton.names, skeleton.parents, rest.offsets, rest.tips, rest.radii)
+        loop = bool(anim.extras.get("loop", False))
+        if loop and n > 1:
+            root, rots = root[:-1], rots[:-1]
+        markers = anim.extras.get("markers", {})
+        markers = {str(k): float(v) for k, v in markers.items()
+                   if isinstance(v, (int, float)) and math.isfinite(v)} if isinstance(markers, dict) else {}
+        return Clip(str(anim.name), skeleton, rate, root, rots, loop=loop, markers=markers)
+    except GltfError:
+        raise
+    except (ValueError, IndexError, KeyError, TypeError) as exc:  # a skin or tracks that make no skeleton or clip
+        raise GltfError(f"{asset.source}: animation {anim.name!r} does not make a clip "
+                        f"({type(exc).__name__}: {exc})"[:300]) from None
 
 
 def load_gltf_clips(path: str | os.PathLike[str], fps: float | None = None, skin: int = 0, scale: float = 1.0) -> list[Clip]:

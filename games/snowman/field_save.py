@@ -31,6 +31,7 @@ import numpy as np
 
 from engine.app import App
 from engine.atomic import atomic_write_bytes
+from engine.npz_safe import read_bounded
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
@@ -48,6 +49,15 @@ __all__ = ["FIELD_VERSION", "FieldError", "FieldSlot", "snapshot", "restore", "s
            "default_field_path", "load_field", "install_field_slot", "prepare", "replay_setup"]
 
 FIELD_VERSION = 1
+# Limits of a field file. Counts bound the step time (1,000 balls made a step take half a
+# second); sizes bound memory (the snow grid is 240x240 cells; a zlib bomb must not inflate).
+MAX_BALLS, MAX_SNOWMEN, MAX_PUPPETS = 64, 32, 8
+MAX_GRID = 1024
+MAX_DEPTH = 10.0  # m of snow
+MAX_RADIUS = 5.0  # m
+MAX_EXTENT = 1000.0  # m from the centre
+MAX_HEADING = 1e4  # rad
+MAX_FILE = 4 << 20
 PUPPET_COLOR = (0.85, 0.32, 0.24)
 
 
@@ -74,15 +84,27 @@ def _encode_depth(depth: np.ndarray) -> dict[str, Any]:
     return {"shape": list(depth.shape), "zlib_f8": base64.b64encode(zlib.compress(raw, 6)).decode("ascii")}
 
 
-def _decode_depth(data: dict[str, Any], shape: tuple[int, ...]) -> np.ndarray:
+def _decode_depth(data: Any, shape: tuple[int, ...] | None) -> np.ndarray:
+    if not isinstance(data, dict) or not isinstance(data.get("shape"), list) or not isinstance(data.get("zlib_f8"), str):
+        raise FieldError("snow grid must be an object with a shape list and zlib_f8 text")
+    grid = data["shape"]
+    if len(grid) != 2 or not all(isinstance(n, int) and not isinstance(n, bool) and 0 < n <= MAX_GRID for n in grid):
+        raise FieldError(f"snow grid shape must be two sides of 1..{MAX_GRID} cells")
+    if shape is not None and tuple(grid) != shape:
+        raise FieldError(f"snow grid is {grid}, this field's is {list(shape)}")
+    size = grid[0] * grid[1] * 8
+    if len(data["zlib_f8"]) > 4 * size:  # base64 of zlib never grows a grid of doubles this much
+        raise FieldError("snow grid text is longer than any grid of its shape")
     try:
-        if tuple(data["shape"]) != shape:
-            raise FieldError(f"snow grid is {data['shape']}, this field's is {list(shape)}")
-        depth = np.frombuffer(zlib.decompress(base64.b64decode(data["zlib_f8"])), dtype="<f8").reshape(shape).copy()
-    except (KeyError, TypeError, ValueError, zlib.error) as exc:
+        # Never inflate past the grid's size: a zlib bomb stops here instead of taking gigabytes.
+        raw = zlib.decompressobj().decompress(base64.b64decode(data["zlib_f8"], validate=True), size + 1)
+    except (ValueError, zlib.error) as exc:
         raise FieldError(f"snow grid unreadable: {exc}") from None
-    if not np.isfinite(depth).all() or (depth < 0).any():
-        raise FieldError("snow grid has negative or non-finite depths")
+    if len(raw) != size:
+        raise FieldError(f"snow grid holds {len(raw)} bytes, its shape needs {size}")
+    depth = np.frombuffer(raw, dtype="<f8").reshape(grid).copy()
+    if not np.isfinite(depth).all() or (depth < 0).any() or (depth > MAX_DEPTH).any():
+        raise FieldError(f"snow grid has depths that are negative, non-finite or over {MAX_DEPTH} m")
     return depth
 
 
@@ -107,35 +129,88 @@ def snapshot(world: World) -> dict[str, Any]:
 
 
 def _vec(value: Any, what: str) -> np.ndarray:
+    if not isinstance(value, list) or len(value) != 3 or not all(_is_number(x) for x in value):
+        raise FieldError(f"{what} must be three numbers, got {repr(value)[:60]}")
     v = np.asarray(value, dtype=np.float64)
-    if v.shape != (3,) or not np.isfinite(v).all():
-        raise FieldError(f"{what} must be three finite numbers, got {value!r}")
+    if not np.isfinite(v).all() or np.abs(v).max() > MAX_EXTENT:
+        raise FieldError(f"{what} must be finite and within {MAX_EXTENT:g} m, got {repr(value)[:60]}")
     return v
 
 
-def _check(snap: dict[str, Any], field_shape: tuple[int, ...]) -> np.ndarray | None:
-    """Validate the whole snapshot before touching the world; returns the decoded snow grid."""
+def _is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _number(value: Any, what: str, lo: float, hi: float) -> float:
+    if not _is_number(value) or not lo <= value <= hi:  # NaN fails both comparisons
+        raise FieldError(f"{what} must be a number in [{lo:g}, {hi:g}], got {repr(value)[:40]}")
+    return float(value)
+
+
+def _count(value: Any, what: str, hi: int) -> int:
+    if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= hi:
+        raise FieldError(f"{what} must be a whole number in 0..{hi}, got {repr(value)[:40]}")
+    return value
+
+
+def _list(snap: dict[str, Any], key: str, limit: int) -> list[dict[str, Any]]:
+    items = snap.get(key)
+    if not isinstance(items, list) or not all(isinstance(x, dict) for x in items):
+        raise FieldError(f"{key} must be a list of objects")
+    if len(items) > limit:
+        raise FieldError(f"{len(items)} {key}; a field holds at most {limit}")
+    return items
+
+
+def _check(snap: Any, field_shape: tuple[int, ...] | None) -> np.ndarray | None:
+    """Validate the whole snapshot before anything in the world changes; returns the decoded snow grid.
+
+    Every value :func:`restore` reads is checked here (types, finiteness, ranges, counts,
+    references between balls), so a restore either happens completely or not at all.
+    ``field_shape`` is the snow grid's shape, ``None`` where it is not known yet (loading).
+    """
     if not isinstance(snap, dict) or snap.get("version") != FIELD_VERSION:
         raise FieldError(f"not a snowman field of version {FIELD_VERSION}")
-    try:
-        for b in snap["balls"]:
-            _vec(b["position"], "ball position")
-            if not (0 < float(b["radius"]) < 5):
-                raise FieldError(f"ball radius {b['radius']!r} out of range")
-            if b["on"] is not None and not 0 <= int(b["on"]) < len(snap["balls"]):
-                raise FieldError(f"ball packed onto missing ball {b['on']!r}")
-        for s in snap["snowmen"]:
-            _vec(s["position"], "snowman position")
-            SnowmanShape(float(s["bottom"]), None if s["middle"] is None else float(s["middle"]), float(s["head"]))
-        for p in snap["puppets"]:
-            _vec(p["position"], "puppet position")
-            float(p["heading"])
-        int(snap["stats"]["built"]), int(snap["stats"]["balls_started"])
-    except (KeyError, TypeError, ValueError) as exc:
-        if isinstance(exc, FieldError):
-            raise
-        raise FieldError(f"field is missing or mistypes {exc}") from None
+    balls = _list(snap, "balls", MAX_BALLS)
+    for b in balls:
+        _vec(b.get("position"), "ball position")
+        _number(b.get("radius"), "ball radius", 1e-3, MAX_RADIUS)
+        _number(b.get("snow"), "ball snow", 0.0, 1e4)
+        on = b.get("on")
+        if on is not None and (not isinstance(on, int) or isinstance(on, bool) or not 0 <= on < len(balls)):
+            raise FieldError(f"ball packed onto missing ball {repr(on)[:20]}")
+    _check_stacks(balls)
+    for s in _list(snap, "snowmen", MAX_SNOWMEN):
+        _vec(s.get("position"), "snowman position")
+        _number(s.get("heading"), "snowman heading", -MAX_HEADING, MAX_HEADING)
+        _count(s.get("number"), "snowman number", 1_000_000)
+        middle = s.get("middle")
+        try:
+            SnowmanShape(_number(s.get("bottom"), "snowman bottom", 1e-3, MAX_RADIUS),
+                         None if middle is None else _number(middle, "snowman middle", 1e-3, MAX_RADIUS),
+                         _number(s.get("head"), "snowman head", 1e-3, MAX_RADIUS))
+        except ValueError as exc:
+            raise FieldError(str(exc)) from None
+    for p in _list(snap, "puppets", MAX_PUPPETS):
+        _vec(p.get("position"), "puppet position")
+        _number(p.get("heading"), "puppet heading", -MAX_HEADING, MAX_HEADING)
+    stats = snap.get("stats")
+    if not isinstance(stats, dict):
+        raise FieldError("stats must be an object")
+    _count(stats.get("built"), "built", 1_000_000)
+    _count(stats.get("balls_started"), "balls_started", 1_000_000)
     return None if snap.get("snow") is None else _decode_depth(snap["snow"], field_shape)
+
+
+def _check_stacks(balls: list[dict[str, Any]]) -> None:
+    """Balls packed onto balls must end on the ground: a ball on itself, or a ring, is no stack."""
+    for start in range(len(balls)):
+        seen, i = {start}, balls[start].get("on")
+        while i is not None:
+            if i in seen:
+                raise FieldError(f"ball {start} is packed onto a ring of balls")
+            seen.add(i)
+            i = balls[i].get("on")
 
 
 def restore(world: World, snap: dict[str, Any]) -> None:
@@ -154,14 +229,15 @@ def restore(world: World, snap: dict[str, Any]) -> None:
     for p in snap["puppets"]:
         spawn_first_puppet(world, _vec(p["position"], "puppet"), float(p["heading"]))
     for s in snap["snowmen"]:
-        shape = SnowmanShape(float(s["bottom"]), None if s["middle"] is None else float(s["middle"]), float(s["head"]))
+        middle = s.get("middle")  # absent or null: a two-ball snowman (as _check reads it)
+        shape = SnowmanShape(float(s["bottom"]), None if middle is None else float(middle), float(s["head"]))
         bring_to_life(world, shape, _vec(s["position"], "snowman"), float(s["heading"]), int(s["number"]))
     spawned = [spawn_ball(world, _vec(b["position"], "ball"), float(b["radius"])) for b in snap["balls"]]
     world.flush()
     for e, b in zip(spawned, snap["balls"], strict=True):
         world.get(e, Transform).position = _vec(b["position"], "ball")  # spawn_ball puts it on the ground
         world.get(e, Snowball).snow = float(b["snow"])
-        if b["on"] is not None:
+        if b.get("on") is not None:
             world.add(e, Stacked(on=spawned[int(b["on"])]))
             world.get(e, Prop).carried = True
 
@@ -182,19 +258,30 @@ def default_field_path() -> Path:
 
 
 def load_field(path: Path) -> dict[str, Any] | None:
-    """The field saved at ``path`` (``None`` if there is none); :class:`FieldError` if it is damaged."""
+    """The field saved at ``path`` (``None`` if there is none), validated whole.
+
+    Raises:
+        FieldError: the file is damaged, too big (over :data:`MAX_FILE`), not a regular
+            file, nested too deeply, or holds a field no game could have saved.
+    """
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_bounded(path, MAX_FILE).decode("utf-8")
     except FileNotFoundError:
         return None
     except OSError as exc:
         raise FieldError(f"{path}: {exc.strerror}") from None
+    except ValueError as exc:  # not a regular file, too big, not UTF-8
+        raise FieldError(f"{path}: {exc}") from None
     try:
         snap = json.loads(text)
     except json.JSONDecodeError as exc:
         raise FieldError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(snap, dict) or snap.get("version") != FIELD_VERSION:
-        raise FieldError(f"{path}: not a snowman field of version {FIELD_VERSION}")
+    except RecursionError:
+        raise FieldError(f"{path}: JSON nested too deeply") from None
+    try:
+        _check(snap, None)
+    except FieldError as exc:
+        raise FieldError(f"{path}: {exc}") from None
     return snap
 
 
@@ -215,8 +302,16 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
 
 
 def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
-    """A replay restores the recorded field but saves nowhere."""
-    return {**recorded, "save_to": ""}
+    """A replay restores the recorded field but saves nowhere; a recorded field that fails the
+    checks (a recording made before fields were checked) is dropped, and F9 restores nothing."""
+    field = recorded.get("field")
+    if field is not None:
+        try:
+            _check(field, None)
+        except FieldError as exc:
+            print(f"snowman: the recording's saved field is unusable ({exc}); F9 will not restore it", file=sys.stderr)
+            field = None
+    return {**recorded, "field": field, "save_to": ""}
 
 
 def install_field_slot(app: App) -> None:

@@ -136,3 +136,77 @@ def test_altered_data_fails_checksum(tmp_path):
     with pytest.raises(ClipFileError, match="checksum"):
         load_clip(path)
     assert zipfile.is_zipfile(path)
+
+
+def _rewrite_signed(path, change):
+    """Like _rewrite_header, and the checksum made to match: what a hostile file can do."""
+    from engine.clipfile import _digest
+
+    def both(h, a):
+        change(h, a)
+        h["sha256"] = _digest(a)
+
+    _rewrite_header(path, both)
+
+
+@pytest.mark.parametrize("change,says", [
+    (lambda h, a: h.update(fps=float("nan")), "fps"),
+    (lambda h, a: h.update(fps=float("inf")), "fps"),
+    (lambda h, a: h.update(fps=-30), "fps"),
+    (lambda h, a: h.update(markers=[1, 2]), "markers"),
+    (lambda h, a: h.update(joints="Hips"), "joints"),
+    (lambda h, a: h.update(loop="yes"), "loop"),
+    (lambda h, a: a.update(offsets=np.full_like(a["offsets"], np.nan)), "offsets"),
+    (lambda h, a: a.update(radii=-a["radii"] - 0.1), "radii"),
+    (lambda h, a: a.update(root=a["root"] * 1e300), "root"),
+    (lambda h, a: a.update(rotations=a["rotations"] * 2.0), "unit"),
+    (lambda h, a: a.update(parents=a["parents"].astype(float)), "parents"),
+    (lambda h, a: a.update(rotations=a["rotations"][:, :2]), "inconsistent"),
+])
+def test_absurd_values_with_a_matching_checksum_are_refused(tmp_path, change, says):
+    path = save_clip(walking_clip(), tmp_path / "walk.ppclip")
+    _rewrite_signed(path, change)
+    with pytest.raises(ClipFileError, match=says):
+        load_clip(path)
+
+
+def test_deeply_nested_header_is_a_clip_error(tmp_path):
+    path = tmp_path / "deep.ppclip"
+    with open(path, "wb") as f:
+        np.savez(f, header=np.frombuffer(b"[" * 100_000 + b"]" * 100_000, dtype=np.uint8))
+    with pytest.raises(ClipFileError, match="corrupt"):
+        load_clip(path)
+
+
+def test_a_member_claiming_a_huge_array_is_refused_before_allocation(tmp_path):
+    import io
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": (10**11, 3)})
+    path = tmp_path / "huge.ppclip"
+    with zipfile.ZipFile(path, "w") as z:
+        z.writestr("root.npy", buf.getvalue() + bytes(64))
+    with pytest.raises(ClipFileError, match="claims"):
+        load_clip(path)
+
+
+def test_flipped_bytes_give_a_clip_error_and_nothing_else(tmp_path):
+    good = save_clip(walking_clip(), tmp_path / "walk.ppclip").read_bytes()
+    path = tmp_path / "bad.ppclip"
+    rng = np.random.default_rng(5)
+    for pos in rng.integers(0, len(good), 300):
+        path.write_bytes(good[:pos] + bytes([good[pos] ^ 0x5A]) + good[pos + 1:])
+        try:
+            load_clip(path)
+        except ClipFileError:
+            pass
+
+
+def test_a_pipe_or_a_folder_is_refused(tmp_path):
+    import os
+
+    fifo = tmp_path / "clip.ppclip"
+    os.mkfifo(fifo)
+    for p in (fifo, tmp_path):
+        with pytest.raises(ClipFileError, match="regular file"):
+            load_clip(p)

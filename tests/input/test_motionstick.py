@@ -5,7 +5,7 @@ import numpy as np
 from engine import quat
 from engine.components import Obstacle, Stick, Transform
 from input.hub import InputHub
-from input.motionstick import StickConfig
+from input.motionstick import StickConfig, StickState
 from input.sample import PoseSample
 from input.source import PoseSource
 from input.stick_geometry import pick, shorten
@@ -136,3 +136,46 @@ def test_velocity_is_filtered_and_an_upward_flick_fires_once(make_app):
     src.push(flagged)
     app.step()
     assert stick.flick
+
+
+def test_a_poisoned_velocity_filter_starts_again_at_rest(make_app):
+    src, app, e = setup(make_app)
+    aim = np.array([0.0, 0.95, 0.0]) - [0, 1.5, -4.0]
+    src.push(world_sample(aim))
+    app.step()
+    st = app.world.get(e, StickState)
+    st.filt_dx = np.array([np.nan, 0.0, 0.0])  # what one 1e308 datagram used to leave behind for good
+    src.push(world_sample(aim))
+    app.step()
+    stick = app.world.get(e, Stick)
+    assert np.all(np.isfinite(stick.velocity)) and np.all(np.isfinite(st.filt_x))
+    src.push(world_sample(aim + [0, 0.08, 0]))
+    app.step()
+    assert np.all(np.isfinite(stick.velocity)) and stick.velocity[1] > 0
+
+
+def test_a_huge_osc_double_is_dropped_and_the_stick_stays_finite(make_app):
+    from pythonosc.osc_message_builder import OscMessageBuilder
+
+    from input.osc import OscSource
+
+    def pose(x):
+        b = OscMessageBuilder("/puppetphone/pose")
+        for v in (x, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0):
+            b.add_arg(v, "d")
+        return b.build().dgram
+
+    osc = OscSource(port=0, admit_after=1)
+    try:
+        app = make_app(InputHub([osc]))
+        e = app.world.query(Stick)[0][0]
+        for i, x in enumerate([0.0, 0.01, 1e308, 5000.0, 0.02, 0.03]):
+            osc.handle_datagram(pose(x), "osc:10.0.0.2", 1.0 + i / 60)
+            app.step()
+            stick = app.world.get(e, Stick)
+            assert np.all(np.isfinite(stick.velocity)) and np.all(np.isfinite(stick.tip))
+            assert abs(stick.pivot[0] - StickConfig().virtual_pivot[0]) < 1.0
+    finally:
+        osc.stop()
+    reasons = osc.status().drop_reasons
+    assert reasons == {"value out of range": 1, "invalid sample": 1}

@@ -13,7 +13,8 @@ import pytest
 
 from engine.components import Stick
 from input.hub import InputHub
-from input.osc import OscSource
+from input.osc import (ADMIT_AFTER, CANDIDATE_BUDGET, MAX_BUNDLE_DEPTH, MAX_CANDIDATES, MAX_DATAGRAM, MAX_MESSAGES, STEP_BUDGET, OscSource,
+                       bundle_shape)
 from input.sample import CONNECT, TOUCH_DOWN
 
 ZIG_SENDER = textwrap.dedent("""
@@ -80,7 +81,7 @@ def test_zigsim_bundles_from_another_process_move_the_stick(make_app):
 
 @pytest.mark.skipif(shutil.which("oscsend") is None, reason="liblo-tools' oscsend is not installed")
 def test_oscsend_messages_for_each_profile():
-    src = OscSource(host="127.0.0.1", port=0)
+    src = OscSource(host="127.0.0.1", port=0, admit_after=1)  # every message counts here, the first too
     hub = InputHub([src]).start()
     try:
         sends = [
@@ -130,9 +131,10 @@ def test_flood_of_ten_thousand_packets_keeps_the_step_cheap(make_app, osc):
         hub.close()
     st = src.status()
     assert worst <= hub.max_samples
-    # What the kernel's buffer kept is either a sample or a counted drop with its reason.
-    assert st.packets > 100 and st.dropped > 2 * 100
-    assert {"malformed packet", "non-finite value"} <= set(st.drop_reasons)
+    # What the kernel's buffer kept is either a sample or a counted drop with its reason; past
+    # the step's decoding budget, datagrams are dropped undecoded.
+    assert st.packets > 20 and st.dropped > 2 * 100
+    assert {"malformed packet", "non-finite value", "over budget"} <= set(st.drop_reasons)
     assert app.world.query(Stick)[0][1].connected
 
 
@@ -143,13 +145,62 @@ def test_locked_to_first_sender_and_rate_limited(osc):
         pkt = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
         for i in range(30):
             src.handle_datagram(pkt, "osc:10.0.0.1", now=100.0)
+            if i % 2:
+                src.drain()  # steps go by: the decoding budget is not what is tested here
         src.handle_datagram(pkt, "osc:10.0.0.2", now=100.0)
         st = src.status()
-        assert st.drop_reasons["rate limit"] == 20 and st.drop_reasons["other sender"] == 1
+        assert st.drop_reasons == {"rate limit": 20, "sender pending": 2, "other sender": 1}
+        assert st.locked_out == ["osc:10.0.0.2"]
         src.handle_datagram(message("/puppetphone/touch", 1), "osc:10.0.0.1", now=101.0)  # tokens refilled
         assert src.drain()[-1].touch is True
     finally:
         src.stop()
+
+
+def test_garbage_or_a_stray_datagram_cannot_claim_the_slot(osc):
+    message, _ = osc
+    src = OscSource(host="127.0.0.1", port=0)
+    pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+    try:
+        src.handle_datagram(b"\x00garbage", "osc:10.0.0.66", now=1.0)  # first on the wire: used to lock everyone out
+        src.handle_datagram(pose, "osc:10.0.0.77", now=1.0)  # one valid datagram is not a pose stream either
+        items = []
+        for i in range(5):  # a phone at 60 Hz, one datagram a step
+            src.handle_datagram(pose, "osc:10.0.0.5", now=1.0 + i / 60)
+            items += src.drain()
+        for sender in ("osc:10.0.0.66", "osc:10.0.0.77"):
+            for _ in range(5):
+                src.handle_datagram(pose, sender, now=1.1)
+        items += src.drain()
+        assert items[0] == (CONNECT, "osc:10.0.0.5")
+        assert {i.source for i in items[1:]} == {"osc:10.0.0.5"} and len(items) == 1 + 5 - (ADMIT_AFTER - 1)
+        st = src.status()
+        assert st.locked_out == ["osc:10.0.0.66", "osc:10.0.0.77"] and st.drop_reasons["other sender"] == 10
+    finally:
+        src.stop()
+
+
+def test_candidates_are_bounded_and_forgotten_when_quiet(osc):
+    message, _ = osc
+    src = OscSource(host="127.0.0.1", port=0, timeout=2.0)
+    try:
+        for i in range(MAX_CANDIDATES + 5):
+            src.handle_datagram(b"junk", f"osc:10.1.0.{i}", now=1.0)
+        assert src.status().drop_reasons["too many senders"] == 5
+        src._expire(10.0)  # every candidate went quiet
+        pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+        items = []
+        for i in range(ADMIT_AFTER):  # one datagram a step
+            src.handle_datagram(pose, "osc:10.2.0.1", now=10.0 + i / 60)
+            items += src.drain()
+        assert items[0] == (CONNECT, "osc:10.2.0.1")
+    finally:
+        src.stop()
+
+
+def test_no_sender_slots_is_refused():
+    with pytest.raises(ValueError, match="OSC senders must be at least 1"):
+        OscSource(host="127.0.0.1", port=0, max_senders=0)
 
 
 def test_bind_error_is_clear():
@@ -159,3 +210,43 @@ def test_bind_error_is_clear():
             OscSource(host="127.0.0.1", port=a.port)
     finally:
         a.stop()
+
+
+def test_bundles_are_measured_without_parsing(osc):
+    message, bundle = osc
+    pose = ("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+    assert bundle_shape(message(*pose)) == (1, "")
+    assert bundle_shape(bundle(pose, pose, pose)) == (3, "")
+    assert bundle_shape(bundle(*[pose] * (MAX_MESSAGES + 1)))[1] == "bundle too large"
+    nested = bundle(pose)
+    for _ in range(MAX_BUNDLE_DEPTH):
+        nested = b"#bundle\x00" + bytes(8) + len(nested).to_bytes(4, "big") + nested
+    assert bundle_shape(nested)[1] == "bundle too deep"
+    assert bundle_shape(b"#bundle\x00" + bytes(8) + (10**9).to_bytes(4, "big")) == (0, "")  # lying sizes: python-osc's
+
+
+def test_decoding_is_budgeted_per_sender_and_step(osc):
+    message, bundle = osc
+    src = OscSource(host="127.0.0.1", port=0, max_senders=2, admit_after=1, max_rate=1e6)
+    try:
+        pose = message("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
+        src.handle_datagram(pose, "osc:10.0.0.1", now=1.0)  # admitted, on the candidates' budget
+        src.drain()
+        for _ in range(STEP_BUDGET[0] + 5):
+            src.handle_datagram(pose, "osc:10.0.0.1", now=1.0)
+        src.handle_datagram(b"x" * (MAX_DATAGRAM + 1), "osc:10.0.0.1", now=1.0)
+        for _ in range(3):
+            src.handle_datagram(b"junk", "osc:10.0.0.9", now=1.0)  # a candidate: the candidates' budget
+        st = src.status()
+        assert st.packets == 1 + STEP_BUDGET[0] and st.drop_reasons["oversize packet"] == 1
+        assert st.drop_reasons["malformed packet"] == CANDIDATE_BUDGET[0]
+        assert st.drop_reasons["over budget"] == 5 + 3 - CANDIDATE_BUDGET[0]
+        src.drain()  # the next step: a fresh budget
+        src.handle_datagram(pose, "osc:10.0.0.1", now=1.0)
+        assert src.status().packets == STEP_BUDGET[0] + 2
+        many = bundle(*[("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)] * 30)
+        for _ in range(3):
+            src.handle_datagram(many, "osc:10.0.0.1", now=1.0)  # messages run out before datagrams do
+        assert src.status().drop_reasons["over budget"] == 5 + 3 - CANDIDATE_BUDGET[0] + 2
+    finally:
+        src.stop()

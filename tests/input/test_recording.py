@@ -146,3 +146,47 @@ def test_replay_source_serves_by_index(make_app, tmp_path):
     src = ReplaySource(path)
     assert src.last_frame == 4 and src.frame_at(2).frame == 2 and src.frame_at(5) is None
     assert src.status().packets == 1
+
+
+def _with_header(path, header: bytes):
+    import struct
+    import zlib
+
+    path.write_bytes(MAGIC + struct.pack("<II", len(header), zlib.crc32(header)) + header)
+    return path
+
+
+@pytest.mark.parametrize("header,says", [
+    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "format": "1"}', "format"),
+    (b'{"game": "snowman", "seed": 0, "dt": "fast"}', "dt"),
+    (b'{"game": "snowman", "seed": 0, "dt": 1e308}', "dt"),
+    (b'{"game": "snowman", "seed": 0, "dt": 0}', "dt"),
+    (b'{"game": "snowman", "seed": -1, "dt": 0.0166}', "seed"),
+    (b'{"game": "snowman", "seed": true, "dt": 0.0166}', "seed"),
+    (b'{"game": ["snowman"], "seed": 0, "dt": 0.0166}', "game"),
+    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "extra": []}', "extra"),
+    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "sources": "osc"}', "sources"),
+    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "hack": 1}', "unknown"),
+    (b'{"seed": 0, "dt": 0.0166}', "missing game"),
+    (b'[1, 2]', "object"),
+    (b"[" * 100_000 + b"]" * 100_000, "unreadable"),
+])
+def test_wrong_typed_or_absurd_header_fields_are_a_recording_error(tmp_path, header, says):
+    with pytest.raises(RecordingError, match=says):
+        read_recording(_with_header(tmp_path / "h.rec", header))
+
+
+def test_devices_pipes_and_huge_header_claims_are_refused_without_reading(tmp_path):
+    import os
+    import struct
+
+    with pytest.raises(RecordingError, match="not a regular file"):
+        read_recording("/dev/zero")
+    fifo = tmp_path / "p.rec"
+    os.mkfifo(fifo)
+    with pytest.raises(RecordingError, match="not a regular file"):
+        read_recording(fifo)  # opening must not wait for a writer
+    big = tmp_path / "big.rec"
+    big.write_bytes(MAGIC + struct.pack("<II", 2**32 - 1, 0))
+    with pytest.raises(RecordingError, match="claims"):
+        read_recording(big)

@@ -1,3 +1,5 @@
+import struct
+
 import numpy as np
 import pytest
 
@@ -20,6 +22,28 @@ def test_sample_rejects_bad_values():
         _sample(acceleration=[1.0, 2.0])
     with pytest.raises(ValueError, match="mode"):
         _sample(mode="screen")
+
+
+@pytest.mark.parametrize("field,value", [
+    ("position", [1e308, 0.0, 0.0]), ("position", [0.0, -1001.0, 0.0]), ("angular_velocity", [0.0, 0.0, 1e5]),
+    ("acceleration", [3000.0, 0.0, 0.0]), ("plane_normal", [0.0, 2.0, 0.0]), ("depth_delta", 1e308),
+    ("orientation", [1e308, 0.0, 0.0, 0.0]),
+])
+def test_sample_rejects_finite_but_absurd_values(field, value):
+    with pytest.raises(ValueError, match="range|unit"):
+        _sample(**{field: value})
+
+
+def test_a_recorded_sample_out_of_range_is_a_codec_error():
+    good = encode_frame(InputFrame(frame=1, samples=(_sample(position=[1.0, 2.0, 3.0]),)))
+    pos = good.index(struct.pack("<3d", 1.0, 2.0, 3.0))
+    for bad in (1e308, float("nan"), float("inf")):
+        data = good[:pos] + struct.pack("<d", bad) + good[pos + 8:]
+        with pytest.raises(CodecError, match="position"):
+            decode_frame(data)
+    q = good.index(struct.pack("<4d", 1.0, 0.0, 0.0, 0.0))
+    with pytest.raises(CodecError, match="unit"):
+        decode_frame(good[:q] + struct.pack("<d", float("nan")) + good[q + 8:])
 
 
 def test_frame_round_trip_is_bit_exact():

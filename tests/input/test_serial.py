@@ -67,6 +67,13 @@ def test_overlong_garbage_without_newline_is_dropped():
     assert p.feed(b"\n1,0,0,0\n")[0].quaternion == (1.0, 0.0, 0.0, 0.0)
 
 
+def test_finite_but_huge_values_are_skipped_not_read():
+    p = SerialStreamParser()
+    out = p.feed(b"1,0,0,0,1e308,0,0\n1e308,0,0,0\n1,0,0,0,5000,0,0\n1,0,0,0,0.5,0,0\n")
+    assert [r.position for r in out] == [(0.5, 0.0, 0.0)]
+    assert p.skipped == {"position out of range": 2, "non-unit quaternion": 1}
+
+
 def _wait(pred, timeout=5.0):
     end = time.monotonic() + timeout
     while time.monotonic() < end:

@@ -87,3 +87,18 @@ def test_a_notice_is_drawn_large_and_fades_after_two_seconds_of_simulation():
     assert 0.0 < notice_line()[0].alpha < 1.0  # fading
     app.run_steps(int(0.1 * shown) + 1)
     assert notice_line()[0] is None  # gone after two simulated seconds, however long they took
+
+
+def test_overlay_names_a_locked_out_phone():
+    osc = OscSource(host="127.0.0.1", port=0, admit_after=1)
+    hub = InputHub([osc])
+    try:
+        app = make_app("sandbox", 0, hub)
+        pose = b"/puppetphone/orientation\x00\x00\x00\x00,ffff\x00\x00\x00" + bytes.fromhex("3f800000") + bytes(12)
+        osc.handle_datagram(pose, "osc:10.0.0.5", now=1.0)
+        osc.handle_datagram(pose, "osc:10.0.0.9", now=1.0)
+        app.step()
+        lines = overlay_lines(app.world, GAME, hub, 60.0, False)
+        assert any("locked out" in line and "osc:10.0.0.9" in line for line in lines)
+    finally:
+        hub.close()

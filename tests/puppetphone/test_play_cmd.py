@@ -85,7 +85,7 @@ def _umask() -> int:
 
 
 @pytest.mark.parametrize("args, says", [
-    (["play", "snowman", "--headless", "--frames", "-5"], "-5 is negative"),
+    (["play", "snowman", "--headless", "--frames", "-5"], "-5 is out of range"),
     (["play", "snowman", "--headless", "--size", "0x0"], "out of range"),
     (["play", "snowman", "--headless", "--screenshot", "x.bmp"], "use .png or .jpg"),
     (["author", "edit", "walk", "--headless", "--bogus"], "usage: puppetphone author edit"),

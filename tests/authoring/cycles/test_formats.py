@@ -142,3 +142,49 @@ def test_recording_input(tmp_path: Path) -> None:
     assert abs(r.period / perf.period - 1) < 0.02
     with pytest.raises(TrajectoryError, match="no source 'phone'"):
         load_performance(tmp_path / "take.rec", ["phone"])
+
+
+def test_npz_that_is_damaged_hostile_or_absurd_is_a_trajectory_error(tmp_path: Path) -> None:
+    import io
+    import zipfile
+
+    t = np.arange(50) / 30.0
+    v = np.sin(t)[:, None]
+    cases = {}
+    cases["garbage"] = b"PK\x03\x04 not really a zip"
+    buf = io.BytesIO()
+    np.savez(buf, values=v, times=t)
+    good = buf.getvalue()
+    cases["cut"] = good[: len(good) // 2]
+    buf = io.BytesIO()
+    np.savez(buf, values=np.array(["a", "b"]), fps=np.float64(30))
+    cases["strings"] = buf.getvalue()
+    buf = io.BytesIO()
+    np.savez(buf, values=v * 1e300, times=t)
+    cases["huge"] = buf.getvalue()
+    buf = io.BytesIO()
+    np.savez(buf, values=v, fps=np.float64(np.nan))
+    cases["nan fps"] = buf.getvalue()
+    head = io.BytesIO()
+    np.lib.format.write_array_header_1_0(head, {"descr": "<f8", "fortran_order": False, "shape": (10**10, 8)})
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        z.writestr("values.npy", head.getvalue() + bytes(80))
+        z.writestr("fps.npy", b"")
+    cases["claims 640 GB"] = buf.getvalue()
+    buf = io.BytesIO()
+    np.savez(buf, values=np.array([object()], dtype=object), fps=np.float64(30))
+    cases["objects"] = buf.getvalue()
+    for name, data in cases.items():
+        path = tmp_path / "p.npz"
+        path.write_bytes(data)
+        with pytest.raises(TrajectoryError):
+            load_performance(path)
+            pytest.fail(name)
+
+
+def test_finite_but_absurd_csv_values_are_refused(tmp_path: Path) -> None:
+    t = np.arange(40) / 30.0
+    _write_csv(tmp_path / "in.csv", t, np.column_stack([np.sin(t), np.full(40, 5e307)]), ["a", "b"])
+    with pytest.raises(TrajectoryError, match="within"):
+        load_performance(tmp_path / "in.csv")

@@ -57,3 +57,32 @@ def test_exports_to_bvh_and_gltf_carry_the_travel(walk, tmp_path):
     with pytest.raises(ValueError, match="export to one of"):
         export_clip(walk, tmp_path / "walk.fbx")
     assert not (tmp_path / "walk.fbx").exists()
+
+
+@pytest.mark.parametrize("edit,says", [
+    (lambda d: d.pop("scales"), "scales"),  # was a KeyError
+    (lambda d: d.update(scales=d["scales"][:-1]), "scales"),
+    (lambda d: d["scales"][0].__setitem__(0, float("inf")), "scales"),
+    (lambda d: d["scales"][0].__setitem__(0, "big"), "scales"),
+    (lambda d: d.update(pins={"l_foot": [10**9]}), "pins"),
+    (lambda d: d.update(pins=[1, 2]), "pins"),
+    (lambda d: d.update(tau=-3), "tau"),
+    (lambda d: d.update(sigma=float("nan")), "sigma"),
+    (lambda d: d.update(version="2"), "version"),
+    (lambda d: d.clear(), "not a MoCurves"),
+])
+def test_a_damaged_side_file_is_a_session_file_error(walk, tmp_path, edit, says):
+    path = save_session(EditSession(walk), tmp_path / "a.ppclip")
+    side = tmp_path / "a.mocurves.json"
+    data = json.loads(side.read_text())
+    edit(data)
+    side.write_text(json.dumps(data))
+    with pytest.raises(SessionFileError, match=says):
+        load_session(path)
+
+
+def test_a_deeply_nested_side_file_is_a_session_file_error(walk, tmp_path):
+    path = save_session(EditSession(walk), tmp_path / "a.ppclip")
+    (tmp_path / "a.mocurves.json").write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(SessionFileError, match="RecursionError"):
+        load_session(path)

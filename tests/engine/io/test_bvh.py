@@ -217,3 +217,42 @@ def test_write_is_atomic_and_refuses_bad_order(tmp_path: Path) -> None:
         write_bvh(target, bad)
     assert target.read_text() == "old"
     assert list(tmp_path.iterdir()) == [target]
+
+
+def _chain_bvh(depth: int, offset: str = "0 1 0", frame: str = "0 0 0 0 0 0", frame_time: str = "0.0083333") -> str:
+    lines = ["HIERARCHY", "ROOT j0", "{", "  OFFSET 0 0 0", "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"]
+    for j in range(1, depth):
+        lines += [f"JOINT j{j}", "{", f"  OFFSET {offset}", "  CHANNELS 0"]
+    lines += ["}"] * depth
+    return "\n".join(lines + ["MOTION", "Frames: 1", f"Frame Time: {frame_time}", frame]) + "\n"
+
+
+def test_a_hierarchy_deeper_than_the_python_stack_reads_and_writes(tmp_path):
+    from engine.io.bvh import MAX_JOINTS, format_bvh
+
+    motion = parse_bvh(_chain_bvh(MAX_JOINTS))
+    assert motion.num_joints == MAX_JOINTS
+    path = write_bvh(tmp_path / "deep.bvh", motion)  # was a RecursionError
+    back = read_bvh(path)
+    assert back.names == motion.names and np.array_equal(back.parents, motion.parents)
+    assert format_bvh(back) == format_bvh(motion)
+    with pytest.raises(BvhError, match="more than"):
+        parse_bvh(_chain_bvh(MAX_JOINTS + 1))
+
+
+@pytest.mark.parametrize("kw,says", [
+    ({"offset": "0 nan 0"}, "OFFSET"),
+    ({"offset": "0 1e308 0"}, "OFFSET"),
+    ({"frame": "0 inf 0 0 0 0"}, "frame 0"),
+    ({"frame": "0 0 0 0 5e307 0"}, "frame 0"),
+    ({"frame_time": "inf"}, "frame time"),
+    ({"frame_time": "nan"}, "frame time"),
+])
+def test_nan_and_absurd_numbers_are_a_bvh_error(kw, says):
+    with pytest.raises(BvhError, match=says):
+        parse_bvh(_chain_bvh(3, **kw))
+
+
+def test_a_device_is_not_read(tmp_path):
+    with pytest.raises(BvhError, match="regular file"):
+        read_bvh("/dev/zero")

@@ -179,3 +179,58 @@ def test_bad_files_give_clear_errors(mocap_dir: Path, tmp_path: Path) -> None:
         gltf_clip(read_gltf(mocap_dir / "Fox.glb"), "Dance")
     with pytest.raises(ValueError, match=".fbx"):
         write_gltf(tmp_path / "x.fbx", _walk_cycle(mocap_dir))
+
+
+def _doc(tmp_path: Path) -> tuple[Path, dict]:  # type: ignore[type-arg]
+    sk = humanoid_skeleton()
+    clip = Clip("still", sk, 30.0, np.zeros((4, 3)), quat.identity(4, sk.num_joints))
+    path = write_gltf(tmp_path / "c.gltf", clip)
+    return path, json.loads(path.read_text())
+
+
+@pytest.mark.parametrize("edit,says", [
+    (lambda d: d["nodes"][0].update(children=[0]), "cycle"),  # looped forever in gltf_clip
+    (lambda d: d["nodes"][1].update(children=[*d["nodes"][1].get("children", []), 0]), "cycle|shared"),
+    (lambda d: d["accessors"][0].update(count=10**10), "count"),
+    (lambda d: d["accessors"][0].update(count="many"), "count"),
+    (lambda d: d["nodes"][0].update(translation=[float("nan"), 0, 0]), "finite"),
+    (lambda d: d.update(nodes="abc"), "malformed"),
+    (lambda d: d["animations"][0].update(channels=[{"sampler": 0, "target": "node"}]), "malformed"),
+    (lambda d: d["animations"][0].setdefault("extras", {}).update(fps=1e12), "fps"),
+    (lambda d: d["animations"][0].setdefault("extras", {}).update(fps=float("nan")), "fps"),
+])
+def test_hostile_documents_are_gltf_errors(tmp_path: Path, edit, says) -> None:  # type: ignore[no-untyped-def]
+    path, doc = _doc(tmp_path)
+    edit(doc)
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError, match=says):
+        load_gltf_clips(path)
+
+
+def test_key_times_far_apart_do_not_allocate_frames(tmp_path: Path) -> None:
+    path, doc = _doc(tmp_path)
+    times = np.array([0.0, 9e4], dtype="<f4").tobytes()
+    doc["buffers"].append({"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(times).decode()})
+    doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": 8})
+    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2,
+                             "type": "SCALAR"})
+    sampler = doc["animations"][0]["samplers"][0]
+    n_out = doc["accessors"][sampler["output"]]["count"]
+    doc["accessors"][sampler["output"]]["count"] = 2 if n_out >= 2 else n_out
+    sampler["input"] = len(doc["accessors"]) - 1
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError, match="node-frames"):
+        load_gltf_clips(path)
+
+
+def test_a_signalling_nan_in_a_buffer_is_a_gltf_error(tmp_path: Path) -> None:
+    path, doc = _doc(tmp_path)
+    snan = b"\x01\x00\xa0\x7f" * 2  # float32 signalling NaNs: widening them raised a RuntimeWarning
+    doc["buffers"].append({"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(snan).decode()})
+    doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": 8})
+    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2,
+                             "type": "SCALAR"})
+    doc["animations"][0]["samplers"][0]["input"] = len(doc["accessors"]) - 1
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError, match="NaN"):
+        read_gltf(path)

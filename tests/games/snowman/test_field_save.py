@@ -11,7 +11,7 @@ import pytest
 from engine.components import Transform
 from engine.ragdoll.components import Prop
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked
-from games.snowman.field_save import FieldError, FieldSlot, restore, snapshot
+from games.snowman.field_save import FieldError, FieldSlot, restore, snapshot, start_snapshot
 from games.snowman.rig import SnowmanShape
 from games.snowman.rules import spawn_ball
 from games.snowman.snow import SnowField
@@ -93,7 +93,7 @@ def test_a_damaged_save_changes_nothing() -> None:
         restore(app.world, truncated)
     mistyped = json.loads(json.dumps(before))
     mistyped["snowmen"][0]["bottom"] = "big"
-    with pytest.raises(FieldError, match="mistypes"):
+    with pytest.raises(FieldError, match="snowman bottom"):
         restore(app.world, mistyped)
     app.world.flush()
     _same(snapshot(app.world), before)
@@ -168,3 +168,91 @@ def test_each_command_tells_the_player_on_screen_without_touching_the_hash() -> 
     before = state_hash(app.world)
     app.world.insert_resource(Notice("something else", 0))
     assert state_hash(app.world) == before  # display only: a replay verifies with or without it
+
+
+def _edited(before: dict, edit) -> dict:  # type: ignore[no-untyped-def]
+    snap = json.loads(json.dumps(before))
+    edit(snap)
+    return snap
+
+
+def _zlib_bomb(snap: dict) -> None:
+    import base64
+    import zlib
+
+    snap["snow"]["zlib_f8"] = base64.b64encode(zlib.compress(bytes(64 << 20), 9)).decode()
+
+
+@pytest.mark.parametrize("edit,says", [
+    (lambda s: s["snowmen"][0].pop("heading"), "snowman heading"),  # used to raise after the field was cleared
+    (lambda s: s["snowmen"][0].update(heading=float("nan")), "snowman heading"),
+    (lambda s: s["puppets"][0].update(heading=float("inf")), "puppet heading"),
+    (lambda s: s["balls"][0].pop("snow"), "ball snow"),
+    (lambda s: s["balls"][0].update(position=[1e308, 0.0, 0.0]), "within"),
+    (lambda s: s["balls"][0].update(on=0), "ring"),
+    (lambda s: s["balls"].extend([dict(s["balls"][0], on=None)] * 1000), "at most"),
+    (lambda s: s["snowmen"][0].update(number=True), "number"),
+    (lambda s: s.update(stats=[]), "stats"),
+    (_zlib_bomb, "snow grid"),
+])
+def test_a_bad_field_is_refused_whole_before_anything_changes(edit, says) -> None:  # type: ignore[no-untyped-def]
+    app = _built_field()
+    before = snapshot(app.world)
+    with pytest.raises(FieldError, match=says):
+        restore(app.world, _edited(before, edit))
+    app.world.flush()
+    _same(snapshot(app.world), before)
+    app.run_steps(2)
+
+
+def test_a_deeply_nested_save_file_is_set_aside(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    field_file.write_text("[" * 100_000 + "]" * 100_000)
+    app = _live_app(InputHub())
+    assert app.world.resource(FieldSlot).saved is None and not field_file.exists()
+    assert "nested too deeply" in capsys.readouterr().err
+    app.run_steps(2)
+
+
+def test_a_bad_file_that_cannot_be_set_aside_is_reported_and_the_game_starts(
+        field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    snap = _edited(start_snapshot(), lambda s: s["puppets"][0].update(heading=float("nan")))
+    field_file.write_text(json.dumps(snap))
+    blocker = Path(str(field_file) + ".bad")
+    blocker.mkdir()
+    (blocker / "keep").write_text("x")  # a non-empty folder where the .bad file would go
+    app = _live_app(InputHub())
+    assert app.world.resource(FieldSlot).saved is None
+    assert "cannot set it aside" in capsys.readouterr().err
+    app.run_steps(3)
+
+
+def test_a_replay_whose_header_carries_a_bad_field_plays_on(tmp_path: Path) -> None:
+    bad = _edited(start_snapshot(), lambda s: s["puppets"][0].update(heading=float("nan")))
+    hub = InputHub()
+    app = make_app("snowman", 3, hub)
+    rec_path = tmp_path / "s.rec"
+    recorder = Recorder(rec_path, RecordingHeader(game="snowman", seed=3, dt=app.world.dt,
+                                                  setup={"field": bad})).attach(app)
+    hub.command(RESTORE)
+    app.run_steps(5)
+    recorder.close()
+    rec = read_recording(rec_path)
+    replayed = load_game("snowman").replay_setup(rec.header.setup)
+    assert replayed["field"] is None
+    result = verify(lambda h: make_app("snowman", 3, h, replayed), rec)
+    assert result.matched == 5
+
+
+def test_stale_temporaries_of_killed_saves_are_removed_at_the_next_save(tmp_path: Path, field_file: Path) -> None:
+    import os
+
+    stale = tmp_path / ".field.json.k1ll3d.tmp"
+    stale.write_text("half a save")
+    os.utime(stale, (1.0, 1.0))
+    fresh = tmp_path / ".field.json.wr1t1ng.tmp"  # a save in progress elsewhere: left alone
+    fresh.write_text("")
+    hub = InputHub()
+    app = _live_app(hub)
+    hub.command(SAVE)
+    app.run_steps(2)
+    assert field_file.exists() and not stale.exists() and fresh.exists()
