@@ -43,7 +43,7 @@ import numpy as np
 
 from engine.ecs import World
 
-__all__ = ["state_hash", "state_parts", "part_digests", "feed", "PART_DIGEST_SIZE"]
+__all__ = ["state_hash", "state_parts", "part_digests", "combine_parts", "feed", "PART_DIGEST_SIZE"]
 
 #: Bytes of each part's digest (recordings store these per step).
 PART_DIGEST_SIZE = 2
@@ -234,7 +234,8 @@ def state_parts(world: World) -> list[tuple[str, Any]]:
     return parts
 
 
-def _combine(parts: list[tuple[str, Any]]) -> tuple[str, dict[str, bytes]]:
+def combine_parts(parts: list[tuple[str, Any]]) -> tuple[str, dict[str, bytes]]:
+    """The state hash of named parts (finished BLAKE2b objects) and their short digests."""
     total = hashlib.blake2b(digest_size=16)
     digests = {}
     for name, h in parts:
@@ -246,9 +247,9 @@ def _combine(parts: list[tuple[str, Any]]) -> tuple[str, dict[str, bytes]]:
 
 def state_hash(world: World) -> str:
     """Hex digest (BLAKE2b, 16 bytes) of the world's simulation state."""
-    return _combine(state_parts(world))[0]
+    return combine_parts(state_parts(world))[0]
 
 
 def part_digests(world: World) -> tuple[str, dict[str, bytes]]:
     """The state hash and a short digest per part, computed once (what a recorder stores)."""
-    return _combine(state_parts(world))
+    return combine_parts(state_parts(world))

@@ -5,26 +5,40 @@ picked up) or the name of a default clip (``walk``, ``run``, …). Ctrl+S saves 
 to ``--output`` (default: beside the input, ``<name>_edited.ppclip``); ``--export`` writes
 BVH/glTF/ppclip copies at the end. ``--headless --frames N --screenshot PNG`` runs the
 scene without a window (CI, screenshots). Wired as ``configure_edit``/``run_edit`` so the
-``author`` command can host it beside ``author record``.
+``author`` command can host it beside ``author record``. ``--record FILE`` records the
+session (its pointer and keys as tool operations, the clip and viewport state each step);
+``puppetphone replay FILE`` reopens the same clip from the recording and repeats the edits.
 """
 
 from __future__ import annotations
 
 import argparse
+import base64
+import hashlib
+import json
 import sys
+import tempfile
 from pathlib import Path
 
-__all__ = ["configure_edit", "run_edit"]
+import numpy as np
+
+__all__ = ["configure_edit", "run_edit", "build_edit", "replay_edit", "edit_digest", "EditActivity", "EDIT_GAME"]
+
+#: The name an edit session's recording gives as its game.
+EDIT_GAME = "author-edit"
 
 
 def configure_edit(parser: argparse.ArgumentParser) -> None:
     """Add the ``author edit`` arguments."""
+    from puppetphone.argtypes import output_file
     from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("clip", help="a .ppclip cycle, or a default clip name (walk, run, crouch_walk, idle…)")
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
+    parser.add_argument("--record", type=output_file, default=None,
+                        help="record the session (pointer, keys, every step's state) to replay it later")
     add_run_arguments(parser)
 
 
@@ -44,101 +58,230 @@ def _open(spec: str):  # type: ignore[no-untyped-def]
     return EditSession(clips[spec]), Path(f"{spec}_edited.ppclip")
 
 
+def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
+    """What a recording needs to reopen the same session: the clip's bytes (and side file), not its path."""
+    from authoring.mocurves.storage import side_path
+
+    path = Path(spec)
+    setup: dict[str, object] = {"clip": spec, "size": list(size)}
+    if path.suffix.lower() == ".ppclip":
+        setup["name"] = path.name
+        setup["ppclip"] = base64.b64encode(path.read_bytes()).decode()
+        side = side_path(path)
+        setup["side"] = base64.b64encode(side.read_bytes()).decode() if side.exists() else ""
+    return setup
+
+
+def _reopen(setup: dict[str, object]):  # type: ignore[no-untyped-def]
+    """The recorded session's clip, from the recording alone."""
+    from authoring.mocurves import load_session
+    from authoring.mocurves.storage import side_path
+
+    if not setup.get("ppclip"):
+        return _open(str(setup["clip"]))[0]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / Path(str(setup.get("name", "clip.ppclip"))).name
+        path.write_bytes(base64.b64decode(str(setup["ppclip"])))
+        if setup.get("side"):
+            side_path(path).write_bytes(base64.b64decode(str(setup["side"])))
+        return load_session(path)
+
+
+def edit_digest(edit) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+    """The edit scene's state in parts: the clip, the scale tracks, the viewport."""
+    from engine.hashing import combine_parts
+
+    clip = edit.session.clip
+    parts = []
+    for name, arrays in (("clip", (clip.root, clip.rotations)), ("scales", (edit.session.scales,))):
+        h = hashlib.blake2b(name.encode(), digest_size=16)
+        for a in arrays:
+            h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+        parts.append((name, h))
+    cam = edit.camera
+    h = hashlib.blake2b(b"scene", digest_size=16)
+    h.update(np.array([edit.time, cam.yaw, cam.pitch, cam.distance, *np.asarray(cam.target, dtype=np.float64),
+                       edit.session.tau, edit.session.sigma, edit.focus, *edit.size], dtype=np.float64).tobytes())
+    h.update(f"{edit.item}|{edit.layer}|{edit.mode}|{edit.playing}|{edit.session.revision}".encode())
+    parts.append(("scene", h))
+    return combine_parts(parts)
+
+
 class EditActivity:
-    """The MoCurves scene as the runner's activity: the loop plays at the fixed 60 Hz step."""
+    """The MoCurves scene as the runner's activity: the loop plays at the fixed 60 Hz step.
+
+    The pointer, wheel and keys reach the scene as tool operations through the input hub
+    (queued by :meth:`on_event`, applied at the next step), so a session records like a
+    game and replays to the same clip: ``--record FILE``, ``puppetphone replay FILE``.
+    A replay saves nothing; Ctrl+S there only checks that the state matches.
+    """
 
     dt = 1.0 / 60.0
 
-    def __init__(self, edit, session, output: Path) -> None:  # type: ignore[no-untyped-def]
-        self.edit, self.session, self.output = edit, session, output
+    def __init__(self, edit, session, output: Path | None, hub, *, recorder=None, check=None) -> None:  # type: ignore[no-untyped-def]
+        self.edit, self.session, self.output, self.hub = edit, session, output, hub
+        self.recorder, self.check = recorder, check
         self.camera = edit.camera
-        self._orbiting = [False]
+        self.frame = 0
+        self._orbiting = False
+        self._pending: list[object] | None = None  # the latest pointer move or summed orbit of this step
 
     def finished(self) -> bool:
-        return False
+        if self.check is not None and not self.check.ok:
+            return True
+        return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
 
-    def step(self) -> None:
-        self.edit.step(self.dt)
+    def _queue(self, op: list[object]) -> None:
+        """Queue a tool operation; pointer moves and orbits are merged to one per step."""
+        if op[0] in ("move", "orbit"):
+            if op[0] == "orbit" and self._pending is not None and self._pending[0] == "orbit":
+                op = ["orbit", self._pending[1] + op[1], self._pending[2] + op[2]]  # type: ignore[operator]
+            elif self._pending is not None and self._pending[0] != op[0]:
+                self._flush()
+            self._pending = op
+            return
+        self._flush()
+        self.hub.tool(json.dumps(op, separators=(",", ":")))
 
-    def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
-        self.edit.size = size
-        self.edit.draw(scene)
+    def _flush(self) -> None:
+        if self._pending is not None:
+            self.hub.tool(json.dumps(self._pending, separators=(",", ":")))
+            self._pending = None
 
     def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
-        return _handle(ev, self.edit, self.session, self.output, self._orbiting)
+        """Translate one pygame event into a tool operation (Esc and P stay the runner's)."""
+        import pygame
+
+        try:
+            mods = ev.mod if ev.type == pygame.KEYDOWN else pygame.key.get_mods()
+        except pygame.error:  # no display initialised (a scripted session): no modifier held
+            mods = 0
+        shift = bool(mods & pygame.KMOD_SHIFT)
+        if ev.type == pygame.MOUSEBUTTONDOWN and ev.button in (1, 3):
+            self._queue(["press", ev.pos[0], ev.pos[1], shift or ev.button == 3])
+        elif ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 2:
+            self._orbiting = True
+        elif ev.type == pygame.MOUSEBUTTONUP and ev.button in (1, 3):
+            self._queue(["release", ev.pos[0], ev.pos[1]])
+        elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 2:
+            self._orbiting = False
+        elif ev.type == pygame.MOUSEMOTION:
+            self._queue(["orbit", ev.rel[0], ev.rel[1]] if self._orbiting else ["move", ev.pos[0], ev.pos[1]])
+        elif ev.type == pygame.MOUSEWHEEL:
+            self._queue(["zoom", 0.9 if ev.y > 0 else 1.1])
+        elif ev.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED) and runner is not None:
+            self._queue(["size", *runner.size])
+        elif ev.type == pygame.KEYDOWN and ev.key not in (pygame.K_ESCAPE, pygame.K_p):
+            self._queue(["key", pygame.key.name(ev.key), bool(mods & pygame.KMOD_CTRL), shift])
+        else:
+            return False
+        return True
+
+    def _apply(self, op: list) -> None:  # type: ignore[type-arg]
+        from authoring.mocurves import save_session
+
+        edit, kind = self.edit, op[0]
+        if kind == "press":
+            edit.press(op[1], op[2], shift=bool(op[3]))
+        elif kind == "move":
+            edit.move(op[1], op[2])
+        elif kind == "release":
+            edit.release(op[1], op[2])
+        elif kind == "orbit":
+            edit.camera.orbit(-op[1] * 0.01, op[2] * 0.01)
+        elif kind == "zoom":
+            edit.camera.zoom(float(op[1]))
+        elif kind == "size":
+            edit.size = (int(op[1]), int(op[2]))
+        elif kind == "key" and op[2] and op[1] == "s":
+            if self.output is not None:
+                save_session(self.session, self.output)
+                edit.message = f"saved {self.output}"
+        elif kind == "key":
+            edit.key(op[1], ctrl=bool(op[2]), shift=bool(op[3]))
+
+    def step(self) -> None:
+        from input.sample import TOOL
+
+        self._flush()
+        frame = self.hub.drain(self.frame)
+        for kind, text in frame.events:
+            if kind == TOOL:
+                self._apply(json.loads(text))
+        self.edit.step(self.dt)
+        digest, parts = edit_digest(self.edit)
+        if self.recorder is not None:
+            self.recorder.write(frame, digest, parts)
+        if self.check is not None:
+            self.check.check(self.frame, digest, parts)
+        self.frame += 1
+
+    def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
+        self.edit.draw(scene)
+
+
+def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record: Path | None = None):  # type: ignore[no-untyped-def]
+    """A live edit session of ``spec`` (optionally recorded)."""
+    from authoring.edit_scene import EditScene
+    from input.hub import InputHub
+    from input.recording import Recorder, RecordingHeader
+
+    session, default_out = _open(spec)
+    recorder = None
+    if record is not None:
+        recorder = Recorder(record, RecordingHeader(game=EDIT_GAME, seed=0, dt=EditActivity.dt, sources=["mouse"],
+                                                    setup=_setup(spec, size)))
+    return EditActivity(EditScene(session, size), session, output or default_out, InputHub(), recorder=recorder)
+
+
+def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
+    """The recorded edit session, rebuilt from the recording alone, checking every step."""
+    from authoring.edit_scene import EditScene
+    from input.hub import InputHub
+    from input.replay import HashCheck, ReplaySource
+
+    setup = recording.header.setup
+    session = _reopen(setup)
+    edit = EditScene(session, tuple(setup.get("size", (1280, 720))))
+    return EditActivity(edit, session, None, InputHub(replay=ReplaySource(recording)),
+                        check=HashCheck(recording) if verify else None)
 
 
 def run_edit(args: argparse.Namespace) -> int:
     """Open the clip, run the scene until the window closes (or ``--frames``), save/export."""
-    from authoring.edit_scene import EditScene
     from authoring.mocurves import export_clip
+    from authoring.mocurves.storage import EXPORT_SUFFIXES
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
     from puppetphone.runargs import run_options
-
-    from authoring.mocurves.storage import EXPORT_SUFFIXES
 
     for path in args.export:
         if path.suffix.lower() not in EXPORT_SUFFIXES:
             print(f"error: cannot export {path}: use one of {', '.join(EXPORT_SUFFIXES)}", file=sys.stderr)
             return 2
-    try:
-        session, default_out = _open(args.clip)
-    except (ValueError, OSError) as exc:
-        print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)
-        return 2
-    output = args.output or default_out
     runner = Runner(run_options(args, "PuppetPhone — MoCurves"))
     try:
         runner.open()
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    activity = EditActivity(EditScene(session, runner.size), session, output)
+    try:
+        activity = build_edit(args.clip, runner.size, args.output, record=args.record)
+    except (ValueError, OSError) as exc:
+        runner.close()
+        print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)
+        return 2
     runner.push_handlers(activity)
     try:
         result = runner.run(activity)
         if result.screenshot is not None:
             print(f"screenshot: {result.screenshot}")
         for path in args.export:
-            export_clip(session.clip, path)
+            export_clip(activity.session.clip, path)
             print(f"exported {path}")
     finally:
         runner.close()
+        if activity.recorder is not None:
+            activity.recorder.close()
+            print(f"recorded {activity.recorder.frames} steps to {activity.recorder.path}", file=sys.stderr)
     return 0
-
-
-def _handle(ev, edit, session, output: Path, orbiting: list[bool]) -> bool:  # type: ignore[no-untyped-def]
-    """Translate one pygame event into scene calls; ``orbiting[0]`` tracks a middle-drag orbit."""
-    import pygame
-
-    from authoring.mocurves import save_session
-
-    mods = pygame.key.get_mods()
-    shift = bool(mods & pygame.KMOD_SHIFT)
-    if ev.type == pygame.MOUSEBUTTONDOWN and ev.button in (1, 3):
-        edit.press(*ev.pos, shift=shift or ev.button == 3)
-    elif ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 2:
-        orbiting[0] = True
-    elif ev.type == pygame.MOUSEBUTTONUP and ev.button in (1, 3):
-        edit.release(*ev.pos)
-    elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 2:
-        orbiting[0] = False
-    elif ev.type == pygame.MOUSEMOTION:
-        if orbiting[0]:
-            edit.camera.orbit(-ev.rel[0] * 0.01, ev.rel[1] * 0.01)
-        else:
-            edit.move(*ev.pos)
-    elif ev.type == pygame.MOUSEWHEEL:
-        edit.camera.zoom(0.9 if ev.y > 0 else 1.1)
-    elif ev.type == pygame.KEYDOWN:
-        name = pygame.key.name(ev.key)
-        ctrl = bool(mods & pygame.KMOD_CTRL)
-        if ctrl and name == "s":
-            save_session(session, output)
-            edit.message = f"saved {output}"
-        else:
-            edit.key(name, ctrl=ctrl, shift=shift)
-    else:
-        return False
-    return True

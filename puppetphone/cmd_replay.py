@@ -40,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from input.recording import RecordingError, read_recording
     from input.replay import ReplaySource
     from input.hub import InputHub
+    from puppetphone.cmd_author_edit import EDIT_GAME
     from puppetphone.cmd_play import run_activity
     from puppetphone.games import load_game
     from puppetphone.runargs import run_options
@@ -59,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
         level = "warning" if cut_short and args.allow_truncated else "error"
         print(f"{level}: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)
     h = rec.header
+    if h.game == EDIT_GAME:
+        return _replay_edit(rec, args, cut_short)
     try:
         game = load_game(h.game)
         activity = build_activity(h.game, h.seed, InputHub(replay=ReplaySource(rec)), setup=game.replay_setup(h.setup),
@@ -72,9 +75,36 @@ def run(args: argparse.Namespace) -> int:
     code, result = run_activity(activity, run_options(args, f"PuppetPhone — replay of {args.file}"))
     if code:
         return code
-    check = activity.check
-    assert check is not None and result is not None
-    steps = result.steps  # type: ignore[attr-defined]
+    return _verdict(activity.check, result.steps, rec, args, cut_short)  # type: ignore[attr-defined]
+
+
+def _replay_edit(rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
+    """An ``author edit`` session: the same clip reopened from the recording, the same edits."""
+    from engine.render.window import NoDisplayError
+    from engine.runner import Runner
+    from puppetphone.cmd_author_edit import replay_edit
+    from puppetphone.runargs import run_options
+
+    try:
+        activity = replay_edit(rec)
+    except (ValueError, KeyError, OSError) as exc:
+        print(f"error: cannot reopen the recorded edit session: {exc}", file=sys.stderr)
+        return 2
+    runner = Runner(run_options(args, f"PuppetPhone — replay of {args.file}"))
+    try:
+        result = runner.run(activity)
+    except NoDisplayError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        runner.close()
+    if result.screenshot is not None:
+        print(f"screenshot: {result.screenshot}")
+    return _verdict(activity.check, result.steps, rec, args, cut_short)
+
+
+def _verdict(check, steps: int, rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
+    """Print how the replay went; the exit code."""
     if not check.ok:
         print(check.message())
         return 1

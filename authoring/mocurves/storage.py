@@ -31,7 +31,7 @@ from engine.clipfile import load_clip, save_clip
 from engine.io import clip_to_bvh, write_bvh, write_gltf
 from engine.npz_safe import read_bounded
 
-__all__ = ["save_session", "load_session", "export_clip", "bake_root_motion", "SessionFileError", "EXPORT_SUFFIXES"]
+__all__ = ["save_session", "load_session", "side_path", "export_clip", "bake_root_motion", "SessionFileError", "EXPORT_SUFFIXES"]
 
 SIDE_FORMAT = "puppetphone-mocurves"
 SIDE_VERSION = 1
@@ -45,7 +45,8 @@ class SessionFileError(ValueError):
     """A session side file that is unreadable, of a newer version, or not of this clip."""
 
 
-def _side_path(path: Path) -> Path:
+def side_path(path: Path) -> Path:
+    """The MoCurves side file that goes with a ``.ppclip``."""
     return path.with_name(path.name.removesuffix(path.suffix) + ".mocurves.json")
 
 
@@ -73,7 +74,7 @@ def save_session(session: EditSession, path: str | Path) -> Path:
     }
     # Side file first: a crash between the two leaves the old clip with a side file that
     # no longer matches it, which load refuses loudly, never a silently wrong pairing.
-    atomic_write_bytes(_side_path(p), json.dumps(side).encode())
+    atomic_write_bytes(side_path(p), json.dumps(side).encode())
     return save_clip(st.clip, p)
 
 
@@ -83,19 +84,19 @@ def load_session(path: str | Path) -> EditSession:
     clip = load_clip(p)
     if not clip.loop:
         raise ValueError(f"{p}: clip {clip.name!r} is not a loop; MoCurves edit cycles")
-    side_path = _side_path(p)
-    if not side_path.exists():
+    side_file = side_path(p)
+    if not side_file.exists():
         return EditSession(clip)
     try:
-        side = json.loads(read_bounded(side_path, MAX_SIDE_FILE).decode("utf-8"))
+        side = json.loads(read_bounded(side_file, MAX_SIDE_FILE).decode("utf-8"))
     except (OSError, ValueError, RecursionError) as exc:
-        raise SessionFileError(f"{side_path}: unreadable session file ({type(exc).__name__}: {exc})"[:300]) from None
+        raise SessionFileError(f"{side_file}: unreadable session file ({type(exc).__name__}: {exc})"[:300]) from None
     try:
         scales, tau, sigma, pins = _side_values(side, clip)
     except SessionFileError as exc:
-        raise SessionFileError(f"{side_path}: {exc}") from None
+        raise SessionFileError(f"{side_file}: {exc}") from None
     if side.get("clip_sha256") != _clip_digest(clip):
-        raise SessionFileError(f"{side_path}: belongs to another version of {p.name}; move it away to open the clip alone")
+        raise SessionFileError(f"{side_file}: belongs to another version of {p.name}; move it away to open the clip alone")
     return EditSession(clip, scales, tau=tau, sigma=sigma, pins=pins)
 
 

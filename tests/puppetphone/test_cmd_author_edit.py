@@ -34,3 +34,68 @@ def test_headless_run_screenshots_and_exports(tmp_path):
 def test_unknown_clip_is_a_clear_error(capsys):
     assert run_edit(parse("no_such_clip", "--headless", "--frames", "1")) == 2
     assert "neither a .ppclip file nor a default clip" in capsys.readouterr().err
+
+
+def test_an_edit_session_records_and_replays_to_the_same_saved_clip(tmp_path):
+    """A drag on a keypoint's arrow and Ctrl+S, recorded; the replay repeats the edit bit for bit."""
+    import os
+    import subprocess
+    import sys
+
+    import numpy as np
+    import pygame
+
+    from authoring.mocurves import save_session
+    from engine.runner import RunOptions, Runner
+    from input.recording import read_recording
+    from puppetphone.cmd_author_edit import build_edit, replay_edit
+
+    out, rec = tmp_path / "walk_edited.ppclip", tmp_path / "edit.rec"
+    act = build_edit("walk", (640, 360), out, record=rec)
+    before = act.session.clip.rotations.copy()
+
+    def send(kind, **fields):
+        assert act.on_event(pygame.event.Event(kind, **fields), None)
+
+    def steps(n=1):
+        for _ in range(n):
+            act.step()
+
+    steps(3)
+    send(pygame.KEYDOWN, key=pygame.K_2, mod=0)  # arrows mode: drag rotates the item around the view axis
+    send(pygame.KEYDOWN, key=pygame.K_SPACE, mod=0)  # pause the loop so the keypoint stays put
+    steps(2)
+    edit = act.edit
+    screen = edit.camera.project(edit.session.curves()[edit.item].positions, *edit.size)
+    k = int(np.nanargmin(np.linalg.norm(screen - np.array([320.0, 180.0]), axis=1)))
+    x, y = (int(round(v)) for v in screen[k])
+    send(pygame.MOUSEBUTTONDOWN, button=1, pos=(x, y))
+    steps()
+    for dx in range(8, 48, 8):
+        send(pygame.MOUSEMOTION, pos=(x + dx, y), rel=(8, 0), buttons=(1, 0, 0))
+        steps()
+    send(pygame.MOUSEBUTTONUP, button=1, pos=(x + 48, y))
+    steps(2)
+    send(pygame.KEYDOWN, key=pygame.K_s, mod=pygame.KMOD_CTRL)
+    steps(3)
+    act.recorder.close()
+    assert out.exists() and not np.allclose(read_clip_rotations(out), before), "the drag edited nothing"
+
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
+    done = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless"],
+                          capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"replayed {act.frame} frames, all {act.frame} state hashes match" in done.stdout
+
+    replayed = replay_edit(read_recording(rec))
+    runner = Runner(RunOptions(headless=True))
+    runner.run(replayed)
+    again = tmp_path / "again.ppclip"
+    save_session(replayed.session, again)
+    assert again.read_bytes() == out.read_bytes()
+
+
+def read_clip_rotations(path):
+    from engine.clipfile import load_clip
+
+    return load_clip(path).rotations
