@@ -111,6 +111,16 @@ class RecordScene:
         self._value: F | None = None
         self._performed: F = np.zeros((0, 4))
 
+    @property
+    def take(self) -> _Take | None:
+        """The take being recorded (``None`` outside one)."""
+        return self._take
+
+    @property
+    def value(self) -> F | None:
+        """The performer's value fed this step (``None``: at rest)."""
+        return self._value
+
     # -- the performance ---------------------------------------------------------------
     def rest_value(self) -> F:
         """The driven channel at the current playback time (what the take starts from)."""

@@ -24,11 +24,12 @@ import argparse
 import sys
 from pathlib import Path
 
-__all__ = ["configure", "run"]
+__all__ = ["configure", "run", "RecordActivity", "replay_record", "record_digest", "RECORD_GAME"]
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add ``record`` and ``edit`` sub-commands."""
+    from puppetphone.argtypes import output_file
     from puppetphone.runargs import add_run_arguments
 
     sub = parser.add_subparsers(dest="scene", metavar="SCENE")
@@ -44,6 +45,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     rec.add_argument("--script", choices=("loops",), default=None, help="a scripted performer instead of a hand")
     add_run_arguments(rec)
     rec.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points")
+    rec.add_argument("--record", type=output_file, default=None,
+                     help="record the take (pointer, keys or device, every step's state) to replay it later")
     from input.factory import add_source_arguments
 
     add_source_arguments(rec)
@@ -88,104 +91,242 @@ def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre,
     return quat.mul(rest, q)
 
 
+RECORD_GAME = "author-record"
+
+
+def record_digest(scene) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+    """The record scene's state in parts: the stacked clip, the candidate loop, the take, the rest."""
+    import hashlib
+
+    import numpy as np
+
+    from engine.hashing import combine_parts, feed
+
+    parts = []
+    for name, clip in (("clip", scene.clip), ("candidate", scene.candidate)):
+        h = hashlib.blake2b(name.encode(), digest_size=16)
+        if clip is not None:
+            h.update(np.ascontiguousarray(clip.root).tobytes() + np.ascontiguousarray(clip.rotations).tobytes())
+        parts.append((name, h))
+    h = hashlib.blake2b(b"take", digest_size=16)
+    take = scene.take
+    if take is not None and take.values:
+        h.update(np.asarray(take.times, dtype=np.float64).tobytes() + np.asarray(take.values, dtype=np.float64).tobytes())
+    parts.append(("take", h))
+    h = hashlib.blake2b(b"scene", digest_size=16)
+    feed(h, [scene.phase, scene.time, scene.timer, scene.rng.bit_generator.state,
+             None if scene.value is None else np.asarray(scene.value, dtype=np.float64)])
+    cam = scene.camera
+    h.update(np.array([cam.yaw, cam.pitch, cam.distance], dtype=np.float64).tobytes())
+    parts.append(("scene", h))
+    return combine_parts(parts)
+
+
 class RecordActivity:
     """The record scene as the runner's activity: one step feeds the performer's value.
 
     The performer is the scripted loops, a device (its orientation relative to where it
     pointed when the take began) or the mouse (a drag from the press point); the runner
     calls :meth:`step` at the fixed 60 Hz whatever the frame rate, so the countdown and
-    the performer's tempo are real time.
+    the performer's tempo are real time. The pointer and keys reach the scene as tool
+    operations through the hub (the pointer sampled once a step while pressed), so a take
+    records (``--record FILE``) and replays (``puppetphone replay FILE``) like a game.
     """
 
     dt = 1.0 / 60.0
 
-    def __init__(self, scene, args: argparse.Namespace, hub) -> None:  # type: ignore[no-untyped-def]
-        self.scene, self.args, self.hub = scene, args, hub
+    def __init__(self, scene, hub, *, script: str | None = None, output: Path | None = None, size=(1280, 720),
+                 recorder=None, check=None) -> None:  # type: ignore[no-untyped-def]
+        self.scene, self.hub, self.script, self.output = scene, hub, script, output
+        self.recorder, self.check = recorder, check
         self.camera = scene.camera
+        self.size = tuple(size)
         self.frame, self.previewing = 0, 0
-        self.press: tuple[int, int, object] | None = None
+        self.pressed = False
+        self.press: tuple[float, float, object] | None = None
         self.phase_acc = [0.0]
         self.reference = None
         self.rest = scene.rest_value()
-        self.size = args.size
-        if args.script:
+        if script:
             scene.start()
 
     def finished(self) -> bool:
-        return False
+        if self.check is not None and not self.check.ok:
+            return True
+        return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
 
-    def _value(self):  # type: ignore[no-untyped-def]
+    def _tool(self, *op: object) -> None:
+        import json
+
+        self.hub.tool(json.dumps(list(op), separators=(",", ":")))
+
+    def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
+        """Pointer, wheel and keys become tool operations (Esc and P stay the runner's)."""
+        import pygame
+
+        if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 1:
+            self.pressed = True
+            self._tool("press", ev.pos[0], ev.pos[1])
+        elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 1:
+            self.pressed = False
+            self._tool("release")
+        elif ev.type == pygame.MOUSEMOTION and ev.buttons[2]:
+            self._tool("orbit", ev.rel[0], ev.rel[1])
+        elif ev.type == pygame.MOUSEWHEEL:
+            self._tool("zoom", 0.9 if ev.y > 0 else 1.1)
+        elif ev.type == pygame.KEYDOWN and ev.key not in (pygame.K_ESCAPE, pygame.K_p):
+            self._tool("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL))
+        else:
+            return False
+        return True
+
+    def _save(self, message: str) -> None:
+        from engine.clipfile import save_clip
+
+        if self.output is not None and self.scene.clip is not None:
+            save_clip(self.scene.clip, self.output)
+            self.scene.message = message.format(output=self.output)
+
+    def _apply(self, op: list) -> object:  # type: ignore[type-arg]
+        """One tool operation; returns a pointer position when the operation is one."""
+        scene, kind = self.scene, op[0]
+        if kind == "press":
+            self.press, self.rest = (float(op[1]), float(op[2]), scene.item_position()), scene.rest_value()
+        elif kind == "release":
+            self.press = None
+        elif kind == "pointer":
+            return float(op[1]), float(op[2])
+        elif kind == "orbit":
+            scene.camera.orbit(-op[1] * 0.01, op[2] * 0.01)
+        elif kind == "zoom":
+            scene.camera.zoom(float(op[1]))
+        elif kind == "key" and op[2] and op[1] == "s":
+            self._save("saved {output}")
+        elif kind == "key" and op[1] in ("return", "enter"):
+            if scene.accept() is not None:
+                self._save("layer accepted and saved to {output}; R records another")
+        elif kind == "key":
+            scene.key(op[1])
+        return None
+
+    def _value(self, frame, pointer):  # type: ignore[no-untyped-def]
         from authoring.record_scene import drag_rotation, mouse_point
         from engine import quat
 
-        scene, fps = self.scene, 1.0 / self.dt
-        if self.args.script:
-            return _scripted(self.frame, fps, self.phase_acc, self.args.drive, scene.item_position(), self.rest)
-        if self.hub is not None:
-            sample = self.hub.drain(self.frame).latest()
-            if sample is None or scene.drive != "rotation":
+        scene = self.scene
+        if self.script:
+            return _scripted(self.frame, 1.0 / self.dt, self.phase_acc, scene.drive, scene.item_position(), self.rest)
+        sample = frame.latest()
+        if sample is not None and sample.source != "mouse":
+            if scene.drive != "rotation":
                 return None
             if scene.phase != "recording" or self.reference is None:
                 self.reference, self.rest = sample.orientation, scene.rest_value()
             return quat.mul(quat.mul(sample.orientation, quat.conjugate(self.reference)), self.rest)
-        if self.press is None:
+        if self.press is None or pointer is None:
             return None
-        import pygame
-
-        px, py = pygame.mouse.get_pos()
+        px, py = pointer
         if scene.drive == "rotation":
             return quat.mul(self.rest, drag_rotation(px - self.press[0], py - self.press[1], self.size[1]))
         return mouse_point(scene.camera, px, py, self.size, self.press[2])
 
     def step(self) -> None:
-        from engine.clipfile import save_clip
+        from input.sample import TOOL
 
+        if self.pressed and self.hub.replay is None:
+            import pygame
+
+            self._tool("pointer", *pygame.mouse.get_pos())
+        frame = self.hub.drain(self.frame)
+        pointer = None
+        for kind, text in frame.events:
+            if kind == TOOL:
+                import json
+
+                pointer = self._apply(json.loads(text)) or pointer
         scene = self.scene
-        scene.feed(self._value())
+        scene.feed(self._value(frame, pointer))
         scene.step(self.dt)
         self.previewing = self.previewing + 1 if scene.phase == "preview" else 0
         # The scripted performer looks at the preview for 2 s, then accepts.
-        if self.args.script and self.previewing == int(2 / self.dt) and scene.accept() is not None:
-            save_clip(scene.clip, self.args.output)  # type: ignore[arg-type]
-            print(f"saved {self.args.output}")
+        if self.script and self.previewing == int(2 / self.dt) and scene.accept() is not None:
+            self._save("saved {output}")
+            if self.output is not None:
+                print(f"saved {self.output}")
+        digest, parts = record_digest(scene)
+        if self.recorder is not None:
+            self.recorder.write(frame, digest, parts)
+        if self.check is not None:
+            self.check.check(self.frame, digest, parts)
         self.frame += 1
 
     def draw(self, render, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
-        self.size = size
         self.scene.draw(render)
 
-    def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
-        from engine.clipfile import save_clip
 
-        self.press, self.rest = _mouse(ev, self.scene, self.press, self.rest, self.args.output, save_clip)
-        return False
+def _record_setup(args: argparse.Namespace, size: tuple[int, int]) -> dict[str, object]:
+    """Everything the take depends on, the base clip's bytes included."""
+    import base64
+
+    return {"item": args.item, "drive": args.drive, "countdown": args.countdown, "seconds": args.seconds,
+            "seed": args.seed, "script": args.script, "size": list(size),
+            "base": base64.b64encode(args.base.read_bytes()).decode() if args.base is not None else ""}
 
 
-def _record(args: argparse.Namespace) -> int:
+def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
+    import base64
+
     import numpy as np
 
     from authoring.record_scene import RecordScene
-    from engine.clipfile import ClipFileError, load_clip
+    from engine.clipfile import load_clip
     from engine.humanoid import humanoid_skeleton
+
+    base = None
+    if setup.get("base"):
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "base.ppclip"
+            path.write_bytes(base64.b64decode(str(setup["base"])))
+            base = load_clip(path)
+    skeleton = base.skeleton if base is not None else humanoid_skeleton()
+    return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),  # type: ignore[arg-type]
+                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])))  # type: ignore[arg-type]
+
+
+def replay_record(recording):  # type: ignore[no-untyped-def]
+    """The recorded take, rebuilt from the recording alone, checking every step (saving nothing)."""
+    from input.hub import InputHub
+    from input.replay import HashCheck, ReplaySource
+
+    setup = recording.header.setup
+    return RecordActivity(_record_scene(setup), InputHub(replay=ReplaySource(recording)), script=setup.get("script"),
+                          size=tuple(setup.get("size", (1280, 720))), check=HashCheck(recording))
+
+
+def _record(args: argparse.Namespace) -> int:
+    from engine.clipfile import ClipFileError
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
+    from input.hub import InputHub
+    from input.recording import Recorder, RecordingHeader
     from puppetphone.runargs import run_options
 
+    live = args.source != "mouse" and args.script is None
+    runner = Runner(run_options(args, "PuppetPhone — record a cycle", pace=live and args.headless))
     try:
-        base = load_clip(args.base) if args.base is not None else None
-        skeleton = base.skeleton if base is not None else humanoid_skeleton()
-        scene = RecordScene(skeleton, args.item, args.drive, base, args.countdown, args.seconds, np.random.default_rng(args.seed))
+        setup = _record_setup(args, args.size)
+        scene = _record_scene(setup)
     except (ValueError, OSError, ClipFileError) as exc:
         print(f"author record: {exc}", file=sys.stderr)
         return 2
-    live = args.source != "mouse" and args.script is None
-    runner = Runner(run_options(args, "PuppetPhone — record a cycle", pace=live and args.headless))
     try:
         runner.open()
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    hub = None
+    hub = InputHub()
     if live:
         from input.factory import make_hub
 
@@ -195,7 +336,11 @@ def _record(args: argparse.Namespace) -> int:
             runner.close()
             print(f"author record: cannot open {args.source}: {exc}", file=sys.stderr)
             return 2
-    activity = RecordActivity(scene, args, hub)
+    recorder = None
+    if args.record is not None:
+        recorder = Recorder(args.record, RecordingHeader(game=RECORD_GAME, seed=args.seed, dt=RecordActivity.dt,
+                                                         sources=[args.source], setup=setup))
+    activity = RecordActivity(scene, hub, script=args.script, output=args.output, size=runner.size, recorder=recorder)
     runner.push_handlers(activity)
     try:
         result = runner.run(activity)
@@ -204,31 +349,8 @@ def _record(args: argparse.Namespace) -> int:
         print(scene.message)
     finally:
         runner.close()
-        if hub is not None:
-            hub.close()
+        hub.close()
+        if recorder is not None:
+            recorder.close()
+            print(f"recorded {recorder.frames} steps to {recorder.path}", file=sys.stderr)
     return 0
-
-
-def _mouse(ev, scene, press, rest, output: Path, save_clip):  # type: ignore[no-untyped-def]
-    """One pygame event: press/release the performing drag, keys, right-drag orbit."""
-    import pygame
-
-    if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 1:
-        return (ev.pos[0], ev.pos[1], scene.item_position()), scene.rest_value()
-    if ev.type == pygame.MOUSEBUTTONUP and ev.button == 1:
-        return None, rest
-    if ev.type == pygame.MOUSEMOTION and ev.buttons[2]:
-        scene.camera.orbit(-ev.rel[0] * 0.01, ev.rel[1] * 0.01)
-    elif ev.type == pygame.MOUSEWHEEL:
-        scene.camera.zoom(0.9 if ev.y > 0 else 1.1)
-    elif ev.type == pygame.KEYDOWN:
-        name = pygame.key.name(ev.key)
-        if name == "s" and pygame.key.get_mods() & pygame.KMOD_CTRL and scene.clip is not None:
-            save_clip(scene.clip, output)
-            scene.message = f"saved {output}"
-        elif name in ("return", "enter") and scene.accept() is not None:
-            save_clip(scene.clip, output)
-            scene.message = f"layer accepted and saved to {output}; R records another"
-        else:
-            scene.key(name)
-    return press, rest

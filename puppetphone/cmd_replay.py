@@ -40,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from input.recording import RecordingError, read_recording
     from input.replay import ReplaySource
     from input.hub import InputHub
+    from puppetphone.cmd_author import RECORD_GAME
     from puppetphone.cmd_author_edit import EDIT_GAME
     from puppetphone.cmd_play import run_activity
     from puppetphone.games import load_game
@@ -60,8 +61,8 @@ def run(args: argparse.Namespace) -> int:
         level = "warning" if cut_short and args.allow_truncated else "error"
         print(f"{level}: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)
     h = rec.header
-    if h.game == EDIT_GAME:
-        return _replay_edit(rec, args, cut_short)
+    if h.game in (EDIT_GAME, RECORD_GAME):
+        return _replay_authoring(rec, args, cut_short)
     try:
         game = load_game(h.game)
         activity = build_activity(h.game, h.seed, InputHub(replay=ReplaySource(rec)), setup=game.replay_setup(h.setup),
@@ -78,17 +79,18 @@ def run(args: argparse.Namespace) -> int:
     return _verdict(activity.check, result.steps, rec, args, cut_short)  # type: ignore[attr-defined]
 
 
-def _replay_edit(rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
-    """An ``author edit`` session: the same clip reopened from the recording, the same edits."""
+def _replay_authoring(rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
+    """An ``author edit`` or ``author record`` session: its clip reopened from the recording, the same input."""
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
-    from puppetphone.cmd_author_edit import replay_edit
+    from puppetphone.cmd_author import replay_record
+    from puppetphone.cmd_author_edit import EDIT_GAME, replay_edit
     from puppetphone.runargs import run_options
 
     try:
-        activity = replay_edit(rec)
-    except (ValueError, KeyError, OSError) as exc:
-        print(f"error: cannot reopen the recorded edit session: {exc}", file=sys.stderr)
+        activity = replay_edit(rec) if rec.header.game == EDIT_GAME else replay_record(rec)
+    except (ValueError, KeyError, TypeError, OSError) as exc:
+        print(f"error: cannot reopen the recorded {rec.header.game} session: {exc}", file=sys.stderr)
         return 2
     runner = Runner(run_options(args, f"PuppetPhone — replay of {args.file}"))
     try:
