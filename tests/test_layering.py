@@ -1,6 +1,7 @@
-"""Imports go downwards: puppetphone -> tools -> games, authoring -> input -> engine (DESIGN.md).
+"""Imports go downwards: puppetphone, tools -> games, authoring -> input -> engine (DESIGN.md).
 
-``tools`` (developer tooling) sits beside the launcher: the runtime never imports it.
+``tools`` (developer tooling) sits on top, beside the launcher whose pieces it uses; the runtime
+(engine, input, authoring, games) never imports it.
 """
 
 import ast

@@ -15,26 +15,24 @@ so a re-recorded demo still gives the right pictures):
 from __future__ import annotations
 
 import sys
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from engine.app import App
 from engine.components import Stick, Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
-from engine.render.renderer import Renderer
 from engine.render.scene import RenderScene
-from engine.render.target import RenderTarget, make_target
+from engine.render.target import save_image
+from engine.runner import RunOptions, Runner
 from engine.statemachine import Brain
 from games.snowman.components import Snowman
-from tools import REPO
-from tools.snowman_demo import DEMO_PATH
 from games.snowman.game import GAME
 from input.hub import InputHub
-from input.plugin import input_plugin
 from input.recording import read_recording
 from input.replay import ReplaySource
+from puppetphone.session import GameActivity, build_activity
+from tools import REPO
+from tools.snowman_demo import DEMO_PATH
 
 __all__ = ["STAGES", "take_screenshots"]
 
@@ -77,46 +75,61 @@ STAGES: dict[str, Callable[[World], bool]] = {
 }
 
 
-def _save_jpeg(app: App, target: RenderTarget, renderer: Renderer, path: Path) -> None:
-    """The game's view with its status lines (the counter), as a JPEG."""
-    from PIL import Image
+class _DemoView:
+    """The replayed demo as the runner's activity, drawn as the README shows it: the game's
+    view and its first status line (the counter), without the overlay's help and sources."""
 
-    scene = RenderScene()
-    GAME.draw(app.world, scene, 1.0)
-    for line in GAME.status(app.world)[:1]:
-        scene.add_text(line, color=(0.1, 0.12, 0.18))
-    renderer.render(scene, GAME.camera(), target.begin())
-    target.end()
-    with tempfile.TemporaryDirectory() as tmp:
-        png = target.screenshot(Path(tmp) / "frame.png")
-        Image.open(png).convert("RGB").save(path, quality=82, optimize=True)
-    print(f"{path.name}: frame {app.world.frame}")
+    def __init__(self, activity: GameActivity) -> None:
+        self.activity, self.app = activity, activity.app
+        self.dt, self.camera = activity.dt, GAME.camera()
+
+    def step(self) -> None:
+        self.activity.step()
+
+    def finished(self) -> bool:
+        return self.activity.finished()
+
+    def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
+        GAME.draw(self.app.world, scene, 1.0)
+        for line in GAME.status(self.app.world)[:1]:
+            scene.add_text(line, color=(0.1, 0.12, 0.18))
+
+
+def _save_jpeg(runner: Runner, view: _DemoView, path: Path) -> None:
+    runner.draw(view)
+    save_image(runner.viewer.read_pixels(), path)
+    print(f"{path.name}: frame {view.app.world.frame}")
 
 
 def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> list[Path]:
-    """Replay the demo and write one JPEG per stage plus the last frame; returns the paths."""
+    """Replay the demo through the runner and write one JPEG per stage plus the last frame."""
     out.mkdir(parents=True, exist_ok=True)
     rec = read_recording(DEMO_PATH)
-    app = App(seed=rec.header.seed)
-    app.add_plugin(input_plugin(InputHub(replay=ReplaySource(rec))))
-    app.add_plugin(GAME.install)
-    target = make_target(True, width, height)
-    renderer = Renderer(target.ctx)
+    activity = build_activity("snowman", rec.header.seed, InputHub(replay=ReplaySource(rec)),
+                              setup=GAME.replay_setup(rec.header.setup), verify=rec)
+    view = _DemoView(activity)
+    runner = Runner(RunOptions(headless=True, width=width, height=height))
     seen: dict[str, int] = {}
-    written = []
+    written: list[Path] = []
+
+    def watch(world: World) -> None:
+        for name, test in STAGES.items():
+            if name not in seen and test(world):
+                seen[name] = world.frame
+            if seen.get(name) == world.frame - DELAY:
+                written.append(out / f"snowman_{name}.jpg")
+                _save_jpeg(runner, view, written[-1])
+
+    activity.app.on_step_end.append(watch)
     try:
-        for _ in rec.frames:
-            app.step()
-            for name, test in STAGES.items():
-                if name not in seen and test(app.world):
-                    seen[name] = app.world.frame
-                if seen.get(name) == app.world.frame - DELAY:
-                    written.append(out / f"snowman_{name}.jpg")
-                    _save_jpeg(app, target, renderer, written[-1])
+        runner.run(view)
         written.append(out / "snowman_second.jpg")
-        _save_jpeg(app, target, renderer, written[-1])
+        _save_jpeg(runner, view, written[-1])
     finally:
-        target.close()
+        runner.close()
+    assert activity.check is not None
+    if not activity.check.ok:
+        raise RuntimeError(f"the demo no longer replays: {activity.check.message()}")
     missing = sorted(set(STAGES) - set(seen))
     if missing:
         raise RuntimeError(f"the demo never showed: {', '.join(missing)}")
