@@ -11,6 +11,8 @@ of the lines stacked at the top, and fades out after :data:`games.common.NOTICE_
 
 from __future__ import annotations
 
+from collections import Counter
+
 from dataclasses import dataclass
 
 from engine.components import Name
@@ -23,7 +25,11 @@ from games.base import Game
 from games.common import Notice
 from input.hub import InputHub
 
-__all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "HELP_KEYS", "COLORS"]
+__all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "HELP_KEYS", "COLORS",
+           "MAX_PUPPET_LINES"]
+
+#: Puppets named one per line in the overlay; the others are summed up in one line.
+MAX_PUPPET_LINES = 4
 
 HELP_KEYS = "H / F1"
 COLORS = {"text": (0.96, 0.97, 1.0), "help": (0.8, 0.88, 1.0), "notice": (1.0, 0.86, 0.42)}
@@ -53,9 +59,7 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
     recoveries = "" if physics is None else f"   physics_recoveries {physics.recoveries}"
     lines = [f"PuppetPhone · {game.name}   {fps:5.1f} fps   frame {world.frame}{recoveries}{pause}{hint}"]
     lines += game.status(world)
-    for e, brain in world.query(Brain):
-        name = world.try_get(e, Name)
-        lines.append(f"{name.value if name is not None else f'#{e}'}: {describe_puppet(world, e, brain)}")
+    lines += _puppet_lines(world)
     for src in hub.sources:
         if type(src).__name__ == "OscSource" and not any(st.packets > 0 for st in hub.statuses()):
             lines += _pairing_lines(src)
@@ -82,6 +86,23 @@ def notice(world: World) -> tuple[str, float] | None:
         return None
     alpha = posted.opacity(world.frame, world.dt)
     return (posted.text, alpha) if alpha > 0.0 else None
+
+
+def _puppet_lines(world: World) -> list[str]:
+    """What each puppet is doing; past :data:`MAX_PUPPET_LINES` the rest are counted by activity,
+    so a crowd does not bury the screen."""
+    lines, rest = [], Counter[str]()
+    for i, (e, brain) in enumerate(world.query(Brain)):
+        doing = describe_puppet(world, e, brain)
+        if i < MAX_PUPPET_LINES:
+            name = world.try_get(e, Name)
+            lines.append(f"{name.value if name is not None else f'#{e}'}: {doing}")
+        else:
+            rest[doing] += 1
+    if rest:
+        counts = ", ".join(f"{n} {doing}" for doing, n in sorted(rest.items(), key=lambda kv: (-kv[1], kv[0])))
+        lines.append(f"and {sum(rest.values())} more: {counts}")
+    return lines
 
 
 def _pairing_lines(source: object) -> list[str]:

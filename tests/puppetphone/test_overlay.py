@@ -102,3 +102,14 @@ def test_overlay_names_a_locked_out_phone():
         assert any("locked out" in line and "osc:10.0.0.9" in line for line in lines)
     finally:
         hub.close()
+
+
+def test_a_crowd_is_summed_up_in_one_line():
+    hub = InputHub()
+    app = make_app("sandbox", 0, hub, {"puppets": 12})
+    app.step()
+    lines = overlay_lines(app.world, GAME, hub, 60.0, False)
+    named = [line for line in lines if line.startswith(("puppet:", "wanderer"))]
+    assert named[0] == "puppet: standing" and len(named) == 4
+    summary = [line for line in lines if line.startswith("and 8 more: ")]
+    assert len(summary) == 1 and any(word in summary[0] for word in ("walking", "running", "standing"))
