@@ -260,6 +260,35 @@ def _roll_snowball(app: App, bot: MouseBot) -> None:
     bot.wait(0.5)
 
 
+def _flick_while_rolling(app: App, bot: MouseBot) -> None:
+    """A player's report: while rolling a ball, hold and flick the mouse up about 160 px."""
+    p = puppet_of(app)
+    bot.wait(0.3)
+    bot.press_on(p)
+    _wheel(bot, -3)
+    bot.wait(0.4)
+    bot.drag_path([P([0.0, 0, 2.0])], 0.7)   # crouch-walk into the big ball: rolling it
+    for _ in range(4):                        # 160 px up in four steps, and held up there
+        bot.move_to_pixel((bot.pos[0], bot.pos[1] - 40.0), (1, 0, 0))
+        bot.step()
+    bot.wait(1.0)
+    bot.release()
+    bot.wait(5.0)
+
+
+def _deep_crouch_walk(app: App, bot: MouseBot) -> None:
+    """A player's report: five wheel-down clicks, then a crouch-walk."""
+    p = puppet_of(app)
+    bot.wait(0.3)
+    bot.press_on(p)
+    _wheel(bot, -5)
+    bot.wait(0.4)
+    bot.drag_path([P([1.2, 0, 1.2])], 0.6)
+    bot.wait(0.5)
+    _wheel(bot, 5)
+    bot.wait(0.5)
+
+
 @dataclass(frozen=True)
 class Session:
     """A recorded session: its world, its controller and its script."""
@@ -288,6 +317,10 @@ SESSIONS: dict[str, Session] = {s.name: s for s in [
     Session("held_in_air", "empty", "mouse", _held_in_air, "wheel up: held in the air, released, settles, gets up"),
     Session("pick_up_carry", "small_ball", "mouse", _pick_up_carry, "crouch still over a small ball, stand, carry it"),
     Session("roll_snowball", "big_ball", "mouse", _roll_snowball, "crouch-walk into a big ball: roll it"),
+    Session("flick_while_rolling", "big_ball", "mouse", _flick_while_rolling,
+            "player repro: flick up while rolling a ball; nothing is thrown out of the field"),
+    Session("deep_crouch_walk", "empty", "mouse", _deep_crouch_walk,
+            "player repro: five wheel-down clicks then a crouch-walk; no ragdoll"),
 ]}
 
 

@@ -340,3 +340,28 @@ def test_the_reason_of_a_fall_goes_once_the_puppet_is_up() -> None:
     assert in_order(words, ["getting up", "standing"]), words
     assert not any("invalid" in w for w in words[words.index("getting up"):]), words
     assert words[-1] == "standing"
+
+
+# -- players' reports of physics that broke (issue: physics that no input can break) -------------
+def test_a_flick_while_rolling_a_ball_throws_nothing_out_of_the_field():
+    """Reported: "Ragdoll (jump_invalid)", a MuJoCo QACC warning, puppet and balls thrown out of view for
+    ~30 s. Now: the invalid jump still drops the puppet, but everything stays near and it gets up again."""
+    w = replay("flick_while_rolling")
+    states = [t.target for t in w.trace]
+    assert "RollSnowball" in states and "Ragdoll" in states
+    assert states[-1] == "Locomotion"  # got up and stands again before the end
+    pos, ball = w.arr("pos"), w.arr("ball")
+    assert np.isfinite(pos).all() and np.isfinite(ball).all()
+    assert np.abs(pos[:, [0, 2]]).max() < 4.0 and pos[:, 1].max() < 2.0  # the puppet stays where it fell
+    fell = w.first("state", "Ragdoll")
+    speed = np.linalg.norm(np.diff(ball[fell - 1:], axis=0), axis=1) * 60
+    assert speed.max() < 3.0 and ball[fell:, 1].max() < 0.5  # m/s, m: the ball is nudged on, never flung
+
+
+def test_five_wheel_clicks_then_a_crouch_walk_stays_on_its_feet():
+    """Reported: the puppet dropped into a ragdoll dragged over the ground."""
+    w = replay("deep_crouch_walk")
+    assert "Ragdoll" not in w.state
+    assert "Crouch" in w.state and w.state[-1] == "Locomotion"
+    moved = np.linalg.norm(w.arr("pos")[-1][[0, 2]] - w.arr("pos")[0][[0, 2]])
+    assert moved > 1.0  # it crouch-walked where it was dragged
