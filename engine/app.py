@@ -181,10 +181,3 @@ class App:
         """Run ``n`` steps back to back (tests, headless replays)."""
         for _ in range(n):
             self.step()
-
-    def tick(self, elapsed: float) -> int:
-        """Advance the clock by real ``elapsed`` seconds and run the steps it yields."""
-        steps = self.clock.advance(elapsed)
-        for _ in range(steps):
-            self.step()
-        return steps

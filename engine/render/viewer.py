@@ -1,13 +1,7 @@
-"""``Viewer``: a target, a renderer and a camera, the one object a play loop holds.
+"""``Viewer``: a target, a renderer and a camera, what the runner draws through.
 
-The loop stays the same with or without a display::
-
-    viewer = Viewer.create(headless=args.headless, width=1280, height=720)
-    while running:
-        for ev in viewer.poll_events(): ...
-        scene.clear(); scene_from_world(world, alpha, scene)
-        viewer.draw(scene)
-    viewer.screenshot("shot.png"); viewer.close()
+The frame loop itself is :class:`engine.runner.Runner`'s; the viewer is the same with or
+without a display (a window or an EGL off-screen target), so the loop does not care.
 """
 
 from __future__ import annotations
