@@ -21,7 +21,7 @@ from collections.abc import Iterable
 from typing import Protocol
 
 from input.codec import decode_frame, encode_frame
-from input.sample import COMMANDS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus
+from input.sample import COMMANDS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus, encode_tool
 from input.source import PoseSource
 
 __all__ = ["InputHub", "FrameSource"]
@@ -57,14 +57,13 @@ class InputHub:
         self._tools: list[str] = []
         self.last_frame = InputFrame()
 
-    def tool(self, operation: str) -> None:
-        """Queue an authoring tool's operation (a short text) for the next step's frame.
+    def tool(self, *operation: str | int | float | bool) -> None:
+        """Queue an authoring tool's operation (a name and its arguments) for the next step's frame.
 
         Ignored while replaying: the recording has its own."""
-        if len(operation.encode()) > 255:
-            raise ValueError(f"tool operation too long to record: {operation[:40]!r}…")
+        text = encode_tool(operation)
         if self.replay is None:
-            self._tools.append(operation)
+            self._tools.append(text)
 
     def command(self, kind: str) -> None:
         """Queue a keyboard command (:data:`~input.sample.COMMANDS`) for the next step's frame,

@@ -18,13 +18,15 @@ Two position modes exist because controllers differ in what they know:
 
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS",
-           "RESET", "SAVE", "RESTORE", "COMMANDS", "TOOL", "LIMITS", "check_sample_ranges"]
+           "RESET", "SAVE", "RESTORE", "COMMANDS", "TOOL", "encode_tool", "decode_tool", "LIMITS", "check_sample_ranges"]
 
 CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP = "connect", "disconnect", "touch_down", "touch_up"
 # Commands from the keyboard (the launcher's keys), recorded like any input so a
@@ -38,6 +40,27 @@ TOOL = "tool"
 EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP, *COMMANDS, TOOL)
 
 F = NDArray[np.float64]
+
+
+def encode_tool(operation: tuple[str | int | float | bool, ...]) -> str:
+    """A tool operation as the compact JSON text an event carries (at most 255 bytes)."""
+    text = json.dumps(list(operation), separators=(",", ":"))
+    if len(text.encode()) > 255:
+        raise ValueError(f"tool operation too long to record: {text[:40]}…")
+    return text
+
+
+def decode_tool(text: str) -> tuple[str | int | float | bool, ...]:
+    """The inverse of :func:`encode_tool`: a name, then finite numbers, booleans or names."""
+    try:
+        operation = json.loads(text)
+    except ValueError:
+        raise ValueError(f"malformed tool operation {text[:40]!r}") from None
+    if (not isinstance(operation, list) or not operation or not isinstance(operation[0], str)
+            or not all(isinstance(v, (str, bool)) or (isinstance(v, (int, float)) and math.isfinite(v))
+                       for v in operation)):
+        raise ValueError(f"malformed tool operation {text[:40]!r}")
+    return tuple(operation)
 
 # Physical bounds of a sample (largest magnitude per component). A finite value can still
 # poison the simulation: 1e308 as a position makes the stick's velocity filter overflow to
@@ -166,6 +189,10 @@ class InputFrame:
             if source is None or s.source == source:
                 return s
         return None
+
+    def tool_operations(self) -> list[tuple[str | int | float | bool, ...]]:
+        """This step's authoring tool operations, decoded; ``ValueError`` names a malformed one."""
+        return [decode_tool(text) for kind, text in self.events if kind == TOOL]
 
     def sources(self) -> list[str]:
         """Distinct source ids in this frame, in first-seen order."""

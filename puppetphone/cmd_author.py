@@ -155,27 +155,22 @@ class RecordActivity:
             return True
         return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
 
-    def _tool(self, *op: object) -> None:
-        import json
-
-        self.hub.tool(json.dumps(list(op), separators=(",", ":")))
-
     def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
         """Pointer, wheel and keys become tool operations (Esc and P stay the runner's)."""
         import pygame
 
         if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 1:
             self.pressed = True
-            self._tool("press", ev.pos[0], ev.pos[1])
+            self.hub.tool("press", ev.pos[0], ev.pos[1])
         elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 1:
             self.pressed = False
-            self._tool("release")
+            self.hub.tool("release")
         elif ev.type == pygame.MOUSEMOTION and ev.buttons[2]:
-            self._tool("orbit", ev.rel[0], ev.rel[1])
+            self.hub.tool("orbit", ev.rel[0], ev.rel[1])
         elif ev.type == pygame.MOUSEWHEEL:
-            self._tool("zoom", 0.9 if ev.y > 0 else 1.1)
+            self.hub.tool("zoom", 0.9 if ev.y > 0 else 1.1)
         elif ev.type == pygame.KEYDOWN and ev.key not in (pygame.K_ESCAPE, pygame.K_p):
-            self._tool("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL))
+            self.hub.tool("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL))
         else:
             return False
         return True
@@ -187,7 +182,7 @@ class RecordActivity:
             save_clip(self.scene.clip, self.output)
             self.scene.message = message.format(output=self.output)
 
-    def _apply(self, op: list) -> object:  # type: ignore[type-arg]
+    def _apply(self, op: tuple) -> object:  # type: ignore[type-arg]
         """One tool operation; returns a pointer position when the operation is one."""
         scene, kind = self.scene, op[0]
         if kind == "press":
@@ -231,19 +226,17 @@ class RecordActivity:
         return mouse_point(scene.camera, px, py, self.size, self.press[2])
 
     def step(self) -> None:
-        from input.sample import TOOL
-
         if self.pressed and self.hub.replay is None:
             import pygame
 
-            self._tool("pointer", *pygame.mouse.get_pos())
+            self.hub.tool("pointer", *pygame.mouse.get_pos())
         frame = self.hub.drain(self.frame)
         pointer = None
-        for kind, text in frame.events:
-            if kind == TOOL:
-                import json
-
-                pointer = self._apply(json.loads(text)) or pointer
+        for op in frame.tool_operations():
+            try:
+                pointer = self._apply(op) or pointer
+            except (IndexError, TypeError):
+                raise ValueError(f"tool operation {list(op)} does not fit the record scene") from None
         scene = self.scene
         scene.feed(self._value(frame, pointer))
         scene.step(self.dt)

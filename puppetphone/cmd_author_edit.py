@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import base64
 import hashlib
-import json
 import sys
 import tempfile
 from pathlib import Path
@@ -141,11 +140,11 @@ class EditActivity:
             self._pending = op
             return
         self._flush()
-        self.hub.tool(json.dumps(op, separators=(",", ":")))
+        self.hub.tool(*op)
 
     def _flush(self) -> None:
         if self._pending is not None:
-            self.hub.tool(json.dumps(self._pending, separators=(",", ":")))
+            self.hub.tool(*self._pending)
             self._pending = None
 
     def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
@@ -177,7 +176,7 @@ class EditActivity:
             return False
         return True
 
-    def _apply(self, op: list) -> None:  # type: ignore[type-arg]
+    def _apply(self, op: tuple) -> None:  # type: ignore[type-arg]
         from authoring.mocurves import save_session
 
         edit, kind = self.edit, op[0]
@@ -201,13 +200,13 @@ class EditActivity:
             edit.key(op[1], ctrl=bool(op[2]), shift=bool(op[3]))
 
     def step(self) -> None:
-        from input.sample import TOOL
-
         self._flush()
         frame = self.hub.drain(self.frame)
-        for kind, text in frame.events:
-            if kind == TOOL:
-                self._apply(json.loads(text))
+        for op in frame.tool_operations():
+            try:
+                self._apply(op)
+            except (IndexError, TypeError):
+                raise ValueError(f"tool operation {list(op)} does not fit the edit scene") from None
         self.edit.step(self.dt)
         digest, parts = edit_digest(self.edit)
         if self.recorder is not None:

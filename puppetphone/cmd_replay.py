@@ -98,6 +98,9 @@ def _replay_authoring(rec, args: argparse.Namespace, cut_short: bool) -> int:  #
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except ValueError as exc:  # a tool operation the scene cannot take: the file was made to lie
+        print(f"error: {args.file}: step {activity.frame}: {exc}", file=sys.stderr)
+        return 2
     finally:
         runner.close()
     if result.screenshot is not None:

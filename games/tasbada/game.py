@@ -52,17 +52,19 @@ CONTROLS = (
 
 def prepare(options: dict[str, str]) -> dict[str, Any]:
     """Read the save file (a damaged one is set aside) and choose the pictures."""
-    for key in ("webcam",):
-        if options[key] not in ("auto", "off"):
-            raise GameOptionError(f"tasbada webcam must be auto or off, not {options[key]!r}")
+    if options["webcam"] not in ("auto", "off"):
+        raise GameOptionError(f"tasbada webcam must be auto or off, not {options['webcam']!r}")
     save = Path(options["save"] or os.environ.get("TASBADA_SAVE") or default_save_path()).expanduser()
     progress = None
     try:
         progress = load_progress(save)
     except SaveError as exc:
         bad = Path(str(save) + ".bad")
-        os.replace(str(save), bad)
-        print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
+        try:
+            os.replace(save, bad)
+            print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
+        except OSError as move:
+            print(f"tasbada: {exc}; cannot set it aside ({move.strerror}), starting a new journey", file=sys.stderr)
     photo = options["photo"] or os.environ.get("TASBADA_PHOTO", "")
     if not photo and progress is not None and progress.photo and Path(progress.photo).is_file():
         photo = progress.photo

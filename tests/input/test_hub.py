@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from input.hub import InputHub
 from input.sample import DISCONNECT, TOUCH_DOWN, TOUCH_UP, PoseSample
@@ -63,3 +64,20 @@ def test_live_frame_is_codec_round_tripped():
     f = hub.drain(0)
     assert isinstance(f.samples[0].position, np.ndarray) and f.samples[0].position.dtype == np.float64
     assert not hub.live  # fed from the main thread only
+
+
+def test_tool_operations_round_trip_and_malformed_ones_are_named():
+    from input.sample import TOOL, InputFrame, decode_tool, encode_tool
+
+    hub = InputHub()
+    hub.tool("press", 512, 300, True)
+    hub.tool("key", "s", True, False)
+    frame = hub.drain(0)
+    assert frame.tool_operations() == [("press", 512, 300, True), ("key", "s", True, False)]
+    assert hub.drain(1).tool_operations() == []
+    for bad in ("{", "[]", "[3, 1]", '["move", NaN, 1]', '{"press": 1}', '["key", [1]]'):
+        with pytest.raises(ValueError, match="malformed tool operation"):
+            InputFrame(frame=0, events=((TOOL, bad),)).tool_operations()
+    with pytest.raises(ValueError, match="too long"):
+        encode_tool(("key", "x" * 300))
+    assert decode_tool(encode_tool(("zoom", 0.9))) == ("zoom", 0.9)

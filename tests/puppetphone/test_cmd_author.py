@@ -47,3 +47,26 @@ def test_a_take_of_another_tempo_is_a_divergence(tmp_path: Path) -> None:
     done = puppetphone("replay", "edited.rec", "--headless", cwd=tmp_path)
     assert done.returncode == 1
     assert "differs at frame 0 in scene " in done.stdout  # the countdown timer is the first thing that differs
+
+
+def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(tmp_path: Path) -> None:
+    from input.recording import Recorder
+    from input.sample import TOOL, InputFrame
+
+    done = puppetphone("author", "record", "--script", "loops", "--headless", "--frames", "20",
+                       "--record", "take.rec", "-o", "loop.ppclip", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    rec = read_recording(tmp_path / "take.rec")
+    with Recorder(tmp_path / "forged.rec", rec.header) as out:
+        for i, (frame, digest, parts) in enumerate(zip(rec.frames, rec.hashes, rec.parts, strict=True)):
+            if i == 5:
+                frame = InputFrame(frame=frame.frame, events=((TOOL, '["zoom", "far"'),))
+            out.write(frame, digest, parts)
+    done = puppetphone("replay", "forged.rec", "--headless", cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert done.stderr.strip() == "error: forged.rec: step 5: malformed tool operation '[\"zoom\", \"far\"'"
+    with Recorder(tmp_path / "short.rec", rec.header) as out:  # well-formed, but missing its arguments
+        for i, (frame, digest, parts) in enumerate(zip(rec.frames, rec.hashes, rec.parts, strict=True)):
+            out.write(InputFrame(frame=frame.frame, events=((TOOL, '["press"]'),)) if i == 3 else frame, digest, parts)
+    done = puppetphone("replay", "short.rec", "--headless", cwd=tmp_path)
+    assert done.returncode == 2 and done.stderr.strip().endswith("does not fit the record scene")
