@@ -1,7 +1,12 @@
 """Clips: joint tracks sampled at a fixed frame rate, with looping and root motion.
 
-A clip stores ``root [F,3]`` and ``rotations [F,J,4]`` at ``fps``. Sampling at any time
-interpolates positions linearly and rotations by slerp. A looping clip wraps time
+A clip stores ``root [F,3]`` and ``rotations [F,J,4]`` at ``fps``, and two optional channels
+a source may animate: ``translations [F,J,3]`` (every joint's local offset per frame: bones
+that stretch, prop bones, a hips joint under a skin with several roots) and ``scales [F,J]``
+(per-joint uniform scale, what MoCurves' scale arrows edit). Both are ``None`` by default,
+and then nothing below looks at them: the puppets' clips pay nothing for the channels.
+Sampling at any time interpolates positions, translations and scales linearly and rotations
+by slerp. A looping clip wraps time
 and accumulates root motion across loops, so a walk played for ten seconds walks
 ten seconds' worth of ground.
 
@@ -49,6 +54,10 @@ class Clip:
         root_motion: travel removed from ``root``/``rotations`` by extraction, if any.
         markers: named normalised times (e.g. ``{"left_down": 0.0, "right_down": 0.5}``) for
             phase synchronisation and contacts.
+        translations: optional ``[F,J,3]`` local offset of every joint per frame (replacing
+            the skeleton's offsets; joint 0's column is unused: ``root`` places it).
+        scales: optional ``[F,J]`` uniform scale of every joint per frame (1 = rest); a joint's
+            scale applies to its children's offsets and to everything below it.
     """
 
     name: str
@@ -59,6 +68,8 @@ class Clip:
     loop: bool = False
     root_motion: RootMotion | None = None
     markers: dict[str, float] = field(default_factory=dict)
+    translations: NDArray[np.float64] | None = None
+    scales: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         root = np.asarray(self.root, dtype=np.float64)
@@ -77,6 +88,18 @@ class Clip:
         rot.setflags(write=False)
         object.__setattr__(self, "root", root)
         object.__setattr__(self, "rotations", rot)
+        j = self.skeleton.num_joints
+        for attr, tail in (("translations", (j, 3)), ("scales", (j,))):
+            value = getattr(self, attr)
+            if value is None:
+                continue
+            arr = np.array(value, dtype=np.float64)
+            if arr.shape != (len(root), *tail):
+                raise ValueError(f"clip {self.name!r}: {attr} must be [F,{','.join(map(str, tail))}], got {arr.shape}")
+            if not np.isfinite(arr).all() or (attr == "scales" and (arr <= 0).any()):
+                raise ValueError(f"clip {self.name!r}: {attr} hold NaN, infinite{' or non-positive' * (attr == 'scales')} values")
+            arr.setflags(write=False)
+            object.__setattr__(self, attr, arr)
 
     @property
     def num_frames(self) -> int:
@@ -107,7 +130,14 @@ class Clip:
         i0, i1, a = self.frame_pair(t)
         root = self.root[i0] + a[..., None] * (self.root[i1] - self.root[i0])
         rot = quat.slerp(self.rotations[i0], self.rotations[i1], np.asarray(a)[..., None])
-        return Pose(root, rot)
+        offsets = scales = None
+        if self.translations is not None:
+            tr = self.translations
+            offsets = tr[i0] + np.asarray(a)[..., None, None] * (tr[i1] - tr[i0])
+        if self.scales is not None:
+            sc = self.scales
+            scales = sc[i0] + np.asarray(a)[..., None] * (sc[i1] - sc[i0])
+        return Pose(root, rot, offsets, scales)
 
     def sample_root_motion(self, t: float) -> tuple[NDArray[np.float64], float]:
         """Accumulated root travel and heading at time ``t``, continuing across loops."""
@@ -175,7 +205,14 @@ class Clip:
         if self.root_motion is not None:
             samples = [self.sample_root_motion(float(x)) for x in t]
             rm = RootMotion(np.array([s[0] for s in samples]), np.array([s[1] for s in samples]))
-        return replace(self, fps=fps, root=pose.root, rotations=pose.rotations, root_motion=rm)
+        return replace(self, fps=fps, root=pose.root, rotations=pose.rotations, root_motion=rm,
+                       translations=pose.offsets, scales=pose.scales)
+
+    def offsets(self) -> NDArray[np.float64]:
+        """``[F,J,3]`` local offsets per frame: the translation channel, or the skeleton's offsets."""
+        if self.translations is not None:
+            return np.array(self.translations)
+        return np.broadcast_to(self.skeleton.offsets, (self.num_frames, self.skeleton.num_joints, 3)).copy()
 
 
 def _yaw(q: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -8,6 +8,11 @@ loaded as garbage. Readers refuse versions newer than they know, and check every
 value before building the clip (sizes before allocation through
 :mod:`engine.npz_safe`, then types, finiteness, fps, radii, unit rotations): whatever
 is wrong with a file, :func:`load_clip` raises :class:`ClipFileError` and nothing else.
+
+Version 2 adds the optional channels ``translations [F,J,3]`` and ``scales [F,J]``, stored
+only when a clip has them; version 1 files (which never do) still read. The container is
+open: arrays a reader does not know are covered by the checksum and otherwise ignored, so
+other tools may store named extras (e.g. fitted curves) beside the clip without a new version.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from engine.skeleton import Skeleton
 __all__ = ["save_clip", "load_clip", "ClipFileError", "FORMAT", "VERSION"]
 
 FORMAT = "puppetphone-clip"
-VERSION = 1
+VERSION = 2
 # Limits a real clip is far inside: an hour of 120 fps mocap on a 100-joint skeleton is ~170 MB.
 MAX_FILE = 256 << 20
 MAX_HEADER = 1 << 20
@@ -61,6 +66,10 @@ def save_clip(clip: Clip, path: str | Path) -> Path:
         "radii": sk.radii,
         "parents": sk.parents,
     }
+    if clip.translations is not None:
+        arrays["translations"] = clip.translations
+    if clip.scales is not None:
+        arrays["scales"] = clip.scales
     if clip.root_motion is not None:
         arrays["rm_translation"] = clip.root_motion.translation
         arrays["rm_heading"] = clip.root_motion.heading
@@ -165,6 +174,15 @@ def load_clip(path: str | Path) -> Clip:
                             _finite("rm_heading", arrays["rm_heading"]))
             if rm.translation.shape != root.shape or rm.heading.shape != root.shape[:1]:
                 raise ClipFileError("root motion does not have one entry per frame")
+        channels = {}
+        for key, tail in (("translations", (sk.num_joints, 3)), ("scales", (sk.num_joints,))):
+            if key in arrays:
+                value = _finite(key, arrays[key], tail)
+                if value.shape[0] != root.shape[0]:
+                    raise ClipFileError(f"{key} do not have one entry per frame")
+                channels[key] = value
+        if "scales" in channels and (channels["scales"] <= 0).any():
+            raise ClipFileError("scales must be positive")
         return Clip(
             name=header["name"],
             skeleton=sk,
@@ -174,6 +192,7 @@ def load_clip(path: str | Path) -> Clip:
             loop=header["loop"],
             root_motion=rm,
             markers={str(k): float(v) for k, v in header.get("markers", {}).items()},
+            **channels,
         )
     except ClipFileError as exc:
         raise ClipFileError(f"{path}: {exc}") from None

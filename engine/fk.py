@@ -42,6 +42,7 @@ def forward_kinematics(
     root: ArrayLike,
     rotations: ArrayLike,
     offsets: ArrayLike | None = None,
+    scales: ArrayLike | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """World positions ``[...,J,3]`` and rotations ``[...,J,4]`` of every joint.
 
@@ -50,7 +51,9 @@ def forward_kinematics(
         root: ``[...,3]`` world position of joint 0.
         rotations: ``[...,J,4]`` local rotations (joint 0's is its world rotation).
         offsets: optional ``[...,J,3]`` per-puppet offsets (snowmen have their own bone
-            lengths); defaults to the skeleton's.
+            lengths, clips with a translation channel); defaults to the skeleton's.
+        scales: optional ``[...,J]`` uniform joint scales (a clip's scale channel): a joint's
+            scale multiplies the offsets of everything below it, as glTF's node scale does.
     """
     rot = np.asarray(rotations, dtype=np.float64)
     off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
@@ -60,6 +63,13 @@ def forward_kinematics(
     wpos[..., 0, :] = np.asarray(root, dtype=np.float64)
     wrot[..., 0, :] = rot[..., 0, :]
     off = np.broadcast_to(off, batch + (skeleton.num_joints, 3))
+    if scales is not None:
+        # Accumulate world scale down the levels, then scale each offset by its parent's.
+        wscale = np.array(np.broadcast_to(np.asarray(scales, dtype=np.float64), batch + (skeleton.num_joints,)))
+        for idx, par in levels(skeleton):
+            wscale[..., idx] *= wscale[..., par]
+        par_all = np.maximum(skeleton.parents, 0)
+        off = off * wscale[..., par_all][..., None]
     for idx, par in levels(skeleton):
         prot = wrot[..., par, :]
         wpos[..., idx, :] = wpos[..., par, :] + quat.rotate(prot, off[..., idx, :])

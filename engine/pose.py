@@ -1,7 +1,9 @@
 """Poses: a root translation plus local joint rotations, batched over any leading axes.
 
 A pose is plain array data, ``root [...,3]`` and ``rotations [...,J,4]`` (unit quaternions,
-w first). The same class holds one pose, a clip's frames ``[F,J,4]`` or a crowd
+w first), and, only when the clip it came from animates them, local joint ``offsets
+[...,J,3]`` and uniform joint ``scales [...,J]`` (``None`` otherwise: the skeleton's rest
+offsets and scale 1, at no cost). The same class holds one pose, a clip's frames ``[F,J,4]`` or a crowd
 ``[P,J,4]``; every operation is vectorised over the leading axes.
 """
 
@@ -24,6 +26,8 @@ class Pose:
 
     root: NDArray[np.float64]
     rotations: NDArray[np.float64]
+    offsets: NDArray[np.float64] | None = None
+    scales: NDArray[np.float64] | None = None
 
     @classmethod
     def rest(cls, skeleton: Skeleton, *batch: int) -> Pose:
@@ -33,7 +37,9 @@ class Pose:
 
     def copy(self) -> Pose:
         """A deep copy, so systems can write without aliasing an asset."""
-        return Pose(self.root.copy(), self.rotations.copy())
+        return Pose(self.root.copy(), self.rotations.copy(),
+                    None if self.offsets is None else self.offsets.copy(),
+                    None if self.scales is None else self.scales.copy())
 
     @property
     def num_joints(self) -> int:

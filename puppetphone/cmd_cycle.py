@@ -1,7 +1,8 @@
 """``puppetphone cycle INPUT -o OUTPUT [--json] [--plot PNG] [--items …]``: one clean loop from a performance.
 
-Input ``.bvh`` / ``.csv`` / ``.npz`` / ``.rec`` (a recording), output ``.bvh`` / ``.ppclip`` (skeletal
-input) or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output is::
+Input ``.bvh`` / ``.gltf`` / ``.glb`` (``--animation``, ``--units``, ``--joint-map``) / ``.csv`` /
+``.npz`` / ``.rec`` (a recording), output ``.bvh`` / ``.ppclip`` / ``.glb`` / ``.gltf`` (skeletal input)
+or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output is::
 
     {"period_frames", "period_seconds", "cycles", "dims", "closure_error", "seconds", ...}
 
@@ -25,8 +26,12 @@ _PROGRESS_SAMPLES = 200_000  # values (T·N) from which a progress bar is worth 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the cycle arguments."""
-    parser.add_argument("input", metavar="INPUT", help="performance: .bvh, .csv (time + columns), .npz or a recording (.rec)")
-    parser.add_argument("-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .csv or .npz")
+    parser.add_argument("input", metavar="INPUT", help="performance: .bvh, .gltf, .glb, .csv (time + columns), .npz or a recording (.rec)")
+    parser.add_argument("-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .glb, .gltf, .csv or .npz")
+    from puppetphone.motion_args import add_export_options, add_motion_options
+
+    add_motion_options(parser)
+    add_export_options(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
     from puppetphone.runargs import image_path
 
@@ -63,6 +68,7 @@ def run(args: argparse.Namespace) -> int:
     from authoring.cycles.extract import CycleError, CycleOptions, extract_cycle
     from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
     from authoring.cycles.trajectory import TrajectoryError
+    from puppetphone.motion_args import export_options, motion_options
 
     def fail(code: int, message: str) -> int:
         print(f"cycle: {message}", file=sys.stderr)
@@ -80,13 +86,15 @@ def run(args: argparse.Namespace) -> int:
             return fail(EXIT_BAD_INPUT, "--plot needs matplotlib: pip install 'puppetphone[plot]'")
     t0 = time.perf_counter()
     try:
-        perf = load_performance(args.input, args.items)
+        perf = load_performance(args.input, args.items, **motion_options(args))
     except FileNotFoundError as exc:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:
         return fail(EXIT_BAD_INPUT, f"cannot read {args.input}: {exc}")
-    if perf.clip is None and out_suffix in (".bvh", ".ppclip"):
-        return fail(EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH); write .csv or .npz for {args.input}")
+    if perf.clip is None and out_suffix in (".bvh", ".ppclip", ".glb", ".gltf"):
+        return fail(EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH, glTF); write .csv or .npz for {args.input}")
+    for warning in perf.motion.warnings if perf.motion else ():
+        print(f"cycle: warning: {warning}", file=sys.stderr)
     traj = perf.trajectory
     big = traj.num_samples * traj.dims >= _PROGRESS_SAMPLES
     bar = _Bar(big and not args.no_progress and sys.stderr.isatty())
@@ -99,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
         return fail(EXIT_NO_CYCLE, str(exc))
     seconds = time.perf_counter() - t1
     try:
-        save_loop(result, perf, args.output)
+        save_loop(result, perf, args.output, **export_options(args))
     except (TrajectoryError, ValueError, OSError) as exc:
         return fail(EXIT_BAD_INPUT, f"cannot write {args.output}: {exc}")
     if args.plot:
@@ -120,6 +128,7 @@ def run(args: argparse.Namespace) -> int:
         "samples": len(result.loop),
         "skipped_frames": perf.skipped,
         "bezier_segments": sum(c.segments for c in result.curves.values()),
+        **({"input": perf.motion.summary()} if perf.motion else {}),
     }
     if not args.json:
         print(

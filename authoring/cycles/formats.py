@@ -4,9 +4,10 @@ A :class:`Performance` is a :class:`Trajectory` plus what is needed to write the
 back in kind: the column names, and for skeletal input (BVH) the source clip, whose
 skeleton the output clip or BVH reuses.
 
-* **BVH** — read with :mod:`engine.io.bvh`, the leading T-pose of CMU conversions
-  skipped, converted to a clip; items are the root position (allowed to travel) and
-  every joint's rotation as a quaternion (never raw Euler angles, which wrap). ``items``
+* **BVH, glTF, GLB** — read with :func:`engine.io.motion_file.load_motion` (the leading
+  T-pose of CMU conversions skipped, units judged or given, a glTF animation chosen by
+  name or index) as a clip; items are the root position (allowed to travel) and every
+  joint's rotation as a quaternion (never raw Euler angles, which wrap). ``items``
   selects joints by name.
 * **CSV** — a header row, first column ``time`` in seconds, one column per dimension.
   Columns named ``NAME.qw NAME.qx NAME.qy NAME.qz`` form a rotation item, ``NAME.x NAME.y
@@ -30,12 +31,13 @@ from authoring.cycles.extract import CycleResult
 from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
+from engine.io.motion_file import MotionFile, MotionFileError, load_motion
 from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
 
 __all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop"]
 
-INPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".rec")
-OUTPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".ppclip")
+INPUT_SUFFIXES = (".bvh", ".gltf", ".glb", ".csv", ".npz", ".rec")
+OUTPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".ppclip", ".glb", ".gltf")
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,9 @@ class Performance:
         clip: for skeletal input, the (T-pose-free) clip the columns came from.
         joints: for skeletal input, the joint index of each rotation item, in item order.
         skipped: leading frames dropped (a T-pose lead-in).
+        motion: for skeletal input, the file's decisions (units, fps, animation, warnings).
+        translated: for skeletal input, the joints whose translation channel moves; each is a
+            position item after the rotation items, in this order.
     """
 
     trajectory: Trajectory
@@ -57,6 +62,8 @@ class Performance:
     clip: Clip | None = None
     joints: tuple[int, ...] = ()
     skipped: int = 0
+    motion: MotionFile | None = None
+    translated: tuple[int, ...] = ()
 
 
 def _select(available: list[str], wanted: list[str] | None, what: str) -> list[str]:
@@ -68,13 +75,40 @@ def _select(available: list[str], wanted: list[str] | None, what: str) -> list[s
     return [a for a in available if a in wanted]
 
 
-def _load_bvh(path: Path, items: list[str] | None) -> Performance:
-    from engine.io.bvh import read_bvh
-    from engine.io.bvh_convert import detect_tpose_frames
+SEAMLESS_REPEATS = 3
+_SEAMLESS = 0.05  # end-to-start pose gap, as a share of the pose's range, below which an animation is a loop
 
-    motion = read_bvh(path)
-    lead = detect_tpose_frames(motion)
-    clip = motion.to_clip(skip_frames=lead)
+
+def seamless_repeats(clip: Clip) -> Clip:
+    """A glTF animation that is one seamless cycle (its last pose is its first), repeated.
+
+    Game assets (Fox's Walk and Run, CesiumMan's walk) hold exactly one cycle, so there is
+    nothing to compare a cycle with; repeated :data:`SEAMLESS_REPEATS` times (the root moving
+    on by the cycle's travel) they are a performance the extractor can measure like any other.
+    Other clips are returned unchanged.
+    """
+    rot = clip.rotations
+    span = float(np.ptp(rot, axis=0).max())
+    if clip.num_frames < 4 or not span > 0 or float(np.abs(rot[-1] - rot[0]).max()) > _SEAMLESS * span:
+        return clip
+    travel = clip.root[-1] - clip.root[0]
+    body = slice(0, clip.num_frames - 1)
+    reps = SEAMLESS_REPEATS
+    root = np.concatenate([clip.root[body] + k * travel for k in range(reps)] + [clip.root[-1:] + (reps - 1) * travel])
+    rots = np.concatenate([rot[body]] * reps + [rot[-1:]])
+    tr = clip.translations
+    tr = None if tr is None else np.concatenate([tr[body]] * reps + [tr[-1:]])
+    return Clip(clip.name, clip.skeleton, clip.fps, root, rots, translations=tr)
+
+
+def _load_skeletal(path: Path, items: list[str] | None, options: dict[str, object]) -> Performance:
+    try:
+        motion = load_motion(path, **options)  # type: ignore[arg-type]
+    except MotionFileError as exc:
+        raise TrajectoryError(str(exc)) from None
+    clip = motion.clip
+    if motion.animation is not None:
+        clip = seamless_repeats(clip)
     sk = clip.skeleton
     chosen = _select(list(sk.names), items, "joint")
     cols = [clip.root]
@@ -88,8 +122,18 @@ def _load_bvh(path: Path, items: list[str] | None) -> Performance:
         names += [f"{name}.qw", f"{name}.qx", f"{name}.qy", f"{name}.qz"]
         its.append(Item(f"{name}.rotation", "rotation", start, start + 4))
         joints.append(j)
+    translated = []
+    if clip.translations is not None:
+        # Joints whose bones stretch or slide loop too: their local translation is a position item.
+        moving = np.ptp(clip.translations, axis=0).max(axis=1) > 1e-9
+        for j in np.flatnonzero(moving[1:]) + 1:
+            start = 3 + 4 * len(joints) + 3 * len(translated)
+            cols.append(clip.translations[:, j])
+            names += [f"{sk.names[j]}.tx", f"{sk.names[j]}.ty", f"{sk.names[j]}.tz"]
+            its.append(Item(f"{sk.names[j]}.translation", "position", start, start + 3))
+            translated.append(int(j))
     traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, its)
-    return Performance(traj, tuple(names), path, clip, tuple(joints), lead)
+    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated))
 
 
 def _items_from_names(names: list[str]) -> list[Item]:
@@ -220,8 +264,11 @@ def _load_recording(path: Path, items: list[str] | None) -> Performance:
     return Performance(traj, tuple(names), path)
 
 
-def load_performance(path: str | Path, items: list[str] | None = None) -> Performance:
+def load_performance(path: str | Path, items: list[str] | None = None, **motion_options: object) -> Performance:
     """Read a performance; ``items`` restricts it to named joints / items / sources.
+
+    ``motion_options`` go to :func:`~engine.io.motion_file.load_motion` for skeletal input
+    (``animation``, ``units``, ``joint_map``); other input refuses them.
 
     Raises:
         TrajectoryError: unreadable or unsuitable content (the message says what).
@@ -231,9 +278,14 @@ def load_performance(path: str | Path, items: list[str] | None = None) -> Perfor
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
     suffix = path.suffix.lower()
-    loaders = {".bvh": _load_bvh, ".csv": _load_csv, ".npz": _load_npz, ".rec": _load_recording}
+    loaders = {".csv": _load_csv, ".npz": _load_npz, ".rec": _load_recording}
+    if suffix in (".bvh", ".gltf", ".glb"):
+        return _load_skeletal(path, items, {k: v for k, v in motion_options.items() if v is not None})
     if suffix not in loaders:
         raise TrajectoryError(f"{path}: unknown input type {suffix!r}; use one of {', '.join(INPUT_SUFFIXES)}")
+    given = sorted(k for k, v in motion_options.items() if v is not None)
+    if given:
+        raise TrajectoryError(f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to BVH/glTF input")
     return loaders[suffix](path, items)
 
 
@@ -249,11 +301,25 @@ def loop_clip(result: CycleResult, perf: Performance, name: str | None = None) -
     rots = rots / np.linalg.norm(rots, axis=-1, keepdims=True)
     for k, j in enumerate(perf.joints):
         rots[:, j] = result.loop[:, 3 + 4 * k : 7 + 4 * k]
-    return Clip(name or f"{src.name}_cycle", src.skeleton, s / result.period, root, rots, loop=True)
+    translations = None
+    if src.translations is not None:
+        translations = np.broadcast_to(src.translations.mean(axis=0), (s, *src.translations.shape[1:])).copy()
+        first = 3 + 4 * len(perf.joints)
+        for k, j in enumerate(perf.translated):
+            translations[:, j] = result.loop[:, first + 3 * k : first + 3 * k + 3]
+    return Clip(name or f"{src.name}_cycle", src.skeleton, s / result.period, root, rots, loop=True,
+                translations=translations)
 
 
-def save_loop(result: CycleResult, perf: Performance, path: str | Path) -> Path:
-    """Write the loop as ``.bvh``, ``.ppclip`` (skeletal input), ``.csv`` or ``.npz``, atomically."""
+def save_loop(
+    result: CycleResult, perf: Performance, path: str | Path, fps: float | None = None, closing_frame: bool | None = None
+) -> Path:
+    """Write the loop as ``.bvh``, ``.ppclip``, ``.glb``/``.gltf`` (skeletal input), ``.csv`` or ``.npz``, atomically.
+
+    BVH and glTF loops are resampled to a whole number of frames at ``fps`` (default: the
+    source's nominal rate, see :mod:`engine.io.loop_export`); a BVH loop ends with a closing
+    frame unless ``closing_frame`` is False (glTF loops always repeat their first key).
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in OUTPUT_SUFFIXES:
@@ -262,11 +328,18 @@ def save_loop(result: CycleResult, perf: Performance, path: str | Path) -> Path:
         from engine.clipfile import save_clip
 
         return save_clip(loop_clip(result, perf), path)
-    if suffix == ".bvh":
+    if suffix in (".bvh", ".glb", ".gltf"):
         from engine.io.bvh import write_bvh
         from engine.io.bvh_convert import clip_to_bvh
+        from engine.io.gltf_write import write_gltf
+        from engine.io.loop_export import closed, loop_at_rate, nominal_rate
 
-        return write_bvh(path, clip_to_bvh(loop_clip(result, perf)))
+        clip = loop_clip(result, perf)
+        travel = result.travel[:3]
+        clip = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel)  # type: ignore[union-attr]
+        if suffix != ".bvh":
+            return write_gltf(path, clip)
+        return write_bvh(path, clip_to_bvh(closed(clip, travel) if closing_frame is not False else clip))
     if suffix == ".csv":
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")

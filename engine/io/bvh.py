@@ -30,7 +30,7 @@ from engine.npz_safe import read_bounded
 if TYPE_CHECKING:
     from engine.clip import Clip
 
-__all__ = ["BvhError", "BvhMotion", "read_bvh", "write_bvh", "parse_bvh", "format_bvh", "CHANNEL_NAMES"]
+__all__ = ["BvhError", "BvhWarning", "BvhMotion", "read_bvh", "write_bvh", "parse_bvh", "format_bvh", "CHANNEL_NAMES"]
 
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 # Limits a real capture is far inside (CMU: 31 joints, 120 fps, centimetres and degrees).
@@ -43,6 +43,10 @@ _CANON = {c.lower(): c for c in CHANNEL_NAMES}
 
 class BvhError(ValueError):
     """A BVH file that cannot be read; the message names the file and line."""
+
+
+class BvhWarning(UserWarning):
+    """A BVH file read despite a harmless inconsistency (a ``Frames:`` count that is off)."""
 
 
 @dataclass(frozen=True)
@@ -267,47 +271,40 @@ def parse_bvh(text: str, source: str = "<string>") -> BvhMotion:
 
 
 def _motion_block(lines: list[str], start: int, n_frames: int, width: int, source: str) -> NDArray[np.float64]:
-    """The ``[F, C]`` matrix; a short or malformed block says how many frames were complete.
+    """The ``[F, C]`` matrix of the complete rows.
 
-    The fast path parses the whole block with numpy's C text reader; only when that fails
-    or the shape is off do we walk the lines to say exactly what is wrong.
+    Tolerant where exporters are sloppy, strict where data is wrong: when the ``Frames:``
+    count disagrees with the number of complete rows (off by one in files shipped by a widely
+    used importer), the complete rows are read and a :class:`BvhWarning` says so; a row with
+    the wrong number of values (a truncated file) or a non-number is refused, naming the line.
+    The fast path parses the whole block with numpy's C text reader; only when that fails do
+    we walk the lines to say exactly what is wrong.
     """
-    if n_frames > 0:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")  # numpy warns (not raises) about some bad input
-            try:
-                data = np.loadtxt(io.StringIO("\n".join(lines[start:])), dtype=np.float64, ndmin=2, comments=None)
-            except (ValueError, UserWarning):
-                data = None
-        if data is not None and data.shape == (n_frames, width):
-            return data
-    rows = [(k, ln.split()) for k, ln in enumerate(lines[start:], start) if ln.strip()]
-    if len(rows) > n_frames:
-        raise BvhError(f"{source}:{rows[n_frames][0] + 1}: more frame lines than the {n_frames} declared")
-    good = 0
-    for _, toks in rows:
-        if len(toks) != width:
-            break
-        good += 1
-    if good < n_frames:
-        if good < len(rows):
-            k, toks = rows[good]
-            raise BvhError(
-                f"{source}:{k + 1}: frame {good} has {len(toks)} values, expected {width}; "
-                f"only {good} of {n_frames} frames are complete (truncated or malformed file)"
-            )
-        raise BvhError(f"{source}: motion truncated: only {good} of {n_frames} frames are complete")
-    if n_frames == 0:
-        return np.zeros((0, width))
-    try:
-        return np.array([t for _, t in rows], dtype=np.float64).reshape(n_frames, width)
-    except ValueError:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy warns (not raises) about some bad input
+        try:
+            data = np.loadtxt(io.StringIO("\n".join(lines[start:])), dtype=np.float64, ndmin=2, comments=None)
+        except (ValueError, UserWarning):
+            data = None
+    if data is None or (data.size and data.shape[1] != width):
+        rows = [(k, ln.split()) for k, ln in enumerate(lines[start:], start) if ln.strip()]
         for f, (k, toks) in enumerate(rows):
+            if len(toks) != width:
+                raise BvhError(
+                    f"{source}:{k + 1}: frame {f} has {len(toks)} values, expected {width}; "
+                    f"only {f} of {n_frames} frames are complete (truncated or malformed file)"
+                )
             try:
                 np.array(toks, dtype=np.float64)
             except ValueError:
                 raise BvhError(f"{source}:{k + 1}: frame {f} holds a non-number; {f} frames are complete") from None
-        raise
+        data = np.array([t for _, t in rows], dtype=np.float64).reshape(len(rows), width)
+    if data.size == 0:
+        data = np.zeros((0, width))
+    if len(data) != n_frames:
+        warnings.warn(BvhWarning(f"{source}: 'Frames: {n_frames}' but the file holds {len(data)} complete frames; "
+                                 f"reading {len(data)}"), stacklevel=3)
+    return data
 
 
 def read_bvh(path: str | os.PathLike[str]) -> BvhMotion:

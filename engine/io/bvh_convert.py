@@ -10,11 +10,14 @@ Real files disagree on conventions, and every rule here comes from one of them:
   when the channel's mean along the OFFSET's main axis is nearer the OFFSET than zero.
 * **Each joint has its own rotation order**; angles compose intrinsically in the listed
   order (``from_euler("zxy", …)``), so ±180° Euler wraps vanish in the quaternions.
-* **A static root above the moving hips** (Bandai's ``joint_Root``): a clip can only move
-  joint 0, so a root whose single child has animated position channels is folded into
-  that child (exact: the child's world transform is unchanged).
-* **Units** differ (cm, inches, metres): with ``scale=None`` the unit is the one of metre,
-  centimetre, millimetre or inch that makes the rest figure closest to a human height.
+* **A static root above the moving hips** (Bandai's ``joint_Root``): a root whose single
+  child has animated position channels is folded into that child (exact: the child's
+  world transform is unchanged), so the travel lands on the clip's root.
+* **Other joints' position channels that really move** (bones that stretch, props) become
+  the clip's translation channel (:attr:`Clip.translations`); constant ones (Bandai repeats
+  each OFFSET in them) are just the offset.
+* **Units** differ (cm, inches, metres, CMU's ASF unit): with ``scale=None`` they are judged
+  by the figure, see :mod:`engine.io.units`.
 * **End Sites** become :attr:`Skeleton.tips`.
 
 The clip keeps the file's axes (BVH is nearly always Y up); :mod:`engine.io.retarget`
@@ -23,6 +26,7 @@ re-orients when it maps onto the puppet.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -32,13 +36,12 @@ from engine import quat
 from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.io._tracks import fold_root
-from engine.io.bvh import BvhError, BvhMotion
+from engine.io.bvh import BvhError, BvhMotion, BvhWarning
+from engine.io.units import judge_units
 from engine.skeleton import Skeleton
 
 __all__ = ["bvh_to_clip", "clip_to_bvh", "detect_unit_scale", "detect_tpose_frames", "skip_leading_tpose"]
 
-_UNITS = (1.0, 0.01, 0.001, 0.0254)  # metre, centimetre, millimetre, inch
-_HUMAN_HEIGHT = 1.7
 
 
 def _replaces_offset(motion: BvhMotion, j: int, axes: list[int], cols: list[int]) -> bool:
@@ -89,13 +92,8 @@ def _local_tracks(
 
 
 def detect_unit_scale(skeleton: Skeleton) -> float:
-    """Metres per file unit, judged from the rest figure's largest extent (height or arm span)."""
-    wpos, wrot = forward_kinematics(skeleton, skeleton.offsets[0], quat.identity(skeleton.num_joints))
-    pts = np.concatenate([wpos, wpos + quat.rotate(wrot, skeleton.tips)])
-    extent = float(np.max(pts.max(axis=0) - pts.min(axis=0)))
-    if not extent > 0:
-        return 1.0
-    return min(_UNITS, key=lambda u: abs(np.log(extent * u / _HUMAN_HEIGHT)))
+    """Metres per file unit, judged by the figure (leg length of a human, else its extent)."""
+    return judge_units(skeleton).scale
 
 
 def bvh_to_clip(
@@ -120,7 +118,7 @@ def bvh_to_clip(
     for j, tip in motion.end_sites.items():
         tips[j] = tip
     moves = has_pos & (np.ptp(trans, axis=0).max(axis=1) > 1e-9 * max(1.0, float(np.abs(trans).max())))
-    names, parents, trans, rots, _, tips = fold_root(list(motion.names), motion.parents.copy(), trans, rots, moves, tips)
+    names, parents, trans, rots, moves, tips = fold_root(list(motion.names), motion.parents.copy(), trans, rots, moves, tips)
     # Non-root joints keep one offset: the mean of their (normally constant) position channels.
     offsets = trans.mean(axis=0)
     offsets[0] = trans[0, 0]  # the root's rest position: where the clip starts
@@ -130,7 +128,8 @@ def bvh_to_clip(
         raise BvhError(f"{motion.source or 'BVH'}: scale must be positive, got {scale}")
     skeleton = Skeleton(skeleton.names, skeleton.parents, offsets * unit, tips * unit)
     clip_name = name if name is not None else (Path(motion.source).stem if motion.source else "bvh")
-    return Clip(clip_name, skeleton, motion.fps, trans[:, 0] * unit, rots)
+    translations = trans * unit if moves[1:].any() else None
+    return Clip(clip_name, skeleton, motion.fps, trans[:, 0] * unit, rots, translations=translations)
 
 
 def _dfs_order(parents: NDArray[np.int64]) -> list[int]:
@@ -147,24 +146,42 @@ def clip_to_bvh(clip: Clip, order: str = "ZXY", unit: float = 100.0) -> BvhMotio
     """A BVH of ``clip``: root ``X/Y/Zposition`` + rotations, other joints rotations in ``order``.
 
     ``unit`` is file units per metre (100: centimetres, what most tools expect). Euler angles
-    are unwrapped over time so curve editors see continuous channels.
+    are unwrapped over time so curve editors see continuous channels. Joints whose
+    translation channel moves get position channels too; every leaf keeps an End Site (a
+    zero one when the bone has no tip), as importers expect. BVH has no scale: a clip's
+    scale channel is dropped with a :class:`~engine.io.bvh.BvhWarning`.
     """
     order = order.upper()
     if sorted(order) != ["X", "Y", "Z"]:
         raise ValueError(f"rotation order must be a permutation of XYZ, got {order!r}")
+    if clip.scales is not None:
+        warnings.warn(BvhWarning(f"clip {clip.name!r}: BVH has no scale channels; the clip's scale is dropped"),
+                      stacklevel=2)
     sk = clip.skeleton
     perm = _dfs_order(sk.parents)
     inv = np.empty(len(perm), dtype=np.int64)
     inv[perm] = np.arange(len(perm))
     parents = np.array([-1 if sk.parents[j] < 0 else inv[sk.parents[j]] for j in perm], dtype=np.int64)
     rot_chans = tuple(f"{a}rotation" for a in order)
-    channels = tuple((("Xposition", "Yposition", "Zposition") + rot_chans) if k == 0 else rot_chans
-                     for k in range(len(perm)))
+    pos_chans = ("Xposition", "Yposition", "Zposition")
+    trans = clip.translations
+    moving = np.zeros(sk.num_joints, dtype=bool)
+    if trans is not None:
+        moving[1:] = np.ptp(trans[:, 1:], axis=0).max(axis=1) > 1e-9
+    channels = tuple((pos_chans + rot_chans) if k == 0 or moving[j] else rot_chans for k, j in enumerate(perm))
     angles = quat.to_euler(order.lower(), clip.rotations[:, perm], degrees=True)  # [F,J,3]
     if clip.num_frames > 1:
         angles = np.unwrap(angles, period=360.0, axis=0)
-    data = np.concatenate([clip.root * unit, angles.reshape(clip.num_frames, -1)], axis=1)
-    end_sites = {k: sk.tips[j] * unit for k, j in enumerate(perm) if np.any(sk.tips[j])}
+    columns = []
+    for k, j in enumerate(perm):
+        if k == 0:
+            columns.append(clip.root * unit)
+        elif moving[j]:
+            columns.append(trans[:, j] * unit)  # type: ignore[index]
+        columns.append(angles[:, k])
+    data = np.concatenate(columns, axis=1)
+    leaves = {j for j in range(sk.num_joints) if not sk.children(j)}
+    end_sites = {k: sk.tips[j] * unit for k, j in enumerate(perm) if j in leaves or np.any(sk.tips[j])}
     offsets = sk.offsets[perm] * unit
     offsets[0] = 0.0  # the root's position channels say where it is; a zero OFFSET leaves no doubt
     return BvhMotion(tuple(sk.names[j] for j in perm), parents, offsets, end_sites,

@@ -3,10 +3,12 @@
 A skin's joints become a :class:`~engine.skeleton.Skeleton` in topological order. The rest
 transform of the nodes above the skin's root (Khronos samples put a ``Z_UP`` matrix and an
 ``Armature`` there) is baked into joint 0, so the clip is in glTF world space: Y up,
-metres. Rest scales are baked into the bone offsets; *animated* scale has no place in a
-rotation clip and is dropped. Each animation is sampled (LINEAR by slerp/lerp, STEP,
-CUBICSPLINE by Hermite) at a fixed frame rate; a static root above moving hips (Fox's
-``_rootJoint``/``b_Root_00``) is folded so the hips' travel moves the clip.
+metres. Rest scales are baked into the bone offsets; an *animated* scale becomes the clip's
+scale channel (uniform: the mean of the three factors, relative to the rest scale), and an
+animated translation of any joint below the root its translation channel. Each animation is
+sampled (LINEAR by slerp/lerp, STEP, CUBICSPLINE by Hermite) at a fixed frame rate — by
+default the rate its keys are spaced at, when they are regular; a static root above
+moving hips (Fox's ``_rootJoint``/``b_Root_00``) is folded so the hips' travel moves the clip.
 """
 
 from __future__ import annotations
@@ -23,7 +25,9 @@ from engine.io._tracks import fold_root
 from engine.io.gltf import GltfAnimation, GltfAsset, GltfChannel, GltfError, read_gltf
 from engine.skeleton import Skeleton
 
-__all__ = ["sample_channel", "skin_nodes", "gltf_skeleton", "gltf_clip", "load_gltf_clips"]
+__all__ = ["sample_channel", "skin_nodes", "gltf_skeleton", "gltf_clip", "load_gltf_clips", "key_rate", "DEFAULT_FPS"]
+
+DEFAULT_FPS = 30.0
 
 MAX_FPS = 1000.0
 MAX_SAMPLES = 4_000_000  # frames x nodes: an hour at 60 fps of an 18-node skeleton
@@ -116,29 +120,41 @@ def _world_rest(asset: GltfAsset, node: int) -> tuple[F64, F64, float]:
     return pos, rot, scl
 
 
-def _tracks(asset: GltfAsset, nodes: list[int], anim: GltfAnimation | None, t: F64) -> tuple[F64, F64, NDArray[np.bool_]]:
-    """Local translations ``[T,J,3]``, rotations ``[T,J,4]`` and which joints' translation is animated."""
+def _tracks(
+    asset: GltfAsset, nodes: list[int], anim: GltfAnimation | None, t: F64
+) -> tuple[F64, F64, NDArray[np.bool_], F64 | None]:
+    """Local translations ``[T,J,3]``, rotations ``[T,J,4]``, which joints' translation is animated,
+    and the animated uniform scale relative to the rest scale ``[T,J]`` (``None`` when none is)."""
     col = {n: k for k, n in enumerate(nodes)}
     trans = np.broadcast_to(asset.translation[nodes], (len(t), len(nodes), 3)).copy()
     rots = np.broadcast_to(asset.rotation[nodes], (len(t), len(nodes), 4)).copy()
     moves = np.zeros(len(nodes), dtype=bool)
+    scales = None
     for ch in anim.channels if anim else ():
         k = col.get(ch.node)
-        if k is None or ch.path not in ("translation", "rotation") or not len(ch.times):
+        if k is None or ch.path not in ("translation", "rotation", "scale") or not len(ch.times):
             continue
         values = sample_channel(ch, t)
         if ch.path == "rotation":
             rots[:, k] = values
+        elif ch.path == "scale":
+            rest = float(np.mean(np.abs(asset.scale[ch.node])))
+            ratio = np.mean(np.abs(values), axis=1) / (rest if rest > 0 else 1.0)
+            if np.ptp(ratio) > 1e-5 or abs(float(ratio[0]) - 1.0) > 1e-5:
+                scales = np.ones((len(t), len(nodes))) if scales is None else scales
+                scales[:, k] = np.maximum(ratio, 1e-6)
         else:
             trans[:, k] = values
             # float32 keys jitter in their last bits; only real travel counts as movement
             moves[k] = bool(np.ptp(values, axis=0).max() > 1e-5 * max(1.0, float(np.abs(values).max())))
-    return trans, rots, moves
+    return trans, rots, moves, scales
 
 
-def _build(asset: GltfAsset, skin: int, anim: GltfAnimation | None, t: F64, scale: float) -> tuple[Skeleton, F64, F64]:
+def _build(
+    asset: GltfAsset, skin: int, anim: GltfAnimation | None, t: F64, scale: float
+) -> tuple[Skeleton, F64, F64, F64 | None, F64 | None]:
     nodes = skin_nodes(asset, skin)
-    trans, rots, _ = _tracks(asset, nodes, anim, t)
+    trans, rots, own_moves, scales = _tracks(asset, nodes, anim, t)
     # Fold by what *any* animation moves, so every clip of one asset shares one skeleton.
     moves = np.zeros(len(nodes), dtype=bool)
     for other in asset.animations:
@@ -154,18 +170,75 @@ def _build(asset: GltfAsset, skin: int, anim: GltfAnimation | None, t: F64, scal
     trans[:, 1:] *= wscale[parents[1:]][None, :, None]
     tips = np.array([asset.extras[n].get("tip", (0.0, 0.0, 0.0)) for n in nodes], dtype=np.float64) * wscale[:, None]
     radii = [asset.extras[n].get("radius") for n in nodes]
-    names, parents, trans, rots, _, tips = fold_root([asset.names[n] for n in nodes], parents, trans, rots, moves, tips)
+    before = len(nodes)
+    names, parents, trans, rots, moves, tips = fold_root([asset.names[n] for n in nodes], parents, trans, rots, moves, tips)
+    folded = before - len(names)
+    if scales is not None:
+        if np.ptp(scales[:, :folded]) > 1e-5 or abs(float(scales[0, :folded].max(initial=1.0)) - 1.0) > 1e-5:
+            raise GltfError(f"{asset.source}: an animated scale on a folded root joint is not supported")
+        scales = scales[:, folded:]
     if len(set(names)) != len(names):
         names = [f"{nm}#{k}" if names.count(nm) > 1 else nm for k, nm in enumerate(names)]
     radii = radii[len(radii) - len(names):]
     r = np.array(radii, dtype=np.float64) * scale if all(isinstance(x, (int, float)) for x in radii) else None
     skeleton = Skeleton(tuple(names), parents, trans[0] * scale, tips * scale, r)
-    return skeleton, trans[:, 0] * scale, rots
+    own_moves = own_moves[folded:]
+    translations = trans * scale if own_moves[1:].any() else None
+    return skeleton, trans[:, 0] * scale, rots, translations, scales
+
+
+def key_rate(anim: GltfAnimation) -> float | None:
+    """Frames per second of an animation whose keys lie on a regular grid, else ``None``.
+
+    The spacing is the smallest gap between distinct key times; the keys are regular when
+    every key time lies on that grid (within float32 precision). A rate within 0.1 % of a
+    whole number is rounded to it (float32 times make 24 fps read as 23.9999).
+    """
+    keys = np.unique(np.concatenate([c.times for c in anim.channels if len(c.times)] or [np.zeros(0)]))
+    if len(keys) < 3:
+        return None
+    step = float(np.min(np.diff(keys)))
+    if not step > 0:
+        return None
+    k = (keys - keys[0]) / step
+    if np.abs(k - np.round(k)).max() > 0.02:
+        return None
+    rate = 1.0 / step
+    whole = round(rate)
+    if whole > 0 and abs(rate - whole) <= 1e-3 * rate:
+        rate = float(whole)
+    return rate if 0 < rate <= MAX_FPS else None
 
 
 def gltf_skeleton(asset: GltfAsset, skin: int = 0, scale: float = 1.0) -> Skeleton:
     """The rest skeleton of a skin (the same one every :func:`gltf_clip` of this asset uses)."""
     return _build(asset, skin, None, np.zeros(1), scale)[0]
+
+
+def animation_rate(anim: GltfAnimation, fps: float | None = None) -> tuple[float, str]:
+    """The sampling rate of ``anim`` and where it comes from: given, our writer's, the keys' spacing, or the default."""
+    if fps is not None:
+        return fps, "given"
+    if "fps" in anim.extras:
+        return anim.extras["fps"], "recorded by PuppetPhone"
+    rate = key_rate(anim)
+    if rate is not None:
+        return rate, "key spacing"
+    return DEFAULT_FPS, f"default {DEFAULT_FPS:g} (keys not evenly spaced)"
+
+
+def find_animation(asset: GltfAsset, animation: int | str = 0) -> GltfAnimation:
+    """An animation by name, or by index (a string of digits that is no animation's name counts as an index)."""
+    names = [a.name for a in asset.animations]
+    if not names:
+        raise GltfError(f"{asset.source}: the file has no animations")
+    if isinstance(animation, str) and animation not in names and animation.strip().isdigit():
+        animation = int(animation)
+    try:
+        return asset.animations[names.index(animation) if isinstance(animation, str) else animation]
+    except (ValueError, IndexError):
+        listed = ", ".join(f"{k}: {n!r}" for k, n in enumerate(names))
+        raise GltfError(f"{asset.source}: no animation {animation!r}; it has {listed}") from None
 
 
 def gltf_clip(
@@ -177,18 +250,15 @@ def gltf_clip(
         asset: from :func:`~engine.io.gltf.read_gltf`.
         animation: index or name.
         skin: which skin's joints form the skeleton.
-        fps: sampling rate of the clip; default: the rate our writer recorded, else 30.
+        fps: sampling rate of the clip; default: the rate our writer recorded, else the
+            keys' regular spacing (:func:`key_rate`), else 30.
         scale: metres per file unit (glTF is metres: 1).
 
     Files written by :func:`engine.io.gltf_write.write_gltf` come back with their loop flag
     and markers (the repeated closing frame of a loop is dropped again).
     """
-    names = [a.name for a in asset.animations]
-    try:
-        anim = asset.animations[names.index(animation) if isinstance(animation, str) else animation]
-    except (ValueError, IndexError):
-        raise GltfError(f"{asset.source}: no animation {animation!r}; it has {names}") from None
-    given = fps if fps is not None else anim.extras.get("fps", 30.0)
+    anim = find_animation(asset, animation)
+    given, _ = animation_rate(anim, fps)
     if isinstance(given, bool) or not isinstance(given, (int, float)) or not 0 < given <= MAX_FPS:
         raise GltfError(f"{asset.source}: fps must be a number in (0, {MAX_FPS:g}], got {repr(given)[:20]}")
     rate = float(given)
@@ -199,16 +269,19 @@ def gltf_clip(
     n = int(round(anim.duration * rate)) + 1
     t = np.minimum(anim.start + np.arange(n) / rate, anim.end)
     try:
-        skeleton, root, rots = _build(asset, skin, anim, t, scale)
+        skeleton, root, rots, translations, scales = _build(asset, skin, anim, t, scale)
         rest = gltf_skeleton(asset, skin, scale)
         skeleton = Skeleton(skeleton.names, skeleton.parents, rest.offsets, rest.tips, rest.radii)
         loop = bool(anim.extras.get("loop", False))
         if loop and n > 1:
             root, rots = root[:-1], rots[:-1]
+            translations = None if translations is None else translations[:-1]
+            scales = None if scales is None else scales[:-1]
         markers = anim.extras.get("markers", {})
         markers = {str(k): float(v) for k, v in markers.items()
                    if isinstance(v, (int, float)) and math.isfinite(v)} if isinstance(markers, dict) else {}
-        return Clip(str(anim.name), skeleton, rate, root, rots, loop=loop, markers=markers)
+        return Clip(str(anim.name), skeleton, rate, root, rots, loop=loop, markers=markers,
+                    translations=translations, scales=scales)
     except GltfError:
         raise
     except (ValueError, IndexError, KeyError, TypeError) as exc:  # a skin or tracks that make no skeleton or clip

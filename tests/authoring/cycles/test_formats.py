@@ -109,10 +109,15 @@ def test_bvh_to_clip_and_bvh(tmp_path: Path, mocap_dir: Path) -> None:
     steps = quat.angle_between(back.rotations[1:], back.rotations[:-1]).max(axis=1)
     wrap = quat.angle_between(back.rotations[0], back.rotations[-1]).max()
     assert wrap <= 2.0 * steps.max()
+    # BVH loops land at the source's nominal rate (30 fps) on a whole number of frames, closed.
     save_loop(r, perf, tmp_path / "walk.bvh")
     bvh = read_bvh(tmp_path / "walk.bvh")
-    assert bvh.num_frames == len(r.loop)
-    assert bvh.frame_time == pytest.approx(r.period / len(r.loop))
+    whole = round(r.period * 30)
+    assert bvh.frame_time == 1 / 30 and bvh.num_frames == whole + 1
+    assert np.allclose(bvh.data[-1, 3:], bvh.data[0, 3:], atol=1e-6)  # the closing frame repeats the pose
+    save_loop(r, perf, tmp_path / "open.bvh", fps=24.0, closing_frame=False)
+    bvh = read_bvh(tmp_path / "open.bvh")
+    assert bvh.frame_time == 1 / 24 and bvh.num_frames == round(r.period * 24)
 
 
 def test_selected_joints_only(mocap_dir: Path) -> None:

@@ -1,0 +1,55 @@
+"""Loops made to land well in other tools: a whole number of frames at a nominal rate, and a closing frame.
+
+An extracted loop lasts whatever its period is (1.1637 s), so writing it at "its own" rate
+gives BVH frame times like 1/120.286 s, which Blender plays 1.2-5x slow unless the user
+changes its import options. :func:`loop_at_rate` instead resamples the loop to the whole
+number of frames nearest to its period at a nominal rate (the source's, or ``--fps``): the
+loop stretches by under half a frame and the file's rate is the one users expect.
+:func:`closed` repeats the first pose at the end (its root moved on by the cycle's travel),
+which is what a Cycles modifier or an NLA repeat expects of a loop's last key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from engine.clip import Clip
+
+__all__ = ["closed", "loop_at_rate", "nominal_rate"]
+
+
+def nominal_rate(fps: float) -> float:
+    """The rate a file means: ``Frame Time: 0.0333333`` is 30.00003 fps, which means 30."""
+    whole = round(fps)
+    return float(whole) if whole > 0 and abs(fps - whole) <= 1e-3 * fps else float(fps)
+
+
+def closed(clip: Clip, travel: ArrayLike | None = None) -> Clip:
+    """A non-looping clip of a loop with its first frame repeated at the end (root + ``travel``)."""
+    if not clip.loop:
+        raise ValueError(f"clip {clip.name!r} is not a loop")
+    shift = np.zeros(3) if travel is None else np.asarray(travel, dtype=np.float64)[:3]
+    root = np.concatenate([clip.root, clip.root[:1] + shift])
+    rot = np.concatenate([clip.rotations, clip.rotations[:1]])
+    tr = None if clip.translations is None else np.concatenate([clip.translations, clip.translations[:1]])
+    sc = None if clip.scales is None else np.concatenate([clip.scales, clip.scales[:1]])
+    return replace(clip, root=root, rotations=rot, loop=False, translations=tr, scales=sc, root_motion=None)
+
+
+def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None) -> Clip:
+    """The loop resampled to ``n = round(duration · rate)`` frames played at exactly ``rate`` fps.
+
+    ``travel`` is the root's travel over one cycle (so the last-to-first segment moves on
+    instead of jumping back); the result is a loop of ``n`` frames at ``rate``.
+    """
+    if not rate > 0:
+        raise ValueError(f"frame rate must be positive, got {rate}")
+    whole = closed(clip, travel)
+    n = max(int(round(clip.duration * rate)), 2)
+    t = np.arange(n) * (whole.duration / n)
+    pose = whole.sample(t)
+    return replace(whole, fps=float(rate), root=pose.root, rotations=pose.rotations, loop=True,
+                   translations=pose.offsets, scales=pose.scales)

@@ -1,0 +1,210 @@
+"""One door for motion files as people have them: BVH, glTF and GLB to a clip, with what was decided.
+
+Every command that takes a motion file (``cycle``, ``cycles``, ``clips add``, ``author edit``)
+calls :func:`load_motion` with the user's options — ``animation`` (glTF: name or index,
+default the first), ``units`` (``cm|m|mm|in|cmu``, default judged by the figure), whether to
+skip a T-pose lead-in — and gets a :class:`MotionFile`: the clip in metres plus the decisions
+(unit and why, frame rate and where it came from, warnings such as a ``Frames:`` count that
+was off), which ``--json`` prints via :meth:`MotionFile.summary`. :func:`load_joint_map`
+reads a ``--joint-map`` file and :func:`to_puppet` retargets, saying which map it used.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from engine.clip import Clip
+from engine.io.bvh import BvhError, BvhWarning, read_bvh
+from engine.io.gltf import GltfError, read_gltf
+from engine.io.units import Units, given_units, judge_units
+from engine.npz_safe import read_bounded
+from engine.skeleton import Skeleton
+
+__all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "load_joint_map", "to_puppet",
+           "scaled_clip"]
+
+MOTION_SUFFIXES = (".bvh", ".gltf", ".glb")
+MAX_MAP_FILE = 1 << 20
+
+
+class MotionFileError(ValueError):
+    """A motion file, option or joint map that cannot be used; the message says which and why."""
+
+
+@dataclass(frozen=True)
+class MotionFile:
+    """A motion file read as a clip in metres.
+
+    Attributes:
+        clip: the motion, on the file's own skeleton.
+        source: the file.
+        units: the length unit decision (name, metres per unit, basis).
+        fps_basis: where the clip's frame rate came from.
+        animation: the glTF animation's name (``None`` for BVH).
+        animations: every animation name in a glTF file.
+        skipped: leading frames dropped (a T-pose lead-in).
+        warnings: what was tolerated on the way (e.g. a ``Frames:`` count that was off).
+    """
+
+    clip: Clip
+    source: Path
+    units: Units
+    fps_basis: str
+    animation: str | None = None
+    animations: tuple[str, ...] = ()
+    skipped: int = 0
+    warnings: tuple[str, ...] = ()
+
+    def summary(self) -> dict[str, Any]:
+        """What ``--json`` reports about the input."""
+        out: dict[str, Any] = {
+            "units": self.units.name, "unit_scale": self.units.scale, "units_basis": self.units.basis,
+            "fps": self.clip.fps, "fps_basis": self.fps_basis, "frames": self.clip.num_frames,
+            "joints": self.clip.skeleton.num_joints,
+        }
+        if self.animation is not None:
+            out["animation"] = self.animation
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
+        return out
+
+
+def scaled_clip(clip: Clip, k: float) -> Clip:
+    """``clip`` with every length multiplied by ``k`` (offsets, tips, radii, root, translations)."""
+    if k == 1.0:
+        return clip
+    sk = clip.skeleton
+    skeleton = Skeleton(sk.names, sk.parents, sk.offsets * k, sk.tips * k, sk.radii * k)
+    rm = clip.root_motion
+    if rm is not None:
+        rm = replace(rm, translation=rm.translation * k)
+    return replace(clip, skeleton=skeleton, root=clip.root * k, root_motion=rm,
+                   translations=None if clip.translations is None else clip.translations * k)
+
+
+def _units(clip: Clip, units: str | None, metric: bool, joint_map: dict[str, str] | None) -> Units:
+    if units is not None:
+        try:
+            return given_units(units)
+        except ValueError as exc:
+            raise MotionFileError(str(exc)) from None
+    return judge_units(clip.skeleton, metric=metric, joint_map=joint_map)
+
+
+def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[str, str] | None) -> MotionFile:
+    from engine.io.bvh_convert import detect_tpose_frames
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", BvhWarning)
+        motion = read_bvh(path)
+    told = tuple(str(w.message) for w in caught if issubclass(w.category, BvhWarning))
+    if motion.num_frames == 0:
+        raise MotionFileError(f"{path}: the file holds no frames")
+    lead = detect_tpose_frames(motion) if skip_tpose else 0
+    raw = motion.to_clip(scale=1.0, skip_frames=lead)
+    unit = _units(raw, units, metric=False, joint_map=joint_map)
+    return MotionFile(scaled_clip(raw, unit.scale), path, unit, "BVH Frame Time", skipped=lead, warnings=told)
+
+
+def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: float | None,
+               joint_map: dict[str, str] | None) -> MotionFile:
+    from engine.io.gltf_clip import animation_rate, find_animation, gltf_clip
+
+    asset = read_gltf(path)
+    anim = find_animation(asset, 0 if animation is None else animation)
+    index = asset.animations.index(anim)
+    raw = gltf_clip(asset, index, fps=fps)
+    unit = _units(raw, units, metric=True, joint_map=joint_map)
+    return MotionFile(scaled_clip(raw, unit.scale), path, unit, animation_rate(anim, fps)[1], anim.name,
+                      tuple(a.name for a in asset.animations))
+
+
+def load_motion(
+    path: str | Path,
+    animation: int | str | None = None,
+    units: str | None = None,
+    skip_tpose: bool = True,
+    fps: float | None = None,
+    joint_map: dict[str, str] | None = None,
+) -> MotionFile:
+    """Read a ``.bvh``, ``.gltf`` or ``.glb`` motion as a clip in metres.
+
+    Args:
+        path: the file.
+        animation: glTF animation name or index (default the first); refused for BVH.
+        units: ``m``, ``cm``, ``mm``, ``in`` or ``cmu``; default judged by the figure.
+        skip_tpose: drop a BVH T-pose lead-in (CMU conversions).
+        fps: glTF sampling rate (default: from the key spacing).
+        joint_map: puppet joint → source joint, when given (helps judge units on odd names).
+
+    Raises:
+        MotionFileError: unknown type, wrong option, or a file that cannot be read (the
+            format's own error, naming file and place, is the message).
+        FileNotFoundError: no such file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path}")
+    suffix = path.suffix.lower()
+    if suffix not in MOTION_SUFFIXES:
+        raise MotionFileError(f"{path}: not a motion file ({suffix or 'no suffix'}); use one of {', '.join(MOTION_SUFFIXES)}")
+    try:
+        if suffix == ".bvh":
+            if animation is not None:
+                raise MotionFileError(f"{path}: --animation is for glTF files; a BVH holds one motion")
+            return _load_bvh(path, units, skip_tpose, joint_map)
+        return _load_gltf(path, units, animation, fps, joint_map)
+    except (BvhError, GltfError) as exc:
+        raise MotionFileError(str(exc)) from None
+
+
+def load_joint_map(path: str | Path) -> dict[str, str]:
+    """A ``--joint-map`` file: a JSON object of source joint name → puppet joint name.
+
+    Raises :class:`MotionFileError` for anything else (not JSON, not an object of strings,
+    unknown puppet joints, one puppet joint given twice, no hips).
+    """
+    from engine.humanoid import humanoid_skeleton
+
+    path = Path(path)
+    try:
+        data = json.loads(read_bounded(path, MAX_MAP_FILE).decode("utf-8"))
+    except (OSError, ValueError) as exc:  # missing, too big, not UTF-8, not JSON
+        raise MotionFileError(f"{path}: not a readable joint map ({type(exc).__name__}: {exc})"[:300]) from None
+    if not isinstance(data, dict) or not data or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
+        raise MotionFileError(f"{path}: a joint map is a JSON object of source joint name -> puppet joint name")
+    puppet = humanoid_skeleton().names
+    unknown = sorted({v for v in data.values() if v not in puppet})
+    if unknown:
+        raise MotionFileError(f"{path}: unknown puppet joints {unknown}; the puppet has {', '.join(puppet)}")
+    out: dict[str, str] = {}
+    for src, dst in data.items():
+        if dst in out:
+            raise MotionFileError(f"{path}: puppet joint {dst!r} is given twice ({out[dst]!r} and {src!r})")
+        out[dst] = src
+    if puppet[0] not in out:
+        raise MotionFileError(f"{path}: the map must give the puppet's root {puppet[0]!r}")
+    return out
+
+
+def to_puppet(clip: Clip, joint_map: dict[str, str] | None = None, map_name: str | None = None) -> tuple[Clip, str]:
+    """``clip`` retargeted onto the puppet, and the name of the map used (a family, or ``map_name``)."""
+    from engine.humanoid import humanoid_skeleton
+    from engine.io.joint_maps import guess_joint_map
+    from engine.io.retarget import retarget
+
+    names = clip.skeleton.names
+    if joint_map is not None:
+        missing = sorted({s for s in joint_map.values() if s not in names})
+        if missing:
+            raise MotionFileError(f"joint map names source joints the file does not have: {missing[:8]}")
+        return retarget(clip, humanoid_skeleton(), joint_map=joint_map, aims={}), map_name or "given"
+    try:
+        family, mapping, aims = guess_joint_map(names)
+    except ValueError as exc:
+        raise MotionFileError(f"{exc}; give one with --joint-map FILE") from None
+    return retarget(clip, humanoid_skeleton(), joint_map=mapping, aims=aims), family
