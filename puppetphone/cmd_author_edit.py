@@ -1,7 +1,9 @@
 """``puppetphone author edit CLIP``: refine a cycle with MoCurves while it plays.
 
 ``CLIP`` is a ``.ppclip`` file (a recorded cycle; its ``.mocurves.json`` side file is
-picked up) or the name of a default clip (``walk``, ``run``, …). Ctrl+S saves atomically
+picked up), a BVH/glTF/GLB motion file (opened as its loop, see
+:mod:`authoring.motion_loop`; ``--animation``, ``--units``, ``--joint-map``, ``--retarget``)
+or the name of a default clip (``walk``, ``run``, …). Ctrl+S saves atomically
 to ``--output`` (default: beside the input, ``<name>_edited.ppclip``); ``--export`` writes
 BVH/glTF/ppclip copies at the end. ``--headless --frames N --screenshot PNG`` runs the
 scene without a window (CI, screenshots). Wired as ``configure_edit``/``run_edit`` so the
@@ -32,7 +34,12 @@ def configure_edit(parser: argparse.ArgumentParser) -> None:
     from puppetphone.argtypes import output_file
     from puppetphone.runargs import add_run_arguments
 
-    parser.add_argument("clip", help="a .ppclip cycle, or a default clip name (walk, run, crouch_walk, idle…)")
+    parser.add_argument("clip", help="a .ppclip cycle, a .bvh/.gltf/.glb motion (opened as its loop), "
+                                     "or a default clip name (walk, run, crouch_walk, idle…)")
+    from puppetphone.motion_args import add_motion_options
+
+    add_motion_options(parser)
+    parser.add_argument("--retarget", action="store_true", help="a BVH/glTF motion: edit it on the puppet's skeleton")
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
@@ -41,29 +48,48 @@ def configure_edit(parser: argparse.ArgumentParser) -> None:
     add_run_arguments(parser)
 
 
-def _open(spec: str):  # type: ignore[no-untyped-def]
+def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[no-untyped-def]
     from authoring.mocurves import EditSession, load_session
     from engine.clips import default_clips
+    from engine.io.motion_file import MOTION_SUFFIXES
 
     path = Path(spec)
-    if path.exists() and path.suffix.lower() != ".ppclip":
-        raise ValueError(f"{path} is not a clip file: author edit opens a .ppclip cycle or a default clip "
-                         f"({', '.join(default_clips())})")
-    if path.suffix.lower() == ".ppclip":
+    suffix = path.suffix.lower()
+    if path.exists() and suffix in MOTION_SUFFIXES:
+        from authoring.motion_loop import open_loop
+
+        clip, note = open_loop(path, **(options or {}))  # type: ignore[arg-type]
+        print(note, file=sys.stderr)
+        return EditSession(clip), path.with_name(path.stem + "_edited.ppclip")
+    if path.exists() and suffix != ".ppclip":
+        raise ValueError(f"{path} is not a clip file: author edit opens a .ppclip cycle, a motion file "
+                         f"({', '.join(MOTION_SUFFIXES)}) or a default clip ({', '.join(default_clips())})")
+    if suffix == ".ppclip":
         return load_session(path), path.with_name(path.stem + "_edited.ppclip")
     clips = default_clips()
     if spec not in clips:
-        raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)})")
+        raise ValueError(f"{spec!r} is neither a clip or motion file nor a default clip ({', '.join(clips)})")
     return EditSession(clips[spec]), Path(f"{spec}_edited.ppclip")
 
 
-def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
-    """What a recording needs to reopen the same session: the clip's bytes (and side file), not its path."""
+def _setup(spec: str, size: tuple[int, int], session) -> dict[str, object]:  # type: ignore[no-untyped-def]
+    """What a recording needs to reopen the same session: the clip's bytes (and side file), not its path.
+
+    A motion file is recorded as the loop it opened as (a ``.ppclip``), so a replay does not
+    depend on the file, its options or the extractor staying the same."""
     from authoring.mocurves.storage import side_path
+    from engine.clipfile import save_clip
+    from engine.io.motion_file import MOTION_SUFFIXES
 
     path = Path(spec)
     setup: dict[str, object] = {"clip": spec, "size": list(size)}
-    if path.suffix.lower() == ".ppclip":
+    if path.suffix.lower() in MOTION_SUFFIXES:
+        with tempfile.TemporaryDirectory() as tmp:
+            saved = save_clip(session.clip, Path(tmp) / "clip.ppclip")
+            setup["name"] = path.stem + ".ppclip"
+            setup["ppclip"] = base64.b64encode(saved.read_bytes()).decode()
+            setup["side"] = ""
+    elif path.suffix.lower() == ".ppclip":
         setup["name"] = path.name
         setup["ppclip"] = base64.b64encode(path.read_bytes()).decode()
         side = side_path(path)
@@ -219,17 +245,18 @@ class EditActivity:
         self.edit.draw(scene)
 
 
-def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record: Path | None = None):  # type: ignore[no-untyped-def]
-    """A live edit session of ``spec`` (optionally recorded)."""
+def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record: Path | None = None,  # type: ignore[no-untyped-def]
+               options: dict[str, object] | None = None):
+    """A live edit session of ``spec`` (optionally recorded); ``options`` open a motion file."""
     from authoring.edit_scene import EditScene
     from input.hub import InputHub
     from input.recording import Recorder, RecordingHeader
 
-    session, default_out = _open(spec)
+    session, default_out = _open(spec, options)
     recorder = None
     if record is not None:
         recorder = Recorder(record, RecordingHeader(game=EDIT_GAME, seed=0, dt=EditActivity.dt, sources=["mouse"],
-                                                    setup=_setup(spec, size)))
+                                                    setup=_setup(spec, size, session)))
     return EditActivity(EditScene(session, size), session, output or default_out, InputHub(), recorder=recorder)
 
 
@@ -244,6 +271,15 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
     edit = EditScene(session, tuple(setup.get("size", (1280, 720))))
     return EditActivity(edit, session, None, InputHub(replay=ReplaySource(recording)),
                         check=HashCheck(recording) if verify else None)
+
+
+def _motion_options(args: argparse.Namespace) -> dict[str, object]:
+    from puppetphone.motion_args import motion_options
+
+    given = [f"--{k}" for k in ("animation", "units", "joint_map", "retarget") if getattr(args, k, None)]
+    if given and Path(args.clip).suffix.lower() not in (".bvh", ".gltf", ".glb"):
+        raise ValueError(f"{', '.join(g.replace('_', '-') for g in given)} only apply to a BVH/glTF/GLB file")
+    return {**motion_options(args), "retarget": bool(getattr(args, "retarget", False))}
 
 
 def run_edit(args: argparse.Namespace) -> int:
@@ -265,7 +301,7 @@ def run_edit(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     try:
-        activity = build_edit(args.clip, runner.size, args.output, record=args.record)
+        activity = build_edit(args.clip, runner.size, args.output, record=args.record, options=_motion_options(args))
     except (ValueError, OSError) as exc:
         runner.close()
         print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)

@@ -34,7 +34,8 @@ from engine.clip import Clip
 from engine.io.motion_file import MotionFile, MotionFileError, load_motion
 from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
 
-__all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop"]
+__all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop",
+           "performance_from_motion", "seamless_repeats", "is_seamless"]
 
 INPUT_SUFFIXES = (".bvh", ".gltf", ".glb", ".csv", ".npz", ".rec")
 OUTPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".ppclip", ".glb", ".gltf")
@@ -79,6 +80,13 @@ SEAMLESS_REPEATS = 3
 _SEAMLESS = 0.05  # end-to-start pose gap, as a share of the pose's range, below which an animation is a loop
 
 
+def is_seamless(clip: Clip) -> bool:
+    """Whether a clip's last pose is its first (a game asset's cycle, or our own closed BVH loop)."""
+    rot = clip.rotations
+    span = float(np.ptp(rot, axis=0).max())
+    return clip.num_frames >= 4 and span > 0 and float(np.abs(rot[-1] - rot[0]).max()) <= _SEAMLESS * span
+
+
 def seamless_repeats(clip: Clip) -> Clip:
     """A glTF animation that is one seamless cycle (its last pose is its first), repeated.
 
@@ -87,10 +95,9 @@ def seamless_repeats(clip: Clip) -> Clip:
     on by the cycle's travel) they are a performance the extractor can measure like any other.
     Other clips are returned unchanged.
     """
-    rot = clip.rotations
-    span = float(np.ptp(rot, axis=0).max())
-    if clip.num_frames < 4 or not span > 0 or float(np.abs(rot[-1] - rot[0]).max()) > _SEAMLESS * span:
+    if not is_seamless(clip):
         return clip
+    rot = clip.rotations
     travel = clip.root[-1] - clip.root[0]
     body = slice(0, clip.num_frames - 1)
     reps = SEAMLESS_REPEATS
@@ -106,6 +113,12 @@ def _load_skeletal(path: Path, items: list[str] | None, options: dict[str, objec
         motion = load_motion(path, **options)  # type: ignore[arg-type]
     except MotionFileError as exc:
         raise TrajectoryError(str(exc)) from None
+    return performance_from_motion(motion, items)
+
+
+def performance_from_motion(motion: MotionFile, items: list[str] | None = None) -> Performance:
+    """The performance of a motion file read by :func:`~engine.io.motion_file.load_motion`."""
+    path = motion.source
     clip = motion.clip
     if motion.animation is not None:
         clip = seamless_repeats(clip)

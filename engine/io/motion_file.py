@@ -74,11 +74,14 @@ class MotionFile:
 
 
 def scaled_clip(clip: Clip, k: float) -> Clip:
-    """``clip`` with every length multiplied by ``k`` (offsets, tips, radii, root, translations)."""
+    """``clip`` with every length multiplied by ``k`` (offsets, tips, root, translations).
+
+    Radii are left alone: a file without them gets the skeleton's default in metres.
+    """
     if k == 1.0:
         return clip
     sk = clip.skeleton
-    skeleton = Skeleton(sk.names, sk.parents, sk.offsets * k, sk.tips * k, sk.radii * k)
+    skeleton = Skeleton(sk.names, sk.parents, sk.offsets * k, sk.tips * k, sk.radii)
     rm = clip.root_motion
     if rm is not None:
         rm = replace(rm, translation=rm.translation * k)

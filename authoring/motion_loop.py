@@ -1,0 +1,56 @@
+"""A motion file (BVH, glTF, GLB) opened as a loop for editing, on its own skeleton or the puppet's.
+
+MoCurves edits cycles. A file that already is one (a game asset's walk, or a loop this
+project exported: its last pose is its first) opens as that loop, the closing frame
+dropped; any other take goes through the cycle extractor first, so the editor opens the
+loop ``puppetphone cycle`` would write. With ``retarget`` the loop is moved onto the
+puppet's skeleton (a built-in name map, or the user's ``--joint-map``). The travel is split
+into root motion, so the loop plays in place like the built-in cycles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from engine.clip import Clip
+
+__all__ = ["open_loop"]
+
+
+def open_loop(
+    path: str | Path,
+    animation: int | str | None = None,
+    units: str | None = None,
+    joint_map: dict[str, str] | None = None,
+    retarget: bool = False,
+) -> tuple[Clip, str]:
+    """The loop of a motion file and a one-line note of how it was made.
+
+    Raises ``ValueError`` (a :class:`~engine.io.motion_file.MotionFileError`, a
+    :class:`~authoring.cycles.extract.CycleError` or a trajectory error) saying why not.
+    """
+    from authoring.cycles.extract import extract_cycle
+    from authoring.cycles.formats import is_seamless, loop_clip, performance_from_motion
+    from engine.io.motion_file import load_motion, to_puppet
+
+    motion = load_motion(path, animation=animation, units=units, joint_map=joint_map)
+    clip = motion.clip
+    if is_seamless(clip):
+        n = clip.num_frames - 1
+        tr = None if clip.translations is None else clip.translations[:n]
+        sc = None if clip.scales is None else clip.scales[:n]
+        loop = replace(clip, root=clip.root[:n], rotations=clip.rotations[:n], loop=True, translations=tr, scales=sc)
+        note = f"{motion.source.name}: a seamless loop of {n} frames"
+    else:
+        perf = performance_from_motion(motion)
+        result = extract_cycle(perf.trajectory, np.random.default_rng(0))
+        loop = loop_clip(result, perf, name=clip.name)
+        note = f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles"
+    if retarget:
+        loop, family = to_puppet(loop, joint_map)
+        note += f", retargeted to the puppet with the {family!r} map"
+    # Edit in place, as the built-in cycles are: the travel rides in root motion.
+    return loop.extract_root_motion(), note
