@@ -4,7 +4,9 @@ Edited cycles leave the engine this way (issue 9) for Blender, three.js or any g
 viewer. Each joint is a node whose rest translation is its bone offset and whose rest
 rotation is the identity (the engine's rest pose); the skin's inverse bind matrices
 match that rest pose, so a mesh bound later deforms correctly. The animation has the
-root's translation and every joint's rotation, sampled once per clip frame (LINEAR).
+root's translation and every joint's rotation, sampled once per clip frame (LINEAR), plus
+the translation of every other joint whose translation channel moves and the scale of
+every joint whose scale channel leaves 1 (uniform, written as ``(s, s, s)``).
 A looping clip gets its first frame repeated at ``F / fps`` so any viewer loops it
 seamlessly; ``extras`` remember the loop flag, markers and frame rate, and bone tips and
 radii ride in node ``extras`` so :func:`engine.io.gltf_clip.gltf_clip` gets the clip back.
@@ -66,9 +68,12 @@ def _document(clip: Clip) -> tuple[dict[str, Any], bytes]:
     j_count = sk.num_joints
     root, rots = clip.root, clip.rotations
     times = np.arange(clip.num_frames) / clip.fps
+    trans, scales = clip.translations, clip.scales
     if clip.loop:
         root = np.concatenate([root, root[:1]])
         rots = np.concatenate([rots, rots[:1]])
+        trans = None if trans is None else np.concatenate([trans, trans[:1]])
+        scales = None if scales is None else np.concatenate([scales, scales[:1]])
         times = np.append(times, clip.num_frames / clip.fps)
     nodes: list[dict[str, Any]] = []
     for j in range(j_count):
@@ -91,6 +96,15 @@ def _document(clip: Clip) -> tuple[dict[str, Any], bytes]:
     for j in range(j_count):
         samplers.append({"input": t_acc, "output": buf.add(quat.to_xyzw(rots[:, j]), "VEC4"), "interpolation": "LINEAR"})
         channels.append({"sampler": len(samplers) - 1, "target": {"node": j, "path": "rotation"}})
+    for j in range(1, j_count):
+        if trans is not None and np.ptp(trans[:, j], axis=0).max() > 1e-9:
+            samplers.append({"input": t_acc, "output": buf.add(trans[:, j], "VEC3"), "interpolation": "LINEAR"})
+            channels.append({"sampler": len(samplers) - 1, "target": {"node": j, "path": "translation"}})
+    for j in range(j_count):
+        if scales is not None and np.abs(scales[:, j] - 1.0).max() > 1e-9:
+            samplers.append({"input": t_acc, "output": buf.add(np.repeat(scales[:, j, None], 3, axis=1), "VEC3"),
+                             "interpolation": "LINEAR"})
+            channels.append({"sampler": len(samplers) - 1, "target": {"node": j, "path": "scale"}})
     blob = buf.blob()
     doc: dict[str, Any] = {
         "asset": {"version": "2.0", "generator": "PuppetPhone engine.io.gltf_write"},

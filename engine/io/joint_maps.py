@@ -8,8 +8,11 @@ joint, the source joint its bone points at when the source joint has no End Site
 no End Site (iClone and Bandai feet end in toe joints, not End Sites).
 
 Sources: the joint lists of the files in ``shared/data/mocap`` (CMU/DAZ ``hip``/``lThigh``,
-iClone ``CC_Base_*``, Bandai ``UpperLeg_L``) and the published Mixamo and CMU
-(cgspeed MotionBuilder-friendly) naming.
+iClone ``CC_Base_*``, Bandai ``UpperLeg_L``), the published Mixamo and CMU (cgspeed
+MotionBuilder-friendly) naming, the classic Biovision/MotionBuilder naming (``LeftHip``,
+``LeftKnee``, ``LeftAnkle``, ``LeftCollar``/``LeftShoulder``/``LeftElbow``/``LeftWrist``) and
+the lowercase naming of pose estimators (``lhip``/``lknee``/``lfoot``). Any other skeleton
+takes a map from the user (``--joint-map FILE``, :func:`engine.io.motion_file.load_joint_map`).
 """
 
 from __future__ import annotations
@@ -47,6 +50,20 @@ JOINT_MAPS: dict[str, dict[str, tuple[str, ...]]] = {
         **_limbs({"upper_arm": ("CC_Base_{s}_Upperarm",), "lower_arm": ("CC_Base_{s}_Forearm",),
                   "hand": ("CC_Base_{s}_Hand",), "upper_leg": ("CC_Base_{s}_Thigh",),
                   "lower_leg": ("CC_Base_{s}_Calf",), "foot": ("CC_Base_{s}_Foot",)}, "L", "R"),
+    },
+    "biovision": {  # classic Biovision / MotionBuilder: LeftHip/LeftKnee/LeftAnkle, LeftShoulder/LeftElbow/LeftWrist
+        "hips": ("Hips", "Hip", "Pelvis"), "spine": ("Spine", "Chest"), "chest": ("Chest2", "Spine1", "UpperChest"),
+        "neck": ("Neck",), "head": ("Head",),
+        **_limbs({"upper_arm": ("{s}Shoulder", "{s}UpArm"), "lower_arm": ("{s}Elbow", "{s}LowArm"),
+                  "hand": ("{s}Wrist", "{s}Hand"), "upper_leg": ("{s}Hip", "{s}UpLeg"),
+                  "lower_leg": ("{s}Knee", "{s}LowLeg"), "foot": ("{s}Ankle", "{s}Foot")}, "Left", "Right"),
+    },
+    "lowercase": {  # pose estimators (lhip/lknee/lfoot, lshoulder/lelbow/lwrist)
+        "hips": ("hip", "hips", "pelvis", "root"), "spine": ("spine", "abdomen", "torso"),
+        "chest": ("chest", "thorax", "spine1"), "neck": ("neck",), "head": ("head",),
+        **_limbs({"upper_arm": ("{s}shoulder", "{s}shldr"), "lower_arm": ("{s}elbow", "{s}forearm"),
+                  "hand": ("{s}wrist", "{s}hand"), "upper_leg": ("{s}hip", "{s}thigh"),
+                  "lower_leg": ("{s}knee", "{s}shin"), "foot": ("{s}foot", "{s}ankle")}, "l", "r"),
     },
     "bandai": {
         "hips": ("Hips",), "spine": ("Spine",), "chest": ("Chest",), "neck": ("Neck",), "head": ("Head",),

@@ -12,9 +12,16 @@ Local rotations follow as ``parent⁻¹ · child``; unmapped target joints keep 
 
 The root travels with the source's hips, scaled by the ratio of leg lengths so the
 stride fits the puppet's legs and the feet stay on the floor.
+
+The puppet's bones are rigid: a source's translation channel (stretching bones, props)
+and scale channel place the source joints (so the hips travel right) but are not carried
+over. They are dropped explicitly, with a :class:`RetargetWarning` when they moved a
+joint by more than :data:`LARGE_TRANSLATION` of the source's leg length.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,7 +32,13 @@ from engine.fk import forward_kinematics
 from engine.io.joint_maps import guess_joint_map
 from engine.skeleton import Skeleton
 
-__all__ = ["retarget", "leg_length"]
+__all__ = ["retarget", "leg_length", "RetargetWarning", "LARGE_TRANSLATION"]
+
+LARGE_TRANSLATION = 0.02  # share of the source leg length
+
+
+class RetargetWarning(UserWarning):
+    """Retargeting dropped motion the puppet cannot play (translation or scale channels)."""
 
 F64 = NDArray[np.float64]
 _AXES = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0], [0, 0, -1]], dtype=np.float64)
@@ -105,6 +118,34 @@ def _floor_level(target: Skeleton, root: F64, local: F64) -> float:
     return float(np.percentile(pts.min(axis=1), 5.0))
 
 
+def _warn_dropped(clip: Clip, target: Skeleton, a_pos: F64, tmap: dict[int, int]) -> None:
+    """Warn when the translation or scale channel the puppet cannot play moved joints noticeably."""
+    if clip.translations is None and clip.scales is None:
+        return
+    src = clip.skeleton
+    rigid, _ = forward_kinematics(src, clip.root, clip.rotations)
+    full, _ = forward_kinematics(src, clip.root, clip.rotations, clip.translations, clip.scales)
+    moved = np.linalg.norm(full - rigid, axis=-1).max(axis=0)  # [J] largest displacement per joint
+    scale = max(_source_leg(target, a_pos, tmap), 1e-9)
+    worst = int(np.argmax(moved))
+    if moved[worst] > LARGE_TRANSLATION * scale:
+        channels = " and ".join(n for n, v in (("translation", clip.translations), ("scale", clip.scales)) if v is not None)
+        warnings.warn(RetargetWarning(
+            f"clip {clip.name!r}: the puppet's bones are rigid; its {channels} channel is dropped, which moves "
+            f"{src.names[worst]!r} by up to {moved[worst]:.3g} m ({moved[worst] / scale:.0%} of the leg)"), stacklevel=3)
+
+
+def _source_leg(target: Skeleton, a_pos: F64, tmap: dict[int, int]) -> float:
+    """Source leg length (hip to foot joint, rest) through the map, or the rest figure's extent."""
+    legs = []
+    for side in ("l", "r"):
+        names = [f"{side}_{b}" for b in ("upper_leg", "lower_leg", "foot")]
+        if all(n in target.names and target.index(n) in tmap for n in names):
+            pts = a_pos[[tmap[target.index(n)] for n in names]]
+            legs.append(float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()))
+    return float(np.mean(legs)) if legs else float(np.ptp(a_pos, axis=0).max())
+
+
 def retarget(
     clip: Clip,
     target: Skeleton,
@@ -138,8 +179,9 @@ def retarget(
         raise ValueError(f"the joint map must map the target root {target.names[0]!r}")
     aim_idx = {target.index(t): src.index(s) for t, s in aims.items()}
 
-    s_pos, s_rot = forward_kinematics(src, clip.root, clip.rotations)
+    s_pos, s_rot = forward_kinematics(src, clip.root, clip.rotations, clip.translations, clip.scales)
     a_pos, a_rot = forward_kinematics(src, src.offsets[0], quat.identity(src.num_joints))
+    _warn_dropped(clip, target, a_pos, tmap)
     b_pos, b_rot = forward_kinematics(target, target.offsets[0], quat.identity(target.num_joints))
     root_src = tmap[0]
 

@@ -1,0 +1,108 @@
+"""Human BVH files made in the test, in any naming, unit and frame count (no files shipped).
+
+The figure is an adult in metres (leg 0.82 m from hip joint to ankle) scaled to the file
+unit; it walks on the spot with swinging legs and arms while the root moves forward, so
+cycle extraction, units and retargeting all have something real to measure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# role -> (parent role, offset in metres)
+_BONES = {
+    "hips": (None, (0.0, 0.95, 0.0)),
+    "spine": ("hips", (0.0, 0.12, 0.0)),
+    "chest": ("spine", (0.0, 0.2, 0.0)),
+    "neck": ("chest", (0.0, 0.2, 0.0)),
+    "head": ("neck", (0.0, 0.1, 0.0)),
+    "l_upper_arm": ("chest", (0.18, 0.15, 0.0)),
+    "l_lower_arm": ("l_upper_arm", (0.0, -0.28, 0.0)),
+    "l_hand": ("l_lower_arm", (0.0, -0.25, 0.0)),
+    "r_upper_arm": ("chest", (-0.18, 0.15, 0.0)),
+    "r_lower_arm": ("r_upper_arm", (0.0, -0.28, 0.0)),
+    "r_hand": ("r_lower_arm", (0.0, -0.25, 0.0)),
+    "l_upper_leg": ("hips", (0.1, -0.05, 0.0)),
+    "l_lower_leg": ("l_upper_leg", (0.0, -0.42, 0.0)),
+    "l_foot": ("l_lower_leg", (0.0, -0.40, 0.0)),
+    "r_upper_leg": ("hips", (-0.1, -0.05, 0.0)),
+    "r_lower_leg": ("r_upper_leg", (0.0, -0.42, 0.0)),
+    "r_foot": ("r_lower_leg", (0.0, -0.40, 0.0)),
+}
+_TIPS = {"head": (0.0, 0.12, 0.0), "l_hand": (0.0, -0.08, 0.0), "r_hand": (0.0, -0.08, 0.0),
+         "l_foot": (0.0, -0.05, 0.14), "r_foot": (0.0, -0.05, 0.14)}
+
+MIXAMO = {"hips": "Hips", "spine": "Spine", "chest": "Spine1", "neck": "Neck", "head": "Head",
+          **{f"{s}_{b}": f"{w}{n}" for s, w in (("l", "Left"), ("r", "Right"))
+             for b, n in (("upper_arm", "Arm"), ("lower_arm", "ForeArm"), ("hand", "Hand"),
+                          ("upper_leg", "UpLeg"), ("lower_leg", "Leg"), ("foot", "Foot"))}}
+BIOVISION = {"hips": "Hips", "spine": "Chest", "chest": "Chest2", "neck": "Neck", "head": "Head",
+             **{f"{s}_{b}": f"{w}{n}" for s, w in (("l", "Left"), ("r", "Right"))
+                for b, n in (("upper_arm", "Shoulder"), ("lower_arm", "Elbow"), ("hand", "Wrist"),
+                             ("upper_leg", "Hip"), ("lower_leg", "Knee"), ("foot", "Ankle"))}}
+LOWERCASE = {"hips": "hip", "spine": "abdomen", "chest": "chest", "neck": "neck", "head": "head",
+             **{f"{s}_{b}": f"{s}{n}" for s in ("l", "r")
+                for b, n in (("upper_arm", "shoulder"), ("lower_arm", "elbow"), ("hand", "wrist"),
+                             ("upper_leg", "hip"), ("lower_leg", "knee"), ("foot", "foot"))}}
+ODD = {role: f"bone_{k:02d}" for k, role in enumerate(_BONES)}
+
+
+def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int = 120, fps: float = 30.0,
+              period: float = 1.0, stretch: float = 0.0, frames_header: int | None = None,
+              zero_end_site: bool = False) -> str:
+    """BVH text of the walking figure.
+
+    Args:
+        names: role -> joint name.
+        unit: file units per metre (100: cm; 1 / 0.05644: CMU's ASF unit).
+        frames, fps, period: the take's length, rate and stride period in seconds.
+        stretch: share by which the left shin stretches and shrinks over the stride (its
+            position channels move; 0: no position channels below the root).
+        frames_header: the ``Frames:`` count written (default: the true count).
+        zero_end_site: give the head an End Site with a zero OFFSET.
+    """
+    roles = list(_BONES)
+    kids: dict[str | None, list[str]] = {}
+    for r in roles:
+        kids.setdefault(_BONES[r][0], []).append(r)
+    lines = ["HIERARCHY"]
+    order: list[str] = []
+
+    def emit(role: str, depth: int) -> None:
+        pad = "  " * depth
+        order.append(role)
+        lines.append(f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {names[role]}")
+        lines.append(pad + "{")
+        off = np.array(_BONES[role][1]) * unit
+        lines.append(f"{pad}  OFFSET {off[0]:.6f} {off[1]:.6f} {off[2]:.6f}")
+        pos = depth == 0 or (stretch and role == "l_lower_leg")
+        chans = "Xposition Yposition Zposition " if pos else ""
+        lines.append(f"{pad}  CHANNELS {6 if pos else 3} {chans}Zrotation Xrotation Yrotation")
+        for k in kids.get(role, []):
+            emit(k, depth + 1)
+        tip = (0.0, 0.0, 0.0) if zero_end_site and role == "head" else _TIPS.get(role)
+        if tip is not None and not kids.get(role):
+            t = np.array(tip) * unit
+            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET {t[0]:.6f} {t[1]:.6f} {t[2]:.6f}", f"{pad}  }}"])
+        lines.append(pad + "}")
+
+    emit("hips", 0)
+    t = np.arange(frames) / fps
+    ph = 2 * np.pi * t / period
+    rows = []
+    for f in range(frames):
+        row: list[float] = []
+        for role in order:
+            if role == "hips":
+                row += [0.0, (0.95 + 0.02 * np.cos(2 * ph[f])) * unit, 1.2 * t[f] * unit]
+            elif stretch and role == "l_lower_leg":
+                row += [0.0, -0.42 * (1 + stretch * np.sin(ph[f])) * unit, 0.0]
+            swing = {"l_upper_leg": 25, "r_upper_leg": -25, "l_upper_arm": -20, "r_upper_arm": 20}.get(role, 0.0)
+            knee = {"l_lower_leg": 1.0, "r_lower_leg": -1.0}.get(role, 0.0)
+            x = swing * np.sin(ph[f]) + (20 * (1 + knee * np.sin(ph[f])) if knee else 0.0)
+            y = 5 * np.sin(ph[f]) if role in ("hips", "chest") else 0.0
+            row += [0.0, x, y]
+        rows.append(" ".join(f"{v:.6f}" for v in row))
+    count = frames if frames_header is None else frames_header
+    lines += ["MOTION", f"Frames: {count}", f"Frame Time: {1.0 / fps:.7f}", *rows]
+    return "\n".join(lines) + "\n"
