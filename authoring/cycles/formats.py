@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from authoring.cycles.extract import CycleResult
+from authoring.cycles.heading import normalise, restore
 from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
@@ -55,6 +56,8 @@ class Performance:
         motion: for skeletal input, the file's decisions (units, fps, animation, warnings).
         translated: for skeletal input, the joints whose translation channel moves; each is a
             position item after the rotation items, in this order.
+        heading: for skeletal input, the column of the travelling heading item: the root
+            position and rotation items are heading-normalised (:mod:`authoring.cycles.heading`).
     """
 
     trajectory: Trajectory
@@ -65,6 +68,7 @@ class Performance:
     skipped: int = 0
     motion: MotionFile | None = None
     translated: tuple[int, ...] = ()
+    heading: int | None = None
 
 
 def _select(available: list[str], wanted: list[str] | None, what: str) -> list[str]:
@@ -124,14 +128,17 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
         clip = seamless_repeats(clip)
     sk = clip.skeleton
     chosen = _select(list(sk.names), items, "joint")
-    cols = [clip.root]
+    local, level, heading = normalise(clip.root, clip.rotations[:, 0])
+    rotations = clip.rotations.copy()
+    rotations[:, 0] = level
+    cols = [local]
     names = [f"{sk.names[0]}.x", f"{sk.names[0]}.y", f"{sk.names[0]}.z"]
     its = [Item(f"{sk.names[0]}.position", "position", 0, 3, travel=True)]
     joints = []
     for name in chosen:
         j = sk.index(name)
         start = 3 + 4 * len(joints)
-        cols.append(clip.rotations[:, j])
+        cols.append(rotations[:, j])
         names += [f"{name}.qw", f"{name}.qx", f"{name}.qy", f"{name}.qz"]
         its.append(Item(f"{name}.rotation", "rotation", start, start + 4))
         joints.append(j)
@@ -145,8 +152,12 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
             names += [f"{sk.names[j]}.tx", f"{sk.names[j]}.ty", f"{sk.names[j]}.tz"]
             its.append(Item(f"{sk.names[j]}.translation", "position", start, start + 3))
             translated.append(int(j))
+    column = 3 + 4 * len(joints) + 3 * len(translated)
+    cols.append(heading[:, None])
+    names.append(f"{sk.names[0]}.heading")
+    its.append(Item(f"{sk.names[0]}.heading", "position", column, column + 1, travel=True))
     traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, its)
-    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated))
+    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column)
 
 
 def _items_from_names(names: list[str]) -> list[Item]:
@@ -308,12 +319,12 @@ def loop_clip(result: CycleResult, perf: Performance, name: str | None = None) -
         raise TrajectoryError("only skeletal input (BVH) can become a clip or BVH; write .csv or .npz instead")
     src = perf.clip
     s = len(result.loop)
-    root = result.loop[:, 0:3]
     rots = np.broadcast_to(src.rotations.mean(axis=0), (s, *src.rotations.shape[1:])).copy()
     # Joints that were not analysed keep their mean pose from the performance.
     rots = rots / np.linalg.norm(rots, axis=-1, keepdims=True)
     for k, j in enumerate(perf.joints):
         rots[:, j] = result.loop[:, 3 + 4 * k : 7 + 4 * k]
+    root, rots[:, 0], _ = _world_root(result, perf, rots[:, 0])
     translations = None
     if src.translations is not None:
         translations = np.broadcast_to(src.translations.mean(axis=0), (s, *src.translations.shape[1:])).copy()
@@ -322,6 +333,29 @@ def loop_clip(result: CycleResult, perf: Performance, name: str | None = None) -
             translations[:, j] = result.loop[:, first + 3 * k : first + 3 * k + 3]
     return Clip(name or f"{src.name}_cycle", src.skeleton, s / result.period, root, rots, loop=True,
                 translations=translations)
+
+
+def _world_root(result: CycleResult, perf: Performance, level: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The loop's world root position, root rotation and per-cycle travel (heading restored)."""
+    if perf.heading is None:
+        return result.loop[:, 0:3], level, result.travel[:3]
+    hc = perf.heading
+    if 0 not in perf.joints:  # the root rotation was not analysed: it keeps its level mean
+        level = np.broadcast_to(level[:1], level.shape)
+    return restore(result.loop[:, 0:3], level, result.loop[:, hc], result.travel[:3], float(result.travel[hc]))
+
+
+def loop_travel(result: CycleResult, perf: Performance) -> tuple[NDArray[np.float64], float]:
+    """World travel and heading change (radians about +Y) of one cycle of the loop clip."""
+    level = result.loop[:, 3:7] if 0 in perf.joints else np.tile(quat_identity(), (len(result.loop), 1))
+    travel = _world_root(result, perf, level)[2]
+    return travel, float(result.travel[perf.heading]) if perf.heading is not None else 0.0
+
+
+def quat_identity() -> NDArray[np.float64]:
+    """The identity rotation ``(1, 0, 0, 0)``."""
+    return np.array([1.0, 0.0, 0.0, 0.0])
 
 
 def save_loop(
@@ -348,11 +382,11 @@ def save_loop(
         from engine.io.loop_export import closed, loop_at_rate, nominal_rate
 
         clip = loop_clip(result, perf)
-        travel = result.travel[:3]
-        clip = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel)  # type: ignore[union-attr]
+        travel, turn = loop_travel(result, perf)
+        clip = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]
         if suffix != ".bvh":
             return write_gltf(path, clip)
-        return write_bvh(path, clip_to_bvh(closed(clip, travel) if closing_frame is not False else clip))
+        return write_bvh(path, clip_to_bvh(closed(clip, travel, turn) if closing_frame is not False else clip))
     if suffix == ".csv":
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")

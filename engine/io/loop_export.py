@@ -16,6 +16,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike
 
+from engine import quat
 from engine.clip import Clip
 
 __all__ = ["closed", "loop_at_rate", "nominal_rate"]
@@ -27,19 +28,25 @@ def nominal_rate(fps: float) -> float:
     return float(whole) if whole > 0 and abs(fps - whole) <= 1e-3 * fps else float(fps)
 
 
-def closed(clip: Clip, travel: ArrayLike | None = None) -> Clip:
-    """A non-looping clip of a loop with its first frame repeated at the end (root + ``travel``)."""
+def closed(clip: Clip, travel: ArrayLike | None = None, turn: float = 0.0) -> Clip:
+    """A non-looping clip of a loop with its first frame repeated at the end.
+
+    The repeated root is moved on by ``travel`` (world, per cycle) and its rotation turned
+    by ``turn`` radians about +Y, so a walk that travels or turns continues instead of
+    jumping back."""
     if not clip.loop:
         raise ValueError(f"clip {clip.name!r} is not a loop")
     shift = np.zeros(3) if travel is None else np.asarray(travel, dtype=np.float64)[:3]
     root = np.concatenate([clip.root, clip.root[:1] + shift])
-    rot = np.concatenate([clip.rotations, clip.rotations[:1]])
+    first = clip.rotations[:1].copy()
+    first[:, 0] = quat.mul(quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), turn), first[:, 0])
+    rot = np.concatenate([clip.rotations, first])
     tr = None if clip.translations is None else np.concatenate([clip.translations, clip.translations[:1]])
     sc = None if clip.scales is None else np.concatenate([clip.scales, clip.scales[:1]])
     return replace(clip, root=root, rotations=rot, loop=False, translations=tr, scales=sc, root_motion=None)
 
 
-def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None) -> Clip:
+def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None, turn: float = 0.0) -> Clip:
     """The loop resampled to ``n = round(duration · rate)`` frames played at exactly ``rate`` fps.
 
     ``travel`` is the root's travel over one cycle (so the last-to-first segment moves on
@@ -47,7 +54,7 @@ def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None) -> Cl
     """
     if not rate > 0:
         raise ValueError(f"frame rate must be positive, got {rate}")
-    whole = closed(clip, travel)
+    whole = closed(clip, travel, turn)
     n = max(int(round(clip.duration * rate)), 2)
     t = np.arange(n) * (whole.duration / n)
     pose = whole.sample(t)

@@ -122,7 +122,7 @@ def test_bvh_to_clip_and_bvh(tmp_path: Path, mocap_dir: Path) -> None:
 
 def test_selected_joints_only(mocap_dir: Path) -> None:
     perf = load_performance(mocap_dir / "bandai1_walk_normal_001.bvh", ["Hips", "UpperLeg_L", "UpperLeg_R"])
-    assert perf.trajectory.dims == 3 + 3 * 4
+    assert perf.trajectory.dims == 3 + 3 * 4 + 1  # root position, three rotations, the heading
     r = extract_cycle(perf.trajectory)
     assert 30 <= r.period_samples <= 35
 

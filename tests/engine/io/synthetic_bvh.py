@@ -49,7 +49,7 @@ ODD = {role: f"bone_{k:02d}" for k, role in enumerate(_BONES)}
 
 def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int = 120, fps: float = 30.0,
               period: float = 1.0, stretch: float = 0.0, frames_header: int | None = None,
-              zero_end_site: bool = False) -> str:
+              zero_end_site: bool = False, turn: float = 0.0, turn_period: float = 8.0) -> str:
     """BVH text of the walking figure.
 
     Args:
@@ -60,6 +60,8 @@ def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int =
             position channels move; 0: no position channels below the root).
         frames_header: the ``Frames:`` count written (default: the true count).
         zero_end_site: give the head an End Site with a zero OFFSET.
+        turn: amplitude in degrees of the heading, ``turn · sin(2πt / turn_period)``: the
+            walker weaves (a figure eight's left and right arcs) instead of going straight.
     """
     roles = list(_BONES)
     kids: dict[str | None, list[str]] = {}
@@ -89,18 +91,22 @@ def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int =
     emit("hips", 0)
     t = np.arange(frames) / fps
     ph = 2 * np.pi * t / period
+    heading = np.radians(turn) * np.sin(2 * np.pi * t / turn_period)
+    step = 1.2 / fps * np.stack([np.sin(heading), np.cos(heading)], axis=1)
+    ground = np.concatenate([np.zeros((1, 2)), np.cumsum(step[:-1], axis=0)])
     rows = []
     for f in range(frames):
         row: list[float] = []
         for role in order:
             if role == "hips":
-                row += [0.0, (0.95 + 0.02 * np.cos(2 * ph[f])) * unit, 1.2 * t[f] * unit]
+                row += [ground[f, 0] * unit, (0.95 + 0.02 * np.cos(2 * ph[f])) * unit, ground[f, 1] * unit]
             elif stretch and role == "l_lower_leg":
                 row += [0.0, -0.42 * (1 + stretch * np.sin(ph[f])) * unit, 0.0]
             swing = {"l_upper_leg": 25, "r_upper_leg": -25, "l_upper_arm": -20, "r_upper_arm": 20}.get(role, 0.0)
             knee = {"l_lower_leg": 1.0, "r_lower_leg": -1.0}.get(role, 0.0)
             x = swing * np.sin(ph[f]) + (20 * (1 + knee * np.sin(ph[f])) if knee else 0.0)
             y = 5 * np.sin(ph[f]) if role in ("hips", "chest") else 0.0
+            y += float(np.degrees(heading[f])) if role == "hips" else 0.0
             row += [0.0, x, y]
         rows.append(" ".join(f"{v:.6f}" for v in row))
     count = frames if frames_header is None else frames_header
