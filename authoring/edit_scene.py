@@ -96,7 +96,7 @@ class EditScene:
         scene.ground.snow = 0.0  # a flat floor: curves and arrows read better on it
         scene.ground.grid_spacing = 0.25
         pose = clip.sample(self.time)
-        pos, rot = forward_kinematics(clip.skeleton, pose.root, pose.rotations)
+        pos, rot = forward_kinematics(clip.skeleton, pose.root, pose.rotations, pose.offsets, pose.scales)
         a, b, r, _ = puppet_capsules(clip.skeleton, pos, rot)
         scene.add_capsules(a, b, r, color=(0.86, 0.86, 0.9))
         for name in self.items:

@@ -46,7 +46,9 @@ class EditSession:
 
     Args:
         clip: the cycle to edit (must loop).
-        scales: optional ``[F,J]`` scale tracks (ones otherwise).
+        scales: optional ``[F,J]`` scale tracks (default: the clip's scale channel, else ones).
+            The scale arrows edit them; :attr:`clip` carries them as its scale channel, so a
+            scale edit reaches the character, the saved ``.ppclip`` and the glTF export.
         tau: falloff range τ (keypoints) of arrow edits.
         sigma: falloff sharpness σ of arrow edits.
     """
@@ -57,6 +59,8 @@ class EditSession:
             raise ValueError(f"clip {clip.name!r} is not a loop; MoCurves edit motion cycles")
         if clip.num_frames < 4:
             raise ValueError(f"clip {clip.name!r} has {clip.num_frames} frames; a cycle needs at least 4")
+        if scales is None:
+            scales = clip.scales
         s = np.ones((clip.num_frames, clip.skeleton.num_joints)) if scales is None else np.array(scales, dtype=np.float64)
         if s.shape != (clip.num_frames, clip.skeleton.num_joints) or not np.all(s > 0):
             raise ValueError(f"scales must be positive [{clip.num_frames},{clip.skeleton.num_joints}]")
@@ -68,6 +72,7 @@ class EditSession:
         self._preview: EditState | None = None
         self._warps: dict[tuple[int, float], TimeWarp] = {}
         self._curves: tuple[EditState, dict[str, MoCurve]] | None = None
+        self._channel: tuple[EditState, Clip] | None = None
         self.tau = int(tau)
         self.sigma = float(sigma)
         self.revision = 0
@@ -81,8 +86,16 @@ class EditSession:
 
     @property
     def clip(self) -> Clip:
-        """The edited clip as currently shown."""
-        return self.state.clip
+        """The edited clip as currently shown, its scale tracks as its scale channel (none while all are 1)."""
+        st = self.state
+        if self._channel is None or self._channel[0] is not st:
+            unit = bool(np.all(st.scales == 1.0))
+            if unit and st.clip.scales is None:
+                clip = st.clip
+            else:
+                clip = replace(st.clip, scales=None if unit else st.scales)
+            self._channel = (st, clip)
+        return self._channel[1]
 
     @property
     def scales(self) -> F:

@@ -75,7 +75,7 @@ def save_session(session: EditSession, path: str | Path) -> Path:
     # Side file first: a crash between the two leaves the old clip with a side file that
     # no longer matches it, which load refuses loudly, never a silently wrong pairing.
     atomic_write_bytes(side_path(p), json.dumps(side).encode())
-    return save_clip(st.clip, p)
+    return save_clip(session.clip, p)  # the scale tracks ride in the clip's scale channel too
 
 
 def load_session(path: str | Path) -> EditSession:

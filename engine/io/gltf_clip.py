@@ -174,7 +174,7 @@ def _build(
     names, parents, trans, rots, moves, tips = fold_root([asset.names[n] for n in nodes], parents, trans, rots, moves, tips)
     folded = before - len(names)
     if scales is not None:
-        if np.ptp(scales[:, :folded]) > 1e-5 or abs(float(scales[0, :folded].max(initial=1.0)) - 1.0) > 1e-5:
+        if folded and np.abs(scales[:, :folded] - 1.0).max() > 1e-5:
             raise GltfError(f"{asset.source}: an animated scale on a folded root joint is not supported")
         scales = scales[:, folded:]
     if len(set(names)) != len(names):
