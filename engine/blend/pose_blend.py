@@ -83,13 +83,35 @@ def blend_vectors(weights: ArrayLike, vectors: ArrayLike) -> F:
     return np.sum(w[..., None] * v, axis=-2)
 
 
+def _channels(poses: Sequence[Pose]) -> tuple[F | None, F | None]:
+    """Stacked ``[..., K, J, 3]`` offsets and ``[..., K, J]`` scales of poses that carry them.
+
+    A missing scale is 1; a missing offset is the skeleton's, which a pose does not know,
+    so mixing poses with and without offsets is refused (blend spaces fill them from clips).
+    """
+    have = [p.offsets is not None for p in poses]
+    offsets = None
+    if any(have):
+        if not all(have):
+            raise ValueError("some poses carry joint offsets (a translation channel) and some do not")
+        offsets = np.stack([np.asarray(p.offsets, dtype=np.float64) for p in poses], axis=-3)
+    scales = None
+    if any(p.scales is not None for p in poses):
+        ones = np.ones(np.shape(poses[0].rotations)[:-1])
+        scales = np.stack([ones if p.scales is None else np.asarray(p.scales, dtype=np.float64) for p in poses], axis=-2)
+    return offsets, scales
+
+
 def blend(weights: ArrayLike, poses: Sequence[Pose] | Pose, method: str = "nlerp") -> Pose:
     """Blend poses: a list of ``K`` poses, or one stacked ``Pose`` with the clip axis before the joints.
 
-    Returns a new pose with the batch shape of the inputs (the clip axis removed).
+    Returns a new pose with the batch shape of the inputs (the clip axis removed). Joint
+    offsets and scales, when the poses carry them, blend linearly with the same weights.
     """
+    offsets = scales = None
     if isinstance(poses, Pose):
         root, rot = np.asarray(poses.root), np.asarray(poses.rotations)
+        offsets, scales = poses.offsets, poses.scales
     else:
         if len(poses) == 0:
             raise ValueError("no poses to blend")
@@ -98,11 +120,17 @@ def blend(weights: ArrayLike, poses: Sequence[Pose] | Pose, method: str = "nlerp
             raise ValueError(f"poses have different joint counts {sorted(joints)}")
         root = np.stack([np.asarray(p.root, dtype=np.float64) for p in poses], axis=-2)
         rot = np.stack([np.asarray(p.rotations, dtype=np.float64) for p in poses], axis=-3)
+        offsets, scales = _channels(poses)
     w = np.asarray(weights, dtype=np.float64)
     # Rotations carry a joint axis after the clip axis: move it before so the clip axis is -2.
     rot_t = np.moveaxis(rot, -3, -2)
     blended = blend_quaternions(w[..., None, :], rot_t, method)
-    return Pose(blend_vectors(w, root), blended)
+    out = Pose(blend_vectors(w, root), blended)
+    if offsets is not None:
+        out.offsets = np.sum(_check_weights(w, w.shape[-1])[..., None, None] * np.asarray(offsets), axis=-3)
+    if scales is not None:
+        out.scales = np.sum(_check_weights(w, w.shape[-1])[..., None] * np.asarray(scales), axis=-2)
+    return out
 
 
 def additive_delta(pose: Pose, reference: Pose) -> Pose:
@@ -128,10 +156,17 @@ def apply_additive(base: Pose, delta: Pose, weight: float | ArrayLike = 1.0) -> 
 
 
 def crossfade(a: Pose, b: Pose, t: float | ArrayLike) -> Pose:
-    """``t`` of the way from pose ``a`` to pose ``b`` (slerp per joint, lerp of the root)."""
+    """``t`` of the way from pose ``a`` to pose ``b`` (slerp per joint, lerp of the root, offsets and scales)."""
     t = np.asarray(t, dtype=np.float64)
     root = np.asarray(a.root) + t[..., None] * (np.asarray(b.root) - np.asarray(a.root))
-    return Pose(root, quat.slerp(a.rotations, b.rotations, t[..., None] if t.ndim else t))
+    out = Pose(root, quat.slerp(a.rotations, b.rotations, t[..., None] if t.ndim else t))
+    if a.offsets is not None or b.offsets is not None or a.scales is not None or b.scales is not None:
+        offsets, scales = _channels([a, b])
+        if offsets is not None:
+            out.offsets = offsets[..., 0, :, :] + t[..., None, None] * (offsets[..., 1, :, :] - offsets[..., 0, :, :])
+        if scales is not None:
+            out.scales = scales[..., 0, :] + t[..., None] * (scales[..., 1, :] - scales[..., 0, :])
+    return out
 
 
 def fade_weight(elapsed: float, duration: float) -> float:

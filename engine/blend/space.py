@@ -45,6 +45,23 @@ __all__ = ["BlendSpace", "gradient_band_weights"]
 F = NDArray[np.float64]
 
 
+def _blend_channels(pose: Pose, clips: list[Clip], pairs: list[tuple[F, F, F]], w: F) -> None:
+    """Blend the clips' translation and scale channels into ``pose`` (only when some clip has one).
+
+    A clip without a channel contributes its skeleton's offsets (or scale 1), so a stretching
+    clip blended with a rigid one stretches by its weight.
+    """
+    offsets, scales = [], []
+    for c, (i0, i1, a) in zip(clips, pairs, strict=True):
+        tr = c.offsets()
+        offsets.append(tr[i0] + np.asarray(a)[..., None, None] * (tr[i1] - tr[i0]))
+        sc = np.ones((c.num_frames, c.skeleton.num_joints)) if c.scales is None else c.scales
+        scales.append(sc[i0] + np.asarray(a)[..., None] * (sc[i1] - sc[i0]))
+    wn = w / w.sum(axis=-1, keepdims=True)
+    pose.offsets = np.sum(wn[..., None, None] * np.stack(offsets, axis=-3), axis=-3)
+    pose.scales = np.sum(wn[..., None] * np.stack(scales, axis=-2), axis=-2)
+
+
 def gradient_band_weights(points: ArrayLike, p: ArrayLike) -> F:
     """Gradient-band weights ``[..., K]`` of query points ``p [..., N]`` over samples ``points [K, N]``."""
     pts = np.asarray(points, dtype=np.float64)
@@ -143,7 +160,10 @@ class BlendSpace:
         frac = np.stack([np.asarray(a) for _, _, a in pairs])[..., None]
         rot = np.stack(list(quat.slerp(r0, r1, frac)), axis=-2)  # [..., J, K', 4]
         wa = w[..., active]
-        return Pose(blend_vectors(wa, root), blend_quaternions(wa[..., None, :], rot, self.method))
+        pose = Pose(blend_vectors(wa, root), blend_quaternions(wa[..., None, :], rot, self.method))
+        if any(c.translations is not None or c.scales is not None for c in clips):
+            _blend_channels(pose, clips, pairs, wa)
+        return pose
 
     def sample_root(self, weights: ArrayLike, phase: ArrayLike) -> F:
         """Only the blended root position ``[..., 3]`` (what measuring heights needs; no joint slerps)."""
