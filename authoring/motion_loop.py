@@ -36,9 +36,15 @@ def open_loop(
     from authoring.cycles.formats import is_seamless, loop_clip, performance_from_motion
     from engine.io.motion_file import load_motion, to_puppet
 
-    motion = load_motion(path, animation=animation, units=units, joint_map=joint_map)
+    # A loop is judged on every frame (a T-pose lead-in check must not cut a closed loop).
+    motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False)
     clip = motion.clip
-    if is_seamless(clip):
+    if not is_seamless(clip) and motion.animation is None:
+        motion = load_motion(path, units=units, joint_map=joint_map)
+        clip = motion.clip
+    if clip.loop:  # a loop our glTF writer marked as one
+        loop, note = clip, f"{motion.source.name}: a loop of {clip.num_frames} frames"
+    elif is_seamless(clip):
         n = clip.num_frames - 1
         tr = None if clip.translations is None else clip.translations[:n]
         sc = None if clip.scales is None else clip.scales[:n]

@@ -7,9 +7,10 @@ previewed â€” the performance in orange, the extracted cycle in green (Fig. 9) â
 accepted (it stacks onto the motion cycle) or retried. The stacked cycle is a looping
 :class:`~engine.clip.Clip`, saved as ``.ppclip``.
 
-What can be driven: a joint's **rotation** (any joint), or the root's **translation**.
-Other joints' translations would need IK and clips carry no scale, so those are refused
-with the reason rather than silently ignored.
+What can be driven: a joint's **rotation** (any joint), the root's **translation**, or a
+joint's **scale** (uniform, the clip's scale channel: a head that swells on every step).
+Other joints' translations would need IK, so those are refused with the reason rather
+than silently ignored.
 
 Layers are synchronised by phase: the scene knows where the playing cycle was when
 each performed cycle started, so a new layer is placed at that phase (the performer
@@ -73,7 +74,7 @@ class RecordScene:
     Args:
         skeleton: the character.
         item: the joint to drive.
-        drive: ``"rotation"`` or ``"translation"`` (root only); ``"scale"`` is refused.
+        drive: ``"rotation"``, ``"translation"`` (root only) or ``"scale"`` (any joint, uniform).
         base: a looping clip already authored (its layers play back while performing).
         countdown: seconds before the take starts.
         take_seconds: the take stops by itself after this long (or on :meth:`stop`).
@@ -84,8 +85,6 @@ class RecordScene:
                  countdown: float = 3.0, take_seconds: float = 8.0, rng: np.random.Generator | None = None) -> None:
         if drive not in DRIVES:
             raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
-        if drive == "scale":
-            raise ValueError("clips carry no scale channel; drive 'rotation' or the root's 'translation'")
         if item not in skeleton.names:
             raise ValueError(f"no joint {item!r}; the character has {', '.join(skeleton.names)}")
         joint = skeleton.index(item)
@@ -125,22 +124,25 @@ class RecordScene:
     def rest_value(self) -> F:
         """The driven channel at the current playback time (what the take starts from)."""
         root, rot = self._pose(self.time, None)
+        if self.drive == "scale":
+            return np.array([self._scales(self.time, None)[self.joint]])
         return root.copy() if self.drive == "translation" else rot[self.joint].copy()
 
     def item_position(self) -> F:
         """World position of the driven joint now (where the mouse plane goes through)."""
         root, rot = self._pose(self.time, self.candidate)
-        wpos, _ = forward_kinematics(self.skeleton, root, rot)
+        wpos, _ = forward_kinematics(self.skeleton, root, rot, scales=self._scales(self.time, self.candidate))
         return wpos[self.joint]
 
     def feed(self, value: F | None) -> None:
-        """The performed value for this step (a point, or a unit quaternion), or ``None`` if unchanged."""
+        """The performed value for this step (a point, a unit quaternion or a scale), or ``None`` if unchanged."""
         if value is None:
             return
         v = np.asarray(value, dtype=np.float64).reshape(-1)
-        want = 3 if self.drive == "translation" else 4
-        if v.shape != (want,) or not np.isfinite(v).all():
-            raise ValueError(f"a {self.drive} performance value is {want} finite numbers, got {v.tolist()}")
+        want = {"translation": 3, "rotation": 4, "scale": 1}[self.drive]
+        if v.shape != (want,) or not np.isfinite(v).all() or (self.drive == "scale" and v[0] <= 0):
+            raise ValueError(f"a {self.drive} performance value is {want} finite numbers"
+                             f"{' (positive)' * (self.drive == 'scale')}, got {v.tolist()}")
         self._value = quat.normalize(v) if want == 4 else v
 
     # -- the workflow ------------------------------------------------------------------
@@ -199,7 +201,7 @@ class RecordScene:
         self.phase = "preview"
         assert take is not None
         values = np.asarray(take.values)
-        kind = "position" if self.drive == "translation" else "rotation"
+        kind = {"translation": "position", "rotation": "rotation", "scale": "scale"}[self.drive]
         name = f"{self.skeleton.names[self.joint]}.{self.drive}"
         try:
             traj = Trajectory(np.asarray(take.times), values, (Item(name, kind, 0, values.shape[1]),))
@@ -222,10 +224,12 @@ class RecordScene:
             fps = frames / result.period
             base_rot = np.broadcast_to(quat.identity(self.skeleton.num_joints), (frames, self.skeleton.num_joints, 4)).copy()
             base_root = np.broadcast_to(self.skeleton.offsets[0], (frames, 3)).copy()
+            base_scales = None
             shift = 0.0
         else:
             frames, fps = self.clip.num_frames, self.clip.fps
             base_root, base_rot = np.array(self.clip.root), np.array(self.clip.rotations)
+            base_scales = None if self.clip.scales is None else np.array(self.clip.scales)
             # Where the playing cycle was when each performed cycle began: the layer starts there.
             starts = result.aligned.knots_time[:, 0] + take.base_time
             ang = 2 * np.pi * np.mod(starts / self.clip.duration, 1.0)
@@ -234,10 +238,13 @@ class RecordScene:
         values = _sample_loop(loop, phase, self.drive == "rotation")
         if self.drive == "rotation":
             base_rot[:, self.joint] = values
+        elif self.drive == "scale":
+            base_scales = np.ones((frames, self.skeleton.num_joints)) if base_scales is None else base_scales
+            base_scales[:, self.joint] = np.maximum(values[:, 0], 1e-3)
         else:
             base_root = values
         name = self.clip.name if self.clip is not None else "performed_cycle"
-        return Clip(name, self.skeleton, fps, base_root, base_rot, loop=True)
+        return Clip(name, self.skeleton, fps, base_root, base_rot, loop=True, scales=base_scales)
 
     def _pose(self, t: float, clip: Clip | None) -> tuple[F, F]:
         c = clip if clip is not None else self.clip
@@ -246,6 +253,13 @@ class RecordScene:
         pose = c.sample(t)
         return np.asarray(pose.root), np.asarray(pose.rotations)
 
+    def _scales(self, t: float, clip: Clip | None) -> F:
+        """``[J]`` joint scales of the playing (or candidate) cycle at ``t``: its scale channel, else ones."""
+        c = clip if clip is not None else self.clip
+        if c is None or c.scales is None:
+            return np.ones(self.skeleton.num_joints)
+        return np.asarray(c.sample(t).scales)
+
     # -- drawing -----------------------------------------------------------------------
     def _joint_path(self, values: F, rotation: bool) -> F:
         """World path of the driven joint's child (or the root) when the values drive it, over the base pose."""
@@ -253,11 +267,15 @@ class RecordScene:
         root, rot = self._pose(self.time, None)
         roots = np.broadcast_to(root, (n, 3)).copy()
         rots = np.broadcast_to(rot, (n, *rot.shape)).copy()
+        scales = np.broadcast_to(self._scales(self.time, None), (n, self.skeleton.num_joints)).copy()
         if rotation:
             rots[:, self.joint] = values
+        elif self.drive == "scale":
+            scales[:, self.joint] = values[:, 0]
+            rotation = True  # show the driven bone's end, as for a rotation
         else:
             roots = values
-        wpos, wrot = forward_kinematics(self.skeleton, roots, rots)
+        wpos, wrot = forward_kinematics(self.skeleton, roots, rots, scales=scales)
         kids = self.skeleton.children(self.joint)
         if rotation and kids:
             return wpos[:, kids[0]]
@@ -269,13 +287,17 @@ class RecordScene:
         """The puppet (candidate layer applied in preview), the take in orange, the loop in green, the overlay."""
         clip = self.candidate if self.phase == "preview" and self.candidate is not None else None
         root, rot = self._pose(self.time, clip)
+        scales = self._scales(self.time, clip)
         if self.phase == "recording" and self._value is not None:
             if self.drive == "rotation":
                 rot = rot.copy()
                 rot[self.joint] = self._value
+            elif self.drive == "scale":
+                scales = scales.copy()
+                scales[self.joint] = self._value[0]
             else:
                 root = self._value
-        wpos, wrot = forward_kinematics(self.skeleton, root, rot)
+        wpos, wrot = forward_kinematics(self.skeleton, root, rot, scales=scales)
         a, b, r, owner = puppet_capsules(self.skeleton, wpos, wrot)
         colors = np.tile(np.array([0.82, 0.8, 0.76]), (len(a), 1))
         colors[owner == self.joint] = PERFORMANCE

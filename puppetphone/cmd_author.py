@@ -85,6 +85,8 @@ def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre,
     tremor = 0.01 * np.sin(step * 1.7)
     if drive == "translation":
         return centre + np.array([0.15 * np.sin(p), 0.08 * np.sin(2 * p) + tremor, 0.0])
+    if drive == "scale":
+        return rest * (1.0 + 0.25 * np.sin(p) ** 2 + tremor)
     q = drag_rotation(260 * np.sin(p) + 40 * tremor, 160 * np.sin(2 * p + 0.5), 720)
     from engine import quat
 
@@ -205,6 +207,8 @@ class RecordActivity:
         return None
 
     def _value(self, frame, pointer):  # type: ignore[no-untyped-def]
+        import numpy as np
+
         from authoring.record_scene import drag_rotation, mouse_point
         from engine import quat
 
@@ -223,6 +227,8 @@ class RecordActivity:
         px, py = pointer
         if scene.drive == "rotation":
             return quat.mul(self.rest, drag_rotation(px - self.press[0], py - self.press[1], self.size[1]))
+        if scene.drive == "scale":  # drag up to grow, down to shrink: a screen height is a factor e^2
+            return self.rest * np.exp(2.0 * (self.press[1] - py) / self.size[1])
         return mouse_point(scene.camera, px, py, self.size, self.press[2])
 
     def step(self) -> None:

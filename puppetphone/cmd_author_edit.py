@@ -48,6 +48,22 @@ def configure_edit(parser: argparse.ArgumentParser) -> None:
     add_run_arguments(parser)
 
 
+def _motion_setup(path: Path, size: tuple[int, int], options: dict[str, object] | None) -> dict[str, object]:
+    """A motion file opened as its loop, as the setup a recording keeps: the loop's ``.ppclip`` bytes.
+
+    The live session is built from these same bytes (:func:`_reopen`), so a replay opens
+    exactly the clip the session edited, whatever the file, its options or the extractor."""
+    from authoring.motion_loop import open_loop
+    from engine.clipfile import save_clip
+
+    clip, note = open_loop(path, **(options or {}))  # type: ignore[arg-type]
+    print(note, file=sys.stderr)
+    with tempfile.TemporaryDirectory() as tmp:
+        data = save_clip(clip, Path(tmp) / "clip.ppclip").read_bytes()
+    return {"clip": str(path), "size": list(size), "name": path.stem + ".ppclip",
+            "ppclip": base64.b64encode(data).decode(), "side": ""}
+
+
 def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[no-untyped-def]
     from authoring.mocurves import EditSession, load_session
     from engine.clips import default_clips
@@ -56,11 +72,8 @@ def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[
     path = Path(spec)
     suffix = path.suffix.lower()
     if path.exists() and suffix in MOTION_SUFFIXES:
-        from authoring.motion_loop import open_loop
-
-        clip, note = open_loop(path, **(options or {}))  # type: ignore[arg-type]
-        print(note, file=sys.stderr)
-        return EditSession(clip), path.with_name(path.stem + "_edited.ppclip")
+        setup = _motion_setup(path, (0, 0), options)
+        return _reopen(setup), path.with_name(path.stem + "_edited.ppclip")
     if path.exists() and suffix != ".ppclip":
         raise ValueError(f"{path} is not a clip file: author edit opens a .ppclip cycle, a motion file "
                          f"({', '.join(MOTION_SUFFIXES)}) or a default clip ({', '.join(default_clips())})")
@@ -68,28 +81,18 @@ def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[
         return load_session(path), path.with_name(path.stem + "_edited.ppclip")
     clips = default_clips()
     if spec not in clips:
-        raise ValueError(f"{spec!r} is neither a clip or motion file nor a default clip ({', '.join(clips)})")
+        raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)}) "
+                         f"nor a motion file ({', '.join(MOTION_SUFFIXES)})")
     return EditSession(clips[spec]), Path(f"{spec}_edited.ppclip")
 
 
-def _setup(spec: str, size: tuple[int, int], session) -> dict[str, object]:  # type: ignore[no-untyped-def]
-    """What a recording needs to reopen the same session: the clip's bytes (and side file), not its path.
-
-    A motion file is recorded as the loop it opened as (a ``.ppclip``), so a replay does not
-    depend on the file, its options or the extractor staying the same."""
+def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
+    """What a recording needs to reopen the same session: the clip's bytes (and side file), not its path."""
     from authoring.mocurves.storage import side_path
-    from engine.clipfile import save_clip
-    from engine.io.motion_file import MOTION_SUFFIXES
 
     path = Path(spec)
     setup: dict[str, object] = {"clip": spec, "size": list(size)}
-    if path.suffix.lower() in MOTION_SUFFIXES:
-        with tempfile.TemporaryDirectory() as tmp:
-            saved = save_clip(session.clip, Path(tmp) / "clip.ppclip")
-            setup["name"] = path.stem + ".ppclip"
-            setup["ppclip"] = base64.b64encode(saved.read_bytes()).decode()
-            setup["side"] = ""
-    elif path.suffix.lower() == ".ppclip":
+    if path.suffix.lower() == ".ppclip":
         setup["name"] = path.name
         setup["ppclip"] = base64.b64encode(path.read_bytes()).decode()
         side = side_path(path)
@@ -252,11 +255,19 @@ def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record:
     from input.hub import InputHub
     from input.recording import Recorder, RecordingHeader
 
-    session, default_out = _open(spec, options)
+    from engine.io.motion_file import MOTION_SUFFIXES
+
+    path = Path(spec)
+    if path.exists() and path.suffix.lower() in MOTION_SUFFIXES:
+        setup = _motion_setup(path, size, options)
+        session, default_out = _reopen(setup), path.with_name(path.stem + "_edited.ppclip")
+    else:
+        session, default_out = _open(spec, options)
+        setup = _setup(spec, size) if record is not None else {}
     recorder = None
     if record is not None:
         recorder = Recorder(record, RecordingHeader(game=EDIT_GAME, seed=0, dt=EditActivity.dt, sources=["mouse"],
-                                                    setup=_setup(spec, size, session)))
+                                                    setup=setup))
     return EditActivity(EditScene(session, size), session, output or default_out, InputHub(), recorder=recorder)
 
 

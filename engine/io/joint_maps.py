@@ -33,6 +33,11 @@ def _limbs(fmt: dict[str, tuple[str, ...]], left: str, right: str) -> dict[str, 
 
 
 JOINT_MAPS: dict[str, dict[str, tuple[str, ...]]] = {
+    "puppetphone": {  # our own exports: the puppet's joint names
+        **{j: (j,) for j in ("hips", "spine", "chest", "neck", "head")},
+        **_limbs({b: (f"{{s}}_{b}",) for b in ("upper_arm", "lower_arm", "hand", "upper_leg", "lower_leg", "foot")},
+                 "l", "r"),
+    },
     "cmu_daz": {
         "hips": ("hip",), "spine": ("abdomen",), "chest": ("chest",), "neck": ("neck",), "head": ("head",),
         **_limbs({"upper_arm": ("{s}Shldr",), "lower_arm": ("{s}ForeArm",), "hand": ("{s}Hand",),

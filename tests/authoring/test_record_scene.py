@@ -20,8 +20,11 @@ def _perform(scene: RecordScene, seconds: float, period: float = 1.0, jitter: fl
     for k in range(int(seconds * FPS)):
         phase += (1.0 + jitter * np.sin(2 * np.pi * k / FPS / 4.1)) / (period * FPS)
         p = 2 * np.pi * phase
-        scene.feed(drag_rotation(200 * np.sin(p), 120 * np.sin(2 * p + 0.4), 720) if scene.drive == "rotation"
-                   else np.array([0.1 * np.sin(p), 0.95 + 0.03 * np.sin(2 * p), 0.0]))
+        if scene.drive == "scale":
+            scene.feed(np.array([1.0 + 0.3 * np.sin(p) ** 2]))
+        else:
+            scene.feed(drag_rotation(200 * np.sin(p), 120 * np.sin(2 * p + 0.4), 720) if scene.drive == "rotation"
+                       else np.array([0.1 * np.sin(p), 0.95 + 0.03 * np.sin(2 * p), 0.0]))
         scene.step(1.0 / FPS)
 
 
@@ -91,12 +94,36 @@ def test_root_translation_and_refusals() -> None:
     clip = scene.accept()
     assert clip is not None
     assert np.ptp(clip.root[:, 0]) == pytest.approx(0.2, rel=0.1)
-    with pytest.raises(ValueError, match="no scale"):
-        RecordScene(sk, "head", "scale")
     with pytest.raises(ValueError, match="only the root"):
         RecordScene(sk, "head", "translation")
     with pytest.raises(ValueError, match="finite numbers"):
         scene.feed(np.array([1.0, 0.0]))
+
+
+def test_a_scale_drive_records_the_clips_scale_channel_through_to_gltf(tmp_path: Path) -> None:
+    from engine.io.gltf_clip import load_gltf_clips
+    from engine.io.gltf_write import write_gltf
+
+    sk = humanoid_skeleton()
+    scene = RecordScene(sk, "r_upper_arm", countdown=0.1, take_seconds=30.0)
+    _run_take(scene)
+    base = scene.accept()
+    assert base is not None and base.scales is None
+    scene = RecordScene(sk, "head", "scale", base=base, countdown=0.1, take_seconds=30.0)
+    assert scene.rest_value().tolist() == [1.0]
+    _run_take(scene)
+    clip = scene.accept()
+    assert clip is not None and clip.scales is not None
+    head = sk.index("head")
+    # The performed swell (1 .. 1.3, twice per loop) is the head's scale; other joints stay 1.
+    assert clip.scales[:, head].min() == pytest.approx(1.0, abs=0.05)
+    assert clip.scales[:, head].max() == pytest.approx(1.3, abs=0.05)
+    assert np.all(np.delete(clip.scales, head, axis=1) == 1.0)
+    assert np.allclose(clip.rotations, base.rotations)  # the earlier layer is kept
+    back = load_gltf_clips(write_gltf(tmp_path / "swell.glb", clip))[0]
+    assert np.abs(back.scales - clip.scales).max() < 1e-5
+    with pytest.raises(ValueError, match="positive"):
+        scene.feed(np.array([-1.0]))
 
 
 def test_mouse_point_lies_on_the_plane() -> None:
