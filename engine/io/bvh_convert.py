@@ -34,7 +34,6 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.clip import Clip
-from engine.fk import forward_kinematics
 from engine.io._tracks import fold_root
 from engine.io.bvh import BvhError, BvhMotion, BvhWarning
 from engine.io.units import judge_units

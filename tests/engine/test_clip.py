@@ -210,3 +210,36 @@ def test_a_pipe_or_a_folder_is_refused(tmp_path):
     for p in (fifo, tmp_path):
         with pytest.raises(ClipFileError, match="regular file"):
             load_clip(p)
+
+
+def test_version_2_channels_round_trip_and_version_1_still_reads(tmp_path):
+    from dataclasses import replace
+
+    from engine.clipfile import VERSION, _digest
+    from engine.fk import forward_kinematics
+
+    assert VERSION == 2
+    clip = walking_clip()
+    f, j = clip.num_frames, clip.skeleton.num_joints
+    grow = 1.0 + 0.1 * np.sin(np.linspace(0, 2 * np.pi, f))[:, None, None]
+    chan = replace(clip, translations=clip.offsets() * grow, scales=np.tile(np.linspace(0.9, 1.1, j), (f, 1)))
+    back = load_clip(save_clip(chan, tmp_path / "chan.ppclip"))
+    assert np.array_equal(back.translations, chan.translations) and np.array_equal(back.scales, chan.scales)
+    pos = forward_kinematics(back.skeleton, back.root, back.rotations, back.translations, back.scales)[0]
+    rigid = forward_kinematics(clip.skeleton, clip.root, clip.rotations)[0]
+    assert np.abs(pos - rigid).max() > 0.01  # the channels do move the joints
+    # A file written before the channels existed (version 1, no channel arrays) reads as before.
+    path = save_clip(clip, tmp_path / "old.ppclip")
+    _rewrite_header(path, lambda h, a: h.update(version=1, sha256=_digest(a)))
+    old = load_clip(path)
+    assert old.translations is None and old.scales is None and np.array_equal(old.root, clip.root)
+    # A bad channel is refused in one line.
+    path = save_clip(chan, tmp_path / "bad.ppclip")
+
+    def negative(h, a):
+        a["scales"] = -a["scales"]
+        h["sha256"] = _digest(a)
+
+    _rewrite_header(path, negative)
+    with pytest.raises(ClipFileError, match="scales must be positive"):
+        load_clip(path)

@@ -23,7 +23,7 @@ from engine.io.gltf_clip import gltf_clip, key_rate
 from engine.io.gltf_write import write_gltf
 from engine.io.motion_file import MotionFileError, load_joint_map, load_motion, scaled_clip, to_puppet
 from engine.io.retarget import RetargetWarning
-from tests.engine.io.synthetic_bvh import BIOVISION, LOWERCASE, MIXAMO, ODD, human_bvh
+from tests.engine.io.synthetic_bvh import BIOVISION, LOWERCASE, ODD, human_bvh
 
 
 def _write(tmp_path: Path, name: str, text: str) -> Path:
