@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -19,8 +20,8 @@ from tests.engine.io.synthetic_bvh import human_bvh
 
 def _edit(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
-    return subprocess.run(["puppetphone", "author", "edit", *args, "--headless", "--frames", "10"], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run([sys.executable, "-m", "puppetphone", "author", "edit", *args, "--headless", "--frames", "10"],
+                          cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
 
 
 def test_author_edit_opens_a_bvh_and_a_glb(mocap_dir: Path, tmp_path: Path) -> None:
@@ -32,8 +33,8 @@ def test_author_edit_opens_a_bvh_and_a_glb(mocap_dir: Path, tmp_path: Path) -> N
     assert r.returncode == 0, r.stderr
     assert "a seamless loop of 17 frames" in r.stderr
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
-    again = subprocess.run(["puppetphone", "replay", "fox.rec", "--verify", "--headless"], cwd=tmp_path, env=env,
-                           capture_output=True, text=True, timeout=300)
+    again = subprocess.run([sys.executable, "-m", "puppetphone", "replay", "fox.rec", "--verify", "--headless"],
+                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert again.returncode == 0, again.stdout + again.stderr  # the opened loop rides in the recording
 
 

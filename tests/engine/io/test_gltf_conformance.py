@@ -12,6 +12,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -55,8 +56,8 @@ def _written_gltfs(out: Path) -> list[Path]:
     scales = 1.0 + 0.2 * np.sin(np.linspace(0, 2 * np.pi, clip.num_frames))[:, None] * (np.arange(clip.skeleton.num_joints) == 4)
     files.append(write_gltf(out / "channels.glb", replace(clip, scales=scales)))
     for suffix in (".glb", ".gltf"):
-        r = subprocess.run(["puppetphone", "cycle", str(src), "-o", f"loop{suffix}"], cwd=out, capture_output=True,
-                           text=True, timeout=300)
+        r = subprocess.run([sys.executable, "-m", "puppetphone", "cycle", str(src), "-o", f"loop{suffix}"], cwd=out,
+                           capture_output=True, text=True, timeout=300)
         assert r.returncode == 0, r.stderr
         files.append(out / f"loop{suffix}")
     return files

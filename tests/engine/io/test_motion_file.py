@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
 import warnings
 from dataclasses import replace
 from pathlib import Path
@@ -33,7 +34,8 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(["puppetphone", *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+    return subprocess.run([sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, cwd=cwd,
+                          timeout=300)
 
 
 # -- wall 1: commands take glTF ------------------------------------------------------------------
