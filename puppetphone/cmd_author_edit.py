@@ -252,10 +252,9 @@ def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record:
                options: dict[str, object] | None = None):
     """A live edit session of ``spec`` (optionally recorded); ``options`` open a motion file."""
     from authoring.edit_scene import EditScene
+    from engine.io.motion_file import MOTION_SUFFIXES
     from input.hub import InputHub
     from input.recording import Recorder, RecordingHeader
-
-    from engine.io.motion_file import MOTION_SUFFIXES
 
     path = Path(spec)
     if path.exists() and path.suffix.lower() in MOTION_SUFFIXES:

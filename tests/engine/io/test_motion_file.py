@@ -59,7 +59,10 @@ def test_a_wrong_animation_name_lists_the_animations(mocap_dir: Path, tmp_path: 
     assert r.returncode == 2
     assert "no animation 'Trot'" in r.stderr and "0: 'Survey', 1: 'Walk', 2: 'Run'" in r.stderr
     assert not (tmp_path / "x.bvh").exists()
-    assert load_motion(mocap_dir / "Fox.glb", animation="2").animation == "Run"  # an index works too
+    run = load_motion(mocap_dir / "Fox.glb", animation="2")  # an index works too
+    assert run.animation == "Run"
+    # Run's keys are 24 fps with one longer gap where an exporter dropped keys: still 24 fps.
+    assert run.clip.fps == 24.0 and run.fps_basis == "key spacing"
 
 
 def test_animation_is_refused_for_bvh(tmp_path: Path) -> None:
