@@ -7,7 +7,7 @@ replays with the very clips it was made with — on another machine, after the l
 was edited or deleted. (Storing only the content hash would make the recording
 unplayable the moment the library changed; the clips cost a few tens of KB of header.)
 
-Layout: ``{"sha256": set hash, "clips": {role: {"name", "fps", "loop", "markers",
+Layout: ``{"sha256": hash of the canonical JSON of "clips", "clips": {role: {"name", "fps", "loop", "markers",
 "frames", "data": base64(zlib(float64 root | rotations | root-motion translation |
 heading))}}}``. All clips are on the puppet's skeleton (the library refuses others), so
 the skeleton is not repeated; :func:`decode` rebuilds and checks every clip and the set
@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import base64
 import binascii
+import hashlib
+import json
 import math
 import zlib
 from collections.abc import Mapping
@@ -26,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from engine.clip import Clip, RootMotion
-from engine.cliplib.library import ClipLibraryError, set_digest
+from engine.cliplib.library import ClipLibraryError
 from engine.cliplib.roles import RoleError, normalise_role
 from engine.skeleton import Skeleton
 
@@ -47,7 +49,12 @@ def encode(clips: Mapping[str, Clip]) -> dict[str, Any]:
         out[role] = {"name": clip.name, "fps": clip.fps, "loop": clip.loop, "markers": dict(clip.markers),
                      "frames": clip.num_frames, "root_motion": clip.root_motion is not None,
                      "data": base64.b64encode(zlib.compress(raw, 9)).decode("ascii")}
-    return {"sha256": set_digest(clips), "clips": out}
+    return {"sha256": _payload_digest(out), "clips": out}
+
+
+def _payload_digest(payload: Any) -> str:
+    """SHA-256 of the clips' canonical JSON: what a recording carries, bit for bit."""
+    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
 
 
 def _clip(role: str, e: Any, skeleton: Skeleton) -> Clip:
@@ -92,6 +99,8 @@ def decode(value: Any, skeleton: Skeleton) -> dict[str, Clip]:
         raise ClipLibraryError("the recorded clips are not {'sha256': …, 'clips': {…}}")
     if len(value["clips"]) > _MAX_CLIPS:
         raise ClipLibraryError(f"the recording names {len(value['clips'])} clips; the limit is {_MAX_CLIPS}")
+    if _payload_digest(value["clips"]) != value["sha256"]:
+        raise ClipLibraryError("the recorded clips do not match their hash; the recording was altered")
     clips = {}
     for role, e in value["clips"].items():
         try:
@@ -99,6 +108,4 @@ def decode(value: Any, skeleton: Skeleton) -> dict[str, Clip]:
         except RoleError as exc:
             raise ClipLibraryError(f"recorded clips: {exc}") from None
         clips[name] = _clip(name, e, skeleton)
-    if set_digest(clips) != value["sha256"]:
-        raise ClipLibraryError("the recorded clips do not match their hash; the recording was altered")
     return clips

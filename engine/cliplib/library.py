@@ -168,8 +168,10 @@ class ClipLibrary:
             raise ClipLibraryError(str(exc)) from None
         entries = self.entries()
         self.root.mkdir(parents=True, exist_ok=True)
-        entry = Entry(role, f"{role}.ppclip", clip_digest(clip), source)
-        save_clip(clip, self.root / entry.file)
+        file = f"{role}.ppclip"
+        save_clip(clip, self.root / file)
+        # The digest of what a load gives back (reading renormalises rotations, to the last bit).
+        entry = Entry(role, file, clip_digest(load_clip(self.root / file)), source)
         entries[role] = entry
         self._write_manifest(entries)
         return entry
