@@ -58,8 +58,11 @@ class _ScriptedPhone(PoseSource):
         self._status.connected = True
 
 
-def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 6.0, seed: int = 0) -> Path:
-    """Record the sandbox puppet walked ``distance`` m along +Z at ``speed`` m/s by a phone, then let go.
+def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 5.0, seed: int = 0,
+                      direction: tuple[float, float] = (0.6, -0.8)) -> Path:
+    """Record the sandbox puppet walked ``distance`` m along ground ``direction`` (x, z) at ``speed`` m/s by
+    a phone, then let go. The default direction crosses the sandbox camera's view, so a screenshot shows
+    the puppet side-on.
 
     A phone rather than the mouse: its positions are floats, so the stick's speed is
     steady (a mouse moves in whole pixels, and a step without a new pixel reads as a
@@ -97,8 +100,9 @@ def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 6.
         push(touch=True)
         push(15)
         steps = max(1, int(round(distance / speed / world.dt)))
+        way = np.array([direction[0], 0.0, direction[1]]) / float(np.hypot(*direction))
         for k in range(1, steps + 1):
-            state["position"] = np.array([0.0, 0.0, distance * k / steps])
+            state["position"] = way * (distance * k / steps)
             push()
         push(30)
         push(touch=False)
