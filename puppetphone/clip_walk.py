@@ -59,10 +59,10 @@ class _ScriptedPhone(PoseSource):
 
 
 def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 5.0, seed: int = 0,
-                      direction: tuple[float, float] = (0.6, -0.8)) -> Path:
+                      direction: tuple[float, float] = (0.6, -0.8), clips: dict | None = None) -> Path:
     """Record the sandbox puppet walked ``distance`` m along ground ``direction`` (x, z) at ``speed`` m/s by
     a phone, then let go. The default direction crosses the sandbox camera's view, so a screenshot shows
-    the puppet side-on.
+    the puppet side-on. ``clips`` (an :func:`engine.cliplib.embed.encode` value) plays authored clips.
 
     A phone rather than the mouse: its positions are floats, so the stick's speed is
     steady (a mouse moves in whole pixels, and a step without a new pixel reads as a
@@ -76,10 +76,11 @@ def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 5.
     from puppetphone.games import make_app
 
     phone = _ScriptedPhone()
-    app = make_app("sandbox", seed, InputHub([phone]), {"scene": "empty", "puppets": 1})
+    setup = {"scene": "empty", "puppets": 1, **({"clips": clips} if clips is not None else {})}
+    app = make_app("sandbox", seed, InputHub([phone]), setup)
     world = app.world
-    header = RecordingHeader(game="sandbox", seed=seed, dt=world.dt, sources=["phone"],
-                             setup={"scene": "empty", "puppets": 1}, extra={"session": "stick_walk"})
+    header = RecordingHeader(game="sandbox", seed=seed, dt=world.dt, sources=["phone"], setup=setup,
+                             extra={"session": "stick_walk"})
     puppet = next(e for e, _ in world.query(Brain))
     pivot = np.array(world.resource(StickConfig).virtual_pivot, dtype=np.float64)
     state = {"position": np.zeros(3), "orientation": quat.identity()}
