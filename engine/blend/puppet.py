@@ -106,4 +106,5 @@ def install_puppet_locomotion(app: App) -> None:
         from engine.cliplib.authored import AuthoredClips, authored_locomotion
 
         authored = app.world.try_resource(AuthoredClips)  # a clip library the game plays (see engine.cliplib)
-        library.add("humanoid", authored_locomotion(authored)[0] if authored and authored.clips else puppet_locomotion())
+        played = authored_locomotion(authored)[0] if authored and authored.clips else puppet_locomotion()
+        library.add("humanoid", played)

@@ -43,7 +43,9 @@ def merged_clips(authored: Mapping[str, Clip]) -> dict[str, Clip]:
     return clips
 
 
-def authored_locomotion(resource: AuthoredClips, density: int = 31, dt: float = 1.0 / 60.0) -> tuple[LocomotionSet, MeasureCache | None]:
+def authored_locomotion(
+    resource: AuthoredClips, density: int = 31, dt: float = 1.0 / 60.0
+) -> tuple[LocomotionSet, MeasureCache | None]:
     """The locomotion set over the merged clips; its table from the cache when the clips were measured before."""
     clips = merged_clips(resource.clips)
     cache = None

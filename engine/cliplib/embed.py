@@ -60,7 +60,8 @@ def _payload_digest(payload: Any) -> str:
 def _clip(role: str, e: Any, skeleton: Skeleton) -> Clip:
     if not isinstance(e, dict):
         raise ClipLibraryError(f"recorded clip {role!r} is not an object")
-    name, fps, loop, frames, rm, markers = (e.get(k) for k in ("name", "fps", "loop", "frames", "root_motion", "markers"))
+    keys = ("name", "fps", "loop", "frames", "root_motion", "markers")
+    name, fps, loop, frames, rm, markers = (e.get(k) for k in keys)
     if not isinstance(name, str) or not isinstance(loop, bool) or not isinstance(rm, bool):
         raise ClipLibraryError(f"recorded clip {role!r}: name, loop or root_motion has the wrong type")
     if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0 < fps <= 1000:
@@ -74,7 +75,8 @@ def _clip(role: str, e: Any, skeleton: Skeleton) -> Clip:
     j = skeleton.num_joints
     per_frame = 3 + 4 * j + (4 if rm else 0)
     try:
-        raw = zlib.decompressobj().decompress(base64.b64decode(str(e.get("data")), validate=True), per_frame * frames * 8 + 1)
+        packed = base64.b64decode(str(e.get("data")), validate=True)
+        raw = zlib.decompressobj().decompress(packed, per_frame * frames * 8 + 1)  # bounded: no zip bomb
     except (binascii.Error, ValueError, zlib.error):
         raise ClipLibraryError(f"recorded clip {role!r}: its data is not base64 zlib") from None
     if len(raw) != per_frame * frames * 8:
@@ -95,7 +97,7 @@ def _clip(role: str, e: Any, skeleton: Skeleton) -> Clip:
 
 def decode(value: Any, skeleton: Skeleton) -> dict[str, Clip]:
     """The clips by role of an :func:`encode` value, checked against its set hash."""
-    if not isinstance(value, dict) or not isinstance(value.get("clips"), dict) or not isinstance(value.get("sha256"), str):
+    if not (isinstance(value, dict) and isinstance(value.get("clips"), dict) and isinstance(value.get("sha256"), str)):
         raise ClipLibraryError("the recorded clips are not {'sha256': …, 'clips': {…}}")
     if len(value["clips"]) > _MAX_CLIPS:
         raise ClipLibraryError(f"the recording names {len(value['clips'])} clips; the limit is {_MAX_CLIPS}")

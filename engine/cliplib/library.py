@@ -150,8 +150,8 @@ class ClipLibrary:
         return out
 
     def _write_manifest(self, entries: Mapping[str, Entry]) -> None:
-        body = {"format": FORMAT, "version": VERSION,
-                "clips": {r: {"file": e.file, "sha256": e.sha256, "source": e.source} for r, e in sorted(entries.items())}}
+        clips = {r: {"file": e.file, "sha256": e.sha256, "source": e.source} for r, e in sorted(entries.items())}
+        body = {"format": FORMAT, "version": VERSION, "clips": clips}
         atomic_write_bytes(self.manifest_path, (json.dumps(body, indent=2) + "\n").encode())
 
     def add(self, clip: Clip, role: str, skeleton: Skeleton, defaults: Mapping[str, Clip], source: str = "") -> Entry:

@@ -115,7 +115,8 @@ def check_role(clip: Clip, role: str, skeleton: Skeleton) -> None:
     if spec is None:
         return
     if spec.loop is True and not clip.loop:
-        raise RoleError(f"a {role} must be a loop and {clip.name!r} is not one: extract a cycle with `puppetphone cycle`")
+        raise RoleError(f"a {role} must be a loop and {clip.name!r} is not one: "
+                        "extract a cycle with `puppetphone cycle`")
     if spec.loop is True:
         if clip.num_frames < 8:
             raise RoleError(f"{clip.name!r} has {clip.num_frames} frames; a {role} cycle needs at least 8")
