@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -26,7 +27,8 @@ BLEND_BAR_PCT = 5.0
 
 
 def _run(*args: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess[str]:
-    out = subprocess.run(["puppetphone", *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=300)
+    out = subprocess.run([sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, env=env,
+                         cwd=cwd, timeout=300)
     assert out.returncode == 0, f"puppetphone {' '.join(args)}: {out.stderr}"
     return out
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -14,7 +15,8 @@ from engine.clips import default_clips
 
 def _pp(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
     e = dict(os.environ, XDG_DATA_HOME=str(cwd / "data"), XDG_CACHE_HOME=str(cwd / "cache"), **(env or {}))
-    return subprocess.run(["puppetphone", *args], capture_output=True, text=True, cwd=cwd, env=e, timeout=300)
+    return subprocess.run([sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, cwd=cwd,
+                          env=e, timeout=300)
 
 
 @pytest.fixture
