@@ -7,10 +7,20 @@ previewed — the performance in orange, the extracted cycle in green (Fig. 9) �
 accepted (it stacks onto the motion cycle) or retried. The stacked cycle is a looping
 :class:`~engine.clip.Clip`, saved as ``.ppclip``.
 
-What can be driven: a joint's **rotation** (any joint), the root's **translation**, or a
-joint's **scale** (uniform, the clip's scale channel: a head that swells on every step).
-Other joints' translations would need IK, so those are refused with the reason rather
-than silently ignored.
+What can be driven (paper §3: any item's translation and rotation):
+
+- a joint's **rotation** (any joint: its local rotation);
+- an item's **translation**: the root's position, or a hand or foot (any item MoCurves can
+  position, :func:`~authoring.mocurves.curves.item_chain`) as an IK target: each frame the
+  two-bone chain above it bends so the item is where it was performed (character space);
+- its **pose**, both at once from a 6-DoF device (a phone's tracked position and
+  orientation, a SpaceMouse): one take, one extracted loop of 7 numbers, so position and
+  rotation stay in step; the position is reached by the IK, the rotation is the item's own.
+
+- a joint's **scale** (uniform, the clip's scale channel: a head that swells on every step).
+
+An item whose position only follows its parents (the spine, the chest) cannot take a
+translation: it is refused with the reason.
 
 Layers are synchronised by phase: the scene knows where the playing cycle was when
 each performed cycle started, so a new layer is placed at that phase (the performer
@@ -29,10 +39,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from authoring.cycles import CycleError, CycleResult, Item, Trajectory, extract_cycle
+from authoring.mocurves.curves import item_chain
 from engine import quat
 from engine.camera import OrbitCamera
 from engine.clip import Clip
 from engine.fk import forward_kinematics
+from engine.ik import two_bone_ik
+from engine.pose import Pose
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
 from engine.skeleton import Skeleton
@@ -40,7 +53,8 @@ from engine.skeleton import Skeleton
 __all__ = ["DRIVES", "RecordScene", "drag_rotation", "mouse_point"]
 
 F = NDArray[np.float64]
-DRIVES = ("translation", "rotation", "scale")
+DRIVES = ("translation", "rotation", "pose", "scale")
+_WIDTH = {"translation": 3, "rotation": 4, "pose": 7, "scale": 1}  # numbers in one performed value
 PERFORMANCE = (0.95, 0.55, 0.1)  # orange: what was performed
 CYCLE = (0.1, 0.75, 0.25)  # green: the extracted cycle (paper Fig. 9)
 
@@ -74,7 +88,8 @@ class RecordScene:
     Args:
         skeleton: the character.
         item: the joint to drive.
-        drive: ``"rotation"``, ``"translation"`` (root only) or ``"scale"`` (any joint, uniform).
+        drive: ``"rotation"``, ``"translation"`` (the root, or a hand or foot by IK) or ``"pose"``
+            (translation and rotation together, from a 6-DoF device); ``"scale"`` (any joint, uniform).
         base: a looping clip already authored (its layers play back while performing).
         countdown: seconds before the take starts.
         take_seconds: the take stops by itself after this long (or on :meth:`stop`).
@@ -88,8 +103,10 @@ class RecordScene:
         if item not in skeleton.names:
             raise ValueError(f"no joint {item!r}; the character has {', '.join(skeleton.names)}")
         joint = skeleton.index(item)
-        if drive == "translation" and joint != 0:
-            raise ValueError(f"only the root ({skeleton.names[0]}) can be driven by translation; drive {item!r} by rotation")
+        self.chain = item_chain(skeleton, joint)
+        if drive in ("translation", "pose") and joint != 0 and self.chain is None:
+            raise ValueError(f"{item}'s position follows its parents: drive the root, a hand or a foot by "
+                             f"{drive}, or {item!r} by rotation")
         if base is not None and (base.skeleton.names != skeleton.names or not base.loop):
             raise ValueError("the base clip must be a looping clip of the same skeleton")
         self.skeleton = skeleton
@@ -122,11 +139,20 @@ class RecordScene:
 
     # -- the performance ---------------------------------------------------------------
     def rest_value(self) -> F:
-        """The driven channel at the current playback time (what the take starts from)."""
+        """The driven channel at the current playback time (what the take starts from).
+
+        A translation is the item's position in character space (the root's: the root
+        track); a pose is that position followed by the item's local rotation.
+        """
         root, rot = self._pose(self.time, None)
         if self.drive == "scale":
             return np.array([self._scales(self.time, None)[self.joint]])
-        return root.copy() if self.drive == "translation" else rot[self.joint].copy()
+        position = root if self.joint == 0 else forward_kinematics(self.skeleton, root, rot)[0][self.joint]
+        if self.drive == "rotation":
+            return rot[self.joint].copy()
+        if self.drive == "translation":
+            return np.array(position)
+        return np.concatenate([position, rot[self.joint]])
 
     def item_position(self) -> F:
         """World position of the driven joint now (where the mouse plane goes through)."""
@@ -139,11 +165,14 @@ class RecordScene:
         if value is None:
             return
         v = np.asarray(value, dtype=np.float64).reshape(-1)
-        want = {"translation": 3, "rotation": 4, "scale": 1}[self.drive]
-        if v.shape != (want,) or not np.isfinite(v).all() or (self.drive == "scale" and v[0] <= 0):
+        want = _WIDTH[self.drive]
+        if v.shape != (want,) or not np.isfinite(v).all() or (want > 3 and np.linalg.norm(v[-4:]) < 1e-9) \
+                or (self.drive == "scale" and v[0] <= 0):
             raise ValueError(f"a {self.drive} performance value is {want} finite numbers"
                              f"{' (positive)' * (self.drive == 'scale')}, got {v.tolist()}")
-        self._value = quat.normalize(v) if want == 4 else v
+        if want > 3:
+            v = np.concatenate([v[:-4], quat.normalize(v[-4:])])
+        self._value = v
 
     # -- the workflow ------------------------------------------------------------------
     def start(self) -> None:
@@ -201,10 +230,13 @@ class RecordScene:
         self.phase = "preview"
         assert take is not None
         values = np.asarray(take.values)
-        kind = {"translation": "position", "rotation": "rotation", "scale": "scale"}[self.drive]
-        name = f"{self.skeleton.names[self.joint]}.{self.drive}"
+        item = self.skeleton.names[self.joint]
+        items = {"translation": (Item(f"{item}.translation", "position", 0, 3),),
+                 "rotation": (Item(f"{item}.rotation", "rotation", 0, 4),),
+                 "scale": (Item(f"{item}.scale", "scale", 0, 1),),
+                 "pose": (Item(f"{item}.translation", "position", 0, 3), Item(f"{item}.rotation", "rotation", 3, 7))}
         try:
-            traj = Trajectory(np.asarray(take.times), values, (Item(name, kind, 0, values.shape[1]),))
+            traj = Trajectory(np.asarray(take.times), values, items[self.drive])
             self.result = extract_cycle(traj, self.rng)
         except (CycleError, ValueError) as exc:
             self.result, self.candidate = None, None
@@ -235,16 +267,36 @@ class RecordScene:
             ang = 2 * np.pi * np.mod(starts / self.clip.duration, 1.0)
             shift = float(np.mod(np.arctan2(np.sin(ang).mean(), np.cos(ang).mean()) / (2 * np.pi), 1.0))
         phase = np.mod(np.arange(frames) / frames - shift, 1.0)
-        values = _sample_loop(loop, phase, self.drive == "rotation")
-        if self.drive == "rotation":
-            base_rot[:, self.joint] = values
-        elif self.drive == "scale":
+        values = _sample_loop(loop, phase, self.drive)
+        if self.drive == "scale":
             base_scales = np.ones((frames, self.skeleton.num_joints)) if base_scales is None else base_scales
             base_scales[:, self.joint] = np.maximum(values[:, 0], 1e-3)
         else:
-            base_root = values
+            base_root, base_rot = self._driven(base_root, base_rot, values)
         name = self.clip.name if self.clip is not None else "performed_cycle"
         return Clip(name, self.skeleton, fps, base_root, base_rot, loop=True, scales=base_scales)
+
+    def _driven(self, root: F, rot: F, values: F) -> tuple[F, F]:
+        """Poses ``root [N,3]``, ``rot [N,J,4]`` with the driven channel set to ``values [N,d]``.
+
+        A position goes to the root track, or to the item through two-bone IK on its chain
+        (a pose's rotation is then set as the item's local rotation, exactly as performed).
+        """
+        root, rot = np.array(root), np.array(rot)
+        if self.drive in ("translation", "pose"):
+            target = values[:, :3]
+            if self.joint == 0:
+                root = np.array(target)
+            else:
+                assert self.chain is not None
+                # A translation keeps the item's world orientation from before (as a MoCurves drag does).
+                keep = forward_kinematics(self.skeleton, root, rot)[1][:, self.joint]
+                pose = Pose(root, rot)
+                two_bone_ik(self.skeleton, pose, self.chain, target, end_rotation=keep)
+                rot = np.asarray(pose.rotations)
+        if self.drive in ("rotation", "pose"):
+            rot[:, self.joint] = values[:, -4:]
+        return root, rot
 
     def _pose(self, t: float, clip: Clip | None) -> tuple[F, F]:
         c = clip if clip is not None else self.clip
@@ -262,19 +314,21 @@ class RecordScene:
 
     # -- drawing -----------------------------------------------------------------------
     def _joint_path(self, values: F, rotation: bool) -> F:
-        """World path of the driven joint's child (or the root) when the values drive it, over the base pose."""
+        """World path of the driven joint's child (or the root) when the values drive it, over the base pose.
+
+        A translation or pose draws the performed positions themselves (the item's path).
+        """
+        if not rotation:
+            return np.asarray(values, dtype=np.float64)[:, :3]
         n = len(values)
         root, rot = self._pose(self.time, None)
         roots = np.broadcast_to(root, (n, 3)).copy()
         rots = np.broadcast_to(rot, (n, *rot.shape)).copy()
         scales = np.broadcast_to(self._scales(self.time, None), (n, self.skeleton.num_joints)).copy()
-        if rotation:
-            rots[:, self.joint] = values
-        elif self.drive == "scale":
+        if self.drive == "scale":
             scales[:, self.joint] = values[:, 0]
-            rotation = True  # show the driven bone's end, as for a rotation
         else:
-            roots = values
+            rots[:, self.joint] = values
         wpos, wrot = forward_kinematics(self.skeleton, roots, rots, scales=scales)
         kids = self.skeleton.children(self.joint)
         if rotation and kids:
@@ -289,20 +343,18 @@ class RecordScene:
         root, rot = self._pose(self.time, clip)
         scales = self._scales(self.time, clip)
         if self.phase == "recording" and self._value is not None:
-            if self.drive == "rotation":
-                rot = rot.copy()
-                rot[self.joint] = self._value
-            elif self.drive == "scale":
+            if self.drive == "scale":
                 scales = scales.copy()
                 scales[self.joint] = self._value[0]
             else:
-                root = self._value
+                roots, rots = self._driven(root[None], rot[None], self._value[None])
+                root, rot = roots[0], rots[0]
         wpos, wrot = forward_kinematics(self.skeleton, root, rot, scales=scales)
         a, b, r, owner = puppet_capsules(self.skeleton, wpos, wrot)
         colors = np.tile(np.array([0.82, 0.8, 0.76]), (len(a), 1))
         colors[owner == self.joint] = PERFORMANCE
         scene.add_capsules(a, b, r, colors)
-        rotation = self.drive == "rotation"
+        rotation = self.drive in ("rotation", "scale")  # both show the driven bone's end
         if self._take is not None and len(self._take.values) > 1:
             scene.add_polyline(self._joint_path(np.asarray(self._take.values), rotation), PERFORMANCE, 2.0)
         if self.phase == "preview" and self.result is not None:
@@ -316,13 +368,17 @@ class RecordScene:
             scene.add_text(self.message, size=16)
 
 
-def _sample_loop(loop: F, phase: F, rotation: bool) -> F:
-    """Values of a closed loop ``[S+1, d]`` (end = start) at phases in ``[0, 1)``, interpolated."""
+def _sample_loop(loop: F, phase: F, drive: str) -> F:
+    """Values of a closed loop ``[S+1, d]`` (end = start) at phases in ``[0, 1)``, interpolated.
+
+    Positions linearly, rotations (a rotation, or a pose's last four numbers) by nlerp.
+    """
     s = len(loop) - 1
     x = phase * s
     i = np.minimum(np.floor(x).astype(np.int64), s - 1)
     w = x - i
-    if rotation:
-        return quat.nlerp(loop[i], loop[i + 1], w)
-    return loop[i] * (1.0 - w)[:, None] + loop[i + 1] * w[:, None]
+    out = loop[i] * (1.0 - w)[:, None] + loop[i + 1] * w[:, None]
+    if drive in ("rotation", "pose"):
+        out[:, -4:] = quat.nlerp(loop[i, -4:], loop[i + 1, -4:], w)
+    return out
 

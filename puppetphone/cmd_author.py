@@ -7,9 +7,11 @@
                               [--headless --frames N --screenshot PNG --script loops]
 
 Mouse: hold the left button and move in loops — for a rotation the drag from the press
-point turns the joint, for the root's translation the cursor is the position. A phone,
-HID or serial device drives a rotation with its orientation (relative to where it
-pointed when the take began). Keys: R record, Space stop, Enter accept, Backspace retry,
+point turns the joint, for a translation (the root, or a hand or foot reached by IK) the
+cursor is the position. A phone, HID or serial device drives a rotation with its
+orientation (relative to where it pointed when the take began), a translation with its
+tracked position (relative to where it was then), and a 6-DoF device (a tracked phone,
+a SpaceMouse) drives ``--drive pose``: position and rotation together in one take. Keys: R record, Space stop, Enter accept, Backspace retry,
 Ctrl+S save; right-drag orbits. Every accepted layer is saved to ``-o`` at once.
 
 ``--script loops`` replaces the hand with a scripted performer (loops of ±15 % tempo
@@ -37,7 +39,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     rec = sub.add_parser("record", help=record_help, description=record_help)
     rec.set_defaults(_parser=rec)
     rec.add_argument("--item", default="r_upper_arm", help="joint to drive (default r_upper_arm)")
-    rec.add_argument("--drive", default="rotation", choices=("rotation", "translation", "scale"), help="what to drive")
+    rec.add_argument("--drive", default="rotation", choices=("rotation", "translation", "pose", "scale"),
+                     help="what to drive: a joint's rotation, the root's or a hand's/foot's translation (IK), "
+                          "or its pose (translation and rotation in one take, from a 6-DoF device)")
     rec.add_argument("--base", type=Path, default=None, help="a looping .ppclip whose layers play back while performing")
     rec.add_argument("-o", "--output", type=Path, default=Path("performed_cycle.ppclip"), help="where accepted cycles are saved")
     rec.add_argument("--countdown", type=float, default=3.0, help="seconds of countdown (default 3)")
@@ -83,14 +87,15 @@ def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre,
     rng_phase[0] += tempo / (1.2 * fps)
     p = 2 * np.pi * rng_phase[0]
     tremor = 0.01 * np.sin(step * 1.7)
-    if drive == "translation":
-        return centre + np.array([0.15 * np.sin(p), 0.08 * np.sin(2 * p) + tremor, 0.0])
     if drive == "scale":
         return rest * (1.0 + 0.25 * np.sin(p) ** 2 + tremor)
-    q = drag_rotation(260 * np.sin(p) + 40 * tremor, 160 * np.sin(2 * p + 0.5), 720)
     from engine import quat
 
-    return quat.mul(rest, q)
+    position = centre + np.array([0.15 * np.sin(p), 0.08 * np.sin(2 * p) + tremor, 0.0])
+    if drive == "translation":
+        return position
+    q = quat.mul(rest[-4:], drag_rotation(260 * np.sin(p) + 40 * tremor, 160 * np.sin(2 * p + 0.5), 720))
+    return np.concatenate([position, q]) if drive == "pose" else q
 
 
 RECORD_GAME = "author-record"
@@ -148,6 +153,7 @@ class RecordActivity:
         self.press: tuple[float, float, object] | None = None
         self.phase_acc = [0.0]
         self.reference = None
+        self.reference_position = None
         self.rest = scene.rest_value()
         if script:
             scene.start()
@@ -217,11 +223,7 @@ class RecordActivity:
             return _scripted(self.frame, 1.0 / self.dt, self.phase_acc, scene.drive, scene.item_position(), self.rest)
         sample = frame.latest()
         if sample is not None and sample.source != "mouse":
-            if scene.drive != "rotation":
-                return None
-            if scene.phase != "recording" or self.reference is None:
-                self.reference, self.rest = sample.orientation, scene.rest_value()
-            return quat.mul(quat.mul(sample.orientation, quat.conjugate(self.reference)), self.rest)
+            return self._device_value(sample)
         if self.press is None or pointer is None:
             return None
         px, py = pointer
@@ -229,7 +231,28 @@ class RecordActivity:
             return quat.mul(self.rest, drag_rotation(px - self.press[0], py - self.press[1], self.size[1]))
         if scene.drive == "scale":  # drag up to grow, down to shrink: a screen height is a factor e^2
             return self.rest * np.exp(2.0 * (self.press[1] - py) / self.size[1])
-        return mouse_point(scene.camera, px, py, self.size, self.press[2])
+        point = mouse_point(scene.camera, px, py, self.size, self.press[2])
+        return point if scene.drive == "translation" else np.concatenate([point, self.rest[-4:]])
+
+    def _device_value(self, sample):  # type: ignore[no-untyped-def]
+        """A device's value: its orientation and tracked position relative to where they were when the take began."""
+        import numpy as np
+
+        from engine import quat
+
+        scene = self.scene
+        if scene.drive == "scale":
+            return None  # a device's pose holds no scale: a scale is performed with the mouse
+        if scene.phase != "recording" or self.reference is None:
+            self.reference, self.rest = sample.orientation, scene.rest_value()
+            self.reference_position = None if sample.position is None else np.array(sample.position, dtype=np.float64)
+        if scene.drive in ("translation", "pose") and (sample.position is None or self.reference_position is None):
+            return None  # an orientation-only device (an IMU, a gamepad) cannot perform a position
+        rotation = quat.mul(quat.mul(sample.orientation, quat.conjugate(self.reference)), self.rest[-4:])
+        if scene.drive == "rotation":
+            return rotation
+        position = self.rest[:3] + (np.asarray(sample.position, dtype=np.float64) - self.reference_position)
+        return position if scene.drive == "translation" else np.concatenate([position, rotation])
 
     def step(self) -> None:
         if self.pressed and self.hub.replay is None:

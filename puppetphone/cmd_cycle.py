@@ -41,6 +41,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--items", metavar="NAME", nargs="+", help="only these joints (BVH), items (CSV/npz) or sources (recording)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random probe points (default 0)")
     parser.add_argument("--samples", type=int, help="samples in the output loop (default: the period at the input rate)")
+    parser.add_argument("--retarget", choices=("puppet",), default=None,
+                        help="move a BVH performance onto the puppet's skeleton first (the loop is then the puppet's)")
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
 
 
@@ -87,6 +89,11 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         perf = load_performance(args.input, args.items, **motion_options(args))
+        if args.retarget:
+            from authoring.cycles.retarget_source import retarget_performance
+            from engine.humanoid import humanoid_skeleton
+
+            perf = retarget_performance(perf, humanoid_skeleton())
     except FileNotFoundError as exc:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:

@@ -29,6 +29,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
                         help="a game option (snowman: field=PATH; tasbada: save, photo, selfie, webcam; "
                              "sandbox: scene, puppets); repeatable")
+    parser.add_argument("--clips", type=Path, default=None, metavar="DIR",
+                        help="play the authored clips of this library (default: $XDG_DATA_HOME/puppetphone/clips "
+                             "when live; an empty or missing library means the built-in clips)")
     parser.add_argument("--puppets", type=int, default=None, metavar="N",
                         help="sandbox: a crowd of N puppets wandering the field (same as --set puppets=N)")
     parser.epilog = ("exit codes: 0 the session ran; 2 a bad option value, no display for a window, an input "
@@ -114,9 +117,12 @@ def run(args: argparse.Namespace) -> int:
         if not recording.complete:
             print(f"warning: {recording.problem}", file=sys.stderr)
     try:
+        from puppetphone.cmd_clips import library_setup
+
+        clips = library_setup(args.clips, replay=hub.replay is not None)
         activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
-                                  source_label=source)
-    except (GameOptionError, OSError) as exc:
+                                  source_label=source, clips=clips)
+    except (GameOptionError, OSError, ValueError) as exc:
         hub.close()
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -37,11 +37,16 @@ def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None =
 
     ``setup`` is what the game's ``prepare`` returned (live) or what a recording's header
     carries (replay); ``None`` is the empty setup: the game's pure defaults (no save file,
-    the shipped pictures, no camera).
+    the shipped pictures, no camera). A setup's ``"clips"`` (``play --clips``) are the
+    authored clips the puppets play (:mod:`engine.cliplib`).
     """
     g = load_game(game)
     app = App(seed=seed)
     app.world.insert_resource(GameSetup(setup))
+    if setup and setup.get("clips") is not None:
+        from puppetphone.cmd_clips import authored_resource
+
+        app.world.insert_resource(authored_resource(setup["clips"]))
     app.add_plugin(input_plugin(hub))
     app.add_plugin(g.install)
     return app

@@ -100,7 +100,7 @@ class GameActivity:
 
 def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str, Any] | None = None,
                    options: dict[str, str] | None = None, record: Path | None = None, source_label: str = "",
-                   verify: Recording | None = None) -> GameActivity:
+                   verify: Recording | None = None, clips: dict[str, Any] | None = None) -> GameActivity:
     """The session of ``game_name``.
 
     Args:
@@ -108,10 +108,13 @@ def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str,
             ``prepare``, which reads save files and pictures.
         record: write the session (its setup in the header) to this file.
         verify: compare every step's state hash with this recording's.
+        clips: the authored clips to play (``engine.cliplib.embed``), over any in the setup.
     """
     game = load_game(game_name)
     if setup is None:
         setup = game.prepare(dict(game.options) if options is None else options)
+    if clips is not None:
+        setup = {**setup, "clips": clips}
     app = make_app(game_name, seed, hub, setup)
     recorder = None
     if record is not None:

@@ -12,8 +12,11 @@ so the result is cached per process and per set of clips.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
 
 from engine.app import App
 from engine.blend.locomotion import BlendLibrary, LocomotionSet, install_blend
@@ -21,6 +24,8 @@ from engine.blend.lookup import LinearMapping, LookupTable
 from engine.blend.measure import LOCOMOTION_PROPERTIES, measure_locomotion
 from engine.blend.space import BlendSpace
 from engine.clip import Clip
+
+F = NDArray[np.float64]
 
 __all__ = [
     "PUPPET_PLACEMENT",
@@ -53,13 +58,22 @@ def build_locomotion(
     dt: float = 1.0 / 60.0,
     power: float = 7.0,
     neighbours: int = 16,
+    memo: Callable[[F, Callable[[F], F]], F] | None = None,
 ) -> LocomotionSet:
-    """Blend space + measured lookup table + the remaining clips as one-shots."""
+    """Blend space + measured lookup table + the remaining clips as one-shots.
+
+    ``memo(probes, measure)`` may answer the measurement from a cache (see
+    :mod:`engine.cliplib.cache`); it must return what ``measure(probes)`` would.
+    """
     space = puppet_blend_space(clips)
+
+    def measure(probes: F) -> F:
+        return measure_locomotion(space, probes, dt)
+
     table = LookupTable.measure(
         space.dims,
         density,
-        lambda probes: measure_locomotion(space, probes, dt),
+        measure if memo is None else (lambda probes: memo(probes, measure)),
         LOCOMOTION_PROPERTIES,
         power=power,
         neighbours=neighbours,
@@ -84,8 +98,13 @@ def height_mapping(table: LookupTable, low: float, high: float) -> LinearMapping
 
 
 def install_puppet_locomotion(app: App) -> None:
-    """Plugin: :func:`install_blend` plus the default puppet's set under ``"humanoid"``."""
+    """Plugin: :func:`install_blend` plus the puppet's set under ``"humanoid"``: the built-in clips, or
+    the authored ones of an :class:`engine.cliplib.authored.AuthoredClips` resource over them."""
     app.add_plugin(install_blend)
     library = app.world.resource(BlendLibrary)
     if "humanoid" not in library:
-        library.add("humanoid", puppet_locomotion())
+        from engine.cliplib.authored import AuthoredClips, authored_locomotion
+
+        authored = app.world.try_resource(AuthoredClips)  # a clip library the game plays (see engine.cliplib)
+        played = authored_locomotion(authored)[0] if authored and authored.clips else puppet_locomotion()
+        library.add("humanoid", played)

@@ -94,8 +94,8 @@ def test_root_translation_and_refusals() -> None:
     clip = scene.accept()
     assert clip is not None
     assert np.ptp(clip.root[:, 0]) == pytest.approx(0.2, rel=0.1)
-    with pytest.raises(ValueError, match="only the root"):
-        RecordScene(sk, "head", "translation")
+    with pytest.raises(ValueError, match="chest's position follows its parents"):
+        RecordScene(sk, "chest", "translation")
     with pytest.raises(ValueError, match="finite numbers"):
         scene.feed(np.array([1.0, 0.0]))
 
@@ -124,6 +124,72 @@ def test_a_scale_drive_records_the_clips_scale_channel_through_to_gltf(tmp_path:
     assert np.abs(back.scales - clip.scales).max() < 1e-5
     with pytest.raises(ValueError, match="positive"):
         scene.feed(np.array([-1.0]))
+
+
+def _perform_values(scene: RecordScene, values, seconds: float = 7.0) -> None:  # type: ignore[no-untyped-def]
+    scene.key("r")
+    for _ in range(int(scene.countdown * FPS) + 1):
+        scene.step(1.0 / FPS)
+    for k in range(int(seconds * FPS)):
+        scene.feed(values(k / FPS))
+        scene.step(1.0 / FPS)
+    scene.key("space")
+
+
+def test_a_hand_is_driven_by_translation_through_the_ik() -> None:
+    """A layer drives the hand's position: every frame the arm bends so the hand is where it was performed."""
+    from engine.fk import forward_kinematics
+
+    sk = humanoid_skeleton()
+    scene = RecordScene(sk, "r_hand", "translation", countdown=0.1, take_seconds=30.0)
+    rest = scene.rest_value()
+    centre = rest + np.array([0.05, 0.25, 0.2])  # in front of the body, within reach
+    path = lambda t: centre + np.array([0.12 * np.sin(2 * np.pi * t), 0.06 * np.sin(4 * np.pi * t), 0.0])  # noqa: E731
+    _perform_values(scene, path)
+    clip = scene.accept()
+    assert clip is not None and clip.loop
+    hand = sk.index("r_hand")
+    wpos, _ = forward_kinematics(sk, clip.root, clip.rotations)
+    t = np.arange(clip.num_frames) / clip.fps
+    assert clip.duration == pytest.approx(1.0, rel=0.03)
+    # The hand draws the performed figure (up to the loop's phase) and the elbow, not the shoulder, moved.
+    assert np.ptp(wpos[:, hand, 0]) == pytest.approx(0.24, rel=0.1)
+    assert np.ptp(wpos[:, hand, 1]) == pytest.approx(0.12, rel=0.15)
+    assert np.allclose(wpos[:, hand, 2], centre[2], atol=0.01)
+    moved = quat.angle_between(clip.rotations[:, sk.index("r_lower_arm")], quat.identity(1)[0])
+    assert moved.max() > 0.2
+    assert np.allclose(clip.rotations[:, sk.index("chest")], quat.identity(1)[0])
+    assert len(t) == clip.num_frames
+
+
+def test_a_six_dof_take_records_position_and_rotation_together() -> None:
+    """One take of a 6-DoF device: the foot's position by IK and its rotation, from one loop of 7 numbers."""
+    from engine.fk import forward_kinematics
+
+    sk = humanoid_skeleton()
+    scene = RecordScene(sk, "l_foot", "pose", countdown=0.1, take_seconds=30.0)
+    rest = scene.rest_value()
+    assert rest.shape == (7,)
+
+    def device(t: float) -> np.ndarray:
+        p = 2 * np.pi * t / 1.2
+        position = rest[:3] + np.array([0.0, 0.08 * (1 - np.cos(p)), 0.15 * np.sin(p)])  # a step's arc
+        rotation = quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.float64(0.4 * np.sin(p)))
+        return np.concatenate([position, rotation])
+
+    _perform_values(scene, device, seconds=8.0)
+    assert scene.result is not None and len(scene.result.curves) == 2  # one loop, both items
+    clip = scene.accept()
+    assert clip is not None and clip.duration == pytest.approx(1.2, rel=0.03)
+    foot = sk.index("l_foot")
+    wpos, _ = forward_kinematics(sk, clip.root, clip.rotations)
+    assert np.ptp(wpos[:, foot, 2]) == pytest.approx(0.3, rel=0.1)
+    assert np.ptp(wpos[:, foot, 1]) == pytest.approx(0.16, rel=0.15)
+    # Rotation and position stay in step: the foot pitches forward exactly when it is in front.
+    pitch = 2 * np.arctan2(clip.rotations[:, foot, 1], clip.rotations[:, foot, 0])
+    forward = wpos[:, foot, 2] - rest[2]
+    assert np.corrcoef(pitch, forward)[0, 1] > 0.99
+    assert np.abs(pitch).max() == pytest.approx(0.4, rel=0.05)
 
 
 def test_mouse_point_lies_on_the_plane() -> None:

@@ -70,3 +70,71 @@ def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(tmp_
             out.write(InputFrame(frame=frame.frame, events=((TOOL, '["press"]'),)) if i == 3 else frame, digest, parts)
     done = puppetphone("replay", "short.rec", "--headless", cwd=tmp_path)
     assert done.returncode == 2 and done.stderr.strip().endswith("does not fit the record scene")
+
+
+def test_a_scripted_pose_take_of_a_foot_records_and_replays(tmp_path: Path) -> None:
+    """``--drive pose`` on a foot: position (by IK) and rotation in one take; the recording replays it."""
+    done = puppetphone("author", "record", "--item", "l_foot", "--drive", "pose", "--script", "loops", "--headless",
+                       "--frames", "600", "--countdown", "1", "--seconds", "6", "--record", "take.rec",
+                       "-o", "loop.ppclip", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    loop = load_clip(tmp_path / "loop.ppclip")
+    import numpy as np
+
+    from engine import quat
+    from engine.fk import forward_kinematics
+
+    foot = loop.skeleton.index("l_foot")
+    wpos, _ = forward_kinematics(loop.skeleton, loop.root, loop.rotations)
+    assert 0.2 < float(np.ptp(wpos[:, foot, 0])) < 0.4  # the scripted figure is 0.3 m wide
+    turned = quat.angle_between(loop.rotations[:, foot], quat.identity(1)[0])
+    assert turned.max() > 0.2  # and the foot's own rotation was performed with it
+    done = puppetphone("replay", "take.rec", "--verify", "--headless", cwd=tmp_path)
+    assert done.returncode == 0 and "all 600 state hashes match" in done.stdout, done.stdout + done.stderr
+
+
+def test_a_six_dof_device_drives_position_and_rotation_together() -> None:
+    """A tracked phone's samples through the hub: position relative to the take's start, rotation likewise."""
+    import numpy as np
+
+    from authoring.record_scene import RecordScene
+    from engine import quat
+    from engine.humanoid import humanoid_skeleton
+    from input.hub import InputHub
+    from input.sample import PoseSample
+    from input.source import PoseSource
+    from puppetphone.cmd_author import RecordActivity
+
+    class Phone(PoseSource):
+        threaded = False
+
+        def __init__(self) -> None:
+            super().__init__("phone")
+            self._status.connected = True
+
+    phone = Phone()
+    scene = RecordScene(humanoid_skeleton(), "r_hand", "pose", countdown=0.1, take_seconds=30.0)
+    activity = RecordActivity(scene, InputHub([phone]))
+    rest = scene.rest_value()
+    start = np.array([0.3, 1.2, 0.4])  # where the phone happens to be: only its motion counts
+    scene.key("r")
+    steps = int(7.0 / activity.dt) + 12
+    for k in range(steps):
+        t = max(k - 12, 0) * activity.dt
+        p = 2 * np.pi * t
+        position = start + np.array([0.0, 0.06 * (1 - np.cos(p)), 0.1 * np.sin(p)])  # a hanging arm swings
+        orientation = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.float64(0.5 * np.sin(p)))
+        phone.push(PoseSample(time=k * activity.dt, source="phone", orientation=orientation, position=position))
+        activity.step()
+    scene.key("space")
+    assert scene.result is not None, scene.message
+    clip = scene.accept()
+    assert clip is not None and clip.duration == np.float64(clip.duration) and abs(clip.duration - 1.0) < 0.03
+    from engine.fk import forward_kinematics
+
+    hand = clip.skeleton.index("r_hand")
+    wpos, _ = forward_kinematics(clip.skeleton, clip.root, clip.rotations)
+    assert abs(float(np.ptp(wpos[:, hand, 2])) - 0.2) < 0.02 and abs(float(np.ptp(wpos[:, hand, 1])) - 0.12) < 0.015
+    assert np.allclose(wpos[:, hand].min(axis=0)[[0, 1]], rest[:2], atol=0.02)  # from where the hand was
+    twist = quat.angle_between(clip.rotations[:, hand], rest[3:])
+    assert abs(float(twist.max()) - 0.5) < 0.05

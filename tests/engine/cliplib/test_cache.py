@@ -1,0 +1,54 @@
+"""The lookup measurement cache: the same numbers as measuring, a second start without measuring."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from engine.clips import default_clips
+from engine.cliplib.authored import AuthoredClips, authored_locomotion
+from engine.cliplib.cache import MeasureCache
+from engine.cliplib.roles import conform
+
+
+def _authored() -> dict:
+    return {"walk": conform(default_clips()["walk"].resampled(50.0), "walk")}
+
+
+def test_second_build_reads_the_cache_and_gives_the_same_table(tmp_path: Path) -> None:
+    t0 = time.perf_counter()
+    first, c1 = authored_locomotion(AuthoredClips(_authored(), tmp_path), density=9)
+    cold = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    second, c2 = authored_locomotion(AuthoredClips(_authored(), tmp_path), density=9)
+    warm = time.perf_counter() - t0
+    assert c1 is not None and c2 is not None and (c1.misses, c2.hits, c2.misses) == (1, 1, 0)
+    assert np.array_equal(first.table.values, second.table.values)
+    assert warm < cold
+    uncached, none = authored_locomotion(AuthoredClips(_authored(), None), density=9)
+    assert none is None and np.array_equal(uncached.table.values, first.table.values)
+
+
+def test_other_clips_or_grid_get_another_key(tmp_path: Path) -> None:
+    a = MeasureCache(tmp_path, "clips-a:9")
+    assert a.path != MeasureCache(tmp_path, "clips-b:9").path != MeasureCache(tmp_path, "clips-a:31").path
+
+
+def test_a_damaged_cache_file_is_measured_again(tmp_path: Path) -> None:
+    probes = np.linspace(0.0, 1.0, 8).reshape(4, 2)
+    cache = MeasureCache(tmp_path, "k")
+    calls = []
+
+    def measure(p: np.ndarray) -> np.ndarray:
+        calls.append(1)
+        return p * 2.0
+
+    assert np.array_equal(cache(probes, measure), probes * 2.0)
+    cache.path.write_bytes(b"PK\x03\x04 broken")
+    assert np.array_equal(cache(probes, measure), probes * 2.0)
+    assert np.array_equal(cache(probes, measure), probes * 2.0)
+    assert len(calls) == 2 and cache.hits == 1
+    assert np.array_equal(cache(probes[:2], measure), probes[:2] * 2.0)  # other probes: not this entry
+    assert len(calls) == 3
