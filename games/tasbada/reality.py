@@ -12,10 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 from PIL import Image
 
-from games.tasbada.compositor import Sprites, build_sprites, compose
+from games.tasbada.compositor import Layers, Sprites, build_sprites, compose
 from games.tasbada.images import PHOTO_SIZE, clothes_color, fit_photo, load_image
 from games.tasbada.quest import MIXED, REAL, Quest
 from games.tasbada.webcam import Webcam
@@ -39,13 +38,15 @@ class Reality:
     SIM_STATE = False
 
     def __init__(self, photo: str | Path = SHIPPED_PHOTO, selfie: str | Path = SHIPPED_SELFIE,
-                 webcam: Webcam | None = None, message: str = "") -> None:
+                 webcam: Webcam | None = None, message: str = "", light_deg: float | None = None) -> None:
         self.photo_path = str(photo)
         self.photo = fit_photo(load_image(photo))
         self.selfie_img = load_image(selfie)
         self.color = clothes_color(self.selfie_img)
         self.webcam = webcam
         self.message = message
+        self.light_deg = light_deg
+        """Where the props' shadows fall (degrees; ``None``: as found in the photo)."""
         self.frozen = webcam is None
         self.selfie_taken = webcam is None
         self._sprites: tuple[bytes, Sprites] | None = None
@@ -77,12 +78,13 @@ class Reality:
         if not q.marks:
             return None
         key = b"".join(m.kind.encode() + np.ascontiguousarray(m.points).tobytes() for m in q.marks)
+        key += np.float64(q.ground_v).tobytes()
         if self._sprites is None or self._sprites[0] != key:
-            self._sprites = (key, build_sprites(self.photo, q.marks))
+            self._sprites = (key, build_sprites(self.photo, q.marks, q.ground_v, self.light_deg))
         return self._sprites[1]
 
-    def frame(self, q: Quest, now: float, gaze: float) -> NDArray[np.uint8]:
-        """This frame's backdrop picture."""
+    def frame(self, q: Quest, now: float, gaze: float) -> Layers:
+        """This frame's backdrop, living props and interface."""
         self._live(q)
         sprites = None if q.stage == REAL else self.sprites(q)
         return compose(self._photo_pil, sprites, q, now, self._selfie_pil, self.color, gaze)
