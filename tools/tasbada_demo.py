@@ -198,7 +198,9 @@ def journey(d: _Driver) -> Iterator[str]:
     while q.stage != "mixed":
         d.step()
     yield "mixed"
-    d.step(60)
+    d.step(50)
+    d.shot("mixed_pose")  # the avatar still holds the player's pose
+    d.step(10)
     lay = layout(q.ground_v, q.marks)
     start = lay.start + np.array([0.0, 0.95, 0.0])
     px = d.camera.project(start[None], *SIZE)[0]
@@ -235,11 +237,24 @@ def journey(d: _Driver) -> Iterator[str]:
     d.shot("virtual")
 
 
+def demo_setup() -> dict[str, object]:
+    """The demo's set-up: only the pose found in the shipped selfie (the rest are defaults)."""
+    from games.tasbada.game import _selfie_pose
+    from games.tasbada.reality import SHIPPED_SELFIE
+
+    points, aspect, note = _selfie_pose(str(SHIPPED_SELFIE), True)
+    if points is None:
+        raise RuntimeError(f"the demo needs the pose estimator (pip install 'puppetphone[pose]'): {note}")
+    return {"pose": points, "pose_aspect": aspect, "pose_note": note}
+
+
 def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> list[str]:
     """Play the journey and record it to ``path``; returns the stages in the order reached.
 
-    The game is built with the empty setup: a new journey, the shipped photo, no camera,
-    saving nowhere — so the demo depends on nothing outside the repository.
+    The game is built with a new journey's setup: the shipped photo and selfie, no camera,
+    saving nowhere, and the player's pose found in the shipped selfie (recorded in the
+    header, so the replay needs no pose estimator) — the demo depends on nothing outside
+    the repository.
     """
     from games.tasbada.view import game_camera
     from input.hub import InputHub
@@ -249,8 +264,9 @@ def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> li
 
     mouse = MouseSource()
     hub = InputHub([mouse]).start()
-    app = make_app("tasbada", seed, hub, {})
-    header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"], setup={})
+    setup = demo_setup()
+    app = make_app("tasbada", seed, hub, setup)
+    header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"], setup=setup)
     recorder = Recorder(path, header).attach(app)
     d = _Driver(app, mouse, game_camera(), shots)
     try:

@@ -26,6 +26,8 @@ from engine.components import Stick
 from engine.ecs import World
 from engine.render.components import Appearance
 from games.tasbada import marking, narrator, objects
+from games.tasbada.pose import lift
+from games.tasbada.posing import SelfiePose
 from games.tasbada.quest import MENU, MIXED, PROPS_ALIVE, REAL, STAGES, VIRTUAL, Quest
 from games.tasbada.view import to_image
 from input.sample import TOUCH_DOWN, TOUCH_UP, InputFrame
@@ -93,7 +95,12 @@ def _spawn_mixed(world: World, q: Quest) -> None:
     objects.spawn_objects(world, q)
     look = world.try_resource(AvatarLook) or AvatarLook()
     start = objects.layout(q.ground_v, q.marks).start
-    q.avatar = spawn_puppet(world, start, heading=np.pi, name="avatar", extra=(Appearance(color=look.color),))
+    extra: tuple[object, ...] = (Appearance(color=look.color),)
+    if q.pose:
+        rotations, posed = lift(q.pose, q.pose_aspect)
+        extra += (SelfiePose(rotations, posed, world.time),)
+    # Facing the camera, as the person did for the selfie (grabbing it turns it where it walks).
+    q.avatar = spawn_puppet(world, start, heading=0.0, name="avatar", extra=extra)
 
 
 def restart_from(world: World, q: Quest, stage: str) -> None:

@@ -93,6 +93,8 @@ def matte(photo: NDArray[np.uint8], mark: Mark) -> Matte:
     if (mask == cv2.GC_PR_FGD).any() and (mask == cv2.GC_BGD).any():
         cv2.grabCut(patch, mask, None, bgd, fgd, _ITERATIONS, cv2.GC_INIT_WITH_MASK)
     hard = np.isin(mask, (cv2.GC_FGD, cv2.GC_PR_FGD)).astype(np.uint8)
+    # Slivers of the room along the prop (a strip of skirting board) are thinner than any part of it.
+    hard = cv2.morphologyEx(hard, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5)))
     hard = _largest_parts(hard)
     if hard.mean() < 0.02:  # nothing stood out: keep the marked region itself
         hard = (_seed((h, w), mark, crop) == cv2.GC_PR_FGD).astype(np.uint8)

@@ -111,6 +111,11 @@ class Quest:
     milestones: list[str] = field(default_factory=list)
     menu_open: bool = False
     saved_reached: list[str] = field(default_factory=list)
+    pose: dict[str, list[float]] = field(default_factory=dict)
+    """The player's keypoints (normalised selfie ``[x, y]`` by name, :mod:`games.tasbada.pose`):
+    found in the selfie at set-up, or placed by hand with the pose picker; empty: none."""
+    pose_aspect: float = 1.0
+    """Width / height of the picture the keypoints are measured on."""
     """Stages reached in an earlier session (from the save file), offered by the menu."""
 
     def time_in_stage(self, now: float) -> float:

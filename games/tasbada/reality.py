@@ -46,6 +46,8 @@ class Reality:
         self.webcam = webcam
         self.message = message
         self.light_deg = light_deg
+        self.pose_note = ""
+        """What the pose estimator said about the selfie (shown in the status lines)."""
         """Where the props' shadows fall (degrees; ``None``: as found in the photo)."""
         self.frozen = webcam is None
         self.selfie_taken = webcam is None
