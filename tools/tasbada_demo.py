@@ -177,12 +177,14 @@ def journey(d: _Driver) -> Iterator[str]:
     d.press()
     d.move(_px(0.775, 0.095), 25)
     d.release()
-    # The floor line: drag it down a little, then back onto the skirting.
-    d.move(_px(0.35, q.ground_v), 15)
+    # The floor line: drag its knob down a little, then back onto the skirting.
+    from games.tasbada.marking import GROUND_HANDLE_U
+
+    d.move(_px(GROUND_HANDLE_U, q.ground_v), 15)
     d.press()
-    d.move(_px(0.35, 0.6), 15)
+    d.move(_px(GROUND_HANDLE_U, 0.6), 15)
     d.shot("real")
-    d.move(_px(0.35, 0.556), 15)
+    d.move(_px(GROUND_HANDLE_U, 0.556), 15)
     d.release()
     yield "real"
     d.click(_px(0.895, 0.07), 20)

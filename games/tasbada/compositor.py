@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image, ImageDraw, ImageFont
 
-from games.tasbada import marking, narrator
+from games.tasbada import marking, narrator, picker
 from games.tasbada.matting import inpaint_hole, matte
 from games.tasbada.propmesh import Deform, PropTexture, deform
 from games.tasbada.quest import MENU, MIXED, PROPS_ALIVE, REAL, STAGES, Mark, Quest
@@ -125,10 +125,15 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
     w, h = img.size
     d = ImageDraw.Draw(img, "RGBA")
     gy = q.ground_v * h
-    hot_ground = q.gesture == "ground" or abs(q.pointer[1] - q.ground_v) < marking.GROUND_GRAB
+    hot_ground = q.gesture == "ground" or marking.on_ground_handle(q.pointer, q.ground_v)
+    line = (ACCENT if hot_ground else (255, 255, 255)) + (255,)
     for x in range(0, w, 28):
-        d.line((x, gy, x + 16, gy), fill=(ACCENT if hot_ground else (255, 255, 255)) + (255,), width=3)
-    d.text((w * 0.012, gy - 6), "floor line (drag it)", font=font(int(h * 0.028)), fill=(255, 255, 255, 255),
+        d.line((x, gy, x + 16, gy), fill=line, width=3)
+    hx, hr = marking.GROUND_HANDLE_U * w, marking.GROUND_GRAB * h
+    d.ellipse((hx - hr, gy - hr, hx + hr, gy + hr), fill=line[:3] + (230,), outline=INK + (255,), width=3)
+    d.polygon([(hx, gy - hr * 0.75), (hx - hr * 0.35, gy - hr * 0.25), (hx + hr * 0.35, gy - hr * 0.25)], fill=INK + (255,))
+    d.polygon([(hx, gy + hr * 0.75), (hx - hr * 0.35, gy + hr * 0.25), (hx + hr * 0.35, gy + hr * 0.25)], fill=INK + (255,))
+    d.text((hx + hr + 6, gy - 6), "floor line (drag the knob)", font=font(int(h * 0.028)), fill=(255, 255, 255, 255),
            anchor="lb", stroke_width=2, stroke_fill=INK + (255,))
     for i, m in enumerate(q.marks):
         pts = m.points * np.array([w, h])
@@ -148,9 +153,9 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
         (x0, y0), (x1, y1) = q.path[0], q.path[-1]
         d.rectangle((min(x0, x1) * w, min(y0, y1) * h, max(x0, x1) * w, max(y0, y1) * h), outline=(255, 255, 255, 120))
     for b in marking.REAL_BUTTONS:
-        _button(d, b.rect, b.label, (w, h), b.contains(q.pointer), enabled=bool(q.marks))
+        _button(d, b.rect, b.label, (w, h), b.contains(q.pointer), enabled=bool(q.marks or q.undo))
     hint = ("Drag a box (or draw a lasso) around a thing in your room; the first one will talk."
-            if not q.marks else f"{len(q.marks)} marked. Mark more, drag the floor line, then press Done.")
+            if not q.marks else f"{len(q.marks)} marked. Mark more, drag the floor line's knob, then press Done.")
     _banner(d, hint, (w, h))
     _pointer(d, q, (w, h))
 
@@ -248,6 +253,36 @@ def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: flo
         d.rectangle((0, 0, w, h), fill=(255, 255, 255, int(220 * (1 - (now - q.line_t) / 0.25))))
 
 
+def _picker(img: Image.Image, q: Quest) -> None:
+    """The pose picker's panel: a stick figure whose elbows, hands, knees and feet can be dragged."""
+    w, h = img.size
+    d = ImageDraw.Draw(img, "RGBA")
+    u0, v0, u1, v1 = picker.PANEL
+    d.rounded_rectangle((u0 * w, v0 * h, u1 * w, v1 * h), radius=14, fill=PAPER + (225,), outline=INK + (255,), width=3)
+    d.text(((u0 + u1) / 2 * w, v0 * h + 8), "Pose your avatar: drag the dots", font=font(int(h * 0.026)),
+           fill=INK + (255,), anchor="mt")
+
+    def px(name: str) -> tuple[float, float]:
+        p = picker.to_panel(q.pose[name])
+        return (float(p[0] * w), float(p[1] * h))
+
+    for a, b in picker.BONES:
+        if a in q.pose and b in q.pose:
+            d.line((px(a), px(b)), fill=INK + (255,), width=6)
+    if "l_shoulder" in q.pose and "r_shoulder" in q.pose:
+        (lx, ly), (rx, ry) = px("l_shoulder"), px("r_shoulder")
+        r = abs(lx - rx) * 0.42
+        d.ellipse(((lx + rx) / 2 - r, (ly + ry) / 2 - 2.6 * r, (lx + rx) / 2 + r, (ly + ry) / 2 - 0.6 * r),
+                  outline=INK + (255,), width=5)
+    for name in picker.HANDLES:
+        if name in q.pose:
+            x, y = px(name)
+            hot = q.gesture == "pose:" + name
+            r = 9 if hot else 7
+            d.ellipse((x - r, y - r, x + r, y + r), fill=(ACCENT if hot else (255, 120, 60)) + (255,),
+                      outline=INK + (255,), width=2)
+
+
 def _menu(img: Image.Image, q: Quest) -> None:
     w, h = img.size
     d = ImageDraw.Draw(img, "RGBA")
@@ -296,7 +331,10 @@ def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, s
         d = ImageDraw.Draw(ui, "RGBA")
         if top is not None and talking_text:
             _bubble(d, talking_text, top, (w, h))
-        _selfie_pip(ui, selfie, q, now, color)
+        if q.pose_picker and q.stage == PROPS_ALIVE:
+            _picker(ui, q)
+        else:
+            _selfie_pip(ui, selfie, q, now, color)
     d = ImageDraw.Draw(ui, "RGBA")
     if q.menu_open or q.stage == MENU:
         _menu(ui, q)

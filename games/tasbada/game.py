@@ -36,6 +36,8 @@ from games.base import Game, GameOptionError, GameSetup
 from games.tasbada import draw as draw_mod
 from games.tasbada.flow import AvatarLook, SaveSlot, quest_system, save_system
 from games.tasbada.objects import follow_system
+from games.tasbada.picker import panel_aspect
+from games.tasbada.pose import default_keypoints
 from games.tasbada.pose import validate as validate_pose
 from games.tasbada.posing import selfie_pose_system
 from games.tasbada.quest import MIXED, PROPS_ALIVE, STAGES, VIRTUAL, Mark, Quest
@@ -129,6 +131,8 @@ def install(app: App) -> None:
         q.ground_v = float(setup.get("ground_v"))
     q.pose = validate_pose(setup.get("pose")) or {}
     q.pose_aspect = float(setup.get("pose_aspect", 1.0) or 1.0)
+    if not q.pose:  # nothing from the selfie: the person poses a stick figure by hand
+        q.pose, q.pose_aspect, q.pose_picker = default_keypoints(), panel_aspect(), True
     photo = setup.get("photo", "")
     webcam, message = None, ""
     if setup.get("webcam", False):
