@@ -64,11 +64,14 @@ class Sprites:
         self.depth_at = depth_at
 
 
+PropLayer = tuple[NDArray[np.uint8], tuple[float, float, float, float], tuple[float, float, float] | None]
+"""A living prop's picture, its rectangle on the photo (normalised) and the world point it stands at."""
+
+
 class Layers:
     """One drawn frame of the photo side: the backdrop, the props at their depths, the interface on top."""
 
-    def __init__(self, background: NDArray[np.uint8], props: list[tuple[NDArray[np.uint8], tuple[float, float, float, float],
-                 tuple[float, float, float] | None]], ui: NDArray[np.uint8]) -> None:
+    def __init__(self, background: NDArray[np.uint8], props: list[PropLayer], ui: NDArray[np.uint8]) -> None:
         self.background = background
         self.props = props
         """``(rgba, rect, depth_at)`` per prop, ``rect`` normalised on the photo."""
@@ -131,8 +134,10 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
         d.line((x, gy, x + 16, gy), fill=line, width=3)
     hx, hr = marking.GROUND_HANDLE_U * w, marking.GROUND_GRAB * h
     d.ellipse((hx - hr, gy - hr, hx + hr, gy + hr), fill=line[:3] + (230,), outline=INK + (255,), width=3)
-    d.polygon([(hx, gy - hr * 0.75), (hx - hr * 0.35, gy - hr * 0.25), (hx + hr * 0.35, gy - hr * 0.25)], fill=INK + (255,))
-    d.polygon([(hx, gy + hr * 0.75), (hx - hr * 0.35, gy + hr * 0.25), (hx + hr * 0.35, gy + hr * 0.25)], fill=INK + (255,))
+    for s in (-1.0, 1.0):  # up and down arrows on the knob
+        tip, side = gy + s * hr * 0.75, gy + s * hr * 0.25
+        d.polygon([(hx, tip), (hx - hr * 0.35, side), (hx + hr * 0.35, side)],
+                  fill=INK + (255,))
     d.text((hx + hr + 6, gy - 6), "floor line (drag the knob)", font=font(int(h * 0.028)), fill=(255, 255, 255, 255),
            anchor="lb", stroke_width=2, stroke_fill=INK + (255,))
     for i, m in enumerate(q.marks):
@@ -304,7 +309,7 @@ def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, s
     """
     w, h = photo.size
     ui = Image.new("RGBA", (w, h), (0, 0, 0, 0))
-    props: list[tuple[NDArray[np.uint8], tuple[float, float, float, float], tuple[float, float, float] | None]] = []
+    props: list[PropLayer] = []
     if q.stage in (REAL, MENU) or sprites is None:
         background = np.asarray(photo.convert("RGB")).copy()
         if q.stage == REAL and not q.menu_open:

@@ -12,7 +12,9 @@ Options (``--set key=value``; the ``$TASBADA_*`` variables are read as defaults)
 ``photo`` — the backdrop (``$TASBADA_PHOTO``, else the save's photo, else a webcam, else
 the shipped ``assets/room.jpg``); ``selfie`` (``$TASBADA_SELFIE`` or the shipped one);
 ``webcam`` — ``auto`` or ``off``; ``pose`` — ``auto`` (find the player's pose in the selfie
-with MediaPipe when installed) or ``off`` (pose the avatar by hand).
+with MediaPipe when installed) or ``off`` (pose the avatar by hand); ``light`` — where the
+props' shadows fall, in degrees on the floor (0 right, 90 back, 180 left; empty: as measured
+from their shadows in the photo).
 
 :func:`prepare` reads the save file and picks the pictures; :func:`install` builds the
 quest from that setup alone, so a recording replays from its header. The pictures and
@@ -27,6 +29,8 @@ import os
 import sys
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from engine.app import App
 from engine.camera import OrbitCamera
@@ -79,6 +83,13 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
             raise GameOptionError(f"tasbada {label} {path!r} is not a file")
     if options["pose"] not in ("auto", "off"):
         raise GameOptionError(f"tasbada pose must be auto or off, not {options['pose']!r}")
+    light = options["light"].strip()
+    try:
+        light_deg = float(light) if light else None
+    except ValueError:
+        raise GameOptionError(f"tasbada light must be a number of degrees, not {light!r}") from None
+    if light_deg is not None and not np.isfinite(light_deg):
+        raise GameOptionError(f"tasbada light must be a finite number of degrees, not {light!r}")
     found, aspect, note = _selfie_pose(selfie, options["pose"] == "auto")
     return {
         "save_to": str(save),
@@ -91,6 +102,7 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
         "pose": found or {},
         "pose_aspect": aspect,
         "pose_note": note,
+        "light": light_deg,
     }
 
 
@@ -142,7 +154,9 @@ def install(app: App) -> None:
         print(f"tasbada: {message}", file=sys.stderr)
     elif not photo:
         message = f"using the photo {SHIPPED_PHOTO.name}"
-    reality = Reality(photo or SHIPPED_PHOTO, setup.get("selfie", "") or SHIPPED_SELFIE, webcam, message)
+    light = setup.get("light")
+    reality = Reality(photo or SHIPPED_PHOTO, setup.get("selfie", "") or SHIPPED_SELFIE, webcam, message,
+                      light_deg=float(light) if isinstance(light, (int, float)) and np.isfinite(light) else None)
     reality.pose_note = str(setup.get("pose_note", ""))
     save_to = setup.get("save_to", "")
     slot = SaveSlot(Path(save_to) if save_to else None)
@@ -181,5 +195,6 @@ def _camera() -> OrbitCamera:
 
 
 GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
-            options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto"}, prepare=prepare,
+            options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto",
+                     "light": ""}, prepare=prepare,
             replay_setup=replay_setup)
