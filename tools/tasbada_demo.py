@@ -95,6 +95,10 @@ class _Driver:
             target = make_target(True, *SIZE)
             self._render = (target, Renderer(target.ctx), RenderScene())
         target, renderer, scene = self._render
+        from games.tasbada.quest import Quest
+        from games.tasbada.reality import Reality
+
+        self.world.resource(Reality).sprites(self.world.resource(Quest), wait=True)  # the props, built
         scene.clear()
         GAME.draw(self.world, scene, 1.0)
         for line in GAME.status(self.world):

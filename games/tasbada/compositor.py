@@ -314,6 +314,8 @@ def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, s
         background = np.asarray(photo.convert("RGB")).copy()
         if q.stage == REAL and not q.menu_open:
             _draw_real(ui, q)
+        elif q.stage not in (REAL, MENU) and q.marks:  # the props are still being cut out
+            _banner(ImageDraw.Draw(ui, "RGBA"), "Waking up the things you marked...", (w, h))
     else:
         background = sprites.base.copy()
         t = now - q.alive_t

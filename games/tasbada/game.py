@@ -52,7 +52,7 @@ from games.tasbada.view import game_camera
 __all__ = ["GAME", "install", "prepare", "replay_setup", "status", "CONTROLS"]
 
 CONTROLS = (
-    "Stage 1: drag a box or draw a lasso around things in the photo; drag the dashed floor line; Done.",
+    "Stage 1: drag a box or draw a lasso around things in the photo; drag the floor line by its knob; Undo; Done.",
     "Stage 2: the first thing you marked talks; click to skip a line; look into the camera for the selfie.",
     "Stage 3: grab your avatar and walk it to the cages, over the crystals, then through the gate.",
     "Menu (bottom right): restart from any stage you reached. Progress is saved as you go.",

@@ -9,6 +9,7 @@ not per frame.
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ from PIL import Image
 
 from games.tasbada.compositor import Layers, Sprites, build_sprites, compose
 from games.tasbada.images import PHOTO_SIZE, clothes_color, fit_photo, load_image
-from games.tasbada.quest import MIXED, REAL, Quest
+from games.tasbada.quest import MIXED, REAL, Mark, Quest
 from games.tasbada.webcam import Webcam
 
 __all__ = ["Reality", "SHIPPED_PHOTO", "SHIPPED_SELFIE"]
@@ -52,6 +53,7 @@ class Reality:
         self.frozen = webcam is None
         self.selfie_taken = webcam is None
         self._sprites: tuple[bytes, Sprites] | None = None
+        self._building: tuple[bytes, threading.Thread, list[Sprites | BaseException]] | None = None
         self._photo_pil = Image.fromarray(self.photo)
         self._selfie_pil = Image.fromarray(self.selfie_img)
 
@@ -75,15 +77,42 @@ class Reality:
                     self.color = clothes_color(frame)
                     self.selfie_taken = True
 
-    def sprites(self, q: Quest) -> Sprites | None:
-        """The cut-outs for ``q``'s marks (built on first use for a new set of marks)."""
+    def sprites(self, q: Quest, wait: bool = False) -> Sprites | None:
+        """The living props for ``q``'s marks, or ``None`` while they are still being built.
+
+        Matting, shadows and inpainting take seconds, so they run on a worker thread
+        (OpenCV releases the GIL) and the window keeps drawing the plain photo meanwhile;
+        ``wait`` blocks until they are ready (screenshots, tests).
+        """
         if not q.marks:
             return None
         key = b"".join(m.kind.encode() + np.ascontiguousarray(m.points).tobytes() for m in q.marks)
         key += np.float64(q.ground_v).tobytes()
-        if self._sprites is None or self._sprites[0] != key:
-            self._sprites = (key, build_sprites(self.photo, q.marks, q.ground_v, self.light_deg))
-        return self._sprites[1]
+        if self._sprites is not None and self._sprites[0] == key:
+            return self._sprites[1]
+        if self._building is None or self._building[0] != key:
+            job: list[Sprites | BaseException] = []
+            args = (self.photo.copy(), [Mark(m.kind, m.points.copy()) for m in q.marks], q.ground_v, self.light_deg)
+
+            def run() -> None:
+                try:
+                    job.append(build_sprites(*args))
+                except BaseException as exc:  # handed to the drawing thread below
+                    job.append(exc)
+
+            worker = threading.Thread(target=run, name="tasbada-props", daemon=True)
+            worker.start()
+            self._building = (key, worker, job)
+        _, worker, job = self._building
+        if wait:
+            worker.join()
+        if not job:
+            return None
+        self._building = None
+        if isinstance(job[0], BaseException):
+            raise job[0]
+        self._sprites = (key, job[0])
+        return job[0]
 
     def frame(self, q: Quest, now: float, gaze: float) -> Layers:
         """This frame's backdrop, living props and interface."""

@@ -77,7 +77,7 @@ def find_shadow(photo: NDArray[np.uint8], m: Matte, floor_row: float, others: ND
     if others is not None:
         blocked |= others > 0.05
     search = region & ~blocked
-    ratio = _ratio(photo, blocked, height)
+    ratio = _ratio(photo, blocked, height, (bx, by), radius)
     dark = ndimage.binary_opening(search & (ratio < _DARKER), iterations=2)  # not the planks' thin seams
     near_base = (xs - bx) ** 2 + (ys - by) ** 2 < (0.15 * height + 6.0) ** 2
     labels, n = ndimage.label(dark)
@@ -102,23 +102,40 @@ def find_shadow(photo: NDArray[np.uint8], m: Matte, floor_row: float, others: ND
     return Shadow((float(light[0]), float(light[1])), strength, soft.astype(np.float32), r, True)
 
 
-def _ratio(photo: NDArray[np.uint8], blocked: NDArray[np.bool_], height: float) -> NDArray[np.float32]:
-    """Light received / light the floor would get without a small dark patch, per pixel.
+def _ratio(photo: NDArray[np.uint8], blocked: NDArray[np.bool_], height: float,
+           around: tuple[float, float], reach: float) -> NDArray[np.float32]:
+    """Light received / light the floor would get without a small dark patch, per pixel (1 far from ``around``).
 
     The unshadowed light is the *bright envelope* of the luminance: a greyscale closing
     with an ellipse a bit larger than a contact shadow is thick, so a shadow (a dark patch
     smaller than the ellipse) is lifted to its surroundings, while a rug or a floor colour
     (larger than the ellipse) keeps its own level. The props are inpainted first so they
-    are not taken for the floor's level.
+    are not taken for the floor's level. Worked out on the crop within ``reach`` of
+    ``around`` at quarter size (a shadow is a low-frequency darkening), then scaled back.
     """
     import cv2
 
-    props = cv2.inpaint(np.ascontiguousarray(photo), blocked.astype(np.uint8) * 255, 3, cv2.INPAINT_TELEA)
-    lum = cv2.GaussianBlur(_luma(props), (0, 0), 1.5)
+    h, w = photo.shape[:2]
     kx, ky = int(0.9 * height) | 1, int(0.35 * height) | 1
-    env = cv2.morphologyEx(lum, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (kx, ky)))
-    env = cv2.GaussianBlur(env, (0, 0), 3.0)
-    return (lum / np.maximum(env, 1.0)).astype(np.float32)
+    m = int(reach + kx)
+    x0, x1 = max(int(around[0]) - m, 0), min(int(around[0]) + m, w)
+    y0, y1 = max(int(around[1]) - m, 0), min(int(around[1]) + m, h)
+    crop, hole = photo[y0:y1, x0:x1], blocked[y0:y1, x0:x1].astype(np.uint8)
+    k = 4
+    sw, sh = max((x1 - x0) // k, 1), max((y1 - y0) // k, 1)
+    small = cv2.resize(np.ascontiguousarray(crop), (sw, sh), interpolation=cv2.INTER_AREA)
+    small_hole = cv2.dilate(cv2.resize(hole, (sw, sh), interpolation=cv2.INTER_NEAREST), np.ones((3, 3), np.uint8))
+    small = cv2.inpaint(small, small_hole * 255, 2, cv2.INPAINT_TELEA)
+    lum_small = _luma(small)
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (max(kx // k, 1) | 1, max(ky // k, 1) | 1))
+    env = cv2.morphologyEx(lum_small, cv2.MORPH_CLOSE, kernel)
+    env = cv2.resize(cv2.GaussianBlur(env, (0, 0), 0.75), (x1 - x0, y1 - y0), interpolation=cv2.INTER_LINEAR)
+    props = cv2.inpaint(np.ascontiguousarray(crop), cv2.dilate(hole, np.ones((3, 3), np.uint8)) * 255, 3,
+                        cv2.INPAINT_TELEA)
+    lum = cv2.GaussianBlur(_luma(props), (0, 0), 1.5)
+    out = np.ones((h, w), dtype=np.float32)
+    out[y0:y1, x0:x1] = np.minimum(lum / np.maximum(env, 1.0), 1.5)
+    return out
 
 
 def _from_angle(deg: float, length: float = 0.5) -> tuple[float, float]:

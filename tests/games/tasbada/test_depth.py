@@ -36,6 +36,9 @@ def mixed():
     restart_from(app.world, q, MIXED)
     for _ in range(3):
         app.step()
+    from games.tasbada.reality import Reality
+
+    assert app.world.resource(Reality).sprites(q, wait=True) is not None  # the props are built
     viewer = Viewer(make_target(True, W, H, samples=0))
     viewer.camera = game_camera()
     yield app, viewer
@@ -68,7 +71,7 @@ def test_the_pot_hides_what_stands_behind_it_and_not_what_stands_in_front(mixed)
 
     app, viewer = mixed
     reality = app.world.resource(Reality)
-    sprites = reality.sprites(app.world.resource(Quest))
+    sprites = reality.sprites(app.world.resource(Quest), wait=True)
     assert sprites is not None and sprites.depth_at[0] is not None
     tex, z_pot = sprites.textures[0], sprites.depth_at[0][2]
     ph, pw = reality.photo.shape[:2]
