@@ -102,7 +102,11 @@ def matte(photo: NDArray[np.uint8], mark: Mark) -> Matte:
 
 
 def _largest_parts(hard: NDArray[np.uint8]) -> NDArray[np.uint8]:
-    """Keep the blobs of at least a tenth of the biggest (the prop and its sizeable parts), holes filled."""
+    """Keep the blobs of at least a tenth of the biggest (the prop and its sizeable parts), small holes filled.
+
+    A small hole is a speck GrabCut missed (a highlight); a large one is the room seen
+    through the prop (between a plant's leaves) and stays open.
+    """
     from scipy import ndimage
 
     labels, n = ndimage.label(hard)
@@ -110,7 +114,11 @@ def _largest_parts(hard: NDArray[np.uint8]) -> NDArray[np.uint8]:
         return hard
     sizes = ndimage.sum(hard, labels, index=np.arange(1, n + 1))
     keep = np.isin(labels, np.nonzero(sizes >= 0.1 * sizes.max())[0] + 1)
-    return ndimage.binary_fill_holes(keep).astype(np.uint8)
+    holes, m = ndimage.label(ndimage.binary_fill_holes(keep) & ~keep)
+    if m:
+        area = ndimage.sum(np.ones_like(keep), holes, index=np.arange(1, m + 1))
+        keep |= np.isin(holes, np.nonzero(area < 0.01 * keep.sum())[0] + 1)
+    return keep.astype(np.uint8)
 
 
 def _feather(hard: NDArray[np.uint8]) -> NDArray[np.float32]:
