@@ -243,7 +243,7 @@ def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: flo
     x, y = 16, h - ph - 70
     counting = q.script == "selfie" and q.line < 3
     if counting or q.stage == MIXED and now - q.stage_t < 6.0:
-        img.paste(selfie.resize((pw, ph), Image.Resampling.BILINEAR), (x, y))
+        img.paste(_thumbnail(selfie, (pw, ph)), (x, y))
         d.rectangle((x - 3, y - 3, x + pw + 3, y + ph + 3), outline=PAPER + (255,), width=4)
         if counting:
             n = 3 - q.line
@@ -286,6 +286,21 @@ def _picker(img: Image.Image, q: Quest) -> None:
             r = 9 if hot else 7
             d.ellipse((x - r, y - r, x + r, y + r), fill=(ACCENT if hot else (255, 120, 60)) + (255,),
                       outline=INK + (255,), width=2)
+
+
+_THUMBS: dict[tuple[int, int, int], tuple[Image.Image, Image.Image]] = {}
+
+
+def _thumbnail(picture: Image.Image, size: tuple[int, int]) -> Image.Image:
+    """``picture`` at ``size``, resized once per picture (a webcam's selfie is a new picture each frame).
+
+    The cache holds the picture itself too, so its ``id`` cannot be reused by another.
+    """
+    key = (id(picture), *size)
+    if key not in _THUMBS:
+        _THUMBS.clear()
+        _THUMBS[key] = (picture, picture.resize(size, Image.Resampling.BILINEAR))
+    return _THUMBS[key][1]
 
 
 def _menu(img: Image.Image, q: Quest) -> None:

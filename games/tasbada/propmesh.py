@@ -106,13 +106,15 @@ def deform(tex: PropTexture, d: Deform) -> tuple[NDArray[np.uint8], tuple[int, i
     X, Ya = Xb / d.sx, Yb / d.sy
     Y = Ya.copy()
     inside_mouth = np.zeros(Y.shape, dtype=bool)
+    gap = None
     if d.mouth > 0:
-        gap = tex._gap(X, d)
+        gap = tex._gap(X, d)  # depends on X only: once per frame
         inside_mouth = (Ya >= tex.mouth_y) & (Ya < tex.mouth_y + gap) & (gap > 0.5)
         up = Ya >= tex.mouth_y + gap
         Yu = Ya - gap
-        for _ in range(6):  # Y = Ya − lift(X, Y): a contraction above the mouth line
-            Yu = Ya - tex._lift(X, np.maximum(Yu, tex.mouth_y), d)
+        fall = tex._fall_height()
+        for _ in range(6):  # Y = Ya − gap·(1 − fall(Y − Y_m)): a contraction above the mouth line
+            Yu = Ya - gap * (1.0 - np.clip((Yu - tex.mouth_y) / fall, 0.0, 1.0))
         Y = np.where(up, Yu, Y)
     mapx = (bx + X - x0).astype(np.float32)
     mapy = (by - Y - y0).astype(np.float32)
@@ -121,7 +123,7 @@ def deform(tex: PropTexture, d: Deform) -> tuple[NDArray[np.uint8], tuple[int, i
         lip_y = (by - tex.mouth_y - y0).astype(np.float32) if np.ndim(by) else np.float32(by - tex.mouth_y - y0)
         a = cv2.remap(tex.rgba[..., 3], mapx, np.full_like(mapy, lip_y), cv2.INTER_LINEAR,
                       borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-        shade = np.clip((Ya - tex.mouth_y) / np.maximum(tex._gap(X, d), 1.0), 0.0, 1.0)
+        shade = np.clip((Ya - tex.mouth_y) / np.maximum(gap, 1.0), 0.0, 1.0)
         inner = (np.array(MOUTH_COLOR, dtype=np.float32)[None, None, :] * (0.6 + 0.4 * shade[..., None]))
         out[inside_mouth, :3] = inner[inside_mouth].astype(np.uint8)
         out[inside_mouth, 3] = a[inside_mouth]
