@@ -4,7 +4,7 @@ After a change to the simulation the shipped recordings' state hashes no longer 
 after a change to the look the screenshots are stale. Each target rebuilds one kind of
 artefact from its script: ``demos`` (the games' ``demo.rec``), ``recordings`` (the
 puppet sessions in ``tests/data``), ``screenshots`` (``docs/screenshots``, from the snowman
-demo) and ``assets`` (tasbada's drawn room and selfie). ``all`` runs them in dependency
+demo) and ``assets`` (tasbada's drawn room). ``all`` runs them in dependency
 order: assets first (the demo plays over them), screenshots last (they replay the demo).
 """
 

@@ -2,10 +2,11 @@
 
 ``room.jpg`` stands in for the camera in the demo and when no webcam is present: a
 living-room corner (back wall, window, picture, wooden floor, rug) with three things
-worth marking — an orange clay pot, a potted plant and a floor lamp. ``selfie.jpg`` is
-a person in a teal sweater against a wall, for the clothes-colour step. Both are drawn
-with a fixed seed, so running ``puppetphone regen assets`` again rebuilds the
-very same files.
+worth marking — an orange clay pot, a potted plant and a floor lamp — drawn with a fixed
+seed, so running ``puppetphone regen assets`` again rebuilds the very same file.
+:func:`draw_selfie` draws a person in a sweater for the clothes-colour test; the shipped
+``selfie.jpg`` is a real photo (a pose estimator needs one; origin and licence in
+``assets/README.md``).
 """
 
 from __future__ import annotations
@@ -127,10 +128,9 @@ def draw_selfie(seed: int = 11, sweater: tuple[int, int, int] = (34, 138, 146)) 
 
 
 def main() -> None:
-    """Write ``assets/room.jpg`` and ``assets/selfie.jpg``."""
+    """Write ``assets/room.jpg`` (the selfie is a photo of a person: see ``assets/README.md``)."""
     ASSETS.mkdir(exist_ok=True)
     draw_room().save(ASSETS / "room.jpg", quality=92)
-    draw_selfie().save(ASSETS / "selfie.jpg", quality=92)
 
 
 if __name__ == "__main__":

@@ -95,6 +95,10 @@ class _Driver:
             target = make_target(True, *SIZE)
             self._render = (target, Renderer(target.ctx), RenderScene())
         target, renderer, scene = self._render
+        from games.tasbada.quest import Quest
+        from games.tasbada.reality import Reality
+
+        self.world.resource(Reality).sprites(self.world.resource(Quest), wait=True)  # the props, built
         scene.clear()
         GAME.draw(self.world, scene, 1.0)
         for line in GAME.status(self.world):
@@ -177,12 +181,14 @@ def journey(d: _Driver) -> Iterator[str]:
     d.press()
     d.move(_px(0.775, 0.095), 25)
     d.release()
-    # The floor line: drag it down a little, then back onto the skirting.
-    d.move(_px(0.35, q.ground_v), 15)
+    # The floor line: drag its knob down a little, then back onto the skirting.
+    from games.tasbada.marking import GROUND_HANDLE_U
+
+    d.move(_px(GROUND_HANDLE_U, q.ground_v), 15)
     d.press()
-    d.move(_px(0.35, 0.6), 15)
+    d.move(_px(GROUND_HANDLE_U, 0.6), 15)
     d.shot("real")
-    d.move(_px(0.35, 0.556), 15)
+    d.move(_px(GROUND_HANDLE_U, 0.556), 15)
     d.release()
     yield "real"
     d.click(_px(0.895, 0.07), 20)
@@ -198,7 +204,9 @@ def journey(d: _Driver) -> Iterator[str]:
     while q.stage != "mixed":
         d.step()
     yield "mixed"
-    d.step(60)
+    d.step(50)
+    d.shot("mixed_pose")  # the avatar still holds the player's pose
+    d.step(10)
     lay = layout(q.ground_v, q.marks)
     start = lay.start + np.array([0.0, 0.95, 0.0])
     px = d.camera.project(start[None], *SIZE)[0]
@@ -235,11 +243,24 @@ def journey(d: _Driver) -> Iterator[str]:
     d.shot("virtual")
 
 
+def demo_setup() -> dict[str, object]:
+    """The demo's set-up: only the pose found in the shipped selfie (the rest are defaults)."""
+    from games.tasbada.game import _selfie_pose
+    from games.tasbada.reality import SHIPPED_SELFIE
+
+    points, aspect, note = _selfie_pose(str(SHIPPED_SELFIE), True)
+    if points is None:
+        raise RuntimeError(f"the demo needs the pose estimator (pip install 'puppetphone[pose]'): {note}")
+    return {"pose": points, "pose_aspect": aspect, "pose_note": note}
+
+
 def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> list[str]:
     """Play the journey and record it to ``path``; returns the stages in the order reached.
 
-    The game is built with the empty setup: a new journey, the shipped photo, no camera,
-    saving nowhere — so the demo depends on nothing outside the repository.
+    The game is built with a new journey's setup: the shipped photo and selfie, no camera,
+    saving nowhere, and the player's pose found in the shipped selfie (recorded in the
+    header, so the replay needs no pose estimator) — the demo depends on nothing outside
+    the repository.
     """
     from games.tasbada.view import game_camera
     from input.hub import InputHub
@@ -249,8 +270,9 @@ def make_demo(path: Path = DEMO, shots: Path | None = None, seed: int = 0) -> li
 
     mouse = MouseSource()
     hub = InputHub([mouse]).start()
-    app = make_app("tasbada", seed, hub, {})
-    header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"], setup={})
+    setup = demo_setup()
+    app = make_app("tasbada", seed, hub, setup)
+    header = RecordingHeader(game="tasbada", seed=seed, dt=app.world.dt, sources=["mouse"], setup=setup)
     recorder = Recorder(path, header).attach(app)
     d = _Driver(app, mouse, game_camera(), shots)
     try:

@@ -13,7 +13,9 @@ Passes, in order (each kind of primitive is one instanced draw call):
 5. **sky** — a gradient with a sun glow (and the background photo, faded) on the pixels
    nothing else covered (depth test at the far plane).
 6. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
-7. **text** — the overlay, in pixels.
+7. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
+   depth (a real prop in front of or behind 3-D objects) or over everything (an interface).
+8. **text** — the overlay, in pixels.
 
 Opaque passes run nearest-first because on a software rasteriser (llvmpipe) fragment
 shading is the cost: the early depth test then skips ground and sky under the puppets.
@@ -95,6 +97,7 @@ class Renderer:
             "line": ctx.program(vertex_shader=h + S.LINE_VS, fragment_shader=h + S.LINE_FS),
             "point": ctx.program(vertex_shader=h + S.POINT_VS, fragment_shader=h + S.POINT_FS),
             "text": ctx.program(vertex_shader=h + S.TEXT_VS, fragment_shader=h + S.TEXT_FS),
+            "overlay": ctx.program(vertex_shader=h + S.OVERLAY_VS, fragment_shader=lit + S.OVERLAY_FS),
         }
         strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
                    "lines": LINE_STRIDE, "points": POINT_STRIDE}
@@ -122,6 +125,7 @@ class Renderer:
         for name in ("ground", "ground_photo"):
             self._vaos[name] = ctx.vertex_array(p[name], [(quad, "2f", "in_corner")])
         self._vaos["text"] = ctx.vertex_array(p["text"], [(unit, "2f", "in_corner")])
+        self._vaos["overlay"] = ctx.vertex_array(p["overlay"], [(unit, "2f", "in_corner")])
         self._vaos["lines"] = ctx.vertex_array(
             p["line"], [(seg, "2f", "in_corner"), (self._inst["lines"].buf, *_LINE_FMT)], skip_errors=True)
         self._vaos["points"] = ctx.vertex_array(p["point"], [(self._inst["points"].buf, *_POINT_FMT)], skip_errors=True)
@@ -217,6 +221,7 @@ class Renderer:
         if counts["points"]:
             self._vaos["points"].render(moderngl.POINTS, vertices=counts["points"])
         self._mark("lines_points")
+        self._draw_overlays(scene, vp)
         self._draw_text(scene, (w, h))
         framebuffer.depth_mask = True
         ctx.enable_only(moderngl.NOTHING)
@@ -286,6 +291,33 @@ class Renderer:
             self._background.filter = (moderngl.LINEAR, moderngl.LINEAR)
             self._background_src = bg
         return self._background
+
+    def _draw_overlays(self, scene: RenderScene, vp: NDArray[np.float64]) -> None:
+        """Pictures over the view: depth-placed ones against the scene's depth, the rest on top."""
+        if not scene.overlays:
+            return
+        prog = self._programs["overlay"]
+        set_uniform(prog, "u_tex", 0)
+        for ov in scene.overlays:
+            depth = 0.0
+            if ov.depth_at is not None:
+                clip = vp @ np.array([*ov.depth_at, 1.0])
+                if clip[3] <= 1e-9:
+                    continue  # behind the camera
+                depth = float(np.clip(clip[2] / clip[3] * 0.5 + 0.5, 0.0, 1.0))
+                self.ctx.enable(moderngl.DEPTH_TEST)
+            else:
+                self.ctx.disable(moderngl.DEPTH_TEST)
+            img = ov.image
+            tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes())
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.use(location=0)
+            for name, value in (("u_rect", ov.rect), ("u_alpha", ov.alpha), ("u_depth", depth),
+                                ("u_photo", 1.0 if ov.photo else 0.0)):
+                set_uniform(prog, name, value)
+            self._vaos["overlay"].render(moderngl.TRIANGLE_STRIP)
+            tex.release()
+        self.ctx.enable(moderngl.DEPTH_TEST)
 
     def _draw_text(self, scene: RenderScene, size: tuple[int, int]) -> None:
         if not scene.texts:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["RenderScene", "Rows", "Ground", "Sun", "TextLine", "CAPSULE_STRIDE", "BOX_STRIDE",
+__all__ = ["RenderScene", "Rows", "Ground", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE", "BOX_STRIDE",
            "LINE_STRIDE", "POINT_STRIDE"]
 
 CAPSULE_STRIDE = 11
@@ -128,6 +128,25 @@ class TextLine:
 
 
 @dataclass
+class Overlay:
+    """A picture laid over the view, aligned with the background photo (tasbada's props and interface).
+
+    ``image`` is ``[h,w,4]`` uint8 RGBA covering ``rect = (u0, v0, u1, v1)`` of the photo
+    (normalised, top-left origin). With ``depth_at`` (a world point) its opaque pixels
+    stand at that point's depth: 3-D objects nearer than it cover them, farther ones are
+    covered (a real prop's matte as a depth mask); without, it draws over everything
+    (an interface). ``photo`` pictures are tone-mapped like the background photo so they
+    match it; ``alpha`` fades the whole picture.
+    """
+
+    image: NDArray[np.uint8]
+    rect: tuple[float, float, float, float] = (0.0, 0.0, 1.0, 1.0)
+    depth_at: tuple[float, float, float] | None = None
+    photo: bool = False
+    alpha: float = 1.0
+
+
+@dataclass
 class RenderScene:
     """Primitives and settings for one rendered frame."""
 
@@ -148,12 +167,15 @@ class RenderScene:
     """Optional ``[H,W,3]`` uint8 photo drawn behind everything (tasbada's composite)."""
     background_fade: float = 1.0
     """0 shows only the photo behind objects, 1 only the sky and ground; between blends them."""
+    overlays: list[Overlay] = field(default_factory=list)
+    """Pictures over the 3-D view, in order (see :class:`Overlay`); the text overlay stays on top."""
 
     def clear(self) -> None:
         """Empty every primitive buffer (settings and background stay)."""
         for rows in (self.capsules, self.spheres, self.boxes, self.lines, self.points):
             rows.clear()
         self.texts.clear()
+        self.overlays.clear()
 
     # -- builders ---------------------------------------------------------------------
     def add_capsules(self, a: ArrayLike, b: ArrayLike, radius: ArrayLike,
@@ -260,6 +282,19 @@ class RenderScene:
             if not 0.0 <= fade <= 1.0:
                 raise ValueError(f"background fade must be in [0, 1], got {fade}")
             self.background_fade = float(fade)
+
+    def add_overlay(self, image: ArrayLike, rect: tuple[float, float, float, float] = (0.0, 0.0, 1.0, 1.0),
+                    depth_at: ArrayLike | None = None, photo: bool = False, alpha: float = 1.0) -> None:
+        """Append an :class:`Overlay` (drawn after the 3-D scene, before the text)."""
+        img = np.asarray(image)
+        if img.ndim != 3 or img.shape[2] != 4 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
+            raise ValueError(f"overlay must be uint8 [H,W,4], got {img.dtype} {img.shape}")
+        at = None if depth_at is None else tuple(float(x) for x in np.asarray(depth_at, dtype=np.float64).reshape(3))
+        r = tuple(float(x) for x in rect)
+        if not (r[0] < r[2] and r[1] < r[3]):
+            raise ValueError(f"overlay rect must be (u0, v0, u1, v1) with u0 < u1 and v0 < v1, got {rect}")
+        self.overlays.append(Overlay(np.ascontiguousarray(img), r, at, bool(photo),  # type: ignore[arg-type]
+                                     float(np.clip(alpha, 0.0, 1.0))))
 
     # -- views ------------------------------------------------------------------------
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:

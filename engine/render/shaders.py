@@ -17,7 +17,7 @@ the ground (:mod:`engine.render.shadows`).
 from __future__ import annotations
 
 __all__ = ["HEADER", "LIGHTING", "CAPSULE_VS", "BOX_VS", "LIT_FS", "FLAT_FS", "DEPTH_FS", "LINE_VS",
-           "LINE_FS", "POINT_VS", "POINT_FS", "TEXT_VS", "TEXT_FS"]
+           "LINE_FS", "POINT_VS", "POINT_FS", "TEXT_VS", "TEXT_FS", "OVERLAY_VS", "OVERLAY_FS"]
 
 HEADER = "#version 330 core\n"
 
@@ -268,4 +268,37 @@ uniform float u_alpha;          // fades a whole line, panel included
 in vec2 v_uv;
 out vec4 f_color;
 void main() { vec4 c = texture(u_tex, v_uv); f_color = vec4(c.rgb, c.a * u_alpha); }
+"""
+
+# Overlays: a picture over a rectangle of the background photo, placed as the photo is
+# (cover-fitted to the viewport); optionally at one depth, so the 3-D scene's depth test
+# decides, pixel by pixel of its alpha, what is in front.
+OVERLAY_VS = """
+uniform vec4 u_rect;            // u0, v0, u1, v1 on the photo, top-left origin
+uniform vec2 u_bg_scale;
+in vec2 in_corner;              // 0..1
+out vec2 v_uv;
+void main() {
+    vec2 img = mix(u_rect.xy, u_rect.zw, in_corner);
+    vec2 s = (vec2(img.x, 1.0 - img.y) - 0.5) / u_bg_scale + 0.5;
+    gl_Position = vec4(s * 2.0 - 1.0, 0.0, 1.0);
+    v_uv = in_corner;
+}
+"""
+
+OVERLAY_FS = """
+uniform sampler2D u_tex;
+uniform float u_alpha;
+uniform float u_depth;          // window depth of the picture (0 when not depth-tested)
+uniform float u_photo;          // 1: tone-map like the background photo
+in vec2 v_uv;
+out vec4 f_color;
+void main() {
+    vec4 c = texture(u_tex, v_uv);
+    float a = c.a * u_alpha;
+    if (a < 0.004) discard;
+    vec3 rgb = u_photo > 0.5 ? finish(to_linear(c.rgb)) : c.rgb;
+    gl_FragDepth = u_depth;
+    f_color = vec4(rgb, a);
+}
 """

@@ -1,20 +1,21 @@
-"""The 2-D layer over the photo, composed once per drawn frame (never in the simulation).
+"""The photo side of the view, composed once per drawn frame (never in the simulation).
 
-The renderer shows one background picture behind the 3-D world, so everything that
-lives *in the photo* is painted into that picture here, with Pillow, at the photo's
-resolution (so it lines up with the pointer mapping of :mod:`games.tasbada.view`):
+Three layers, at the photo's resolution (so they line up with the pointer mapping of
+:mod:`games.tasbada.view`):
 
-- stage 1: the marks (boxes, lassos, the stroke being drawn), the floor line and the
-  Undo/Done buttons;
-- from stage 2: the marked objects cut out of the photo (their holes filled once), each
-  one a sprite that hops with squash and stretch over a soft shadow that shrinks and
-  fades as it rises; the first mark is the narrator, with eyes that blink and follow the
-  avatar and a mouth that moves while it talks in a speech bubble (Fig. 6.11);
-- the selfie count-down as a picture-in-picture, then the clothes colour swatch;
-- the Menu button, and the menu itself when open.
+- the **backdrop**: the photo; from stage 2 the photo with the marked props and their
+  real shadows taken out (:mod:`~games.tasbada.matting`, :mod:`~games.tasbada.shadow`),
+  darkened where each living prop casts its shadow *now*;
+- the **props**: each marked thing as a photo-real deformable surface
+  (:mod:`~games.tasbada.propmesh`) that hops with squash, stretch and lean; the first is
+  the narrator, with eyes that blink and follow the avatar and a mouth that opens in
+  its own surface while it talks (Fig. 6.11). Each carries its depth (its base on the
+  floor), so the renderer puts it in front of or behind the 3-D things;
+- the **interface**: marks, the floor line, buttons, speech bubbles, the selfie and the
+  menu, always drawn over the 3-D scene.
 
-Per frame this is a copy of the filled photo plus a few small sprite resizes and
-alpha blends (a few milliseconds for a 960x540 photo).
+Per frame: a copy of the cleaned photo, one remap and one affine warp per prop, and the
+interface drawn with Pillow.
 """
 
 from __future__ import annotations
@@ -25,13 +26,15 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
-from PIL import Image, ImageDraw, ImageFilter, ImageFont
+from PIL import Image, ImageDraw, ImageFont
 
-from games.tasbada import marking, narrator
-from games.tasbada.images import cutout, fill_holes, mark_mask
+from games.tasbada import marking, narrator, picker
+from games.tasbada.matting import inpaint_hole, matte
+from games.tasbada.propmesh import Deform, PropTexture, deform
 from games.tasbada.quest import MENU, MIXED, PROPS_ALIVE, REAL, STAGES, Mark, Quest
+from games.tasbada.shadow import Shadow, cast, find_shadow, remove_shadows
 
-__all__ = ["Sprites", "build_sprites", "compose", "font"]
+__all__ = ["Sprites", "Layers", "build_sprites", "compose", "composite", "font", "DEPTH_BIAS"]
 
 INK = (32, 28, 40)
 PAPER = (255, 252, 244)
@@ -50,31 +53,58 @@ def font(size: int) -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
 
 
 class Sprites:
-    """The cut-outs of the marked objects and the photo with their holes filled."""
+    """Stage 2 onwards: the room without its props and their shadows, and each prop's texture,
+    shadow and depth point (built once per set of marks)."""
 
-    def __init__(self, base: Image.Image, sprites: list[tuple[Image.Image, tuple[int, int, int, int]]],
-                 shadow: Image.Image) -> None:
+    def __init__(self, base: NDArray[np.uint8], textures: list[PropTexture], shadows: list[Shadow],
+                 depth_at: list[tuple[float, float, float] | None]) -> None:
         self.base = base
-        self.sprites = sprites
-        self.shadow = shadow
+        self.textures = textures
+        self.shadows = shadows
+        self.depth_at = depth_at
 
 
-def build_sprites(photo: NDArray[np.uint8], marks: list[Mark]) -> Sprites:
-    """Cut every mark out of ``photo`` and fill the holes (once per set of marks)."""
+PropLayer = tuple[NDArray[np.uint8], tuple[float, float, float, float], tuple[float, float, float] | None]
+"""A living prop's picture, its rectangle on the photo (normalised) and the world point it stands at."""
+
+
+class Layers:
+    """One drawn frame of the photo side: the backdrop, the props at their depths, the interface on top."""
+
+    def __init__(self, background: NDArray[np.uint8], props: list[PropLayer], ui: NDArray[np.uint8]) -> None:
+        self.background = background
+        self.props = props
+        """``(rgba, rect, depth_at)`` per prop, ``rect`` normalised on the photo."""
+        self.ui = ui
+
+
+def build_sprites(photo: NDArray[np.uint8], marks: list[Mark], ground_v: float = 0.555,
+                  light_deg: float | None = None) -> Sprites:
+    """Matte every mark (GrabCut), find its shadow, and clean both out of the photo (once per set of marks)."""
+    from games.tasbada.view import floor_point
+
     h, w = photo.shape[:2]
-    hole = np.zeros((h, w), dtype=np.float32)
-    sprites = []
-    for m in marks:
-        rgba, box = cutout(photo, m)
-        sprites.append((Image.fromarray((rgba * 255).astype(np.uint8), "RGBA"), box))
-        hole = np.maximum(hole, np.clip(mark_mask(m, (w, h), 2.0) * 1.4, 0, 1))
-    base = Image.fromarray(fill_holes(photo, hole)).convert("RGBA")
-    sh = Image.new("L", (128, 48), 0)
-    ImageDraw.Draw(sh).ellipse((16, 10, 112, 38), fill=170)
-    sh = sh.filter(ImageFilter.GaussianBlur(6))
-    shadow = Image.new("RGBA", sh.size, (24, 16, 12, 0))
-    shadow.putalpha(sh)
-    return Sprites(base, sprites, shadow)
+    mattes = [matte(photo, m) for m in marks]
+    alphas = [mt.full((w, h)) for mt in mattes]
+    shadows = []
+    for i, mt in enumerate(mattes):
+        others = np.max([a for j, a in enumerate(alphas) if j != i], axis=0) if len(alphas) > 1 else None
+        shadows.append(find_shadow(photo, mt, ground_v * h, others, light_deg))
+    textures = [PropTexture(photo, mt, mouth_at=0.36) for mt in mattes]
+    clean = remove_shadows(photo, shadows)
+    hole = np.max(alphas, axis=0) if alphas else np.zeros((h, w), np.float32)
+    base = inpaint_hole(clean, hole)
+    depth_at: list[tuple[float, float, float] | None] = []
+    for t in textures:
+        p = floor_point(t.base[0] / w, t.base[1] / h)
+        # A thing standing on the floor is as deep as its base (a little nearer, so it wins its own
+        # floor row); one above the horizon (on the wall) stays in the backdrop.
+        depth_at.append(None if p is None else (float(p[0]), 0.0, float(p[2]) + DEPTH_BIAS))
+    return Sprites(base, textures, shadows, depth_at)
+
+
+DEPTH_BIAS = 0.12
+"""Metres a prop's depth is brought forward from its base (it stands on that floor row)."""
 
 
 def _button(d: ImageDraw.ImageDraw, rect: tuple[float, float, float, float], label: str, size: tuple[int, int],
@@ -98,10 +128,17 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
     w, h = img.size
     d = ImageDraw.Draw(img, "RGBA")
     gy = q.ground_v * h
-    hot_ground = q.gesture == "ground" or abs(q.pointer[1] - q.ground_v) < marking.GROUND_GRAB
+    hot_ground = q.gesture == "ground" or marking.on_ground_handle(q.pointer, q.ground_v)
+    line = (ACCENT if hot_ground else (255, 255, 255)) + (255,)
     for x in range(0, w, 28):
-        d.line((x, gy, x + 16, gy), fill=(ACCENT if hot_ground else (255, 255, 255)) + (255,), width=3)
-    d.text((w * 0.012, gy - 6), "floor line (drag it)", font=font(int(h * 0.028)), fill=(255, 255, 255, 255),
+        d.line((x, gy, x + 16, gy), fill=line, width=3)
+    hx, hr = marking.GROUND_HANDLE_U * w, marking.GROUND_GRAB * h
+    d.ellipse((hx - hr, gy - hr, hx + hr, gy + hr), fill=line[:3] + (230,), outline=INK + (255,), width=3)
+    for s in (-1.0, 1.0):  # up and down arrows on the knob
+        tip, side = gy + s * hr * 0.75, gy + s * hr * 0.25
+        d.polygon([(hx, tip), (hx - hr * 0.35, side), (hx + hr * 0.35, side)],
+                  fill=INK + (255,))
+    d.text((hx + hr + 6, gy - 6), "floor line (drag the knob)", font=font(int(h * 0.028)), fill=(255, 255, 255, 255),
            anchor="lb", stroke_width=2, stroke_fill=INK + (255,))
     for i, m in enumerate(q.marks):
         pts = m.points * np.array([w, h])
@@ -121,9 +158,9 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
         (x0, y0), (x1, y1) = q.path[0], q.path[-1]
         d.rectangle((min(x0, x1) * w, min(y0, y1) * h, max(x0, x1) * w, max(y0, y1) * h), outline=(255, 255, 255, 120))
     for b in marking.REAL_BUTTONS:
-        _button(d, b.rect, b.label, (w, h), b.contains(q.pointer), enabled=bool(q.marks))
+        _button(d, b.rect, b.label, (w, h), b.contains(q.pointer), enabled=bool(q.marks or q.undo))
     hint = ("Drag a box (or draw a lasso) around a thing in your room; the first one will talk."
-            if not q.marks else f"{len(q.marks)} marked. Mark more, drag the floor line, then press Done.")
+            if not q.marks else f"{len(q.marks)} marked. Mark more, drag the floor line's knob, then press Done.")
     _banner(d, hint, (w, h))
     _pointer(d, q, (w, h))
 
@@ -136,51 +173,46 @@ def _pointer(d: ImageDraw.ImageDraw, q: Quest, size: tuple[int, int]) -> None:
     d.ellipse((x - 3, y - 3, x + 3, y + 3), fill=INK + (255,))
 
 
-def _prop(img: Image.Image, sp: Sprites, i: int, motion: narrator.PropMotion) -> tuple[float, float, float, float]:
-    """Paste prop ``i`` (shadow, then the squashed/stretched sprite); returns its drawn box."""
-    w, h = img.size
-    sprite, (x0, y0, x1, y1) = sp.sprites[i]
-    sw, shh = x1 - x0, y1 - y0
-    nw, nh = max(int(round(sw * motion.sx)), 2), max(int(round(shh * motion.sy)), 2)
-    lift = motion.hop * h
-    cx, base_y = (x0 + x1) / 2.0, float(y1)
-    # Shadow: wide as the base, smaller and fainter as the prop rises.
-    k = max(0.35, 1.0 - 6.0 * motion.hop)
-    shw, shh2 = max(int(sw * 0.95 * motion.sx * k), 4), max(int(sw * 0.22 * k), 3)
-    shadow = sp.shadow.resize((shw, shh2), Image.Resampling.BILINEAR)
-    if k < 1.0:
-        shadow.putalpha(shadow.getchannel("A").point(lambda a: int(a * k)))
-    img.alpha_composite(shadow, (int(cx - shw / 2), int(base_y - shh2 * 0.6)))
-    scaled = sprite.resize((nw, nh), Image.Resampling.BILINEAR)
-    left, top = int(round(cx - nw / 2)), int(round(base_y - lift - nh))
-    if left >= w or top >= h or left + nw <= 0 or top + nh <= 0:
-        return (left, top, left + nw, top + nh)
-    crop = scaled.crop((max(-left, 0), max(-top, 0), min(nw, w - left), min(nh, h - top)))
-    img.alpha_composite(crop, (max(left, 0), max(top, 0)))
-    return (left, top, left + nw, top + nh)
+def _deform(t: PropTexture, m: narrator.PropMotion, img_h: int) -> Deform:
+    return Deform(hop=m.hop * img_h, sx=m.sx, sy=m.sy, lean=m.lean, mouth=m.mouth)
 
 
-def _face(d: ImageDraw.ImageDraw, box: tuple[float, float, float, float], m: narrator.PropMotion) -> None:
-    x0, y0, x1, y1 = box
-    bw, bh = x1 - x0, y1 - y0
-    s = min(bw, bh)
-    er = s * 0.09
+def _prop(background: NDArray[np.uint8], sp: Sprites, i: int, m: narrator.PropMotion,
+          narrator_face: bool) -> tuple[NDArray[np.uint8], tuple[int, int]]:
+    """Deform prop ``i``, darken the backdrop with the shadow it casts now; its picture and top-left."""
+    h, w = background.shape[:2]
+    tex = sp.textures[i]
+    d = _deform(tex, m, h)
+    rgba, origin = deform(tex, d)
+    dark, (sx0, sy0) = cast(rgba[..., 3].astype(np.float32) / 255.0, origin, tex.base[1], sp.shadows[i], (w, h),
+                            lift=d.hop)
+    if dark.size:
+        region = background[sy0 : sy0 + dark.shape[0], sx0 : sx0 + dark.shape[1]]
+        region[:] = np.clip(region.astype(np.float32) * (1.0 - dark[: region.shape[0], : region.shape[1], None]),
+                            0, 255).astype(np.uint8)
+    if narrator_face:
+        pic = Image.fromarray(rgba, "RGBA")
+        _eyes(ImageDraw.Draw(pic, "RGBA"), tex, d, m, origin)
+        rgba = np.asarray(pic)
+    return rgba, origin
+
+
+def _eyes(dr: ImageDraw.ImageDraw, tex: PropTexture, d: Deform, m: narrator.PropMotion,
+          origin: tuple[int, int]) -> None:
+    """The narrator's eyes, riding on the deformed surface (they blink and follow the avatar)."""
+    bx, by = tex.base
+    s = min(tex.width, tex.height)
+    er = s * 0.085 * float(np.sqrt(d.sx * d.sy))
+    ex = np.array([bx - 0.14 * tex.width, bx + 0.14 * tex.width])
+    ey = np.full(2, by - 0.6 * tex.height)
+    fx, fy = tex.forward(ex, ey, d)
     eh = er * (1.0 - 0.9 * m.blink)
-    for ex in (x0 + bw * 0.36, x0 + bw * 0.64):
-        ey = y0 + bh * 0.42
-        d.ellipse((ex - er, ey - eh, ex + er, ey + eh), fill=(255, 255, 255, 255), outline=INK + (255,), width=2)
+    for x, y in zip(fx - origin[0], fy - origin[1], strict=True):
+        dr.ellipse((x - er, y - eh, x + er, y + eh), fill=(255, 255, 255, 255), outline=INK + (255,), width=2)
         if m.blink < 0.5:
-            px = ex + m.gaze * er * 0.45
-            pr = er * 0.48
-            d.ellipse((px - pr, ey - pr * 0.9, px + pr, ey + pr * 0.9), fill=INK + (255,))
-            d.ellipse((px - pr * 0.35 + pr * 0.3, ey - pr * 0.6, px + pr * 0.25, ey - pr * 0.1), fill=(255, 255, 255, 220))
-    mx, my = x0 + bw * 0.5, y0 + bh * 0.62
-    mw = s * 0.16
-    if m.mouth > 0.05:
-        mh = s * 0.12 * m.mouth
-        d.ellipse((mx - mw, my - mh * 0.4, mx + mw, my + mh), fill=(90, 20, 30, 255), outline=INK + (255,), width=2)
-    else:
-        d.arc((mx - mw, my - mw * 0.6, mx + mw, my + mw * 0.6), 20, 160, fill=INK + (255,), width=3)
+            px, pr = x + m.gaze * er * 0.45, er * 0.48
+            dr.ellipse((px - pr, y - pr * 0.9, px + pr, y + pr * 0.9), fill=INK + (255,))
+            dr.ellipse((px - pr * 0.05, y - pr * 0.6, px + pr * 0.25, y - pr * 0.1), fill=(255, 255, 255, 220))
 
 
 def _bubble(d: ImageDraw.ImageDraw, text: str, anchor: tuple[float, float], size: tuple[int, int]) -> None:
@@ -211,7 +243,7 @@ def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: flo
     x, y = 16, h - ph - 70
     counting = q.script == "selfie" and q.line < 3
     if counting or q.stage == MIXED and now - q.stage_t < 6.0:
-        img.paste(selfie.resize((pw, ph), Image.Resampling.BILINEAR), (x, y))
+        img.paste(_thumbnail(selfie, (pw, ph)), (x, y))
         d.rectangle((x - 3, y - 3, x + pw + 3, y + ph + 3), outline=PAPER + (255,), width=4)
         if counting:
             n = 3 - q.line
@@ -224,6 +256,51 @@ def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: flo
                    stroke_width=2, stroke_fill=INK + (255,))
     if q.script == "selfie" and q.line == 3 and now - q.line_t < 0.25:
         d.rectangle((0, 0, w, h), fill=(255, 255, 255, int(220 * (1 - (now - q.line_t) / 0.25))))
+
+
+def _picker(img: Image.Image, q: Quest) -> None:
+    """The pose picker's panel: a stick figure whose elbows, hands, knees and feet can be dragged."""
+    w, h = img.size
+    d = ImageDraw.Draw(img, "RGBA")
+    u0, v0, u1, v1 = picker.PANEL
+    d.rounded_rectangle((u0 * w, v0 * h, u1 * w, v1 * h), radius=14, fill=PAPER + (225,), outline=INK + (255,), width=3)
+    d.text(((u0 + u1) / 2 * w, v0 * h + 8), "Pose your avatar: drag the dots", font=font(int(h * 0.026)),
+           fill=INK + (255,), anchor="mt")
+
+    def px(name: str) -> tuple[float, float]:
+        p = picker.to_panel(q.pose[name])
+        return (float(p[0] * w), float(p[1] * h))
+
+    for a, b in picker.BONES:
+        if a in q.pose and b in q.pose:
+            d.line((px(a), px(b)), fill=INK + (255,), width=6)
+    if "l_shoulder" in q.pose and "r_shoulder" in q.pose:
+        (lx, ly), (rx, ry) = px("l_shoulder"), px("r_shoulder")
+        r = abs(lx - rx) * 0.42
+        d.ellipse(((lx + rx) / 2 - r, (ly + ry) / 2 - 2.6 * r, (lx + rx) / 2 + r, (ly + ry) / 2 - 0.6 * r),
+                  outline=INK + (255,), width=5)
+    for name in picker.HANDLES:
+        if name in q.pose:
+            x, y = px(name)
+            hot = q.gesture == "pose:" + name
+            r = 9 if hot else 7
+            d.ellipse((x - r, y - r, x + r, y + r), fill=(ACCENT if hot else (255, 120, 60)) + (255,),
+                      outline=INK + (255,), width=2)
+
+
+_THUMBS: dict[tuple[int, int, int], tuple[Image.Image, Image.Image]] = {}
+
+
+def _thumbnail(picture: Image.Image, size: tuple[int, int]) -> Image.Image:
+    """``picture`` at ``size``, resized once per picture (a webcam's selfie is a new picture each frame).
+
+    The cache holds the picture itself too, so its ``id`` cannot be reused by another.
+    """
+    key = (id(picture), *size)
+    if key not in _THUMBS:
+        _THUMBS.clear()
+        _THUMBS[key] = (picture, picture.resize(size, Image.Resampling.BILINEAR))
+    return _THUMBS[key][1]
 
 
 def _menu(img: Image.Image, q: Quest) -> None:
@@ -239,40 +316,74 @@ def _menu(img: Image.Image, q: Quest) -> None:
 
 
 def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, selfie: Image.Image | None,
-            color: tuple[float, float, float], gaze: float) -> NDArray[np.uint8]:
-    """This frame's background picture ``[H,W,3]`` uint8 (a new array every call).
+            color: tuple[float, float, float], gaze: float) -> Layers:
+    """This frame's layers: the backdrop ``[H,W,3]``, the living props, the interface ``[H,W,4]``.
 
-    Sprites are blended on an RGBA canvas; the drawing after that happens on RGB,
-    where Pillow's ``"RGBA"`` draw mode blends translucent fills instead of replacing.
+    The interface (marks, floor line, buttons, speech bubbles, the selfie, the menu) is
+    its own transparent layer, so the view can draw it over the 3-D scene.
     """
+    w, h = photo.size
+    ui = Image.new("RGBA", (w, h), (0, 0, 0, 0))
+    props: list[PropLayer] = []
     if q.stage in (REAL, MENU) or sprites is None:
-        img = photo.convert("RGB")
+        background = np.asarray(photo.convert("RGB")).copy()
         if q.stage == REAL and not q.menu_open:
-            _draw_real(img, q)
+            _draw_real(ui, q)
+        elif q.stage not in (REAL, MENU) and q.marks:  # the props are still being cut out
+            _banner(ImageDraw.Draw(ui, "RGBA"), "Waking up the things you marked...", (w, h))
     else:
-        canvas = sprites.base.copy()
+        background = sprites.base.copy()
         t = now - q.alive_t
         talking_text = narrator.script_line(q.script, q.line)
-        boxes, motions = [], []
-        for i in range(len(sprites.sprites)):
+        top: tuple[float, float] | None = None
+        for i in range(len(sprites.textures)):
             if i == 0:
                 wake = q.stage == PROPS_ALIVE and q.script == "wake" and q.line == 0
                 m = narrator.prop_motion(t, 0.0, talking=bool(talking_text), energy=1.6 if wake else 1.0, gaze=gaze)
             else:
                 m = narrator.prop_motion(t - 0.4 * i, 0.31 * i, energy=0.6, gaze=gaze)
-            boxes.append(_prop(canvas, sprites, i, m))
-            motions.append(m)
-        img = canvas.convert("RGB")
-        d = ImageDraw.Draw(img, "RGBA")
-        if boxes:
-            _face(d, boxes[0], motions[0])
-            if talking_text:
-                _bubble(d, talking_text, ((boxes[0][0] + boxes[0][2]) / 2, boxes[0][1]), img.size)
-        _selfie_pip(img, selfie, q, now, color)
-    d = ImageDraw.Draw(img, "RGBA")
+            rgba, (ox, oy) = _prop(background, sprites, i, m, narrator_face=i == 0)
+            if i == 0:
+                top = (ox + rgba.shape[1] / 2.0, float(oy + 4))
+            at = sprites.depth_at[i]
+            if at is None:  # on the wall: part of the backdrop
+                _paste(background, rgba, (ox, oy))
+            else:
+                props.append((rgba, (ox / w, oy / h, (ox + rgba.shape[1]) / w, (oy + rgba.shape[0]) / h), at))
+        d = ImageDraw.Draw(ui, "RGBA")
+        if top is not None and talking_text:
+            _bubble(d, talking_text, top, (w, h))
+        if q.pose_picker and q.stage == PROPS_ALIVE:
+            _picker(ui, q)
+        else:
+            _selfie_pip(ui, selfie, q, now, color)
+    d = ImageDraw.Draw(ui, "RGBA")
     if q.menu_open or q.stage == MENU:
-        _menu(img, q)
+        _menu(ui, q)
     else:
-        _button(d, marking.MENU_BUTTON.rect, marking.MENU_BUTTON.label, img.size,
+        _button(d, marking.MENU_BUTTON.rect, marking.MENU_BUTTON.label, (w, h),
                 marking.MENU_BUTTON.contains(q.pointer))
-    return np.asarray(img).copy()
+    return Layers(background, props, np.asarray(ui).copy())
+
+
+def _paste(background: NDArray[np.uint8], rgba: NDArray[np.uint8], origin: tuple[int, int]) -> None:
+    """Alpha-blend ``rgba`` into ``background`` at ``origin`` (clipped to the picture)."""
+    h, w = background.shape[:2]
+    ox, oy = origin
+    x0, y0, x1, y1 = max(ox, 0), max(oy, 0), min(ox + rgba.shape[1], w), min(oy + rgba.shape[0], h)
+    if x1 <= x0 or y1 <= y0:
+        return
+    src = rgba[y0 - oy : y1 - oy, x0 - ox : x1 - ox].astype(np.float32)
+    a = src[..., 3:] / 255.0
+    dst = background[y0:y1, x0:x1]
+    dst[:] = np.clip(dst * (1.0 - a) + src[..., :3] * a + 0.5, 0, 255).astype(np.uint8)
+
+
+def composite(layers: Layers) -> NDArray[np.uint8]:
+    """The layers flattened into one ``[H,W,3]`` picture (no 3-D scene): for tests and previews."""
+    out = layers.background.copy()
+    h, w = out.shape[:2]
+    for rgba, rect, _ in layers.props:
+        _paste(out, rgba, (int(round(rect[0] * w)), int(round(rect[1] * h))))
+    _paste(out, layers.ui, (0, 0))
+    return out

@@ -1,6 +1,8 @@
-"""The view of Tasbada: the composed photo behind, the virtual things in front, the dissolve.
+"""The view of Tasbada: the composed photo behind, the virtual things among the real props, the dissolve.
 
-Reads the world only. The photo layer comes from :class:`~games.tasbada.reality.Reality`;
+Reads the world only. The photo layers come from :class:`~games.tasbada.reality.Reality`:
+the backdrop behind everything, each living prop at the depth of its base (3-D things
+behind it are hidden by its matte, those in front cover it), the interface on top;
 the 3-D layer is the avatar (in the selfie's clothes colour, with a drop line and a
 ring under it while it is lifted), the cages and creatures, crystals and the gate, all
 standing on the invisible floor whose contact shadows the renderer draws over the photo.
@@ -157,7 +159,11 @@ def draw(world: World, scene: RenderScene, alpha: float) -> None:
     reality = world.resource(Reality)
     now = (world.frame - 1 + alpha) * world.dt if world.frame > 0 else 0.0
     f = dissolve(q, now)
-    scene.set_background(reality.frame(q, now, _gaze(world, q)), f)
+    layers = reality.frame(q, now, _gaze(world, q))
+    scene.set_background(layers.background, f)
+    for rgba, rect, at in layers.props:
+        scene.add_overlay(rgba, rect, depth_at=at, photo=True, alpha=1.0 - f)
+    scene.add_overlay(layers.ui)  # the interface: over the 3-D scene, always
     scene.ground.grid = f > 0.5
     scene.ground.snow = 0.15 * f
     scene.ground.color = _lerp((0.8, 0.8, 0.8), (0.42, 0.62, 0.5), f)

@@ -26,6 +26,9 @@ from engine.components import Stick
 from engine.ecs import World
 from engine.render.components import Appearance
 from games.tasbada import marking, narrator, objects
+from games.tasbada.picker import picker_step
+from games.tasbada.pose import lift
+from games.tasbada.posing import SelfiePose
 from games.tasbada.quest import MENU, MIXED, PROPS_ALIVE, REAL, STAGES, VIRTUAL, Quest
 from games.tasbada.view import to_image
 from input.sample import TOUCH_DOWN, TOUCH_UP, InputFrame
@@ -93,7 +96,12 @@ def _spawn_mixed(world: World, q: Quest) -> None:
     objects.spawn_objects(world, q)
     look = world.try_resource(AvatarLook) or AvatarLook()
     start = objects.layout(q.ground_v, q.marks).start
-    q.avatar = spawn_puppet(world, start, heading=np.pi, name="avatar", extra=(Appearance(color=look.color),))
+    extra: tuple[object, ...] = (Appearance(color=look.color),)
+    if q.pose:
+        rotations, posed = lift(q.pose, q.pose_aspect)
+        extra += (SelfiePose(rotations, posed, world.time),)
+    # Facing the camera, as the person did for the selfie (grabbing it turns it where it walks).
+    q.avatar = spawn_puppet(world, start, heading=0.0, name="avatar", extra=extra)
 
 
 def restart_from(world: World, q: Quest, stage: str) -> None:
@@ -105,6 +113,7 @@ def restart_from(world: World, q: Quest, stage: str) -> None:
         stage = REAL
     if stage == REAL:
         q.marks.clear()
+        q.undo.clear()
     q.alive_t = -1.0
     q.script, q.line, q.selfie_t = "", -1, -1.0
     q.gesture, q.path = "", []
@@ -160,8 +169,9 @@ def _real(world: World, q: Quest, pressed: bool, released: bool) -> None:
         b = marking.hit_button(marking.REAL_BUTTONS, p)
         if b is not None:
             q.gesture = "button:" + b.action
-        elif abs(p[1] - q.ground_v) < marking.GROUND_GRAB:
+        elif marking.on_ground_handle(p, q.ground_v):
             q.gesture = "ground"
+            q.undo.append(["ground", q.ground_v])
         else:
             q.gesture, q.path = "draw", [(float(p[0]), float(p[1]))]
         q.down = True
@@ -179,14 +189,31 @@ def _real(world: World, q: Quest, pressed: bool, released: bool) -> None:
             mark = marking.classify_path(q.path)
             if mark is not None and len(q.marks) < marking.MAX_MARKS:
                 q.marks.append(mark)
+                q.undo.append(["mark", float(len(q.marks))])
             q.path = []
+        elif gesture == "ground" and q.undo and q.undo[-1] == ["ground", q.ground_v]:
+            q.undo.pop()  # the line did not move: nothing to undo
         elif gesture.startswith("button:"):
             b = marking.hit_button(marking.REAL_BUTTONS, p)
             if b is not None and gesture == "button:" + b.action:
-                if b.action == "undo" and q.marks:
-                    q.marks.pop()
+                if b.action == "undo":
+                    _undo(q)
                 elif b.action == "done" and q.marks:
                     enter_stage(world, q, PROPS_ALIVE)
+
+
+def _undo(q: Quest) -> None:
+    """Take back the last set-up action: a mark, or a move of the floor line."""
+    while q.undo:
+        kind, value = q.undo.pop()
+        if kind == "ground":
+            q.ground_v = float(value)
+            return
+        if kind == "mark" and len(q.marks) == int(value):
+            q.marks.pop()
+            return
+    if q.marks:  # marks restored from a save have no history: take the last one
+        q.marks.pop()
 
 
 def _advance_line(world: World, q: Quest, pressed: bool) -> None:
@@ -238,6 +265,8 @@ def quest_system(world: World) -> None:
         return
     if q.stage == REAL:
         _real(world, q, pressed, released)
+        return
+    if q.pose_picker and q.stage == PROPS_ALIVE and picker_step(q, pressed, released):
         return
     _advance_line(world, q, pressed)
     if q.stage in (MIXED, VIRTUAL):

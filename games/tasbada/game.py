@@ -11,7 +11,10 @@ Options (``--set key=value``; the ``$TASBADA_*`` variables are read as defaults)
 ``save`` — the progress file (default ``$TASBADA_SAVE`` or the user's data folder);
 ``photo`` — the backdrop (``$TASBADA_PHOTO``, else the save's photo, else a webcam, else
 the shipped ``assets/room.jpg``); ``selfie`` (``$TASBADA_SELFIE`` or the shipped one);
-``webcam`` — ``auto`` or ``off``.
+``webcam`` — ``auto`` or ``off``; ``pose`` — ``auto`` (find the player's pose in the selfie
+with MediaPipe when installed) or ``off`` (pose the avatar by hand); ``light`` — where the
+props' shadows fall, in degrees on the floor (0 right, 90 back, 180 left; empty: as measured
+from their shadows in the photo).
 
 :func:`prepare` reads the save file and picks the pictures; :func:`install` builds the
 quest from that setup alone, so a recording replays from its header. The pictures and
@@ -27,6 +30,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from engine.app import App
 from engine.camera import OrbitCamera
 from engine.ecs import World
@@ -35,7 +40,11 @@ from games.base import Game, GameOptionError, GameSetup
 from games.tasbada import draw as draw_mod
 from games.tasbada.flow import AvatarLook, SaveSlot, quest_system, save_system
 from games.tasbada.objects import follow_system
-from games.tasbada.quest import MIXED, STAGES, VIRTUAL, Mark, Quest
+from games.tasbada.picker import panel_aspect
+from games.tasbada.pose import default_keypoints
+from games.tasbada.pose import validate as validate_pose
+from games.tasbada.posing import selfie_pose_system
+from games.tasbada.quest import MIXED, PROPS_ALIVE, STAGES, VIRTUAL, Mark, Quest
 from games.tasbada.reality import SHIPPED_PHOTO, SHIPPED_SELFIE, Reality
 from games.tasbada.save import SaveError, default_save_path, load_progress
 from games.tasbada.view import game_camera
@@ -43,7 +52,7 @@ from games.tasbada.view import game_camera
 __all__ = ["GAME", "install", "prepare", "replay_setup", "status", "CONTROLS"]
 
 CONTROLS = (
-    "Stage 1: drag a box or draw a lasso around things in the photo; drag the dashed floor line; Done.",
+    "Stage 1: drag a box or draw a lasso around things in the photo; drag the floor line by its knob; Undo; Done.",
     "Stage 2: the first thing you marked talks; click to skip a line; look into the camera for the selfie.",
     "Stage 3: grab your avatar and walk it to the cages, over the crystals, then through the gate.",
     "Menu (bottom right): restart from any stage you reached. Progress is saved as you go.",
@@ -72,6 +81,16 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
     for label, path in (("photo", photo), ("selfie", selfie)):
         if path and not Path(path).is_file():
             raise GameOptionError(f"tasbada {label} {path!r} is not a file")
+    if options["pose"] not in ("auto", "off"):
+        raise GameOptionError(f"tasbada pose must be auto or off, not {options['pose']!r}")
+    light = options["light"].strip()
+    try:
+        light_deg = float(light) if light else None
+    except ValueError:
+        raise GameOptionError(f"tasbada light must be a number of degrees, not {light!r}") from None
+    if light_deg is not None and not np.isfinite(light_deg):
+        raise GameOptionError(f"tasbada light must be a finite number of degrees, not {light!r}")
+    found, aspect, note = _selfie_pose(selfie, options["pose"] == "auto")
     return {
         "save_to": str(save),
         "reached": list(progress.reached) if progress else [],
@@ -80,7 +99,27 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
         "photo": photo,
         "selfie": selfie,
         "webcam": not photo and options["webcam"] == "auto",
+        "pose": found or {},
+        "pose_aspect": aspect,
+        "pose_note": note,
+        "light": light_deg,
     }
+
+
+def _selfie_pose(selfie: str, auto: bool) -> tuple[dict[str, list[float]] | None, float, str]:
+    """The player's keypoints in the selfie (recorded in the set-up: a replay needs no estimator)."""
+    from games.tasbada.images import PhotoError, load_image
+    from games.tasbada.pose import estimate
+
+    if not auto:
+        return None, 1.0, "pose: off (tasbada pose=off); drag the avatar's hands and feet to pose it"
+    try:
+        img = load_image(selfie)
+    except PhotoError as exc:
+        raise GameOptionError(f"tasbada selfie: {exc}") from exc
+    points, note = estimate(img)
+    print(f"tasbada: {note}", file=sys.stderr)
+    return points, img.shape[1] / img.shape[0], note
 
 
 def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
@@ -102,6 +141,10 @@ def install(app: App) -> None:
     q.marks = [Mark.from_json(m) for m in setup.get("marks", [])]
     if setup.get("ground_v") is not None:
         q.ground_v = float(setup.get("ground_v"))
+    q.pose = validate_pose(setup.get("pose")) or {}
+    q.pose_aspect = float(setup.get("pose_aspect", 1.0) or 1.0)
+    if not q.pose:  # nothing from the selfie: the person poses a stick figure by hand
+        q.pose, q.pose_aspect, q.pose_picker = default_keypoints(), panel_aspect(), True
     photo = setup.get("photo", "")
     webcam, message = None, ""
     if setup.get("webcam", False):
@@ -111,7 +154,10 @@ def install(app: App) -> None:
         print(f"tasbada: {message}", file=sys.stderr)
     elif not photo:
         message = f"using the photo {SHIPPED_PHOTO.name}"
-    reality = Reality(photo or SHIPPED_PHOTO, setup.get("selfie", "") or SHIPPED_SELFIE, webcam, message)
+    light = setup.get("light")
+    reality = Reality(photo or SHIPPED_PHOTO, setup.get("selfie", "") or SHIPPED_SELFIE, webcam, message,
+                      light_deg=float(light) if isinstance(light, (int, float)) and np.isfinite(light) else None)
+    reality.pose_note = str(setup.get("pose_note", ""))
     save_to = setup.get("save_to", "")
     slot = SaveSlot(Path(save_to) if save_to else None)
     slot.photo = reality.photo_path if webcam is None else ""
@@ -119,6 +165,7 @@ def install(app: App) -> None:
     world.insert_resource(reality)
     world.insert_resource(slot)
     world.insert_resource(AvatarLook(reality.color))
+    app.add_system("animation", selfie_pose_system)
     app.add_system("rules", quest_system)
     app.add_system("rules", follow_system)
     app.add_system("hash", save_system)
@@ -138,6 +185,8 @@ def status(world: World) -> list[str]:
     reality = world.try_resource(Reality)
     if reality is not None and reality.message and q.stage != VIRTUAL:
         lines.append(reality.message)
+    if reality is not None and reality.pose_note and q.stage in (PROPS_ALIVE, MIXED):
+        lines.append(reality.pose_note)
     return lines
 
 
@@ -146,5 +195,6 @@ def _camera() -> OrbitCamera:
 
 
 GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
-            options={"save": "", "photo": "", "selfie": "", "webcam": "auto"}, prepare=prepare,
+            options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto",
+                     "light": ""}, prepare=prepare,
             replay_setup=replay_setup)

@@ -2,7 +2,10 @@
 
 One gesture is a press, a drag and a release of the MotionStick (mouse button or
 phone touch). What it does is decided at the press: on a button it is a button press,
-near the floor line it drags the line, anywhere else it draws. A drawn path becomes a
+on the floor line's *handle* (a knob at the line's left end, :func:`on_ground_handle`)
+it drags the line, anywhere else it draws — so a box may start right on the floor line
+(where things stand) without grabbing it. Every set-up action (a mark, a move of the
+floor line) is undoable, last first. A drawn path becomes a
 *lasso* when it comes back near its start after going around (its length is well over
 the half-perimeter of its bounding box); otherwise it is a *box* from the press to the
 release point — so the same gesture serves a quick rectangle and a careful outline.
@@ -17,14 +20,22 @@ from numpy.typing import NDArray
 
 from games.tasbada.quest import Mark
 
-__all__ = ["Button", "REAL_BUTTONS", "MENU_BUTTON", "MAX_MARKS", "MIN_SIZE", "GROUND_GRAB", "classify_path",
-           "hit_button", "menu_buttons", "clamp_ground"]
+__all__ = ["Button", "REAL_BUTTONS", "MENU_BUTTON", "MAX_MARKS", "MIN_SIZE", "GROUND_GRAB", "GROUND_HANDLE_U",
+           "classify_path", "hit_button", "menu_buttons", "clamp_ground", "on_ground_handle"]
 
 MAX_MARKS = 4
 MIN_SIZE = 0.025
 """Smallest mark side (fraction of the image): shorter drags are taken as slips."""
-GROUND_GRAB = 0.03
-"""How close (fraction of the image height) a press must be to the floor line to drag it."""
+GROUND_GRAB = 0.035
+"""The floor-line handle's radius (fraction of the image height)."""
+GROUND_HANDLE_U = 0.04
+"""Where the handle sits along the floor line (fraction of the image width): its left end."""
+_ASPECT = 16.0 / 9.0
+
+
+def on_ground_handle(p: NDArray[np.float64], ground_v: float) -> bool:
+    """Whether a press at ``p`` takes the floor line's handle (a round knob, aspect-corrected)."""
+    return bool(np.hypot((p[0] - GROUND_HANDLE_U) * _ASPECT, p[1] - ground_v) < GROUND_GRAB)
 
 
 class Button:

@@ -50,8 +50,9 @@ def script_line(script: str, index: int) -> str:
 class PropMotion:
     """One frame of an animated prop, in image units (fractions of the image height).
 
-    ``hop`` lifts the cut-out; ``sx``/``sy`` scale it about its base; ``mouth`` in [0,1]
-    opens the mouth; ``blink`` in [0,1] closes the eyes; ``gaze`` in [-1,1] turns the eyes.
+    ``hop`` lifts the prop; ``sx``/``sy`` scale it about its base; ``mouth`` in [0,1]
+    opens the mouth; ``blink`` in [0,1] closes the eyes; ``gaze`` in [-1,1] turns the eyes;
+    ``lean`` shears it sideways (image units of sideways shift per unit of height).
     """
 
     hop: float
@@ -60,6 +61,7 @@ class PropMotion:
     mouth: float
     blink: float
     gaze: float
+    lean: float = 0.0
 
 
 def prop_motion(t: float, phase: float = 0.0, talking: bool = False, energy: float = 1.0,
@@ -74,7 +76,7 @@ def prop_motion(t: float, phase: float = 0.0, talking: bool = False, energy: flo
         gaze: where the eyes look, -1 left to 1 right.
     """
     if t < 0:
-        return PropMotion(0.0, 1.0, 1.0, 0.0, 0.0, 0.0)
+        return PropMotion(0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0)
     period = 0.9 if talking else 1.25
     s = ((t + phase) / period) % 1.0
     hop = 0.035 * energy * math.sin(math.pi * s) ** 1.5
@@ -90,4 +92,6 @@ def prop_motion(t: float, phase: float = 0.0, talking: bool = False, energy: flo
         mouth = 0.0
     beat = (t + 0.37 * phase) % 3.3
     blink = max(0.0, 1.0 - abs(beat - 0.08) / 0.08) if beat < 0.16 else 0.0
-    return PropMotion(hop, sx, sy, mouth, blink, max(-1.0, min(1.0, gaze)))
+    # Lean into the jump on the way up, back on the way down, and a little towards what it looks at.
+    lean = 0.07 * energy * math.sin(2.0 * math.pi * s) + 0.04 * max(-1.0, min(1.0, gaze))
+    return PropMotion(hop, sx, sy, mouth, blink, max(-1.0, min(1.0, gaze)), lean)

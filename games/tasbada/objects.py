@@ -94,9 +94,9 @@ def _clear_of(points: NDArray[np.float64], spots: NDArray[np.float64], room: flo
     return out
 
 
-def _overlap(gate: NDArray[np.float64], marks: list[Mark]) -> float:
-    """Image area the gate would cover of the marked things (they live in the photo, behind it)."""
-    corners = gate + np.array([[-1.0, 0.0, 0.0], [1.0, 1.75, 0.0]])
+def _overlap(gate: NDArray[np.float64], marks: list[Mark], half_width: float = 1.0, height: float = 1.75) -> float:
+    """Image area a thing this big at ``gate`` shares with the marked things (hiding them or hidden by them)."""
+    corners = gate + np.array([[-half_width, 0.0, 0.0], [half_width, height, 0.0]])
     uv = to_image(corners)
     gu0, gu1 = sorted(uv[:, 0])
     gv0, gv1 = sorted(uv[:, 1])
@@ -121,8 +121,14 @@ def layout(ground_v: float, marks: list[Mark] | None = None) -> Layout:
     spots = real_spots(marks or [], ground_v)
     gates = np.array([[x, 0.0, z0 - 0.15] for x in (0.0, -1.3, 1.3, -2.2, 2.2)])
     gate = gates[int(np.argmin([_overlap(g, marks or []) for g in gates]))]  # first least hidden-behind
-    start = np.array([[1.2, 0.0, z1 - 0.1 * span]])
-    return Layout(_clear_of(cages, spots), _clear_of(crystals, spots, 0.8), gate, _clear_of(start, spots)[0])
+    # The avatar starts where no real prop hides it (props occlude what stands behind them).
+    xs = sorted(np.linspace(-2.6, 2.6, 27), key=lambda x: (abs(x - 1.2), x))  # nearest the usual spot first
+    starts = _clear_of(np.array([[x, 0.0, z1 - 0.1 * span] for x in xs]), spots)
+    cages = _clear_of(cages, spots)
+    away = np.array([min(_xz(p, c) for c in cages) > CAGE_REACH + 0.5 for p in starts])  # no cage opened by arriving
+    starts = starts[away] if away.any() else starts
+    start = starts[int(np.argmin([_overlap(p, marks or [], 0.35, 1.8) for p in starts]))]
+    return Layout(cages, _clear_of(crystals, spots, 0.8), gate, start)
 
 
 def spawn_objects(world: World, q: Quest) -> None:

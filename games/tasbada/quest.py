@@ -92,6 +92,8 @@ class Quest:
     gesture: str = ""
     """What the current press does: ``draw`` a mark, drag the ``ground`` line, a ``button``."""
     path: list[tuple[float, float]] = field(default_factory=list)
+    undo: list[list[object]] = field(default_factory=list)
+    """Set-up actions to take back, last first: ``["mark", count after]`` or ``["ground", previous v]``."""
     alive_t: float = -1.0
     """When the props came alive (the narrator's clock), -1 before."""
     # Narration.
@@ -111,6 +113,13 @@ class Quest:
     milestones: list[str] = field(default_factory=list)
     menu_open: bool = False
     saved_reached: list[str] = field(default_factory=list)
+    pose: dict[str, list[float]] = field(default_factory=dict)
+    """The player's keypoints (normalised selfie ``[x, y]`` by name, :mod:`games.tasbada.pose`):
+    found in the selfie at set-up, or placed by hand with the pose picker; empty: none."""
+    pose_aspect: float = 1.0
+    """Width / height of the picture the keypoints are measured on."""
+    pose_picker: bool = False
+    """No pose came from the selfie: stage 2 shows the pose picker (:mod:`games.tasbada.picker`)."""
     """Stages reached in an earlier session (from the save file), offered by the menu."""
 
     def time_in_stage(self, now: float) -> float:

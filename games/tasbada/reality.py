@@ -9,15 +9,15 @@ not per frame.
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 from PIL import Image
 
-from games.tasbada.compositor import Sprites, build_sprites, compose
+from games.tasbada.compositor import Layers, Sprites, build_sprites, compose
 from games.tasbada.images import PHOTO_SIZE, clothes_color, fit_photo, load_image
-from games.tasbada.quest import MIXED, REAL, Quest
+from games.tasbada.quest import MIXED, REAL, Mark, Quest
 from games.tasbada.webcam import Webcam
 
 __all__ = ["Reality", "SHIPPED_PHOTO", "SHIPPED_SELFIE"]
@@ -39,16 +39,21 @@ class Reality:
     SIM_STATE = False
 
     def __init__(self, photo: str | Path = SHIPPED_PHOTO, selfie: str | Path = SHIPPED_SELFIE,
-                 webcam: Webcam | None = None, message: str = "") -> None:
+                 webcam: Webcam | None = None, message: str = "", light_deg: float | None = None) -> None:
         self.photo_path = str(photo)
         self.photo = fit_photo(load_image(photo))
         self.selfie_img = load_image(selfie)
         self.color = clothes_color(self.selfie_img)
         self.webcam = webcam
         self.message = message
+        self.light_deg = light_deg
+        self.pose_note = ""
+        """What the pose estimator said about the selfie (shown in the status lines)."""
+        """Where the props' shadows fall (degrees; ``None``: as found in the photo)."""
         self.frozen = webcam is None
         self.selfie_taken = webcam is None
         self._sprites: tuple[bytes, Sprites] | None = None
+        self._building: tuple[bytes, threading.Thread, list[Sprites | BaseException]] | None = None
         self._photo_pil = Image.fromarray(self.photo)
         self._selfie_pil = Image.fromarray(self.selfie_img)
 
@@ -72,17 +77,45 @@ class Reality:
                     self.color = clothes_color(frame)
                     self.selfie_taken = True
 
-    def sprites(self, q: Quest) -> Sprites | None:
-        """The cut-outs for ``q``'s marks (built on first use for a new set of marks)."""
+    def sprites(self, q: Quest, wait: bool = False) -> Sprites | None:
+        """The living props for ``q``'s marks, or ``None`` while they are still being built.
+
+        Matting, shadows and inpainting take seconds, so they run on a worker thread
+        (OpenCV releases the GIL) and the window keeps drawing the plain photo meanwhile;
+        ``wait`` blocks until they are ready (screenshots, tests).
+        """
         if not q.marks:
             return None
         key = b"".join(m.kind.encode() + np.ascontiguousarray(m.points).tobytes() for m in q.marks)
-        if self._sprites is None or self._sprites[0] != key:
-            self._sprites = (key, build_sprites(self.photo, q.marks))
-        return self._sprites[1]
+        key += np.float64(q.ground_v).tobytes()
+        if self._sprites is not None and self._sprites[0] == key:
+            return self._sprites[1]
+        if self._building is None or self._building[0] != key:
+            job: list[Sprites | BaseException] = []
+            args = (self.photo.copy(), [Mark(m.kind, m.points.copy()) for m in q.marks], q.ground_v, self.light_deg)
 
-    def frame(self, q: Quest, now: float, gaze: float) -> NDArray[np.uint8]:
-        """This frame's backdrop picture."""
+            def run() -> None:
+                try:
+                    job.append(build_sprites(*args))
+                except BaseException as exc:  # handed to the drawing thread below
+                    job.append(exc)
+
+            worker = threading.Thread(target=run, name="tasbada-props", daemon=True)
+            worker.start()
+            self._building = (key, worker, job)
+        _, worker, job = self._building
+        if wait:
+            worker.join()
+        if not job:
+            return None
+        self._building = None
+        if isinstance(job[0], BaseException):
+            raise job[0]
+        self._sprites = (key, job[0])
+        return job[0]
+
+    def frame(self, q: Quest, now: float, gaze: float) -> Layers:
+        """This frame's backdrop, living props and interface."""
         self._live(q)
         sprites = None if q.stage == REAL else self.sprites(q)
         return compose(self._photo_pil, sprites, q, now, self._selfie_pil, self.color, gaze)
