@@ -4,7 +4,10 @@ Input ``.bvh`` / ``.gltf`` / ``.glb`` (``--animation``, ``--units``, ``--joint-m
 ``.npz`` / ``.rec`` (a recording), output ``.bvh`` / ``.ppclip`` / ``.glb`` / ``.gltf`` (skeletal input)
 or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output is::
 
-    {"period_frames", "period_seconds", "cycles", "dims", "closure_error", "seconds", ...}
+    {"period_frames", "period_seconds", "cycles", "dims", "closure_error", "seconds", ...,
+     "input": {"units", "unit_scale", "units_basis", "fps", "fps_basis", "animation", ...}}
+
+(``input`` for BVH/glTF input: what was decided about the file).
 
 When no cycle can be found the command exits with status 3 and says why on standard
 error (and, with ``--json``, an ``{"error": …}`` line); nothing is written then.

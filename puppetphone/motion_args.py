@@ -32,7 +32,8 @@ def add_export_options(parser: argparse.ArgumentParser) -> None:
     """``--fps`` and ``--closing-frame`` / ``--no-closing-frame`` for loops written to BVH/glTF."""
     parser.add_argument("--fps", type=float, metavar="N",
                         help="frame rate of a BVH/glTF loop (default: the source's nominal rate); the loop is "
-                             "resampled to a whole number of frames at about this rate")
+                             "resampled to a whole number of frames at exactly this rate (it stretches by under "
+                             "half a frame)")
     parser.add_argument("--closing-frame", action=argparse.BooleanOptionalAction, default=None,
                         help="repeat the first pose at the end of a BVH loop, so Blender's Cycles modifier "
                              "loops without skipping a pose (default: on for BVH)")
