@@ -28,6 +28,8 @@ __all__ = ["configure", "run", "library_setup", "authored_resource"]
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the clips sub-commands."""
+    from puppetphone.motion_args import add_motion_options
+
     parser.add_argument("--clips", type=Path, default=None, metavar="DIR",
                         help="the library folder (default $XDG_DATA_HOME/puppetphone/clips)")
     sub = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
@@ -36,6 +38,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     add.add_argument("--role", required=True,
                      help="idle, walk, run, crouch_idle, crouch_walk, get_up, mid_jump, or a new name")
     add.add_argument("--clips", type=Path, default=argparse.SUPPRESS, metavar="DIR", help="the library folder")
+    add_motion_options(add)
     ls = sub.add_parser("list", help="the library's roles: clip, frames, speed, hips height, source")
     ls.add_argument("--clips", type=Path, default=argparse.SUPPRESS, metavar="DIR", help="the library folder")
     rm = sub.add_parser("remove", help="remove a role's clip (the built-in clip plays it again)")
@@ -49,18 +52,20 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
     from engine.cliplib.roles import RoleError, check_role, conform, normalise_role
     from engine.cliplib.source import read_motion, to_puppet
     from engine.humanoid import humanoid_skeleton
+    from puppetphone.motion_args import motion_options
 
     skeleton = humanoid_skeleton()
     try:
         role = normalise_role(args.role)
-        clip, retargeted = to_puppet(read_motion(args.file), skeleton)
+        options = motion_options(args)
+        clip, joint_map = to_puppet(read_motion(args.file, **options), skeleton, options["joint_map"])
         check_role(clip, role, skeleton)
         entry = library.add(conform(clip, role), role, skeleton, default_clips(), source=args.file.name)
     except RoleError as exc:
         print(f"clips: {args.file.name} refused as the {args.role}: {exc}", file=sys.stderr)
         return 2
     stored = library.load()[entry.role]
-    how = "retargeted to the puppet, " if retargeted else ""
+    how = f"retargeted to the puppet by the {joint_map} joint map, " if joint_map else ""
     print(f"added {args.file.name} as the {entry.role} ({how}{stored.num_frames} frames at {stored.fps:g} fps, "
           f"{stored.average_speed():.2f} m/s) -> {library.root / entry.file}")
     return 0

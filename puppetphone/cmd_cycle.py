@@ -91,12 +91,13 @@ def run(args: argparse.Namespace) -> int:
             return fail(EXIT_BAD_INPUT, "--plot needs matplotlib: pip install 'puppetphone[plot]'")
     t0 = time.perf_counter()
     try:
-        perf = load_performance(args.input, args.items, **motion_options(args))
+        options = motion_options(args)
+        perf = load_performance(args.input, args.items, **options)
         if args.retarget:
             from authoring.cycles.retarget_source import retarget_performance
             from engine.humanoid import humanoid_skeleton
 
-            perf = retarget_performance(perf, humanoid_skeleton())
+            perf = retarget_performance(perf, humanoid_skeleton(), options["joint_map"])
     except FileNotFoundError as exc:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:

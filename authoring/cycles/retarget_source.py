@@ -4,44 +4,28 @@ Retargeting first (rather than the loop after) makes the extractor analyse the p
 17 joints — what will play — instead of the actor's 40-odd, and the loop it writes is a
 ``.ppclip``/BVH on the puppet's skeleton, ready for ``clips add``. The retarget
 (:func:`engine.cliplib.source.to_puppet`) scales the root's travel by the leg-length
-ratio, so the stride and the speed fit the puppet's legs, and puts the feet on y = 0.
+ratio, so the stride and the speed fit the puppet's legs, and puts the feet on y = 0; the
+retargeted clip is then analysed exactly as a file on the puppet's skeleton would be
+(:func:`~authoring.cycles.formats.performance_from_motion`: heading-normalised).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
-
-from authoring.cycles.formats import Performance
-from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
-from engine.clip import Clip
+from authoring.cycles.formats import Performance, performance_from_motion
+from authoring.cycles.trajectory import TrajectoryError
 from engine.cliplib.source import to_puppet
 from engine.skeleton import Skeleton
 
-__all__ = ["TARGETS", "retarget_performance", "clip_performance"]
+__all__ = ["TARGETS", "retarget_performance"]
 
 TARGETS = ("puppet",)
 
 
-def clip_performance(clip: Clip, base: Performance) -> Performance:
-    """The performance of a clip: the root's position (travelling) and every joint's rotation."""
-    sk = clip.skeleton
-    cols = [clip.root]
-    names = [f"{sk.names[0]}.{a}" for a in "xyz"]
-    items = [Item(f"{sk.names[0]}.position", "position", 0, 3, travel=True)]
-    for j, name in enumerate(sk.names):
-        start = 3 + 4 * j
-        cols.append(clip.rotations[:, j])
-        names += [f"{name}.q{a}" for a in "wxyz"]
-        items.append(Item(f"{name}.rotation", "rotation", start, start + 4))
-    traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, items)
-    return replace(base, trajectory=traj, names=tuple(names), clip=clip, joints=tuple(range(sk.num_joints)))
-
-
-def retarget_performance(perf: Performance, target: Skeleton) -> Performance:
-    """``perf`` played by ``target`` (skeletal input only)."""
-    if perf.clip is None:
-        raise TrajectoryError("--retarget needs skeletal input (BVH)")
-    clip, _ = to_puppet(perf.clip, target)
-    return clip_performance(clip, perf)
+def retarget_performance(perf: Performance, target: Skeleton, joint_map: dict[str, str] | None = None) -> Performance:
+    """``perf`` played by ``target`` (skeletal input only), through ``joint_map`` when one is given."""
+    if perf.motion is None:
+        raise TrajectoryError("--retarget needs skeletal input (BVH or glTF)")
+    clip, _ = to_puppet(perf.motion.clip, target, joint_map)
+    return performance_from_motion(replace(perf.motion, clip=clip))

@@ -1,10 +1,12 @@
 """Any motion file as a clip on the puppet's skeleton: ``.ppclip``, ``.bvh`` or glTF, retargeted.
 
-What ``clips add`` and ``cycle --retarget puppet`` read. A clip on another skeleton is
-retargeted with :func:`engine.io.retarget.retarget` (the name maps of
-:mod:`engine.io.joint_maps` — CMU/DAZ, CC_Base, Bandai, Mixamo): bone directions copied,
-the root's travel scaled by the ratio of leg lengths so the stride fits the puppet's
-legs, and the motion shifted so the feet stand on y = 0.
+What ``clips add`` and ``cycle --retarget puppet`` read. Motion files go through the one
+loader, :func:`engine.io.motion_file.load_motion` (units judged by the figure, the glTF
+animation chosen, a ``Frames:`` count that is off tolerated), and a clip on another
+skeleton through :func:`engine.io.motion_file.to_puppet` (the name maps of
+:mod:`engine.io.joint_maps`, or the user's ``--joint-map``): bone directions copied, the
+root's travel scaled by the ratio of leg lengths so the stride fits the puppet's legs,
+and the motion shifted so the feet stand on y = 0.
 """
 
 from __future__ import annotations
@@ -19,8 +21,9 @@ __all__ = ["SOURCE_SUFFIXES", "read_motion", "to_puppet"]
 SOURCE_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
 
 
-def read_motion(path: str | Path) -> Clip:
-    """The clip in ``path`` (a glTF's first animation; a CMU BVH without its T-pose lead-in).
+def read_motion(path: str | Path, animation: int | str | None = None, units: str | None = None,
+                joint_map: dict[str, str] | None = None) -> Clip:
+    """The clip in ``path`` (a glTF's chosen animation; a CMU BVH without its T-pose lead-in).
 
     Raises:
         ValueError: not a motion file this build reads, or a damaged one (the message says which).
@@ -32,26 +35,17 @@ def read_motion(path: str | Path) -> Clip:
         from engine.clipfile import load_clip
 
         return load_clip(path)
-    if suffix == ".bvh":
-        from engine.io.bvh import read_bvh
-        from engine.io.bvh_convert import detect_tpose_frames
+    if suffix not in SOURCE_SUFFIXES:
+        raise ValueError(f"{path.name}: unknown motion type {suffix!r}; use one of {', '.join(SOURCE_SUFFIXES)}")
+    from engine.io.motion_file import load_motion
 
-        motion = read_bvh(path)
-        return motion.to_clip(skip_frames=detect_tpose_frames(motion))
-    if suffix in (".glb", ".gltf"):
-        from engine.io.gltf_clip import load_gltf_clips
-
-        clips = load_gltf_clips(path)
-        if not clips:
-            raise ValueError(f"{path.name} has no animation")
-        return clips[0]
-    raise ValueError(f"{path.name}: unknown motion type {suffix!r}; use one of {', '.join(SOURCE_SUFFIXES)}")
+    return load_motion(path, animation=animation, units=units, joint_map=joint_map).clip
 
 
-def to_puppet(clip: Clip, skeleton: Skeleton) -> tuple[Clip, bool]:
-    """``clip`` on ``skeleton`` (retargeted unless it already is on it) and whether it was retargeted."""
+def to_puppet(clip: Clip, skeleton: Skeleton, joint_map: dict[str, str] | None = None) -> tuple[Clip, str | None]:
+    """``clip`` on ``skeleton`` (retargeted unless it already is on it) and the joint map used (``None``: none)."""
     if tuple(clip.skeleton.names) == tuple(skeleton.names):
-        return clip, False
-    from engine.io.retarget import retarget
+        return clip, None
+    from engine.io.motion_file import to_puppet as retarget_to_puppet
 
-    return retarget(clip, skeleton), True
+    return retarget_to_puppet(clip, joint_map)
