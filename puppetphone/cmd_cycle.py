@@ -1,4 +1,4 @@
-"""``puppetphone cycle INPUT -o OUTPUT [--json] [--plot PNG] [--items …]``: one clean loop from a performance.
+"""``puppetphone cycle INPUT -o OUTPUT [--json] [--plot PNG] [--items …] [--start T0 --end T1]``: one clean loop from a performance.
 
 Input ``.bvh`` / ``.csv`` / ``.npz`` / ``.rec`` (a recording), output ``.bvh`` / ``.ppclip`` (skeletal
 input) or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output is::
@@ -6,7 +6,9 @@ input) or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output 
     {"period_frames", "period_seconds", "cycles", "dims", "closure_error", "seconds", ...}
 
 When no cycle can be found the command exits with status 3 and says why on standard
-error (and, with ``--json``, an ``{"error": …}`` line); nothing is written then.
+error (and, with ``--json``, an ``{"error": …}`` line); nothing is written then. A take
+refused as a whole is searched for a part that loops, and the message names the best
+one ("frames 0–363 loop with period 1.00 s (5 cycles); try --start 0 --end 6.07").
 """
 
 from __future__ import annotations
@@ -37,6 +39,18 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the random probe points (default 0)")
     parser.add_argument("--samples", type=int, help="samples in the output loop (default: the period at the input rate)")
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+    parser.add_argument("--start", metavar="T0", type=_bound, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)")
+    parser.add_argument("--end", metavar="T1", type=_bound, help="analyse up to here (excluded): seconds or a frame")
+
+
+def _bound(text: str) -> object:
+    """A ``--start/--end`` value, checked where argparse reads it."""
+    from authoring.cycles.take_range import parse_bound
+
+    try:
+        return parse_bound(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 class _Bar:
@@ -62,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
 
     from authoring.cycles.extract import CycleError, CycleOptions, extract_cycle
     from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
+    from authoring.cycles.take_range import refusal_hint, select
     from authoring.cycles.trajectory import TrajectoryError
 
     def fail(code: int, message: str) -> int:
@@ -80,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
             return fail(EXIT_BAD_INPUT, "--plot needs matplotlib: pip install 'puppetphone[plot]'")
     t0 = time.perf_counter()
     try:
-        perf = load_performance(args.input, args.items)
+        whole = load_performance(args.input, args.items)
+        perf, offset = select(whole, args.start, args.end) if args.start or args.end else (whole, 0)
     except FileNotFoundError as exc:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:
@@ -96,7 +112,8 @@ def run(args: argparse.Namespace) -> int:
         result = extract_cycle(traj, np.random.default_rng(args.seed), opts, progress=bar)
     except CycleError as exc:
         bar.enabled = False
-        return fail(EXIT_NO_CYCLE, str(exc))
+        hint = refusal_hint(whole, perf, offset, args.seed)
+        return fail(EXIT_NO_CYCLE, f"{exc}" + (f"; {hint}" if hint else ""))
     seconds = time.perf_counter() - t1
     try:
         save_loop(result, perf, args.output)

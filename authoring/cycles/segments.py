@@ -55,7 +55,7 @@ class SegmentSettings:
 
     min_period: float = 0.25
     max_period: float = 4.0
-    loop_score: float = 0.2
+    loop_score: float = 0.35
     tolerance: float = 0.03
     same_period: float = 0.25
     min_cycles: float = 2.5
@@ -169,12 +169,6 @@ def _runs(lag: NDArray[np.int64], cfg: SegmentSettings) -> Iterator[tuple[int, i
         i = j + 1
 
 
-def _same(a: tuple[int, int, float, float], b: tuple[int, int, float, float], cfg: SegmentSettings) -> bool:
-    """Two neighbouring runs that touch and agree on the period are one activity (a dropout split it)."""
-    ref = max(a[2], b[2])
-    return b[0] <= a[1] + 0.25 * ref and abs(a[2] - b[2]) <= cfg.same_period * ref
-
-
 def find_segments(traj: Trajectory, settings: SegmentSettings | None = None) -> list[Segment]:
     """Candidate looping segments of a take, in time order, not overlapping.
 
@@ -193,17 +187,19 @@ def find_segments(traj: Trajectory, settings: SegmentSettings | None = None) -> 
     s = _scores(x, lags)
     lag, score = _frame_periods(s, lags, cfg)
     raw: list[tuple[int, int, float, float]] = []
+    last_start = -1
     for first, last, period in _runs(lag, cfg):
         begin, end = first, min(len(t) - 1, last + int(round(2 * period)))
-        if (end - begin) < cfg.min_cycles * period:
-            continue
         sc = score[first : last + 1]
         entry = (begin, end, period, float(np.median(sc[np.isfinite(sc)])))
-        if raw and _same(raw[-1], entry, cfg):
+        # A dropout of under half a period between two runs of one period split one activity.
+        if raw and first - last_start <= 0.5 * period and abs(raw[-1][2] - period) <= cfg.same_period * period:
             a = raw[-1]
             raw[-1] = (a[0], max(a[1], end), 0.5 * (a[2] + period), max(a[3], entry[3]))
         else:
             raw.append(entry)
+        last_start = last
+    raw = [r for r in raw if r[1] - r[0] >= cfg.min_cycles * r[2]]
     # Neighbours overlap by up to two periods (a run's frames look two cycles ahead): split the overlap.
     for k in range(1, len(raw)):
         a, b = raw[k - 1], raw[k]
