@@ -18,6 +18,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "replay": ("puppetphone.cmd_replay", "replay a recording, optionally verifying every state hash"),
     "author": ("puppetphone.cmd_author", "authoring scenes: record cycles by acting, edit them with MoCurves"),
     "cycle": ("puppetphone.cmd_cycle", "extract one clean loop from a performed motion"),
+    "cycles": ("puppetphone.cmd_cycles", "extract every loop of a mocap library into a clip library with an index"),
     "devices": ("puppetphone.cmd_devices", "list input devices and where a phone should send"),
     "bench": ("puppetphone.cmd_bench", "run benchmarks and print figures against baselines"),
     "blendspace": ("puppetphone.cmd_blendspace", "inspect the puppet's blend space and IDW lookup"),
