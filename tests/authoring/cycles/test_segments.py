@@ -75,3 +75,23 @@ def test_real_mocap_walk_is_one_segment_and_the_jump_none(mocap_dir: Path) -> No
     assert seg.t1 - seg.t0 > 0.9 * walk.times[-1]
     jump = load_performance(mocap_dir / "cmu_13_32_forward_jump_NEGATIVE_daz.bvh").trajectory
     assert find_segments(jump) == []
+
+
+@pytest.mark.fuzz
+def test_fuzz_parse_bound() -> None:
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from authoring.cycles.take_range import parse_bound
+
+    @settings(max_examples=300, deadline=None)
+    @given(st.text(max_size=12))
+    def check(text: str) -> None:
+        try:
+            b = parse_bound(text)
+        except ValueError:
+            return
+        assert b.unit in ("s", "f") and np.isfinite(b.value) and b.value >= 0
+
+    check()
+    assert parse_bound("480f").value == 480 and parse_bound("4.5s").value == 4.5 and parse_bound("2").unit == "s"
