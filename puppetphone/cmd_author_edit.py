@@ -29,10 +29,14 @@ EDIT_GAME = "author-edit"
 
 def configure_edit(parser: argparse.ArgumentParser) -> None:
     """Add the ``author edit`` arguments."""
-    from puppetphone.argtypes import output_file
+    from puppetphone.argtypes import output_file, take_position
     from puppetphone.runargs import add_run_arguments
 
-    parser.add_argument("clip", help="a .ppclip cycle, or a default clip name (walk, run, crouch_walk, idle…)")
+    parser.add_argument("clip", help="a .ppclip cycle, a default clip name (walk, run, crouch_walk, idle…), or a "
+                                     "BVH take whose loop is extracted first (with --start/--end: of that part)")
+    parser.add_argument("--start", metavar="T0", type=take_position, help="a take: extract the loop from here "
+                        "(seconds, or a frame: 480f)")
+    parser.add_argument("--end", metavar="T1", type=take_position, help="a take: ...up to here (excluded)")
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
@@ -55,6 +59,20 @@ def _open(spec: str):  # type: ignore[no-untyped-def]
     if spec not in clips:
         raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)})")
     return EditSession(clips[spec]), Path(f"{spec}_edited.ppclip")
+
+
+def _cycle_of_take(spec: str, start: object, end: object) -> tuple[str, Path]:
+    """A take opens as the loop extracted from it (or from the part ``--start/--end`` pick), kept in a temporary file."""
+    import atexit
+    import shutil
+
+    from authoring.cycles.take_range import cycle_of_take
+
+    take = Path(spec)
+    tmp = Path(tempfile.mkdtemp(prefix="ppedit-"))
+    atexit.register(shutil.rmtree, tmp, True)
+    loop = cycle_of_take(take, start, end, tmp / f"{take.stem}_cycle.ppclip")  # type: ignore[arg-type]
+    return str(loop), take.with_name(f"{take.stem}_cycle_edited.ppclip")
 
 
 def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
@@ -219,13 +237,20 @@ class EditActivity:
         self.edit.draw(scene)
 
 
-def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record: Path | None = None):  # type: ignore[no-untyped-def]
-    """A live edit session of ``spec`` (optionally recorded)."""
+def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record: Path | None = None,  # type: ignore[no-untyped-def]
+               start: object = None, end: object = None):
+    """A live edit session of ``spec`` (optionally recorded); a take opens as its loop (``start``/``end``: of a part)."""
     from authoring.edit_scene import EditScene
     from input.hub import InputHub
     from input.recording import Recorder, RecordingHeader
 
+    take_out = None
+    if Path(spec).suffix.lower() == ".bvh":
+        spec, take_out = _cycle_of_take(spec, start, end)
+    elif start is not None or end is not None:
+        raise ValueError("--start/--end pick a part of a take (.bvh), not of a clip")
     session, default_out = _open(spec)
+    default_out = take_out or default_out
     recorder = None
     if record is not None:
         recorder = Recorder(record, RecordingHeader(game=EDIT_GAME, seed=0, dt=EditActivity.dt, sources=["mouse"],
@@ -265,7 +290,7 @@ def run_edit(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     try:
-        activity = build_edit(args.clip, runner.size, args.output, record=args.record)
+        activity = build_edit(args.clip, runner.size, args.output, record=args.record, start=args.start, end=args.end)
     except (ValueError, OSError) as exc:
         runner.close()
         print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)

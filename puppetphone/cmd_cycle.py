@@ -30,6 +30,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="INPUT", help="performance: .bvh, .csv (time + columns), .npz or a recording (.rec)")
     parser.add_argument("-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .csv or .npz")
     parser.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
+    from puppetphone.argtypes import take_position
     from puppetphone.runargs import image_path
 
     parser.add_argument("--plot", metavar="IMAGE", type=image_path,
@@ -39,18 +40,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the random probe points (default 0)")
     parser.add_argument("--samples", type=int, help="samples in the output loop (default: the period at the input rate)")
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
-    parser.add_argument("--start", metavar="T0", type=_bound, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)")
-    parser.add_argument("--end", metavar="T1", type=_bound, help="analyse up to here (excluded): seconds or a frame")
-
-
-def _bound(text: str) -> object:
-    """A ``--start/--end`` value, checked where argparse reads it."""
-    from authoring.cycles.take_range import parse_bound
-
-    try:
-        return parse_bound(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    parser.add_argument("--start", metavar="T0", type=take_position, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)")
+    parser.add_argument("--end", metavar="T1", type=take_position, help="analyse up to here (excluded): seconds or a frame")
 
 
 class _Bar:

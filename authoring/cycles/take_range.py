@@ -15,11 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from authoring.cycles.formats import Performance
+from pathlib import Path
+
+from authoring.cycles.extract import CycleError, extract_cycle
+from authoring.cycles.formats import Performance, load_performance, save_loop
 from authoring.cycles.segments import Segment, best_segment, cut, looping_segments
 from authoring.cycles.trajectory import TrajectoryError
 
-__all__ = ["Bound", "parse_bound", "select", "refusal_hint"]
+__all__ = ["Bound", "parse_bound", "select", "refusal_hint", "cycle_of_take"]
 
 
 @dataclass(frozen=True)
@@ -103,3 +106,19 @@ def refusal_hint(perf: Performance, analysed: Performance, offset: int = 0, seed
         return None
     seg, result = best
     return _describe(perf, seg, offset, result.period, result.cycles)
+
+
+def cycle_of_take(take: Path, start: Bound | None, end: Bound | None, out: Path, seed: int = 0) -> Path:
+    """Extract the loop of ``take`` between ``start`` and ``end`` and write it to ``out`` (``author edit`` opens it).
+
+    Raises:
+        ValueError: an unreadable take, a range outside it, or no loop there (with the hint of the part that loops).
+    """
+    whole = load_performance(take)
+    perf, offset = select(whole, start, end)
+    try:
+        result = extract_cycle(perf.trajectory, np.random.default_rng(seed))
+    except CycleError as exc:
+        hint = refusal_hint(whole, perf, offset, seed)
+        raise ValueError(f"{exc}" + (f"; {hint}" if hint else "")) from None
+    return save_loop(result, perf, out)
