@@ -79,6 +79,9 @@ def run(args: argparse.Namespace) -> int:
     from authoring.cycles.formats import INPUT_SUFFIXES
 
     t0 = time.perf_counter()
+    if args.send_bytes and not args.scheduler:
+        print("cycles: --send-bytes sends takes to a Dask cluster's workers; give --scheduler too", file=sys.stderr)
+        return EXIT_BAD_INPUT
     libdir = Path(args.output)
     options = BatchOptions(retarget=args.retarget, segments=not args.no_segments, seed=args.seed)
     try:
@@ -91,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"cycles: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
-        plan = plan_batch(sources, index, send_bytes=args.send_bytes)
+        plan = plan_batch(sources, index)
         for path, reason in plan.unreadable:
             print(f"failed   {Path(path).name}: cannot read: {reason}")
         if not plan.tasks:
@@ -110,7 +113,8 @@ def run(args: argparse.Namespace) -> int:
                 bar.update(task, description=f"cycles ({workers} worker{'s' if workers != 1 else ''})")
 
             jobs = args.jobs or default_jobs()
-            for outcome in run_tasks(plan.tasks, options, jobs=jobs, scheduler=args.scheduler, on_start=started):
+            for outcome in run_tasks(plan.tasks, options, jobs=jobs, scheduler=args.scheduler, on_start=started,
+                                     send_bytes=args.send_bytes):
                 files = library.add(outcome)
                 counts[outcome.outcome] += 1
                 clips += len(files)

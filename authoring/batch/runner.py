@@ -96,7 +96,7 @@ class Plan:
     unreadable: list[tuple[str, str]] = field(default_factory=list)  # (path, reason)
 
 
-def plan_batch(sources: list[Path], index: LibraryIndex, send_bytes: bool = False) -> Plan:
+def plan_batch(sources: list[Path], index: LibraryIndex) -> Plan:
     """Hash every source (or reuse the hash of an unchanged file) and keep those not in the index."""
     known = index.known_hashes()
     plan = Plan()
@@ -117,7 +117,7 @@ def plan_batch(sources: list[Path], index: LibraryIndex, send_bytes: bool = Fals
             plan.duplicates += 1
         else:
             seen.add(digest)
-            plan.tasks.append(TakeTask(str(path), digest, path.read_bytes() if send_bytes else None))
+            plan.tasks.append(TakeTask(str(path), digest))
     index.commit()
     return plan
 
@@ -144,18 +144,20 @@ class Library:
 
 
 def run_tasks(tasks: list[TakeTask], options: BatchOptions, jobs: int = 1, scheduler: str | None = None,
-              on_start: Callable[[int], None] | None = None) -> Iterator[TakeOutcome]:
+              on_start: Callable[[int], None] | None = None, send_bytes: bool = False) -> Iterator[TakeOutcome]:
     """Process the tasks and yield each outcome as it arrives.
 
-    ``scheduler`` (a Dask address, ``tcp://host:8786``) sends every task to the cluster;
-    otherwise ``jobs > 1`` runs a process pool of that many workers (each imports the heavy
-    modules once, at start) and ``jobs == 1`` runs them here, one after another.
-    ``on_start`` is told the number of workers once they are up.
+    ``scheduler`` (a Dask address, ``tcp://host:8786``) sends every task to the cluster,
+    a few per worker at a time (with ``send_bytes``, each take's bytes, read as it is
+    sent, for workers that cannot read the path); otherwise ``jobs > 1`` runs a process
+    pool of that many workers (each imports the heavy modules once, at start) and
+    ``jobs == 1`` runs them here, one after another. ``on_start`` is told the number of
+    workers once they are up.
     """
     if not tasks:
         return
     if scheduler:
-        yield from _dask(tasks, options, scheduler, on_start)
+        yield from _dask(tasks, options, scheduler, on_start, send_bytes)
     elif jobs > 1 and len(tasks) > 1:
         yield from _pool(tasks, options, min(jobs, len(tasks)), on_start)
     else:
@@ -181,7 +183,8 @@ def _pool(tasks: list[TakeTask], options: BatchOptions, jobs: int, on_start: Cal
                 fut.cancel()
 
 
-def _dask(tasks: list[TakeTask], options: BatchOptions, address: str, on_start: Callable[[int], None] | None) -> Iterator[TakeOutcome]:
+def _dask(tasks: list[TakeTask], options: BatchOptions, address: str, on_start: Callable[[int], None] | None,
+          send_bytes: bool) -> Iterator[TakeOutcome]:
     try:
         from distributed import Client
         from distributed import as_completed as dask_completed
@@ -193,15 +196,33 @@ def _dask(tasks: list[TakeTask], options: BatchOptions, address: str, on_start: 
         raise SourceError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
     try:
         client.run(warm_up)  # heavy imports once on every worker, before the tasks
+        workers = len(client.scheduler_info().get("workers", {}))
         if on_start:
-            on_start(len(client.scheduler_info().get("workers", {})))
-        futures = [client.submit(process_take, task, options, key=f"take-{task.digest}-{options.key()}", pure=False)
-                   for task in tasks]
+            on_start(workers)
+        pending = iter(tasks)
+        running = dask_completed()
+        submitted = []
+
+        def submit_next() -> None:
+            task = next(pending, None)
+            if task is None:
+                return
+            if send_bytes:  # read only now: a library's bytes never sit in memory all at once
+                task = TakeTask(task.source, task.digest, Path(task.source).read_bytes())
+            fut = client.submit(process_take, task, options, key=f"take-{task.digest}-{options.key()}", pure=False)
+            submitted.append(fut)
+            running.add(fut)
+
+        for _ in range(max(2, 4 * workers)):  # enough queued to keep every worker busy
+            submit_next()
         try:
-            for fut in dask_completed(futures):
-                yield fut.result()
+            for fut in running:
+                outcome = fut.result()
+                fut.release()
+                submit_next()
+                yield outcome
         finally:
-            client.cancel(futures)
+            client.cancel([f for f in submitted if not f.done()])
     finally:
         client.close()
 
