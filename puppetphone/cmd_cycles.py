@@ -21,6 +21,12 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # imported inside run(): `puppetphone --help` stays instant
+    from rich.progress import Progress
+
+    from authoring.batch.worker import TakeOutcome
 
 __all__ = ["configure", "run"]
 
@@ -48,7 +54,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
 
 
-def _line(outcome, files: list[str]) -> list[str]:  # type: ignore[no-untyped-def]
+def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
     """The per-take lines: one per clip, or one with the reason."""
     name = Path(outcome.source).name
     if outcome.outcome != "looped":
@@ -62,10 +68,17 @@ def _line(outcome, files: list[str]) -> list[str]:  # type: ignore[no-untyped-de
     return lines
 
 
-def _progress(enabled: bool):  # type: ignore[no-untyped-def]
+def _progress(enabled: bool) -> Progress:
     """A rich progress bar on standard error (disabled off a terminal); per-take lines print above it."""
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     return Progress(TextColumn("[progress.description]{task.description}"), BarColumn(), MofNCompleteColumn(),
                     TimeElapsedColumn(), TimeRemainingColumn(), console=Console(stderr=True), disable=not enabled)

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from authoring.batch.worker import TakeOutcome
 
-__all__ = ["INDEX_NAME", "SCHEMA_VERSION", "ClipEntry", "LibraryIndexError", "LibraryIndex", "TakeEntry", "read_index"]
+__all__ = ["INDEX_NAME", "SCHEMA_VERSION", "ClipEntry", "LibraryIndex", "LibraryIndexError", "TakeEntry", "read_index"]
 
 INDEX_NAME = "index.sqlite"
 SCHEMA_VERSION = 1
@@ -178,9 +178,12 @@ def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
     try:
         con = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=30.0)
         try:
-            takes = [TakeEntry(*row) for row in con.execute("SELECT * FROM takes ORDER BY source, hash")]
-            clips = [ClipEntry(*row, path=libdir / row[0]) for row in
-                     con.execute("SELECT * FROM clips ORDER BY source, start_frame, file")]
+            cur = con.execute("SELECT * FROM takes ORDER BY source, hash")
+            names = [d[0] for d in cur.description]
+            takes = [TakeEntry(**dict(zip(names, row, strict=True))) for row in cur]
+            cur = con.execute("SELECT * FROM clips ORDER BY source, start_frame, file")
+            names = [d[0] for d in cur.description]
+            clips = [ClipEntry(**dict(zip(names, row, strict=True)), path=libdir / row[0]) for row in cur]
         finally:
             con.close()
     except sqlite3.DatabaseError as exc:

@@ -19,8 +19,14 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-__all__ = ["BatchOptions", "ClipOut", "TakeOutcome", "TakeTask", "process_take", "warm_up", "KINDS_BY_NAME"]
+if TYPE_CHECKING:  # the heavy modules are imported by the worker when it starts (warm_up), not by the CLI
+    from authoring.cycles.extract import CycleResult
+    from authoring.cycles.formats import Performance
+    from authoring.cycles.segments import Segment
+
+__all__ = ["KINDS_BY_NAME", "BatchOptions", "ClipOut", "TakeOutcome", "TakeTask", "process_take", "warm_up"]
 
 # Motion kinds a file name may announce, first match wins (CMU, Bandai and studio names use these words).
 KINDS_BY_NAME = (
@@ -102,15 +108,15 @@ class TakeOutcome:
 
 def warm_up() -> None:
     """Import the heavy modules once per worker process, before the first take arrives."""
-    import authoring.cycles.extract  # noqa: F401
-    import authoring.cycles.formats  # noqa: F401
+    import authoring.cycles.extract
+    import authoring.cycles.formats
     import authoring.cycles.segments  # noqa: F401
-    import engine.clipfile  # noqa: F401
-    import engine.io.bvh  # noqa: F401
+    import engine.clipfile
+    import engine.io.bvh
     import engine.io.retarget  # noqa: F401
 
 
-def _load(path: Path):  # type: ignore[no-untyped-def]
+def _load(path: Path) -> Performance:
     """The one place a take is read (the loader that knows every input format)."""
     from authoring.cycles.formats import load_performance
 
@@ -130,7 +136,7 @@ def kind_of(name: str, speed: float | None) -> str:
     return "walk" if speed < RUN_MIN_SPEED else "run"
 
 
-def _clip_bytes(result, perf, retarget: str | None, workdir: Path) -> tuple[str, bytes]:  # type: ignore[no-untyped-def]
+def _clip_bytes(result: CycleResult, perf: Performance, retarget: str | None, workdir: Path) -> tuple[str, bytes]:
     """The loop in the project's clip format: ``.ppclip`` for skeletal takes (retargeted if asked), else ``.npz``."""
     from authoring.cycles.formats import loop_clip, save_loop
     from engine.clipfile import save_clip
@@ -147,7 +153,7 @@ def _clip_bytes(result, perf, retarget: str | None, workdir: Path) -> tuple[str,
     return ".ppclip", save_clip(clip, workdir / "loop.ppclip").read_bytes()
 
 
-def _speed(result, perf) -> float | None:  # type: ignore[no-untyped-def]
+def _speed(result: CycleResult, perf: Performance) -> float | None:
     """Horizontal root travel per second (m/s, Y up) for skeletal takes; None for other inputs."""
     if perf.clip is None:
         return None
@@ -171,24 +177,25 @@ def process_take(task: TakeTask, options: BatchOptions) -> TakeOutcome:
         except (OSError, ValueError) as exc:  # TrajectoryError and the format errors are ValueErrors
             return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {exc}"[:500], 0, 0.0, 0,
                                time.perf_counter() - t0)
-        except Exception as exc:  # a reader bug must not stop the batch; the reason names it
+        except Exception as exc:  # noqa: BLE001 -- a reader bug must not stop the batch; the reason names it
             return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {type(exc).__name__}: {exc}"[:500],
                                0, 0.0, 0, time.perf_counter() - t0)
         traj = perf.trajectory
-        base = dict(source=task.source, digest=task.digest, frames=traj.num_samples, fps=1.0 / traj.dt, dims=traj.dims)
+
+        def outcome(kind: str, reason: str, clips: tuple[ClipOut, ...] = ()) -> TakeOutcome:
+            return TakeOutcome(task.source, task.digest, kind, reason, traj.num_samples, 1.0 / traj.dt, traj.dims,
+                               time.perf_counter() - t0, clips)
+
         if options.retarget and perf.clip is None:
-            return TakeOutcome(**base, outcome="refused", reason="--retarget puppet needs a skeletal take (BVH)",
-                               seconds=time.perf_counter() - t0)
+            return outcome("refused", "--retarget puppet needs a skeletal take (BVH)")
         try:
             clips, reason = _extract_all(perf, options, name, workdir)
-        except Exception as exc:  # an extractor or retarget bug on one take: reported, the batch goes on
-            return TakeOutcome(**base, outcome="failed", reason=f"{type(exc).__name__}: {exc}"[:500],
-                               seconds=time.perf_counter() - t0)
-    outcome = "looped" if clips else "refused"
-    return TakeOutcome(**base, outcome=outcome, reason=reason, seconds=time.perf_counter() - t0, clips=tuple(clips))
+        except Exception as exc:  # noqa: BLE001 -- an extractor or retarget bug on one take: reported, the batch goes on
+            return outcome("failed", f"{type(exc).__name__}: {exc}"[:500])
+    return outcome("looped" if clips else "refused", reason, tuple(clips))
 
 
-def _extract_all(perf, options: BatchOptions, name: str, workdir: Path) -> tuple[list[ClipOut], str]:  # type: ignore[no-untyped-def]
+def _extract_all(perf: Performance, options: BatchOptions, name: str, workdir: Path) -> tuple[list[ClipOut], str]:
     """Clips of the take (whole, or per segment) and a note: the refusal, or how many segments looped."""
     from authoring.cycles.segments import Segment, find_segments
 
@@ -208,7 +215,7 @@ def _extract_all(perf, options: BatchOptions, name: str, workdir: Path) -> tuple
     return [], refusals[0] if refusals else "no cycle"
 
 
-def _extract_segment(perf, seg, k: int, name: str, options: BatchOptions, workdir: Path,  # type: ignore[no-untyped-def]
+def _extract_segment(perf: Performance, seg: Segment, k: int, name: str, options: BatchOptions, workdir: Path,
                      refusals: list[str]) -> ClipOut | None:
     """One segment's loop as a :class:`ClipOut`, or ``None`` with its refusal appended to ``refusals``."""
     import dataclasses

@@ -32,7 +32,7 @@ from authoring.cycles.average import sample_linear
 from authoring.cycles.extract import CycleError, CycleOptions, CycleResult, extract_cycle
 from authoring.cycles.trajectory import Trajectory, TrajectoryError
 
-__all__ = ["Segment", "SegmentSettings", "find_segments", "cut", "best_segment", "looping_segments"]
+__all__ = ["Segment", "SegmentSettings", "best_segment", "cut", "find_segments", "looping_segments"]
 
 F64 = NDArray[np.float64]
 
@@ -100,7 +100,7 @@ def _features(traj: Trajectory, step: float, components: int) -> tuple[F64, F64]
     x = sample_linear(traj.times, v, t)
     x = x - x.mean(axis=0)
     if x.shape[1] > components:
-        _, s, vt = np.linalg.svd(x, full_matrices=False)
+        vt = np.linalg.svd(x, full_matrices=False)[2]
         x = x @ vt[:components].T
     return t, x
 
@@ -179,8 +179,8 @@ def find_segments(traj: Trajectory, settings: SegmentSettings | None = None) -> 
     dt = traj.dt
     step = dt * max(1, int(np.floor(1.0 / (cfg.max_rate * dt))))
     t, x = _features(traj, step, cfg.components)
-    lo = max(2, int(round(cfg.min_period / step)))
-    hi = min(int(round(cfg.max_period / step)), (len(t) - 1) // 2)
+    lo = max(2, round(cfg.min_period / step))
+    hi = min(round(cfg.max_period / step), (len(t) - 1) // 2)
     if hi <= lo + 2:
         return []
     lags = range(lo, hi + 1)
@@ -189,9 +189,9 @@ def find_segments(traj: Trajectory, settings: SegmentSettings | None = None) -> 
     raw: list[tuple[int, int, float, float]] = []
     last_start = -1
     for first, last, period in _runs(lag, cfg):
-        begin, end = first, min(len(t) - 1, last + int(round(2 * period)))
-        sc = score[first : last + 1]
-        entry = (begin, end, period, float(np.median(sc[np.isfinite(sc)])))
+        begin, end = first, min(len(t) - 1, last + round(2 * period))
+        run_scores = score[first : last + 1]
+        entry = (begin, end, period, float(np.median(run_scores[np.isfinite(run_scores)])))
         # A dropout of under half a period between two runs of one period split one activity.
         if raw and first - last_start <= 0.5 * period and abs(raw[-1][2] - period) <= cfg.same_period * period:
             a = raw[-1]

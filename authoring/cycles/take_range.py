@@ -12,17 +12,16 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
-
-from pathlib import Path
 
 from authoring.cycles.extract import CycleError, extract_cycle
 from authoring.cycles.formats import Performance, load_performance, save_loop
 from authoring.cycles.segments import Segment, best_segment, cut, looping_segments
 from authoring.cycles.trajectory import TrajectoryError
 
-__all__ = ["Bound", "parse_bound", "select", "refusal_hint", "cycle_of_take"]
+__all__ = ["Bound", "cycle_of_take", "parse_bound", "refusal_hint", "select"]
 
 
 @dataclass(frozen=True)
