@@ -134,3 +134,18 @@ def test_dask_local_cluster_of_two_workers(tmp_path: Path) -> None:
             assert _content(lib) == _content(tmp_path / "local")
     unreachable = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "x"), "--scheduler", "tcp://127.0.0.1:9")
     assert unreachable.returncode == 2 and "cannot reach the Dask scheduler" in unreachable.stderr
+
+
+def test_retarget_puppet_writes_clips_on_the_puppet_skeleton(mocap_dir: Path, tmp_path: Path) -> None:
+    from engine.clipfile import load_clip
+    from engine.humanoid import humanoid_skeleton
+
+    r = _cycles(str(mocap_dir / "cmu_16_15_walk_daz.bvh"), str(mocap_dir / "bandai1_walk_normal_001.bvh"),
+                "-o", str(tmp_path / "lib"), "--retarget", "puppet", "--jobs", "1")
+    assert r.returncode == 0, r.stderr
+    _, clips = read_index(tmp_path / "lib")
+    assert len(clips) == 2
+    for c in clips:
+        clip = load_clip(c.path)
+        assert clip.skeleton.names == humanoid_skeleton().names and clip.loop
+        assert clip.duration == pytest.approx(c.period, rel=0.02)
