@@ -87,7 +87,15 @@ def _progress(enabled: bool) -> Progress:
 def run(args: argparse.Namespace) -> int:
     """Plan, extract on the chosen scheduler, write the library, summarise."""
     from authoring.batch.index import LibraryIndex, LibraryIndexError
-    from authoring.batch.runner import Library, SourceError, collect_sources, default_jobs, plan_batch, run_tasks
+    from authoring.batch.runner import (
+        BatchError,
+        Library,
+        SourceError,
+        collect_sources,
+        default_jobs,
+        plan_batch,
+        run_tasks,
+    )
     from authoring.batch.worker import BatchOptions
     from authoring.cycles.formats import INPUT_SUFFIXES
 
@@ -98,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     libdir = Path(args.output)
     options = BatchOptions(retarget=args.retarget, segments=not args.no_segments, seed=args.seed)
     try:
-        sources = collect_sources(args.sources, INPUT_SUFFIXES)
+        sources = collect_sources(args.sources, INPUT_SUFFIXES, exclude=libdir)
         if libdir.exists() and not libdir.is_dir():
             raise SourceError(f"{libdir} is not a folder")
         libdir.mkdir(parents=True, exist_ok=True)
@@ -137,6 +145,9 @@ def run(args: argparse.Namespace) -> int:
     except SourceError as exc:
         print(f"cycles: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except BatchError as exc:
+        print(f"cycles: {exc}; the takes done so far are in {index.path}: run again to resume", file=sys.stderr)
+        return EXIT_SOME_FAILED
     finally:
         index.close()
     skipped = f"{plan.already} already done" + (f", {plan.duplicates} duplicate(s)" if plan.duplicates else "")

@@ -19,6 +19,7 @@ import multiprocessing
 import os
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from authoring.batch.index import LibraryIndex
 from authoring.batch.worker import BatchOptions, TakeOutcome, TakeTask, process_take, warm_up
 from engine.atomic import atomic_write_bytes
 
-__all__ = ["Library", "Plan", "SourceError", "collect_sources", "default_jobs", "file_hash", "licence_of", "plan_batch", "run_tasks"]
+__all__ = ["BatchError", "Library", "Plan", "SourceError", "collect_sources", "default_jobs", "file_hash", "licence_of", "plan_batch", "run_tasks"]
 
 CLIPS_DIR = "clips"
 _CHUNK = 1 << 20
@@ -40,7 +41,11 @@ KNOWN_LICENCES = (
 
 
 class SourceError(ValueError):
-    """A source argument that names nothing to read."""
+    """A source argument that names nothing to read, or a scheduler that cannot be used."""
+
+
+class BatchError(RuntimeError):
+    """The workers were lost (a process killed, a cluster gone); what was recorded stays, a rerun resumes."""
 
 
 def licence_of(path: str, given: str | None) -> str:
@@ -54,8 +59,11 @@ def licence_of(path: str, given: str | None) -> str:
     return "unknown"
 
 
-def collect_sources(args: Iterable[str], suffixes: Iterable[str]) -> list[Path]:
+def collect_sources(args: Iterable[str], suffixes: Iterable[str], exclude: Path | None = None) -> list[Path]:
     """Files, folders (searched recursively for ``suffixes``) and glob patterns, in a stable order, once each.
+
+    Files under ``exclude`` (the library being written, when it sits inside a source
+    folder) are left out: its own loops are not takes.
 
     Raises:
         SourceError: an argument that matches no readable file.
@@ -72,8 +80,11 @@ def collect_sources(args: Iterable[str], suffixes: Iterable[str]) -> list[Path]:
             found = sorted(Path(f) for f in glob.glob(arg, recursive=True) if Path(f).is_file())
             if not found:
                 raise SourceError(f"{arg}: no such file, folder, or matching file")
+        skip = exclude.resolve() if exclude is not None else None
         for f in found:
-            out.setdefault(f.resolve(), None)
+            f = f.resolve()
+            if skip is None or not f.is_relative_to(skip):
+                out.setdefault(f, None)
     return list(out)
 
 
@@ -177,7 +188,11 @@ def _pool(tasks: list[TakeTask], options: BatchOptions, jobs: int, on_start: Cal
         futures = [pool.submit(process_take, task, options) for task in tasks]
         try:
             for fut in as_completed(futures):
-                yield fut.result()
+                try:
+                    outcome = fut.result()
+                except BrokenProcessPool as exc:  # a worker was killed (out of memory, a signal)
+                    raise BatchError(f"a worker process died ({exc})") from None
+                yield outcome
         finally:
             for fut in futures:
                 fut.cancel()
@@ -217,7 +232,10 @@ def _dask(tasks: list[TakeTask], options: BatchOptions, address: str, on_start: 
             submit_next()
         try:
             for fut in running:
-                outcome = fut.result()
+                try:
+                    outcome = fut.result()
+                except Exception as exc:  # noqa: BLE001 -- process_take never raises: this is the cluster (KilledWorker…)
+                    raise BatchError(f"the cluster lost a task: {type(exc).__name__}: {exc}") from None
                 fut.release()
                 submit_next()
                 yield outcome

@@ -65,3 +65,11 @@ def test_licence_given_known_or_unknown() -> None:
     assert licence_of("/x/bandai1_walk.bvh", None).startswith("CC BY-NC")
     assert licence_of("/x/cmu_16_15.bvh", None).startswith("CMU")
     assert licence_of("/x/mine.bvh", None) == "unknown" and licence_of("/x/cmu.bvh", "CC0") == "CC0"
+
+
+def test_the_library_inside_a_source_folder_is_not_a_source(tmp_path: Path) -> None:
+    (tmp_path / "lib" / "clips").mkdir(parents=True)
+    (tmp_path / "take.npz").write_text("")
+    (tmp_path / "lib" / "clips" / "take-0.npz").write_text("")
+    assert [p.name for p in collect_sources([str(tmp_path)], (".npz",), exclude=tmp_path / "lib")] == ["take.npz"]
+    assert len(collect_sources([str(tmp_path)], (".npz",))) == 2
