@@ -26,8 +26,13 @@ def open_loop(
     units: str | None = None,
     joint_map: dict[str, str] | None = None,
     retarget: bool = False,
+    start: object = None,
+    end: object = None,
 ) -> tuple[Clip, str]:
     """The loop of a motion file and a one-line note of how it was made.
+
+    ``start``/``end`` (:class:`~authoring.cycles.take_range.Bound`) pick the part of a take
+    the loop is extracted from; a take refused there names the part that loops instead.
 
     Raises ``ValueError`` (a :class:`~engine.io.motion_file.MotionFileError`, a
     :class:`~authoring.cycles.extract.CycleError` or a trajectory error) saying why not.
@@ -42,7 +47,9 @@ def open_loop(
     if not is_seamless(clip) and motion.animation is None:
         motion = load_motion(path, units=units, joint_map=joint_map)
         clip = motion.clip
-    if clip.loop:  # a loop our glTF writer marked as one
+    if start is not None or end is not None:
+        loop, note = _loop_of_part(motion, start, end)
+    elif clip.loop:  # a loop our glTF writer marked as one
         loop, note = clip, f"{motion.source.name}: a loop of {clip.num_frames} frames"
     elif is_seamless(clip):
         n = clip.num_frames - 1
@@ -60,3 +67,20 @@ def open_loop(
         note += f", retargeted to the puppet with the {family!r} map"
     # Edit in place, as the built-in cycles are: the travel rides in root motion.
     return loop.extract_root_motion(), note
+
+
+def _loop_of_part(motion, start: object, end: object) -> tuple[Clip, str]:  # type: ignore[no-untyped-def]
+    """The loop extracted from the part ``[start, end)`` of a take (the refusal names the part that loops)."""
+    from authoring.cycles.extract import CycleError, extract_cycle
+    from authoring.cycles.formats import loop_clip, performance_from_motion
+    from authoring.cycles.take_range import refusal_hint, select
+
+    whole = performance_from_motion(motion)
+    perf, offset = select(whole, start, end)  # type: ignore[arg-type]
+    try:
+        result = extract_cycle(perf.trajectory, np.random.default_rng(0))
+    except CycleError as exc:
+        hint = refusal_hint(whole, perf, offset, 0)
+        raise ValueError(f"{exc}" + (f"; {hint}" if hint else "")) from None
+    note = f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles of the part picked"
+    return loop_clip(result, perf, name=motion.clip.name), note

@@ -15,6 +15,7 @@ BENCHES: dict[str, str] = {
     "ragdoll": "bench.ragdoll",
     "ik": "bench.ik",
     "cycles": "bench.cycles",
+    "cycles-batch": "bench.cycles_batch",
     "mocurves": "bench.mocurves",
     "input-latency": "bench.input_latency",
     "snowman": "bench.snowman",

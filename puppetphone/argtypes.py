@@ -13,7 +13,7 @@ import stat
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["port", "window_size", "int_range", "output_file", "MAX_WINDOW"]
+__all__ = ["port", "window_size", "int_range", "output_file", "take_position", "MAX_WINDOW"]
 
 # Past this a window (and its GL framebuffers) is no screen's: 8K is 7680x4320.
 MAX_WINDOW = 8192
@@ -80,3 +80,13 @@ def output_file(text: str) -> Path:
     if not stat.S_ISREG(mode):
         raise argparse.ArgumentTypeError(f"cannot write {text}: it is not a regular file (a device or a pipe)")
     return path
+
+
+def take_position(text: str) -> object:
+    """A position in a take for ``--start/--end``: seconds (``4.0``, ``4.0s``) or a frame (``480f``)."""
+    from authoring.cycles.take_range import parse_bound
+
+    try:
+        return parse_bound(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None

@@ -19,6 +19,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "author": ("puppetphone.cmd_author", "authoring scenes: record cycles by acting, edit them with MoCurves"),
     "cycle": ("puppetphone.cmd_cycle", "extract one clean loop from a performed motion"),
     "clips": ("puppetphone.cmd_clips", "the clip library games play: add (retargeted, role-checked), list, remove"),
+    "cycles": ("puppetphone.cmd_cycles", "extract every loop of a mocap library into a clip library with an index"),
     "devices": ("puppetphone.cmd_devices", "list input devices and where a phone should send"),
     "bench": ("puppetphone.cmd_bench", "run benchmarks and print figures against baselines"),
     "blendspace": ("puppetphone.cmd_blendspace", "inspect the puppet's blend space and IDW lookup"),

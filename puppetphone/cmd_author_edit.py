@@ -31,7 +31,7 @@ EDIT_GAME = "author-edit"
 
 def configure_edit(parser: argparse.ArgumentParser) -> None:
     """Add the ``author edit`` arguments."""
-    from puppetphone.argtypes import output_file
+    from puppetphone.argtypes import output_file, take_position
     from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("clip", help="a .ppclip cycle, a .bvh/.gltf/.glb motion (opened as its loop), "
@@ -40,6 +40,9 @@ def configure_edit(parser: argparse.ArgumentParser) -> None:
 
     add_motion_options(parser)
     parser.add_argument("--retarget", action="store_true", help="a BVH/glTF motion: edit it on the puppet's skeleton")
+    parser.add_argument("--start", metavar="T0", type=take_position, help="a take: extract the loop from here "
+                        "(seconds, or a frame: 480f)")
+    parser.add_argument("--end", metavar="T1", type=take_position, help="a take: ...up to here (excluded)")
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
@@ -286,10 +289,12 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
 def _motion_options(args: argparse.Namespace) -> dict[str, object]:
     from puppetphone.motion_args import motion_options
 
-    given = [f"--{k}" for k in ("animation", "units", "joint_map", "retarget") if getattr(args, k, None)]
+    given = [f"--{k}" for k in ("animation", "units", "joint_map", "retarget", "start", "end")
+             if getattr(args, k, None) is not None and getattr(args, k, None) is not False]
     if given and Path(args.clip).suffix.lower() not in (".bvh", ".gltf", ".glb"):
         raise ValueError(f"{', '.join(g.replace('_', '-') for g in given)} only apply to a BVH/glTF/GLB file")
-    return {**motion_options(args), "retarget": bool(getattr(args, "retarget", False))}
+    return {**motion_options(args), "retarget": bool(getattr(args, "retarget", False)),
+            "start": getattr(args, "start", None), "end": getattr(args, "end", None)}
 
 
 def run_edit(args: argparse.Namespace) -> int:

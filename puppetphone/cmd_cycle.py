@@ -1,4 +1,4 @@
-"""``puppetphone cycle INPUT -o OUTPUT [--json] [--plot PNG] [--items …]``: one clean loop from a performance.
+"""``puppetphone cycle INPUT -o OUTPUT [--json] [--plot PNG] [--items …] [--start T0 --end T1]``: one clean loop from a performance.
 
 Input ``.bvh`` / ``.gltf`` / ``.glb`` (``--animation``, ``--units``, ``--joint-map``) / ``.csv`` /
 ``.npz`` / ``.rec`` (a recording), output ``.bvh`` / ``.ppclip`` / ``.glb`` / ``.gltf`` (skeletal input)
@@ -10,7 +10,9 @@ or ``.csv`` / ``.npz``. With ``--json`` the last line of standard output is::
 (``input`` for BVH/glTF input: what was decided about the file).
 
 When no cycle can be found the command exits with status 3 and says why on standard
-error (and, with ``--json``, an ``{"error": …}`` line); nothing is written then.
+error (and, with ``--json``, an ``{"error": …}`` line); nothing is written then. A take
+refused as a whole is searched for a part that loops, and the message names the best
+one ("frames 0–363 loop with period 1.00 s (5 cycles); try --start 0 --end 6.07").
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     add_motion_options(parser)
     add_export_options(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON summary as the last line")
+    from puppetphone.argtypes import take_position
     from puppetphone.runargs import image_path
 
     parser.add_argument("--plot", metavar="IMAGE", type=image_path,
@@ -47,6 +50,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--retarget", choices=("puppet",), default=None,
                         help="move a BVH performance onto the puppet's skeleton first (the loop is then the puppet's)")
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+    parser.add_argument("--start", metavar="T0", type=take_position, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)")
+    parser.add_argument("--end", metavar="T1", type=take_position, help="analyse up to here (excluded): seconds or a frame")
 
 
 class _Bar:
@@ -72,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
 
     from authoring.cycles.extract import CycleError, CycleOptions, extract_cycle
     from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
+    from authoring.cycles.take_range import refusal_hint, select
     from authoring.cycles.trajectory import TrajectoryError
     from puppetphone.motion_args import export_options, motion_options
 
@@ -92,12 +98,13 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         options = motion_options(args)
-        perf = load_performance(args.input, args.items, **options)
+        whole = load_performance(args.input, args.items, **options)
         if args.retarget:
             from authoring.cycles.retarget_source import retarget_performance
             from engine.humanoid import humanoid_skeleton
 
-            perf = retarget_performance(perf, humanoid_skeleton(), options["joint_map"])
+            whole = retarget_performance(whole, humanoid_skeleton(), options["joint_map"])
+        perf, offset = select(whole, args.start, args.end) if args.start or args.end else (whole, 0)
     except FileNotFoundError as exc:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:
@@ -115,7 +122,8 @@ def run(args: argparse.Namespace) -> int:
         result = extract_cycle(traj, np.random.default_rng(args.seed), opts, progress=bar)
     except CycleError as exc:
         bar.enabled = False
-        return fail(EXIT_NO_CYCLE, str(exc))
+        hint = refusal_hint(whole, perf, offset, args.seed)
+        return fail(EXIT_NO_CYCLE, f"{exc}" + (f"; {hint}" if hint else ""))
     seconds = time.perf_counter() - t1
     try:
         save_loop(result, perf, args.output, **export_options(args))

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from authoring.cycles.trajectory import Item, Trajectory
 from engine import quat
 
-__all__ = ["Performance", "loop_error", "make_performance", "repeat_loop"]
+__all__ = ["Performance", "loop_error", "make_performance", "mixed_take", "repeat_loop"]
 
 
 @dataclass(frozen=True)
@@ -187,3 +187,27 @@ def loop_error(loop: NDArray[np.float64], truth: Callable[[NDArray[np.float64]],
     ref = truth(np.mod(base + phase, 1.0))
     scale = float(np.sqrt(np.mean((var - var.mean(axis=0)) ** 2)))
     return float(np.sqrt(np.mean((ref - loop) ** 2)) / scale), phase
+
+
+def mixed_take(
+    dims: int, rng: np.random.Generator, activities: tuple[tuple[float, int], ...] = ((1.0, 6), (1.6, 5), (0.7, 7)),
+    fps: float = 60.0, fade: float = 0.3,
+) -> tuple[Trajectory, list[Performance], NDArray[np.float64]]:
+    """One long take of several activities in a row (jumping jacks, then twists, then squats).
+
+    Each ``(period, cycles)`` is a :func:`make_performance` of its own shape; each activity
+    fades in from where the previous one ended over ``fade`` seconds, as a performer moves
+    from one to the next. Returns the take, the activities (their truths and periods) and
+    the time each activity starts, with the end time last.
+    """
+    parts = [make_performance(dims, rng, cycles=c, period=p, fps=fps) for p, c in activities]
+    blocks: list[NDArray[np.float64]] = []
+    n_fade = max(1, int(fade * fps))
+    for part in parts:
+        v = part.trajectory.values.copy()
+        if blocks:
+            w = np.linspace(0.0, 1.0, n_fade)[:, None]
+            v[:n_fade] = blocks[-1][-1] * (1.0 - w) + v[:n_fade] * w
+        blocks.append(v)
+    bounds = np.cumsum([0] + [len(b) for b in blocks]) / fps
+    return Trajectory.uniform(np.concatenate(blocks), fps), parts, bounds

@@ -20,6 +20,12 @@ MODULES = [
     "authoring.cycles.plot",
     "authoring.cycles.baseline",
     "authoring.cycles.synthetic",
+    "authoring.cycles.segments",
+    "authoring.cycles.take_range",
+    "authoring.batch",
+    "authoring.batch.index",
+    "authoring.batch.runner",
+    "authoring.batch.worker",
 ]
 
 

@@ -99,3 +99,19 @@ def read_clip_rotations(path):
     from engine.clipfile import load_clip
 
     return load_clip(path).rotations
+
+
+def test_a_take_opens_as_the_loop_of_the_part_picked(tmp_path, mocap_dir):
+    from engine.clipfile import load_clip
+    from engine.render import egl_available
+
+    if (reason := egl_available()) is not None:
+        pytest.skip(f"no headless GL: {reason}")
+    out = tmp_path / "loop.ppclip"
+    take = str(mocap_dir / "cmu_16_15_walk_daz.bvh")
+    args = parse(take, "--start", "0.1", "--end", "390f", "--headless", "--frames", "2", "--size", "160x90", "--export", str(out))
+    assert run_edit(args) == 0
+    clip = load_clip(out)
+    assert clip.loop and clip.duration == pytest.approx(1.17, rel=0.04)
+    assert run_edit(parse(take, "--start", "0", "--end", "0.5", "--headless", "--frames", "1")) == 2
+    assert run_edit(parse("walk", "--start", "0", "--headless", "--frames", "1")) == 2
