@@ -46,6 +46,24 @@ def resolve_source(source: str, game: str) -> str:
     return source
 
 
+def announce_web(hub) -> None:  # type: ignore[no-untyped-def]
+    """Print a web controller's link, fingerprint and QR code, and publish it for ``devices``."""
+    from input.web.server import WebSource
+
+    for source in hub.sources:
+        if isinstance(source, WebSource):
+            from input.pairing import qr_ascii
+            import atexit
+
+            from input.web.pairing import publish, unpublish, web_link
+
+            link = web_link(source)
+            print("\n".join(link.lines()), file=sys.stderr)
+            print(qr_ascii(link.urls[0]), file=sys.stderr)
+            publish(link)
+            atexit.register(unpublish)
+
+
 def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-untyped-def]
     """Run a game activity through the runner; ``(exit code, run result)``."""
     from engine.render.window import NoDisplayError
@@ -99,10 +117,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"--record: replacing the existing {args.record}", file=sys.stderr)
     source = resolve_source(args.source, args.game)
     try:
-        hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud)
+        hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
+                       args.web_host, args.web_port)
     except (ValueError, OSError, RecordingError) as exc:
         print(f"cannot open input {source!r}: {exc}", file=sys.stderr)
         return 2
+    announce_web(hub)
     seed, setup = args.seed, None
     if hub.replay is not None:
         recording = hub.replay.recording  # type: ignore[attr-defined]
