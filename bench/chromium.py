@@ -11,6 +11,7 @@ a closed network needs (without them it stalls on lookups) and, for these tools 
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import os
 import shutil
@@ -57,6 +58,7 @@ class Chromium:
         self.proc = subprocess.Popen([exe, *FLAGS, f"--user-data-dir={self._dir}", "about:blank"],
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         self._id = 0
+        self._stack = contextlib.ExitStack()
         self.events: list[dict[str, Any]] = []
         try:
             port = self._devtools_port(timeout)
@@ -86,7 +88,8 @@ class Chromium:
             with urlopen(f"http://127.0.0.1:{port}/json/list", timeout=5) as r:
                 pages = [t for t in json.load(r) if t.get("type") == "page"]
             if pages:
-                return connect(pages[0]["webSocketDebuggerUrl"], max_size=None, open_timeout=timeout)
+                return self._stack.enter_context(connect(pages[0]["webSocketDebuggerUrl"], max_size=None,
+                                                         open_timeout=timeout))
             time.sleep(0.1)
         raise ChromiumError("chromium has no page")
 
@@ -193,9 +196,7 @@ class Chromium:
 
     def close(self) -> None:
         """Quit the browser and remove its profile."""
-        ws = getattr(self, "_ws", None)
-        if ws is not None:
-            ws.close()
+        self._stack.close()
         if self.proc.poll() is None:
             self.proc.terminate()
             try:
