@@ -55,6 +55,10 @@ class GameActivity:
         """One simulation step."""
         self.app.step()
 
+    def input_arrivals(self) -> list[float]:
+        """When the last step's readings arrived (``time.monotonic``): the runner phase-locks steps to them."""
+        return [s.time for s in self.hub.last_frame.samples] if self.hub.replay is None else []
+
     def finished(self) -> bool:
         """A replay ends after its last recorded frame or at the first hash that differs."""
         if self.check is not None and not self.check.ok:
