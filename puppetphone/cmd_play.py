@@ -23,6 +23,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("game", help="snowman, tasbada or sandbox")
     add_source_arguments(parser)
     add_run_arguments(parser)
+    parser.add_argument("--view", choices=("orbit", "phone"), default="orbit",
+                        help="phone: see the scene from the held controller (web, OSC or SpaceMouse); V switches")
     parser.add_argument("--record", type=output_file, default=None,
                         help="record the session's input and state hashes (an existing file is replaced)")
     parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
@@ -135,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"warning: {recording.problem}", file=sys.stderr)
     try:
         activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
-                                  source_label=source)
+                                  source_label=source, view=args.view)
     except (GameOptionError, OSError) as exc:
         hub.close()
         print(f"error: {exc}", file=sys.stderr)

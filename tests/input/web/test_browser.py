@@ -66,8 +66,8 @@ def drive(browser: Chromium, url: str, shot: Path | None = None) -> None:
     browser.touch("touch", "touchEnd")  # drop
 
 
-def replay_in_process(rec: Path) -> tuple[int, float, set[str]]:
-    """Frames in which the puppet was held, how far it went meanwhile, and the recorded sources."""
+def replay_in_process(rec: Path) -> tuple[list[int], float, set[str]]:
+    """The frames in which the puppet was held, how far it went meanwhile, and the recorded sources."""
     from engine.components import Stick, Transform
     from input.recording import read_recording
     from input.replay import replay_hub
@@ -77,14 +77,15 @@ def replay_in_process(rec: Path) -> tuple[int, float, set[str]]:
     game = load_game(recording.header.game)
     hub = replay_hub(recording)
     app = make_app(recording.header.game, recording.header.seed, hub, game.replay_setup(recording.header.setup))
-    held, start, far, sources = 0, None, 0.0, set()
+    held: list[int] = []
+    start, far, sources = None, 0.0, set()
     for _ in range(len(recording.frames)):
         app.step()
         frame = hub.last_frame
         sources.update(s.source for s in frame.samples)
         stick = app.world.query(Stick)[0][1]
         if stick.grabbed is not None:
-            held += 1
+            held.append(app.world.frame)
             pos = app.world.get(stick.grabbed, Transform).position
             start = pos.copy() if start is None else start
             far = max(far, float(np.linalg.norm((pos - start)[[0, 2]])))
@@ -93,7 +94,7 @@ def replay_in_process(rec: Path) -> tuple[int, float, set[str]]:
 
 def test_chromium_grabs_and_moves_the_puppet_and_the_session_replays(tmp_path):
     rec = tmp_path / "web.rec"
-    play, url = start_play(tmp_path, 1500, "--record", str(rec))
+    play, url = start_play(tmp_path, 1200, "--record", str(rec))
     try:
         with Chromium() as browser:
             drive(browser, url, tmp_path / "page.png")
@@ -106,9 +107,19 @@ def test_chromium_grabs_and_moves_the_puppet_and_the_session_replays(tmp_path):
     assert (tmp_path / "page.png").stat().st_size > 1000
     held, far, sources = replay_in_process(rec)
     assert sources == {"web:1"}
-    assert held > 60, f"the puppet was held for {held} steps only"
+    assert len(held) > 60, f"the puppet was held for {len(held)} steps only"
     assert far > 0.3, f"the held puppet moved {far:.2f} m only"
-    replay = subprocess.run(["puppetphone", "replay", str(rec), "--verify", "--headless"], capture_output=True,
-                            text=True, timeout=120, env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
-    assert replay.returncode == 0, replay.stderr
-    assert "state hashes match" in replay.stdout
+    # The replay reproduces the session, seen from the phone and from the orbit camera while held.
+    shots = {}
+    for view in ("phone", "orbit"):
+        shots[view] = tmp_path / f"{view}.png"
+        replay = subprocess.run(["puppetphone", "replay", str(rec), "--verify", "--headless", "--view", view,
+                                 "--screenshot", str(shots[view]), "--screenshot-at", str(held[len(held) // 2])],
+                                capture_output=True, text=True, timeout=120,
+                                env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
+        assert replay.returncode == 0, replay.stderr
+        assert "state hashes match" in replay.stdout
+    from PIL import Image
+
+    phone, orbit = (np.asarray(Image.open(shots[v]).convert("L"), dtype=float) for v in ("phone", "orbit"))
+    assert np.mean(np.abs(phone - orbit)) > 5.0, "the phone view looks like the orbit view"
