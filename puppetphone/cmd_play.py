@@ -54,9 +54,9 @@ def announce_web(hub) -> None:  # type: ignore[no-untyped-def]
 
     for source in hub.sources:
         if isinstance(source, WebSource):
-            from input.pairing import qr_ascii
             import atexit
 
+            from input.pairing import qr_ascii
             from input.web.pairing import publish, unpublish, web_link
 
             link = web_link(source)

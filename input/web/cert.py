@@ -69,7 +69,7 @@ def _usable(cert_path: Path, key_path: Path) -> bytes | None:
         serialization.load_pem_private_key(key_path.read_bytes(), password=None)
     except (OSError, ValueError, TypeError):
         return None
-    if cert.not_valid_after_utc <= _dt.datetime.now(_dt.timezone.utc) + _dt.timedelta(days=1):
+    if cert.not_valid_after_utc <= _dt.datetime.now(_dt.UTC) + _dt.timedelta(days=1):
         return None
     return cert.public_bytes(serialization.Encoding.DER)
 
@@ -92,7 +92,7 @@ def _create(addresses: list[str]) -> tuple[bytes, bytes, bytes]:
             continue
         if x509.IPAddress(ip) not in alt:
             alt.append(x509.IPAddress(ip))
-    now = _dt.datetime.now(_dt.timezone.utc)
+    now = _dt.datetime.now(_dt.UTC)
     cert = (x509.CertificateBuilder().subject_name(name).issuer_name(name).public_key(key.public_key())
             .serial_number(x509.random_serial_number())
             .not_valid_before(now - _dt.timedelta(minutes=5)).not_valid_after(now + _dt.timedelta(days=VALID_DAYS))

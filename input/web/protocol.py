@@ -23,8 +23,9 @@ Z-X'-Y'' rotation of the W3C spec, device → Earth (X east, Y north, Z up), so 
 attitude is ``Rz(alpha)·Rx(beta)·Ry(gamma)`` and :func:`input.phone_frames.phone_to_stick`
 makes it a stick (out of the phone's top edge). A WebXR viewer is oriented like an
 ARKit camera (:func:`input.phone_frames.arkit_to_stick`). The crouch slider lowers the
-stick's pivot by up to :data:`CROUCH_DEPTH` metres, as lowering the phone would; the
-jump button is a flick.
+stick's pivot by up to :data:`CROUCH_DEPTH` metres, as lowering the phone would (the
+page moves it at 1.5 of its range per second at most, so raising the slider is never as
+fast as a flick); the jump button is a flick.
 """
 
 from __future__ import annotations
@@ -133,7 +134,7 @@ def parse_message(text: str | bytes) -> ControllerMessage | Ping:
         return Ping(_number(msg["ping"], "ping", 1e16))
     unknown = set(msg) - _KEYS
     if unknown:
-        raise WebMessageError(f"unknown field {sorted(unknown)[0][:20]!r}")
+        raise WebMessageError(f"unknown field {min(unknown)[:20]!r}")
     seq = msg.get("seq")
     if isinstance(seq, bool) or not isinstance(seq, int) or not 0 <= seq < 2**53:
         raise WebMessageError("seq must be a whole number")

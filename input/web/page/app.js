@@ -80,6 +80,9 @@ function onMotion(e) {
   if (a && a.x !== null) state.acc = [a.x, a.y, a.z];
   const r = e.rotationRate;
   if (r && r.alpha !== null) state.rot = [r.alpha, r.beta, r.gamma];
+  // Readings go out on orientation events (motion values ride along); a phone without an
+  // orientation sensor still streams its acceleration at the motion sensor's rate.
+  if (state.sensor === "none" && state.acc) sendReading();
 }
 
 async function enableSensors() {
@@ -131,7 +134,18 @@ press($("touch"), () => { state.touch = true; $("touch").classList.add("down"); 
   () => { if (!state.touch) return; state.touch = false; $("touch").classList.remove("down"); sendReading(); });
 press($("jump"), () => { state.jump = true; $("jump").classList.add("down"); sendReading(); },
   () => $("jump").classList.remove("down"));
-$("crouch").addEventListener("input", (e) => { state.crouch = Number(e.target.value); sendReading(); });
+// The slider's value is approached at CROUCH_SPEED per second: the crouch lowers the stick, and a
+// slider pushed back up at once would lift it faster than a flick, which means "jump".
+const CROUCH_SPEED = 1.5;
+let crouchTarget = 0;
+$("crouch").addEventListener("input", (e) => { crouchTarget = Number(e.target.value); });
+setInterval(() => {
+  if (state.crouch === crouchTarget) return;
+  const step = CROUCH_SPEED / 60;
+  state.crouch = Math.abs(crouchTarget - state.crouch) <= step ? crouchTarget
+    : state.crouch + Math.sign(crouchTarget - state.crouch) * step;
+  sendReading();
+}, 1000 / 60);
 $("calibrate").addEventListener("click", () => { state.cal = true; sendReading(); });
 $("enable").addEventListener("click", enableSensors);
 $("xr").addEventListener("click", () => startXR().catch((err) => { $("status").textContent = "AR: " + err; }));

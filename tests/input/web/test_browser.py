@@ -12,7 +12,6 @@ from __future__ import annotations
 import os
 import re
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -98,7 +97,7 @@ def test_chromium_grabs_and_moves_the_puppet_and_the_session_replays(tmp_path):
     try:
         with Chromium() as browser:
             drive(browser, url, tmp_path / "page.png")
-        out, err = play.communicate(timeout=120)
+        _, err = play.communicate(timeout=120)
     finally:
         if play.poll() is None:
             play.kill()

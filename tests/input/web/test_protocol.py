@@ -11,8 +11,16 @@ from hypothesis import strategies as st
 
 from engine import quat
 from input.sample import PoseSample, check_sample_ranges
-from input.web.protocol import (CROUCH_DEPTH, MAX_MESSAGE_BYTES, ControllerMessage, Ping, WebMessageError,
-                                orientation_to_quat, parse_message, to_sample_fields)
+from input.web.protocol import (
+    CROUCH_DEPTH,
+    MAX_MESSAGE_BYTES,
+    ControllerMessage,
+    Ping,
+    WebMessageError,
+    orientation_to_quat,
+    parse_message,
+    to_sample_fields,
+)
 
 READING = {"seq": 3, "t": 1.7e12, "kind": "orientation", "o": [0.0, 0.0, 0.0], "touch": True}
 FORWARD = np.array([0.0, 0.0, 1.0])
