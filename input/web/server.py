@@ -14,8 +14,8 @@ Safety on a LAN:
   another phone is told every puppet is taken (``{"taken": true}``) and closed;
 - every message passes :func:`input.web.protocol.parse_message`; malformed ones, and
   readings beyond ``max_rate`` per second per connection (a token bucket), are counted
-  with their reason and dropped, never raised. Messages over 64 KiB close the
-  connection in the WebSocket layer before they are read.
+  with their reason and dropped, never raised. A message over 64 KiB closes the
+  connection in the WebSocket layer before it is read (counted as "message too big").
 
 :attr:`WebSource.page_times` remembers, for the latest readings, the page's clock at
 the sensor event, keyed by the sample's receive time: the latency bench reads it.
@@ -33,6 +33,9 @@ from collections import OrderedDict
 from importlib import resources
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
+
+from websockets.exceptions import ConnectionClosed
+from websockets.frames import CloseCode
 
 from input.source import PoseSource
 from input.web.cert import WebCertificate, load_or_create
@@ -162,9 +165,11 @@ class WebSource(PoseSource):
                 reply = self._handle(message, controller, bucket, time.monotonic())
                 if reply is not None:
                     await ws.send(reply)
+        except ConnectionClosed as exc:
+            if exc.sent is not None and exc.sent.code == CloseCode.MESSAGE_TOO_BIG:
+                self.drop("message too big", controller)
         except Exception as exc:  # a broken connection ends this controller, never the server
-            if not type(exc).__name__.startswith("ConnectionClosed"):
-                self.error(f"{controller}: {type(exc).__name__}: {exc}")
+            self.error(f"{controller}: {type(exc).__name__}: {exc}")
         finally:
             del self._slots[slot]
             self.disconnected(controller)

@@ -123,3 +123,28 @@ def test_malformed_and_flooding_messages_are_counted_and_dropped(source):
     assert status.drop_reasons["rate limit"] >= 250
     queued = [s for s in source.drain() if isinstance(s, PoseSample)]
     assert 90 <= len(queued) <= 150
+    with _ws(source) as phone:  # a huge message ends that connection, and only that
+        phone.recv(timeout=5)
+        phone.send("x" * 100_000)
+        with pytest.raises(ConnectionClosed):
+            phone.recv(timeout=5)
+    _wait(lambda: source.status().drop_reasons.get("message too big") == 1)
+    with _ws(source) as phone:
+        assert json.loads(phone.recv(timeout=5)) == {"hello": "web:1"}
+
+
+def test_the_link_names_lan_addresses_when_bound_to_all(certificate):
+    from input.pairing import lan_addresses
+    from input.web.pairing import web_link
+
+    src = WebSource(host="0.0.0.0", port=0, certificate=certificate)
+    try:
+        link = web_link(src)
+    finally:
+        src.stop()
+    lan = lan_addresses()
+    if not lan:
+        pytest.skip("this machine has no LAN address")
+    assert link.urls == [f"https://{a}:{src.port}/?t={src.token}" for a in lan]
+    assert not link.loopback_only and "--web-host 0.0.0.0" not in "\n".join(link.lines())
+    assert link.fingerprint == certificate.fingerprint
