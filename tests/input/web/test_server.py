@@ -115,7 +115,8 @@ def test_malformed_and_flooding_messages_are_counted_and_dropped(source):
         phone.send(json.dumps({**READING, "o": [0, float("inf"), 0]}).replace("Infinity", "1e999"))
         for i in range(400):  # far past the 100/s bucket
             phone.send(json.dumps({**READING, "seq": i}))
-        time.sleep(0.1)  # the bucket refills a little: the next message is read
+        _wait(lambda: source.status().packets + source.status().drop_reasons.get("rate limit", 0) == 400)
+        time.sleep(0.1)  # every reading is handled; the bucket refills a little: the ping is read
         phone.send(json.dumps({"ping": 1.0}))
         phone.recv(timeout=5)  # the connection is alive and answers
     status = source.status()
