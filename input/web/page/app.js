@@ -54,6 +54,7 @@ function connect() {
       setState("connected: " + msg.hello + " drives the puppet", "on");
     } else if (msg.taken) {
       state.taken = true;
+      $("start").hidden = true;
       $("taken").hidden = false;
       setState("every puppet is taken", "off");
     }
