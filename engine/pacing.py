@@ -61,34 +61,44 @@ class RealTimePacer:
 
 
 class PhaseLock:
-    """How far to move the step schedule so readings wait ``margin`` seconds for their step.
+    """How far to move the step schedule so readings wait :attr:`target` seconds for their step.
 
     Each step, :meth:`error` takes the arrival times of the readings the step drained and
-    the time it drained them; the newest reading's wait, minus ``margin``, wrapped into
-    half a step either way (a reading that just missed the previous step waited almost a
-    whole one: the schedule is *late* by a little, not early by a lot), is the phase
-    error. :meth:`correction` is a bounded fraction of it, to subtract from the schedule.
+    the time it drained them; the newest reading's wait, minus the target wait, wrapped
+    into half a step either way (a reading that just missed the previous step waited
+    almost a whole one: the schedule is *late* by a little, not early by a lot), is the
+    phase error. :meth:`correction` is a bounded fraction of it, to subtract from the
+    schedule. The target is ``margin``, widened to three times the readings' jitter (the
+    running mean of the error's size) when they arrive irregularly, as on a busy machine:
+    a reading that misses its step waits a whole step more.
 
     Args:
         dt: the fixed step.
-        margin: the wait to aim at, slack for the readings' jitter.
+        margin: the smallest wait to aim at.
         gain: fraction of the error corrected per step.
         max_step: largest correction per step, in seconds.
     """
 
-    def __init__(self, dt: float, margin: float = 0.005, gain: float = 0.2, max_step: float = 0.0005) -> None:
+    def __init__(self, dt: float, margin: float = 0.004, gain: float = 0.2, max_step: float = 0.0005) -> None:
         self.dt, self.margin, self.gain, self.max_step = dt, margin, gain, max_step
+        self.jitter = 0.0
+
+    @property
+    def target(self) -> float:
+        """The wait aimed at: ``margin``, or more for jittery readings (at most 60 % of a step)."""
+        return min(0.6 * self.dt, max(self.margin, 3.0 * self.jitter))
 
     def error(self, arrivals: list[float], drained_at: float) -> float | None:
         """The phase error in seconds (positive: steps come too late), or ``None`` without readings."""
         if not arrivals:
             return None
         waited = drained_at - max(arrivals)
-        return (waited - self.margin + self.dt / 2) % self.dt - self.dt / 2
+        return (waited - self.target + self.dt / 2) % self.dt - self.dt / 2
 
     def correction(self, arrivals: list[float], drained_at: float) -> float:
-        """Seconds to bring the schedule forward (negative: to hold it back)."""
+        """Seconds to bring the schedule forward (negative: to hold it back); updates the jitter."""
         e = self.error(arrivals, drained_at)
         if e is None:
             return 0.0
+        self.jitter += 0.05 * (abs(e) - self.jitter)
         return max(-self.max_step, min(self.max_step, self.gain * e))
