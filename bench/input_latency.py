@@ -70,11 +70,24 @@ def measure(steps: int = 240, dt: float = 1.0 / 60.0) -> np.ndarray:
 
 
 def run() -> list[Figure]:
-    """``osc_latency_p50_ms`` and ``osc_latency_p99_ms`` against one 60 Hz step."""
+    """``osc_latency_p50_ms`` and ``osc_latency_p99_ms`` against one 60 Hz step; the web controller's
+    ``web_latency_p50_ms`` and ``web_latency_p99_ms`` (:mod:`bench.web_latency`) when Chromium is there."""
+    from bench.chromium import find_chromium
+    from bench.web_latency import measure as measure_web
+
     lat = measure() * 1000.0
     step_ms = 1000.0 / 60.0
-    return [
+    figures = [
         Figure("input-latency", "osc_latency_p50_ms", float(np.percentile(lat, 50)), "ms", "one step", step_ms),
         Figure("input-latency", "osc_latency_p99_ms", float(np.percentile(lat, 99)), "ms", "one step", step_ms),
         Figure("input-latency", "osc_packets_applied", float(len(lat)), "count"),
+    ]
+    if find_chromium() is None:
+        print("input-latency: no chromium (apt-get install chromium): the web controller figures are left out")
+        return figures
+    web = measure_web() * 1000.0
+    return figures + [
+        Figure("input-latency", "web_latency_p50_ms", float(np.percentile(web, 50)), "ms", "one step", step_ms),
+        Figure("input-latency", "web_latency_p99_ms", float(np.percentile(web, 99)), "ms", "one step", step_ms),
+        Figure("input-latency", "web_readings_applied", float(len(web)), "count"),
     ]

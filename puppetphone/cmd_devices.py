@@ -1,4 +1,9 @@
-"""``puppetphone devices``: what is connected, where a phone should send, and a QR code."""
+"""``puppetphone devices``: what is connected, where a phone should send, and a QR code.
+
+The web controller's link carries a session token made by each ``play --source web``,
+so its QR code is shown while such a session runs (it publishes its link); otherwise
+the command to start one.
+"""
 
 from __future__ import annotations
 
@@ -28,4 +33,22 @@ def run(args: argparse.Namespace) -> int:
     if info.urls and not args.no_qr:
         print(f"\nScan to pair ({info.urls[0]}):")
         print(qr_ascii(info.urls[0]))
+    _web(args.no_qr)
     return 0
+
+
+def _web(no_qr: bool) -> None:
+    """The running web controller session's link and QR code, or how to start one."""
+    from input.pairing import qr_ascii
+    from input.web.pairing import running_session
+
+    link = running_session()
+    if link is None:
+        print("\nPhone (web browser, no app): no session is running; start one with\n"
+              "  puppetphone play snowman --source web --web-host 0.0.0.0\n"
+              "(it prints the link, its QR code and the certificate fingerprint; run devices again to see them here)")
+        return
+    print("\n" + "\n".join(link.lines()))
+    if not no_qr:
+        print(f"\nScan with the phone's camera ({link.urls[0]}):")
+        print(qr_ascii(link.urls[0]))

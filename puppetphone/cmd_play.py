@@ -23,6 +23,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("game", help="snowman, tasbada or sandbox")
     add_source_arguments(parser)
     add_run_arguments(parser)
+    parser.add_argument("--view", choices=("orbit", "phone"), default="orbit",
+                        help="phone: see the scene from the held controller (web, OSC or SpaceMouse); V switches")
     parser.add_argument("--record", type=output_file, default=None,
                         help="record the session's input and state hashes (an existing file is replaced)")
     parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
@@ -47,6 +49,24 @@ def resolve_source(source: str, game: str) -> str:
         demo = Path(__import__(f"games.{load_game(game).name}", fromlist=["x"]).__file__).parent / "demo.rec"
         return f"replay:{demo}"
     return source
+
+
+def announce_web(hub) -> None:  # type: ignore[no-untyped-def]
+    """Print a web controller's link, fingerprint and QR code, and publish it for ``devices``."""
+    from input.web.server import WebSource
+
+    for source in hub.sources:
+        if isinstance(source, WebSource):
+            import atexit
+
+            from input.pairing import qr_ascii
+            from input.web.pairing import publish, unpublish, web_link
+
+            link = web_link(source)
+            print("\n".join(link.lines()), file=sys.stderr)
+            print(qr_ascii(link.urls[0]), file=sys.stderr)
+            publish(link)
+            atexit.register(unpublish)
 
 
 def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-untyped-def]
@@ -102,10 +122,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"--record: replacing the existing {args.record}", file=sys.stderr)
     source = resolve_source(args.source, args.game)
     try:
-        hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud)
+        hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
+                       args.web_host, args.web_port)
     except (ValueError, OSError, RecordingError) as exc:
         print(f"cannot open input {source!r}: {exc}", file=sys.stderr)
         return 2
+    announce_web(hub)
     seed, setup = args.seed, None
     if hub.replay is not None:
         recording = hub.replay.recording  # type: ignore[attr-defined]
@@ -121,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
 
         clips = library_setup(args.clips, replay=hub.replay is not None)
         activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
-                                  source_label=source, clips=clips)
+                                  source_label=source, clips=clips, view=args.view)
     except (GameOptionError, OSError, ValueError) as exc:
         hub.close()
         print(f"error: {exc}", file=sys.stderr)

@@ -31,6 +31,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--allow-truncated", action="store_true",
                         help="a recording cut short (killed mid-write) replays its complete frames with exit 0")
     add_run_arguments(parser, screenshot_at=True)
+    parser.add_argument("--view", choices=("orbit", "phone"), default="orbit",
+                        help="phone: see the scene from the recorded controller; V switches")
     parser.epilog = "exit codes: 0 replayed and matched; 1 a hash differs or the file is damaged/cut; 2 cannot replay"
 
 
@@ -66,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         game = load_game(h.game)
         activity = build_activity(h.game, h.seed, InputHub(replay=ReplaySource(rec)), setup=game.replay_setup(h.setup),
-                                  verify=rec)
+                                  verify=rec, view=args.view)
     except (GameOptionError, ValueError, KeyError, OSError) as exc:
         print(f"error: cannot rebuild the recorded {h.game!r} session: {exc}", file=sys.stderr)
         return 2

@@ -4,7 +4,8 @@
 one step is ``App.step``; drawing is the game's view plus the overlay; its event layer
 feeds the mouse source, orbits the camera (right-drag) and turns R / F5 / F9 into
 recorded input commands (reset, save, restore), so replays repeat them; H or F1 hides
-and shows the help.
+and shows the help; V switches between the orbit camera and the view from the held
+controller (``--view phone``: :func:`input.controller_view.controller_camera`).
 
 A replay is the same activity built from a recording's header (game, seed, setup) with
 a replay hub; :class:`input.replay.HashCheck` compares every step's state hash with the recorded one
@@ -18,10 +19,11 @@ from pathlib import Path
 from typing import Any
 
 from engine.app import App
-from engine.camera import OrbitCamera
+from engine.camera import Camera, OrbitCamera
 from engine.render.scene import RenderScene
 from engine.runner import Runner
 from games.base import Game
+from input.controller_view import controller_camera
 from input.hub import InputHub
 from input.recording import Recorder, Recording, RecordingHeader
 from input.replay import HashCheck
@@ -39,12 +41,22 @@ class GameActivity:
     game: Game
     app: App
     hub: InputHub
-    camera: OrbitCamera
+    orbit: OrbitCamera
     recorder: Recorder | None = None
     check: HashCheck | None = None
     runner: Runner | None = None
     overlay: OverlayState = field(default_factory=OverlayState)
+    view: str = "orbit"
     _orbiting: bool = field(default=False, repr=False)
+
+    @property
+    def camera(self) -> Camera:
+        """The camera drawn with: the held controller's view in ``phone`` view (while one drives), else the orbit."""
+        if self.view == "phone":
+            phone = controller_camera(self.app.world)
+            if phone is not None:
+                return phone
+        return self.orbit
 
     @property
     def dt(self) -> float:
@@ -54,6 +66,10 @@ class GameActivity:
     def step(self) -> None:
         """One simulation step."""
         self.app.step()
+
+    def input_arrivals(self) -> list[float]:
+        """When the last step's readings arrived (``time.monotonic``): the runner phase-locks steps to them."""
+        return [s.time for s in self.hub.last_frame.samples] if self.hub.replay is None else []
 
     def finished(self) -> bool:
         """A replay ends after its last recorded frame or at the first hash that differs."""
@@ -79,12 +95,15 @@ class GameActivity:
         if event.type == pygame.KEYDOWN and event.key in (pygame.K_h, pygame.K_F1):
             self.overlay.toggle_help()
             return True
+        if event.type == pygame.KEYDOWN and event.key == pygame.K_v:
+            self.view = "orbit" if self.view == "phone" else "phone"
+            return True
         if event.type == pygame.MOUSEBUTTONDOWN and event.button == 3:
             self._orbiting = True
         elif event.type == pygame.MOUSEBUTTONUP and event.button == 3:
             self._orbiting = False
         elif event.type == pygame.MOUSEMOTION and self._orbiting:
-            self.camera.orbit(-0.005 * event.rel[0], -0.005 * event.rel[1])
+            self.orbit.orbit(-0.005 * event.rel[0], -0.005 * event.rel[1])
         for source in self.hub.sources:
             handle = getattr(source, "handle_event", None)
             if handle is not None:
@@ -100,7 +119,8 @@ class GameActivity:
 
 def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str, Any] | None = None,
                    options: dict[str, str] | None = None, record: Path | None = None, source_label: str = "",
-                   verify: Recording | None = None, clips: dict[str, Any] | None = None) -> GameActivity:
+                   verify: Recording | None = None, clips: dict[str, Any] | None = None,
+                   view: str = "orbit") -> GameActivity:
     """The session of ``game_name``.
 
     Args:
@@ -109,6 +129,7 @@ def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str,
         record: write the session (its setup in the header) to this file.
         verify: compare every step's state hash with this recording's.
         clips: the authored clips to play (``engine.cliplib.embed``), over any in the setup.
+        view: ``orbit`` or ``phone`` (the held controller's view; V switches).
     """
     game = load_game(game_name)
     if setup is None:
@@ -124,4 +145,4 @@ def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str,
     if verify is not None:
         check = HashCheck(verify)
         app.on_step_end.append(check)
-    return GameActivity(game, app, hub, game.camera(), recorder, check)
+    return GameActivity(game, app, hub, game.camera(), recorder, check, view=view)

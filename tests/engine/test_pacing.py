@@ -33,3 +33,33 @@ def test_paces_to_real_time_and_skips_ahead_after_a_stall():
 def test_rejects_bad_dt():
     with pytest.raises(ValueError):
         RealTimePacer(0.0)
+
+
+def test_phase_lock_brings_steps_to_just_after_the_readings():
+    from engine.pacing import PhaseLock
+
+    dt = 1 / 60
+    c = FakeClock()
+    pacer = RealTimePacer(dt, clock=c, sleep=c.sleep)
+    lock = PhaseLock(dt, margin=0.005)
+    phase = 0.0123  # readings arrive 12.3 ms into every step period: 4.4 ms before the next drain
+    waits = []
+    for n in range(200):
+        pacer.wait()
+        drained = c.t
+        period = (drained - 100.0) // dt  # the newest reading is the one of the period just before
+        arrival = 100.0 + period * dt + phase
+        arrival -= dt if arrival > drained else 0.0
+        waits.append(drained - arrival)
+        pacer.shift(lock.correction([arrival], drained))
+    assert abs(waits[3] - (dt - phase)) < 2e-3  # at first: the fixed, arbitrary phase
+    assert all(abs(w - 0.005) < 1e-4 for w in waits[-50:])  # then: 5 ms after each reading
+    assert lock.correction([], 0.0) == 0.0
+
+
+def test_phase_lock_holds_back_after_a_reading_just_missed_its_step():
+    from engine.pacing import PhaseLock
+
+    lock = PhaseLock(1 / 60, margin=0.005, gain=1.0, max_step=1.0)
+    assert lock.error([0.0], 0.016) == pytest.approx(-1 / 60 + 0.011)  # it just missed the step before: hold back
+    assert lock.correction([0.0], 0.009) == pytest.approx(0.004)  # waited 9 ms: 4 ms earlier

@@ -57,3 +57,37 @@ def test_the_play_command_devices_prints_listens_where_the_qr_code_points(tmp_pa
     assert game.returncode == 0, err
     frames = read_recording(tmp_path / "paired.rec").frames
     assert sum(len(f.samples) for f in frames) >= 10, "the phone's packets never reached the game"
+
+
+def test_devices_shows_the_running_web_session_with_its_qr_code(tmp_path):
+    """``play --source web`` publishes its link; ``devices`` in another terminal shows it, then forgets it."""
+    import os
+    import re
+    import subprocess
+    import sys
+
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path)}
+    idle = subprocess.run([sys.executable, "-m", "puppetphone", "devices", "--no-qr"], capture_output=True, text=True, env=env, timeout=60)
+    assert "no session is running" in idle.stdout and "--source web --web-host 0.0.0.0" in idle.stdout
+    game = subprocess.Popen([sys.executable, "-m", "puppetphone", "play", "sandbox", "--source", "web", "--web-port", "0", "--headless",
+                             "--frames", "600"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        assert game.stderr is not None
+        printed = ""
+        while "certificate SHA-256" not in printed:
+            line = game.stderr.readline()
+            assert line, "play ended without printing its link"
+            printed += line
+        url = re.search(r"https://\S+", printed).group(0)
+        shown = subprocess.run([sys.executable, "-m", "puppetphone", "devices"], capture_output=True, text=True, env=env, timeout=60).stdout
+        assert url in shown and "Scan with the phone's camera" in shown and "█" in shown
+        assert re.search(r"certificate SHA-256: ([0-9A-F]{2}:){31}[0-9A-F]{2}", shown)
+        assert "this machine only; a phone on the LAN needs --web-host 0.0.0.0" in shown
+        game.communicate(timeout=60)
+    finally:
+        if game.poll() is None:
+            game.kill()
+        game.communicate()
+    assert game.returncode == 0
+    after = subprocess.run([sys.executable, "-m", "puppetphone", "devices", "--no-qr"], capture_output=True, text=True, env=env, timeout=60)
+    assert "no session is running" in after.stdout

@@ -1,0 +1,200 @@
+"""The web controller source: an HTTPS server for the page and a WebSocket for its readings.
+
+``--source web`` starts it. One device thread runs an asyncio loop (``websockets``)
+that only fills the source's queue, like every other device thread; the hub drains it
+once per step, so web readings are recorded and replayed like any source's.
+
+Safety on a LAN:
+
+- binds ``127.0.0.1`` unless told ``0.0.0.0`` (``--web-host``), like OSC;
+- a session token (random, new every start) is part of the URL the QR code carries;
+  the page and the WebSocket answer 403 without it, so someone else on the Wi-Fi
+  cannot drive the game;
+- one controller per puppet: ``max_controllers`` connections hold slots ``web:1`` …;
+  another phone is told every puppet is taken (``{"taken": true}``) and closed;
+- every message passes :func:`input.web.protocol.parse_message`; malformed ones, and
+  readings beyond ``max_rate`` per second per connection (a token bucket), are counted
+  with their reason and dropped, never raised. A message over 64 KiB closes the
+  connection in the WebSocket layer before it is read (counted as "message too big").
+
+:attr:`WebSource.page_times` remembers, for the latest readings, the page's clock at
+the sensor event, keyed by the sample's receive time: the latency bench reads it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import json
+import secrets
+import socket
+import time
+from collections import OrderedDict
+from importlib import resources
+from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+from websockets.exceptions import ConnectionClosed
+from websockets.frames import CloseCode
+
+from input.source import PoseSource
+from input.web.cert import WebCertificate, load_or_create
+from input.web.protocol import ControllerMessage, Ping, WebMessageError, parse_message, to_sample_fields
+
+__all__ = ["WebSource", "DEFAULT_WEB_PORT", "PAGE_FILES"]
+
+DEFAULT_WEB_PORT = 8443
+#: The page's files and their content types (served from the package, no build step).
+PAGE_FILES = {"/": ("index.html", "text/html; charset=utf-8"), "/index.html": ("index.html", "text/html; charset=utf-8"),
+              "/app.js": ("app.js", "text/javascript; charset=utf-8"), "/style.css": ("style.css", "text/css; charset=utf-8")}
+_TOKEN_PAGES = {"/", "/index.html", "/ws"}
+_FRAME_LIMIT = 64 * 1024  # bytes: a larger WebSocket message closes the connection unread
+
+
+def _page(name: str) -> bytes:
+    return resources.files("input.web").joinpath("page", name).read_bytes()
+
+
+class WebSource(PoseSource):
+    """Phones' browsers as MotionSticks (see the module docstring).
+
+    Args:
+        host: bind address (``0.0.0.0`` for phones on the LAN).
+        port: TCP port; 0 picks a free one (read :attr:`port`).
+        max_controllers: phones that may hold a puppet at once.
+        max_rate: readings per second accepted per connection (a burst of one second).
+        certificate: the TLS certificate (default: the user's, made on first use).
+        token: the session token (default: a new random one).
+
+    Raises:
+        ValueError: ``max_controllers`` below 1 or a port outside 0..65535.
+        OSError: the port cannot be bound or the certificate folder cannot be written.
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_WEB_PORT, max_controllers: int = 1,
+                 max_rate: float = 240.0, certificate: WebCertificate | None = None, token: str | None = None,
+                 capacity: int = 256) -> None:
+        if max_controllers < 1:
+            raise ValueError(f"max_controllers must be at least 1, not {max_controllers}")
+        if not 0 <= port <= 65535:
+            raise ValueError(f"web port must be 0..65535, not {port}")
+        super().__init__(f"web {host}:{port}", capacity)
+        from input.pairing import lan_addresses
+
+        self.host = host
+        self.max_controllers = max_controllers
+        self.max_rate = max_rate
+        self.certificate = certificate or load_or_create(lan_addresses())
+        self.token = token or secrets.token_urlsafe(16)
+        self._sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self._sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            self._sock.bind((host, port))
+            self._sock.listen(16)
+        except OSError:
+            self._sock.close()
+            raise
+        self._sock.setblocking(False)
+        self.port: int = self._sock.getsockname()[1]
+        self.name = self._status.name = f"web {host}:{self.port}"
+        self._slots: dict[int, Any] = {}
+        self.page_times: OrderedDict[float, float] = OrderedDict()
+        self.refused = 0
+
+    def url(self, address: str | None = None) -> str:
+        """The controller page's address with the session token (what the QR code carries)."""
+        return f"https://{address or self.host}:{self.port}/?t={self.token}"
+
+    def stop(self, timeout: float = 2.0) -> None:
+        """Stop the server thread and close the listening socket."""
+        super().stop(timeout)
+        self._sock.close()
+
+    # -- the server thread -------------------------------------------------------------
+    def _run(self) -> None:
+        asyncio.run(self._serve())
+
+    async def _serve(self) -> None:
+        from websockets.asyncio.server import serve
+
+        async with serve(self._connection, sock=self._sock, ssl=self.certificate.ssl_context(),
+                         process_request=self._http, max_size=_FRAME_LIMIT, max_queue=32,
+                         ping_interval=5, ping_timeout=10, server_header="PuppetPhone"):
+            while not self.stopping.is_set():
+                await asyncio.sleep(0.05)
+
+    def _authorised(self, path: str) -> bool:
+        given = parse_qs(urlsplit(path).query).get("t", [""])[0]
+        return hmac.compare_digest(given.encode(), self.token.encode())
+
+    def _http(self, connection: Any, request: Any) -> Any:
+        """Serve the page's files; let ``/ws`` with the token through to the WebSocket."""
+        from websockets.datastructures import Headers
+        from websockets.http11 import Response
+
+        route = urlsplit(request.path).path
+        if route in _TOKEN_PAGES and not self._authorised(request.path):
+            self.refused += 1
+            self.drop("wrong session token", route)
+            body = b"This controller link is not for the running game: scan its QR code again.\n"
+            return Response(403, "Forbidden", Headers([("Content-Type", "text/plain; charset=utf-8"),
+                                                      ("Content-Length", str(len(body)))]), body)
+        if route == "/ws":
+            return None
+        if route not in PAGE_FILES:
+            return connection.respond(404, "Not found\n")
+        name, ctype = PAGE_FILES[route]
+        body = _page(name)
+        return Response(200, "OK", Headers([("Content-Type", ctype), ("Content-Length", str(len(body))),
+                                           ("Cache-Control", "no-store")]), body)
+
+    async def _connection(self, ws: Any) -> None:
+        slot = next((i for i in range(1, self.max_controllers + 1) if i not in self._slots), None)
+        if slot is None:
+            self.drop("every puppet taken", str(ws.remote_address))
+            await ws.send(json.dumps({"taken": True}))
+            await ws.close(4001, "every puppet has a controller")
+            return
+        controller = f"web:{slot}"
+        self._slots[slot] = ws
+        self.connected(controller)
+        bucket = [self.max_rate, time.monotonic()]
+        try:
+            await ws.send(json.dumps({"hello": controller}))
+            async for message in ws:
+                reply = self._handle(message, controller, bucket, time.monotonic())
+                if reply is not None:
+                    await ws.send(reply)
+        except ConnectionClosed as exc:
+            if exc.sent is not None and exc.sent.code == CloseCode.MESSAGE_TOO_BIG:
+                self.drop("message too big", controller)
+        except Exception as exc:  # a broken connection ends this controller, never the server
+            self.error(f"{controller}: {type(exc).__name__}: {exc}")
+        finally:
+            del self._slots[slot]
+            self.disconnected(controller)
+
+    def _handle(self, message: str | bytes, controller: str, bucket: list[float], now: float) -> str | None:
+        """One message of one connection: queue its sample, answer a ping, or count and drop it."""
+        tokens = min(self.max_rate, bucket[0] + (now - bucket[1]) * self.max_rate)
+        bucket[1] = now
+        if tokens < 1.0:
+            bucket[0] = tokens
+            self.drop("rate limit", controller)
+            return None
+        bucket[0] = tokens - 1.0
+        try:
+            msg = parse_message(message)
+        except WebMessageError as exc:
+            self.drop("malformed message", f"{controller}: {exc}")
+            return None
+        if isinstance(msg, Ping):
+            return json.dumps({"pong": msg.t})
+        assert isinstance(msg, ControllerMessage)
+        sample = self.offer(**to_sample_fields(msg, controller, now))
+        if sample is not None:
+            self.page_times[sample.time] = msg.t
+            while len(self.page_times) > 4096:
+                self.page_times.popitem(last=False)
+        return None
+
