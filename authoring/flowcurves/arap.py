@@ -125,6 +125,14 @@ class ArapSystem:
             x = sol[:n]
         return x
 
+    def linear_solve(self, hard_targets: F, soft_targets: F) -> F:
+        """The same constraints met by plain Laplacian editing (every rotation the identity):
+        the non-rigid answer ARAP improves on, kept as a reference for tests."""
+        n = len(self.rest)
+        rhs = np.vstack([laplacian(n, self.triangles) @ self.rest + self.weight * (self.soft.T @ soft_targets)
+                         + EPS * self.rest, np.asarray(hard_targets, dtype=np.float64).reshape(-1, 2)])
+        return self.lu.solve(rhs)[:n]
+
     def energy(self, x: F) -> float:
         """ARAP energy of ``x``."""
         return arap_energy(self.rest, self.triangles, x)

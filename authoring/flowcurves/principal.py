@@ -31,19 +31,19 @@ _DENSE = 128
 _REG = 32
 
 
-def _closest_parameters(curve: Hermite, x: F) -> F:
-    s = np.linspace(0.0, 1.0, _DENSE)
-    p = curve(s)
-    d = ((x[:, None, :] - p[None]) ** 2).sum(axis=-1)
-    return s[np.argmin(d, axis=1)]
+def principal_curve(samples: ArrayLike, n: int = CONTROL_POINTS, max_iterations: int = 400,
+                    tolerance: float = 0.02) -> Hermite:
+    """Eq. 3.1 iterated until no control point moves by more than ``tolerance`` pixels.
 
-
-def principal_curve(samples: ArrayLike, n: int = CONTROL_POINTS, max_iterations: int = 200,
-                    tolerance: float = 1e-4) -> Hermite:
-    """Eq. 3.1 iterated until the data term improves by less than ``tolerance`` (relative)."""
+    With w2 = 1000 w1 a step moves the shape ~1 % of the way, so on a bent band this
+    takes hundreds of (sub-millisecond) iterations (capped at 400, ~98 % of the way); samples
+    are thinned to 400.
+    """
     x = np.asarray(samples, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != 2 or len(x) < 3:
         raise ValueError("a principal curve needs at least three 2D samples")
+    if len(x) > 400:
+        x = x[np.linspace(0, len(x) - 1, 400).astype(np.int64)]
     mean = x.mean(axis=0)
     cov = np.cov((x - mean).T)
     axis = np.linalg.eigh(cov)[1][:, -1]
@@ -52,16 +52,16 @@ def principal_curve(samples: ArrayLike, n: int = CONTROL_POINTS, max_iterations:
     proj = (x - mean) @ axis
     curve = Hermite.line(mean + proj.min() * axis, mean + proj.max() * axis, n)
     sreg = np.linspace(0.0, 1.0, _REG)
-    d1 = basis(sreg, n, order=1) * np.sqrt(W2 / _REG)
-    last = np.inf
+    d1 = basis(sreg, n, order=1)
+    reg = W2 / _REG * (d1.T @ d1)  # the integral's normal matrix, the same every iteration
+    dense = basis(np.linspace(0.0, 1.0, _DENSE), n)  # closest points are looked up on these samples
     for _ in range(max_iterations):
-        s = _closest_parameters(curve, x)
-        a = basis(s, n) * np.sqrt(W1)
-        lhs = np.vstack([a, d1])
-        rhs = np.vstack([x * np.sqrt(W1), d1 @ curve.q])
-        curve = Hermite(np.linalg.lstsq(lhs, rhs, rcond=None)[0])
-        err = float(np.sum((x - curve(_closest_parameters(curve, x))) ** 2))
-        if last - err <= tolerance * max(last, 1e-12):
+        p = dense @ curve.q
+        nearest = np.argmin(((x[:, None, :] - p[None]) ** 2).sum(axis=-1), axis=1)
+        a = dense[nearest]
+        q = np.linalg.solve(W1 * (a.T @ a) + reg + 1e-9 * np.eye(2 * n), W1 * (a.T @ x) + reg @ curve.q)
+        moved = float(np.abs(q[:n] - curve.q[:n]).max())
+        curve = Hermite(q)
+        if moved < tolerance:
             break
-        last = err
     return curve
