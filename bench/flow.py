@@ -17,18 +17,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from authoring.flowcurves.adapters import snowman_scene
 from authoring.flowcurves.deform import ITERATIONS, SceneDeformer
 from authoring.flowcurves.principal import principal_curve
 from authoring.flowcurves.securves import SECurve
 from bench.figures import Figure, median_time
+from games.snowman.bent_scenery import flow_scene
 
 __all__ = ["run", "field_problem"]
 
 
 def field_problem():  # type: ignore[no-untyped-def]
     """The field's deformer, one SEcurve per group (principal curves) and a bend for each."""
-    scene = snowman_scene()
+    scene = flow_scene()
     deformer = SceneDeformer(scene)
     groups: dict[str, list[int]] = {}
     for i, o in enumerate(scene.objects):

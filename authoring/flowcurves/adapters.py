@@ -1,58 +1,30 @@
-"""Scenes to open in the flow editor: the snowman field's static scenery.
+"""Flow scenes from plain data: the objects a game describes, seen from a camera.
 
-The snowman field draws each pine tree as a trunk, three snowy tiers and three snow
-caps (``games.snowman.scenery``): seven objects that touch, so a tree bends as one
-while its parts stay attached — 6 trees × 7 + 3 rocks = 45 objects. Moving things
-(puppets, snowballs, snowmen) are not part of it: they keep their own shapes.
+A game that wants its static scenery bent describes it as plain dicts (``{"name",
+"group", "primitives": [{"a", "b", "radius", "color"}]}``, the same shape a flow file
+stores), so authoring never imports a game: the launcher hands the data over.
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from authoring.flowcurves.scene import FlowObject, FlowScene, Primitive
+from engine.camera import Camera
 
-__all__ = ["snowman_scene", "SCENES", "open_scene"]
-
-_TRUNK = (0.36, 0.25, 0.17)
-_SNOW = (0.95, 0.97, 1.0)
+__all__ = ["objects_from_data", "scene_from_data"]
 
 
-def snowman_objects() -> list[FlowObject]:
-    """The field's trees (seven parts each) and rocks, built as ``games.snowman.scenery`` draws them."""
-    from games.snowman.scenery import ROCKS, TREES
-
-    objects = []
-    for t, (x, z, s) in enumerate(TREES):
-        base = np.array([x, 0.0, z])
-        group = f"tree{t}"
-        objects.append(FlowObject(f"{group}.trunk", group, [Primitive(base, base + [0, 1.2 * s, 0], 0.12 * s, _TRUNK)]))
-        for k, (h, r) in enumerate(((1.0, 1.0), (1.9, 0.75), (2.7, 0.5))):
-            c = base + [0, h * s, 0]
-            color = (0.16, 0.36 - 0.03 * k, 0.24)
-            objects.append(FlowObject(f"{group}.tier{k}", group,
-                                      [Primitive(c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, color)]))
-            cap = c + [0, 0.45 * s, 0]
-            objects.append(FlowObject(f"{group}.cap{k}", group, [Primitive(cap, cap.copy(), 0.35 * r * s, _SNOW)]))
-    for k, (x, z, r) in enumerate(ROCKS):
-        centre = np.array([x, 0.6 * r, z])
-        objects.append(FlowObject(f"rock{k}", f"rock{k}", [Primitive(centre, centre.copy(), r, (0.48, 0.5, 0.54))]))
-    return objects
+def objects_from_data(objects: list[dict[str, Any]]) -> list[FlowObject]:
+    """Flow objects from their plain description."""
+    return [FlowObject(str(o["name"]), str(o["group"]),
+                       [Primitive(np.array(p["a"], dtype=np.float64), np.array(p["b"], dtype=np.float64),
+                                  float(p["radius"]), tuple(float(c) for c in p["color"]))  # type: ignore[arg-type]
+                        for p in o["primitives"]]) for o in objects]
 
 
-def snowman_scene(size: tuple[int, int] = (1280, 720)) -> FlowScene:
-    """The snowman field from a camera that frames all its trees."""
-    from engine.camera import OrbitCamera
-
-    camera = OrbitCamera(target=[0.0, 0.8, 0.0], yaw=0.35, pitch=0.42, distance=17.0)
-    return FlowScene("snowman", snowman_objects(), camera, tuple(size))  # type: ignore[arg-type]
-
-
-SCENES = {"snowman": snowman_scene}
-
-
-def open_scene(name: str, size: tuple[int, int] = (1280, 720)) -> FlowScene:
-    """A named scene; ``ValueError`` names the ones there are."""
-    if name not in SCENES:
-        raise ValueError(f"no flow scene {name!r} (scenes: {', '.join(SCENES)})")
-    return SCENES[name](size)
+def scene_from_data(name: str, objects: list[dict[str, Any]], camera: Camera, size: tuple[int, int]) -> FlowScene:
+    """A flow scene of the described objects."""
+    return FlowScene(name, objects_from_data(objects), camera, (int(size[0]), int(size[1])))

@@ -5,14 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from authoring.flowcurves.adapters import snowman_objects
+from authoring.flowcurves.adapters import objects_from_data
 from authoring.flowcurves.scene import FlowScene
 from engine.camera import OrbitCamera
+from games.snowman.bent_scenery import scenery_objects
 
 
 def tree_scene() -> FlowScene:
     """The field's first tree (trunk, three tiers, three snow caps) seen from its side."""
-    objs = [o for o in snowman_objects() if o.group == "tree0"]
+    objs = [o for o in objects_from_data(scenery_objects()) if o.group == "tree0"]
     cam = OrbitCamera(target=[-5.0, 1.5, -4.5], yaw=0.0, pitch=0.15, distance=8.0)
     return FlowScene("tree", objs, cam, (640, 480))
 
