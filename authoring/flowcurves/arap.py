@@ -97,18 +97,21 @@ class ArapSystem:
         self._ej = np.concatenate([triangles[:, b] for _, b in _EDGES])
         self._u = np.concatenate([self.rest_edges[:, k] for k in range(3)])
 
-    def _rhs(self, x: F, hard_targets: F, soft_targets: F) -> F:
+    def _rotated_edges(self, x: F) -> F:
+        """The local step: Σ over each vertex's edges of the best-fit rotated rest edges, ``[V, 2]``."""
         n, t = len(self.rest), len(self.triangles)
         e = x[self._ei] - x[self._ej]
         u = self._u
-        m = np.stack([e[:, 0] * u[:, 0], e[:, 0] * u[:, 1], e[:, 1] * u[:, 0], e[:, 1] * u[:, 1]]).reshape(4, 3, t).sum(1)
-        ang = np.arctan2(m[2] - m[1], m[0] + m[3])
+        # per triangle 2x2 covariance Σ_k e_k u_kᵀ, summed over its three edges (rows k·T … (k+1)·T)
+        m00 = (e[:, 0] * u[:, 0]).reshape(3, t).sum(0)
+        m01 = (e[:, 0] * u[:, 1]).reshape(3, t).sum(0)
+        m10 = (e[:, 1] * u[:, 0]).reshape(3, t).sum(0)
+        m11 = (e[:, 1] * u[:, 1]).reshape(3, t).sum(0)
+        ang = np.arctan2(m10 - m01, m00 + m11)
         c, s = np.tile(np.cos(ang), 3), np.tile(np.sin(ang), 3)
         rx, ry = c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]
-        top = np.c_[np.bincount(self._ei, rx, n) - np.bincount(self._ej, rx, n),
-                    np.bincount(self._ei, ry, n) - np.bincount(self._ej, ry, n)]
-        top += self.weight * (self.soft.T @ soft_targets) + EPS * self.rest
-        return np.vstack([top, hard_targets])
+        return np.c_[np.bincount(self._ei, rx, n) - np.bincount(self._ej, rx, n),
+                     np.bincount(self._ei, ry, n) - np.bincount(self._ej, ry, n)]
 
     def solve(self, hard_targets: F, soft_targets: F, iterations: int = 10, x0: F | None = None,
               dense: bool = False) -> F:
@@ -119,8 +122,11 @@ class ArapSystem:
         soft_targets = np.asarray(soft_targets, dtype=np.float64).reshape(-1, 2)
         x = self.rest.copy() if x0 is None else np.array(x0, dtype=np.float64)
         full = self.matrix.toarray() if dense else None
+        rhs = np.empty((n + len(hard_targets), 2))
+        rhs[n:] = hard_targets
+        fixed = self.weight * (self.soft.T @ soft_targets) + EPS * self.rest  # the same every iteration
         for _ in range(iterations):
-            rhs = self._rhs(x, hard_targets, soft_targets)
+            rhs[:n] = self._rotated_edges(x) + fixed
             sol = np.linalg.solve(full, rhs) if full is not None else self.lu.solve(rhs)
             x = sol[:n]
         return x
