@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from authoring.flowcurves.hermite import Hermite, basis
+from authoring.flowcurves.hermite import Hermite
 
 __all__ = ["abstract_contour", "contour_energy", "outside_count", "thinness", "W_A", "W_O", "W_C", "THIN"]
 
