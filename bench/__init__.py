@@ -23,4 +23,5 @@ BENCHES: dict[str, str] = {
     "state-hash": "bench.state_hash",
     "crowd": "bench.crowd",
     "clips": "bench.clips",
+    "flow": "bench.flow",
 }

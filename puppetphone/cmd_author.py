@@ -17,7 +17,8 @@ Ctrl+S save; right-drag orbits. Every accepted layer is saved to ``-o`` at once.
 ``--script loops`` replaces the hand with a scripted performer (loops of ±15 % tempo
 jitter, a little tremor): a demo, and what the headless test runs.
 
-``author edit`` is the MoCurves scene (``puppetphone.cmd_author_edit``).
+``author edit`` is the MoCurves scene (``puppetphone.cmd_author_edit``); ``author flow``
+bends a scene with Flow Curves (``puppetphone.cmd_author_flow``).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ __all__ = ["configure", "run", "RecordActivity", "replay_record", "record_digest
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
-    """Add ``record`` and ``edit`` sub-commands."""
+    """Add ``record``, ``flow`` and ``edit`` sub-commands."""
     from puppetphone.argtypes import output_file
     from puppetphone.runargs import add_run_arguments
 
@@ -54,6 +55,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     from input.factory import add_source_arguments
 
     add_source_arguments(rec)
+    from puppetphone.cmd_author_flow import configure_flow
+
+    flow_help = "bend a scene's flow with sketched strokes and centre-points (Flow Curves)"
+    flow = sub.add_parser("flow", help=flow_help, description=flow_help)
+    flow.set_defaults(_parser=flow)
+    configure_flow(flow)
     try:
         from puppetphone.cmd_author_edit import configure_edit
     except ModuleNotFoundError:  # the MoCurves scene is optional
@@ -70,8 +77,12 @@ def run(args: argparse.Namespace) -> int:
         from puppetphone.cmd_author_edit import run_edit
 
         return run_edit(args)
+    if args.scene == "flow":
+        from puppetphone.cmd_author_flow import run_flow
+
+        return run_flow(args)
     if args.scene != "record":
-        print("choose a scene: puppetphone author record|edit", file=sys.stderr)
+        print("choose a scene: puppetphone author record|edit|flow", file=sys.stderr)
         return 2
     return _record(args)
 

@@ -36,6 +36,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
                              "when live; an empty or missing library means the built-in clips)")
     parser.add_argument("--puppets", type=int, default=None, metavar="N",
                         help="sandbox: a crowd of N puppets wandering the field (same as --set puppets=N)")
+    parser.add_argument("--flow", default=None, metavar="FILE",
+                        help="snowman: start in the field as a flow file bent it (puppetphone author flow; "
+                             "same as --set flow=FILE)")
     parser.epilog = ("exit codes: 0 the session ran; 2 a bad option value, no display for a window, an input "
                      "that cannot be opened, or a recording of another game")
 
@@ -105,6 +108,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         game = load_game(args.game)
         settings = args.settings + ([f"puppets={args.puppets}"] if args.puppets is not None else [])
+        settings += [f"flow={args.flow}"] if args.flow is not None else []
         options = parse_settings(settings, game.options, game.name)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)

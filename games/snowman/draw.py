@@ -17,6 +17,7 @@ from engine.render.scene import RenderScene
 from games.common import draw_world
 from games.snowman.components import Snowman
 from games.snowman.rig import bezier_spine, middle_ball_parameter
+from games.snowman.bent_scenery import BentScenery
 from games.snowman.scenery import draw_snowfall, draw_trees
 from games.snowman.snow import SnowField
 
@@ -116,7 +117,7 @@ def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
     outlined = {s.focus for _, s in world.query(Stick) if s.focus is not None and s.grabbed is None}
     outlined |= {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None}
     draw_snowmen(world, scene, alpha, outlined)
-    draw_trees(scene)
+    draw_trees(scene, world.try_resource(BentScenery))
     field = world.try_resource(SnowField)
     if field is not None:
         marks = field.marks()

@@ -10,12 +10,14 @@ can build more snowmen in turn.
 
 from __future__ import annotations
 
+from typing import Any
 
 from engine.app import App
 from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.statemachine.puppet import install_puppets
 from games.base import Game
+from games.snowman.bent_scenery import prepare_flow
 from games.snowman.components import SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
@@ -70,6 +72,15 @@ def status(world: World) -> list[str]:
     return lines
 
 
+def prepare_game(options: dict[str, str]) -> dict[str, Any]:
+    """The saved field, and the bent scenery of a flow file when ``flow`` names one."""
+    setup = prepare(options)
+    flow = prepare_flow(options.get("flow", ""))
+    if flow is not None:
+        setup["flow"] = flow
+    return setup
+
+
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": ""}, prepare=prepare, replay_setup=replay_setup)
+            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_setup)
 

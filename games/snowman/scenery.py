@@ -24,12 +24,22 @@ _DRIFT = np.random.default_rng(7).uniform(0, 2 * np.pi, size=900)
 
 
 def build_scenery(world: World) -> None:
-    """Spawn the rocks and trees."""
-    for x, z, s in TREES:
-        world.spawn(Transform(np.array([x, 0.0, z]), scale=s), Obstacle(radius=0.9 * s, height=3.2 * s))
-    for x, z, r in ROCKS:
+    """Spawn the rocks and trees (where a flow file bent them, if the game's setup has one)."""
+    from games.base import GameSetup
+    from games.snowman.bent_scenery import bent_scenery
+
+    setup = world.try_resource(GameSetup)
+    flow = setup.get("flow") if setup is not None else None
+    trunks = [np.array([x, 0.0, z]) for x, z, _ in TREES]
+    rocks = [np.array([x, 0.6 * r, z]) for x, z, r in ROCKS]
+    if flow:
+        bent, trunks, rocks = bent_scenery(flow)
+        world.insert_resource(bent)
+    for (x, z, s), base in zip(TREES, trunks):
+        world.spawn(Transform(np.array(base, dtype=np.float64), scale=s), Obstacle(radius=0.9 * s, height=3.2 * s))
+    for (x, z, r), centre in zip(ROCKS, rocks):
         world.spawn(
-            Transform(np.array([x, 0.6 * r, z])),
+            Transform(np.array(centre, dtype=np.float64)),
             Obstacle(radius=r, height=1.2 * r),
             Shape("sphere", np.array([r])),
             Appearance(color=(0.48, 0.5, 0.54)),
@@ -55,11 +65,12 @@ def _tree_primitives() -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
 _TREE_CAPSULES, _TREE_SNOW = _tree_primitives()
 
 
-def draw_trees(scene: RenderScene) -> None:
-    """Pine trees: a trunk and three snowy tiers each."""
-    a, b, r, col = _TREE_CAPSULES
+def draw_trees(scene: RenderScene, bent=None) -> None:  # type: ignore[no-untyped-def]
+    """Pine trees: a trunk and three snowy tiers each (``bent``: as a flow file deformed them)."""
+    a, b, r, col = _TREE_CAPSULES if bent is None else bent.capsules
     scene.add_capsules(a, b, r, color=col)
-    scene.add_spheres(_TREE_SNOW[0], _TREE_SNOW[1], color=(0.95, 0.97, 1.0))
+    centre, radius = _TREE_SNOW if bent is None else bent.spheres
+    scene.add_spheres(centre, radius, color=(0.95, 0.97, 1.0))
 
 
 def draw_snowfall(scene: RenderScene, time: float) -> None:

@@ -1,0 +1,64 @@
+"""Drawing a flow session: the (deformed) objects, their SEcurves and the flow curves.
+
+Curves live on the screen; to draw them with the scene's line renderer they are put on
+a plane just in front of the camera (their pixels unchanged), so they show over the
+objects they belong to.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from authoring.flowcurves.scene import FlowObject, FlowScene, pixel_rays
+from engine.render.scene import RenderScene
+
+__all__ = ["draw_objects", "draw_screen_polyline", "draw_session", "SECURVE_COLOR", "FLOW_COLOR"]
+
+SECURVE_COLOR = (0.15, 0.45, 1.0)
+FLOW_COLOR = (0.75, 0.2, 0.85)
+CENTRE_COLOR = (1.0, 0.85, 0.1)
+_NEAR = 0.5  # metres in front of the eye where screen curves are drawn
+
+
+def draw_objects(scene: RenderScene, objects: list[FlowObject]) -> None:
+    """Spheres and capsules of every object."""
+    caps = [(p.a, p.b, p.radius, p.color) for o in objects for p in o.primitives if not p.is_sphere]
+    balls = [(p.a, p.radius, p.color) for o in objects for p in o.primitives if p.is_sphere]
+    if caps:
+        a, b, r, c = (np.array(v) for v in zip(*caps))
+        scene.add_capsules(a, b, r, color=c)
+    if balls:
+        a, r, c = (np.array(v) for v in zip(*balls))
+        scene.add_spheres(a, r, color=c)
+
+
+def draw_screen_polyline(scene: RenderScene, flow: FlowScene, xy: NDArray[np.float64], color: tuple[float, float, float],
+                         width: float = 3.0, closed: bool = False) -> None:
+    """A pixel polyline drawn over everything."""
+    xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    if len(xy) < 2:
+        return
+    pts = flow.camera.eye + _NEAR * pixel_rays(flow.camera, xy, flow.size)
+    scene.add_polyline(pts, color=color, width=width, closed=closed)
+
+
+def draw_session(scene: RenderScene, session, show_securves: bool = True, pending=None) -> None:  # type: ignore[no-untyped-def]
+    """The deformed scene, its SEcurves (blue), flow curves (purple), centre-point and a stroke in progress."""
+    from authoring.flowcurves.session import dense
+
+    flow = session.scene
+    draw_objects(scene, session.objects)
+    if show_securves:
+        for s in session.all_securves():
+            draw_screen_polyline(scene, flow, s.points, SECURVE_COLOR, 2.0, s.closed)
+        for seg in session.result.segments:
+            draw_screen_polyline(scene, flow, seg.c, (0.1, 0.9, 0.9), 4.0)
+    for f in session.flows:
+        draw_screen_polyline(scene, flow, dense(f), FLOW_COLOR, 4.0)
+    for e in session.edits:
+        if e.kind == "centre":
+            t = np.linspace(0, 2 * np.pi, 25)
+            draw_screen_polyline(scene, flow, e.points[0] + 10 * np.c_[np.cos(t), np.sin(t)], CENTRE_COLOR, 4.0)
+    if pending is not None and len(pending) > 1:
+        draw_screen_polyline(scene, flow, np.asarray(pending), (1.0, 1.0, 1.0), 2.0)

@@ -1,0 +1,122 @@
+"""Flow Curves: one interactive solve of the whole snowman field (thesis §3.5.3).
+
+``flow_solve_ms_40_objects`` is what a stroke costs while it is dragged over the field:
+the ARAP local/global iterations (:data:`~authoring.flowcurves.deform.ITERATIONS`) on
+the grids of all 45 static objects (6 trees of 7 parts, 3 rocks) with every contact
+kept, after the system was factorised once (``scipy.sparse.linalg.splu``). The goal is
+a frame, 16 ms. The baseline solves the very same KKT system densely (``numpy.linalg.solve``)
+in each iteration; ``flow_solve_cpu_ms_40_objects`` is the same solve in process CPU time
+(these 2 cores are shared by several sessions: wall time includes waiting for a core; the
+solve is single-threaded, so CPU time is what it costs). ``flow_factor_ms_40_objects`` is the one-off factorisation when the
+constraint rows change (a new stroke: building the rows from the grids, then the LU),
+against the solve it enables.
+
+``flow_clicks_row_of_trees`` and ``flow_clicks_centre_point`` count the presses of the
+editor's scripted reproduction of the thesis' two kinds of edit (``author flow --script
+row|centre``: trees bent along one stroke; the field converging on a centre-point
+sketched as a circle, then dragged), against the mean clicks per scene of Table 3.1
+(Flow Curves: 13.1; Maya: 102.4); ``flow_update_ms_*`` is the editor's wall time for
+that edit's updates (correspondence, network, factorisation when the rows change, solve),
+median, against one 60 Hz frame.
+
+Every object gets a flow curve: each group's principal curve, bent, so all 45 objects
+and their 81 contacts are in the system; the repeats move the targets a little (a drag).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from authoring.flowcurves.deform import ITERATIONS, SceneDeformer
+from authoring.flowcurves.principal import principal_curve
+from authoring.flowcurves.securves import SECurve
+from bench.figures import Figure, median_time
+from games.snowman.bent_scenery import flow_scene
+
+__all__ = ["run", "field_problem"]
+
+
+def field_problem():  # type: ignore[no-untyped-def]
+    """The field's deformer, one SEcurve per group (principal curves) and a bend for each."""
+    scene = flow_scene()
+    deformer = SceneDeformer(scene)
+    groups: dict[str, list[int]] = {}
+    for i, o in enumerate(scene.objects):
+        groups.setdefault(o.group, []).append(i)
+    securves = []
+    for members in groups.values():
+        pts = np.vstack([deformer.rasters[i].pixels() for i in members])
+        spine = principal_curve(pts).sample(48)
+        securves.append(SECurve(spine, False, "principal", members, spine))
+
+    def flows(step: int) -> list[np.ndarray]:
+        out = []
+        for s in securves:
+            p = s.points
+            u = np.linspace(0.0, 1.0, len(p))[:, None]
+            out.append(p + (25.0 + step) * u**2 * np.array([[1.0, 0.0]]))
+        return out
+
+    return scene, deformer, securves, flows
+
+
+def run() -> list[Figure]:
+    """Prefactored solve vs dense solve of the same system; the factorisation itself."""
+    scene, deformer, securves, flows = field_problem()
+    first = deformer.solve([(flows(0), securves)])
+    assert len(first.vertices) == len(scene.objects) >= 40
+    system, offsets = first.system, first.offsets
+    assert system is not None and offsets is not None
+    hard = deformer.hard_targets(offsets)
+    taken = [deformer.segments(flows(0), securves)]
+    base = np.vstack([t[owners == o] for _, owners, t in taken[0] for o in sorted(set(owners.tolist()))])
+    ramp = np.linspace(0.0, 1.0, len(base))[:, None]
+    soft = [base + k * ramp * np.array([[1.5, -0.5]]) for k in range(8)]  # the drag moves targets, not rows
+    steps = iter(range(10**9))
+    solve = median_time(lambda: system.solve(hard, soft[next(steps) % 8], ITERATIONS), repeats=15) * 1e3
+    dense = median_time(lambda: system.solve(hard, soft[0], ITERATIONS, dense=True), repeats=3, min_time=0.0) * 1e3
+    cpu = _cpu_median(lambda: system.solve(hard, soft[next(steps) % 8], ITERATIONS))
+    deformer._cache = None
+    factor = median_time(lambda: (setattr(deformer, "_cache", None), deformer._system(
+        list(offsets), [(o, seg.c[owners == o]) for seg, owners, _ in taken[0] for o in sorted(set(owners.tolist()))])),
+        repeats=5, min_time=0.0) * 1e3
+    return [Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system", dense),
+            Figure("flow", "flow_solve_cpu_ms_40_objects", cpu, "ms", "its wall time (shared cores)", solve),
+            Figure("flow", "flow_factor_ms_40_objects", factor, "ms", "one prefactored solve", solve),
+            *_scripted_edits(scene)]
+
+
+def _cpu_median(fn, repeats: int = 15) -> float:  # type: ignore[no-untyped-def]
+    """Median process CPU milliseconds per call: what the solve costs when the cores are shared."""
+    fn()
+    times = []
+    for _ in range(repeats):
+        t0 = time.process_time()
+        fn()
+        times.append(time.process_time() - t0)
+    return float(np.median(times)) * 1e3
+
+
+#: Table 3.1, mean over the ten edits (5 scenes, 2 artists).
+THESIS_CLICKS_OURS, THESIS_CLICKS_MAYA = 13.1, 102.4
+
+
+def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
+    """Clicks and update times of the editor's scripted row and centre-point edits."""
+    from authoring.flowcurves.securves import compute_securves
+    from authoring.flowcurves.session import FlowSession
+    from puppetphone.cmd_author_flow import FlowActivity
+
+    securves = compute_securves(scene, SceneDeformer(scene).rasters)
+    out = []
+    for name, label in (("row", "row_of_trees"), ("centre", "centre_point")):
+        activity = FlowActivity(FlowSession(flow_scene(), securves=securves), None, name)
+        while activity.frame < activity.script_end:
+            activity.step()
+        out.append(Figure("flow", f"flow_clicks_{label}", activity.clicks, "clicks",
+                          "thesis Table 3.1, Flow Curves, mean per scene", THESIS_CLICKS_OURS))
+        out.append(Figure("flow", f"flow_update_ms_{label}", float(np.median(activity.solve_ms)), "ms",
+                          "one frame at 60 Hz", 1000.0 / 60.0))
+    return out

@@ -1,0 +1,38 @@
+"""The centre-point network (Eq. 3.7–3.8): every curve ends up pointing at the centre-point."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from authoring.flowcurves.network import FlowNetwork, average_curves, tip_angle
+
+
+def _posts(xs: tuple[float, ...], lean: float = 0.0) -> list[np.ndarray]:
+    return [np.c_[np.linspace(x, x + lean, 20), np.linspace(500.0, 300.0, 20)] for x in xs]
+
+
+def test_every_curve_converges_on_the_centre_point() -> None:
+    net = FlowNetwork.build(_posts((200.0, 420.0, 860.0, 1080.0)), [640.0, 100.0], 1280)
+    assert len(net.curves) == 4
+    for curve in net.curves:
+        assert math.degrees(tip_angle(curve, net.centre)) < 3.0
+        # kept end: the far one (bottom, y = 500), tangent unchanged
+        assert abs(curve(0.0)[0][1] - 500.0) < 2.0
+    before = [math.degrees(tip_angle(a, net.centre)) for a in net.averages]
+    assert max(before) > 20.0  # they did not point there to begin with
+
+
+def test_dragging_the_centre_point_rebends_live() -> None:
+    net = FlowNetwork.build(_posts((200.0, 1080.0)), [640.0, 100.0], 1280)
+    for point in ([700.0, 150.0], [500.0, 80.0], [900.0, 200.0]):
+        net.move(point, warm=True)
+        assert all(math.degrees(tip_angle(c, net.centre)) < 3.0 for c in net.curves)
+
+
+def test_curves_close_together_are_averaged_into_one() -> None:
+    """Eq. 3.7 extends each curve along its neighbours: two posts 30 px apart make one flow curve,
+    posts far apart (beyond d_Max) stay two."""
+    assert len(average_curves(_posts((400.0, 430.0)), 1280, d_max=60.0)) == 1
+    assert len(average_curves(_posts((200.0, 1000.0)), 1280, d_max=60.0)) == 2
