@@ -21,4 +21,5 @@ BENCHES: dict[str, str] = {
     "render": "bench.render",
     "state-hash": "bench.state_hash",
     "crowd": "bench.crowd",
+    "qp": "bench.qp",
 }
