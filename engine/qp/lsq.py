@@ -4,7 +4,7 @@ Every QP in the project has the same shape: a few weighted residual rows
 (the manipulation E_m, broken tangents E_b, time-warp energies), a diagonal damping
 (E_d, λ), box limits and a band of linear rows (pins, contacts)::
 
-    min_x  Σ_k w_k (g_kᵀ x − b_k)² + Σ_j d_j x_j²
+    min_x  Σ_k w_k (g_kᵀ x − b_k)² + Σ_j d_j x_j² + eᵀx
     s.t.   lo ≤ x ≤ hi,   blo ≤ A x ≤ bhi
 
 Written directly, the Hessian ``2(Gᵀ W G + diag d)`` is dense, and a dense solver spends
@@ -66,13 +66,15 @@ class LeastSquaresQP:
         a: ArrayLike | None = None,
         blo: ArrayLike | None = None,
         bhi: ArrayLike | None = None,
+        linear: ArrayLike | None = None,
     ) -> QPResult:
         """Solve; ``x`` of the result holds the ``n`` original variables only.
 
         Args:
             d: ``[n]`` positive diagonal weights; g, b: ``[r,n]`` residual rows and ``[r]`` targets;
             w: residual weights (scalar or ``[r]``); lo/hi: ``[n]`` bounds; a, blo, bhi: ``[m,n]`` rows
-            and their ``[m]`` band.
+            and their ``[m]`` band; linear: optional ``[n]`` ``e`` (diagonal penalties around a
+            point other than 0, e.g. the thesis' broken-tangent energy E_b).
         """
         n, r, m = self.n, self.r, self.m
         dv = np.asarray(d, dtype=np.float64).reshape(n)
@@ -82,6 +84,7 @@ class LeastSquaresQP:
         idx = np.arange(n + r)
         self._h[idx, idx] = np.concatenate([2.0 * dv, 2.0 * wv])
         self._f[n:] = -2.0 * wv * np.asarray(b, dtype=np.float64).reshape(r)
+        self._f[:n] = 0.0 if linear is None else np.asarray(linear, dtype=np.float64).reshape(n)
         self._a[:r, :n] = np.asarray(g, dtype=np.float64).reshape(r, n)
         if m:
             self._a[r:, :n] = np.asarray(a, dtype=np.float64).reshape(m, n)
