@@ -22,4 +22,5 @@ BENCHES: dict[str, str] = {
     "state-hash": "bench.state_hash",
     "crowd": "bench.crowd",
     "qp": "bench.qp",
+    "curves": "bench.curves",
 }

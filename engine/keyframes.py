@@ -46,6 +46,42 @@ def _basis_slope(lam: F) -> tuple[F, F, F, F]:
             -3.0 * lam * (2.0 - 3.0 * lam))  # fmt: skip
 
 
+def _solve_time(a: F, b: F, gap: F, u: F) -> F:
+    """``λ`` with ``B^X(λ) = u`` per entry (time tangents ``a``, ``b`` within ``[0, gap]``: monotone).
+
+    Newton from the linear guess converges in a few steps; entries it leaves unsettled
+    (a flat spot at an end) finish with Newton safeguarded by bisection.
+    """
+
+    def x_and_slope(lam: F) -> tuple[F, F]:
+        one = 1.0 - lam
+        x = 3.0 * lam * one**2 * a + (3.0 * lam**2 - 2.0 * lam**3) * gap - 3.0 * lam**2 * one * b - u
+        dx = 3.0 * one * (1.0 - 3.0 * lam) * a + 6.0 * lam * one * gap - 3.0 * lam * (2.0 - 3.0 * lam) * b
+        return x, dx
+
+    lam = u / gap
+    for _ in range(6):
+        x, dx = x_and_slope(lam)
+        lam = np.clip(lam - x / np.where(dx > 1e-300, dx, 1e-300), 0.0, 1.0)
+    x, _ = x_and_slope(lam)
+    bad = np.abs(x) > 4e-16 * gap
+    if bad.any():
+        lo, hi, lb = np.zeros(int(bad.sum())), np.ones(int(bad.sum())), lam[bad]
+        a_, b_, g_, u_ = a[bad], b[bad], gap[bad], u[bad]
+        for _ in range(200):
+            one = 1.0 - lb
+            x = 3.0 * lb * one**2 * a_ + (3.0 * lb**2 - 2.0 * lb**3) * g_ - 3.0 * lb**2 * one * b_ - u_
+            dx = 3.0 * one * (1.0 - 3.0 * lb) * a_ + 6.0 * lb * one * g_ - 3.0 * lb * (2.0 - 3.0 * lb) * b_
+            hi = np.where(x > 0, lb, hi)
+            lo = np.where(x <= 0, lb, lo)
+            if np.all((np.abs(x) <= 4e-16 * g_) | (hi - lo <= 1e-16)):
+                break
+            newton = lb - x / np.where(dx > 0, dx, 1.0)
+            lb = np.where((dx > 0) & (newton > lo) & (newton < hi), newton, 0.5 * (lo + hi))
+        lam[bad] = lb
+    return lam
+
+
 @dataclass(frozen=True)
 class BezierCurves:
     """``C`` animation curves over shared keys: values and in/out tangents per key and channel.
@@ -108,28 +144,19 @@ class BezierCurves:
         a = self.out_x[k][:, ch]
         b = self.in_x[k + 1][:, ch]
         lam = np.broadcast_to(u / gap, a.shape).copy()
-        lo, hi = np.zeros_like(lam), np.ones_like(lam)
-        linear = np.isclose(a, gap / 3.0, rtol=0, atol=1e-15) & np.isclose(b, gap / 3.0, rtol=0, atol=1e-15)
-        todo = ~linear
-        for _ in range(80):
-            if not todo.any():
-                break
-            h0, tp, h1, tm = bezier_basis(lam)
-            x = tp * a + h1 * gap + tm * b - u
-            d0, dtp, d1, dtm = _basis_slope(lam)
-            dx = dtp * a + d1 * gap + dtm * b
-            hi = np.where(x > 0, lam, hi)
-            lo = np.where(x <= 0, lam, lo)
-            newton = lam - x / np.where(dx > 0, dx, 1.0)
-            ok = (dx > 0) & (newton > lo) & (newton < hi)
-            nxt = np.where(ok, newton, 0.5 * (lo + hi))
-            todo = todo & (np.abs(x) > 4e-16 * gap) & (hi - lo > 1e-16)
-            lam = np.where(todo, nxt, lam)
+        third = gap / 3.0
+        todo = (np.abs(a - third) > 1e-15) | (np.abs(b - third) > 1e-15)  # else B^X is linear in λ
+        if todo.any():
+            lam[todo] = _solve_time(a[todo], b[todo], np.broadcast_to(gap, a.shape)[todo],
+                                    np.broadcast_to(u, a.shape)[todo])  # fmt: skip
         return k, lam
 
     def sample(self, t: ArrayLike) -> F:
         """``[T,C]`` channel values at times ``t`` (clamped to the key range)."""
-        k, lam = self.parameter(t)
+        return self.evaluate(*self.parameter(t))
+
+    def evaluate(self, k: NDArray[np.int64], lam: F) -> F:
+        """``[T,C]`` channel values at segment ``k [T]`` and curve parameters ``λ [T,C]``."""
         h0, tp, h1, tm = bezier_basis(lam)
         return h0 * self.values[k] + tp * self.out_y[k] + h1 * self.values[k + 1] + tm * self.in_y[k + 1]
 

@@ -29,11 +29,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from authoring.keyframe_curves.jacobian import _fk, batch_points
 from authoring.keyframe_curves.limits import segment_bounds
 from engine import quat
 from engine.ik import IKRig
-from engine.ik._fk import fk_matrices
-from engine.ik.jacobian import dof_axes, orientation_jacobian, point_jacobian
 from engine.keyframes import KeyframedClip, _basis_slope, bezier_basis
 from engine.qp import LeastSquaresQP
 
@@ -140,12 +139,12 @@ class _Segment:
         self.target = None if drag.position is None else np.asarray(drag.position, dtype=np.float64).reshape(3)
         self.target_rot = None if drag.orientation is None else quat.normalize(np.asarray(drag.orientation, float))
         # §4.2.3 reduction of the channel set C.
-        above = rig.ancestors[self.eff][rig.dof_joint]
+        above = rig.ancestors[self.eff][rig.dof_joint] & ~solver.frozen
         active = above.copy()
         kept: list[tuple[Hold, int, NDArray[np.bool_]]] = []
         for h in holds:
             j = sk.index(h.joint) if isinstance(h.joint, str) else int(h.joint)
-            cj = rig.ancestors[j][rig.dof_joint]
+            cj = rig.ancestors[j][rig.dof_joint] & ~solver.frozen
             if not (cj & active).any():
                 continue  # (1) nothing optimised moves it
             if not (cj & ~above).any():
@@ -218,33 +217,33 @@ class TangentSolver:
     Args:
         clip: the clip being edited (replace :attr:`clip` with each accepted edit's result).
         rig: its channel rig (default :func:`curve_rig` of the clip: ±π limits, unit stiffness).
+        frozen: channels no drag may change (e.g. ``range(3)``: the root's translation).
     """
 
-    def __init__(self, clip: KeyframedClip, rig: IKRig | None = None, settings: CurveSettings = CurveSettings()) -> None:
+    def __init__(self, clip: KeyframedClip, rig: IKRig | None = None, settings: CurveSettings = CurveSettings(),
+                 frozen: ArrayLike = ()) -> None:  # fmt: skip
         self.clip = clip
         self.rig = curve_rig(clip) if rig is None else rig
         if self.rig.num_dofs != clip.curves.num_channels:
             raise ValueError("the rig's coordinates must be the clip's channels (see curve_rig)")
+        self.frozen = np.zeros(clip.curves.num_channels, dtype=bool)
+        self.frozen[np.asarray(frozen, dtype=np.int64)] = True
         self.settings = settings
         self._qps: dict[tuple[int, int, int], LeastSquaresQP] = {}
 
     def points(self, times: F, joint: int, point: F, clip: KeyframedClip | None = None) -> F:
         """``[T,3]`` world positions of a joint point at ``times``."""
-        c = (clip or self.clip).coordinates(times)
-        out = np.empty((len(times), 3))
-        for i, row in enumerate(c):
-            root, rot = self.rig.to_pose(row, quat.identity(self.rig.skeleton.num_joints), np.zeros(3))
-            wp, wm = fk_matrices(self.rig.skeleton, root, rot)
-            out[i] = wp[joint] + wm[joint] @ point
-        return out
+        wp, wm = _fk(self.rig, (clip or self.clip).coordinates(times))
+        return wp[:, joint] + wm[:, joint] @ np.asarray(point, dtype=np.float64)
 
     def _linearise(self, seg: _Segment, clip: KeyframedClip, times: F, joints: list[int], pts: list[F],
                    rot_joint: int | None) -> tuple[F, F, F | None, F | None]:  # fmt: skip
         """Points ``[T,3]`` and their Jacobians ``[3T, 4C']`` (and the effector's orientation/Jacobian)."""
         curves, ch, rig, sk = clip.curves, seg.channels, self.rig, self.rig.skeleton
         k = seg.k
-        _, lam = curves.parameter(times, ch)  # [T,C']
-        c_all = curves.sample(times)
+        kk, lam_all = curves.parameter(times)
+        c_all = curves.evaluate(kk, lam_all)
+        lam = lam_all[:, ch]  # [T,C']
         gap = curves.times[k + 1] - curves.times[k]
         a, b = curves.out_x[k, ch], curves.in_x[k + 1, ch]
         ya, yb = curves.out_y[k, ch], curves.in_y[k + 1, ch]
@@ -256,21 +255,9 @@ class TangentSolver:
         slope = dy / np.where(np.abs(dx) > 1e-12, dx, 1e-12)
         dc = np.concatenate([-slope * tp, tp, -slope * tm, tm], axis=1)  # ∂c_i/∂θ per block [T,4C']
         nc = ch.size
-        pos = np.empty((len(times), 3))
-        jac = np.empty((3 * len(times), 4 * nc))
-        rot_now = rot_jac = None
-        ident = quat.identity(sk.num_joints)
-        for i, row in enumerate(c_all):
-            root, rot = rig.to_pose(row, ident, np.zeros(3))
-            wp, wm = fk_matrices(sk, root, rot)
-            axes = dof_axes(rig, row, wm)
-            pos[i] = wp[joints[i]] + wm[joints[i]] @ pts[i]
-            js = point_jacobian(rig, axes, wp, np.array([joints[i]]), pos[i][None], ch)  # [3,C']
-            jac[3 * i : 3 * i + 3] = np.tile(js, 4) * dc[i][None]
-            if i == 0 and rot_joint is not None:
-                rot_now = quat.from_matrix(wm[rot_joint])
-                jo = orientation_jacobian(rig, axes, np.array([rot_joint]), ch)
-                rot_jac = np.tile(jo, 4) * dc[i][None]
+        pos, js, rot_now, jo = batch_points(rig, c_all, np.asarray(joints, dtype=np.int64), np.asarray(pts), ch, rot_joint)
+        jac = (np.tile(js, (1, 1, 4)) * dc[:, None, :]).reshape(3 * len(times), 4 * nc)
+        rot_jac = None if jo is None else np.tile(jo, (1, 4)) * dc[0][None]
         return pos, jac, rot_now, rot_jac
 
     def drag(self, drag: Drag, holds: tuple[Hold, ...] | list[Hold] = ()) -> CurveEdit:
@@ -285,7 +272,12 @@ class TangentSolver:
         pts = [seg.eff_point, *seg.hold_point]
         rho_goal = np.array(seg.hold_target).reshape(-1)
         stiff = self.rig.stiffness[seg.channels]
-        d = st.w_d * np.tile(stiff, 4) ** 2 + st.regularization
+        gap = float(clip.curves.times[seg.k + 1] - clip.curves.times[seg.k])
+        # D per tangent component: a time component is measured in key spacings, so moving
+        # it by the whole spacing resists like turning a joint by a radian. (In seconds it
+        # would be nearly free, and the solver would lean on timing, the most non-linear part.)
+        stiff_x = stiff / gap
+        d = st.w_d * np.concatenate([stiff_x, stiff, stiff_x, stiff]) ** 2 + st.regularization
         partner, has_partner = seg.partner(clip)
         d_b = np.where(has_partner, st.w_b, 0.0)
         w_m = st.w_m / st.length_unit**2
@@ -326,7 +318,6 @@ class TangentSolver:
         cur = merit(ds, drho)
         best, best_clip, strikes, it = cur, clip, 0, 0
         radius, box_r = st.step_radius, st.tangent_radius
-        gap = float(clip.curves.times[seg.k + 1] - clip.curves.times[seg.k])
         done = done_of(ds, drho)
         while not done and it < st.max_iterations and strikes < st.patience:
             it += 1
