@@ -287,8 +287,8 @@ class TangentSolver:
         if qp is None:
             qp = self._qps[key] = LeastSquaresQP(n, rows, 3 * seg.n_hold)
         # Eq. 4.11's band is per component; ε/√3 per component keeps each held point within ε
-        # in distance, with a 10 % margin for the linearisation error.
-        band = 0.9 * st.epsilon / np.sqrt(3.0)
+        # in distance, with half of it left as margin for the linearisation error.
+        band = 0.5 * st.epsilon / np.sqrt(3.0)
         rot_joint = seg.eff if seg.target_rot is not None else None
 
         def residuals(pos: F, rot_now: F | None) -> tuple[F, F]:
