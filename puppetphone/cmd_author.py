@@ -58,6 +58,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     edit = sub.add_parser("edit", help=edit_help, description=edit_help)
     edit.set_defaults(_parser=edit)
     configure_edit(edit)
+    from puppetphone.cmd_author_curves import configure_curves
+
+    curves_help = "edit a keyframed clip's motion curves through its tangents (thesis ch. 4)"
+    curves = sub.add_parser("curves", help=curves_help, description=curves_help)
+    curves.set_defaults(_parser=curves)
+    configure_curves(curves)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -66,8 +72,12 @@ def run(args: argparse.Namespace) -> int:
         from puppetphone.cmd_author_edit import run_edit
 
         return run_edit(args)
+    if args.scene == "curves":
+        from puppetphone.cmd_author_curves import run_curves
+
+        return run_curves(args)
     if args.scene != "record":
-        print("choose a scene: puppetphone author record|edit", file=sys.stderr)
+        print("choose a scene: puppetphone author record|edit|curves", file=sys.stderr)
         return 2
     return _record(args)
 
