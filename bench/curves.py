@@ -27,8 +27,9 @@ import time
 
 import numpy as np
 
-from authoring.keyframe_curves import Drag, Hold, TangentSolver, curve_rig
+from authoring.keyframe_curves import Drag, Hold, TangentSolver
 from bench.figures import Figure
+from engine.ik import IKRig
 from engine.keyframes import BezierCurves, KeyframedClip
 from engine.skeleton import Skeleton
 
@@ -127,11 +128,7 @@ def build_case(config: str, dof: int, frames: int, seed: int = 0) -> tuple[Tange
     oy[:, frozen] = 0.0
     iy[:, frozen] = 0.0
     clip = KeyframedClip("bench", sk, BezierCurves(times, values, ox, oy, ix, iy), fps=FPS)
-    rig = curve_rig(clip)
-    lim = {n: (-LIMIT, LIMIT) for n in sk.names}
-    from engine.ik import IKRig
-
-    rig = IKRig.build(sk, limits=lim, root_translation=True)
+    rig = IKRig.build(sk, limits={n: (-LIMIT, LIMIT) for n in sk.names}, root_translation=True)
     solver = TangentSolver(clip, rig, frozen=frozen)
     t = (1.5 * frames) / FPS
     # Pins over the whole clip; a contact between the two keys of the dragged segment (§4.2.2).

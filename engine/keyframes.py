@@ -28,7 +28,7 @@ from engine import quat
 from engine.clip import Clip, RootMotion
 from engine.skeleton import Skeleton
 
-__all__ = ["BezierCurves", "KeyframedClip", "keyframe_clip", "bezier_basis"]
+__all__ = ["BezierCurves", "KeyframedClip", "keyframe_clip", "bezier_basis", "bezier_basis_slope"]
 
 F = NDArray[np.float64]
 
@@ -40,7 +40,7 @@ def bezier_basis(lam: ArrayLike) -> tuple[F, F, F, F]:
     return (2.0 * lam**3 - 3.0 * lam**2 + 1.0, 3.0 * lam * one**2, 3.0 * lam**2 - 2.0 * lam**3, -3.0 * lam**2 * one)
 
 
-def _basis_slope(lam: F) -> tuple[F, F, F, F]:
+def bezier_basis_slope(lam: F) -> tuple[F, F, F, F]:
     """``d/dλ`` of :func:`bezier_basis`."""
     return (6.0 * lam**2 - 6.0 * lam, 3.0 * (1.0 - lam) * (1.0 - 3.0 * lam), 6.0 * lam - 6.0 * lam**2,
             -3.0 * lam * (2.0 - 3.0 * lam))  # fmt: skip

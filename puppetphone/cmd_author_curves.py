@@ -16,8 +16,6 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
-
 __all__ = ["configure_curves", "run_curves", "CurvesActivity"]
 
 

@@ -33,7 +33,7 @@ from authoring.keyframe_curves.jacobian import _fk, batch_points
 from authoring.keyframe_curves.limits import segment_bounds
 from engine import quat
 from engine.ik import IKRig
-from engine.keyframes import KeyframedClip, _basis_slope, bezier_basis
+from engine.keyframes import KeyframedClip, bezier_basis_slope, bezier_basis
 from engine.qp import LeastSquaresQP
 
 __all__ = ["Drag", "Hold", "CurveSettings", "CurveEdit", "TangentSolver", "curve_rig"]
@@ -249,7 +249,7 @@ class TangentSolver:
         ya, yb = curves.out_y[k, ch], curves.in_y[k + 1, ch]
         v0, v1 = curves.values[k, ch], curves.values[k + 1, ch]
         h0, tp, h1, tm = bezier_basis(lam)
-        d0, dtp, d1, dtm = _basis_slope(lam)
+        d0, dtp, d1, dtm = bezier_basis_slope(lam)
         dx = dtp * a + d1 * gap + dtm * b
         dy = d0 * v0 + dtp * ya + d1 * v1 + dtm * yb
         slope = dy / np.where(np.abs(dx) > 1e-12, dx, 1e-12)
