@@ -3,8 +3,8 @@
 ``CLIP`` is a default clip's name (``walk``, ``run``, …; keyed every 6 frames) or a
 ``.ppclip`` (with its ``.ppkeys`` side file when it has one, else keyed every 3 frames,
 which reproduces its frames). Ctrl+S saves the baked clip and its keys atomically to
-``--output`` (default ``<name>_curves.ppclip``); ``--export`` writes glTF/BVH/ppclip copies
-of the baked clip at the end. ``--headless --frames N --screenshot PNG`` runs without a
+``--output`` (default ``<name>_curves.ppclip``); ``--export`` writes glTF (keys and tangents as CUBICSPLINE), BVH or
+ppclip (the baked clip) at the end. ``--headless --frames N --screenshot PNG`` runs without a
 window; ``--script drag`` plays a scripted gesture (select the left hand, pin both feet,
 drag the hand's trajectory up and forward at frame 15) for tests and screenshots.
 The same runner and conventions as ``author edit``.
@@ -118,6 +118,7 @@ def run_curves(args: argparse.Namespace) -> int:
     from authoring.keyframe_curves.session import CurveSession
     from authoring.mocurves import export_clip
     from authoring.mocurves.storage import EXPORT_SUFFIXES
+    from engine.io.gltf_cubic import write_gltf_cubic
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
     from puppetphone.runargs import run_options
@@ -148,7 +149,10 @@ def run_curves(args: argparse.Namespace) -> int:
             activity.save()
             print(f"saved {args.output}")
         for path in args.export:
-            export_clip(session.clip.bake(), path)
+            if path.suffix.lower() in (".glb", ".gltf"):
+                write_gltf_cubic(path, session.clip)  # keys and tangents, CUBICSPLINE
+            else:
+                export_clip(session.clip.bake(), path)  # BVH and .ppclip are sampled
             print(f"exported {path}")
         print(f"edits: {len(session.history)} ({'; '.join(session.history) or 'none'})")
     finally:

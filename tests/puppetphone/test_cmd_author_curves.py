@@ -34,6 +34,10 @@ def test_scripted_drag_saves_keys_and_exports(tmp_path):
     assert np.array_equal(edited.curves.values, original.curves.values)
     assert not np.array_equal(edited.curves.out_y, original.curves.out_y)
     assert np.array_equal(load_clip(out).rotations, edited.bake().rotations)
+    from engine.io.gltf_cubic import read_gltf_cubic
+
+    exported = read_gltf_cubic(tmp_path / "walk.glb")  # the edit's tangents, as CUBICSPLINE
+    assert np.allclose(exported.curves.out_y[:-1], edited.curves.out_y[:-1], atol=1e-6)
 
 
 def test_bad_clip_and_mismatched_side_file_are_one_line_errors(tmp_path):
