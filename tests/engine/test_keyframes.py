@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from engine.clips import default_clips
 from engine.fk import forward_kinematics
-from engine.keyframes import BezierCurves, KeyframedClip, bezier_basis, keyframe_clip
+from engine.keyframes import BezierCurves, KeyframedClip, bezier_basis, default_keyframed_clips
 
 
 def _curve(a: float, b: float, ya: float = 0.3, yb: float = -0.2) -> BezierCurves:
@@ -46,7 +46,7 @@ def test_bad_curves_are_refused():
 def test_builtin_clips_as_keyframes_bake_back_close(name):
     """Every built-in clip keyed every 3 frames bakes back to its frames (a cubic per segment meets 4 frames)."""
     clip = default_clips()[name]
-    kc = keyframe_clip(clip, every=3)
+    kc = default_keyframed_clips()[name]
     baked = kc.bake()
     assert baked.num_frames == clip.num_frames and baked.loop == clip.loop
     p0, _ = forward_kinematics(clip.skeleton, clip.root, clip.rotations)
