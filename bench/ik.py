@@ -246,7 +246,8 @@ def run() -> list[Figure]:
             figures.append(Figure("ik", f"ik_ms_{tag}", ms, "ms", base, float(THESIS_MS[pins][i])))
             figures.append(Figure("ik", f"ik_error_mm_{tag}", err_mm, "mm", "tolerance", 0.1))
             if pins:
-                figures.append(Figure("ik", f"ik_pin_error_mm_{tag}", drift_mm, "mm", "pin epsilon", 0.1))
+                # The band of Eq. 4.11 is ε = 0.1 mm per component, so a pin may drift √3·ε in distance.
+                figures.append(Figure("ik", f"ik_pin_error_mm_{tag}", drift_mm, "mm", "ε band bound √3·ε", 0.1 * 3**0.5))
             if dof == 168 and pins == 3:
                 figures.extend(_pink(rig, pins, cases, (ms, err_mm, drift_mm)))
             figures.append(Figure("ik", f"ik_reached_pct_{tag}", pct, "%"))
