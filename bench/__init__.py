@@ -24,4 +24,6 @@ BENCHES: dict[str, str] = {
     "crowd": "bench.crowd",
     "clips": "bench.clips",
     "flow": "bench.flow",
+    "qp": "bench.qp",
+    "curves": "bench.curves",
 }

@@ -1,10 +1,10 @@
 """MoCurves: time-warp QP solve time at 30–240 keypoints, cold and warm, and the contact solve.
 
-``timewarp_ms_N`` is a cold solve (OSQP set up and solved for one drag); the goal
+``timewarp_ms_N`` is a cold solve (the QP core's workspace set up and solved for one drag); the goal
 (DESIGN.md) is under 5 ms at 120 keypoints, and at 120 it is also compared with scipy's
 SLSQP on the same problem — the general-purpose solver a real QP solver replaces.
 ``timewarp_warm_ms_N`` is the interactive case: the next move of a drag, re-solved by the
-same OSQP object from its last answer. ``contact_solve_ms`` is one stroke under the
+same workspace from its last active set. ``contact_solve_ms`` is one stroke under the
 default walk (projection, λ fit, re-integration and the leg IK of both feet).
 """
 

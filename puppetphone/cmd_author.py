@@ -1,4 +1,4 @@
-"""``puppetphone author record|edit``: the authoring scenes.
+"""``puppetphone author record|edit|curves|flow``: the authoring scenes.
 
 ``author record`` acts a motion cycle out (:mod:`authoring.record_scene`)::
 
@@ -69,6 +69,12 @@ def configure(parser: argparse.ArgumentParser) -> None:
     edit = sub.add_parser("edit", help=edit_help, description=edit_help)
     edit.set_defaults(_parser=edit)
     configure_edit(edit)
+    from puppetphone.cmd_author_curves import configure_curves
+
+    curves_help = "edit a keyframed clip's motion curves through its tangents (thesis ch. 4)"
+    curves = sub.add_parser("curves", help=curves_help, description=curves_help)
+    curves.set_defaults(_parser=curves)
+    configure_curves(curves)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -81,8 +87,12 @@ def run(args: argparse.Namespace) -> int:
         from puppetphone.cmd_author_flow import run_flow
 
         return run_flow(args)
+    if args.scene == "curves":
+        from puppetphone.cmd_author_curves import run_curves
+
+        return run_curves(args)
     if args.scene != "record":
-        print("choose a scene: puppetphone author record|edit|flow", file=sys.stderr)
+        print("choose a scene: puppetphone author record|edit|curves|flow", file=sys.stderr)
         return 2
     return _record(args)
 

@@ -6,7 +6,7 @@ A UI-independent library; the interactive scene (``authoring/edit_scene.py``) si
 - :mod:`~authoring.mocurves.spatial` — control-point drags, arrow rotate/scale with the
   Gaussian falloff ``exp(−σ(i−j)²)`` over ``[i−τ, i+τ]``.
 - :mod:`~authoring.mocurves.timewarp` — the periodic time-warp QP (E_C, E_T, E_V, E_S) on
-  OSQP, warm-started between drags; :mod:`~authoring.mocurves.resample` reads the cycle at
+  the shared QP core (engine.qp), warm-started between drags; :mod:`~authoring.mocurves.resample` reads the cycle at
   the new times.
 - :mod:`~authoring.mocurves.contact` — a stroke's plane, projection, the λ spline,
   re-integration and the root moved by ``−λ``: feet planted without sliding.

@@ -73,6 +73,7 @@ def retime_clip(clip: Clip, times: ArrayLike, joints: Sequence[int] | None = Non
     period = clip.duration
     rot = clip.rotations.copy()
     rot[:, layer] = periodic_slerp(clip.rotations[:, layer], period, t)
+    rot = _unit_fixed_point(rot)
     root, rm = clip.root, clip.root_motion
     if 0 in layer:
         root = periodic_cubic(clip.root, period, t)
@@ -85,3 +86,24 @@ def retime_clip(clip: Clip, times: ArrayLike, joints: Sequence[int] | None = Non
         new_scales = s.copy()
         new_scales[:, layer] = periodic_cubic(s[:, layer], period, t)
     return replace(clip, root=root, rotations=rot, root_motion=rm), new_scales
+
+
+def _unit_fixed_point(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Quaternions that normalising leaves bit-for-bit unchanged.
+
+    ``Clip`` normalises its rotations on construction, and dividing by the norm is not
+    always idempotent in the last bit — some values flip between two neighbours forever.
+    A saved clip must load back byte-identical (its digest pairs it with its MoCurves side
+    file), so the rows that still change are nudged by one ulp (far below any visible or
+    simulated effect) until normalisation leaves them alone. Checked on the whole
+    ``[F,J,4]`` array as ``Clip`` sees it: the norm's summation order depends on the layout.
+    """
+    q = quat.normalize(q)
+    for _ in range(32):
+        nq = quat.normalize(q)
+        bad = (nq != q).any(axis=-1)
+        if not bad.any():
+            return q
+        q = nq
+        q[bad, 0] = np.nextafter(q[bad, 0], np.inf)
+    return q

@@ -1,4 +1,4 @@
-"""The periodic time warp of MoCurves (SCA 2017 §5.2, thesis §5.4.2) as an OSQP problem.
+"""The periodic time warp of MoCurves (SCA 2017 §5.2, thesis §5.4.2) as a QP on the shared core.
 
 Dragging keypoint ``i`` of a MoCurve along its curve asks that frame ``i`` show the motion
 the original showed at time ``φ(s_c)``. With ``N`` keypoints per cycle at original times
@@ -13,10 +13,13 @@ of the next cycle — minimising::
           the term at i = 0 compares the first gap with the seam gap t*_N − t*_{N−1}
     subject to  t*_{i+1} − t*_i ≥ 0   (i = 0 … N−1, the seam gap included)
 
-Why OSQP with a fixed sparsity pattern: the Hessian is banded plus a few seam entries and
-never changes shape while a person drags, so the problem is set up once per keypoint
-count; each drag only updates ``P``'s values (which keypoints are constrained), ``q`` and the
-bounds, and OSQP restarts from the previous solution (warm start) — the interactive case.
+Why the dense active-set core (:class:`engine.qp.DenseQP`, DAQP): the Hessian is small
+(``N+1`` ≈ 120 rows), never changes shape while a person drags, and at the answer few
+monotonicity rows are active, so an active-set method ends in a handful of iterations and
+meets the constraints and the optimum exactly, where the ADMM solver this replaces needed
+thousands of iterations for a 1e-9 tolerance. The workspace is set up once per keypoint
+count; each drag updates the Hessian's diagonal (which keypoints are constrained), the
+linear term and the bounds, and starts from the previous active set (warm start).
 """
 
 from __future__ import annotations
@@ -24,9 +27,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-import osqp
 import scipy.sparse as sp
 from numpy.typing import NDArray
+
+from engine.qp import DenseQP
 
 __all__ = ["TimeWarp", "TimeWarpError", "W_STRONG", "W_SOFT"]
 
@@ -65,12 +69,12 @@ def _energy_rows(n: int) -> tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]:
 class TimeWarp:
     """A reusable, warm-started time-warp QP for ``n`` keypoints per cycle of ``period`` seconds.
 
-    Keep one per MoCurve while the person drags: every :meth:`solve` updates the same OSQP
-    object, so after the first solve each re-solve starts from the last answer.
+    Keep one per MoCurve while the person drags: every :meth:`solve` updates the same QP
+    workspace, so after the first solve each re-solve starts from the last active set.
     """
 
     def __init__(self, n: int, period: float, *, w_strong: float = W_STRONG, w_soft: float = W_SOFT,
-                 eps: float = 1e-9, max_iter: int = 20000) -> None:  # fmt: skip
+                 max_iter: int = 2000) -> None:  # fmt: skip
         if n < 3:
             raise TimeWarpError(f"a cycle needs at least 3 keypoints to warp, got {n}")
         if not (np.isfinite(period) and period > 0):
@@ -79,34 +83,17 @@ class TimeWarp:
         self.w_strong, self.w_soft = float(w_strong), float(w_soft)
         self.times = np.arange(n + 1) * (self.period / n)
         """Original keypoint times ``t_0 … t_N`` (``t_N = T`` is the seam)."""
-        self._eps, self._max_iter = eps, max_iter
         period_rows, vel, speed = _energy_rows(self.n)
         gaps = np.diff(self.times)
-        # Quadratic form ½xᵀPx + qᵀx of everything but E_C (which depends on the drag).
+        # Quadratic form ½xᵀHx + fᵀx of everything but E_C (which depends on the drag).
         h = 2.0 * (w_strong * (period_rows.T @ period_rows) + w_soft * (vel.T @ vel) + w_soft * (speed.T @ speed))
-        self._q_base = -2.0 * (w_strong * self.period * period_rows.toarray()[0] + w_soft * (vel.T @ gaps))
-        # The pattern holds every diagonal entry, since any keypoint may carry a constraint;
-        # the +1 marks them and is taken off again (the entries are small integers × weights).
-        upper = sp.triu(sp.csc_matrix(h + sp.eye(n + 1)), format="csc")
-        upper.sort_indices()
-        self._p_rows = upper.indices.copy()
-        self._p_indptr = upper.indptr.copy()
-        self._p_cols = np.repeat(np.arange(n + 1), np.diff(self._p_indptr))
-        self._diag_slot = np.flatnonzero(self._p_rows == self._p_cols)
-        self._p_base = upper.data.copy()
-        self._p_base[self._diag_slot] -= 1.0
+        self._h_base = np.asarray(h.toarray())
+        self._f_base = -2.0 * (w_strong * self.period * period_rows.toarray()[0] + w_soft * (vel.T @ gaps))
         # Monotonicity: t*_{i+1} − t*_i ≥ 0 for i = 0 … N−1.
-        self._a = sp.csc_matrix(sp.diags([-np.ones(n), np.ones(n)], [0, 1], shape=(n, n + 1)))
-        self._lower = np.zeros(n)
-        self._upper = np.full(n, np.inf)
-        self._solver: osqp.OSQP | None = None
+        self._a = np.asarray(sp.diags([-np.ones(n), np.ones(n)], [0, 1], shape=(n, n + 1)).toarray())
+        self._qp = DenseQP(n + 1, n, iter_limit=max_iter)
         self.last_iterations = 0
         self.last_status = ""
-
-    def _p_data(self, constrained: NDArray[np.bool_]) -> F:
-        h = self._p_base.copy()
-        h[self._diag_slot] += 2.0 * self.w_strong * constrained.astype(np.float64)
-        return h
 
     def solve(self, constraints: Mapping[int, float], *, min_gap: float = 0.0) -> F:
         """New keypoint times ``t*`` ``[N+1]`` for ``{keypoint: wanted time}`` (seconds).
@@ -120,7 +107,7 @@ class TimeWarp:
             min_gap: smallest allowed ``t*_{i+1} − t*_i`` (0 in the paper).
 
         Raises:
-            TimeWarpError: an index out of range, a non-finite time, or OSQP failing.
+            TimeWarpError: an index out of range, a non-finite time, or the QP not solving.
         """
         n, period = self.n, self.period
         constrained = np.zeros(n + 1, dtype=bool)
@@ -138,27 +125,16 @@ class TimeWarp:
                 constrained[n], target[n] = True, v + period
         if not constrained.any():
             return self.times.copy()
-        p_data = self._p_data(constrained)
-        q = self._q_base - 2.0 * self.w_strong * target * constrained
-        lower = np.full(n, float(min_gap))
-        if self._solver is None:
-            p = sp.csc_matrix((p_data, self._p_rows, self._p_indptr), shape=(n + 1, n + 1))
-            self._solver = osqp.OSQP()
-            # Absolute tolerance only: the strong weights make |q| ~ 10⁴, and a relative test
-            # would stop while the soft, low-curvature directions (E_V, E_S) are still off.
-            self._solver.setup(p, q, self._a, lower, self._upper, verbose=False, eps_abs=self._eps,
-                               eps_rel=0.0, max_iter=self._max_iter, polishing=False,
-                               warm_starting=True)  # fmt: skip
-        else:
-            self._solver.update(q=q, l=lower, u=self._upper, Px=p_data)
-        res = self._solver.solve(raise_error=False)
-        self.last_status = str(res.info.status)
-        self.last_iterations = int(res.info.iter)
-        if res.x is None or self.last_status not in ("solved", "solved inaccurate"):
+        h = self._h_base.copy()
+        h[np.diag_indices(n + 1)] += 2.0 * self.w_strong * constrained
+        f = self._f_base - 2.0 * self.w_strong * target * constrained
+        res = self._qp.solve(h, f, a=self._a, blo=np.full(n, float(min_gap)), bhi=np.full(n, np.inf))
+        self.last_status = res.status.value
+        self.last_iterations = res.iterations
+        if res.x is None:
             raise TimeWarpError(f"time-warp QP not solved: {self.last_status}")
-        t = np.asarray(res.x, dtype=np.float64)
-        # OSQP meets the inequalities to its tolerance; make monotonicity exact.
-        return np.maximum.accumulate(t)
+        # The active set meets the inequalities to 1e-9; make monotonicity exact.
+        return np.maximum.accumulate(res.x)
 
     def energy(self, t: F, constraints: Mapping[int, float]) -> dict[str, float]:
         """The four energies of ``t`` (``[N+1]``), for tests and the panel's read-out."""

@@ -2,7 +2,7 @@
 
 - :func:`two_bone_ik` — law-of-cosines limb solver with a pole, batched, per frame.
 - :func:`solve_ik` — any joint as effector, pins within ε, joint limits and
-  stiffness, one OSQP problem per linearisation (Eq. 4.13), rejection of
+  stiffness, one QP (engine.qp) per linearisation (Eq. 4.13), rejection of
   unreachable targets after five non-improving iterations (§4.2.3).
 - :func:`ground_feet` / :func:`hands_on_sphere` — feet on uneven ground, palms on a
   snowball, both through the two-bone solver.

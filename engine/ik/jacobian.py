@@ -66,9 +66,19 @@ def dof_axes(rig: IKRig, c: ArrayLike, wmat: ArrayLike) -> F:
     r = ~t
     j, s = rig.dof_joint[r], rig.dof_slot[r]
     ball = rig.kinds[j] == BALL
-    jr = right_jacobian(rv[j[ball]])  # [Kb,3,3]
+    # Column s of J_r(φ) = I − a[φ]× + b[φ]×², with [φ]×² = φφᵀ − θ²I, without building matrices.
+    phi = rv[j[ball]]
+    th2 = np.einsum("ni,ni->n", phi, phi)
+    th = np.sqrt(th2)
+    small = th < 1e-4
+    ths = np.where(small, 1.0, th)
+    a = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(ths)) / ths**2)
+    b = np.where(small, 1.0 / 6.0 - th2 / 120.0, (ths - np.sin(ths)) / ths**3)
+    e = np.zeros_like(phi)
+    e[np.arange(phi.shape[0]), s[ball]] = 1.0
+    col = e * (1.0 - b * th2)[:, None] - a[:, None] * cross(phi, e) + (b * phi[np.arange(phi.shape[0]), s[ball]])[:, None] * phi
     rows = np.zeros((int(r.sum()), 3))
-    rows[ball] = jr[np.arange(jr.shape[0]), :, s[ball]]
+    rows[ball] = col
     rows[~ball] = rig.axes[j[~ball]]
     local[r] = np.einsum("nij,nj->ni", wmat[j], rows)
     return local

@@ -254,7 +254,7 @@ def solve_ik(
             radius *= 0.5
             continue
         trial = c.copy()
-        # OSQP meets bounds to its tolerance only; clip so limits hold exactly (when the input did).
+        # The QP meets bounds to its tolerance only; clip so limits hold exactly (when the input did).
         inside = (c[cols] >= rig.lower[cols]) & (c[cols] <= rig.upper[cols])
         moved = c[cols] + step
         trial[cols] = np.where(inside, np.clip(moved, rig.lower[cols], rig.upper[cols]), moved)

@@ -1,0 +1,200 @@
+"""An editing session over a keyframed clip: drags through the tangent solver, holds, undo/redo, files.
+
+Files: a session saves the baked clip as an ordinary ``.ppclip`` (what every player
+loads) and, beside it, ``<name>.ppkeys``: the keys and Bézier tangents as JSON (floats
+written by ``repr``, so they load back bit-for-bit) with the SHA-256 of the ``.ppclip``
+it belongs to. Opening the ``.ppclip`` again picks the curves up from the side file when
+the digest matches, and refuses a side file that belongs to another version of the clip.
+The side file is written first, so a crash between the two writes leaves a mismatch that
+is refused loudly, never a silently wrong pairing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from authoring.keyframe_curves.limits import retime_segment
+from authoring.keyframe_curves.solver import CurveEdit, Drag, Hold, TangentSolver, curve_rig
+from engine.atomic import atomic_write_bytes
+from engine.ik import humanoid_rig
+from engine.keyframes import BezierCurves, KeyframedClip, keyframe_clip
+
+__all__ = ["CurveSession", "CurveFileError", "save_curves", "load_curves", "keys_path"]
+
+FORMAT = "puppetphone-keyframes"
+VERSION = 1
+MAX_SIDE_FILE = 64 * 1024 * 1024
+
+
+class CurveFileError(ValueError):
+    """A ``.ppkeys`` side file that cannot be read or does not match its clip."""
+
+
+def keys_path(clip_path: str | Path) -> Path:
+    """The side file of a ``.ppclip``."""
+    p = Path(clip_path)
+    return p.with_suffix(".ppkeys")
+
+
+def save_curves(clip: KeyframedClip, path: str | Path) -> Path:
+    """Write ``path`` (``.ppclip``, the baked clip) and its ``.ppkeys`` side file, atomically each."""
+    from engine.clipfile import save_clip
+
+    p = Path(path)
+    if p.suffix.lower() != ".ppclip":
+        raise ValueError(f"{p}: a keyframed clip is saved as .ppclip (export glTF/BVH with --export)")
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        staged = save_clip(clip.bake(), Path(tmp) / p.name)
+        data = staged.read_bytes()
+    c = clip.curves
+    side = {"format": FORMAT, "version": VERSION, "clip_sha256": hashlib.sha256(data).hexdigest(),
+            "fps": clip.fps, "loop": clip.loop,
+            **{k: np.asarray(getattr(c, k)).tolist() for k in ("times", "values", "out_x", "out_y", "in_x", "in_y")}}  # fmt: skip
+    atomic_write_bytes(keys_path(p), json.dumps(side).encode())
+    atomic_write_bytes(p, data)
+    return p
+
+
+def load_curves(path: str | Path) -> KeyframedClip:
+    """The keyframed clip saved at ``path`` (its ``.ppclip`` and ``.ppkeys``)."""
+    from engine.clipfile import load_clip
+
+    p = Path(path)
+    clip = load_clip(p)
+    side_file = keys_path(p)
+    if not side_file.exists():
+        raise CurveFileError(f"{p}: no {side_file.name} beside it (open the clip to key it afresh)")
+    if side_file.stat().st_size > MAX_SIDE_FILE:
+        raise CurveFileError(f"{side_file}: larger than {MAX_SIDE_FILE} bytes")
+    try:
+        side = json.loads(side_file.read_bytes().decode("utf-8"))
+    except (OSError, ValueError, RecursionError) as exc:
+        raise CurveFileError(f"{side_file}: unreadable ({type(exc).__name__})") from None
+    if not isinstance(side, dict) or side.get("format") != FORMAT:
+        raise CurveFileError(f"{side_file}: not a keyframes file")
+    if side.get("version") != VERSION:
+        raise CurveFileError(f"{side_file}: version {side.get('version')!r} is not {VERSION}")
+    if side.get("clip_sha256") != hashlib.sha256(p.read_bytes()).hexdigest():
+        raise CurveFileError(f"{side_file}: belongs to another version of {p.name}")
+    try:
+        curves = BezierCurves(*(np.asarray(side[k], dtype=np.float64) for k in ("times", "values", "out_x", "out_y",
+                                                                              "in_x", "in_y")))  # fmt: skip
+        return KeyframedClip(clip.name, clip.skeleton, curves, float(side["fps"]), bool(side["loop"]),
+                             clip.root_motion, dict(clip.markers))  # fmt: skip
+    except (KeyError, TypeError, ValueError) as exc:
+        raise CurveFileError(f"{side_file}: {exc}"[:300]) from None
+
+
+@dataclass(frozen=True)
+class _State:
+    clip: KeyframedClip
+    holds: tuple[Hold, ...]
+    label: str
+
+
+class CurveSession:
+    """The clip being edited, its holds, and an undo stack of whole states (clips are immutable)."""
+
+    def __init__(self, clip: KeyframedClip, holds: tuple[Hold, ...] = ()) -> None:
+        rig = curve_rig(clip, humanoid_rig(clip.skeleton)) if "l_hand" in clip.skeleton.names else curve_rig(clip)
+        self.solver = TangentSolver(clip, rig)
+        self._undo: list[_State] = [_State(clip, tuple(holds), "open")]
+        self._redo: list[_State] = []
+        self.preview: KeyframedClip | None = None
+        self.revision = 0
+
+    @classmethod
+    def from_spec(cls, spec: str) -> CurveSession:
+        """A ``.ppclip`` (with its ``.ppkeys``, or keyed afresh every 3 frames) or a default clip's name."""
+        from engine.clipfile import load_clip
+        from engine.clips import default_clips
+
+        p = Path(spec)
+        if p.suffix.lower() == ".ppclip":
+            return cls(load_curves(p) if keys_path(p).exists() else keyframe_clip(load_clip(p), every=3))
+        clips = default_clips()
+        if spec not in clips:
+            raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)})")
+        return cls(keyframe_clip(clips[spec], every=6))
+
+    @property
+    def state(self) -> _State:
+        return self._undo[-1]
+
+    @property
+    def clip(self) -> KeyframedClip:
+        """What is shown: a live drag's preview, else the current state."""
+        return self.preview if self.preview is not None else self.state.clip
+
+    @property
+    def holds(self) -> tuple[Hold, ...]:
+        return self.state.holds
+
+    @property
+    def history(self) -> list[str]:
+        return [s.label for s in self._undo[1:]]
+
+    def _push(self, clip: KeyframedClip, holds: tuple[Hold, ...], label: str) -> None:
+        self._undo.append(_State(clip, holds, label))
+        self._redo.clear()
+        self.solver.clip = clip
+        self.revision += 1
+
+    def undo(self) -> bool:
+        if len(self._undo) < 2:
+            return False
+        self._redo.append(self._undo.pop())
+        self.solver.clip = self.state.clip
+        self.revision += 1
+        return True
+
+    def redo(self) -> bool:
+        if not self._redo:
+            return False
+        self._undo.append(self._redo.pop())
+        self.solver.clip = self.state.clip
+        self.revision += 1
+        return True
+
+    def drag(self, joint: str, time: float, *, position: ArrayLike | None = None,
+             orientation: ArrayLike | None = None, commit: bool = True) -> CurveEdit:  # fmt: skip
+        """One drag from the current state; a reached one becomes the preview (and an undo step if ``commit``)."""
+        self.solver.clip = self.state.clip
+        res = self.solver.drag(Drag(joint, time, position=position, orientation=orientation), self.holds)
+        if res.reached:
+            if commit:
+                self.preview = None
+                self._push(res.clip, self.holds, f"drag {joint}@{time * res.clip.fps:.0f}")
+            else:
+                self.preview = res.clip
+                self.revision += 1
+        return res
+
+    def commit_preview(self, label: str) -> None:
+        """Make a live drag's last preview one undo step."""
+        if self.preview is not None:
+            clip, self.preview = self.preview, None
+            self._push(clip, self.holds, label)
+
+    def retime(self, time: float, sigma: float) -> None:
+        """Eq. 4.12 at ``time`` by ``σ`` seconds of tangent length (one undo step)."""
+        c = self.state.clip
+        self._push(replace(c, curves=retime_segment(c.curves, time, sigma)), self.holds, f"retime {sigma:+.3f}")
+
+    def toggle_hold(self, joint: str, first: int, last: int, contact: bool = False) -> None:
+        """Add a pin/contact on ``joint`` over frames, or remove the one it has (one undo step)."""
+        kept = tuple(h for h in self.holds if h.joint != joint)
+        if len(kept) == len(self.holds):
+            kept = (*kept, Hold(joint, first, last, contact=contact))
+            label = f"{'contact' if contact else 'pin'} {joint} {first}-{last}"
+        else:
+            label = f"unpin {joint}"
+        self._push(self.state.clip, kept, label)

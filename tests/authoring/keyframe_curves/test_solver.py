@@ -1,0 +1,126 @@
+"""The tangent-space solver on the default walk, as keyframed clip (issue 19's Done-means test)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from authoring.keyframe_curves import CurveSettings, Drag, Hold, TangentSolver, curve_rig, retime_segment, segment_bounds
+from engine.clips import default_clips
+from engine.ik import humanoid_rig
+from engine.keyframes import KeyframedClip, keyframe_clip
+
+
+@pytest.fixture(scope="module")
+def walk() -> KeyframedClip:
+    return keyframe_clip(default_clips()["walk"], every=6)
+
+
+def _solver(clip: KeyframedClip) -> TangentSolver:
+    return TangentSolver(clip, curve_rig(clip, humanoid_rig(clip.skeleton)))
+
+
+def _limits_hold(s: TangentSolver, clip: KeyframedClip) -> None:
+    """Eq. 4.7–4.9 on every segment and channel, and the sampled curves inside the channel limits."""
+    c = clip.curves
+    for k in range(c.times.size - 1):
+        ch = np.arange(c.num_channels)
+        lo, hi = segment_bounds(c, k, ch, s.rig.lower, s.rig.upper)
+        n = ch.size
+        th = np.concatenate([c.out_x[k], c.out_y[k], c.in_x[k + 1], c.in_y[k + 1]])
+        # Only tangents the edit moved must obey the limits (the fitted input may not); they are in range here.
+        moved = th != np.concatenate([s.clip.curves.out_x[k], s.clip.curves.out_y[k], s.clip.curves.in_x[k + 1],
+                                      s.clip.curves.in_y[k + 1]])  # fmt: skip
+        assert np.all(th[moved] >= lo[moved] - 1e-12) and np.all(th[moved] <= hi[moved] + 1e-12)
+        gap = c.times[k + 1] - c.times[k]
+        assert np.all(th[:n] >= 0) and np.all(th[:n] <= gap) and np.all(th[2 * n : 3 * n] >= 0)
+        assert np.all(th[2 * n : 3 * n] <= gap)
+    dense = clip.coordinates(np.linspace(0.0, clip.duration, 2000, endpoint=False))
+    before = s.clip.coordinates(np.linspace(0.0, clip.duration, 2000, endpoint=False))
+    u = np.minimum(s.rig.lower, before.min(axis=0))
+    v = np.maximum(s.rig.upper, before.max(axis=0))
+    assert np.all(dense >= u - 1e-9) and np.all(dense <= v + 1e-9), "a curve left its limits (Appendix A)"
+
+
+def test_drag_hand_at_one_frame_keeps_feet_and_keys(walk):
+    s = _solver(walk)
+    sk = walk.skeleton
+    frame = 15  # between keys 12 and 18
+    t = frame / walk.fps
+    hand = sk.index("l_hand")
+    start = s.points(np.array([t]), hand, np.zeros(3))[0]
+    target = start + np.array([0.05, 0.04, 0.03])
+    holds = [Hold("l_foot", 0, 30), Hold("r_foot", 0, 30)]
+    res = s.drag(Drag("l_hand", t, position=target), holds)
+    assert res.reached
+    assert np.linalg.norm(s.points(np.array([t]), hand, np.zeros(3), res.clip)[0] - target) < 1e-3
+    eps = CurveSettings().epsilon
+    frames = np.arange(0, 31) / walk.fps
+    for name in ("l_foot", "r_foot"):
+        j = sk.index(name)
+        drift = np.linalg.norm(s.points(frames, j, np.zeros(3), res.clip) - s.points(frames, j, np.zeros(3)), axis=-1)
+        assert drift.max() <= eps, f"{name} left its pin by {drift.max() * 1e3:.3f} mm"
+    # No key added or moved; only the dragged segment's tangents changed.
+    assert np.array_equal(res.clip.curves.times, walk.curves.times)
+    assert np.array_equal(res.clip.curves.values, walk.curves.values)
+    changed = np.nonzero(np.any(res.clip.curves.out_y != walk.curves.out_y, axis=1))[0]
+    assert set(changed) == {res.segment} == {2}
+    _limits_hold(s, res.clip)
+    # The edit shows at the frame it was made: the baked clip has the hand there.
+    baked = res.clip.bake()
+    assert baked.num_frames == 66
+
+
+def test_contact_holds_a_foot_still_and_unreachable_drag_is_rejected(walk):
+    # A contact needs a foot that stands (Eq. 4.6: s(t_k) = s(t_k+1)); the in-place walk's
+    # stance foot slides back, so the contact is tested on the idle clip, with a drag of the
+    # hips that would carry the feet along.
+    idle = keyframe_clip(default_clips()["idle"], every=6)
+    si = _solver(idle)
+    sk = idle.skeleton
+    t = 15 / idle.fps
+    hips = sk.index("hips")
+    start = si.points(np.array([t]), hips, np.zeros(3))[0]
+    feet = [Hold("l_foot", 12, 18, contact=True), Hold("r_foot", 12, 18, contact=True)]
+    free = si.drag(Drag("hips", t, position=start + [0.0, -0.03, 0.02]))
+    res = si.drag(Drag("hips", t, position=start + [0.0, -0.03, 0.02]), feet)
+    assert free.reached and res.reached
+    planted = si.points(np.array([12 / idle.fps]), sk.index("l_foot"), np.zeros(3))[0]
+    moved = si.points(np.arange(13, 18) / idle.fps, sk.index("l_foot"), np.zeros(3), free.clip)
+    during = si.points(np.arange(13, 18) / idle.fps, sk.index("l_foot"), np.zeros(3), res.clip)
+    assert np.linalg.norm(moved - planted, axis=-1).max() > 0.01, "without the contact the foot goes along"
+    assert np.linalg.norm(during - planted, axis=-1).max() <= CurveSettings().epsilon
+    s = _solver(walk)
+    t = 15 / walk.fps
+    start = s.points(np.array([t]), walk.skeleton.index("r_hand"), np.zeros(3))[0]
+    pinned = [Hold("l_foot", 0, 30), Hold("r_foot", 0, 30)]
+    far = s.drag(Drag("r_hand", t, position=start + [0.0, 3.0, 0.0]), pinned)  # an arm is not 3 m long
+    assert not far.reached and far.clip is s.clip  # the thesis' rejection: stay where you were
+    with pytest.raises(ValueError, match="on a key"):
+        s.drag(Drag("r_hand", 12 / walk.fps, position=start))
+
+
+def test_orientation_drag_and_timing_edit(walk):
+    from engine import quat
+
+    s = _solver(walk)
+    t = 20 / walk.fps
+    j = walk.skeleton.index("head")
+    turn = quat.from_axis_angle([0.0, 1.0, 0.0], 0.2)
+    _, rot = walk.pose_arrays(walk.coordinates([t]))
+    from engine.fk import forward_kinematics
+
+    _, wr = forward_kinematics(walk.skeleton, walk.pose_arrays(walk.coordinates([t]))[0][0], rot[0])
+    res = s.drag(Drag("head", t, orientation=quat.mul(turn, wr[j])))
+    assert res.reached
+    _, wr2 = forward_kinematics(walk.skeleton, *[a[0] for a in res.clip.pose_arrays(res.clip.coordinates([t]))])
+    angle = np.linalg.norm(quat.log(quat.mul(quat.mul(turn, wr[j]), quat.conjugate(wr2[j]))))
+    assert angle < 1e-3 / 0.2
+    # Eq. 4.12: scaling the timing changes only X tangents of that segment, within [0, Δt].
+    c = retime_segment(walk.curves, t, 0.05)
+    k = int(walk.curves.segment_of(t))
+    gap = walk.curves.times[k + 1] - walk.curves.times[k]
+    assert np.all(c.out_x[k] > walk.curves.out_x[k]) and np.all(c.out_x[k] <= gap)
+    assert np.array_equal(c.out_y, walk.curves.out_y) and np.array_equal(c.values, walk.curves.values)
+    mid = walk.curves.times[k] + 0.5 * gap
+    assert not np.allclose(KeyframedClip(walk.name, walk.skeleton, c).coordinates([mid]), walk.coordinates([mid]))
