@@ -36,7 +36,11 @@ BASELINE = "one process per take (puppetphone cycle)"
 
 
 def write_takes(folder: Path, count: int = TAKES, seed: int = 0) -> list[Path]:
-    """``count`` synthetic takes as ``.npz`` (60 fps): most loop, every 8th has three activities, every 8th never repeats."""
+    """``count`` synthetic takes as ``.npz``, sized like mocap (120 fps, 60–240 dims, 4–11 s).
+
+    Most repeat one activity; every 8th has three activities in a row; every 8th never
+    repeats (a random walk), so the batch refuses some.
+    """
     from authoring.cycles.synthetic import make_performance, mixed_take
 
     rng = np.random.default_rng(seed)
@@ -44,14 +48,15 @@ def write_takes(folder: Path, count: int = TAKES, seed: int = 0) -> list[Path]:
     paths = []
     for i in range(count):
         if i % 8 == 7:
-            values = np.cumsum(rng.normal(size=(600, 8)), axis=0)
+            values = np.cumsum(rng.normal(size=(1200, 60)), axis=0)
         elif i % 8 == 3:
-            values = mixed_take(12, rng)[0].values
+            values = mixed_take(60, rng, fps=120.0)[0].values
         else:
-            dims = (6, 24, 60, 120)[i % 4]
-            values = make_performance(dims, rng, cycles=int(rng.integers(5, 9)), period=float(rng.uniform(0.7, 1.4))).trajectory.values
+            dims = (60, 120, 175, 240)[i % 4]
+            values = make_performance(dims, rng, cycles=int(rng.integers(5, 9)), period=float(rng.uniform(0.7, 1.4)),
+                                      fps=120.0).trajectory.values
         path = folder / f"take_{i:03d}.npz"
-        np.savez(path, values=values, fps=np.float64(60.0))
+        np.savez(path, values=values, fps=np.float64(120.0))
         paths.append(path)
     return paths
 
