@@ -46,10 +46,13 @@ def test_the_play_command_devices_prints_listens_where_the_qr_code_points(tmp_pa
     game = subprocess.Popen([sys.executable, "-m", "puppetphone", *args], cwd=tmp_path, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        time.sleep(2.0)
-        for i in range(40):
+        # The phone streams for as long as the game runs (a game starting slowly on a busy
+        # machine misses the first packets, as it would on a real phone).
+        i, deadline = 0, time.monotonic() + 60.0
+        while game.poll() is None and time.monotonic() < deadline:
             subprocess.run(["oscsend", address, str(port), "/ZIGSIM/pair/quaternion", "ffff", "0", "0",
                             str(0.1 * (i % 3)), "1"], check=True, timeout=10)
+            i += 1
             time.sleep(0.03)
         out, err = game.communicate(timeout=120)
     finally:
