@@ -48,6 +48,7 @@ from engine.ik import two_bone_ik
 from engine.pose import Pose
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
+from engine.root_curve import RootCurve
 from engine.skeleton import Skeleton
 
 __all__ = ["DRIVES", "RecordScene", "drag_rotation", "mouse_point"]
@@ -94,10 +95,12 @@ class RecordScene:
         countdown: seconds before the take starts.
         take_seconds: the take stops by itself after this long (or on :meth:`stop`).
         rng: seeded generator for the extractor's probe points.
+        root_curve: the base clip's root curve (from its ``.ppclip``), kept while no layer moves the root.
     """
 
     def __init__(self, skeleton: Skeleton, item: str, drive: str = "rotation", base: Clip | None = None,
-                 countdown: float = 3.0, take_seconds: float = 8.0, rng: np.random.Generator | None = None) -> None:
+                 countdown: float = 3.0, take_seconds: float = 8.0, rng: np.random.Generator | None = None,
+                 root_curve: RootCurve | None = None) -> None:
         if drive not in DRIVES:
             raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
         if item not in skeleton.names:
@@ -123,6 +126,9 @@ class RecordScene:
         self.message = "press R to record"
         self.result: CycleResult | None = None
         self.candidate: Clip | None = None
+        self.root_curve = root_curve if base is not None else None
+        """The extractor's fitted curve of the root position, when a root layer set it (saved with the clip)."""
+        self._candidate_curve: RootCurve | None = None
         self._take: _Take | None = None
         self._value: F | None = None
         self._performed: F = np.zeros((0, 4))
@@ -190,6 +196,7 @@ class RecordScene:
         if self.phase != "preview" or self.candidate is None:
             return None
         self.clip, self.candidate, self.phase = self.candidate, None, "ready"
+        self.root_curve = self._candidate_curve
         self.message = f"layer accepted: {self.skeleton.names[self.joint]} {self.drive}; R records another"
         return self.clip
 
@@ -243,6 +250,7 @@ class RecordScene:
             self.message = f"no clean loop: {exc} — Backspace/R to retry"
             return
         self.candidate = self._stack(self.result, take)
+        self._candidate_curve = self._root_curve(self.result, self.candidate)
         self._performed = values
         self.message = (f"loop of {self.result.period:.2f} s from {self.result.cycles} cycles "
                         f"(spread {self.result.spread:.0%}) — Enter accepts, Backspace retries")
@@ -275,6 +283,23 @@ class RecordScene:
             base_root, base_rot = self._driven(base_root, base_rot, values)
         name = self.clip.name if self.clip is not None else "performed_cycle"
         return Clip(name, self.skeleton, fps, base_root, base_rot, loop=True, scales=base_scales)
+
+    def _root_curve(self, result: CycleResult, candidate: Clip) -> RootCurve | None:
+        """The root curve that goes with ``candidate``: the extracted one when this is the first, root-driving layer.
+
+        A later root layer is phase-shifted and resampled onto the cycle, which no control
+        points follow exactly: MoCurves then fit their own. Other layers leave the root as it was.
+        """
+        if self.joint != 0 or self.drive not in ("translation", "pose"):
+            return self.root_curve
+        if self.clip is not None:
+            return None
+        fitted = result.curves.get(f"{self.skeleton.names[0]}.translation")
+        if fitted is None or fitted.segments > candidate.num_frames:
+            return None
+        curve = RootCurve(fitted.closed_control(), np.zeros(3))
+        misfit = float(np.max(np.abs(curve.positions(candidate.num_frames) - candidate.root)))
+        return curve if misfit <= 2.0 * fitted.max_error + 1e-9 else None
 
     def _driven(self, root: F, rot: F, values: F) -> tuple[F, F]:
         """Poses ``root [N,3]``, ``rot [N,J,4]`` with the driven channel set to ``values [N,d]``.

@@ -12,7 +12,12 @@ is wrong with a file, :func:`load_clip` raises :class:`ClipFileError` and nothin
 Version 2 adds the optional channels ``translations [F,J,3]`` and ``scales [F,J]``, stored
 only when a clip has them; version 1 files (which never do) still read. The container is
 open: arrays a reader does not know are covered by the checksum and otherwise ignored, so
-other tools may store named extras (e.g. fitted curves) beside the clip without a new version.
+other tools may store named extras beside the clip without a new version.
+
+One such extra is read here: the fitted curve of the root position (:class:`~engine.root_curve.RootCurve`,
+arrays ``root_curve_control [K,3]`` and ``root_curve_travel [3]``) that ``cycle`` writes so
+MoCurves opens the extracted control points. :func:`load_clip` ignores it; :func:`load_clip_curve`
+checks it at this same boundary (both arrays or neither, ``4 ≤ K ≤ frames``, finite, bounded).
 """
 
 from __future__ import annotations
@@ -29,9 +34,10 @@ import numpy as np
 from engine.atomic import atomic_write
 from engine.clip import Clip, RootMotion
 from engine.npz_safe import read_bounded, read_npz
+from engine.root_curve import RootCurve
 from engine.skeleton import Skeleton
 
-__all__ = ["save_clip", "load_clip", "ClipFileError", "FORMAT", "VERSION"]
+__all__ = ["save_clip", "load_clip", "load_clip_curve", "ClipFileError", "FORMAT", "VERSION"]
 
 FORMAT = "puppetphone-clip"
 VERSION = 2
@@ -55,8 +61,8 @@ def _digest(arrays: dict[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
-def save_clip(clip: Clip, path: str | Path) -> Path:
-    """Write ``clip`` atomically to ``path``."""
+def save_clip(clip: Clip, path: str | Path, root_curve: RootCurve | None = None) -> Path:
+    """Write ``clip`` atomically to ``path``, with the fitted ``root_curve`` of its root when given."""
     sk = clip.skeleton
     arrays: dict[str, np.ndarray] = {
         "root": clip.root,
@@ -73,6 +79,11 @@ def save_clip(clip: Clip, path: str | Path) -> Path:
     if clip.root_motion is not None:
         arrays["rm_translation"] = clip.root_motion.translation
         arrays["rm_heading"] = clip.root_motion.heading
+    if root_curve is not None:
+        if not 4 <= root_curve.count <= clip.num_frames:
+            raise ValueError(f"a root curve of {root_curve.count} control points does not fit {clip.num_frames} frames")
+        arrays["root_curve_control"] = root_curve.control
+        arrays["root_curve_travel"] = root_curve.travel
     header = {
         "format": FORMAT,
         "version": VERSION,
@@ -133,8 +144,27 @@ def _check_header(header: dict[str, Any]) -> None:
         raise ClipFileError("markers must map names to finite times")
 
 
+def _root_curve(arrays: dict[str, np.ndarray], frames: int) -> RootCurve | None:
+    """The stored root curve, checked: both arrays or neither, ``[K,3]`` with ``4 ≤ K ≤ frames``, ``[3]``."""
+    present = [k in arrays for k in ("root_curve_control", "root_curve_travel")]
+    if not any(present):
+        return None
+    if not all(present):
+        raise ClipFileError("root curve is incomplete (needs root_curve_control and root_curve_travel)")
+    control = _finite("root_curve_control", arrays["root_curve_control"], (3,))
+    travel = _finite("root_curve_travel", arrays["root_curve_travel"])
+    if control.ndim != 2 or not 4 <= control.shape[0] <= frames or travel.shape != (3,):
+        raise ClipFileError(f"root curve has shapes {control.shape} and {travel.shape}, expected [4..{frames},3] and [3]")
+    return RootCurve(control, travel)
+
+
 def load_clip(path: str | Path) -> Clip:
-    """Read a clip, checking format, version, checksum and every value.
+    """Read a clip, checking format, version, checksum and every value (see :func:`load_clip_curve`)."""
+    return load_clip_curve(path)[0]
+
+
+def load_clip_curve(path: str | Path) -> tuple[Clip, RootCurve | None]:
+    """Read a clip and its root curve (None when the file has none), checking every value.
 
     Raises:
         ClipFileError: the file is not a readable clip: too big, damaged, of a newer version,
@@ -183,7 +213,7 @@ def load_clip(path: str | Path) -> Clip:
                 channels[key] = value
         if "scales" in channels and (channels["scales"] <= 0).any():
             raise ClipFileError("scales must be positive")
-        return Clip(
+        clip = Clip(
             name=header["name"],
             skeleton=sk,
             fps=float(header["fps"]),
@@ -194,6 +224,7 @@ def load_clip(path: str | Path) -> Clip:
             markers={str(k): float(v) for k, v in header.get("markers", {}).items()},
             **channels,
         )
+        return clip, _root_curve(arrays, clip.num_frames)
     except ClipFileError as exc:
         raise ClipFileError(f"{path}: {exc}") from None
     except (KeyError, ValueError, TypeError) as exc:

@@ -208,7 +208,7 @@ class RecordActivity:
         from engine.clipfile import save_clip
 
         if self.output is not None and self.scene.clip is not None:
-            save_clip(self.scene.clip, self.output)
+            save_clip(self.scene.clip, self.output, root_curve=self.scene.root_curve)
             self.scene.message = message.format(output=self.output)
 
     def _apply(self, op: tuple) -> object:  # type: ignore[type-arg]
@@ -322,20 +322,20 @@ def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
     import numpy as np
 
     from authoring.record_scene import RecordScene
-    from engine.clipfile import load_clip
+    from engine.clipfile import load_clip_curve
     from engine.humanoid import humanoid_skeleton
 
-    base = None
+    base, curve = None, None
     if setup.get("base"):
         import tempfile
 
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "base.ppclip"
             path.write_bytes(base64.b64decode(str(setup["base"])))
-            base = load_clip(path)
+            base, curve = load_clip_curve(path)
     skeleton = base.skeleton if base is not None else humanoid_skeleton()
     return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),  # type: ignore[arg-type]
-                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])))  # type: ignore[arg-type]
+                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve)  # type: ignore[arg-type]
 
 
 def replay_record(recording):  # type: ignore[no-untyped-def]

@@ -91,7 +91,11 @@ class CycleResult:
         average: ``[S+1, N]`` the average before stitching.
         points: the probe points' outcomes.
         anchor: the probe point whose matches cut the performance.
-        curves: Bézier loops per item name (empty when ``fit`` was off).
+        curves: Bézier loops per item name (empty when ``fit`` was off). The root position's
+            goes into a ``.ppclip`` for MoCurves to edit (:mod:`authoring.cycles.root_curve`);
+            the rotation curves are kept for other callers (``cycle --json`` counts them, ~10 ms on
+            a 43-joint walk) but no clip stores them: MoCurves edit rotations with per-keypoint
+            arrows and have no rotation control points to start from.
     """
 
     period: float

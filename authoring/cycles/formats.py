@@ -372,9 +372,11 @@ def save_loop(
     if suffix not in OUTPUT_SUFFIXES:
         raise TrajectoryError(f"{path}: unknown output type {suffix!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
     if suffix == ".ppclip":
+        from authoring.cycles.root_curve import loop_root_curve
         from engine.clipfile import save_clip
 
-        return save_clip(loop_clip(result, perf), path)
+        clip = loop_clip(result, perf)
+        return save_clip(clip, path, root_curve=loop_root_curve(result, perf, clip))
     if suffix in (".bvh", ".glb", ".gltf"):
         from engine.io.bvh import write_bvh
         from engine.io.bvh_convert import clip_to_bvh

@@ -58,6 +58,15 @@ class BezierLoop:
         """Number of Bézier segments ``K``."""
         return int(self.control.shape[0])
 
+    def closed_control(self) -> NDArray[np.float64]:
+        """``[K, d]`` the periodic B-spline control points the Bézier segments came from.
+
+        Indexed as :func:`engine.root_curve.closed_basis` (MoCurves' control points): segment
+        ``k``'s inner Bézier points are ``(2c + c')/3`` and ``(c + 2c')/3`` of two consecutive
+        control points, so ``c = 2·b1 − b2`` recovers them exactly.
+        """
+        return 2.0 * self.control[:, 1, :] - self.control[:, 2, :]
+
     def evaluate(self, t: NDArray[np.float64] | float) -> NDArray[np.float64]:
         """Values at times ``t`` (wrapped into the period): ``[..., d]`` or quaternions ``[..., 4]``."""
         u = np.mod(np.asarray(t, dtype=np.float64) / self.period, 1.0) * self.segments

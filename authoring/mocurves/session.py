@@ -5,6 +5,13 @@ a frozen snapshot — the clip (an immutable asset), the per-joint scale tracks 
 pinned keypoints — so every edit is "replace the snapshot", undo puts the previous one
 back *as the same arrays*, bit for bit, and redo does the reverse.
 
+A clip that comes with the extractor's fitted root curve (:class:`~engine.root_curve.RootCurve`,
+stored in ``.ppclip`` files written by ``cycle``) is edited from those control points, as the
+paper's MoCurves start from the extracted spline: a control-point drag moves them exactly,
+and an edit that moves the root another way (a retime, a contact) re-fits them with the same
+count. Other items, and clips without a curve, get MoCurves' own fit. Rotations have no
+curve to start from: they are edited with the per-keypoint arrows.
+
 Continuous gestures (dragging a keypoint along its curve) preview live without touching
 the stack: :meth:`EditSession.begin_retime` returns a :class:`RetimeDrag` whose every move
 re-solves the warm-started time-warp QP from the gesture's start state and shows the
@@ -25,6 +32,7 @@ from authoring.mocurves.curves import MoCurve, layer_joints, mocurves
 from authoring.mocurves.resample import retime_clip
 from authoring.mocurves.timewarp import TimeWarp
 from engine.clip import Clip
+from engine.root_curve import RootCurve
 
 __all__ = ["EditSession", "EditState", "RetimeDrag"]
 
@@ -33,12 +41,22 @@ F = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class EditState:
-    """One undoable snapshot: clip, ``[F,J]`` scales, pinned keypoints per item, and a label."""
+    """One undoable snapshot: clip, ``[F,J]`` scales, pinned keypoints per item, a label, the root curve."""
 
     clip: Clip
     scales: F
     pins: Mapping[str, frozenset[int]] = field(default_factory=dict)
     label: str = "open"
+    root_curve: RootCurve | None = None
+
+
+def _synced(old: EditState, new: EditState) -> EditState:
+    """``new`` with its root curve re-fitted when the edit moved the root but left the curve as it was."""
+    if new.root_curve is None or new.root_curve is not old.root_curve or new.clip.root is old.clip.root:
+        return new
+    if np.array_equal(new.clip.root, old.clip.root):
+        return new
+    return replace(new, root_curve=new.root_curve.refit(new.clip.root))
 
 
 class EditSession:
@@ -51,10 +69,11 @@ class EditSession:
             scale edit reaches the character, the saved ``.ppclip`` and the glTF export.
         tau: falloff range τ (keypoints) of arrow edits.
         sigma: falloff sharpness σ of arrow edits.
+        root_curve: the extractor's fitted root curve, when the clip came with one.
     """
 
     def __init__(self, clip: Clip, scales: ArrayLike | None = None, *, tau: int = 6, sigma: float = 0.08,
-                 pins: Mapping[str, Iterable[int]] | None = None) -> None:  # fmt: skip
+                 pins: Mapping[str, Iterable[int]] | None = None, root_curve: RootCurve | None = None) -> None:  # fmt: skip
         if not clip.loop:
             raise ValueError(f"clip {clip.name!r} is not a loop; MoCurves edit motion cycles")
         if clip.num_frames < 4:
@@ -66,7 +85,9 @@ class EditSession:
             raise ValueError(f"scales must be positive [{clip.num_frames},{clip.skeleton.num_joints}]")
         s.setflags(write=False)
         frozen = {k: frozenset(int(i) for i in v) for k, v in (pins or {}).items()}
-        self._state = EditState(clip, s, frozen)
+        if root_curve is not None and root_curve.count > clip.num_frames:
+            raise ValueError(f"a root curve of {root_curve.count} control points does not fit {clip.num_frames} keypoints")
+        self._state = EditState(clip, s, frozen, root_curve=root_curve)
         self._undo: list[EditState] = []
         self._redo: list[EditState] = []
         self._preview: EditState | None = None
@@ -98,6 +119,11 @@ class EditSession:
         return self._channel[1]
 
     @property
+    def root_curve(self) -> RootCurve | None:
+        """The root's curve as currently shown (None when MoCurves fit their own)."""
+        return self.state.root_curve
+
+    @property
     def scales(self) -> F:
         """``[F,J]`` scale tracks as currently shown."""
         return self.state.scales
@@ -123,6 +149,7 @@ class EditSession:
     def _push(self, new: EditState) -> EditState:
         if self._preview is not None:
             raise RuntimeError("finish the current drag (commit or cancel) before another edit")
+        new = _synced(self._state, new)
         self._undo.append(self._state)
         self._redo.clear()
         self._state = new
@@ -179,12 +206,21 @@ class EditSession:
         s.setflags(write=False)
         return self._push(replace(st, scales=s, label=f"scale {item}@{i}"))
 
+    def _root_curve(self, item: str) -> RootCurve | None:
+        return self.state.root_curve if self.joint(item) == 0 else None
+
     def control_count(self, item: str) -> int:
-        """How many control points ``item``'s γ_P shows (about one per five keypoints, at least 4)."""
+        """How many control points ``item``'s γ_P shows: the root curve's, else about one per five keypoints (≥ 4)."""
+        curve = self._root_curve(item)
+        if curve is not None:
+            return curve.count
         return int(min(self.clip.num_frames, max(4, self.clip.num_frames // 5)))
 
     def control_points(self, item: str) -> F:
-        """``[K,3]`` control points of ``item``'s γ_P."""
+        """``[K,3]`` control points of ``item``'s γ_P (the root curve's, drawn on its travel: :meth:`RootCurve.shown`)."""
+        curve = self._root_curve(item)
+        if curve is not None:
+            return curve.shown()
         return spatial.control_points(self.curves()[item].positions, self.control_count(item))
 
     def move_control_point(self, item: str, index: int, delta: ArrayLike) -> EditState:
@@ -192,7 +228,8 @@ class EditSession:
         st = self._state
         curve = mocurves(st.clip, st.scales)[item]
         clip = spatial.move_control_point(st.clip, curve.joint, curve.positions, self.control_count(item), index, delta)
-        return self._push(replace(st, clip=clip, label=f"move {item} control {index}"))
+        root_curve = st.root_curve.moved(index, delta) if curve.joint == 0 and st.root_curve is not None else st.root_curve
+        return self._push(replace(st, clip=clip, root_curve=root_curve, label=f"move {item} control {index}"))
 
     # -- temporal edits ---------------------------------------------------------------------
     def time_warp(self) -> TimeWarp:
@@ -235,7 +272,7 @@ class EditSession:
 
     # used by RetimeDrag
     def _set_preview(self, state: EditState | None) -> None:
-        self._preview = state
+        self._preview = None if state is None else _synced(self._state, state)
         self.revision += 1
 
 
@@ -262,7 +299,7 @@ class RetimeDrag:
         assert scales is not None
         scales.setflags(write=False)
         pins = {**self.base.pins, self.item: frozenset(self.constraints)}
-        self.session._set_preview(EditState(clip, scales, pins, f"retime {self.item}"))
+        self.session._set_preview(EditState(clip, scales, pins, f"retime {self.item}", self.base.root_curve))
         return clip
 
     def drag_to(self, keypoint: int, point: ArrayLike) -> Clip:

@@ -25,6 +25,7 @@ from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.ik import two_bone_ik
 from engine.pose import Pose
+from engine.root_curve import closed_basis
 
 __all__ = [
     "gaussian_weights",
@@ -88,18 +89,12 @@ def scale_arrow(scales: ArrayLike, joint: int, i: int, ds: float, tau: int, sigm
 
 
 def control_basis(n: int, k: int) -> F:
-    """``[n,k]`` closed uniform cubic B-spline basis at the ``n`` keypoints (partition of unity)."""
-    if k < 4 or k > n:
-        raise ValueError(f"need 4 ≤ control points ≤ keypoints, got {k} for {n}")
-    u = np.arange(n) / n * k
-    seg = np.floor(u).astype(np.int64)
-    s = u - seg
-    w = np.stack([(1 - s) ** 3, 3 * s**3 - 6 * s**2 + 4, -3 * s**3 + 3 * s**2 + 3 * s + 1, s**3], axis=1) / 6.0
-    b = np.zeros((n, k))
-    rows = np.arange(n)
-    for m in range(4):
-        np.add.at(b, (rows, (seg + m - 1) % k), w[:, m])
-    return b
+    """``[n,k]`` closed uniform cubic B-spline basis at the ``n`` keypoints (partition of unity).
+
+    The engine's (:func:`engine.root_curve.closed_basis`), so the extractor's root curve and
+    MoCurves' own control points index alike.
+    """
+    return closed_basis(n, k)
 
 
 def control_points(positions: ArrayLike, k: int) -> F:

@@ -1,7 +1,7 @@
 """Saving and exporting an edited cycle: atomic ``.ppclip`` + session side file, BVH, glTF.
 
 :func:`save_session` writes the edited clip with the engine's own format (versioned,
-checksummed, atomic) and, beside it, ``<name>.mocurves.json`` with what a clip cannot hold:
+checksummed, atomic; with the root's fitted curve when the session has one) and, beside it, ``<name>.mocurves.json`` with what a clip cannot hold:
 the scale tracks and the pinned keypoints. The side file records the clip's SHA-256 so a
 pair that does not belong together is refused instead of silently mismatched; every value
 in it is checked against the clip (shapes, ranges, types), and whatever is wrong with it
@@ -27,7 +27,7 @@ from authoring.mocurves.session import EditSession
 from engine import quat
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
-from engine.clipfile import load_clip, save_clip
+from engine.clipfile import load_clip_curve, save_clip
 from engine.io import clip_to_bvh, write_bvh, write_gltf
 from engine.npz_safe import read_bounded
 
@@ -75,18 +75,19 @@ def save_session(session: EditSession, path: str | Path) -> Path:
     # Side file first: a crash between the two leaves the old clip with a side file that
     # no longer matches it, which load refuses loudly, never a silently wrong pairing.
     atomic_write_bytes(side_path(p), json.dumps(side).encode())
-    return save_clip(session.clip, p)  # the scale tracks ride in the clip's scale channel too
+    # The scale tracks ride in the clip's scale channel too; the root curve as the clip's curve section.
+    return save_clip(session.clip, p, root_curve=session.root_curve)
 
 
 def load_session(path: str | Path) -> EditSession:
     """An :class:`EditSession` from a ``.ppclip`` (and its side file when there is one)."""
     p = Path(path)
-    clip = load_clip(p)
+    clip, root_curve = load_clip_curve(p)
     if not clip.loop:
         raise ValueError(f"{p}: clip {clip.name!r} is not a loop; MoCurves edit cycles")
     side_file = side_path(p)
     if not side_file.exists():
-        return EditSession(clip)
+        return EditSession(clip, root_curve=root_curve)
     try:
         side = json.loads(read_bounded(side_file, MAX_SIDE_FILE).decode("utf-8"))
     except (OSError, ValueError, RecursionError) as exc:
@@ -97,7 +98,7 @@ def load_session(path: str | Path) -> EditSession:
         raise SessionFileError(f"{side_file}: {exc}") from None
     if side.get("clip_sha256") != _clip_digest(clip):
         raise SessionFileError(f"{side_file}: belongs to another version of {p.name}; move it away to open the clip alone")
-    return EditSession(clip, scales, tau=tau, sigma=sigma, pins=pins)
+    return EditSession(clip, scales, tau=tau, sigma=sigma, pins=pins, root_curve=root_curve)
 
 
 def _side_values(side: Any, clip: Clip) -> tuple[np.ndarray, int, float, dict[str, list[int]]]:

@@ -241,3 +241,27 @@ def test_author_record_command_headless(tmp_path: Path, capsys: pytest.CaptureFi
     assert (tmp_path / "s.png").stat().st_size > 1000
     assert "saved" in capsys.readouterr().out
     assert main(["author", "record", "--item", "nose", "--headless"]) == 2
+
+
+def test_an_accepted_root_layer_keeps_the_extracted_curve_for_mocurves(tmp_path: Path) -> None:
+    from authoring.mocurves import load_session
+    from engine.clipfile import save_clip
+
+    sk = humanoid_skeleton()
+    scene = RecordScene(sk, sk.names[0], "translation", countdown=0.1, take_seconds=30.0)
+    _run_take(scene)
+    assert scene.root_curve is None  # nothing accepted yet
+    clip = scene.accept()
+    assert clip is not None and scene.result is not None and scene.root_curve is not None
+    fitted = scene.result.curves[f"{sk.names[0]}.translation"]
+    assert np.array_equal(scene.root_curve.control, fitted.closed_control())
+    # A rotation layer on top leaves the root, and so its curve, as it was.
+    arm = RecordScene(sk, "r_upper_arm", "rotation", base=clip, countdown=0.1, take_seconds=30.0,
+                      root_curve=scene.root_curve)
+    _run_take(arm)
+    stacked = arm.accept()
+    assert stacked is not None and np.array_equal(stacked.root, clip.root) and arm.root_curve is scene.root_curve
+    path = save_clip(stacked, tmp_path / "acted.ppclip", root_curve=arm.root_curve)
+    session = load_session(path)
+    assert session.root_curve is not None and np.array_equal(session.root_curve.control, fitted.closed_control())
+    assert session.control_count(sk.names[0]) == fitted.segments

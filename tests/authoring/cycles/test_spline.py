@@ -49,3 +49,16 @@ def test_rotation_fit_in_tangent_space() -> None:
 def test_too_short_loop_is_refused() -> None:
     with pytest.raises(ValueError, match="at least 4"):
         fit_item(Item("a", "scalar", 0, 1), np.zeros((3, 1)), 1.0)
+
+
+def test_closed_control_is_the_same_curve_on_the_engine_basis() -> None:
+    from engine.root_curve import closed_basis
+
+    s = 90
+    ph = np.arange(s) / s
+    loop = np.stack([np.sin(2 * np.pi * ph), 0.3 * np.cos(4 * np.pi * ph), 0.1 * np.sin(6 * np.pi * ph) ** 3], axis=1)
+    fit = fit_item(Item("p", "position", 0, 3), loop, period=1.5, tolerance=0.003)
+    c = fit.closed_control()
+    assert c.shape == (fit.segments, 3)
+    on_engine_basis = closed_basis(s, fit.segments) @ c
+    assert np.allclose(on_engine_basis, fit.evaluate(ph * 1.5), atol=1e-12)
