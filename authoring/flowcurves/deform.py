@@ -84,9 +84,12 @@ class SceneDeformer:
     def owners(self, xy: F, objects: list[int]) -> NDArray[np.int64]:
         """The object seen at each pixel among ``objects`` (nearest grid when none covers it)."""
         depth = np.stack([self.rasters[o].depth_at(xy) for o in objects], axis=1)
-        near = np.stack([np.sqrt(((xy[:, None, :] - self.embeddings[o].grid.vertices[None]) ** 2).sum(-1)).min(1)
-                         for o in objects], axis=1)
-        pick = np.where(np.isfinite(depth).any(axis=1), np.argmin(depth, axis=1), np.argmin(near, axis=1))
+        pick = np.argmin(depth, axis=1)
+        bare = ~np.isfinite(depth).any(axis=1)
+        if bare.any():  # the nearest grid only for the pixels no object covers
+            near = np.stack([((xy[bare, None, :] - self.embeddings[o].grid.vertices[None]) ** 2).sum(-1).min(1)
+                             for o in objects], axis=1)
+            pick[bare] = np.argmin(near, axis=1)
         return np.asarray(objects, dtype=np.int64)[pick]
 
     def fixed_points(self, objects: set[int]) -> F:

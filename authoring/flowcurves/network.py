@@ -234,16 +234,17 @@ def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iter
         x = np.stack([_free_of(starts[i]) for i in members])  # [b, m]
         b, m = x.shape
         for _ in range(iterations):
-            e, g = (a[:, 0] for a in energy.batch(x[:, None], gradient=True))
             h = 1e-5 * np.maximum(1.0, np.abs(x))
-            _, probed = energy.batch(x[:, None, :] + h[:, None, :] * np.eye(m), gradient=True)
-            hess = (probed - g[:, None, :]) / h[:, :, None]
+            probes = x[:, None, :] + np.concatenate([np.zeros((1, m)), np.eye(m)])[None] * h[:, None, :]
+            values, grads = energy.batch(probes, gradient=True)  # at x, then one step along each variable
+            e, g = values[:, 0], grads[:, 0]
+            hess = (grads[:, 1:] - g[:, None, :]) / h[:, :, None]
             w, v = np.linalg.eigh(0.5 * (hess + np.swapaxes(hess, 1, 2)))
             w = np.maximum(np.abs(w), 1e-8 * np.abs(w).max(axis=1, keepdims=True) + 1e-12)
             step = -np.einsum("bij,bj->bi", v, np.einsum("bji,bj->bi", v, g) / w)
             tried = energy.batch(x[:, None, :] + _STEPS[None, :, None] * step[:, None, :])
             best = np.argmin(tried, axis=1)
-            better = tried[np.arange(b), best] < e
+            better = tried[np.arange(b), best] < e - 1e-8 * (1.0 + np.abs(e))  # converged curves stop
             if not better.any():
                 break
             x = np.where(better[:, None], x + _STEPS[best][:, None] * step, x)
