@@ -17,7 +17,7 @@ row|centre``: trees bent along one stroke; the field converging on a centre-poin
 sketched as a circle, then dragged), against the mean clicks per scene of Table 3.1
 (Flow Curves: 13.1; Maya: 102.4); ``flow_update_ms_*`` is the editor's wall time for
 that edit's updates (correspondence, network, factorisation when the rows change, solve),
-median, against one 60 Hz frame.
+median, against one 60 Hz frame. ``flow_drag_*``: see :mod:`bench.flow_drag`.
 
 Every object gets a flow curve: each group's principal curve, bent, so all 45 objects
 and their 81 contacts are in the system; the repeats move the targets a little (a drag).
@@ -33,6 +33,7 @@ from authoring.flowcurves.deform import ITERATIONS, SceneDeformer
 from authoring.flowcurves.principal import principal_curve
 from authoring.flowcurves.securves import SECurve
 from bench.figures import Figure, median_time
+from bench.flow_drag import drag_figures
 from games.snowman.bent_scenery import flow_scene
 
 __all__ = ["run", "field_problem"]
@@ -119,4 +120,4 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
                           "thesis Table 3.1, Flow Curves, mean per scene", THESIS_CLICKS_OURS))
         out.append(Figure("flow", f"flow_update_ms_{label}", float(np.median(activity.solve_ms)), "ms",
                           "one frame at 60 Hz", 1000.0 / 60.0))
-    return out
+    return out + drag_figures(flow_scene(), securves)

@@ -90,9 +90,13 @@ def correspond(securves: list[tuple[F, bool]], flow: ArrayLike, d_m: float = D_M
     """Segments of the SEcurves ``[(points, closed), …]`` that the flow curve (a dense polyline) takes."""
     g = np.asarray(flow, dtype=np.float64)
     g_tan, g_arc = tangents(g), _arc(g)
+    g_lo, g_hi = g.min(axis=0), g.max(axis=0)
     out = []
     for ci, (points, closed) in enumerate(securves):
-        c = discretise(points, closed)
+        p = np.asarray(points, dtype=np.float64)
+        if np.linalg.norm(np.maximum(0.0, np.maximum(p.min(axis=0) - g_hi, g_lo - p.max(axis=0)))) >= d_m:
+            continue  # its bounding box is beyond d_m of the flow's: no sample can be near (a network's far curves)
+        c = discretise(p, closed)
         if len(c) < 2:
             continue
         c_tan = tangents(np.vstack([c[-1:], c, c[:1]]))[1:-1] if closed else tangents(c)

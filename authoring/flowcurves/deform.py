@@ -78,14 +78,18 @@ class SceneDeformer:
                 parent[root(c.b)] = root(c.a)
         self.component = [root(i) for i in range(len(scene.objects))]
         self._cache: tuple[object, ArapSystem] | None = None
+        self._hard: tuple[tuple[int, ...], sp.csr_matrix] | None = None
 
     # -- constraints --------------------------------------------------------------------
     def owners(self, xy: F, objects: list[int]) -> NDArray[np.int64]:
         """The object seen at each pixel among ``objects`` (nearest grid when none covers it)."""
         depth = np.stack([self.rasters[o].depth_at(xy) for o in objects], axis=1)
-        near = np.stack([np.sqrt(((xy[:, None, :] - self.embeddings[o].grid.vertices[None]) ** 2).sum(-1)).min(1)
-                         for o in objects], axis=1)
-        pick = np.where(np.isfinite(depth).any(axis=1), np.argmin(depth, axis=1), np.argmin(near, axis=1))
+        pick = np.argmin(depth, axis=1)
+        bare = ~np.isfinite(depth).any(axis=1)
+        if bare.any():  # the nearest grid only for the pixels no object covers
+            near = np.stack([((xy[bare, None, :] - self.embeddings[o].grid.vertices[None]) ** 2).sum(-1).min(1)
+                             for o in objects], axis=1)
+            pick[bare] = np.argmin(near, axis=1)
         return np.asarray(objects, dtype=np.int64)[pick]
 
     def fixed_points(self, objects: set[int]) -> F:
@@ -120,23 +124,32 @@ class SceneDeformer:
         if self._cache is not None and self._cache[0] == key:
             return self._cache[1], offsets, 0.0
         t0 = time.perf_counter()
-
-        def placed(o: int, xy: F) -> sp.csr_matrix:
-            r = self.embeddings[o].grid.rows(xy).tocoo()
-            return sp.csr_matrix((r.data, (r.row, r.col + offsets[o])), shape=(r.shape[0], n))
-
+        if self._hard is None or self._hard[0] != key[0]:  # contact rows change only with the active objects
+            blocks = [[(c.a, c.points, 1.0)] + ([(c.b, c.points, -1.0)] if c.b is not None else [])
+                      for c in self.contacts if c.a in offsets]
+            self._hard = (key[0], self._rows(blocks, offsets, n))
         rest = np.vstack([self.embeddings[o].grid.vertices for o in active])
         tris = np.vstack([self.embeddings[o].grid.triangles + offsets[o] for o in active])
-        hard_rows = []
-        for c in self.contacts:
-            if c.a not in offsets:
-                continue
-            hard_rows.append(placed(c.a, c.points) - (placed(c.b, c.points) if c.b is not None else 0))
-        hard = sp.vstack(hard_rows).tocsr() if hard_rows else sp.csr_matrix((0, n))
-        softm = sp.vstack([placed(o, xy) for o, xy in soft]).tocsr() if soft else sp.csr_matrix((0, n))
-        system = ArapSystem(rest, tris, hard, softm)
+        system = ArapSystem(rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n))
         self._cache = (key, system)
         return system, offsets, (time.perf_counter() - t0) * 1e3
+
+    def _rows(self, blocks: list[list[tuple[int, F, float]]], offsets: dict[int, int], n: int) -> sp.csr_matrix:
+        """One sparse matrix of point rows: each block is points on objects (with a sign), summed
+        row by row — a contact is its points on one object minus the same points on the other."""
+        rows, cols, vals, start = [], [], [], 0
+        for block in blocks:
+            m = len(block[0][1])
+            for o, xy, sign in block:
+                grid = self.embeddings[o].grid
+                t, bary = grid.locate(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+                rows.append(np.repeat(np.arange(start, start + m), 3))
+                cols.append(grid.triangles[t].ravel() + offsets[o])
+                vals.append(sign * bary.ravel())
+            start += m
+        if not rows:
+            return sp.csr_matrix((0, n))
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(start, n))
 
     def hard_targets(self, offsets: dict[int, int]) -> F:
         """Right-hand side of the contact rows: the ground points where they are, 0 for touches."""
