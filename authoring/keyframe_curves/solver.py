@@ -9,12 +9,25 @@ variables, four per channel (time and value of each). Each iteration linearises 
 weights and ``∂c/∂θ^X`` follows from ``B^X(λ) = t`` by the implicit function theorem —
 and solves one QP on the shared core::
 
-    min  w_m‖Δs' − J_s Δθ‖² + w_d‖D Δθ‖² + w_b‖T⁺θ' − T⁻θ'‖² + λ‖Δθ‖²
+    min  w_m‖Δs' − J_s Δθ‖² + w_d‖D (θ' − θ₀)‖² + w_b‖T⁺θ' − T⁻θ'‖² + λ‖Δθ‖²
     s.t. Δρ' − ε ≤ J_ρ Δθ ≤ Δρ' + ε                 (pins and contacts, Eq. 4.11)
          tangent limits (Eq. 4.7–4.9, :mod:`.limits`)
 
 ``E_b`` pairs each optimised tangent with the other side of its key (which belongs to the
 neighbouring segment and stays fixed), so it is a diagonal term plus a linear one.
+``E_d``'s ``Δθ`` is measured from the tangents the drag started from (θ' − θ of Eq. 4.4, θ
+the clip before the drag), not from the current iterate: every iteration then minimises the
+same energy, and the QP settles E_d and E_b's trade-off exactly in one step. Re-measured
+from each iterate, E_d becomes a fixed damping that lets each step close only
+``w_b / (w_b + w_d·D²)`` (about half) of E_b's gap along J's null space, and each such
+move bends the chain off the target again: unconstrained drags, where the whole chain is
+free, then crawled to the tolerance at ~3× per iteration instead of converging in 2–3.
+Where a step fails (a contact's linearisation is poor), damping of the step ``μ·w_d‖DΔθ‖²``
+is added back, Levenberg–Marquardt style: doubled on a failed step, quartered on a good one,
+zero at the first iteration (which is therefore exactly Eq. 4.10). Where the chain is
+nearly singular, E_d's pull from θ₀ can hold the point a little short of the target
+(w_m is large, not infinite); a step that stops improving moves E_d's reference to the
+current tangents, so from there E_d only damps, as in the per-iterate form.
 Pins hold a joint point on its trajectory over a frame range, contacts hold it where it
 was at the range's first frame; both are sampled at the frames of the range that fall in
 the segment, at most ``4·|C_sj|`` of them (§4.2.3). Iterations re-linearise until the
@@ -277,7 +290,9 @@ class TangentSolver:
         # it by the whole spacing resists like turning a joint by a radian. (In seconds it
         # would be nearly free, and the solver would lean on timing, the most non-linear part.)
         stiff_x = stiff / gap
-        d = st.w_d * np.concatenate([stiff_x, stiff, stiff_x, stiff]) ** 2 + st.regularization
+        d_d = st.w_d * np.concatenate([stiff_x, stiff, stiff_x, stiff]) ** 2
+        d = d_d + st.regularization
+        start = seg.theta(clip)  # E_d's reference
         partner, has_partner = seg.partner(clip)
         d_b = np.where(has_partner, st.w_b, 0.0)
         w_m = st.w_m / st.length_unit**2
@@ -318,6 +333,7 @@ class TangentSolver:
         cur = merit(ds, drho)
         best, best_clip, strikes, it = cur, clip, 0, 0
         radius, box_r = st.step_radius, st.tangent_radius
+        mu = 0.0  # extra damping of the step, Levenberg–Marquardt style: grows when a step fails
         done = done_of(ds, drho)
         while not done and it < st.max_iterations and strikes < st.patience:
             it += 1
@@ -338,11 +354,12 @@ class TangentSolver:
             lo, hi = np.maximum(seg.lo - th, -box), np.minimum(seg.hi - th, box)
             bad = lo > hi
             lo[bad], hi[bad] = np.clip(0.0, lo, hi)[bad], np.clip(0.0, lo, hi)[bad]
-            linear = 2.0 * d_b * (th - partner)
-            res = qp.solve(d + d_b, g, want.reshape(-1), w_m, lo, hi, jac[3:], drho - band, drho + band, linear=linear)
+            linear = 2.0 * d_b * (th - partner) + 2.0 * d_d * (th - start)
+            res = qp.solve(d + d_b + mu * d_d, g, want.reshape(-1), w_m, lo, hi, jac[3:], drho - band, drho + band,
+                           linear=linear)  # fmt: skip
             if res.x is None:
                 strikes += 1
-                radius, box_r = 0.5 * radius, 0.5 * box_r
+                radius, box_r, mu = 0.5 * radius, 0.5 * box_r, max(2.0 * mu, 1.0)
                 continue
             trial = seg.with_theta(clip, np.clip(th + res.x, seg.lo, seg.hi))
             t_pos, t_jac, t_rot, t_rjac = self._linearise(seg, trial, times, joints, pts, rot_joint)
@@ -352,12 +369,14 @@ class TangentSolver:
                 clip, pos, jac, rot_now, rot_jac, ds, drho, cur = trial, t_pos, t_jac, t_rot, t_rjac, t_ds, t_drho, t_merit
                 radius = min(2.0 * radius, 4.0 * st.step_radius)
                 box_r = min(1.5 * box_r, 2.5 * st.tangent_radius)
+                mu *= 0.25
             else:
-                radius, box_r = 0.5 * radius, 0.5 * box_r
+                radius, box_r, mu = 0.5 * radius, 0.5 * box_r, max(2.0 * mu, 1.0)
             done = done_of(ds, drho)
             if done or cur < best * (1.0 - 1e-3):
                 best, best_clip, strikes = cur, clip, 0
             else:
                 strikes += 1
+                start = seg.theta(clip)  # stalled: E_d's pull may be what holds the point short
         return CurveEdit(clip=clip if done else self.clip, reached=done, iterations=it, error=error_of(ds),
                          hold_error=hold_error(drho), variables=n, segment=seg.k, closest=best_clip)  # fmt: skip

@@ -23,17 +23,20 @@ __all__ = ["fk_matrices"]
 
 F = NDArray[np.float64]
 
-_JUMPS: dict[int, list[NDArray[np.int64]]] = {}
+# Keyed by the parent array's bytes, not ``id(skeleton)``: a freed skeleton's id is reused
+# by the next one allocated, which then silently got another hierarchy's table.
+_JUMPS: dict[bytes, list[NDArray[np.int64]]] = {}
 
 
 def _jumps(skeleton: Skeleton) -> list[NDArray[np.int64]]:
     """Per round, the ancestor each joint composes with (index ``J`` is the identity)."""
-    key = id(skeleton)
+    parents = np.asarray(skeleton.parents, dtype=np.int64)
+    key = parents.tobytes()
     hit = _JUMPS.get(key)
-    if hit is not None and hit[0].size == skeleton.num_joints + 1:
+    if hit is not None:
         return hit
     n = skeleton.num_joints
-    anc = np.where(np.asarray(skeleton.parents) < 0, n, np.asarray(skeleton.parents)).astype(np.int64)
+    anc = np.where(parents < 0, n, parents).astype(np.int64)
     anc = np.r_[anc, n]
     rounds = []
     while np.any(anc[:n] != n):

@@ -63,3 +63,22 @@ def test_build_rejects_bad_specs():
         IKRig.build(sk, limits={"spine": (1.0, -1.0)})
     with pytest.raises(ValueError, match="non-zero axis"):
         IKRig.build(sk, hinges={"l_lower_leg": (0, 0, 0)})
+
+
+def test_fk_of_a_new_skeleton_ignores_a_freed_one_with_the_same_joint_count():
+    # The pointer-jumping table is cached per hierarchy; a skeleton freed and replaced by
+    # another of as many joints (CPython reuses the id) must not inherit the old table.
+    from engine.fk import forward_kinematics
+    from engine.skeleton import Skeleton
+
+    n = 6
+    rng = np.random.default_rng(2)
+    offsets = rng.normal(scale=0.1, size=(n, 3))
+    rot = quat.exp(rng.normal(scale=0.5, size=(n, 3)))
+    for trial in range(20):
+        parents = np.array([-1, 0, 1, 2, 3, 4]) if trial % 2 else np.array([-1, 0, 0, 0, 0, 0])
+        sk = Skeleton(tuple(f"j{i}" for i in range(n)), parents, offsets, np.zeros((n, 3)))
+        wp, _ = fk_matrices(sk, np.zeros(3), rot)
+        ref, _ = forward_kinematics(sk, np.zeros(3), rot)
+        assert np.allclose(wp, ref, atol=1e-12), f"trial {trial}: FK used another hierarchy's table"
+        del sk
