@@ -50,7 +50,7 @@ def measure(steps: int = 240, dt: float = 1.0 / 60.0) -> np.ndarray:
 
     th = threading.Thread(target=sender, daemon=True)
     th.start()
-    pacer = RealTimePacer(dt)
+    pacer = RealTimePacer(dt, wake=hub.arrived)  # as in play: a packet may start its step early
     latencies = []
     try:
         for _ in range(steps):

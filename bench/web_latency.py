@@ -8,10 +8,10 @@ system clock as :func:`time.time` on this machine) and the simulation, paced to 
 time, notes when each reading's sample has been applied to the ``Stick`` (the end of
 the step whose ``InputFrame`` carried it). The goal is within one step: 16.7 ms.
 
-The steps are phase-locked to the readings (:class:`engine.pacing.PhaseLock`), as in
-``play``: Chromium delivers sensor events on its own 60 Hz tick, so without the lock the
-latency is whatever phase the two clocks happened to start at (1 to 22 ms from run to
-run here). The first ``warmup`` steps, while the lock converges, are not counted.
+A reading may start its step up to half a step early (:class:`engine.pacing.RealTimePacer`'s
+``wake``), as in ``play``: Chromium delivers sensor events on its own 60 Hz tick, so with
+slots alone the latency is whatever phase the two clocks happened to start at (1 to 22 ms
+from run to run here). The first ``warmup`` steps are not counted.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 __all__ = ["measure"]
 
 
-def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, lock: bool = True) -> np.ndarray:
+def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, wake: bool = True) -> np.ndarray:
     """Latencies in seconds of every reading applied during ``steps`` paced steps.
 
     Raises:
@@ -35,7 +35,7 @@ def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, lock: bo
     from bench.chromium import Chromium
     from engine.app import App
     from engine.components import Stick
-    from engine.pacing import PhaseLock, RealTimePacer
+    from engine.pacing import RealTimePacer
     from input.hub import InputHub
     from input.plugin import install_input
     from input.sample import InputFrame
@@ -65,8 +65,8 @@ def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, lock: bo
 
                 th = threading.Thread(target=driver, daemon=True)
                 th.start()
-                phase = PhaseLock(dt) if lock else None
-                latencies = _run(app, src, steps, warmup, RealTimePacer(dt), phase, InputFrame, Stick)
+                pacer = RealTimePacer(dt, wake=hub.arrived if wake else None)
+                latencies = _run(app, src, steps, warmup, pacer, InputFrame, Stick)
                 stop.set()
                 th.join(2.0)
         finally:
@@ -75,20 +75,16 @@ def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, lock: bo
     return np.array(latencies)
 
 
-def _run(app, src, steps, warmup, pacer, phase, InputFrame, Stick) -> list[float]:  # type: ignore[no-untyped-def]
+def _run(app, src, steps, warmup, pacer, InputFrame, Stick) -> list[float]:  # type: ignore[no-untyped-def]
     out = []
     for k in range(warmup + steps):
         pacer.wait()
-        drained = time.monotonic()  # the clock the source stamps arrivals with
         app.step()
         applied = time.time() * 1000.0
         assert app.world.query(Stick)
-        samples = app.world.resource(InputFrame).samples
-        if phase is not None:
-            pacer.shift(phase.correction([s.time for s in samples], drained))
         if k < warmup:
             continue
-        for s in samples:
+        for s in app.world.resource(InputFrame).samples:
             page = src.page_times.get(s.time)
             if page is not None and page > 0:
                 out.append((applied - page) / 1000.0)

@@ -33,7 +33,7 @@ from typing import Any, Protocol
 
 from engine.camera import Camera
 from engine.clock import FixedStepClock
-from engine.pacing import PhaseLock, RealTimePacer
+from engine.pacing import RealTimePacer
 from engine.render.scene import RenderScene
 from engine.render.window import INVISIBLE_DRIVERS, NoDisplayError
 
@@ -224,20 +224,16 @@ class Runner:
             self._take_screenshot(activity)
 
     def _run_headless(self, activity: Activity) -> int:
-        pacer = RealTimePacer(activity.dt, clock=self._wall) if self.options.pace else None
-        # Steps follow a live controller's phase (PhaseLock): readings' arrival times, on time.monotonic.
-        arrivals = getattr(activity, "input_arrivals", None) if pacer is not None else None
-        lock = PhaseLock(activity.dt)
+        # A live controller's reading may start its step up to half a step early (RealTimePacer's wake).
+        wake = getattr(activity, "input_wake", None)
+        pacer = RealTimePacer(activity.dt, clock=self._wall, wake=wake) if self.options.pace else None
         steps = 0
         if self.options.screenshot_at == 0:
             self._take_screenshot(activity)
         while self._limit(steps) > 0 and not activity.finished() and not self._stopped:
             if pacer is not None:
                 pacer.wait()
-            drained = time.monotonic()
             activity.step()
-            if arrivals is not None:
-                pacer.shift(lock.correction(arrivals(), drained))  # type: ignore[union-attr]
             steps += 1
             self._after_step(activity, steps)
         return steps

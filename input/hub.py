@@ -17,6 +17,7 @@ recorded frame for each index instead of draining live sources.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterable
 from typing import Protocol
 
@@ -49,6 +50,10 @@ class InputHub:
     def __init__(self, sources: Iterable[PoseSource] = (), replay: FrameSource | None = None,
                  max_samples: int = 8) -> None:
         self.sources: list[PoseSource] = list(sources)
+        # Set whenever a live source queues a reading: a paced loop may start the step early for it.
+        self.arrived = threading.Event()
+        for source in self.sources:
+            source.arrived = self.arrived
         self.replay = replay
         self.max_samples = max_samples
         self.coalesced = 0
@@ -81,6 +86,7 @@ class InputHub:
     def add(self, source: PoseSource) -> PoseSource:
         """Register another live source."""
         self.sources.append(source)
+        source.arrived = self.arrived
         return source
 
     def start(self) -> InputHub:

@@ -73,6 +73,7 @@ class PoseSource:
         self._lock = threading.Lock()
         self._thread: threading.Thread | None = None
         self.stopping = threading.Event()
+        self.arrived: threading.Event | None = None  # set on each reading: the hub's wake-up for a paced step
 
     # -- lifecycle -------------------------------------------------------------------
     def start(self) -> PoseSource:
@@ -112,6 +113,8 @@ class PoseSource:
         self._meter.tick()
         with self._lock:
             self._status.packets += 1
+        if self.arrived is not None:
+            self.arrived.set()
 
     def offer(self, **fields: object) -> PoseSample | None:
         """Build a :class:`PoseSample` from ``fields`` and queue it, or drop and count it.

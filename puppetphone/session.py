@@ -14,6 +14,7 @@ and ends the activity at the first difference.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -67,9 +68,10 @@ class GameActivity:
         """One simulation step."""
         self.app.step()
 
-    def input_arrivals(self) -> list[float]:
-        """When the last step's readings arrived (``time.monotonic``): the runner phase-locks steps to them."""
-        return [s.time for s in self.hub.last_frame.samples] if self.hub.replay is None else []
+    @property
+    def input_wake(self) -> threading.Event | None:
+        """Set when a live reading arrives: the paced runner starts the step early for it (none in a replay)."""
+        return self.hub.arrived if self.hub.replay is None else None
 
     def finished(self) -> bool:
         """A replay ends after its last recorded frame or at the first hash that differs."""

@@ -1,3 +1,4 @@
+import numpy as np
 import pytest
 
 from engine.pacing import RealTimePacer
@@ -35,31 +36,71 @@ def test_rejects_bad_dt():
         RealTimePacer(0.0)
 
 
-def test_phase_lock_brings_steps_to_just_after_the_readings():
-    from engine.pacing import PhaseLock
+class FakeEvent:
+    """A wake event on the fake clock: ``arrivals`` are the times readings are queued."""
 
+    def __init__(self, clock, arrivals=()):
+        self.clock, self.arrivals, self.flag = clock, sorted(arrivals), False
+        self.waits = []
+
+    def _catch_up(self):
+        while self.arrivals and self.arrivals[0] <= self.clock.t:
+            self.arrivals.pop(0)
+            self.flag = True
+
+    def wait(self, timeout):
+        self.waits.append(round(timeout, 9))
+        self._catch_up()
+        if self.flag:
+            return True
+        if self.arrivals and self.arrivals[0] <= self.clock.t + timeout:
+            self.clock.t = self.arrivals.pop(0)
+            self.flag = True
+            return True
+        self.clock.t += timeout
+        return False
+
+    def clear(self):
+        self._catch_up()  # a reading queued before this moment was drained by the step about to run
+        self.flag = False
+
+
+def test_a_reading_starts_its_step_early_but_only_within_the_window():
+    c = FakeClock()
+    dt = 0.01
+    ev = FakeEvent(c, arrivals=[100.012, 100.0285])
+    p = RealTimePacer(dt, clock=c, sleep=c.sleep, wake=ev, early=0.004)
+    p.wait()  # step 0 at 100.0; slot 1 at 100.01 with no reading: waits for the slot
+    p.wait()
+    assert c.t == pytest.approx(100.01) and p.early_steps == 0
+    p.wait()  # a reading at 100.012 was queued long before the window opened at 100.016: step at once then
+    assert c.t == pytest.approx(100.016) and p.early_steps == 1
+    p.wait()  # the window for slot 3 opens at 100.026, the reading comes at 100.0285: step then
+    assert c.t == pytest.approx(100.0285) and p.early_steps == 2
+    p.wait()  # that reading was used: the next step waits for its slot
+    assert c.t == pytest.approx(100.04) and p.early_steps == 2
+
+
+def test_early_steps_keep_the_rate_and_never_burst():
     dt = 1 / 60
     c = FakeClock()
-    pacer = RealTimePacer(dt, clock=c, sleep=c.sleep)
-    lock = PhaseLock(dt, margin=0.005)
-    phase = 0.0123  # readings arrive 12.3 ms into every step period: 4.4 ms before the next drain
-    waits = []
-    for n in range(200):
-        pacer.wait()
-        drained = c.t
-        period = (drained - 100.0) // dt  # the newest reading is the one of the period just before
-        arrival = 100.0 + period * dt + phase
-        arrival -= dt if arrival > drained else 0.0
-        waits.append(drained - arrival)
-        pacer.shift(lock.correction([arrival], drained))
-    assert abs(waits[3] - (dt - phase)) < 2e-3  # at first: the fixed, arbitrary phase
-    assert all(abs(w - 0.005) < 1e-4 for w in waits[-50:])  # then: 5 ms after each reading
-    assert lock.correction([], 0.0) == 0.0
+    rng = np.random.default_rng(1)
+    arrivals = 100.0 + np.cumsum(rng.uniform(0.2 * dt, 1.8 * dt, 3000))  # readings at a jittery ~60 Hz
+    ev = FakeEvent(c, arrivals.tolist())
+    p = RealTimePacer(dt, clock=c, sleep=c.sleep, wake=ev)
+    starts = []
+    for _ in range(1000):
+        p.wait()
+        starts.append(c.t)
+        c.t += 0.001  # the step's work
+    gaps = np.diff(starts)
+    assert p.early_steps > 300
+    assert gaps.min() >= dt / 2 - 1e-9  # at most half a step early: never two steps back to back
+    assert (starts[-1] - starts[0]) / 999 == pytest.approx(dt, abs=dt / 999)  # the average rate is the step rate
+    slots = 100.0 + dt * np.arange(1000)
+    assert np.all(np.array(starts) <= slots + 1e-9) and np.all(np.array(starts) >= slots - dt / 2 - 1e-9)
 
 
-def test_phase_lock_holds_back_after_a_reading_just_missed_its_step():
-    from engine.pacing import PhaseLock
-
-    lock = PhaseLock(1 / 60, margin=0.005, gain=1.0, max_step=1.0)
-    assert lock.error([0.0], 0.016) == pytest.approx(-1 / 60 + 0.011)  # it just missed the step before: hold back
-    assert lock.correction([0.0], 0.009) == pytest.approx(0.004)  # waited 9 ms: 4 ms earlier
+def test_rejects_an_early_window_of_a_whole_step():
+    with pytest.raises(ValueError):
+        RealTimePacer(0.01, early=0.01)
