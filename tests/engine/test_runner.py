@@ -144,3 +144,30 @@ def test_absurd_options_are_refused() -> None:
         RunOptions(frames=-1)
     with pytest.raises(ValueError, match="needs a screenshot file"):
         RunOptions(screenshot_at=3)
+
+
+def test_a_paced_headless_run_starts_steps_early_for_readings_but_keeps_the_rate() -> None:
+    """Each step queues a reading (as a phone streaming at the step rate would): the next starts up to half a
+    step before its slot, while the schedule itself stays at one step per ``dt``."""
+    import threading
+    import time
+
+    import numpy as np
+
+    class Live(Counter):
+        def __init__(self) -> None:
+            super().__init__(limit=30)
+            self.input_wake = threading.Event()
+            self.times: list[float] = []
+
+        def step(self) -> None:
+            self.times.append(time.perf_counter())
+            self.input_wake.set()
+            super().step()
+
+    activity = Live()
+    Runner(RunOptions(headless=True, pace=True)).run(activity)
+    t = np.array(activity.times)
+    behind_slot = t[1:] - (t[0] + Counter.dt * np.arange(1, len(t)))
+    assert np.median(behind_slot) < -Counter.dt / 4  # early, not at the slot
+    assert np.median(np.diff(t)) == pytest.approx(Counter.dt, abs=0.003)  # and still one step per dt
