@@ -82,13 +82,3 @@ class RealTimePacer:
         """Readings from here on belong to the next step: only they may wake it."""
         if self._wake is not None:
             self._wake.clear()
-
-    def _release(self) -> None:
-        """Readings from here on belong to the next step: only they may wake it."""
-        if self._wake is not None:
-            self._wake.clear()
-
-    def shift(self, seconds: float) -> None:
-        """Bring the next steps forward by ``seconds`` (negative: later): a phase change, not a rate change."""
-        if self._next is not None:
-            self._next -= seconds
