@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from authoring.keyframe_curves.session import CurveSession
+from authoring.screen_pick import pick_point, point_on_view_plane
 from engine import quat
 from engine.camera import OrbitCamera
 from engine.fk import forward_kinematics
@@ -36,7 +37,6 @@ from engine.render.scene import RenderScene
 __all__ = ["CurvesScene"]
 
 F = NDArray[np.float64]
-PICK_PX = 14.0
 ORANGE = (0.95, 0.55, 0.1)
 RED = (0.9, 0.1, 0.1)
 PURPLE = (0.6, 0.15, 0.85)
@@ -76,19 +76,6 @@ class CurvesScene:
         s = self.session
         j = s.clip.skeleton.index(self.joint)
         return s.solver.points(self.frame_times(), j, np.zeros(3), clip or s.clip)
-
-    def _on_view_plane(self, px: tuple[float, float], through: F) -> F:
-        origin, d = self.camera.ray(px[0], px[1], *self.size)
-        n = self.camera.forward
-        t = float(np.dot(through - origin, n) / max(np.dot(d, n), 1e-9))
-        return origin + t * d
-
-    def _pick(self, points: F, px: tuple[float, float]) -> int | None:
-        screen = self.camera.project(points, *self.size)
-        dist = np.linalg.norm(screen - np.asarray(px), axis=1)
-        dist = np.where(np.isnan(dist), np.inf, dist)
-        k = int(np.argmin(dist))
-        return k if dist[k] <= PICK_PX else None
 
     def _key_frames(self) -> NDArray[np.int64]:
         clip = self.session.clip
@@ -142,7 +129,7 @@ class CurvesScene:
         """Button down on the trajectory: start a drag (or a re-time with Shift)."""
         p = (float(px), float(py))
         traj = self.trajectory()
-        f = self._pick(traj, p)
+        f = pick_point(self.camera, self.size, traj, p)
         if f is None:
             return False
         if f in set(self._key_frames().tolist()) and not shift:
@@ -157,7 +144,7 @@ class CurvesScene:
         g = self.gesture
         if g is None or g.kind != "drag":
             return
-        target = self._on_view_plane((float(px), float(py)), g.anchor)
+        target = point_on_view_plane(self.camera, self.size, (float(px), float(py)), g.anchor)
         res = self.session.drag(self.joint, self.frame_times()[g.frame], position=target, commit=False)
         self.message = "" if res.reached else f"out of reach (miss {res.error * 1e3:.0f} mm): kept the last pose"
 

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from authoring.mocurves import LAYERS, EditSession, RetimeDrag, item_chain, plane_from_stroke
+from authoring.screen_pick import pick_point, point_on_view_plane
 from engine.camera import OrbitCamera
 from engine.fk import forward_kinematics
 from engine.render.extract import puppet_capsules
@@ -36,7 +37,6 @@ __all__ = ["EditScene", "MODES"]
 
 F = NDArray[np.float64]
 MODES = ("points", "arrows", "timing", "contact")
-PICK_PX = 14.0
 CURVE = (0.95, 0.55, 0.1)
 FAINT = (0.55, 0.6, 0.7)
 RED = (0.9, 0.1, 0.1)
@@ -123,7 +123,7 @@ class EditScene:
         scene.add_points(curve.positions[frame][None], 16.0, (1.0, 0.9, 0.1), pixels=True)
         g = self.gesture
         if g is not None and g.kind == "stroke":
-            scene.add_line(g.anchor, self._on_view_plane(g.last_px, g.anchor), PURPLE, 4.0)
+            scene.add_line(g.anchor, point_on_view_plane(self.camera, self.size, g.last_px, g.anchor), PURPLE, 4.0)
         self._panel(scene)
 
     def _panel(self, scene: RenderScene) -> None:
@@ -138,21 +138,6 @@ class EditScene:
         if self.message:
             scene.add_text(self.message, 12, 108, 18, (1.0, 0.85, 0.4))
 
-    # -- geometry helpers ----------------------------------------------------------------------
-    def _on_view_plane(self, px: tuple[float, float], through: F) -> F:
-        """The point under pixel ``px`` on the plane through ``through`` facing the camera."""
-        origin, d = self.camera.ray(px[0], px[1], *self.size)
-        n = self.camera.forward
-        t = float(np.dot(through - origin, n) / max(np.dot(d, n), 1e-9))
-        return origin + t * d
-
-    def _pick(self, points: F, px: tuple[float, float]) -> int | None:
-        screen = self.camera.project(points, *self.size)
-        dist = np.linalg.norm(screen - np.asarray(px), axis=1)
-        dist = np.where(np.isnan(dist), np.inf, dist)
-        k = int(np.argmin(dist))
-        return k if dist[k] <= PICK_PX else None
-
     # -- mouse ------------------------------------------------------------------------------------
     def press(self, px: float, py: float, *, shift: bool = False) -> bool:
         """Mouse button down at pixel ``(px, py)``; True when it started a gesture."""
@@ -160,15 +145,15 @@ class EditScene:
         curve = s.curves()[self.item]
         if self.mode == "contact":
             centre = np.mean([s.curves()[i].positions.mean(axis=0) for i in self.contact_items], axis=0)
-            self.gesture = _Gesture("stroke", -1, p, self._on_view_plane(p, centre), p)
+            self.gesture = _Gesture("stroke", -1, p, point_on_view_plane(self.camera, self.size, p, centre), p)
             return True
         if self.mode == "points":
             ctrl = s.control_points(self.item)
-            k = self._pick(ctrl, p)
+            k = pick_point(self.camera, self.size, ctrl, p)
             if k is not None:
                 self.gesture = _Gesture("control", k, p, ctrl[k], p)
             return k is not None
-        k = self._pick(curve.positions, p)
+        k = pick_point(self.camera, self.size, curve.positions, p)
         if k is None:
             return False
         self.focus = k
@@ -184,12 +169,12 @@ class EditScene:
         g, p = self.gesture, (float(px), float(py))
         if g is None:
             if self.mode == "arrows":
-                k = self._pick(self.session.curves()[self.item].positions, p)
+                k = pick_point(self.camera, self.size, self.session.curves()[self.item].positions, p)
                 self.focus = self.focus if k is None else k
             return
         g.last_px = p
         if g.kind == "retime" and g.retime is not None:
-            g.retime.drag_to(g.index, self._on_view_plane(p, g.anchor))
+            g.retime.drag_to(g.index, point_on_view_plane(self.camera, self.size, p, g.anchor))
 
     def release(self, px: float, py: float) -> None:
         """Mouse button up: the gesture becomes one undoable edit (or a clear message)."""
@@ -200,10 +185,11 @@ class EditScene:
         s = self.session
         try:
             if g.kind == "retime" and g.retime is not None:
-                g.retime.drag_to(g.index, self._on_view_plane(p, g.anchor))
+                g.retime.drag_to(g.index, point_on_view_plane(self.camera, self.size, p, g.anchor))
                 g.retime.commit()
             elif g.kind == "control":
-                s.move_control_point(self.item, g.index, self._on_view_plane(p, g.anchor) - g.anchor)
+                moved = point_on_view_plane(self.camera, self.size, p, g.anchor) - g.anchor
+                s.move_control_point(self.item, g.index, moved)
             elif g.kind == "arrow":
                 dx, dy = p[0] - g.start_px[0], p[1] - g.start_px[1]
                 if g.scale:
@@ -211,7 +197,7 @@ class EditScene:
                 else:
                     s.rotate_arrow(self.item, g.index, self.camera.forward * (dx * 0.01))
             elif g.kind == "stroke":
-                end = self._on_view_plane(p, g.anchor)
+                end = point_on_view_plane(self.camera, self.size, p, g.anchor)
                 root = s.curves()[s.clip.skeleton.names[0]].positions.mean(axis=0)
                 plane = plane_from_stroke(g.anchor, end, self.camera.forward, root)
                 result = s.add_contact(list(self.contact_items), plane)

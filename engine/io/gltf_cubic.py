@@ -88,23 +88,7 @@ def write_gltf_cubic(path: str | os.PathLike[str], clip: KeyframedClip) -> Path:
     anim["extras"]["keyframed"] = True
     blob = buf.blob()
     doc["buffers"] = [{"byteLength": len(blob)}]
-    return atomic_write_bytes(p, _encode(doc, blob, p.suffix.lower() == ".glb"))
-
-
-def _encode(doc: dict, blob: bytes, binary: bool) -> bytes:  # type: ignore[type-arg]
-    import base64
-    import json
-    import struct
-
-    if not binary:
-        doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
-        return json.dumps(doc, indent=1).encode("utf-8")
-    js = json.dumps(doc, separators=(",", ":")).encode("utf-8")
-    js += b" " * ((-len(js)) % 4)
-    blob += b"\0" * ((-len(blob)) % 4)
-    total = 12 + 8 + len(js) + 8 + len(blob)
-    return b"".join([struct.pack("<4sII", b"glTF", 2, total), struct.pack("<I4s", len(js), b"JSON"), js,
-                     struct.pack("<I4s", len(blob), b"BIN\0"), blob])  # fmt: skip
+    return atomic_write_bytes(p, gltf_write.container_bytes(doc, blob, p.suffix.lower() == ".glb"))
 
 
 def read_gltf_cubic(path: str | os.PathLike[str], animation: int = 0, skin: int = 0) -> KeyframedClip:

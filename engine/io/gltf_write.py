@@ -31,7 +31,7 @@ from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
 from engine.fk import forward_kinematics
 
-__all__ = ["write_gltf", "gltf_bytes"]
+__all__ = ["write_gltf", "gltf_bytes", "container_bytes"]
 
 
 class _Bin:
@@ -126,6 +126,11 @@ def _document(clip: Clip) -> tuple[dict[str, Any], bytes]:
 def gltf_bytes(clip: Clip, binary: bool = True) -> bytes:
     """The file content: GLB when ``binary``, else glTF JSON with a data-URI buffer."""
     doc, blob = _document(clip)
+    return container_bytes(doc, blob, binary)
+
+
+def container_bytes(doc: dict, blob: bytes, binary: bool) -> bytes:  # type: ignore[type-arg]
+    """A glTF document and its buffer as a file: a GLB container, or JSON with the buffer as a data URI."""
     if not binary:
         doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
         return json.dumps(doc, indent=1).encode("utf-8")
