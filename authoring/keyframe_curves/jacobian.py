@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.ik._fk import _jumps
+from engine.ik.jacobian import ball_axis_columns
 from engine.ik._vec import cross
 from engine.ik.rig import IKRig
 
@@ -63,16 +64,7 @@ def batch_points(rig: IKRig, c: F, joints: NDArray[np.int64], points: F, cols: N
     slot = rig.dof_slot[cols]
     # World axis of every channel at every time: R_world(parent frame of the joint) · J_r(φ)[:, s].
     phi = c[:, 3:].reshape(c.shape[0], -1, 3)[:, dj]  # [T,C',3]
-    th2 = np.einsum("tki,tki->tk", phi, phi)
-    th = np.sqrt(th2)
-    small = th < 1e-4
-    ths = np.where(small, 1.0, th)
-    a = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(ths)) / ths**2)
-    b = np.where(small, 1.0 / 6.0 - th2 / 120.0, (ths - np.sin(ths)) / ths**3)
-    e = np.zeros_like(phi)
-    e[:, np.arange(cols.size), slot] = 1.0
-    phis = np.take_along_axis(phi, slot[None, :, None], axis=2)[..., 0]
-    local = e * (1.0 - b * th2)[..., None] - a[..., None] * cross(phi, e) + (b * phis)[..., None] * phi
+    local = ball_axis_columns(phi, slot)
     axes = np.einsum("tkij,tkj->tki", wmat[:, dj], local)
     axes[:, trans] = np.eye(3)[slot[trans]][None]
     lever = pos[:, None, :] - wpos[:, dj]

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from engine.ik._vec import cross
 from engine.ik.rig import BALL, IKRig
 
-__all__ = ["right_jacobian", "dof_axes", "point_jacobian", "orientation_jacobian"]
+__all__ = ["right_jacobian", "ball_axis_columns", "dof_axes", "point_jacobian", "orientation_jacobian"]
 
 F = NDArray[np.float64]
 
@@ -49,6 +49,26 @@ def right_jacobian(phi: ArrayLike) -> F:
     return eye - a[..., None, None] * k + b[..., None, None] * (k @ k)
 
 
+def ball_axis_columns(phi: F, slot: NDArray[np.int64]) -> F:
+    """Column ``slot`` of the right Jacobian ``J_r(φ)`` of rotation vectors ``phi [...,3]``: ``[...,3]``.
+
+    ``J_r(φ) = I − a[φ]× + b[φ]×²`` with ``[φ]×² = φφᵀ − θ²I``, taken column by column
+    without building matrices (the IK's and the tangent solver's inner loops call it for
+    every ball joint at every sample time); ``slot`` broadcasts against ``phi.shape[:-1]``.
+    Near θ = 0 the coefficients use their series, so the columns stay exact.
+    """
+    th2 = np.einsum("...i,...i->...", phi, phi)
+    th = np.sqrt(th2)
+    small = th < 1e-4
+    ths = np.where(small, 1.0, th)
+    a = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(ths)) / ths**2)
+    b = np.where(small, 1.0 / 6.0 - th2 / 120.0, (ths - np.sin(ths)) / ths**3)
+    slot = np.broadcast_to(slot, phi.shape[:-1])
+    e = (slot[..., None] == np.arange(3)).astype(np.float64)
+    phis = np.take_along_axis(phi, slot[..., None], axis=-1)[..., 0]
+    return e * (1.0 - b * th2)[..., None] - a[..., None] * cross(phi, e) + (b * phis)[..., None] * phi
+
+
 def dof_axes(rig: IKRig, c: ArrayLike, wmat: ArrayLike) -> F:
     """``[K,3]`` world axis of every coordinate (rotation axis, or translation direction).
 
@@ -66,17 +86,7 @@ def dof_axes(rig: IKRig, c: ArrayLike, wmat: ArrayLike) -> F:
     r = ~t
     j, s = rig.dof_joint[r], rig.dof_slot[r]
     ball = rig.kinds[j] == BALL
-    # Column s of J_r(φ) = I − a[φ]× + b[φ]×², with [φ]×² = φφᵀ − θ²I, without building matrices.
-    phi = rv[j[ball]]
-    th2 = np.einsum("ni,ni->n", phi, phi)
-    th = np.sqrt(th2)
-    small = th < 1e-4
-    ths = np.where(small, 1.0, th)
-    a = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(ths)) / ths**2)
-    b = np.where(small, 1.0 / 6.0 - th2 / 120.0, (ths - np.sin(ths)) / ths**3)
-    e = np.zeros_like(phi)
-    e[np.arange(phi.shape[0]), s[ball]] = 1.0
-    col = e * (1.0 - b * th2)[:, None] - a[:, None] * cross(phi, e) + (b * phi[np.arange(phi.shape[0]), s[ball]])[:, None] * phi
+    col = ball_axis_columns(rv[j[ball]], s[ball])
     rows = np.zeros((int(r.sum()), 3))
     rows[ball] = col
     rows[~ball] = rig.axes[j[~ball]]
