@@ -11,7 +11,9 @@ machine: requested root speed in m/s and hips height in m):
    that phase interval moves the puppet's ``Transform`` (turned into its heading);
 4. the blended pose (cross-faded with a one-shot or override clip, if one plays)
    is written to ``LocalPose`` with the root in world space and the heading folded
-   into joint 0, ready for IK and FK.
+   into joint 0, ready for IK and FK;
+5. the blend's foot-contact votes (each clip's contact labels, weighted) go to the
+   puppet's ``IKRequest.foot_lock``, so the leg IK holds planted feet where they landed.
 
 Puppets sharing a locomotion set are evaluated together, batched over puppets:
 one inside test and one k-d tree query for all their requests, one sample per
@@ -31,11 +33,14 @@ from numpy.typing import NDArray
 from engine import quat
 from engine.app import App
 from engine.blend.lookup import LookupTable, Resolution
+from engine.blend.measure import contact_votes
 from engine.blend.pose_blend import crossfade, fade_weight
 from engine.blend.space import BlendSpace
 from engine.clip import Clip
 from engine.components import LocalPose, Puppet, Transform
+from engine.clips.contacts import foot_contacts
 from engine.ecs import World
+from engine.ik.system import IKRequest
 from engine.pose import Pose
 
 __all__ = ["LocomotionSet", "BlendLibrary", "LocomotionPlayer", "animate", "install_blend"]
@@ -75,11 +80,22 @@ class BlendLibrary:
     def __init__(self) -> None:
         self.sets: dict[str, LocomotionSet] = {}
         self.memo: dict[tuple[str, float, float | None], Resolution] = {}
+        self.contact_tracks: dict[str, list[NDArray[np.bool_]] | None] = {}
 
     def add(self, name: str, locomotion: LocomotionSet) -> None:
         """Register (or replace) a set."""
         self.sets[name] = locomotion
         self.memo.clear()
+        self.contact_tracks.pop(name, None)
+
+    def tracks(self, name: str) -> list[NDArray[np.bool_]] | None:
+        """Each clip's per-frame foot contacts ``[frames, 2]`` of set ``name`` (``None`` for a
+        skeleton without ``l_foot``/``r_foot``): what the leg IK's foot locks follow."""
+        if name not in self.contact_tracks:
+            clips = self[name].space.clips
+            feet = all({"l_foot", "r_foot"} <= set(c.skeleton.names) for c in clips)
+            self.contact_tracks[name] = [foot_contacts(c) for c in clips] if feet else None
+        return self.contact_tracks[name]
 
     def __getitem__(self, name: str) -> LocomotionSet:
         try:
@@ -248,7 +264,9 @@ def animate(world: World) -> None:
         roots, rots = pose.root * scale[:, None], pose.rotations.copy()
         travel = travel * scale[:, None]
         keep_turn = np.ones(len(members))
-        for i, (_e, _tr, _pup, player) in enumerate(members):
+        tracks = library.tracks(key)
+        votes = None if tracks is None else contact_votes(space, w, new_phase, tracks)
+        for i, (e, _tr, _pup, player) in enumerate(members):
             player.phase = float(new_phase[i] % 1.0)
             clip, weight, clip_travel = _override(player, loco, dt)
             if clip is not None:
@@ -257,6 +275,9 @@ def animate(world: World) -> None:
                 roots[i], rots[i] = local.root, local.rotations
                 travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
                 keep_turn[i] = 1.0 - weight
+            ik = world.try_get(e, IKRequest)
+            if ik is not None:
+                ik.foot_lock.contacts = None if votes is None else votes[i] * (1.0 - (weight if clip is not None else 0.0))
         # Heading, travel and the world root for the whole group at once.
         yaw = _yaw(np.array([m[1].rotation for m in members]))
         hq = quat.from_axis_angle(_UP, yaw)

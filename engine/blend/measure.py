@@ -22,7 +22,7 @@ from engine import quat
 from engine.blend.space import BlendSpace
 from engine.fk import forward_kinematics, world_points
 
-__all__ = ["Playback", "play", "measure_locomotion", "foot_slide", "blended_contacts", "LOCOMOTION_PROPERTIES"]
+__all__ = ["Playback", "play", "measure_locomotion", "foot_slide", "blended_contacts", "contact_votes", "LOCOMOTION_PROPERTIES"]
 
 F = NDArray[np.float64]
 LOCOMOTION_PROPERTIES: tuple[str, ...] = ("speed", "height")
@@ -121,23 +121,29 @@ def measure_locomotion(space: BlendSpace, probes: ArrayLike, dt: float = 1.0 / 6
     return np.stack([speed, height_sum / period], axis=-1)
 
 
-def blended_contacts(
-    space: BlendSpace, weights: ArrayLike, phase: ArrayLike, tracks: Sequence[ArrayLike]
-) -> NDArray[np.bool_]:
-    """Contacts ``[..., F]`` of a blend: a foot is planted when clips holding most of the weight plant it.
+def contact_votes(space: BlendSpace, weights: ArrayLike, phase: ArrayLike, tracks: Sequence[ArrayLike]) -> F:
+    """How much of a blend's weight plants each foot: ``[..., F]`` in ``[0, 1]``.
 
     ``tracks[k]`` is clip ``k``'s per-frame contact labels ``[frames, F]`` (e.g.
-    ``engine.clips.foot_contacts``); each is read at the clip's synced frame and the
-    votes are weighted by the blend weights (strict majority).
+    ``engine.clips.foot_contacts``); each is read at the clip's synced frame and
+    weighted by the blend weights.
     """
     w = np.asarray(weights, dtype=np.float64)
     times = space.sync.clip_times(phase)
-    votes = 0.0
+    votes = np.zeros(w.shape[:-1] + (np.asarray(tracks[0]).shape[-1],))
     for k, (clip, track) in enumerate(zip(space.clips, tracks, strict=True)):
         labels = np.asarray(track, dtype=bool)
         frame = np.round(times[..., k] * clip.fps).astype(np.int64) % clip.num_frames
         votes = votes + w[..., k, None] * labels[frame]
-    return np.asarray(votes) > 0.5
+    return votes
+
+
+def blended_contacts(
+    space: BlendSpace, weights: ArrayLike, phase: ArrayLike, tracks: Sequence[ArrayLike]
+) -> NDArray[np.bool_]:
+    """Contacts ``[..., F]`` of a blend: a foot is planted when clips holding most of the weight
+    plant it (a strict majority of :func:`contact_votes`)."""
+    return contact_votes(space, weights, phase, tracks) > 0.5
 
 
 def foot_slide(

@@ -16,7 +16,7 @@ as arrays over the puppets.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.ik._limb import solve_limb
+from engine.ik.foot_lock import FootLock, floor_lift, lock_feet
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
 from engine.ik._vec import path_fk
 from engine.pose import Pose
@@ -81,13 +82,15 @@ class HeightfieldGround:
 
 @dataclass(frozen=True)
 class Leg:
-    """A leg's joints, the knee's pole direction in the hips' frame, and the sole in the foot's frame."""
+    """A leg's joints, the knee's pole direction in the hips' frame, the sole centre and the
+    back of the heel in the foot's frame (the toe tip is the foot bone's tip)."""
 
     upper: str
     lower: str
     foot: str
     sole: tuple[float, float, float]
     knee_forward: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    heel: tuple[float, float, float] = (0.0, -0.05, -0.05)
 
 
 # The humanoid's sole centre: under the ankle, half-way to the toe tip (tips: (0, -0.05, 0.15)).
@@ -95,6 +98,41 @@ HUMANOID_LEGS: tuple[Leg, ...] = (
     Leg("l_upper_leg", "l_lower_leg", "l_foot", (0.0, -0.05, 0.075)),
     Leg("r_upper_leg", "r_lower_leg", "r_foot", (0.0, -0.05, 0.075)),
 )
+
+
+def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_rot: F, floor: F, normal: F,
+                   locks: Sequence[FootLock | None] | None, dt: float, weight: F) -> F:
+    """Ankle targets ``[P, L, 3]`` with no toe or heel under the ground and planted toes locked.
+
+    ``floor [P, L, 3]`` is the ground point under each sole and ``normal`` its normal: toe
+    and heel are kept on the positive side of that tangent plane (a foot on a slope is
+    measured along the slope). ``weight [P]`` scales the lift like the rest of the
+    grounding; a puppet whose lock has no ``contacts`` this step is only lifted."""
+    tips = np.array([skeleton.tips[skeleton.index(leg.foot)] for leg in legs])
+    heels = np.array([leg.heel for leg in legs])
+    toes = targets + quat.rotate(new_rot, tips)
+    backs = targets + quat.rotate(new_rot, heels)
+    n = (1.0 - weight[:, None, None]) * np.array(_UP) + weight[:, None, None] * normal
+    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    depth = np.stack([((toes - floor) * n).sum(-1), ((backs - floor) * n).sum(-1)], axis=-1)
+    lift = floor_lift(depth, np.zeros(depth.shape[:-1])) / n[..., 1]
+    targets = targets.copy()
+    targets[..., 1] += lift
+    toes[..., 1] += lift
+    if locks is None:
+        return targets
+    for p, lock in enumerate(locks):
+        if lock is None or lock.contacts is None:
+            continue
+        count = len(legs)
+        if lock.weights.shape != (count,):
+            lock.points, lock.weights, lock.planted = np.zeros((count, 3)), np.zeros(count), np.zeros(count, dtype=bool)
+        contacts = np.broadcast_to(np.asarray(lock.contacts, dtype=np.float64), (count,))
+        lock.points, lock.weights, lock.planted, toe = lock_feet(
+            lock.points, lock.weights, lock.planted, toes[p], contacts, toes[p, :, 1] - floor[p, :, 1], dt,
+            lock.release_time, lock.max_stretch, lock.release_height)
+        targets[p, :, [0, 2]] += (toe - toes[p])[:, [0, 2]].T
+    return targets
 
 
 def ground_feet(
@@ -108,6 +146,8 @@ def ground_feet(
     contact_height: float = 0.03,
     max_pelvis_shift: float = 0.5,
     weight: float = 1.0,
+    lock: FootLock | None = None,
+    dt: float = 0.0,
 ) -> F:
     """Plant one puppet's feet on ``ground`` in place; returns the pelvis height change applied.
 
@@ -119,6 +159,8 @@ def ground_feet(
         contact_height: sole height (m) below which the foot counts as planted (fully aligned).
         max_pelvis_shift: largest pelvis move (m), either way.
         weight: 0..1 blend of the whole effect.
+        lock: the puppet's :class:`~engine.ik.foot_lock.FootLock` (updated in place); planted
+            toes stay where they landed. ``dt`` is the step it advances by.
     """
     if not 0.0 <= weight <= 1.0:
         raise ValueError("weight must lie in 0..1")
@@ -145,6 +187,10 @@ def ground_feet(
         r = qmul(slerp(Q_ID, between(_UP, n), planted), q)
         new_rot.append(r)
         targets.append(sub((s[0], h * weight + ch, s[2]), qrot(r, leg.sole)))
+    floor = np.array([[(sl[0], h * weight, sl[2]) for sl, h in zip(sole, height, strict=True)]])
+    fixed = _lock_and_lift(skeleton, legs, np.array([targets]), np.array([new_rot]), floor, np.array([normal]),
+                           None if lock is None else [lock], dt, np.array([weight]))[0]
+    targets = [tuple(t) for t in fixed.tolist()]
     # Pelvis: follow the lowest foot (negative into dips, positive onto steps).
     shift = min(max(min(t[1] - a[1] for t, a in zip(targets, ankle)), -max_pelvis_shift), max_pelvis_shift)
     pose.root[1] += shift
@@ -170,6 +216,8 @@ def ground_feet_batch(
     contact_height: float = 0.03,
     max_pelvis_shift: float = 0.5,
     weight: ArrayLike = 1.0,
+    locks: Sequence[FootLock | None] | None = None,
+    dt: float = 0.0,
 ) -> F:
     """:func:`ground_feet` for ``P`` puppets of one skeleton at once, in place.
 
@@ -183,6 +231,7 @@ def ground_feet_batch(
         rotations: ``[P,J,4]`` local rotations (the legs are solved in them).
         offsets: ``[J,3]`` or ``[P,J,3]`` bone offsets.
         weight: ``[P]`` (or one) 0..1 blend of the whole effect.
+        locks: per puppet, its :class:`~engine.ik.foot_lock.FootLock` (or ``None``), advanced by ``dt``.
 
     Returns:
         ``[P]`` pelvis height changes applied.
@@ -211,7 +260,8 @@ def ground_feet_batch(
     tilt = quat.between(np.broadcast_to(_UP, normal.shape), normal)
     new_rot = quat.mul(quat.slerp(quat.identity(*planted.shape), tilt, planted), qfeet)
     flat = np.stack([sole[..., 0], height * w[:, None] + clip_height, sole[..., 2]], axis=-1)
-    targets = flat - quat.rotate(new_rot, soles)
+    floor = np.stack([sole[..., 0], height * w[:, None], sole[..., 2]], axis=-1)
+    targets = _lock_and_lift(skeleton, legs, flat - quat.rotate(new_rot, soles), new_rot, floor, normal, locks, dt, w)
     shift = np.clip(np.min(targets[..., 1] - ankles[..., 1], axis=1), -max_pelvis_shift, max_pelvis_shift)
     roots[:, 1] += shift
     hips = {int(skeleton.parents[u]) for u, _, _ in idx}

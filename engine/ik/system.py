@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from engine.components import LocalPose, Puppet
 from engine.ecs import World
 from engine.humanoid import JOINTS
+from engine.ik.foot_lock import FootLock
 from engine.ik.grounding import GroundQuery, PlaneGround, ground_feet, ground_feet_batch
 from engine.ik.hands import hands_on_sphere
 from engine.ik.rig import IKRig, humanoid_rig
@@ -42,7 +43,9 @@ class IKRequest:
 
     ``effectors``/``pins`` feed the optimisation IK; ``sphere_centre`` with a positive
     ``sphere_radius`` puts both hands on that sphere; ``grounding`` plants the feet.
-    ``reached`` and ``pelvis_shift`` are written back by :func:`ik_system`.
+    ``reached`` and ``pelvis_shift`` are written back by :func:`ik_system`. ``foot_lock``
+    keeps planted toes where they landed while grounding (the animation stage writes its
+    contact votes); it lets go when grounding stops (a jump, a fall).
     """
 
     grounding: bool = False
@@ -54,6 +57,7 @@ class IKRequest:
     keep_closest: bool = True
     reached: bool = True
     pelvis_shift: float = 0.0
+    foot_lock: FootLock = field(default_factory=FootLock)
 
 
 @dataclass
@@ -117,7 +121,8 @@ def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]
         rots = np.array([local.rotations for _, local, _ in group], dtype=np.float64)
         offsets = np.array([p.joint_offsets() for p, _, _ in group])
         weights = np.array([req.grounding_weight for _, _, req in group])
-        shift = ground_feet_batch(sk, roots, rots, query, offsets=offsets, weight=weights)
+        shift = ground_feet_batch(sk, roots, rots, query, offsets=offsets, weight=weights,
+                                  locks=[req.foot_lock for _, _, req in group], dt=world.dt)
         finite = np.isfinite(roots).all(axis=1) & np.isfinite(rots).all(axis=(1, 2))
         for i, (puppet, local, req) in enumerate(group):
             done.add(id(req))
@@ -155,7 +160,11 @@ def ik_system(world: World) -> None:
                 pose.rotations[:] = res.rotations if res.reached else res.closest_rotations
         if req.grounding:
             query = ground.query if ground is not None else PlaneGround()
-            req.pelvis_shift = float(ground_feet(sk, pose, query, offsets=offsets, weight=req.grounding_weight))
+            req.pelvis_shift = float(ground_feet(sk, pose, query, offsets=offsets, weight=req.grounding_weight,
+                                                 lock=req.foot_lock, dt=world.dt))
+        else:
+            req.foot_lock.weights = np.zeros_like(req.foot_lock.weights)
+            req.foot_lock.planted = np.zeros_like(req.foot_lock.planted)
         if req.sphere_centre is not None and req.sphere_radius > 0.0:
             hands_on_sphere(sk, pose, req.sphere_centre, req.sphere_radius, offsets=offsets)
         if pose.is_finite():

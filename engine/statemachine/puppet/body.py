@@ -28,8 +28,15 @@ class PuppetTuning:
     Heights are hips heights in metres; speeds in m/s. ``front`` is how far the body
     reaches in front of its root: balls are carried, rolled and put down beyond it, so
     a bulky puppet (a snowman's bottom ball) never holds a ball inside itself.
+
+    ``controller`` picks the locomotion control: ``"spring"`` (a critically damped spring
+    on the requested velocity, :mod:`~engine.statemachine.puppet.follow`) or ``"legacy"``
+    (the hard-switched follower of earlier rounds, kept so ``bench motion`` compares them).
+    ``max_speed`` caps the legacy request and sets what counts as running; the spring
+    controller asks up to ``top_speed`` and lets the lookup table speed the clips up.
     """
 
+    controller: str = "spring"
     stand_height: float = 0.95
     crouch_height: float = 0.55
     crouch_enter: float = 0.80
@@ -40,6 +47,9 @@ class PuppetTuning:
     follow_deadband: float = 0.06
     turn_rate: float = 5.0
     drag_limit: float = 1.6
+    drag_lead_time: float = 0.5
+    top_speed: float = 6.0
+    follow_omega: float = 20.0
     anticipation: float = 0.16
     landing: float = 0.22
     flick_launch_speed: float = 3.4
@@ -74,6 +84,9 @@ class PuppetBody:
         target_height: hips height the stick asks for (its tip's height).
         heading: facing angle about +Y (0 = +Z).
         speed: smoothed stick ground speed.
+        lead: the stick's ground velocity (the feed-forward of the locomotion control).
+        walk_velocity: the requested ground velocity, smoothed by the control's spring.
+        walk_rate: the spring's rate of change of ``walk_velocity``.
         air: height of the root above the ground during a jump.
         air_velocity: the puppet's velocity while airborne (ballistic jumps).
         ground_velocity: the puppet's measured ground velocity over the last step (its momentum).
@@ -92,6 +105,9 @@ class PuppetBody:
     target_height: float = 0.95
     heading: float = 0.0
     speed: float = 0.0
+    lead: F = field(default_factory=lambda: np.zeros(3))
+    walk_velocity: F = field(default_factory=lambda: np.zeros(3))
+    walk_rate: F = field(default_factory=lambda: np.zeros(3))
     air: float = 0.0
     air_velocity: F = field(default_factory=lambda: np.zeros(3))
     ground_velocity: F = field(default_factory=lambda: np.zeros(3))

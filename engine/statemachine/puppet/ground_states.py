@@ -3,9 +3,10 @@
 Both states drive the same blend space (thesis Fig. 6.3): the stick's ground speed
 becomes the requested root speed, resolved to blend parameters by the IDW lookup
 table; the stick's height becomes the hips height. The puppet follows the stick's
-ground point with the speed of the stick plus a catch-up term on the remaining
-distance, turning toward where it is led at a bounded rate, so the clip's root
-motion — not a teleport — carries it and its feet do not slide.
+ground point through the locomotion control (:mod:`~engine.statemachine.puppet.follow`:
+the stick's velocity plus a smooth catch-up, through a critically damped spring),
+turning toward where it is led at a bounded rate, so the clip's root motion — not a
+teleport — carries it and its feet do not slide.
 """
 
 from __future__ import annotations
@@ -18,38 +19,18 @@ from engine.ecs import Entity, World
 from engine.ik.system import IKRequest
 from engine.statemachine.machine import Brain
 from engine.statemachine.puppet.body import PuppetBody
-from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
+from engine.statemachine.puppet.follow import drag_reach, follow_velocity
+from engine.statemachine.puppet.follow_legacy import follow_stick_legacy
 
 __all__ = ["follow_stick", "update_locomotion", "update_crouch", "locomotion_fits", "wants_crouch", "wants_stand", "lifted"]
 
 
-def _wrap(angle: float) -> float:
-    return float((angle + np.pi) % (2 * np.pi) - np.pi)
-
-
 def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0) -> None:
-    """Steer toward the stick's ground point: set heading and requested speed."""
-    tr = world.get(entity, Transform)
-    t = body.tuning
-    if body.held_by is None:
-        player.speed = 0.0
-        return
-    err = body.target - tr.position
-    err[1] = 0.0
-    dist = float(np.linalg.norm(err))
-    chase = max(dist - t.follow_deadband, 0.0)
-    wanted = 0.0 if chase <= 0.0 and body.speed < t.still_speed else body.speed + t.catch_up_gain * chase
-    if dist > 0.12:
-        goal = float(np.arctan2(err[0], err[2]))
-        turn = _wrap(goal - body.heading)
-        body.heading = _wrap(body.heading + float(np.clip(turn, -t.turn_rate * world.dt, t.turn_rate * world.dt)))
-        # Walk only as fast as the facing allows; a puppet turns before it strides off.
-        facing = max(float(heading_vector(body.heading) @ (err / dist)), 0.0)
-        wanted *= facing
+    """Steer toward the stick's ground point: set heading and requested speed (the tuning's controller)."""
+    if body.tuning.controller == "legacy":
+        follow_stick_legacy(world, entity, body, player, speed_scale)
     else:
-        wanted = min(wanted, t.catch_up_gain * dist)
-    tr.rotation = yaw_rotation(body.heading)
-    player.speed = float(np.clip(wanted * speed_scale, 0.0, t.max_speed))
+        follow_velocity(world, entity, body, player, speed_scale)
 
 
 def lifted(body: PuppetBody) -> bool:
@@ -63,7 +44,8 @@ def locomotion_fits(world: World, entity: Entity, brain: Brain) -> bool:
     if body.held_by is None:
         return True
     tr = world.get(entity, Transform)
-    far = float(np.linalg.norm((body.target - tr.position)[[0, 2]])) > body.tuning.drag_limit
+    reach = body.tuning.drag_limit if body.tuning.controller == "legacy" else drag_reach(body)
+    far = float(np.linalg.norm((body.target - tr.position)[[0, 2]])) > reach
     return not lifted(body) and not far
 
 

@@ -58,12 +58,14 @@ def sense(world: World, entity: Entity, body: PuppetBody) -> Stick | None:
     if held is None:
         body.held_by = None
         body.speed = 0.0
+        body.lead = np.zeros(3)
         return None
     body.held_by, stick = held
     anchor = wanted_anchor(stick)
     body.target = np.array([anchor[0], 0.0, anchor[2]])
     body.target_height = float(anchor[1])
     body.speed = float(np.hypot(stick.velocity[0], stick.velocity[2]))
+    body.lead = np.array([stick.velocity[0], 0.0, stick.velocity[2]])
     return stick
 
 

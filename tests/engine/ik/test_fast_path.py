@@ -59,6 +59,14 @@ def _ref_ground(sk, pose, ground, weight, align_height=0.25, contact_height=0.03
     new_rot = quat.mul(quat.slerp(quat.identity(2), quat.between(UP, normal), planted), qfoot)
     new_sole = np.stack([sole[:, 0], height * weight + clip_height, sole[:, 2]], axis=-1)
     targets = new_sole - quat.rotate(new_rot, sole_local)
+    # No toe tip or heel below the ground: the foot is raised by the deepest one.
+    toes = targets + quat.rotate(new_rot, sk.tips[feet])
+    heels = targets + quat.rotate(new_rot, np.array([g.heel for g in HUMANOID_LEGS]))
+    n = (1 - weight) * UP + weight * normal
+    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    floor = np.stack([sole[:, 0], height * weight, sole[:, 2]], axis=-1)
+    depth = np.minimum(((toes - floor) * n).sum(-1), ((heels - floor) * n).sum(-1))
+    targets[:, 1] += np.maximum(-depth, 0.0) / n[:, 1]
     shift = float(np.clip(np.min(targets[:, 1] - ankle[:, 1]), -max_shift, max_shift))
     pose.root[1] += shift
     for leg, (u, lo, f), tgt, frot in zip(HUMANOID_LEGS, idx, targets, new_rot, strict=True):

@@ -1,0 +1,98 @@
+"""Locomotion control: how a held puppet's requested velocity follows the stick.
+
+Game engines do not feed a character's raw input to its blend: a *critically damped
+spring* on the requested velocity (Unity's ``SmoothDamp``, Unreal's "velocity
+smoothing") turns a jittery or stepped input into a request that is smooth (no pose
+pops, so no foot sliding from sudden blend changes) yet fast (no overshoot, 90 % of a
+step in ``3.89 / ω`` seconds). What it tracks here is the stick's own ground velocity
+(feed-forward: a puppet dragged at 1.2 m/s is asked for 1.2 m/s, whatever its lag)
+plus a catch-up proportional to the remaining distance, faded in smoothly over the
+dead band instead of switched at a hard radius (a switch made the request jump
+between a walk and a stroll several times a second, and each jump skated the feet).
+
+The request is not clamped to the fastest clip: the lookup table projects an
+out-of-reach speed onto its border and plays the animation faster (thesis §6.2.3,
+``u/u'``), so a fast drag makes the puppet sprint rather than fall behind and drop.
+The puppet turns toward the direction of its smoothed velocity at a bounded rate and
+walks only as fast as its facing allows, so a reversal turns it around. The drag
+limit grows with the puppet's own speed (a running puppet reaches further), never with
+the stick's (a yank stays a yank).
+
+Everything is arrays over the ground plane, one puppet at a time (the crowd batches
+the same functions); time is ``world.dt``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.blend.locomotion import LocomotionPlayer
+from engine.components import Transform
+from engine.ecs import Entity, World
+from engine.statemachine.puppet.body import PuppetBody, PuppetTuning
+from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
+
+__all__ = ["spring_step", "wanted_velocity", "follow_velocity", "drag_reach"]
+
+F = NDArray[np.float64]
+
+
+def spring_step(value: F, rate: F, goal: F, omega: float, dt: float) -> tuple[F, F]:
+    """One exact step of a critically damped spring pulling ``value`` toward ``goal``.
+
+    The closed form of ``x'' = -2ωx' - ω²x`` (``x = value - goal``) over ``dt``, so it is
+    stable for any step and does not overshoot a step change. Returns ``(value, rate)``.
+    """
+    x = value - goal
+    decay = np.exp(-omega * dt)
+    k = rate + omega * x
+    return goal + (x + k * dt) * decay, (rate - omega * k * dt) * decay
+
+
+def wanted_velocity(error: F, lead: F, tuning: PuppetTuning) -> F:
+    """The ground velocity the puppet should have: the stick's, plus a catch-up on ``error``.
+
+    The catch-up gain fades in as ``d² / (d² + deadband²)`` of the distance ``d``, so a
+    puppet standing at its stick does not creep toward every tremor of the hand, and
+    nothing switches at a radius. The result is capped at ``tuning.top_speed``.
+    """
+    d2 = float(error @ error)
+    band2 = tuning.follow_deadband**2
+    wanted = lead + tuning.catch_up_gain * (d2 / (d2 + band2) if d2 > 0.0 else 0.0) * error
+    speed = float(np.linalg.norm(wanted))
+    return wanted * (tuning.top_speed / speed) if speed > tuning.top_speed else wanted
+
+
+def drag_reach(body: PuppetBody) -> float:
+    """How far the stick may run ahead before the puppet counts as yanked: more for a faster puppet."""
+    t = body.tuning
+    return t.drag_limit + t.drag_lead_time * float(np.linalg.norm(body.walk_velocity))
+
+
+def _wrap(angle: float) -> float:
+    return float((angle + np.pi) % (2 * np.pi) - np.pi)
+
+
+def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer,
+                    speed_scale: float = 1.0) -> None:
+    """Steer toward the stick: smooth the wanted velocity, turn toward it, request its speed."""
+    tr = world.get(entity, Transform)
+    t = body.tuning
+    if body.held_by is None:
+        goal = np.zeros(3)
+    else:
+        error = (body.target - tr.position) * np.array([1.0, 0.0, 1.0])
+        goal = wanted_velocity(error, body.lead * np.array([1.0, 0.0, 1.0]), t)
+    body.walk_velocity, body.walk_rate = spring_step(body.walk_velocity, body.walk_rate, goal, t.follow_omega, world.dt)
+    v = body.walk_velocity
+    speed = float(np.hypot(v[0], v[2]))
+    facing = 1.0
+    if speed > 1e-3:
+        turn = _wrap(float(np.arctan2(v[0], v[2])) - body.heading)
+        # A slow puppet pivots on the spot faster than a running one can swing round.
+        rate = t.turn_rate * (1.0 + 1.0 / (1.0 + speed))
+        body.heading = _wrap(body.heading + float(np.clip(turn, -rate * world.dt, rate * world.dt)))
+        facing = max(float(heading_vector(body.heading) @ (v / speed)), 0.0)
+    tr.rotation = yaw_rotation(body.heading)
+    player.speed = speed * facing * speed_scale
