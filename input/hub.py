@@ -5,8 +5,9 @@ the deterministic one. It
 
 - drains each source in registration order, keeping samples in arrival order;
 - coalesces floods: per source at most ``max_samples`` samples per step survive
-  (the newest, plus any sample that changes touch or asks to calibrate), the rest
-  are counted as dropped, so a burst never costs the step more than a bounded time;
+  (the newest, plus any sample that changes touch, flicks or asks to calibrate), the
+  rest are counted as coalesced, so a burst never costs the step more than a bounded
+  time; what adds up is kept: their wheel notches move to the next kept sample;
 - turns touch transitions into ``touch_down`` / ``touch_up`` events;
 - round-trips the frame through :mod:`input.codec`, so the live simulation reads
   exactly the bits a recording stores and a replay will feed back.
@@ -18,11 +19,12 @@ recorded frame for each index instead of draining live sources.
 from __future__ import annotations
 
 import threading
+from dataclasses import replace
 from collections.abc import Iterable
 from typing import Protocol
 
 from input.codec import decode_frame, encode_frame
-from input.sample import COMMANDS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus, encode_tool
+from input.sample import LIMITS, COMMANDS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus, encode_tool
 from input.source import PoseSource
 
 __all__ = ["InputHub", "FrameSource"]
@@ -136,6 +138,8 @@ class InputHub:
         return self.last_frame
 
     def _coalesce(self, pose: list[PoseSample]) -> list[PoseSample]:
+        """At most ``max_samples`` per source and step, losing nothing that adds up: dropped
+        samples' wheel notches (``depth_delta``) move to the next kept sample of their source."""
         if len(pose) <= self.max_samples:
             return pose
         keep = set(range(len(pose) - self.max_samples, len(pose)))
@@ -146,4 +150,13 @@ class InputHub:
             if s.touch is not None:
                 last_touch[s.source] = s.touch
         self.coalesced += len(pose) - len(keep)
-        return [s for i, s in enumerate(pose) if i in keep]
+        out: list[PoseSample] = []
+        carried: dict[str, float] = {}
+        for i, s in enumerate(pose):
+            if i not in keep:
+                carried[s.source] = carried.get(s.source, 0.0) + s.depth_delta
+                continue
+            extra = carried.pop(s.source, 0.0)
+            total = min(max(s.depth_delta + extra, -LIMITS["depth_delta"]), LIMITS["depth_delta"])
+            out.append(replace(s, depth_delta=total) if extra else s)
+        return out

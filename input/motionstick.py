@@ -3,8 +3,12 @@
 The puppet hangs at the end of an invisible stick fixed to the controller. Each
 step, for every controller entity (``Stick`` + :class:`StickState`):
 
-1. take the newest sample of the source it is bound to (the first source that
-   speaks, unless bound to one by name); a disconnect releases the puppet;
+1. take *every* sample of the source it is bound to this step (the first source
+   that speaks, unless bound to one by name), in arrival order: the newest sets the
+   pose, wheel notches (``depth_delta``) are summed, a flick in any sample counts, and
+   each sample's tip feeds the velocity filter at its own timestamp (event time, not
+   the step's), so a 125 Hz mouse or a 100 Hz phone loses nothing at 60 steps a
+   second; a disconnect releases the puppet;
 2. build the stick: ``"world"`` samples give pivot and orientation directly (the
    mouse: a stick held at the camera); ``"device"`` samples are turned by the
    calibration heading and pivot at a virtual phone position (moved by the tracked
@@ -16,8 +20,9 @@ step, for every controller entity (``Stick`` + :class:`StickState`):
    rotation relative to the tip; touch up releases;
 5. shorten the stick where the tip would go below the ground or into an
    :class:`~engine.components.Obstacle`;
-6. filter the tip velocity (One Euro) and detect an upward flick; a filter state that is
-   not finite starts again at rest.
+6. filter the tip velocity (One Euro, stepped per sample by the time between samples;
+   a step without samples steps it by ``dt`` at rest) and detect an upward flick; a
+   filter state that is not finite starts again at rest.
 
 Everything here runs on the fixed ``dt`` with state in components, so a replay
 reproduces it bit for bit.
@@ -76,6 +81,7 @@ class StickState:
     filt_dx: F = field(default_factory=lambda: np.zeros(3))
     flick_armed: bool = True
     world_mode: bool = False
+    last_time: float | None = None
 
 
 def spawn_stick(world: World, binding: str = "*") -> Entity:
@@ -136,11 +142,11 @@ def _release(stick: Stick) -> None:
         stick.grabbed, stick.released = None, stick.grabbed
 
 
-def _length(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, focus_t: float | None) -> float:
+def _length(st: StickState, stick: Stick, depth_delta: float, cfg: StickConfig, focus_t: float | None) -> float:
     if stick.grabbed is None:
         return focus_t if focus_t is not None else cfg.idle_length
-    if s is not None and s.depth_delta:
-        st.depth = max(cfg.min_depth, st.depth + s.depth_delta)
+    if depth_delta:
+        st.depth = max(cfg.min_depth, st.depth + depth_delta)
         if st.plane_normal is None:
             st.held_length = st.depth
     if st.plane_normal is not None:
@@ -176,10 +182,13 @@ def motionstick_system(world: World) -> None:
             if first is None:
                 continue
             st.source, stick.source, stick.connected = first, first, True
-        s = frame.latest(st.source)
-        if s is not None:
+        samples = frame.samples_of(st.source)
+        s = samples[-1] if samples else None
+        poses: list[tuple[F, F, float]] = []  # each sample's pivot, direction and time (for the velocity)
+        for sample in samples:
             stick.connected = True
-            _apply_sample(st, stick, s, cfg)
+            _apply_sample(st, stick, sample, cfg)
+            poses.append((stick.pivot.copy(), stick.direction.copy(), sample.time))
         if stick.grabbed is not None and not world.alive(stick.grabbed):
             _release(stick)
         # Ray pick: what would be grabbed now (the renderer outlines it).
@@ -203,33 +212,50 @@ def motionstick_system(world: World) -> None:
             elif kind == TOUCH_UP:
                 stick.touching = False
                 _release(stick)
-        wanted = _length(st, stick, s, cfg, None if hit is None else hit[1])
+        wanted = _length(st, stick, sum(x.depth_delta for x in samples), cfg, None if hit is None else hit[1])
         bases, radii_o, heights = _obstacles(world, stick.grabbed)
+        tips = [(pivot + d * shorten(pivot, d, wanted, cfg.ground_y, bases, radii_o, heights), t) for pivot, d, t in poses]
         stick.length = shorten(stick.pivot, stick.direction, wanted, cfg.ground_y, bases, radii_o, heights)
         stick.tip = stick.pivot + stick.direction * stick.length
         stick.tip_rotation = stick.orientation.copy()
-        _filter_velocity(st, stick, s, cfg, world.dt)
+        if tips:
+            tips[-1] = (stick.tip.copy(), tips[-1][1])
+        _filter_velocity(st, stick, tips, any(x.flick for x in samples), cfg, world.dt)
         # Samples are range-checked where they enter (input.sample.LIMITS), so this never fires;
         # if it does, a NaN was about to enter the world: stop here, not in a later stage.
         assert np.isfinite(stick.tip).all() and np.isfinite(stick.velocity).all(), f"stick {e} is not finite"
 
 
-def _filter_velocity(st: StickState, stick: Stick, s: PoseSample | None, cfg: StickConfig, dt: float) -> None:
-    if st.filt_x is None:
-        st.filt_x, st.filt_dx = stick.tip.copy(), np.zeros(3)
-    else:
-        st.filt_x, st.filt_dx = cfg.filter.step(stick.tip, st.raw_x, st.filt_x, st.filt_dx, dt)
-        if not (np.all(np.isfinite(st.filt_x)) and np.all(np.isfinite(st.filt_dx))):
-            # A filter keeps what it is fed for good: start again at rest rather than carry NaN
-            # into every later step (and into the puppet's locomotion request).
-            st.filt_x, st.filt_dx = stick.tip.copy(), np.zeros(3)
-    st.raw_x = stick.tip.copy()
+def _filter_velocity(st: StickState, stick: Stick, tips: list[tuple[F, float]], flicked: bool, cfg: StickConfig,
+                     dt: float) -> None:
+    """Feed each sample's tip to the One Euro filter at its own time; detect a flick.
+
+    The time between samples comes from their timestamps, at most 0.1 s (a long silence
+    must not make the rate vanish); a source whose stamps do not advance (equal or
+    backwards) gets the step shared evenly between its samples, so a burst never blows the
+    rate up. A step without samples holds the tip still for ``dt``: a mouse that stops
+    sends nothing."""
+    steps = tips or [(stick.tip.copy(), None)]
+    share = dt / len(steps)
+    for tip, stamp in steps:
+        if st.filt_x is None:
+            st.filt_x, st.filt_dx = tip.copy(), np.zeros(3)
+        else:
+            gap = share if stamp is None or st.last_time is None else float(stamp - st.last_time)
+            gap = min(gap, 0.1) if gap > 1e-4 else share
+            st.filt_x, st.filt_dx = cfg.filter.step(tip, st.raw_x, st.filt_x, st.filt_dx, gap)
+            if not (np.all(np.isfinite(st.filt_x)) and np.all(np.isfinite(st.filt_dx))):
+                # A filter keeps what it is fed for good: start again at rest rather than carry NaN
+                # into every later step (and into the puppet's locomotion request).
+                st.filt_x, st.filt_dx = tip.copy(), np.zeros(3)
+        st.raw_x = tip.copy()
+        st.last_time = (st.last_time + dt if st.last_time is not None else None) if stamp is None else float(stamp)
     stick.velocity = st.filt_dx.copy()
     up = float(stick.velocity[1])
     # A "world" source (the mouse) says itself when it flicks: its tip jumps with wheel
     # notches and cursor warps, so its velocity is not a gesture. Devices flick by velocity.
     by_velocity = not st.world_mode and st.flick_armed and stick.grabbed is not None and up > cfg.flick_speed
-    if (s is not None and s.flick) or by_velocity:
+    if flicked or by_velocity:
         stick.flick, st.flick_armed = True, False
     elif up < 0.5 * cfg.flick_speed:
         st.flick_armed = True

@@ -13,7 +13,10 @@ needs the camera:
   ``plane="view"`` it faces the camera (a modelling tool's drag);
 - the wheel changes the grab depth (``wheel_step`` metres per notch): in the ground
   plane, wheel up lifts what is held and wheel down lowers it (a puppet crouches);
-- a quick upward drag is a flick (jumps);
+- a quick upward stroke is a flick (jumps): the cursor rises at least ``flick_rise``
+  screen heights within ``flick_window`` seconds of event time. Judged over a window,
+  not between two events: events queued during a frame are handled in a burst, and a
+  slow drag's one-pixel steps handled a millisecond apart looked like flicks;
 - right-drag orbits the camera: camera-only, so it is left to the game loop
   (``handle_event`` returns ``False`` for it).
 
@@ -54,20 +57,26 @@ class MouseSource(PoseSource):
 
     Args:
         wheel_step: metres of grab depth per wheel notch.
-        flick_speed: upward cursor speed, in screen heights per second, that counts as a flick.
+        flick_rise: how far the cursor must rise (screen heights) within ``flick_window``
+            seconds to flick; an ordinary hand's flick rises 80–250 px in well under 0.15 s.
+        flick_window: the longest stroke, in seconds, that still counts as one flick.
     """
 
     threaded = False
 
-    def __init__(self, wheel_step: float = 0.1, flick_speed: float = 2.5, plane: str = "ground") -> None:
+    def __init__(self, wheel_step: float = 0.1, flick_rise: float = 0.08, flick_window: float = 0.15,
+                 plane: str = "ground") -> None:
         super().__init__("mouse")
         if plane not in ("ground", "view"):
             raise ValueError(f"plane must be 'ground' or 'view', not {plane!r}")
         self.plane = plane
+        if not (flick_rise > 0 and flick_window > 0):
+            raise ValueError("flick_rise and flick_window must be positive")
         self.wheel_step = wheel_step
-        self.flick_speed = flick_speed
+        self.flick_rise, self.flick_window = flick_rise, flick_window
         self.pressed = False
         self._last: tuple[float, float, float] | None = None  # x, y, time
+        self._trail: list[tuple[float, float]] = []  # (time, y) of the held drag, within the window
         self._flicked = False
         self._status.connected = True
 
@@ -84,6 +93,7 @@ class MouseSource(PoseSource):
         if kind == MOUSEBUTTONDOWN:
             self.pressed, self._flicked = True, False
             self._last = (*event.pos, now)
+            self._trail = [(now, float(event.pos[1]))]
             self._emit(camera, size, event.pos, now, touch=True)
             return True
         if kind == MOUSEBUTTONUP:
@@ -94,17 +104,24 @@ class MouseSource(PoseSource):
         if kind == MOUSEMOTION:
             if getattr(event, "buttons", (0, 0, 0))[2] and not self.pressed:
                 return False  # right-drag: orbiting
-            flick = False
-            if self.pressed and self._last is not None:
-                dt = max(now - self._last[2], 1e-3)
-                up_speed = (self._last[1] - event.pos[1]) / size[1] / dt
-                if up_speed > self.flick_speed and not self._flicked:
-                    flick, self._flicked = True, True
-                elif up_speed < 0.5 * self.flick_speed:
-                    self._flicked = False
+            flick = self.pressed and self._stroke(float(event.pos[1]), now, size[1])
             self._last = (*event.pos, now)
             self._emit(camera, size, event.pos, now, flick=flick)
             return True
+        return False
+
+    def _stroke(self, y: float, now: float, height: int) -> bool:
+        """Whether the held cursor, now at ``y``, has just completed an upward flick.
+
+        The rise is measured from the lowest point of the last ``flick_window`` seconds;
+        one flick per stroke: the next needs the cursor to come back down first."""
+        self._trail = [(t, v) for t, v in self._trail if now - t <= self.flick_window] + [(now, y)]
+        rise = (max(v for _, v in self._trail) - y) / height
+        if rise >= self.flick_rise and not self._flicked:
+            self._flicked = True
+            return True
+        if rise <= 0.25 * self.flick_rise:
+            self._flicked = False
         return False
 
     def _plane_normal(self, camera: RayCamera) -> NDArray[np.float64]:

@@ -190,6 +190,10 @@ class InputFrame:
                 return s
         return None
 
+    def samples_of(self, source: str) -> list[PoseSample]:
+        """Every sample of ``source`` this step, in arrival order (a stage uses them all)."""
+        return [s for s in self.samples if s.source == source]
+
     def tool_operations(self) -> list[tuple[str | int | float | bool, ...]]:
         """This step's authoring tool operations, decoded; ``ValueError`` names a malformed one."""
         return [decode_tool(text) for kind, text in self.events if kind == TOOL]

@@ -130,6 +130,8 @@ class LocomotionPlayer:
         override_weight: linear fade progress in ``[0, 1]``.
         override_stopping: fading the override out.
         override_hold: a non-looping override holds its last frame until :meth:`stop`.
+        override_scrub: the state sets ``override_time`` itself each step (a jump's pose
+            follows its place on the arc) instead of the clip playing on by ``dt``.
         finished: name of a one-shot that ended this step (cleared next step).
     """
 
@@ -148,6 +150,7 @@ class LocomotionPlayer:
     override_weight: float = 0.0
     override_stopping: bool = False
     override_hold: bool = False
+    override_scrub: bool = False
     finished: str | None = None
 
     def play(self, clip: str, fade: float = 0.2, hold: bool = False) -> None:
@@ -162,7 +165,7 @@ class LocomotionPlayer:
             self.override_time = 0.0
             self.override_weight = 0.0 if self.override is None else self.override_weight
         self.override, self.override_fade, self.override_stopping = clip, fade, False
-        self.override_hold = hold
+        self.override_hold, self.override_scrub = hold, False
 
     def stop(self, fade: float = 0.2) -> None:
         """Fade the override clip out, back to the blend."""
@@ -177,9 +180,10 @@ def _override(player: LocomotionPlayer, loco: LocomotionSet, dt: float) -> tuple
     clip = loco.clips.get(player.override)
     if clip is None:
         raise KeyError(f"clip {player.override!r} is not in the locomotion set; available: {sorted(loco.clips)}")
-    t0, t1 = player.override_time, player.override_time + dt
+    t0, t1 = player.override_time, player.override_time + (0.0 if player.override_scrub else dt)
     fade = player.override_fade
-    if not clip.loop and not player.override_hold and not player.override_stopping and t1 >= clip.duration - fade:
+    if (not clip.loop and not player.override_hold and not player.override_scrub and not player.override_stopping
+            and t1 >= clip.duration - fade):
         player.override_stopping = True
     step = dt / fade if fade > 0 else 1.0
     step = -step if player.override_stopping else step

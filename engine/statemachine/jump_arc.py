@@ -14,7 +14,24 @@ point ``(x0, y0)`` and the current point ``(xt, yt)`` with the current slope ``y
 ``(−b/2a, y(−b/2a))`` drives the jump animation.
 
 A jump is *invalid* — and the puppet becomes a ragdoll — when (1) it rises again after
-starting the descent, (2) it turns in the air, or (3) it stops in the air.
+starting the descent, (2) it turns in the air, (3) it stops in the air, or (4) the stick
+is pulled down hard. Each is judged against the motion the jump already has, with
+these tolerances (fields of :class:`JumpTracker`):
+
+- *rising again*: the stick climbs faster than ``rise_threshold`` (0.35 m/s) after it
+  fell faster than that;
+- *turning*, when the stick's own path is the arc (a phone lifted): its ground velocity
+  leaves the take-off direction by more than ``turn_limit_deg`` (40°) while faster than
+  ``stop_speed``. A running puppet's stick moves forward: that is the take-off direction,
+  not a turn. When a flick launched the puppet (the mouse, whose stick stays in its
+  plane), the stick *leads*: it turns the jump when its ground point strays more than
+  ``turn_offset`` (0.5 m) from the jump's line for ``turn_time`` (0.15 s) —
+  :meth:`JumpTracker.lead`. A flick's own stroke comes back within that time, and a
+  hand that holds still or follows the jump stays on the line;
+- *stopping*: slower than ``stop_speed`` (0.25 m/s) in every direction for ``stop_time``
+  (0.15 s) while more than 0.15 m up;
+- *pulling down*: the stick falls faster than ``slam_speed`` (6 m/s), beyond any fall
+  from a jump's height.
 """
 
 from __future__ import annotations
@@ -68,6 +85,7 @@ class JumpStatus(enum.Enum):
     ROSE_AGAIN = "rose again after starting to fall"
     TURNED = "turned in the air"
     STOPPED = "stopped in the air"
+    PULLED_DOWN = "pulled down hard"
 
 
 @dataclass
@@ -81,7 +99,12 @@ class JumpTracker:
     turn_limit_deg: float = 40.0
     stop_speed: float = 0.25
     stop_time: float = 0.15
+    slam_speed: float = 6.0
+    turn_offset: float = 0.5
+    turn_time: float = 0.15
     descending: bool = False
+    off_line_for: float = 0.0
+    lead_origin: NDArray[np.float64] | None = None
     stopped_for: float = 0.0
     peak: float = field(default=-np.inf)
     apex: NDArray[np.float64] = field(default_factory=lambda: np.full(2, np.nan))
@@ -99,6 +122,22 @@ class JumpTracker:
         d = np.asarray(point, dtype=np.float64) - self.start
         return float(d[0] * self.direction[0] + d[2] * self.direction[1]), float(point[1])
 
+    def lead(self, stick_point: NDArray[np.float64], dt: float) -> JumpStatus | None:
+        """Judge a launched jump's leading stick (its ground point this step): ``TURNED`` once it
+        has stayed more than ``turn_offset`` off the jump's line for ``turn_time``."""
+        ground = np.array([stick_point[0], stick_point[2]], dtype=np.float64)
+        if self.lead_origin is None:
+            self.lead_origin = ground
+        offset = ground - self.lead_origin
+        lateral = offset - float(offset @ self.direction) * self.direction
+        if float(np.linalg.norm(lateral)) > self.turn_offset:
+            self.off_line_for += dt
+            if self.off_line_for >= self.turn_time:
+                return JumpStatus.TURNED
+        else:
+            self.off_line_for = 0.0
+        return None
+
     def update(self, point: NDArray[np.float64], velocity: NDArray[np.float64], dt: float, height_above_ground: float) -> JumpStatus:
         """Take one frame of the stick tip; returns the jump's status."""
         vy = float(velocity[1])
@@ -107,6 +146,8 @@ class JumpTracker:
         self.peak = max(self.peak, float(point[1]))
         if self.descending and vy > self.rise_threshold:
             return JumpStatus.ROSE_AGAIN
+        if vy < -self.slam_speed:
+            return JumpStatus.PULLED_DOWN
         if vy < -self.rise_threshold:
             self.descending = True
         if np.any(self.direction) and speed_h > self.stop_speed:

@@ -92,6 +92,7 @@ class PuppetBody:
         ground_velocity: the puppet's measured ground velocity over the last step (its momentum).
         last_position: where it stood a step ago (for ``ground_velocity``).
         jump: the arc tracker of the current jump.
+        land_depth: how deep the landing crouch goes (0..1 of a full crouch), from the landing speed.
         jump_from_stick: whether the stick's own path drives the arc (phones) or a flick launched it (mouse).
         object: the prop carried or rolled.
         timer: seconds in the current phase of a multi-phase state.
@@ -113,6 +114,7 @@ class PuppetBody:
     ground_velocity: F = field(default_factory=lambda: np.zeros(3))
     last_position: F | None = None
     jump: JumpTracker | None = None
+    land_depth: float = 0.7
     jump_from_stick: bool = False
     object: int | None = None
     timer: float = 0.0

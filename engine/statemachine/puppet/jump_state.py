@@ -11,27 +11,33 @@ takes off. Two drivers of the arc exist:
 - a ballistic launch, when the flick came from a controller that stays in its
   plane (the mouse): the flick's speed launches the puppet, gravity brings it down.
 
-Either way the apex drives the pose (tuck on the way up, open toward landing), and
-the jump is *invalid* if it rises again after starting to fall, turns in the air or
-stops in the air: the brain raises ``jump_invalid`` and the ragdoll takes over.
-Otherwise the puppet lands, absorbs the shock with a short crouch (Land), and then
-rejoins the stick, which has meanwhile moved along the jump path.
+Either way the arc drives the pose: the airborne clip is not played by the clock but
+sampled by the puppet's place on its arc — from take-off to the apex it tucks, from the
+apex to the ground it opens again — so a higher or longer jump looks higher or longer.
+The jump is *invalid* if it rises again after starting to fall, turns in the air, stops
+in the air or is pulled down hard (tolerances in :mod:`engine.statemachine.jump_arc`,
+judged against the motion the jump already has): the brain raises ``jump_invalid`` and
+the ragdoll takes over. Otherwise the puppet lands with a crouch as deep as the landing
+was fast (Land) and keeps its horizontal speed: a running jump lands running, and the
+puppet rejoins the stick, which has meanwhile moved along the jump path.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from engine.blend.locomotion import LocomotionPlayer
+from engine.blend.locomotion import BlendLibrary, LocomotionPlayer
 from engine.components import Stick, Transform
 from engine.ecs import Entity, World
 from engine.ik.system import IKRequest
 from engine.statemachine.jump_arc import JumpStatus, JumpTracker
 from engine.statemachine.machine import Brain
 from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.ground_states import follow_stick
 from engine.statemachine.puppet.senses import holder, wanted_anchor
 
-__all__ = ["enter_jump", "update_jump", "exit_jump", "enter_land", "update_land", "landing_done", "jump_wanted"]
+__all__ = ["enter_jump", "update_jump", "exit_jump", "enter_land", "update_land", "landing_done", "jump_wanted",
+           "arc_progress"]
 
 
 def jump_wanted(world: World, entity: Entity, brain: Brain) -> bool:
@@ -66,13 +72,36 @@ def _take_off(world: World, entity: Entity, body: PuppetBody, stick: Stick | Non
     else:
         horizontal = np.array([body.air_velocity[0], 0.0, body.air_velocity[2]])
         n = float(np.linalg.norm(horizontal))
-        if n > t.max_speed:
-            horizontal *= t.max_speed / n
+        cap = t.max_speed if t.controller == "legacy" else t.top_speed
+        if n > cap:
+            horizontal *= cap / n
         velocity = horizontal + np.array([0.0, t.flick_launch_speed, 0.0])
     body.air_velocity = velocity
     body.jump = JumpTracker.start_at(start, velocity)
+    body.jump.lead_origin = start[[0, 2]].copy()  # a launched jump's line runs through the puppet
     body.phase, body.timer = "air", 0.0
-    world.get(entity, LocomotionPlayer).play("mid_jump", fade=0.1)
+    player = world.get(entity, LocomotionPlayer)
+    player.play("mid_jump", fade=0.1)
+    player.override_scrub = True
+
+
+def arc_progress(tracker: JumpTracker, height: float) -> float:
+    """Where a jump is on its arc, 0 at take-off, 0.5 at the apex, 1 back at take-off height.
+
+    Read from the height against the predicted apex (the fitted parabola's), so it is the
+    arc, not the clock, that poses the puppet."""
+    y0, top = float(tracker.start[1]), float(tracker.apex[1]) if np.isfinite(tracker.apex).all() else np.nan
+    if not np.isfinite(top) or top <= y0 + 1e-3:
+        return 0.5 if tracker.descending else 0.0
+    f = float(np.clip((height - y0) / (top - y0), 0.0, 1.0))
+    return 1.0 - 0.5 * f if tracker.descending else 0.5 * f
+
+
+def _pose_on_arc(world: World, player: LocomotionPlayer, progress: float) -> None:
+    """The airborne clip at the arc's place: tucking up to the apex, opening after it."""
+    clip = world.resource(BlendLibrary)[player.library_key].clips.get("mid_jump")
+    if clip is not None and player.override == "mid_jump":
+        player.override_time = clip.duration * (1.0 - abs(2.0 * progress - 1.0))
 
 
 def update_jump(world: World, entity: Entity, brain: Brain) -> None:
@@ -100,32 +129,30 @@ def update_jump(world: World, entity: Entity, brain: Brain) -> None:
         velocity = stick.velocity.copy()
         tr.position = np.array([anchor[0], max(anchor[1] - t.stand_height, 0.0), anchor[2]])
         point = anchor
+        body.air_velocity = velocity
     else:
         body.air_velocity = body.air_velocity - np.array([0.0, t.gravity * world.dt, 0.0])
         tr.position = tr.position + body.air_velocity * world.dt
         velocity = body.air_velocity
         point = tr.position + np.array([0.0, t.stand_height, 0.0])
-        lead = None if stick is None else np.array([stick.velocity[0], 0.0, stick.velocity[2]])
-        if lead is not None and body.timer >= t.flick_grace and float(np.linalg.norm(lead)) <= t.max_speed:
-            # The mouse's stick stays in its plane: leading sideways turns the jump and
-            # holding still stops it. Faster than any run is the flick stroke still
-            # fading from the filtered velocity, not a lead: ignored.
-            velocity = np.array([lead[0], body.air_velocity[1], lead[2]])
     body.air = float(tr.position[1])
-    predicted = body.jump.apex.copy()
     status = body.jump.update(point, velocity, world.dt, body.air)
     if not body.jump_from_stick:
-        # Ballistic: the apex is exact (the tracker's refit would mix the stick's lead in);
-        # once past it, the last prediction stands.
+        # Launched: the apex is exact (ballistic); the stick only leads, and turns the jump
+        # when it strays from the jump's line (the flick's own stroke comes back in time).
         vy = float(body.air_velocity[1])
         if vy > 0.0:
             rise = vy / t.gravity
             along = float(body.jump.direction @ body.air_velocity[[0, 2]]) if np.any(body.jump.direction) else 0.0
-            predicted = np.array([body.jump.side_view(point)[0] + along * rise, point[1] + 0.5 * vy * rise])
-        body.jump.apex = predicted
+            body.jump.apex = np.array([body.jump.side_view(point)[0] + along * rise, point[1] + 0.5 * vy * rise])
+        if stick is not None and status not in (JumpStatus.ROSE_AGAIN, JumpStatus.STOPPED):
+            status = body.jump.lead(wanted_anchor(stick), world.dt) or status
     if np.isfinite(body.jump.apex).all():
         brain.memory["jump_apex_height"] = float(body.jump.apex[1])
-    if status in (JumpStatus.ROSE_AGAIN, JumpStatus.TURNED, JumpStatus.STOPPED):
+    progress = arc_progress(body.jump, float(point[1]))
+    brain.memory["jump_progress"] = progress
+    _pose_on_arc(world, player, progress)
+    if status in (JumpStatus.ROSE_AGAIN, JumpStatus.TURNED, JumpStatus.STOPPED, JumpStatus.PULLED_DOWN):
         brain.memory["jump_invalid"] = status.value
         brain.raise_event("jump_invalid")
     elif tr.position[1] <= 0.0 and (status is JumpStatus.LANDED or body.air_velocity[1] < 0 or body.jump.descending):
@@ -137,9 +164,14 @@ def exit_jump(world: World, entity: Entity, brain: Brain) -> None:
     """Leave the air: back on the ground plane, the override clip fading out."""
     body = world.get(entity, PuppetBody)
     tr = world.get(entity, Transform)
-    world.get(entity, LocomotionPlayer).stop(0.15)
+    player = world.get(entity, LocomotionPlayer)
+    player.stop(0.15)
+    player.override_scrub = False
     if brain.memory.get("jump_invalid") is None:
         tr.position = np.array([tr.position[0], 0.0, tr.position[2]])
+        # The jump's horizontal speed carries into the landing: a running jump lands running.
+        body.walk_velocity = body.air_velocity * np.array([1.0, 0.0, 1.0])
+        body.walk_rate = np.zeros(3)
     body.air = 0.0
     body.jump = None
 
@@ -148,18 +180,23 @@ def enter_land(world: World, entity: Entity, brain: Brain) -> None:
     """Absorb the landing with a short crouch."""
     body = world.get(entity, PuppetBody)
     body.phase, body.timer = "land", 0.0
+    # As deep as the landing was fast: a hop barely dips, a fall from high crouches low.
+    body.land_depth = float(np.clip(-body.air_velocity[1] / 5.0, 0.25, 1.0))
 
 
 def update_land(world: World, entity: Entity, brain: Brain) -> None:
-    """A quick dip of the hips and back up, then the puppet rejoins the stick."""
+    """A dip of the hips (scaled by the landing speed) and back up, still moving as the jump did."""
     body = world.get(entity, PuppetBody)
     player = world.get(entity, LocomotionPlayer)
     t = body.tuning
     body.timer += world.dt
     s = min(body.timer / t.landing, 1.0)
     dip = np.sin(np.pi * s)
-    player.height = float(t.stand_height - dip * (t.stand_height - t.crouch_height) * 0.7)
-    player.speed = 0.0
+    player.height = float(t.stand_height - dip * (t.stand_height - t.crouch_height) * body.land_depth)
+    if t.controller == "legacy":
+        player.speed = 0.0
+    else:
+        follow_stick(world, entity, body, player)
     ik = world.try_get(entity, IKRequest)
     if ik is not None:
         ik.grounding = True
