@@ -26,4 +26,5 @@ BENCHES: dict[str, str] = {
     "flow": "bench.flow",
     "qp": "bench.qp",
     "curves": "bench.curves",
+    "motion": "bench.motion",
 }

@@ -18,6 +18,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("names", nargs="*", metavar="NAME", help=f"benches to run (default all): {', '.join(BENCHES)}")
     parser.add_argument("--json", metavar="FILE", help="write the figures as a JSON list")
+    parser.add_argument("--plot", metavar="PNG", help="motion: draw foot height and speed over time for one case")
+    parser.add_argument("--case", default="stop_and_go", help="motion: the case --plot draws (default stop_and_go)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -42,6 +44,16 @@ def run(args: argparse.Namespace) -> int:
         for fig in module.run():
             print(fig.line(), flush=True)
             figures.append(fig)
+    if args.plot and "motion" in names:
+        from bench.motion import plot_case
+        from bench.motion_play import CASES
+
+        case = next((c for c in CASES if c.name == args.case), None)
+        if case is None:
+            print(f"unknown case {args.case!r}; cases: {', '.join(c.name for c in CASES)}", file=sys.stderr)
+            return 2
+        plot_case(case, args.plot)
+        print(f"wrote {args.plot}")
     if args.json:
         atomic_write_bytes(args.json, json.dumps([f.as_dict() for f in figures], indent=2).encode())
     return 1 if failed else 0

@@ -63,7 +63,7 @@ class LocomotionSet:
     space: BlendSpace
     table: LookupTable
     clips: dict[str, Clip] = field(default_factory=dict)
-    smoothing: float = 0.08
+    smoothing: float = 0.04
 
     def standing_heights(self, speeds: F) -> F:
         """What ``height=None`` requests: the tallest blend at each speed (beyond the fastest, at the fastest)."""

@@ -13,7 +13,8 @@ The toe tip is the locked point because it is what stays still longest in a step
 (heel-off rolls over it) and what an onlooker sees skate. A lock fades only once the
 toe is really off the floor (``release_height``): contact labels end while the toe
 still pushes off. Only the ground-plane
-position is locked; heights stay the grounding's (clip clearance over the real
+position is locked (a releasing foot far from its animated place steps there on a low
+arc); heights stay the grounding's (clip clearance over the real
 ground), then :func:`floor_lift` keeps toe and heel above the floor.
 
 All functions work on arrays ``[P, L, …]`` (puppets, legs) so a crowd locks its feet
@@ -45,6 +46,7 @@ class FootLock:
         release_time: seconds a lock takes to fade after its foot lifts.
         max_stretch: metres the locked toe may be from the animated one before it lets go.
         release_height: metres the animated toe must rise before a lifted foot's lock fades.
+        enabled: off, planted feet follow the animation (the legacy controller's behaviour).
     """
 
     contacts: F | None = None
@@ -52,8 +54,9 @@ class FootLock:
     weights: F = field(default_factory=lambda: np.zeros(0))
     planted: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     release_time: float = 0.12
-    max_stretch: float = 0.25
+    max_stretch: float = 0.12
     release_height: float = 0.035
+    enabled: bool = True
 
 
 def _smooth(w: F) -> F:
@@ -61,7 +64,8 @@ def _smooth(w: F) -> F:
 
 
 def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], toes: F, contacts: F, clearance: F, dt: float,
-              release_time: float, max_stretch: float, release_height: float) -> tuple[F, F, NDArray[np.bool_], F]:
+              release_time: float, max_stretch: float, release_height: float,
+              step_height: float = 0.08) -> tuple[F, F, NDArray[np.bool_], F]:
     """Advance the locks one step and say where each toe should go.
 
     Args:
@@ -73,8 +77,9 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], toes: F, contac
             while the toe still pushes off the floor).
 
     Returns:
-        ``(points, weights, planted, targets)``: the new state and ``[P, L, 3]`` toe targets
-        (only x and z differ from ``toes``).
+        ``(points, weights, planted, targets)``: the new state and ``[P, L, 3]`` toe targets:
+        x and z pulled to the locks, and a fading lock's foot lifted on an arc of up to
+        ``step_height`` (half the distance it still has to go), so it steps, not slides.
     """
     down = contacts > 0.5
     shown = toes + _smooth(weights)[..., None] * (points - toes)
@@ -89,7 +94,11 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], toes: F, contac
     fading = ~planted
     weights = np.where(fading, np.maximum(weights - dt / release_time, 0.0), weights)
     targets = toes + _smooth(weights)[..., None] * (points - toes)
-    targets[..., 1] = toes[..., 1]
+    # A foot let go far from where the animation wants it (the puppet stopped or turned
+    # mid-stride) steps there: it rises on an arc while it moves instead of sliding.
+    gap = np.linalg.norm((points - toes)[..., [0, 2]], axis=-1)
+    arc = np.where(fading, 4.0 * weights * (1.0 - weights) * np.minimum(0.5 * gap, step_height), 0.0)
+    targets[..., 1] = toes[..., 1] + arc
     return points, weights, planted, targets
 
 

@@ -122,7 +122,7 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
     if locks is None:
         return targets
     for p, lock in enumerate(locks):
-        if lock is None or lock.contacts is None:
+        if lock is None or lock.contacts is None or not lock.enabled:
             continue
         count = len(legs)
         if lock.weights.shape != (count,):
@@ -131,7 +131,7 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
         lock.points, lock.weights, lock.planted, toe = lock_feet(
             lock.points, lock.weights, lock.planted, toes[p], contacts, toes[p, :, 1] - floor[p, :, 1], dt,
             lock.release_time, lock.max_stretch, lock.release_height)
-        targets[p, :, [0, 2]] += (toe - toes[p])[:, [0, 2]].T
+        targets[p] += toe - toes[p]
     return targets
 
 

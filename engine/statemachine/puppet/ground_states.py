@@ -26,7 +26,12 @@ __all__ = ["follow_stick", "update_locomotion", "update_crouch", "locomotion_fit
 
 
 def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0) -> None:
-    """Steer toward the stick's ground point: set heading and requested speed (the tuning's controller)."""
+    """Steer toward the stick's ground point: set heading and requested speed (the tuning's controller).
+
+    The legacy controller comes as it was: without the leg IK's foot locks either."""
+    ik = world.try_get(entity, IKRequest)
+    if ik is not None:
+        ik.foot_lock.enabled = body.tuning.controller != "legacy"
     if body.tuning.controller == "legacy":
         follow_stick_legacy(world, entity, body, player, speed_scale)
     else:

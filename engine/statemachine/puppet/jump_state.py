@@ -147,6 +147,8 @@ def update_jump(world: World, entity: Entity, brain: Brain) -> None:
             body.jump.apex = np.array([body.jump.side_view(point)[0] + along * rise, point[1] + 0.5 * vy * rise])
         if stick is not None and status not in (JumpStatus.ROSE_AGAIN, JumpStatus.STOPPED):
             status = body.jump.lead(wanted_anchor(stick), world.dt) or status
+            if stick.flick and body.timer >= t.flick_grace:
+                status = JumpStatus.ROSE_AGAIN  # a second flick in mid-air: a hop off nothing
     if np.isfinite(body.jump.apex).all():
         brain.memory["jump_apex_height"] = float(body.jump.apex[1])
     progress = arc_progress(body.jump, float(point[1]))
