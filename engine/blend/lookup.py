@@ -201,7 +201,7 @@ class LookupTable:
         exact = dist[..., 0] <= 1e-12
         # Weights relative to the nearest probe: (d0/d)^q stays finite for any q.
         d0 = np.where(exact[..., None], 1.0, dist[..., :1])
-        w = (d0 / np.where(dist > 0, dist, 1.0)) ** self.power
+        w = np.clip(d0 / np.where(dist > 0, dist, 1.0), 0.0, 1.0) ** self.power
         values = self.probes[idx]
         if self.slopes is not None:
             delta = (x[..., None, :] - self._scaled_values[idx])[..., None]

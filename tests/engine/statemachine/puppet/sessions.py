@@ -183,7 +183,7 @@ def _turn_in_air(app: App, bot: MouseBot) -> None:
     bot.flick()
     bot.wait(0.05)
     tip = bot.tip()
-    bot.drag_path([tip + P([1.0, 0, 0])], 3.0)  # sideways while airborne
+    bot.drag_path([tip + P([1.2, 0, 0])], 4.0)  # a sharp sideways drag while airborne
     bot.wait(0.5)
 
 
