@@ -110,6 +110,14 @@ class Campaign:
         return f"fuzz {name}: {sum(self.outcomes.values())} cases, " + ", ".join(
             f"{k} {v}" for k, v in self.outcomes.most_common())
 
+    def check(self, name: str, min_ok: int = 1) -> None:
+        """Print the report, and fail unless at least ``min_ok`` cases parsed: a reader that refused
+        every file (or a campaign whose mutations never leave a readable one) would otherwise pass."""
+        print(self.report(name))
+        assert self.outcomes["ok"] >= min_ok, (
+            f"fuzz {name}: {self.outcomes['ok']} of {sum(self.outcomes.values())} cases parsed "
+            f"(at least {min_ok} must: is the reader refusing everything?)")
+
 
 @pytest.fixture
 def campaign() -> Iterator[Callable[..., Campaign]]:
