@@ -1,6 +1,7 @@
 """Batched FK against a reference written one joint at a time with scipy."""
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from engine import quat
@@ -48,3 +49,44 @@ def test_per_puppet_offsets():
     offsets = np.stack([sk.offsets, sk.offsets * 2.0])
     pos, _ = forward_kinematics(sk, np.zeros((2, 3)), quat.identity(2, sk.num_joints), offsets)
     np.testing.assert_allclose(pos[1], pos[0] * 2.0, atol=1e-12)
+
+
+def reference_fk_scaled(sk, root, rots, scales):
+    """One joint at a time: a joint's world scale is its parent's times its own, and scales every bone below it."""
+    n = sk.num_joints
+    R, S, P = [None] * n, np.ones(n), np.zeros((n, 3))
+    for j in range(n):
+        local = Rotation.from_quat(quat.to_xyzw(rots[j]))
+        p = sk.parents[j]
+        if p < 0:
+            R[j], S[j], P[j] = local, scales[j], root
+        else:
+            R[j], S[j] = R[p] * local, S[p] * scales[j]
+            P[j] = P[p] + R[p].apply(S[p] * np.array(sk.offsets[j]))
+    return P
+
+
+def test_scales_on_joints_with_children_reach_every_descendant():
+    """Scale channels on inner joints (spine, chest, an upper arm, a thigh): each scales all bones below it.
+
+    Shown to fail when broken: scaling each offset by the joint's *own* scale (``wscale[..., idx]``
+    instead of its parent's), or not accumulating the scale down the levels (dropping the
+    ``wscale[..., idx] *= wscale[..., par]`` loop), both move the hands, head and feet off the reference.
+    """
+    sk = humanoid_skeleton()
+    rng = np.random.default_rng(8)
+    rots = quat.exp(rng.normal(scale=0.4, size=(3, sk.num_joints, 3)))
+    roots = rng.normal(size=(3, 3))
+    scales = np.ones((3, sk.num_joints))
+    for name, s in (("spine", 1.3), ("chest", 0.8), ("l_upper_arm", 1.5), ("r_upper_leg", 0.7)):
+        scales[:, sk.index(name)] = s
+    scales[2] = rng.uniform(0.5, 2.0, sk.num_joints)
+    pos, _ = forward_kinematics(sk, roots, rots, scales=scales)
+    for k in range(3):
+        np.testing.assert_allclose(pos[k], reference_fk_scaled(sk, roots[k], rots[k], scales[k]), atol=1e-12)
+    # Read directly: the upper arm's 1.5 lengthens the forearm bone (upper arm -> elbow is the arm's own
+    # offset, scaled by the chest's 0.8 x spine's 1.3), and the hand bone below it by 1.5 as well.
+    plain, _ = forward_kinematics(sk, roots[0], rots[0])
+    ua, la, hand = sk.index("l_upper_arm"), sk.index("l_lower_arm"), sk.index("l_hand")
+    assert np.linalg.norm(pos[0, la] - pos[0, ua]) == pytest.approx(1.5 * 1.3 * 0.8 * np.linalg.norm(plain[la] - plain[ua]))
+    assert np.linalg.norm(pos[0, hand] - pos[0, la]) == pytest.approx(1.5 * 1.3 * 0.8 * np.linalg.norm(plain[hand] - plain[la]))

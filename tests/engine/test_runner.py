@@ -146,13 +146,38 @@ def test_absurd_options_are_refused() -> None:
         RunOptions(screenshot_at=3)
 
 
-def test_a_paced_headless_run_starts_steps_early_for_readings_but_keeps_the_rate() -> None:
-    """Each step queues a reading (as a phone streaming at the step rate would): the next starts up to half a
-    step before its slot, while the schedule itself stays at one step per ``dt``."""
+class FakeTime:
+    """A wall clock that moves only when someone sleeps on it (so pacing is exact and load cannot shift it)."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def clock(self) -> float:
+        return self.now
+
+    def sleep(self, seconds: float) -> None:
+        self.now += max(seconds, 0.0)
+
+
+def test_a_paced_headless_run_starts_steps_early_for_readings_but_keeps_the_rate(monkeypatch) -> None:
+    """Each step queues a reading (as a phone streaming at the step rate would): the next starts half a
+    step before its slot, while the schedule itself stays at one step per ``dt``.
+
+    On a fake clock (the runner's ``wall`` and the pacer's ``sleep``): it used to measure
+    ``perf_counter`` spacing, which a loaded machine moves. Shown to fail when the runner does not
+    hand the activity's ``input_wake`` to the pacer (every step then starts at its slot), or when the
+    pacer's schedule advances from the early start instead of the slot (the rate creeps up).
+    """
+    import functools
     import threading
-    import time
 
     import numpy as np
+
+    import engine.runner
+    from engine.pacing import RealTimePacer
+
+    fake = FakeTime()
+    monkeypatch.setattr(engine.runner, "RealTimePacer", functools.partial(RealTimePacer, sleep=fake.sleep))
 
     class Live(Counter):
         def __init__(self) -> None:
@@ -161,13 +186,14 @@ def test_a_paced_headless_run_starts_steps_early_for_readings_but_keeps_the_rate
             self.times: list[float] = []
 
         def step(self) -> None:
-            self.times.append(time.perf_counter())
+            self.times.append(fake.clock())
             self.input_wake.set()
             super().step()
 
     activity = Live()
-    Runner(RunOptions(headless=True, pace=True)).run(activity)
+    Runner(RunOptions(headless=True, pace=True), wall=fake.clock).run(activity)
     t = np.array(activity.times)
-    behind_slot = t[1:] - (t[0] + Counter.dt * np.arange(1, len(t)))
-    assert np.median(behind_slot) < -Counter.dt / 4  # early, not at the slot
-    assert np.median(np.diff(t)) == pytest.approx(Counter.dt, abs=0.003)  # and still one step per dt
+    assert len(t) == 30
+    slots = t[0] + Counter.dt * np.arange(1, len(t))
+    np.testing.assert_allclose(t[1:] - slots, -Counter.dt / 2, atol=1e-9)  # each half a step early
+    np.testing.assert_allclose(np.diff(t)[1:], Counter.dt, atol=1e-9)  # and still one step per dt

@@ -1,9 +1,13 @@
-"""A 10 s flood from loopback while a phone plays: the step rate holds and the phone still drives.
+"""A flood from loopback while a phone plays 600 paced steps: the phone still drives, the flood is counted.
 
 The flood is what the issue's campaign found expensive: 62 KB bundles of poses, 8 KB
 bundles of 64 messages that do get parsed, nested bundles and garbage, from two other
 loopback addresses (127.0.0.2, 127.0.0.3) that stay *candidates* (``max_senders=3``), so
 their datagrams are not refused as locked out but reach the size checks and the decoder.
+
+Asserted on counts only (issue 37): 600 steps, not "10 s of wall clock", and no steps-per-second
+floor (it failed at 53.3 steps/s on a loaded machine); the rate is printed for the log. The flood
+runs until the steps are done and is then stopped, so it covers every step whatever the machine's load.
 """
 
 from __future__ import annotations
@@ -80,49 +84,60 @@ FLOOD = textwrap.dedent("""
 FLOOD_RATE = 4000  # datagrams/s, a quarter of them 62 KB: ~70 MB/s, more than a LAN delivers to a laptop
 
 
-def test_a_ten_second_flood_keeps_sixty_steps_a_second_and_the_phone_driving():
+STEPS = 600
+
+
+def _drops(src: OscSource) -> int:
+    return sum(src.status().drop_reasons.values())
+
+
+def test_a_flood_leaves_the_phone_driving_every_step():
     src = OscSource(host="127.0.0.1", port=0, max_senders=3)
     hub = InputHub([src]).start()
     app = App(seed=0)
     install_input(app, hub)
     GAME.install(app)
-    phone = subprocess.Popen([sys.executable, "-c", PHONE, str(src.port), "13"])
+    phone = subprocess.Popen([sys.executable, "-c", PHONE, str(src.port), "600"])
     flood = None
     try:
-        end = time.monotonic() + 5
+        end = time.monotonic() + 30
         while app.world.query(Stick)[0][1].source != "osc:127.0.0.1" and time.monotonic() < end:
             app.step()
             time.sleep(1 / 60)
         assert app.world.query(Stick)[0][1].source == "osc:127.0.0.1", "the phone was not admitted"
-        flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(src.port), "10.5", str(FLOOD_RATE)], stdout=subprocess.PIPE, text=True)
-        time.sleep(0.5)  # the flood is under way
+        flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(src.port), "600", str(FLOOD_RATE)],
+                                 stdout=subprocess.DEVNULL)
+        end = time.monotonic() + 30
+        while _drops(src) < 200 and time.monotonic() < end:  # the flood is under way
+            time.sleep(0.05)
+        assert _drops(src) >= 200, "the flood never reached the decoder"
         pacer = RealTimePacer(app.world.dt)
-        steps, with_phone, headings = 0, 0, []
+        with_phone, headings, late_drops = 0, [], 0
         t0 = time.perf_counter()
-        while time.perf_counter() - t0 < 10.0:
+        for step in range(STEPS):
             pacer.wait()
             app.step()
-            steps += 1
             frame = app.world.resource(InputFrame)
             with_phone += frame.latest("osc:127.0.0.1") is not None
             d = app.world.query(Stick)[0][1].direction
             headings.append(float(np.arctan2(d[0], d[2])))
-        rate = steps / (time.perf_counter() - t0)
-        sent = int(flood.communicate(timeout=10)[0])
+            if step == STEPS - 60:
+                late_drops = _drops(src)
+        rate = STEPS / (time.perf_counter() - t0)
+        assert flood.poll() is None and _drops(src) > late_drops, "the flood stopped before the last second of steps"
     finally:
-        if flood is not None and flood.poll() is None:
+        if flood is not None:
             flood.kill()
+            flood.wait(5)
         phone.kill()
         phone.wait(5)
         hub.close()
     st = src.status()
-    print(f"flood: {sent} datagrams sent, {rate:.1f} steps/s, phone samples in {with_phone}/{steps} steps, "
+    print(f"flood: {STEPS} steps at {rate:.1f} steps/s (not asserted), phone samples in {with_phone}/{STEPS} steps, "
           f"drops {st.drop_reasons}")
-    assert sent > 10_000
-    assert rate >= 58.0
     # The phone's 60 Hz stream still reaches most steps (steps without one are clock jitter; before
     # the size and budget checks, a receiver busy decoding let 1 step in 100 see the phone).
-    assert with_phone >= 0.6 * steps
+    assert with_phone >= 0.6 * STEPS
     assert max(headings) > 0.6 and min(headings) < -0.6  # and its sweep still turns the stick
     for reason in ("oversize packet", "bundle too deep", "over budget", "non-unit quaternion"):
         assert st.drop_reasons.get(reason, 0) > 100, reason

@@ -124,11 +124,14 @@ def test_bad_arguments_in_one_line(tmp_path: Path) -> None:
 
 
 def test_dask_local_cluster_of_two_workers(tmp_path: Path) -> None:
+    """The cluster listens on free ports only: with ``dashboard_address=None`` the scheduler's HTTP server
+    still took 8787, and the test failed whenever that was in use (shown by holding 8787 while it ran)."""
     distributed = pytest.importorskip("distributed", reason="Dask's distributed is not installed (the 'cluster' extra)")
     write_takes(tmp_path / "takes", count=8)
     local = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "local"), "--jobs", "1")
     assert local.returncode == 0, local.stderr
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address="127.0.0.1:0") as cluster:  # any free port, not 8787
         for mode in ([], ["--send-bytes"]):
             lib = tmp_path / f"dask{len(mode)}"
             r = _cycles(str(tmp_path / "takes"), "-o", str(lib), "--scheduler", cluster.scheduler_address, *mode)

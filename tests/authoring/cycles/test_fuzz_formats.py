@@ -40,7 +40,7 @@ def test_fuzz_npz_performances(campaign, mutations, fuzz_budget, tmp_path, compr
     for data in mutations(buf.getvalue(), cases, seed):
         path.write_bytes(data)
         c.run(_check, path)
-    print(c.report(f"npz ({'compressed' if compressed else 'stored'})"))
+    c.check(f"npz ({'compressed' if compressed else 'stored'})")
 
 
 def test_fuzz_csv_performances(campaign, mutations, fuzz_budget, tmp_path):
@@ -53,4 +53,4 @@ def test_fuzz_csv_performances(campaign, mutations, fuzz_budget, tmp_path):
     for data in mutations(text.encode(), cases, seed):
         path.write_bytes(data)
         c.run(_check, path)
-    print(c.report("csv"))
+    c.check("csv")

@@ -27,19 +27,33 @@ def _edited() -> tuple[EditSession, int, int]:
 
 
 def test_a_scale_edit_becomes_the_clips_scale_channel_and_shows_on_the_character() -> None:
+    """The head has no children, so its scale is checked on the clip; what the character shows is
+    checked on a joint *with* children (the left forearm: its hand bone grows by the scale).
+
+    Repaired: this used to guard its only FK assertion with ``if kids:`` on the head, a leaf, so it
+    never ran. Shown to fail when ``Clip.sample`` drops the sampled scales (``pose.scales``) or FK
+    scales each offset by the joint's own scale instead of its parent's.
+    """
     session, j, frame = _edited()
     clip = session.clip
     assert clip.scales is not None and clip.scales[frame, j] == pytest.approx(1.5)
     assert np.all(np.delete(clip.scales, j, axis=1) == 1.0)
-    # What the editor draws: FK of the sampled pose with its scales; the head's bone tip moves out.
+    session.undo()
+    assert session.clip.scales is None
+    # What the editor draws: FK of the sampled pose with its scales; the forearm's bone tip moves out.
+    arm = session.joint("l_lower_arm")
+    session.scale_arrow("l_lower_arm", frame, float(np.log(1.5)))
+    clip = session.clip
     pose = clip.sample(frame / clip.fps)
-    assert pose.scales is not None and pose.scales[j] == pytest.approx(1.5)
+    assert pose.scales is not None and pose.scales[arm] == pytest.approx(1.5)
     sk = clip.skeleton
-    kids = sk.children(j)
-    if kids:
-        pos, _ = forward_kinematics(sk, pose.root, pose.rotations, scales=pose.scales)
-        plain, _ = forward_kinematics(sk, pose.root, pose.rotations)
-        assert np.linalg.norm(pos[kids[0]] - pos[j]) == pytest.approx(1.5 * np.linalg.norm(plain[kids[0]] - plain[j]))
+    kids = sk.children(arm)
+    assert kids, "the forearm has the hand below it"
+    pos, _ = forward_kinematics(sk, pose.root, pose.rotations, scales=pose.scales)
+    plain, _ = forward_kinematics(sk, pose.root, pose.rotations)
+    assert np.linalg.norm(pos[kids[0]] - pos[arm]) == pytest.approx(1.5 * np.linalg.norm(plain[kids[0]] - plain[arm]))
+    assert np.linalg.norm(pos[arm] - pos[sk.parents[arm]]) == pytest.approx(
+        np.linalg.norm(plain[arm] - plain[sk.parents[arm]]))  # the forearm's own bone is its parent's to scale
     session.undo()
     assert session.clip.scales is None
 

@@ -5,22 +5,34 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from authoring.mocurves.timewarp import W_SOFT, W_STRONG, TimeWarp, TimeWarpError, _energy_rows
+from authoring.mocurves.timewarp import W_SOFT, W_STRONG, TimeWarp, TimeWarpError
 
 
 def reference_solution(n: int, period: float, constraints: dict[int, float]) -> np.ndarray:
-    """The same energy minimised by dense least squares (valid when no inequality is active)."""
+    """The energy of the module docstring, written out row by row here (not taken from the module), minimised
+    by dense least squares (valid when no inequality is active)."""
     times = np.arange(n + 1) * period / n
-    pr, vel, speed = (m.toarray() for m in _energy_rows(n))
-    rows = [np.sqrt(W_STRONG) * pr, np.sqrt(W_SOFT) * vel, np.sqrt(W_SOFT) * speed]
-    rhs = [np.sqrt(W_STRONG) * np.array([period]), np.sqrt(W_SOFT) * np.diff(times), np.zeros(n)]
-    for i, t in constraints.items():
-        for k, v in ((i, t), (n, t + period)) if i == 0 else ((i, t),):
-            row = np.zeros((1, n + 1))
-            row[0, k] = np.sqrt(W_STRONG)
-            rows.append(row)
-            rhs.append(np.array([np.sqrt(W_STRONG) * v]))
-    return np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
+    rows: list[np.ndarray] = []
+    rhs: list[float] = []
+
+    def residual(weight: float, coeffs: dict[int, float], target: float) -> None:
+        row = np.zeros(n + 1)
+        for k, c in coeffs.items():
+            row[k] += c
+        rows.append(np.sqrt(weight) * row)
+        rhs.append(np.sqrt(weight) * target)
+
+    residual(W_STRONG, {n: 1.0, 0: -1.0}, period)  # E_T: t*_N - t*_0 = T
+    for i in range(n):  # E_V: each gap near the original gap
+        residual(W_SOFT, {i + 1: 1.0, i: -1.0}, times[i + 1] - times[i])
+    for i in range(1, n):  # E_S: (t*_{i+1} - t*_i) - (t*_i - t*_{i-1})
+        residual(W_SOFT, {i + 1: 1.0, i: -2.0, i - 1: 1.0}, 0.0)
+    residual(W_SOFT, {1: 1.0, 0: -1.0, n: -1.0, n - 1: 1.0}, 0.0)  # E_S at i = 0: the first gap vs the seam gap
+    for i, t in constraints.items():  # E_C, a constraint on keypoint 0 also holds its copy N one period later
+        residual(W_STRONG, {i: 1.0}, t)
+        if i == 0:
+            residual(W_STRONG, {n: 1.0}, t + period)
+    return np.linalg.lstsq(np.vstack(rows), np.array(rhs), rcond=None)[0]
 
 
 @pytest.mark.parametrize("n", [30, 120])
@@ -58,15 +70,23 @@ def test_monotonic_when_the_drag_asks_for_time_to_run_backwards():
 
 
 def test_periodic_across_the_seam():
-    """The seam is a keypoint like any other: shifting the drag shifts the warp, nothing else."""
+    """The seam is a keypoint like any other: turning the drags round the cycle turns the warp, nothing else.
+
+    Two keypoints dragged (one ahead of its time, one behind), so the optimum is no pure shift and the
+    speed-change term at the seam (``E_S`` at ``i = 0``) shapes it. Repaired: this used to drag one
+    keypoint, where every warp is the same shift whatever that term is. Shown to fail with that term
+    dropped from ``_energy_rows`` (its row left empty) or made non-periodic (comparing the first gap
+    with ``t*_0`` alone).
+    """
     n, period = 48, 1.0
-    tw = TimeWarp(n, period)
-    base = tw.solve({10: 10 / n + 0.05})
+    drags = {6: 6 / n + 0.06, 14: 14 / n - 0.03}
+    base = TimeWarp(n, period).solve(drags)
     gaps = np.diff(base)
-    for shift in (20, 38, 41):  # 38 + 10 = 48: the dragged keypoint lands on the seam (0)
-        k = (10 + shift) % n
-        t = TimeWarp(n, period).solve({k: k / n + 0.05})
+    assert np.ptp(gaps) > 1e-3  # not a pure shift
+    for shift in (20, 38, 41):  # 38 + 6 = 44, 41 + 6 = 47: the stretched gaps straddle the seam
+        t = TimeWarp(n, period).solve({(k + shift) % n: (k + shift) / n + (v - k / n) for k, v in drags.items()})
         np.testing.assert_allclose(np.diff(t), np.roll(gaps, shift), atol=2e-5)
+    np.testing.assert_allclose(base, reference_solution(n, period, drags), atol=2e-5)
 
 
 def test_drag_across_the_seam_is_unwrapped():

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,15 +17,11 @@ def _authored() -> dict:
 
 
 def test_second_build_reads_the_cache_and_gives_the_same_table(tmp_path: Path) -> None:
-    t0 = time.perf_counter()
     first, c1 = authored_locomotion(AuthoredClips(_authored(), tmp_path), density=9)
-    cold = time.perf_counter() - t0
-    t0 = time.perf_counter()
     second, c2 = authored_locomotion(AuthoredClips(_authored(), tmp_path), density=9)
-    warm = time.perf_counter() - t0
+    # Counted, not timed (``warm < cold`` on the wall clock was flaky): the second build measured nothing.
     assert c1 is not None and c2 is not None and (c1.misses, c2.hits, c2.misses) == (1, 1, 0)
     assert np.array_equal(first.table.values, second.table.values)
-    assert warm < cold
     uncached, none = authored_locomotion(AuthoredClips(_authored(), None), density=9)
     assert none is None and np.array_equal(uncached.table.values, first.table.values)
 

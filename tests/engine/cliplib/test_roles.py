@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from engine import quat
-from engine.clip import Clip
+from engine.clip import Clip, RootMotion
 from engine.clips import default_clips, foot_contacts, foot_sliding
 from engine.clips.contacts import world_poses
 from engine.cliplib.plant import plant_feet
@@ -112,3 +112,42 @@ def test_planting_removes_the_retargeted_mocap_skate(cmu_walk_loop: Clip) -> Non
     walk = conform(cmu_walk_loop, "walk")
     check_role(walk, "walk", SK)
     assert 0.9 < walk.average_speed() < 1.3 and foot_sliding(walk).max() < 0.01
+
+
+def _every(clip: Clip, k: int, n: int) -> Clip:
+    """Frames ``0, k, 2k …`` (``n`` of them) of ``clip`` at ``fps / k``: the same cycle, fewer frames."""
+    idx = np.arange(n) * k
+    rm = clip.root_motion
+    assert rm is not None
+    return replace(clip, fps=clip.fps / k, root=clip.root[idx], rotations=clip.rotations[idx],
+                   root_motion=RootMotion(rm.translation[idx], rm.heading[idx]))
+
+
+def test_a_cycle_needs_at_least_eight_frames() -> None:
+    """Shown to fail with the minimum lowered (``clip.num_frames < 8`` made ``< 7``) or removed: the
+    7-frame walk (the built-in walk every 10th frame) then passes every other check."""
+    walk = default_clips()["walk"]
+    check_role(_every(walk, 9, 8), "walk", SK)  # eight frames: a cycle
+    with pytest.raises(RoleError, match="has 7 frames; a walk cycle needs at least 8"):
+        check_role(_every(walk, 10, 7), "walk", SK)
+
+
+def test_a_walk_must_plant_both_feet_in_turn() -> None:
+    """The left knee bent up through the whole walk: the left foot never touches the ground.
+
+    Shown to fail with the contact check removed, or reduced to one foot (``not contacts[:, 0].any() or``
+    dropped): the clip is then accepted as a walk."""
+    walk = default_clips()["walk"]
+    rot = np.array(walk.rotations)
+    knee = SK.index("l_lower_leg")
+    rot[:, knee] = quat.mul(quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(-90.0)), rot[:, knee])
+    lame = replace(walk, rotations=rot, name="lame")
+    assert foot_contacts(lame)[:, 1].any() and not foot_contacts(lame)[:, 0].any()
+    with pytest.raises(RoleError, match="plants both feet in turn; in 'lame' the left foot never touches"):
+        check_role(lame, "walk", SK)
+    # The mirror image: the right foot up.
+    rot = np.array(walk.rotations)
+    knee = SK.index("r_lower_leg")
+    rot[:, knee] = quat.mul(quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(-90.0)), rot[:, knee])
+    with pytest.raises(RoleError, match="the right foot never touches"):
+        check_role(replace(walk, rotations=rot, name="lame"), "walk", SK)

@@ -49,17 +49,32 @@ def test_limits_hold_when_the_target_pulls_against_them():
 
 
 def test_unreachable_target_is_reported_and_pose_kept():
+    """A bent chain asked to reach a point beyond its length, off to one side: the pose is kept, and the
+    closest pose (the chain stretched towards the target) is reported apart.
+
+    Repaired: the chain used to start straight with the target along it, so the input pose, the
+    closest pose and "pose kept" were all the same thing. Shown to fail when the solver returns the
+    closest pose as the result (``out_root, out_rot = best_root, best_rot`` whatever ``done``), or
+    reports the input as the closest pose.
+    """
     joints = 6
     sk = chain_skeleton(joints)
     rig = IKRig.build(sk)
-    rot = quat.identity(joints)
-    res = solve_ik(rig, np.zeros(3), rot, [Effector(joints - 1, [0.0, 2.0, 0.0], point=TIP)])
+    rot = quat.exp(np.tile([0.25, 0.0, 0.15], (joints, 1)))
+    root = np.zeros(3)
+    target = np.array([1.5, 0.8, -1.0])  # 1.97 m away; the chain with its tip is 0.6 m long
+    res = solve_ik(rig, root, rot, [Effector(joints - 1, target, point=TIP)])
     assert not res.reached
-    assert np.array_equal(res.rotations, rot)
+    assert np.array_equal(res.rotations, rot) and np.array_equal(res.root, root)
     assert res.iterations < IKSettings().max_iterations  # rejected after non-improving iterations
-    # the closest pose points the chain at the target, fully stretched
+    # the closest pose points the chain at the target, fully stretched, and is far from the input
     wp, wr = _world(sk, res.closest_root, res.closest_rotations)
-    assert np.linalg.norm(wp[-1] + quat.rotate(wr[-1], TIP)) == pytest.approx(0.6, abs=1e-3)
+    tip = wp[-1] + quat.rotate(wr[-1], TIP)
+    assert np.linalg.norm(tip) == pytest.approx(0.6, abs=5e-3)
+    assert tip @ target / (np.linalg.norm(tip) * np.linalg.norm(target)) > 0.99
+    wp0, wr0 = _world(sk, root, rot)
+    assert np.linalg.norm(tip - (wp0[-1] + quat.rotate(wr0[-1], TIP))) > 0.5
+    assert res.error == pytest.approx(np.linalg.norm(target - tip), abs=1e-6)
 
 
 def test_pins_make_a_target_unreachable():

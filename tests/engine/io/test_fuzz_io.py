@@ -54,7 +54,7 @@ def test_fuzz_ppclip_bytes(campaign, mutations, fuzz_budget, tmp_path):
         clip = c.run(load_clip, path)
         if clip is not None:
             _check_clip(clip)
-    print(c.report("ppclip bytes"))
+    c.check("ppclip bytes")
 
 
 json_leaf = st.one_of(st.none(), st.booleans(), st.integers(-2**70, 2**70), st.floats(allow_nan=True),
@@ -100,7 +100,7 @@ def test_fuzz_bvh_bytes(campaign, mutations, fuzz_budget, mocap_dir):
     c = campaign(BvhError)
     for data in mutations(_bvh_head(mocap_dir), cases, seed):
         c.run(_check_motion, data)
-    print(c.report("bvh text"))
+    c.check("bvh text")
 
 
 def _check_gltf(path: Path) -> None:
@@ -124,7 +124,7 @@ def test_fuzz_gltf_bytes(campaign, mutations, fuzz_budget, mocap_dir, tmp_path, 
     for data in mutations(good, cases, seed):
         path.write_bytes(data)
         c.run(_check_gltf, path)
-    print(c.report(f"gltf {name}"))
+    c.check(f"gltf {name}")
 
 
 def test_fuzz_our_own_gltf_as_json(campaign, mutations, fuzz_budget, tmp_path):
@@ -135,4 +135,4 @@ def test_fuzz_our_own_gltf_as_json(campaign, mutations, fuzz_budget, tmp_path):
     for data in mutations(good, cases, seed):
         path.write_bytes(data)
         c.run(_check_gltf, path)
-    print(c.report("gltf (our writer's)"))
+    c.check("gltf (our writer's)")

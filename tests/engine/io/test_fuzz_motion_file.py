@@ -65,10 +65,11 @@ def test_fuzz_ppclip_v2_channels(campaign, mutations, fuzz_budget, tmp_path: Pat
     good = save_clip(clip, tmp_path / "good.ppclip").read_bytes()
     cases, seed = fuzz_budget(300)
     c = campaign(ClipFileError)
+    assert c.run(load_clip, tmp_path / "good.ppclip") is not None  # the unmutated file reads
     path = tmp_path / "m.ppclip"
     for data in mutations(good, cases, seed):
         path.write_bytes(data)
         got = c.run(load_clip, path)
         if got is not None and got.scales is not None:
             assert np.isfinite(got.scales).all() and (got.scales > 0).all()
-    print(c.report("ppclip v2 bytes"))
+    c.check("ppclip v2 bytes")

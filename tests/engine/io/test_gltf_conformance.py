@@ -2,7 +2,7 @@
 and round trips BVH -> clip -> BVH/glTF -> clip that compare joint positions.
 
 The validator is the npm package ``gltf-validator`` that ``.ci/run`` installs into
-``~/.cache/puppetphone/npm`` (or ``$PUPPETPHONE_NPM``); driven by ``tools/gltf_validate.js``.
+``${XDG_CACHE_HOME:-~/.cache}/puppetphone/npm`` (or ``$PUPPETPHONE_NPM``); driven by ``tools/gltf_validate.js``.
 Without node or the package the validator test skips and says so.
 """
 
@@ -30,14 +30,32 @@ from tests.engine.io.synthetic_bvh import human_bvh
 _ROOT = Path(__file__).resolve().parents[3]
 
 
+def npm_dir() -> Path:
+    """Where ``.ci/run`` installs the validator: ``${XDG_CACHE_HOME:-$HOME/.cache}/puppetphone/npm``."""
+    if os.environ.get("PUPPETPHONE_NPM"):
+        return Path(os.environ["PUPPETPHONE_NPM"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "puppetphone" / "npm"
+
+
+def test_the_validator_is_looked_for_where_ci_installs_it(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Shown to fail with the old lookup (always ``~/.cache``): under CI's ``XDG_CACHE_HOME`` it skipped silently."""
+    monkeypatch.delenv("PUPPETPHONE_NPM", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert npm_dir() == tmp_path / "puppetphone" / "npm"
+    monkeypatch.setenv("XDG_CACHE_HOME", "")  # empty counts as unset, as in bash's ${XDG_CACHE_HOME:-...}
+    assert npm_dir() == Path.home() / ".cache" / "puppetphone" / "npm"
+    ci = (_ROOT / ".ci" / "run").read_text()
+    assert 'gltf_npm="${XDG_CACHE_HOME:-$HOME/.cache}/puppetphone/npm"' in ci
+
+
 def _validator() -> tuple[str, Path]:
     node = shutil.which("node")
-    npm_dir = Path(os.environ.get("PUPPETPHONE_NPM", Path.home() / ".cache" / "puppetphone" / "npm"))
+    npm_dir_ = npm_dir()
     if node is None:
         pytest.skip("node is not installed (the Khronos glTF validator runs on node; .ci/run installs npm)")
-    if not (npm_dir / "node_modules" / "gltf-validator").is_dir():
-        pytest.skip(f"gltf-validator not found in {npm_dir}/node_modules (.ci/run installs it with npm)")
-    return node, npm_dir / "node_modules"
+    if not (npm_dir_ / "node_modules" / "gltf-validator").is_dir():
+        pytest.skip(f"gltf-validator not found in {npm_dir_}/node_modules (.ci/run installs it with npm)")
+    return node, npm_dir_ / "node_modules"
 
 
 def _written_gltfs(out: Path) -> list[Path]:
