@@ -10,7 +10,6 @@ into root motion, so the loop plays in place like the built-in cycles.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -38,25 +37,17 @@ def open_loop(
     :class:`~authoring.cycles.extract.CycleError` or a trajectory error) saying why not.
     """
     from authoring.cycles.extract import extract_cycle
-    from authoring.cycles.formats import is_seamless, loop_clip, performance_from_motion
-    from engine.io.motion_file import load_motion, to_puppet
+    from authoring.cycles.formats import loop_clip, performance_from_motion
+    from engine.io.motion_file import load_motion, load_motion_loop, to_puppet
 
-    # A loop is judged on every frame (a T-pose lead-in check must not cut a closed loop).
-    motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False)
+    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map)
     clip = motion.clip
-    if not is_seamless(clip) and motion.animation is None:
-        motion = load_motion(path, units=units, joint_map=joint_map)
-        clip = motion.clip
     if start is not None or end is not None:
+        # The part is cut from the take as stored (a closed loop keeps its closing frame).
+        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=not clip.loop)
         loop, note = _loop_of_part(motion, start, end)
-    elif clip.loop:  # a loop our glTF writer marked as one
-        loop, note = clip, f"{motion.source.name}: a loop of {clip.num_frames} frames"
-    elif is_seamless(clip):
-        n = clip.num_frames - 1
-        tr = None if clip.translations is None else clip.translations[:n]
-        sc = None if clip.scales is None else clip.scales[:n]
-        loop = replace(clip, root=clip.root[:n], rotations=clip.rotations[:n], loop=True, translations=tr, scales=sc)
-        note = f"{motion.source.name}: a seamless loop of {n} frames"
+    elif clip.loop:  # a loop our glTF writer marked as one, or a closed loop (its last pose is its first)
+        loop, note = clip, f"{motion.source.name}: a {'seamless ' * motion.seamless}loop of {clip.num_frames} frames"
     else:
         perf = performance_from_motion(motion)
         result = extract_cycle(perf.trajectory, np.random.default_rng(0))

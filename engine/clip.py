@@ -196,17 +196,49 @@ class Clip:
         rot[:, 0] = quat.mul(quat.from_axis_angle(_UP, -heading), rot[:, 0])
         return replace(self, root=root, rotations=rot, root_motion=RootMotion(travel, heading - h0))
 
+    def root_travel(self) -> NDArray[np.float64]:
+        """Travel ``[3]`` of the root track over one full cycle of a loop (zero for other clips).
+
+        A loop that keeps its travel in the root track (what ``cycle`` writes, a glTF walk)
+        does not say where its frame after the last stands: frame 0 moved on by one cycle's
+        travel. Its closing step is judged as the mean of the last and the first step, which
+        is exact to second order (a walk's surge changes speed slowly within one frame), and
+        zero for an in-place loop (a sway's last and first steps cancel). A clip whose
+        travel is root motion keeps its root track in place: no travel.
+        """
+        n = self.num_frames
+        if not self.loop or self.root_motion is not None or n < 3:
+            return np.zeros(3)
+        closing = 0.5 * ((self.root[-1] - self.root[-2]) + (self.root[1] - self.root[0]))
+        return self.root[-1] - self.root[0] + closing
+
     def resampled(self, fps: float) -> Clip:
-        """The same motion sampled at another frame rate."""
+        """The same motion sampled at another frame rate.
+
+        A loop is sampled as one cycle closed by its first frame moved on by
+        :meth:`root_travel`, so its last new frames keep walking forward instead of
+        interpolating back to where the cycle started (which cut a 30 fps walk's speed
+        in half and popped at the seam). :meth:`sample` itself still wraps: it is what
+        play uses, and what the shipped recordings replay.
+        """
         n = max(int(round(self.duration * fps)) + (0 if self.loop else 1), 1)
         t = np.arange(n) / fps
-        pose = self.sample(t)
+        pose = self._closed().sample(t) if self.loop else self.sample(t)
         rm = None
         if self.root_motion is not None:
             samples = [self.sample_root_motion(float(x)) for x in t]
             rm = RootMotion(np.array([s[0] for s in samples]), np.array([s[1] for s in samples]))
         return replace(self, fps=fps, root=pose.root, rotations=pose.rotations, root_motion=rm,
                        translations=pose.offsets, scales=pose.scales)
+
+    def _closed(self) -> Clip:
+        """A loop as a one-shot of ``F + 1`` frames: the first frame repeated, moved on by the cycle's travel."""
+        def more(a: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
+            return None if a is None else np.concatenate([a, a[:1]])
+
+        root = np.concatenate([self.root, self.root[:1] + self.root_travel()])
+        return replace(self, loop=False, root=root, rotations=more(self.rotations), root_motion=None,
+                       translations=more(self.translations), scales=more(self.scales))
 
     def offsets(self) -> NDArray[np.float64]:
         """``[F,J,3]`` local offsets per frame: the translation channel, or the skeleton's offsets."""

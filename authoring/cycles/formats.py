@@ -32,6 +32,7 @@ from authoring.cycles.heading import normalise, restore
 from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
+from engine.io.loop_export import is_seamless
 from engine.io.motion_file import MotionFile, MotionFileError, load_motion
 from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
 
@@ -81,14 +82,6 @@ def _select(available: list[str], wanted: list[str] | None, what: str) -> list[s
 
 
 SEAMLESS_REPEATS = 3
-_SEAMLESS = 0.05  # end-to-start pose gap, as a share of the pose's range, below which an animation is a loop
-
-
-def is_seamless(clip: Clip) -> bool:
-    """Whether a clip's last pose is its first (a game asset's cycle, or our own closed BVH loop)."""
-    rot = clip.rotations
-    span = float(np.ptp(rot, axis=0).max())
-    return clip.num_frames >= 4 and span > 0 and float(np.abs(rot[-1] - rot[0]).max()) <= _SEAMLESS * span
 
 
 def seamless_repeats(clip: Clip) -> Clip:
@@ -385,7 +378,7 @@ def save_loop(
 
         clip = loop_clip(result, perf)
         travel, turn = loop_travel(result, perf)
-        clip = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]
+        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]
         if suffix != ".bvh":
             return write_gltf(path, clip)
         return write_bvh(path, clip_to_bvh(closed(clip, travel, turn) if closing_frame is not False else clip))

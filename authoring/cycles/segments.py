@@ -176,6 +176,8 @@ def find_segments(traj: Trajectory, settings: SegmentSettings | None = None) -> 
     a take with no repetition gives none.
     """
     cfg = settings or SegmentSettings()
+    if traj.num_samples < 3:  # nothing repeats in a frame or two (and their velocities are not defined)
+        return []
     dt = traj.dt
     step = dt * max(1, int(np.floor(1.0 / (cfg.max_rate * dt))))
     t, x = _features(traj, step, cfg.components)

@@ -94,9 +94,7 @@ def _ground_speed(clip: Clip) -> float:
     """Mean ground speed of the root (root motion or, if none, the root track itself) over the clip."""
     if clip.root_motion is not None:
         return clip.average_speed()
-    travel = clip.root[-1] - clip.root[0]
-    if clip.loop and clip.num_frames > 2:
-        travel = travel * clip.num_frames / (clip.num_frames - 1)
+    travel = clip.root_travel() if clip.loop else clip.root[-1] - clip.root[0]
     return float(np.linalg.norm(travel[[0, 2]]) / clip.duration)
 
 
@@ -162,7 +160,7 @@ def _facing_travel(clip: Clip) -> Clip:
     """A loop without root motion, turned so its travel goes along +Z from the ground origin."""
     if clip.root_motion is not None:
         return clip
-    travel = clip.root[-1] - clip.root[0]
+    travel = clip.root_travel() if clip.loop else clip.root[-1] - clip.root[0]
     angle = -float(np.arctan2(travel[0], travel[2]))
     centre = np.array([clip.root[0, 0], 0.0, clip.root[0, 2]])
     return _turned(clip, angle, centre)
@@ -173,7 +171,7 @@ def _with_travel_root_motion(clip: Clip) -> Clip:
     if clip.root_motion is not None:
         return clip
     n = clip.num_frames
-    step = (clip.root[-1, 2] - clip.root[0, 2]) / max(n - 1, 1)
+    step = clip.root_travel()[2] / n if clip.loop else (clip.root[-1, 2] - clip.root[0, 2]) / max(n - 1, 1)
     z = clip.root[0, 2] + step * np.arange(n)
     trans = np.zeros((n, 3))
     trans[:, 2] = z - z[0]

@@ -25,6 +25,9 @@ def read_motion(path: str | Path, animation: int | str | None = None, units: str
                 joint_map: dict[str, str] | None = None) -> Clip:
     """The clip in ``path`` (a glTF's chosen animation; a CMU BVH without its T-pose lead-in).
 
+    A file that already is a loop (``cycle -o loop.bvh`` closes its loop with the first
+    pose) is read as that loop, as the same loop written as ``.glb`` or ``.ppclip`` is.
+
     Raises:
         ValueError: not a motion file this build reads, or a damaged one (the message says which).
         OSError: the file cannot be opened.
@@ -37,9 +40,9 @@ def read_motion(path: str | Path, animation: int | str | None = None, units: str
         return load_clip(path)
     if suffix not in SOURCE_SUFFIXES:
         raise ValueError(f"{path.name}: unknown motion type {suffix!r}; use one of {', '.join(SOURCE_SUFFIXES)}")
-    from engine.io.motion_file import load_motion
+    from engine.io.motion_file import load_motion_loop
 
-    return load_motion(path, animation=animation, units=units, joint_map=joint_map).clip
+    return load_motion_loop(path, animation=animation, units=units, joint_map=joint_map).clip
 
 
 def to_puppet(clip: Clip, skeleton: Skeleton, joint_map: dict[str, str] | None = None) -> tuple[Clip, str | None]:

@@ -24,7 +24,8 @@ from engine.io.units import Units, given_units, judge_units
 from engine.npz_safe import read_bounded
 from engine.skeleton import Skeleton
 
-__all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "load_joint_map", "to_puppet",
+__all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "load_motion_loop", "load_joint_map",
+           "to_puppet",
            "scaled_clip"]
 
 MOTION_SUFFIXES = (".bvh", ".gltf", ".glb")
@@ -48,6 +49,8 @@ class MotionFile:
         animations: every animation name in a glTF file.
         skipped: leading frames dropped (a T-pose lead-in).
         warnings: what was tolerated on the way (e.g. a ``Frames:`` count that was off).
+        seamless: the clip is a loop read from a closed file, its closing frame dropped
+            (:func:`load_motion_loop`).
     """
 
     clip: Clip
@@ -58,6 +61,7 @@ class MotionFile:
     animations: tuple[str, ...] = ()
     skipped: int = 0
     warnings: tuple[str, ...] = ()
+    seamless: bool = False
 
     def summary(self) -> dict[str, Any]:
         """What ``--json`` reports about the input."""
@@ -163,6 +167,32 @@ def load_motion(
         return _load_gltf(path, units, animation, fps, joint_map)
     except (BvhError, GltfError) as exc:
         raise MotionFileError(str(exc)) from None
+
+
+def load_motion_loop(
+    path: str | Path,
+    animation: int | str | None = None,
+    units: str | None = None,
+    joint_map: dict[str, str] | None = None,
+) -> MotionFile:
+    """:func:`load_motion`, with a file that already is a loop read as one.
+
+    A loop this project wrote (``cycle -o loop.bvh``: its last pose repeats its first) or a
+    game asset's single seamless cycle comes back with ``loop`` set and the closing frame
+    dropped (see :func:`engine.io.loop_export.opened`); it is judged on every frame, since
+    a T-pose lead-in check must not cut a closed loop. Any other file is the take as
+    :func:`load_motion` reads it (its T-pose lead-in skipped).
+    """
+    from engine.io.loop_export import is_seamless, opened
+
+    whole = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False)
+    if whole.clip.loop:
+        return whole
+    if is_seamless(whole.clip):
+        return replace(whole, clip=opened(whole.clip), seamless=True)
+    if whole.animation is not None:
+        return whole
+    return load_motion(path, units=units, joint_map=joint_map)
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:

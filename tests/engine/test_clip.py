@@ -66,6 +66,24 @@ def test_root_motion_extraction_removes_travel_and_accumulates_over_loops():
     assert np.linalg.norm(after - before) < 1.5 * 3 * eps
 
 
+def test_a_30_fps_loop_resampled_to_60_keeps_walking_across_its_seam():
+    """A loop's last new frames move on towards the next cycle, not back to where it started."""
+    clip = walking_clip(frames=30, fps=30.0, speed=1.5)
+    np.testing.assert_allclose(clip.root_travel(), [0.0, 0.0, 1.5], atol=1e-4)  # the bob's closing step: 2nd order
+    out = clip.resampled(60.0)
+    assert out.loop and out.num_frames == 60 and out.duration == pytest.approx(clip.duration)
+    np.testing.assert_allclose(np.diff(out.root[:, 2]), 1.5 / 60.0, atol=1e-12)  # no step back before the seam
+    np.testing.assert_allclose(out.root_travel(), clip.root_travel(), atol=1e-4)
+    # Played as it is, the sampling path still wraps (what play and the shipped recordings use).
+    np.testing.assert_allclose(clip.sample(clip.duration - 0.5 / clip.fps).root, 0.5 * (clip.root[-1] + clip.root[0]))
+
+
+def test_an_in_place_loop_gets_no_travel():
+    clip = walking_clip(speed=0.0)
+    np.testing.assert_allclose(clip.root_travel(), 0.0, atol=1e-4)
+    assert not walking_clip().extract_root_motion().root_travel().any()
+
+
 def test_root_motion_heading():
     clip = walking_clip(turn=0.5).extract_root_motion()
     _, h = clip.sample_root_motion(0.5)

@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 from authoring.cycles.synthetic import make_performance
+from engine import quat
+from engine.clip import Clip
 from puppetphone.cli import main
 
 
@@ -92,3 +94,18 @@ def test_console_entry_point(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     assert _last_json(proc.stdout)["cycles"] >= 4
     assert (tmp_path / "l.npz").is_file()
+
+
+@pytest.mark.parametrize("frames", [1, 2])
+def test_a_one_or_two_frame_bvh_is_refused_in_one_line(tmp_path: Path, frames: int,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """No cycle in a frame or two: exit 3 and why, not a traceback from the part-that-loops search."""
+    from engine.humanoid import humanoid_skeleton
+    from engine.io import clip_to_bvh, write_bvh
+
+    sk = humanoid_skeleton()
+    still = Clip("still", sk, 30.0, np.tile(sk.offsets[0], (frames, 1)), quat.identity(frames, sk.num_joints))
+    write_bvh(tmp_path / "one.bvh", clip_to_bvh(still))
+    code = main(["cycle", str(tmp_path / "one.bvh"), "-o", str(tmp_path / "o.bvh"), "--json"])
+    err = capsys.readouterr().err
+    assert code == 3 and len(err.strip().splitlines()) == 1 and "too few" in err, err

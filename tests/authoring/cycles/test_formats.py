@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from authoring.cycles.extract import extract_cycle
-from authoring.cycles.formats import load_performance, loop_clip, save_loop
+from authoring.cycles.formats import load_performance, loop_clip, loop_travel, save_loop
 from authoring.cycles.synthetic import make_performance
 from authoring.cycles.trajectory import TrajectoryError
 from engine import quat
@@ -115,6 +115,9 @@ def test_bvh_to_clip_and_bvh(tmp_path: Path, mocap_dir: Path) -> None:
     whole = round(r.period * 30)
     assert bvh.frame_time == 1 / 30 and bvh.num_frames == whole + 1
     assert np.allclose(bvh.data[-1, 3:], bvh.data[0, 3:], atol=1e-6)  # the closing frame repeats the pose
+    # 32.5 frames became 33: the travel stretched with the loop, so it walks at the loop's speed.
+    speed = np.linalg.norm((bvh.data[-1, :3] - bvh.data[0, :3])[[0, 2]]) / 100.0 / (whole * bvh.frame_time)
+    assert speed == pytest.approx(np.linalg.norm(loop_travel(r, perf)[0][[0, 2]]) / r.period, rel=1e-3)
     save_loop(r, perf, tmp_path / "open.bvh", fps=24.0, closing_frame=False)
     bvh = read_bvh(tmp_path / "open.bvh")
     assert bvh.frame_time == 1 / 24 and bvh.num_frames == round(r.period * 24)

@@ -95,6 +95,25 @@ def test_conform_gives_forward_root_motion_and_heel_strike_markers() -> None:
     assert foot_sliding(out).max() < 0.01
 
 
+def _at_rate(clip: Clip, frames: int) -> Clip:
+    """One cycle of a root-motion loop sampled at ``frames`` per cycle, its travel baked into the root track."""
+    t = np.arange(frames) * clip.duration / frames
+    pose = clip.sample(t)
+    travel = np.array([clip.sample_root_motion(float(x))[0] for x in t])
+    return Clip("raw", clip.skeleton, frames / clip.duration, pose.root + travel, pose.rotations, loop=True)
+
+
+@pytest.mark.parametrize("rate", [24.0, 30.0, 50.0, 120.0])
+def test_a_loop_at_any_rate_is_conformed_at_its_speed_without_a_seam_pop(rate: float) -> None:
+    walk = default_clips()["walk"]
+    raw = _at_rate(walk, int(round(walk.duration * rate)))
+    out = conform(raw, "walk")
+    assert out.fps == 60.0 and out.average_speed() == pytest.approx(walk.average_speed(), rel=0.01)
+    # Root position continuous across the seam within one frame's travel (sway and bob stay in the root).
+    seam = np.linalg.norm(out.root[0] - out.root[-1])
+    assert seam <= walk.average_speed() / out.fps
+
+
 def test_planting_removes_the_retargeted_mocap_skate(cmu_walk_loop: Clip) -> None:
     raw = conform(cmu_walk_loop, "idle")  # resampled and turned only, no planting
     from engine.cliplib.roles import _facing_travel, _with_travel_root_motion
