@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from engine.app import App
+from engine.atomic import WriteError, set_aside
 from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.statemachine.puppet import install_puppets
@@ -46,7 +47,7 @@ from games.tasbada.pose import validate as validate_pose
 from games.tasbada.posing import selfie_pose_system
 from games.tasbada.quest import MIXED, PROPS_ALIVE, STAGES, VIRTUAL, Mark, Quest
 from games.tasbada.reality import SHIPPED_PHOTO, SHIPPED_SELFIE, Reality
-from games.tasbada.save import SaveError, default_save_path, load_progress
+from games.tasbada.save import SAVE_HEADS, SaveError, default_save_path, load_progress
 from games.tasbada.view import game_camera
 
 __all__ = ["GAME", "install", "prepare", "replay_setup", "status", "CONTROLS"]
@@ -68,12 +69,15 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
     try:
         progress = load_progress(save)
     except SaveError as exc:
-        bad = Path(str(save) + ".bad")
         try:
-            os.replace(save, bad)
+            bad = set_aside(save, SAVE_HEADS)
+        except WriteError as move:
+            print(f"tasbada: {exc}; {move}, starting a new journey", file=sys.stderr)
+        else:
+            if bad is None:
+                raise GameOptionError(f"tasbada save {save} is not progress this program saved ({exc}); it is "
+                                      "left as it is: choose another file with --set save=PATH") from None
             print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
-        except OSError as move:
-            print(f"tasbada: {exc}; cannot set it aside ({move.strerror}), starting a new journey", file=sys.stderr)
     photo = options["photo"] or os.environ.get("TASBADA_PHOTO", "")
     if not photo and progress is not None and progress.photo and Path(progress.photo).is_file():
         photo = progress.photo
