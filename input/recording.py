@@ -233,6 +233,8 @@ def _header_problem(d: object) -> str:
         return "sources must be a list of names"
     if not isinstance(d.get("engine_version", ""), str) or not isinstance(d.get("extra", {}), dict):
         return "engine_version must be a string and extra an object"
+    if not isinstance(d.get("setup", {}), dict):
+        return "setup must be an object (the game checks its values when it rebuilds the session)"
     return ""
 
 

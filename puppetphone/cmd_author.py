@@ -316,6 +316,34 @@ def _record_setup(args: argparse.Namespace, size: tuple[int, int]) -> dict[str, 
             "base": base64.b64encode(args.base.read_bytes()).decode() if args.base is not None else ""}
 
 
+def _check_record_setup(setup: object) -> dict[str, object]:
+    """A recorded take's set-up, every value type- and range-checked (``ValueError`` in one line)."""
+    import math
+
+    def number(key: str, lo: float, hi: float) -> None:
+        v = setup.get(key)  # type: ignore[union-attr]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not lo <= v <= hi:
+            raise ValueError(f"the recorded {key} {repr(v)[:30]} is not a number in [{lo:g}, {hi:g}]")
+
+    if not isinstance(setup, dict):
+        raise ValueError("the recorded take's set-up is not an object")
+    if not isinstance(setup.get("item"), str) or not isinstance(setup.get("base", ""), str):
+        raise ValueError("the recorded item and base must be text")
+    if setup.get("drive") not in ("rotation", "translation", "pose", "scale"):
+        raise ValueError(f"the recorded drive {repr(setup.get('drive'))[:30]} is not one the scene knows")
+    if setup.get("script") not in (None, "loops"):
+        raise ValueError(f"the recorded script {repr(setup.get('script'))[:30]} is not one the scene knows")
+    number("countdown", 0.0, 600.0)
+    number("seconds", 0.1, 3600.0)
+    seed, size = setup.get("seed"), setup.get("size", [1280, 720])
+    if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+        raise ValueError("the recorded seed is not a whole number in 0..2**63-1")
+    if not (isinstance(size, list) and len(size) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)):
+        raise ValueError("the recorded window size is not two whole numbers in 0..16384")
+    return setup
+
+
 def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
     import base64
 
@@ -343,7 +371,7 @@ def replay_record(recording):  # type: ignore[no-untyped-def]
     from input.hub import InputHub
     from input.replay import HashCheck, ReplaySource
 
-    setup = recording.header.setup
+    setup = _check_record_setup(recording.header.setup)
     return RecordActivity(_record_scene(setup), InputHub(replay=ReplaySource(recording)), script=setup.get("script"),
                           size=tuple(setup.get("size", (1280, 720))), check=HashCheck(recording))
 
