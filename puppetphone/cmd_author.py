@@ -204,12 +204,18 @@ class RecordActivity:
             return False
         return True
 
-    def _save(self, message: str) -> None:
+    def _save(self, message: str) -> bool:
+        """Save the accepted cycle; whether it was written (a failure is shown, the take stays open)."""
         from engine.clipfile import save_clip
+        from puppetphone.saving import save_or_say
 
-        if self.output is not None and self.scene.clip is not None:
-            save_clip(self.scene.clip, self.output, root_curve=self.scene.root_curve)
-            self.scene.message = message.format(output=self.output)
+        if self.output is None or self.scene.clip is None:
+            return False
+        clip, curve = self.scene.clip, self.scene.root_curve
+        said = save_or_say(lambda: save_clip(clip, self.output, root_curve=curve), self.output)
+        saved = said.startswith("saved")
+        self.scene.message = message.format(output=self.output) if saved else said
+        return saved
 
     def _apply(self, op: tuple) -> object:  # type: ignore[type-arg]
         """One tool operation; returns a pointer position when the operation is one."""
@@ -293,8 +299,7 @@ class RecordActivity:
         self.previewing = self.previewing + 1 if scene.phase == "preview" else 0
         # The scripted performer looks at the preview for 2 s, then accepts.
         if self.script and self.previewing == int(2 / self.dt) and scene.accept() is not None:
-            self._save("saved {output}")
-            if self.output is not None:
+            if self._save("saved {output}"):
                 print(f"saved {self.output}")
         digest, parts = record_digest(scene)
         if self.recorder is not None:

@@ -234,6 +234,7 @@ class EditActivity:
 
     def _apply(self, op: tuple) -> None:  # type: ignore[type-arg]
         from authoring.mocurves import save_session
+        from puppetphone.saving import save_or_say
 
         edit, kind = self.edit, op[0]
         if kind == "press":
@@ -250,8 +251,7 @@ class EditActivity:
             edit.size = (int(op[1]), int(op[2]))
         elif kind == "key" and op[2] and op[1] == "s":
             if self.output is not None:
-                save_session(self.session, self.output)
-                edit.message = f"saved {self.output}"
+                edit.message = save_or_say(lambda: save_session(self.session, self.output), self.output)
         elif kind == "key":
             edit.key(op[1], ctrl=bool(op[2]), shift=bool(op[3]))
 
