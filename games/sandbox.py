@@ -99,5 +99,15 @@ def camera() -> OrbitCamera:
     return OrbitCamera(target=[0.0, 0.8, 0.0], yaw=0.5, pitch=0.35, distance=6.0)
 
 
+def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
+    """A recording's set-up, checked like the options it came from (``GameOptionError`` in one line)."""
+    scene, puppets = recorded.get("scene", "empty"), recorded.get("puppets", 1)
+    if not isinstance(scene, str) or scene not in SCENES:
+        raise GameOptionError(f"the recorded sandbox scene {repr(scene)[:40]} is not one of {', '.join(SCENES)}")
+    if not isinstance(puppets, int) or isinstance(puppets, bool) or not 1 <= puppets <= MAX_PUPPETS:
+        raise GameOptionError(f"the recorded sandbox puppets {repr(puppets)[:40]} is not a number from 1 to {MAX_PUPPETS}")
+    return dict(recorded)
+
+
 GAME = Game(name="sandbox", install=install, draw=draw_world, camera=camera,
-            options={"scene": "empty", "puppets": "1"}, prepare=prepare)
+            options={"scene": "empty", "puppets": "1"}, prepare=prepare, replay_setup=replay_setup)

@@ -8,6 +8,11 @@ File layout (little-endian)::
     parts    =  u8 flags  [u16 n  names (UTF-8, newline-separated) if flags & 1]
                 u8 count  count × 2-byte part digest
 
+A finished recording ends with a closing record (format 4): ``u32 0  u32 frame_count`` (a
+length no real record has). A file without it was cut — the session was killed (``kill -9``)
+or the disk filled — even when the cut fell exactly between two records, and the reader
+says so ("ended without its closing record") instead of replaying it as complete.
+
 ``parts`` (format 3) holds a short digest of each named part of the state — a component
 type, a resource, the RNG (:func:`engine.hashing.state_parts`) — so a replay that
 diverges names what differs first; the part names are written only when they change
@@ -19,7 +24,8 @@ The header holds ``format`` (this module's :data:`FORMAT_VERSION`), ``engine_ver
 a save's contents: see :mod:`games.base`), so a replay needs nothing but the file. The file is append-only and flushed after
 every step, so a crash or a cut at any byte loses at most the frame being written:
 :func:`read_recording` returns every complete, checksummed record before the cut
-and says why it stopped (the replay prints that as a warning).
+and says why it stopped (the replay prints that as a warning). A write that fails (a full
+disk) stops the recording with one line on the terminal; the session itself plays on.
 
 Size per minute of play (60 steps/s; measured by ``tests/input/test_recording.py``
 and the figures in the closing report):
@@ -38,7 +44,9 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import struct
+import sys
 import zlib
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
@@ -54,9 +62,11 @@ from input.sample import InputFrame
 __all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording",
            "MAX_RECORDING"]
 
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
 #: The first format whose records carry per-part digests.
 PARTS_FORMAT = 3
+#: The first format whose finished files end with a closing record.
+CLOSING_FORMAT = 4
 MAGIC = b"PPREC\n"
 # An hour of a 60 Hz phone is about 30 MB; a header holds a game's saved field (a few KB).
 MAX_RECORDING = 512 << 20
@@ -106,6 +116,7 @@ class Recording:
     complete: bool = True
     problem: str = ""
     parts: list[dict[str, bytes]] = field(default_factory=list)
+    cut: bool = False  # the file stops short (killed mid-session), as opposed to damaged
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -129,6 +140,7 @@ class Recorder:
         self.frames = 0
         self.bytes = self._file.tell()
         self._names: tuple[str, ...] = ()
+        self.failed = ""  # why the recording stopped early ("" while it is fine)
 
     def attach(self, app: App) -> Recorder:
         """Write a record at the end of every step of ``app`` (``app.on_step_end``)."""
@@ -141,14 +153,32 @@ class Recorder:
         self.write(world.resource(InputFrame), digest, parts)
 
     def write(self, frame: InputFrame, digest: str, parts: dict[str, bytes] | None = None) -> None:
-        """Append one record and flush it to the OS."""
+        """Append one record and flush it to the OS (after a failed write: nothing, see :attr:`failed`)."""
         if self._file is None:
+            if self.failed:
+                return
             raise RecordingError(f"recording {self.path} is closed")
         payload = bytes.fromhex(digest) + self._parts_block(parts or {}) + encode_frame(frame)
-        self._file.write(_LEN.pack(len(payload), zlib.crc32(payload)) + payload)
-        self._file.flush()
-        self.frames += 1
-        self.bytes += _LEN.size + len(payload)
+        if self._put(_LEN.pack(len(payload), zlib.crc32(payload)) + payload):
+            self.frames += 1
+            self.bytes += _LEN.size + len(payload)
+
+    def _put(self, data: bytes) -> bool:
+        """Write and flush; a failure (full disk) stops the recording with one line, never the session."""
+        assert self._file is not None
+        try:
+            self._file.write(data)
+            self._file.flush()
+        except OSError as exc:
+            self.failed = f"recording {self.path} stopped after {self.frames} frames: {exc.strerror or exc}"
+            print(self.failed, file=sys.stderr)
+            try:
+                self._file.close()
+            except OSError:
+                pass  # the data that did not fit is lost either way; the frames before it are on disk
+            self._file = None
+            return False
+        return True
 
     def _parts_block(self, parts: dict[str, bytes]) -> bytes:
         names = tuple(parts)
@@ -165,9 +195,14 @@ class Recorder:
         return bytes(block)
 
     def close(self) -> None:
-        """Flush and close (idempotent)."""
-        if self._file is not None:
-            self._file.close()
+        """Write the closing record, sync and close (idempotent)."""
+        if self._file is not None and self._put(_LEN.pack(0, self.frames)):
+            try:
+                os.fsync(self._file.fileno())
+                self._file.close()
+            except OSError as exc:
+                self.failed = f"recording {self.path} may be incomplete: {exc.strerror or exc}"
+                print(self.failed, file=sys.stderr)
             self._file = None
 
     def __enter__(self) -> Recorder:
@@ -233,6 +268,8 @@ def _header_problem(d: object) -> str:
         return "sources must be a list of names"
     if not isinstance(d.get("engine_version", ""), str) or not isinstance(d.get("extra", {}), dict):
         return "engine_version must be a string and extra an object"
+    if not isinstance(d.get("setup", {}), dict):
+        return "setup must be an object (the game checks its values when it rebuilds the session)"
     return ""
 
 
@@ -256,12 +293,17 @@ def read_recording(path: str | Path) -> Recording:
     parts: list[dict[str, bytes]] = []
     names: tuple[str, ...] = ()
     pos = f.tell()
-    problem = ""
+    problem, closed = "", header.format < CLOSING_FORMAT
     while pos < len(data):
         if pos + _LEN.size > len(data):
             problem = f"cut inside the record of frame {len(frames)} (byte {pos})"
             break
         n, crc = _LEN.unpack_from(data, pos)
+        if n == 0 and header.format >= CLOSING_FORMAT:
+            if crc != len(frames) or pos + _LEN.size != len(data):
+                problem = f"damaged closing record after frame {len(frames)} (byte {pos})"
+            closed = not problem
+            break
         payload = data[pos + _LEN.size : pos + _LEN.size + n]
         if len(payload) < n:
             problem = f"cut inside the record of frame {len(frames)} (byte {pos})"
@@ -281,8 +323,11 @@ def read_recording(path: str | Path) -> Recording:
         frames.append(frame)
         hashes.append(payload[:16].hex())
         pos += _LEN.size + n
+    cut = problem.startswith("cut inside")
+    if not problem and not closed:
+        problem, cut = f"cut: ended without its closing record after {len(frames)} frames (killed mid-session?)", True
     return Recording(header=header, frames=frames, hashes=hashes, complete=not problem, problem=problem,
-                     parts=parts[: len(frames)])
+                     parts=parts[: len(frames)], cut=cut)
 
 
 def _read_parts(payload: bytes, names: tuple[str, ...]) -> tuple[tuple[str, ...], dict[str, bytes], int]:

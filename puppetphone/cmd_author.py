@@ -204,12 +204,18 @@ class RecordActivity:
             return False
         return True
 
-    def _save(self, message: str) -> None:
+    def _save(self, message: str) -> bool:
+        """Save the accepted cycle; whether it was written (a failure is shown, the take stays open)."""
         from engine.clipfile import save_clip
+        from puppetphone.saving import save_or_say
 
-        if self.output is not None and self.scene.clip is not None:
-            save_clip(self.scene.clip, self.output, root_curve=self.scene.root_curve)
-            self.scene.message = message.format(output=self.output)
+        if self.output is None or self.scene.clip is None:
+            return False
+        clip, curve = self.scene.clip, self.scene.root_curve
+        said = save_or_say(lambda: save_clip(clip, self.output, root_curve=curve), self.output)
+        saved = said.startswith("saved")
+        self.scene.message = message.format(output=self.output) if saved else said
+        return saved
 
     def _apply(self, op: tuple) -> object:  # type: ignore[type-arg]
         """One tool operation; returns a pointer position when the operation is one."""
@@ -293,8 +299,7 @@ class RecordActivity:
         self.previewing = self.previewing + 1 if scene.phase == "preview" else 0
         # The scripted performer looks at the preview for 2 s, then accepts.
         if self.script and self.previewing == int(2 / self.dt) and scene.accept() is not None:
-            self._save("saved {output}")
-            if self.output is not None:
+            if self._save("saved {output}"):
                 print(f"saved {self.output}")
         digest, parts = record_digest(scene)
         if self.recorder is not None:
@@ -314,6 +319,34 @@ def _record_setup(args: argparse.Namespace, size: tuple[int, int]) -> dict[str, 
     return {"item": args.item, "drive": args.drive, "countdown": args.countdown, "seconds": args.seconds,
             "seed": args.seed, "script": args.script, "size": list(size),
             "base": base64.b64encode(args.base.read_bytes()).decode() if args.base is not None else ""}
+
+
+def _check_record_setup(setup: object) -> dict[str, object]:
+    """A recorded take's set-up, every value type- and range-checked (``ValueError`` in one line)."""
+    import math
+
+    def number(key: str, lo: float, hi: float) -> None:
+        v = setup.get(key)  # type: ignore[union-attr]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not lo <= v <= hi:
+            raise ValueError(f"the recorded {key} {repr(v)[:30]} is not a number in [{lo:g}, {hi:g}]")
+
+    if not isinstance(setup, dict):
+        raise ValueError("the recorded take's set-up is not an object")
+    if not isinstance(setup.get("item"), str) or not isinstance(setup.get("base", ""), str):
+        raise ValueError("the recorded item and base must be text")
+    if setup.get("drive") not in ("rotation", "translation", "pose", "scale"):
+        raise ValueError(f"the recorded drive {repr(setup.get('drive'))[:30]} is not one the scene knows")
+    if setup.get("script") not in (None, "loops"):
+        raise ValueError(f"the recorded script {repr(setup.get('script'))[:30]} is not one the scene knows")
+    number("countdown", 0.0, 600.0)
+    number("seconds", 0.1, 3600.0)
+    seed, size = setup.get("seed"), setup.get("size", [1280, 720])
+    if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+        raise ValueError("the recorded seed is not a whole number in 0..2**63-1")
+    if not (isinstance(size, list) and len(size) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)):
+        raise ValueError("the recorded window size is not two whole numbers in 0..16384")
+    return setup
 
 
 def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
@@ -343,7 +376,7 @@ def replay_record(recording):  # type: ignore[no-untyped-def]
     from input.hub import InputHub
     from input.replay import HashCheck, ReplaySource
 
-    setup = recording.header.setup
+    setup = _check_record_setup(recording.header.setup)
     return RecordActivity(_record_scene(setup), InputHub(replay=ReplaySource(recording)), script=setup.get("script"),
                           size=tuple(setup.get("size", (1280, 720))), check=HashCheck(recording))
 

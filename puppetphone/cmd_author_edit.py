@@ -103,11 +103,35 @@ def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
     return setup
 
 
+def _check_setup(setup: object) -> dict[str, object]:
+    """A recorded edit set-up, every value checked; a clip without its bytes must be a default clip's name.
+
+    A recording is self-contained: a path in it never makes a replay open a file (a clip
+    on the replaying person's disk). ``ValueError`` in one line for anything else.
+    """
+    from engine.clips import default_clips
+
+    if not isinstance(setup, dict):
+        raise ValueError("the recorded edit set-up is not an object")
+    size = setup.get("size", [1280, 720])
+    if not (isinstance(size, list) and len(size) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)):
+        raise ValueError("the recorded window size is not two whole numbers in 0..16384")
+    for key in ("clip", "name", "ppclip", "side"):
+        if not isinstance(setup.get(key, ""), str):
+            raise ValueError(f"the recorded {key} is not text")
+    if not setup.get("ppclip") and setup.get("clip") not in default_clips():
+        raise ValueError(f"the recording names the clip {str(setup.get('clip'))[:80]!r} without carrying it; "
+                         f"a replay opens only a clip the recording holds or a default clip")
+    return setup
+
+
 def _reopen(setup: dict[str, object]):  # type: ignore[no-untyped-def]
-    """The recorded session's clip, from the recording alone."""
+    """The recorded session's clip, from the recording alone (never from a path it names)."""
     from authoring.mocurves import load_session
     from authoring.mocurves.storage import side_path
 
+    setup = _check_setup(setup)
     if not setup.get("ppclip"):
         return _open(str(setup["clip"]))[0]
     with tempfile.TemporaryDirectory() as tmp:
@@ -210,6 +234,7 @@ class EditActivity:
 
     def _apply(self, op: tuple) -> None:  # type: ignore[type-arg]
         from authoring.mocurves import save_session
+        from puppetphone.saving import save_or_say
 
         edit, kind = self.edit, op[0]
         if kind == "press":
@@ -226,8 +251,7 @@ class EditActivity:
             edit.size = (int(op[1]), int(op[2]))
         elif kind == "key" and op[2] and op[1] == "s":
             if self.output is not None:
-                save_session(self.session, self.output)
-                edit.message = f"saved {self.output}"
+                edit.message = save_or_say(lambda: save_session(self.session, self.output), self.output)
         elif kind == "key":
             edit.key(op[1], ctrl=bool(op[2]), shift=bool(op[3]))
 
@@ -279,7 +303,7 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
     from input.hub import InputHub
     from input.replay import HashCheck, ReplaySource
 
-    setup = recording.header.setup
+    setup = _check_setup(recording.header.setup)
     session = _reopen(setup)
     edit = EditScene(session, tuple(setup.get("size", (1280, 720))))
     return EditActivity(edit, session, None, InputHub(replay=ReplaySource(recording)),

@@ -214,9 +214,10 @@ class FlowActivity:
         """Write the flow file (edits and deformed scenery) atomically."""
         from authoring.flowcurves.storage import save_flow
 
+        from puppetphone.saving import save_or_say
+
         if self.output is not None:
-            save_flow(self.session, self.output)
-            self.message = f"saved {self.output}"
+            self.message = save_or_say(lambda: save_flow(self.session, self.output), self.output)
 
     def step(self) -> None:
         ops, self.queue = self.script.get(self.frame, []) + self.queue, []

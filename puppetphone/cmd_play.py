@@ -139,10 +139,11 @@ def run(args: argparse.Namespace) -> int:
             hub.close()
             print(f"the recording is of {recording.header.game!r}, not {args.game!r}", file=sys.stderr)
             return 2
-        seed, setup = recording.header.seed, game.replay_setup(recording.header.setup)
         if not recording.complete:
             print(f"warning: {recording.problem}", file=sys.stderr)
     try:
+        if hub.replay is not None:  # the recorded set-up, checked by the game like any outside input
+            seed, setup = recording.header.seed, game.replay_setup(recording.header.setup)
         from puppetphone.cmd_clips import library_setup
 
         clips = library_setup(args.clips, replay=hub.replay is not None)

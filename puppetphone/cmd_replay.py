@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     except (OSError, RecordingError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    cut_short = not rec.complete and rec.problem.startswith("cut inside")
+    cut_short = not rec.complete and rec.cut
     if not rec.complete:
         level = "warning" if cut_short and args.allow_truncated else "error"
         print(f"{level}: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)

@@ -25,7 +25,7 @@ from typing import Any
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded
 
-__all__ = ["FlowFileError", "parse_flow", "load_flow", "save_flow", "flow_document", "FORMAT", "VERSION", "MAX_FILE"]
+__all__ = ["FlowFileError", "parse_flow", "parse_objects", "load_flow", "save_flow", "flow_document", "FORMAT", "VERSION", "MAX_FILE"]
 
 FORMAT, VERSION = "puppetphone-flow", 1
 MAX_FILE = 8 * 1024 * 1024
@@ -65,6 +65,30 @@ def _dict(v: Any, what: str) -> dict[str, Any]:
     return v
 
 
+def parse_objects(value: Any) -> list[dict[str, Any]]:
+    """Validate the deformed objects of a flow document (also as a recording's set-up carries them)."""
+    objects = []
+    names = set()
+    for o in _list({"objects": value}, "objects", MAX_OBJECTS, "objects"):
+        o = _dict(o, "an object")
+        name, group = o.get("name"), o.get("group")
+        if not isinstance(name, str) or not isinstance(group, str) or not 0 < len(name) <= 200 or len(group) > 200:
+            raise FlowFileError("an object needs a name and a group")
+        if name in names:
+            raise FlowFileError(f"object {name!r} appears twice"[:200])
+        names.add(name)
+        prims = []
+        for p in _list(o, "primitives", MAX_PRIMITIVES, f"primitives of {name!r}"[:200]):
+            p = _dict(p, "a primitive")
+            prims.append({"a": _vec(p.get("a"), 3, "a primitive end"), "b": _vec(p.get("b"), 3, "a primitive end"),
+                          "radius": _num(p.get("radius"), "a primitive radius", 1e-4, 1e3),
+                          "color": _vec(p.get("color"), 3, "a primitive colour", 0.0, 1.0)})
+        if not prims:
+            raise FlowFileError(f"object {name!r} has no primitives"[:200])
+        objects.append({"name": name, "group": group, "primitives": prims})
+    return objects
+
+
 def parse_flow(doc: Any) -> dict[str, Any]:
     """Validate a decoded flow document; returns it normalised (floats, known keys only)."""
     d = _dict(doc, "a flow file")
@@ -92,25 +116,7 @@ def parse_flow(doc: Any) -> dict[str, Any]:
             raise FlowFileError(f"a {e['kind']} edit needs {'a point' if e['kind'] == 'centre' else 'two points'}")
         edits.append({"kind": e["kind"], "points": [_vec(p, 2, "an edit point") for p in pts],
                       "d_max": _num(e.get("d_max", 60.0), "d_max", 1.0, 10000.0)})
-    objects = []
-    names = set()
-    for o in _list(d, "objects", MAX_OBJECTS, "objects"):
-        o = _dict(o, "an object")
-        name, group = o.get("name"), o.get("group")
-        if not isinstance(name, str) or not isinstance(group, str) or not 0 < len(name) <= 200 or len(group) > 200:
-            raise FlowFileError("an object needs a name and a group")
-        if name in names:
-            raise FlowFileError(f"object {name!r} appears twice"[:200])
-        names.add(name)
-        prims = []
-        for p in _list(o, "primitives", MAX_PRIMITIVES, f"primitives of {name!r}"[:200]):
-            p = _dict(p, "a primitive")
-            prims.append({"a": _vec(p.get("a"), 3, "a primitive end"), "b": _vec(p.get("b"), 3, "a primitive end"),
-                          "radius": _num(p.get("radius"), "a primitive radius", 1e-4, 1e3),
-                          "color": _vec(p.get("color"), 3, "a primitive colour", 0.0, 1.0)})
-        if not prims:
-            raise FlowFileError(f"object {name!r} has no primitives"[:200])
-        objects.append({"name": name, "group": group, "primitives": prims})
+    objects = parse_objects(d.get("objects"))
     return {"format": FORMAT, "version": VERSION, "scene": scene, "size": size, "camera": camera,
             "edits": edits, "objects": objects}
 

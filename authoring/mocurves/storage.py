@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import tempfile
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -58,15 +59,26 @@ def _clip_digest(clip: Clip) -> str:
 
 
 def save_session(session: EditSession, path: str | Path) -> Path:
-    """Write the shown state atomically: ``path`` (``.ppclip``) and its ``.mocurves.json``."""
+    """Write the shown state atomically: ``path`` (``.ppclip``) and its ``.mocurves.json``.
+
+    The side file's checksum is taken on the clip as :func:`load_session` will see it — the
+    clip is written to bytes and read back first — because loading renormalises the rotations,
+    which can change their last bit: a checksum of the clip in memory made saved work
+    unopenable ("belongs to another version").
+    """
     p = Path(path)
     if p.suffix != ".ppclip":
         raise ValueError(f"{p}: a session is saved as .ppclip (use export_clip for BVH/glTF)")
     st = session.state
+    with tempfile.TemporaryDirectory() as tmp:
+        # The scale tracks ride in the clip's scale channel too; the root curve as the clip's curve section.
+        staged = save_clip(session.clip, Path(tmp) / p.name, root_curve=session.root_curve)
+        data = staged.read_bytes()
+        reloaded, _curve = load_clip_curve(staged)
     side = {
         "format": SIDE_FORMAT,
         "version": SIDE_VERSION,
-        "clip_sha256": _clip_digest(st.clip),
+        "clip_sha256": _clip_digest(reloaded),
         "scales": [[float(x) for x in row] for row in st.scales],
         "pins": {k: sorted(v) for k, v in st.pins.items()},
         "tau": session.tau,
@@ -75,8 +87,7 @@ def save_session(session: EditSession, path: str | Path) -> Path:
     # Side file first: a crash between the two leaves the old clip with a side file that
     # no longer matches it, which load refuses loudly, never a silently wrong pairing.
     atomic_write_bytes(side_path(p), json.dumps(side).encode())
-    # The scale tracks ride in the clip's scale channel too; the root curve as the clip's curve section.
-    return save_clip(session.clip, p, root_curve=session.root_curve)
+    return atomic_write_bytes(p, data)
 
 
 def load_session(path: str | Path) -> EditSession:

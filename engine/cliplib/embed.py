@@ -36,6 +36,9 @@ __all__ = ["encode", "decode"]
 
 _MAX_FRAMES = 100_000
 _MAX_CLIPS = 64
+#: All clips of a set together, decoded (float64): a recording's header (16 MB at most) holds
+#: far less real motion than this, while 64 clips of 100,000 frames would take gigabytes.
+_MAX_DECODED = 64 << 20
 
 
 def encode(clips: Mapping[str, Clip]) -> dict[str, Any]:
@@ -95,6 +98,16 @@ def _clip(role: str, e: Any, skeleton: Skeleton) -> Clip:
         raise ClipLibraryError(f"recorded clip {role!r}: {exc}") from None
 
 
+def _declared_bytes(e: Any, joints: int) -> int:
+    """What a recorded clip claims it decodes to (0 when it claims nothing usable: :func:`_clip` refuses it)."""
+    if not isinstance(e, dict):
+        return 0
+    frames, rm = e.get("frames"), e.get("root_motion") is True
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= _MAX_FRAMES:
+        return 0
+    return (3 + 4 * joints + (4 if rm else 0)) * frames * 8
+
+
 def decode(value: Any, skeleton: Skeleton) -> dict[str, Clip]:
     """The clips by role of an :func:`encode` value, checked against its set hash."""
     if not (isinstance(value, dict) and isinstance(value.get("clips"), dict) and isinstance(value.get("sha256"), str)):
@@ -103,6 +116,10 @@ def decode(value: Any, skeleton: Skeleton) -> dict[str, Clip]:
         raise ClipLibraryError(f"the recording names {len(value['clips'])} clips; the limit is {_MAX_CLIPS}")
     if _payload_digest(value["clips"]) != value["sha256"]:
         raise ClipLibraryError("the recorded clips do not match their hash; the recording was altered")
+    j = skeleton.num_joints
+    total = sum(_declared_bytes(e, j) for e in value["clips"].values())
+    if total > _MAX_DECODED:
+        raise ClipLibraryError(f"the recorded clips would take {total >> 20} MB decoded; the limit is {_MAX_DECODED >> 20} MB")
     clips = {}
     for role, e in value["clips"].items():
         try:

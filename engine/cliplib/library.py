@@ -11,7 +11,11 @@ The manifest is the one validation boundary of the folder: a manifest that is no
 this shape, a clip file missing or changed behind its back (its content hash no longer
 the recorded one) is refused in one line by :class:`ClipLibraryError`. Every write
 (manifest and clips) is atomic, and a clip is written before the manifest names it,
-so an interrupted ``clips add`` never leaves the library naming a missing file.
+so an interrupted ``clips add`` never leaves the library naming a missing file. A new
+clip for a role that already has one never goes over the file the manifest names: it is
+written under the role's other name (``walk.ppclip`` / ``walk.1.ppclip`` in turn) and the
+old file is removed only after the manifest names the new one, so a kill at any point
+leaves a library that loads (the old clip or the new one, never a mismatch).
 """
 
 from __future__ import annotations
@@ -168,12 +172,15 @@ class ClipLibrary:
             raise ClipLibraryError(str(exc)) from None
         entries = self.entries()
         self.root.mkdir(parents=True, exist_ok=True)
-        file = f"{role}.ppclip"
+        old = entries.get(role)
+        file = f"{role}.1.ppclip" if old is not None and old.file == f"{role}.ppclip" else f"{role}.ppclip"
         save_clip(clip, self.root / file)
         # The digest of what a load gives back (reading renormalises rotations, to the last bit).
         entry = Entry(role, file, clip_digest(load_clip(self.root / file)), source)
         entries[role] = entry
         self._write_manifest(entries)
+        if old is not None and old.file != file:
+            (self.root / old.file).unlink(missing_ok=True)
         return entry
 
     def remove(self, role: str) -> Entry:

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["scenery_objects", "prepare_flow", "BentScenery", "bent_scenery", "TRUNK_COLOR", "SNOW_COLOR"]
+__all__ = ["scenery_objects", "prepare_flow", "recorded_flow", "BentScenery", "bent_scenery", "TRUNK_COLOR", "SNOW_COLOR"]
 
 TRUNK_COLOR = (0.36, 0.25, 0.17)
 SNOW_COLOR = (0.95, 0.97, 1.0)
@@ -68,6 +68,19 @@ def prepare_flow(path: str) -> list[dict[str, Any]] | None:
         raise GameOptionError(f"flow: {path} bends the scene {doc['scene']!r}, not the snowman field")
     check_objects(doc["objects"])
     return doc["objects"]
+
+
+def recorded_flow(value: Any) -> list[dict[str, Any]]:
+    """The bent objects a recording's set-up carries, checked like a flow file's (``GameOptionError``)."""
+    from authoring.flowcurves.storage import FlowFileError, parse_objects
+    from games.base import GameOptionError
+
+    try:
+        objects = parse_objects(value)
+    except FlowFileError as exc:
+        raise GameOptionError(f"the recorded flow: {exc}") from None
+    check_objects(objects)
+    return objects
 
 
 def check_objects(objects: list[dict[str, Any]]) -> None:

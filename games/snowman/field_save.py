@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from engine.app import App
-from engine.atomic import atomic_write_bytes
+from engine.atomic import WriteError, atomic_write_bytes, set_aside
 from engine.npz_safe import read_bounded
 from engine.components import Transform
 from engine.ecs import World
@@ -58,6 +58,9 @@ MAX_RADIUS = 5.0  # m
 MAX_EXTENT = 1000.0  # m from the centre
 MAX_HEADING = 1e4  # rad
 MAX_FILE = 4 << 20
+#: How every field file this program writes begins (``json.dumps`` of :func:`snapshot`): only
+#: such a file is ever set aside or replaced, never a user's folder, device or other file.
+FIELD_HEADS = (b'{"version": 1, "balls": ',)
 PUPPET_COLOR = (0.85, 0.32, 0.24)
 
 
@@ -286,17 +289,27 @@ def load_field(path: Path) -> dict[str, Any] | None:
 
 
 def prepare(options: dict[str, str]) -> dict[str, Any]:
-    """Read the saved field (a damaged file is set aside as ``.bad``) into the game's setup."""
+    """Read the saved field into the game's setup; a damaged field file of ours is set aside as ``.bad``.
+
+    Raises:
+        GameOptionError: the path holds something this program did not write (a folder, a
+            device, someone's text file): it is left untouched and no save would replace it.
+    """
+    from games.base import GameOptionError
+
     path = Path(options["field"]).expanduser() if options["field"] else default_field_path()
     try:
         saved = load_field(path)
     except FieldError as exc:
-        bad = Path(str(path) + ".bad")
         try:
-            os.replace(path, bad)
-            print(f"snowman: {exc}; set aside as {bad}, starting on a fresh field", file=sys.stderr)
-        except OSError as move:
-            print(f"snowman: {exc}; cannot set it aside ({move.strerror}), starting on a fresh field", file=sys.stderr)
+            bad = set_aside(path, FIELD_HEADS)
+        except WriteError as move:
+            print(f"snowman: {exc}; {move}, starting on a fresh field", file=sys.stderr)
+            return {"field": None, "save_to": str(path)}
+        if bad is None:
+            raise GameOptionError(f"snowman field {path} is not a field this program saved ({exc}); "
+                                  "it is left as it is: choose another file with --set field=PATH") from None
+        print(f"snowman: {exc}; set aside as {bad}, starting on a fresh field", file=sys.stderr)
         saved = None
     return {"field": saved, "save_to": str(path)}
 
@@ -335,9 +348,16 @@ def field_commands(world: World) -> None:
             _tell(world, "new field")
         elif kind == SAVE:
             slot.saved = snapshot(world)
-            if slot.path is not None:
-                atomic_write_bytes(slot.path, json.dumps(slot.saved).encode("utf-8"))
-            _tell(world, "field saved", f" to {slot.path}" if slot.path is not None else "")
+            if slot.path is None:
+                _tell(world, "field saved")
+                continue
+            try:
+                atomic_write_bytes(slot.path, json.dumps(slot.saved).encode("utf-8"), expect_head=FIELD_HEADS)
+            except WriteError as exc:  # the game goes on; the field stays in the slot for F9
+                _tell(world, "field NOT saved to disk (F9 still restores it)",
+                      f": {exc}; start with --set field=PATH to save elsewhere")
+                continue
+            _tell(world, "field saved", f" to {slot.path}")
         elif kind == RESTORE:
             if slot.saved is None:
                 _tell(world, "nothing saved to restore (F5 saves the field)")

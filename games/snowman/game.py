@@ -17,7 +17,7 @@ from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.statemachine.puppet import install_puppets
 from games.base import Game
-from games.snowman.bent_scenery import prepare_flow
+from games.snowman.bent_scenery import prepare_flow, recorded_flow
 from games.snowman.components import SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
@@ -81,6 +81,14 @@ def prepare_game(options: dict[str, str]) -> dict[str, Any]:
     return setup
 
 
+def replay_game(recorded: dict[str, Any]) -> dict[str, Any]:
+    """A recording's set-up, checked: the saved field (dropped when unusable) and the bent scenery."""
+    setup = replay_setup(recorded)
+    if setup.get("flow") is not None:
+        setup["flow"] = recorded_flow(setup["flow"])
+    return setup
+
+
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_setup)
+            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game)
 

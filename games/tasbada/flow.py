@@ -25,6 +25,7 @@ import numpy as np
 from engine.components import Stick
 from engine.ecs import World
 from engine.render.components import Appearance
+from games.common import post_notice
 from games.tasbada import marking, narrator, objects
 from games.tasbada.picker import picker_step
 from games.tasbada.pose import lift
@@ -283,7 +284,10 @@ def save_system(world: World) -> None:
     slot.dirty = False
     try:
         save_progress(slot.path, progress_of(world.resource(Quest), slot.photo))  # type: ignore[arg-type]
-    except OSError as exc:
+    except OSError as exc:  # a WriteError: one line; the journey goes on and the next change tries again
         if not slot.error:
-            print(f"tasbada: cannot save progress to {slot.path}: {exc}", file=sys.stderr)
+            print(f"tasbada: progress NOT saved: {exc}; start with --set save=PATH to save elsewhere", file=sys.stderr)
+            post_notice(world, "progress NOT saved (see the terminal)")
         slot.error = str(exc)
+    else:
+        slot.error = ""

@@ -18,9 +18,8 @@ from their shadows in the photo).
 
 :func:`prepare` reads the save file and picks the pictures; :func:`install` builds the
 quest from that setup alone, so a recording replays from its header. The pictures and
-the webcam are display only (no simulation state depends on them): a replay shows the
-recorded photo files, and the frames of a webcam are not recorded — a replay of a
-webcam session shows the shipped photo instead, and says so.
+the webcam are display only (no simulation state depends on them) and are not recorded:
+a replay shows the shipped pictures and never opens a path named in a recording.
 """
 
 from __future__ import annotations
@@ -33,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from engine.app import App
+from engine.atomic import WriteError, set_aside
 from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.statemachine.puppet import install_puppets
@@ -46,7 +46,7 @@ from games.tasbada.pose import validate as validate_pose
 from games.tasbada.posing import selfie_pose_system
 from games.tasbada.quest import MIXED, PROPS_ALIVE, STAGES, VIRTUAL, Mark, Quest
 from games.tasbada.reality import SHIPPED_PHOTO, SHIPPED_SELFIE, Reality
-from games.tasbada.save import SaveError, default_save_path, load_progress
+from games.tasbada.save import SAVE_HEADS, SaveError, checked_progress, default_save_path, load_progress
 from games.tasbada.view import game_camera
 
 __all__ = ["GAME", "install", "prepare", "replay_setup", "status", "CONTROLS"]
@@ -68,12 +68,15 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
     try:
         progress = load_progress(save)
     except SaveError as exc:
-        bad = Path(str(save) + ".bad")
         try:
-            os.replace(save, bad)
+            bad = set_aside(save, SAVE_HEADS)
+        except WriteError as move:
+            print(f"tasbada: {exc}; {move}, starting a new journey", file=sys.stderr)
+        else:
+            if bad is None:
+                raise GameOptionError(f"tasbada save {save} is not progress this program saved ({exc}); it is "
+                                      "left as it is: choose another file with --set save=PATH") from None
             print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
-        except OSError as move:
-            print(f"tasbada: {exc}; cannot set it aside ({move.strerror}), starting a new journey", file=sys.stderr)
     photo = options["photo"] or os.environ.get("TASBADA_PHOTO", "")
     if not photo and progress is not None and progress.photo and Path(progress.photo).is_file():
         photo = progress.photo
@@ -123,12 +126,29 @@ def _selfie_pose(selfie: str, auto: bool) -> tuple[dict[str, list[float]] | None
 
 
 def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
-    """A replay saves nowhere and opens no camera; missing picture files fall back to the shipped ones."""
-    setup = {**recorded, "save_to": "", "webcam": False}
-    for key in ("photo", "selfie"):
-        if setup.get(key) and not Path(setup[key]).is_file():
-            setup[key] = ""
-    return setup
+    """A recording's set-up, checked value by value; a replay saves nowhere, opens no camera and no file.
+
+    The recorded photo and selfie paths are dropped (the shipped pictures are shown): a
+    recording is self-contained, and a path in it must never make a replay read the
+    replaying person's disk. The quest values are checked like a save's (:func:`checked_progress`).
+
+    Raises:
+        GameOptionError: a value of the wrong type or range (the recording was altered).
+    """
+    try:
+        reached, marks, ground_v = checked_progress(recorded.get("reached", []), recorded.get("marks", []),
+                                                    recorded.get("ground_v"))
+    except SaveError as exc:
+        raise GameOptionError(f"the recorded progress: {exc}") from None
+    aspect, light, note = recorded.get("pose_aspect", 1.0), recorded.get("light"), recorded.get("pose_note", "")
+    if isinstance(aspect, bool) or not isinstance(aspect, (int, float)) or not 0.01 <= aspect <= 100.0:
+        raise GameOptionError(f"the recorded pose_aspect {repr(aspect)[:30]} is not a number in [0.01, 100]")
+    if light is not None and (isinstance(light, bool) or not isinstance(light, (int, float)) or not np.isfinite(light)):
+        raise GameOptionError(f"the recorded light {repr(light)[:30]} is not a finite number of degrees")
+    if not isinstance(note, str):
+        raise GameOptionError("the recorded pose_note is not text")
+    return {**recorded, "save_to": "", "webcam": False, "photo": "", "selfie": "", "reached": reached,
+            "marks": [m.to_json() for m in marks], "ground_v": ground_v, "pose_note": note[:500]}
 
 
 def install(app: App) -> None:

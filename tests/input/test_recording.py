@@ -64,17 +64,18 @@ def test_cut_at_any_byte_recovers_every_complete_frame(make_app, tmp_path):
     while pos < len(data):
         pos += 8 + int.from_bytes(data[pos:pos + 4], "little")
         ends.append(pos)
-    assert ends[-1] == len(data) and len(ends) == 30
+    assert ends[-1] == len(data) and len(ends) == 31  # 30 records and the closing one
+    assert full.complete and len(full) == 30
+    ends = ends[:-1]
     cuts = np.random.default_rng(0).choice(np.arange(first, len(data)), 60, replace=False)
-    for cut in sorted(cuts):
+    for cut in sorted([*cuts, *ends[::7]]):
         p = tmp_path / "cut.rec"
         p.write_bytes(data[:cut])
         r = read_recording(p)
         whole = sum(1 for e in ends if e <= cut)
-        assert len(r) == whole and r.complete == (cut in ends)
+        assert len(r) == whole and not r.complete and r.cut  # a cut between records is a cut too
         assert r.hashes == full.hashes[:whole]
-        if not r.complete:
-            assert "cut inside" in r.problem
+        assert ("ended without its closing record" if cut in ends or cut == first else "cut inside") in r.problem
 
 
 def test_a_cut_recording_still_replays_its_complete_frames(make_app, tmp_path):
@@ -91,10 +92,10 @@ def test_damaged_byte_and_bad_headers(make_app, tmp_path):
     path = tmp_path / "s.rec"
     record_session(make_app, path, steps=10)
     data = bytearray(path.read_bytes())
-    data[-5] ^= 0xFF
+    data[-13] ^= 0xFF  # inside the last record (the closing record is the last 8 bytes)
     path.write_bytes(bytes(data))
     r = read_recording(path)
-    assert len(r) == 9 and "checksum" in r.problem
+    assert len(r) == 9 and "checksum" in r.problem and not r.cut
     for bad, msg in ((b"not a recording", "bad magic"), (MAGIC + b"\x05", "cut inside its header"),
                      (bytes(data[:20]), "cut inside its header")):
         path.write_bytes(bad)
@@ -116,8 +117,39 @@ def test_file_grows_as_frames_are_written(make_app, tmp_path):
     for _ in range(3):
         app.step()
         sizes.append(path.stat().st_size)  # flushed without closing
-    assert sizes[0] < sizes[1] < sizes[2] and read_recording(path).complete and len(read_recording(path)) == 3
+    open_now = read_recording(path)
+    assert sizes[0] < sizes[1] < sizes[2] and len(open_now) == 3 and "closing record" in open_now.problem
     rec.close()
+    assert read_recording(path).complete and len(read_recording(path)) == 3
+
+
+def test_a_closing_record_that_does_not_match_is_damage(make_app, tmp_path):
+    path = tmp_path / "s.rec"
+    record_session(make_app, path, steps=5)
+    data = bytearray(path.read_bytes())
+    data[-4] = 9  # claims 9 frames
+    path.write_bytes(bytes(data))
+    assert "damaged closing record" in read_recording(path).problem
+    path.write_bytes(bytes(data[:-4]) + (5).to_bytes(4, "little") + b"junk")
+    assert "damaged closing record" in read_recording(path).problem
+
+
+def test_a_full_disk_stops_the_recording_with_one_line_and_the_session_plays_on(make_app, tmp_path, capsys):
+    from tests.faults import full_disk
+
+    with full_disk(tmp_path / "disk", free=8192) as disk:
+        src = Fed("m")
+        app = make_app(InputHub([src]))
+        rec = Recorder(disk / "s.rec", RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
+        for i in range(400):  # ~100 bytes a record: the disk fills long before the end
+            src.push(PoseSample(time=i / 60, source="osc:1", orientation=quat.from_axis_angle([1, 0, 0], 0.01 * i)))
+            app.step()
+        rec.close()
+        assert app.world.frame == 400 and rec.failed and 0 < rec.frames < 400
+        err = capsys.readouterr().err
+        assert err.count("stopped after") == 1 and "Traceback" not in err
+        r = read_recording(disk / "s.rec")
+        assert not r.complete and len(r) <= rec.frames
 
 
 def test_size_per_minute(make_app, tmp_path):

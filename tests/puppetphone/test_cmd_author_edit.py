@@ -115,3 +115,33 @@ def test_a_take_opens_as_the_loop_of_the_part_picked(tmp_path, mocap_dir):
     assert clip.loop and clip.duration == pytest.approx(1.17, rel=0.04)
     assert run_edit(parse(take, "--start", "0", "--end", "0.5", "--headless", "--frames", "1")) == 2
     assert run_edit(parse("walk", "--start", "0", "--headless", "--frames", "1")) == 2
+
+
+@pytest.mark.parametrize("blocker", ["folder", "full disk"])
+def test_a_failed_ctrl_s_says_so_and_the_session_goes_on(tmp_path, capsys, blocker):
+    """A folder in the way or a full disk: one line, the edit stays open, a later Ctrl+S elsewhere works."""
+    from tests.faults import full_disk
+    from puppetphone.cmd_author_edit import build_edit
+
+    def ctrl_s(act):
+        act.hub.tool("key", "s", True, False)
+        act.step()
+
+    if blocker == "folder":
+        out = tmp_path / "walk_edited.ppclip"
+        out.mkdir()
+        act = build_edit("walk", (320, 180), out)
+        ctrl_s(act)
+    else:
+        with full_disk(tmp_path / "disk") as disk:
+            out = disk / "walk_edited.ppclip"
+            act = build_edit("walk", (320, 180), out)
+            ctrl_s(act)
+            assert not out.exists()
+    assert act.edit.message.startswith("NOT saved") and "cannot save" in act.edit.message
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    act.step()
+    act.output = tmp_path / "elsewhere.ppclip"
+    ctrl_s(act)
+    assert act.edit.message == f"saved {act.output}" and act.output.stat().st_size > 0

@@ -86,3 +86,14 @@ def test_a_deeply_nested_side_file_is_a_session_file_error(walk, tmp_path):
     (tmp_path / "a.mocurves.json").write_text("[" * 100_000 + "]" * 100_000)
     with pytest.raises(SessionFileError, match="RecursionError"):
         load_session(path)
+
+
+@pytest.mark.parametrize("name", ["idle", "walk", "run", "crouch_idle", "crouch_walk"])
+def test_a_saved_session_reopens_unedited_and_again_after_a_second_save(name, tmp_path):
+    """Loading renormalises rotations (last bit); the side file's checksum must be of the clip as loaded."""
+    from engine.clips import default_clips
+
+    path = save_session(EditSession(default_clips()[name]), tmp_path / f"{name}.ppclip")
+    back = load_session(path)
+    again = load_session(save_session(back, tmp_path / f"{name}_2.ppclip"))
+    assert again.clip.num_frames == back.clip.num_frames and again.scales.tobytes() == back.scales.tobytes()

@@ -103,3 +103,24 @@ def test_fuzz_manifest(tmp_path_factory: pytest.TempPathFactory, value: object) 
         ClipLibrary(folder).load()
     except ClipLibraryError as exc:
         assert "\n" not in str(exc)
+
+
+def test_a_clips_add_killed_after_writing_the_clip_leaves_the_library_loading(tmp_path: Path,
+                                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """The kill falls between the clip and the manifest: the old walk still loads, then the new one replaces it."""
+    lib = ClipLibrary(tmp_path / "lib")
+    first = lib.add(_slow_walk(), "walk", SK, default_clips())
+    second_walk = default_clips()["walk"].resampled(55.0)
+
+    def killed(self, entries):  # type: ignore[no-untyped-def]
+        raise KeyboardInterrupt("killed before the manifest was written")
+
+    with monkeypatch.context() as m:
+        m.setattr(ClipLibrary, "_write_manifest", killed)
+        with pytest.raises(KeyboardInterrupt):
+            lib.add(second_walk, "walk", SK, default_clips())
+    assert clip_digest(lib.load()["walk"]) == first.sha256  # nothing earlier was lost
+    second = lib.add(second_walk, "walk", SK, default_clips())
+    assert second.file != first.file and clip_digest(lib.load()["walk"]) == second.sha256
+    assert sorted(p.name for p in (tmp_path / "lib").iterdir()) == sorted(["clips.json", second.file])
+    assert lib.add(_slow_walk(), "walk", SK, default_clips()).file == first.file

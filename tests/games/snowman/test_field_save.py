@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -142,10 +143,11 @@ def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file
 
 
 def test_a_corrupt_save_file_is_set_aside_with_a_message(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    field_file.write_text("{ not json")
+    cut = json.dumps(start_snapshot())[:40]  # a field this program wrote, cut short
+    field_file.write_text(cut)
     app = _live_app(InputHub())
     assert app.world.resource(FieldSlot).saved is None
-    assert Path(str(field_file) + ".bad").read_text() == "{ not json" and not field_file.exists()
+    assert Path(str(field_file) + ".bad").read_text() == cut and not field_file.exists()
     assert "set aside" in capsys.readouterr().err
     app.run_steps(3)
     assert app.world.query(Transform)
@@ -206,24 +208,75 @@ def test_a_bad_field_is_refused_whole_before_anything_changes(edit, says) -> Non
 
 
 def test_a_deeply_nested_save_file_is_set_aside(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    field_file.write_text("[" * 100_000 + "]" * 100_000)
+    field_file.write_text('{"version": 1, "balls": ' + "[" * 100_000 + "]" * 100_000 + "}")
     app = _live_app(InputHub())
     assert app.world.resource(FieldSlot).saved is None and not field_file.exists()
     assert "nested too deeply" in capsys.readouterr().err
     app.run_steps(2)
 
 
-def test_a_bad_file_that_cannot_be_set_aside_is_reported_and_the_game_starts(
+def test_a_bad_file_is_set_aside_beside_an_existing_bad_without_replacing_it(
         field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
     snap = _edited(start_snapshot(), lambda s: s["puppets"][0].update(heading=float("nan")))
     field_file.write_text(json.dumps(snap))
     blocker = Path(str(field_file) + ".bad")
     blocker.mkdir()
-    (blocker / "keep").write_text("x")  # a non-empty folder where the .bad file would go
+    (blocker / "keep").write_text("x")  # a folder where the .bad file would go
     app = _live_app(InputHub())
     assert app.world.resource(FieldSlot).saved is None
-    assert "cannot set it aside" in capsys.readouterr().err
+    assert (blocker / "keep").read_text() == "x" and json.loads(Path(f"{field_file}.1.bad").read_text()) is not None
+    assert "set aside" in capsys.readouterr().err
     app.run_steps(3)
+
+
+@pytest.mark.parametrize("make", [
+    lambda p: (p.mkdir(), (p / "notes.txt").write_text("mine")),  # a user's folder
+    lambda p: p.write_text("my shopping list\n"),  # a user's text file
+    lambda p: p.write_text("[" * 100_000),  # not JSON a field ever was
+])
+def test_a_field_path_holding_something_else_is_refused_and_left_untouched(field_file: Path, make) -> None:  # type: ignore[no-untyped-def]
+    from games.base import GameOptionError
+
+    make(field_file)
+    before = sorted((str(p), p.read_bytes()) for p in field_file.parent.rglob("*") if p.is_file())
+    with pytest.raises(GameOptionError, match="not a field this program saved"):
+        load_game("snowman").prepare({"field": str(field_file)})
+    assert sorted((str(p), p.read_bytes()) for p in field_file.parent.rglob("*") if p.is_file()) == before
+
+
+def test_a_pipe_as_field_is_refused_and_never_renamed(tmp_path: Path) -> None:
+    """A pipe stands for any special file (a device: run as root, the old code renamed /dev/null)."""
+    import stat
+
+    from games.base import GameOptionError
+
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    with pytest.raises(GameOptionError, match="not a field this program saved"):
+        load_game("snowman").prepare({"field": str(pipe)})
+    assert stat.S_ISFIFO(pipe.lstat().st_mode) and not Path(f"{pipe}.bad").exists()
+
+
+def test_a_failed_f5_says_so_keeps_playing_and_keeps_the_field(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from games.common import Notice
+
+    hub = InputHub()
+    app = _live_app(hub)
+    field_file.mkdir()  # a folder appears in the way after the start
+    hub.command(SAVE)
+    app.step()
+    assert app.world.resource(Notice).text.startswith("field NOT saved")
+    out = capsys.readouterr().out
+    assert "cannot save" in out and "Traceback" not in out and len(out.strip().splitlines()) == 1
+    assert app.world.resource(FieldSlot).saved is not None and field_file.is_dir()
+    field_file.rmdir()
+    field_file.write_text("someone else's file")  # nor is a foreign file replaced by F5
+    hub.command(SAVE)
+    app.step()
+    assert field_file.read_text() == "someone else's file"
+    hub.command(RESTORE)
+    app.run_steps(3)
+    assert app.world.resource(Notice).text == "field restored"
 
 
 def test_a_replay_whose_header_carries_a_bad_field_plays_on(tmp_path: Path) -> None:
