@@ -55,11 +55,17 @@ def wanted_velocity(error: F, lead: F, tuning: PuppetTuning) -> F:
 
     The catch-up gain fades in as ``d² / (d² + deadband²)`` of the distance ``d``, so a
     puppet standing at its stick does not creep toward every tremor of the hand, and
-    nothing switches at a radius. The result is capped at ``tuning.top_speed``.
+    nothing switches at a radius; the stick's velocity fades out once the puppet is a
+    dead band ahead of it along that velocity. The result is capped at ``tuning.top_speed``.
     """
     d2 = float(error @ error)
     band2 = tuning.follow_deadband**2
-    wanted = lead + tuning.catch_up_gain * (d2 / (d2 + band2) if d2 > 0.0 else 0.0) * error
+    pace = float(np.linalg.norm(lead))
+    # The feed-forward fades out once the puppet is ahead of its stick along the lead (the hand
+    # stopped and its filtered velocity still trails): a puppet never strides past the hand.
+    ahead = -float(error @ lead) / pace if pace > 1e-9 else 0.0
+    gate = float(np.clip(1.0 - ahead / tuning.follow_deadband, 0.0, 1.0))
+    wanted = gate * lead + tuning.catch_up_gain * (d2 / (d2 + band2) if d2 > 0.0 else 0.0) * error
     speed = float(np.linalg.norm(wanted))
     return wanted * (tuning.top_speed / speed) if speed > tuning.top_speed else wanted
 
@@ -84,7 +90,10 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
     else:
         error = (body.target - tr.position) * np.array([1.0, 0.0, 1.0])
         goal = wanted_velocity(error, body.lead * np.array([1.0, 0.0, 1.0]), t)
-    body.walk_velocity, body.walk_rate = spring_step(body.walk_velocity, body.walk_rate, goal, t.follow_omega, world.dt)
+    # Braking is quicker than speeding up (people stop within a step): twice the stiffness.
+    braking = float(np.linalg.norm(goal)) < float(np.linalg.norm(body.walk_velocity))
+    omega = t.follow_omega * (2.0 if braking else 1.0)
+    body.walk_velocity, body.walk_rate = spring_step(body.walk_velocity, body.walk_rate, goal, omega, world.dt)
     v = body.walk_velocity
     speed = float(np.hypot(v[0], v[2]))
     facing = 1.0
