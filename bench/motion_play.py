@@ -146,11 +146,15 @@ class _Driver:
         self.puppet = next(e for e, _ in self.world.query(Brain))
         body = self.world.get(self.puppet, PuppetBody)
         body.tuning = replace(body.tuning, controller=controller)
+        # Facing the way the cases lead: the time to 90 % is a speed step, not a turn on the spot.
+        body.heading = float(np.arctan2(_WAY[0], _WAY[1]))
+        self.world.get(self.puppet, Transform).rotation = quat.from_axis_angle([0.0, 1.0, 0.0], body.heading)
         self.camera = load_game("sandbox").camera()
         self.size = (1280, 720)
         self.sk = self.world.get(self.puppet, Puppet).skeleton
         self.feet = [self.sk.index(n) for n in ("l_foot", "r_foot")]
         self.time = 0.0
+        self.clock = 0.0  # seconds since the drag began (the cases' time)
         self.offset = np.zeros(3)  # phone: its tracked position; the stick tip moves with it
         self.orientation = quat.identity()
         self.lift = 0.0  # phone height offset / mouse cursor rise in pixels (flicks)
@@ -171,21 +175,24 @@ class _Driver:
         px = self.camera.project(np.asarray(point, dtype=np.float64)[None], *self.size)[0]
         return float(px[0]), float(px[1] - self.lift)
 
-    def step(self, ground: F | None = None) -> None:
-        """One 60 Hz step; the device reports ``ground`` (the stick's wanted ground point) at its rate."""
+    def step(self, path: Callable[[float], F] | None = None) -> None:
+        """One 60 Hz step; the device reports ``path(t)`` (the stick's wanted ground offset at ``t`` s
+        since the drag began) at its own rate, each reading where the hand is at its event time."""
         dt = self.world.dt
         n = int(round(RATE * dt))
         for k in range(1, n + 1):
             t = self.time + dt * k / n
-            if ground is None:
+            if path is None:
                 continue
+            ground = path(self.clock + dt * k / n)
             if self.device == "phone":
                 self.offset = self.offset0 + np.array([ground[0], 0.0, ground[1]])
                 self._phone_sample(t)
             else:
-                px = self._pixel(np.array([self.anchor0[0] + ground[0], self.height, self.anchor0[2] + ground[1]]))
+                px = self._pixel(np.array([self.tip0[0] + ground[0], self.height, self.tip0[2] + ground[1]]))
                 self._mouse_event(pygame.MOUSEMOTION, t, pos=px, rel=(0, 0), buttons=(1, 0, 0))
         self.time += dt
+        self.clock += dt
         self.app.step()
         self._record()
 
@@ -227,10 +234,11 @@ class _Driver:
         stick = next(s for _, s in self.world.query(Stick))
         if stick.grabbed != self.puppet:
             raise RuntimeError(f"the {self.device} did not grab the puppet")
-        self.height = float(stick.tip[1])
+        self.height, self.tip0 = float(stick.tip[1]), stick.tip.copy()
         for _ in range(15):
-            self.step(np.zeros(2))
+            self.step(lambda t: np.zeros(2))
         self._rows.clear()
+        self.clock = 0.0
 
     def result(self) -> Run:
         """The steps recorded since the grab."""
@@ -243,9 +251,8 @@ def drive(case: Case, device: str = "phone", controller: str = "spring", settle:
     """Play ``case`` with ``device`` and the given locomotion ``controller``; keep ``settle`` s after it."""
     d = _Driver(device, controller)
     d.grab()
-    steps = int(round((case.moving + settle) / d.world.dt))
-    for k in range(1, steps + 1):
-        d.step(case.path(k * d.world.dt))
+    for _ in range(int(round((case.moving + settle) / d.world.dt))):
+        d.step(case.path)
     return d.result()
 
 
@@ -367,7 +374,7 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
                 d.offset = d.offset0 + np.array([ground[0], 0.0, ground[1]])
                 d._phone_sample(sample_t)
             else:
-                px = d._pixel(np.array([d.anchor0[0] + ground[0], d.height, d.anchor0[2] + ground[1]]))
+                px = d._pixel(np.array([d.tip0[0] + ground[0], d.height, d.tip0[2] + ground[1]]))
                 d._mouse_event(pygame.MOUSEMOTION, sample_t, pos=px, rel=(0, 0), buttons=(1, 0, 0))
         d.time += dt
         d.app.step()

@@ -135,6 +135,7 @@ def _grab(world: World, st: StickState, stick: Stick, target: Entity) -> None:
     stick.grab_offset = quat.rotate(inv, anchor - tip)
     stick.grab_rotation = quat.normalize(quat.mul(inv, tr.rotation))
     stick.grabbed, stick.just_grabbed = target, True
+    st.filt_x = None  # the tip jumps to the held length: a grab is not a velocity
 
 
 def _release(stick: Stick) -> None:

@@ -49,7 +49,7 @@ class PuppetTuning:
     drag_limit: float = 1.6
     drag_lead_time: float = 0.5
     top_speed: float = 6.0
-    follow_omega: float = 30.0
+    follow_omega: float = 40.0
     anticipation: float = 0.16
     landing: float = 0.22
     flick_launch_speed: float = 3.4
