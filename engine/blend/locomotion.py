@@ -47,6 +47,7 @@ __all__ = ["LocomotionSet", "BlendLibrary", "LocomotionPlayer", "animate", "inst
 
 F = NDArray[np.float64]
 _UP = np.array([0.0, 1.0, 0.0])
+_SETTLE_SPEED = 0.05  # m/s: asked for less, a puppet is coming to stand (its feet shuffle into place)
 
 
 @dataclass(frozen=True)
@@ -282,6 +283,7 @@ def animate(world: World) -> None:
             ik = world.try_get(e, IKRequest)
             if ik is not None:
                 ik.foot_lock.contacts = None if votes is None else votes[i] * (1.0 - (weight if clip is not None else 0.0))
+                ik.foot_lock.settle = player.speed < _SETTLE_SPEED
         # Heading, travel and the world root for the whole group at once.
         yaw = _yaw(np.array([m[1].rotation for m in members]))
         hq = quat.from_axis_angle(_UP, yaw)

@@ -7,15 +7,16 @@ labels say a foot is down, its toe tip is *locked* at the point where it touched
 ground, and the two-bone leg solve reaches there; when the label lifts it, the lock
 fades out over ``release_time`` (smoothstep), so the foot eases back to its animated
 path instead of snapping. A lock that would stretch the leg beyond ``max_stretch``
-from the animated foot (a sharp turn, a yank) lets go the same way.
+from the animated foot (a sharp turn, a yank) lets go the same way. When the puppet comes
+to stand, a foot left away from where the standing pose wants it takes a step there (one
+foot at a time), as a person shuffles into stance, instead of creeping or hovering.
 
 The toe tip is the locked point because it is what stays still longest in a step
 (heel-off rolls over it) and what an onlooker sees skate. A lock fades only once the
 toe is really off the floor (``release_height``): contact labels end while the toe
-still pushes off. Only the ground-plane
-position is locked (a releasing foot far from its animated place steps there on a low
-arc); heights stay the grounding's (clip clearance over the real
-ground), then :func:`floor_lift` keeps toe and heel above the floor.
+still pushes off. Only the ground-plane position is locked; heights stay the grounding's
+(clip clearance over the real ground) plus the arc of a step, then :func:`floor_lift`
+keeps toe and heel above the floor.
 
 All functions work on arrays ``[P, L, …]`` (puppets, legs) so a crowd locks its feet
 in one call; the state lives in :class:`FootLock` on the request (hashed, replayed).
@@ -43,9 +44,14 @@ class FootLock:
         points: ``[L, 3]`` locked toe tips (world), meaningful where ``weights > 0``.
         weights: ``[L]`` lock strength in ``[0, 1]`` (1 while planted, fading after).
         planted: ``[L]`` whether each leg is in its contact phase (the lock was taken).
+        settle: written by the animation stage: the puppet is asked to stand still.
+        stepping: ``[L]`` a standing puppet's foot on its way to its place.
+        animated: ``[L, 3]`` last step's animated toe tips (is the standing place still moving?).
         release_time: seconds a lock takes to fade after its foot lifts.
         max_stretch: metres the locked toe may be from the animated one before it lets go.
         release_height: metres the animated toe must rise before a lifted foot's lock fades.
+        settle_gap: metres a standing puppet's foot may be from its place before it steps there.
+        step_time, step_height: how long (s) and how high (m, at most) such a step is.
         enabled: off, planted feet follow the animation (the legacy controller's behaviour).
     """
 
@@ -53,9 +59,15 @@ class FootLock:
     points: F = field(default_factory=lambda: np.zeros((0, 3)))
     weights: F = field(default_factory=lambda: np.zeros(0))
     planted: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    settle: bool = False
+    stepping: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    animated: F = field(default_factory=lambda: np.zeros((0, 3)))
     release_time: float = 0.12
     max_stretch: float = 0.12
     release_height: float = 0.035
+    settle_gap: float = 0.05
+    step_time: float = 0.3
+    step_height: float = 0.08
     enabled: bool = True
 
 
@@ -63,43 +75,60 @@ def _smooth(w: F) -> F:
     return w * w * (3.0 - 2.0 * w)
 
 
-def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], toes: F, contacts: F, clearance: F, dt: float,
-              release_time: float, max_stretch: float, release_height: float,
-              step_height: float = 0.08) -> tuple[F, F, NDArray[np.bool_], F]:
+def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArray[np.bool_], toes: F, contacts: F,
+              clearance: F, settle: NDArray[np.bool_], still: NDArray[np.bool_], dt: float, lock: FootLock) -> tuple[F, F, NDArray[np.bool_],
+                                                                                            NDArray[np.bool_], F]:
     """Advance the locks one step and say where each toe should go.
 
     Args:
-        points, weights, planted: the lock state ``[P, L, 3]``, ``[P, L]``, ``[P, L]``.
+        points, weights, planted, stepping: the lock state ``[P, L, 3]``, ``[P, L]``, ``[P, L]``,
+            ``[P, L]`` (``stepping``: a standing puppet's foot on its way to its place).
         toes: ``[P, L, 3]`` where the animation (after grounding) puts each toe tip.
         contacts: ``[P, L]`` contact votes; above 0.5 a foot is planted.
         clearance: ``[P, L]`` the animated toe's height above the ground: a planted toe stays
             locked until it is ``release_height`` up, even after its label lifted (labels end
             while the toe still pushes off the floor).
+        settle: ``[P]`` the puppet is coming to stand: a foot held more than ``settle_gap``
+            from where the standing pose wants it takes a step there, one foot at a time,
+            once that place has stopped moving (``still [P, L]``: the blend has settled).
+        lock: the settings (``release_time``, ``max_stretch``, ``settle_gap``, ``step_time``,
+            ``step_height``).
 
     Returns:
-        ``(points, weights, planted, targets)``: the new state and ``[P, L, 3]`` toe targets:
-        x and z pulled to the locks, and a fading lock's foot lifted on an arc of up to
-        ``step_height`` (half the distance it still has to go), so it steps, not slides.
+        ``(points, weights, planted, stepping, targets)``: the new state and ``[P, L, 3]`` toe
+        targets: x and z pulled to the locks; a fading lock's foot lifted on a low arc (it
+        was let go far from its animated place), a stepping foot rising first, moving in the
+        middle of its step and setting down at the end, so feet step, never slide.
     """
     down = contacts > 0.5
+    stepping = stepping & (weights > 0.0)
     shown = toes + _smooth(weights)[..., None] * (points - toes)
     shown[..., 1] = toes[..., 1]
-    start = down & ~planted
+    start = down & ~planted & ~stepping
     # A lock taken while an old one still fades starts where the foot is shown: no pop.
     points = np.where(start[..., None], shown, points)
     weights = np.where(start, 1.0, weights)
-    stretched = np.linalg.norm((points - toes)[..., [0, 2]], axis=-1) > max_stretch
-    holding = down | (planted & (clearance < release_height))
-    planted = holding & ~stretched & (planted | start)
-    fading = ~planted
-    weights = np.where(fading, np.maximum(weights - dt / release_time, 0.0), weights)
-    targets = toes + _smooth(weights)[..., None] * (points - toes)
-    # A foot let go far from where the animation wants it (the puppet stopped or turned
-    # mid-stride) steps there: it rises on an arc while it moves instead of sliding.
     gap = np.linalg.norm((points - toes)[..., [0, 2]], axis=-1)
-    arc = np.where(fading, 4.0 * weights * (1.0 - weights) * np.minimum(0.5 * gap, step_height), 0.0)
-    targets[..., 1] = toes[..., 1] + arc
-    return points, weights, planted, targets
+    held = planted | start
+    # Standing, a far foot waits for its step (one foot at a time) instead of letting go.
+    stretched = (gap > lock.max_stretch) & ~settle[:, None]
+    # Standing: the farthest misplaced foot steps, if no foot of the puppet is stepping already.
+    misplaced = held & settle[:, None] & still & (gap > lock.settle_gap)
+    first = misplaced & (gap >= np.max(np.where(misplaced, gap, 0.0), axis=-1, keepdims=True))
+    step_now = first & ~np.any(stepping, axis=-1, keepdims=True)
+    stepping = stepping | step_now
+    holding = down | (planted & (clearance < lock.release_height))
+    planted = holding & ~stretched & held & ~stepping
+    fading = ~planted
+    rate = np.where(stepping, dt / lock.step_time, dt / lock.release_time)
+    weights = np.where(fading, np.maximum(weights - rate, 0.0), weights)
+    progress = 1.0 - weights
+    along = np.where(stepping, 1.0 - _smooth(np.clip((progress - 0.25) / 0.5, 0.0, 1.0)), _smooth(weights))
+    targets = toes + along[..., None] * (points - toes)
+    lift = np.where(stepping, np.sin(np.pi * progress) * np.minimum(0.5 * gap + 0.04, lock.step_height),
+                    np.where(fading, 4.0 * weights * (1.0 - weights) * np.minimum(0.5 * gap, lock.step_height), 0.0))
+    targets[..., 1] = toes[..., 1] + lift
+    return points, weights, planted, stepping, targets
 
 
 def floor_lift(heights: F, ground: F) -> F:

@@ -35,6 +35,7 @@ __all__ = ["GroundQuery", "PlaneGround", "HeightfieldGround", "Leg", "HUMANOID_L
 F = NDArray[np.float64]
 GroundQuery = Callable[[F, F], tuple[F, F]]
 _UP = (0.0, 1.0, 0.0)
+_STILL = 0.1  # m/s: an animated toe slower than this has found its standing place
 
 
 @dataclass(frozen=True)
@@ -125,14 +126,31 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
         if lock is None or lock.contacts is None or not lock.enabled:
             continue
         count = len(legs)
-        if lock.weights.shape != (count,):
-            lock.points, lock.weights, lock.planted = np.zeros((count, 3)), np.zeros(count), np.zeros(count, dtype=bool)
+        if lock.weights.shape != (count,) or lock.stepping.shape != (count,) or lock.animated.shape != (count, 3):
+            lock.points, lock.weights, lock.animated = np.zeros((count, 3)), np.zeros(count), toes[p].copy()
+            lock.planted, lock.stepping = np.zeros(count, dtype=bool), np.zeros(count, dtype=bool)
         contacts = np.broadcast_to(np.asarray(lock.contacts, dtype=np.float64), (count,))
-        lock.points, lock.weights, lock.planted, toe = lock_feet(
-            lock.points, lock.weights, lock.planted, toes[p], contacts, toes[p, :, 1] - floor[p, :, 1], dt,
-            lock.release_time, lock.max_stretch, lock.release_height)
+        still = np.linalg.norm((toes[p] - lock.animated)[:, [0, 2]], axis=-1) <= _STILL * max(dt, 1e-9)
+        lock.animated = toes[p].copy()
+        state = lock_feet(lock.points[None], lock.weights[None], lock.planted[None], lock.stepping[None],
+                          toes[p][None], contacts[None], (toes[p, :, 1] - floor[p, :, 1])[None],
+                          np.array([lock.settle]), still[None], dt, lock)
+        lock.points, lock.weights, lock.planted, lock.stepping = (a[0] for a in state[:4])
+        toe = state[4][0]
         targets[p] += toe - toes[p]
     return targets
+
+
+def _reach_shift(hips: F, targets: F, lengths: F, shift: F, max_pelvis_shift: float) -> F:
+    """Lower the pelvis ``shift [P]`` further where an ankle target ``[P, L, 3]`` lies beyond its leg's
+    reach (``lengths [P, L]``) from its hip ``[P, L, 3]``: a foot held back by its lock, or on a
+    step down, is reached by bending the knees, as FinalIK's grounder does, never by a leg
+    that dangles short of the ground."""
+    reach = lengths - 1e-4  # a straight leg in the clip stays straight
+    dxz = np.linalg.norm((targets - hips)[..., [0, 2]], axis=-1)
+    dy = hips[..., 1] + shift[:, None] - targets[..., 1]
+    need = np.where(dxz < reach, dy - np.sqrt(np.maximum(reach**2 - dxz**2, 0.0)), 0.0)
+    return np.maximum(shift - np.maximum(need, 0.0).max(axis=-1), -max_pelvis_shift)
 
 
 def ground_feet(
@@ -169,10 +187,10 @@ def ground_feet(
     off = (skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)).tolist()
     rot = pose.rotations.tolist()
     root = tuple(pose.root.tolist())
-    ankle, qfoot, sole = [], [], []
-    for (_, _, f), leg in zip(idx, legs, strict=True):
+    ankle, qfoot, sole, hips = [], [], [], []
+    for (u, _, f), leg in zip(idx, legs, strict=True):
         wp, wr = chain_fk(par, root, rot, off, f)
-        ankle.append(wp[f]), qfoot.append(wr[f])
+        ankle.append(wp[f]), qfoot.append(wr[f]), hips.append(wp[u])
         sole.append(add(wp[f], qrot(wr[f], leg.sole)))
     clip_height = [s[1] for s in sole]  # authored on flat ground at y = 0
     height, normal = ground(np.array([s[0] for s in sole]), np.array([s[2] for s in sole]))
@@ -193,6 +211,8 @@ def ground_feet(
     targets = [tuple(t) for t in fixed.tolist()]
     # Pelvis: follow the lowest foot (negative into dips, positive onto steps).
     shift = min(max(min(t[1] - a[1] for t, a in zip(targets, ankle)), -max_pelvis_shift), max_pelvis_shift)
+    lengths = np.array([[np.linalg.norm(off[lo]) + np.linalg.norm(off[f]) for _, lo, f in idx]])
+    shift = float(_reach_shift(np.array([hips]), np.array([targets]), lengths, np.array([shift]), max_pelvis_shift)[0])
     pose.root[1] += shift
     root = tuple(pose.root.tolist())
     for leg, (u, lo, f), tgt, frot in zip(legs, idx, targets, new_rot, strict=True):
@@ -244,10 +264,10 @@ def ground_feet_batch(
     off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
     idx = [(skeleton.index(leg.upper), skeleton.index(leg.lower), skeleton.index(leg.foot)) for leg in legs]
     soles = np.array([leg.sole for leg in legs])
-    ankle, qfoot = [], []
-    for _, _, f in idx:
+    ankle, qfoot, hip = [], [], []
+    for u, _, f in idx:
         wp, wr = path_fk(skeleton, roots, rotations, f, off)
-        ankle.append(wp[f]), qfoot.append(wr[f])
+        ankle.append(wp[f]), qfoot.append(wr[f]), hip.append(wp[u])
     ankles, qfeet = np.stack(ankle, axis=1), np.stack(qfoot, axis=1)  # [P,L,3], [P,L,4]
     sole = ankles + quat.rotate(qfeet, soles)
     clip_height = sole[..., 1]  # authored on flat ground at y = 0
@@ -263,6 +283,10 @@ def ground_feet_batch(
     floor = np.stack([sole[..., 0], height * w[:, None], sole[..., 2]], axis=-1)
     targets = _lock_and_lift(skeleton, legs, flat - quat.rotate(new_rot, soles), new_rot, floor, normal, locks, dt, w)
     shift = np.clip(np.min(targets[..., 1] - ankles[..., 1], axis=1), -max_pelvis_shift, max_pelvis_shift)
+    offs = np.broadcast_to(off, rotations.shape[:-2] + off.shape[-2:])
+    lengths = np.stack([np.linalg.norm(offs[..., lo, :], axis=-1) + np.linalg.norm(offs[..., f, :], axis=-1)
+                        for _, lo, f in idx], axis=-1)
+    shift = _reach_shift(np.stack(hip, axis=1), targets, lengths, shift, max_pelvis_shift)
     roots[:, 1] += shift
     hips = {int(skeleton.parents[u]) for u, _, _ in idx}
     if len(hips) != 1:  # legs hung from different joints: one solve per leg

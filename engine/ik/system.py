@@ -165,6 +165,7 @@ def ik_system(world: World) -> None:
         else:
             req.foot_lock.weights = np.zeros_like(req.foot_lock.weights)
             req.foot_lock.planted = np.zeros_like(req.foot_lock.planted)
+            req.foot_lock.stepping = np.zeros_like(req.foot_lock.stepping)
         if req.sphere_centre is not None and req.sphere_radius > 0.0:
             hands_on_sphere(sk, pose, req.sphere_centre, req.sphere_radius, offsets=offsets)
         if pose.is_finite():

@@ -68,6 +68,12 @@ def _ref_ground(sk, pose, ground, weight, align_height=0.25, contact_height=0.03
     depth = np.minimum(((toes - floor) * n).sum(-1), ((heels - floor) * n).sum(-1))
     targets[:, 1] += np.maximum(-depth, 0.0) / n[:, 1]
     shift = float(np.clip(np.min(targets[:, 1] - ankle[:, 1]), -max_shift, max_shift))
+    # Lower further where a target is out of the leg's reach from its hip (knees bend).
+    for (u, lo, f), tgt in zip(idx, targets, strict=True):
+        reach = np.linalg.norm(sk.offsets[lo]) + np.linalg.norm(sk.offsets[f]) - 1e-4
+        dxz = np.hypot(*(tgt - wp[u])[[0, 2]])
+        if dxz < reach:
+            shift = max(min(shift, tgt[1] + np.sqrt(reach**2 - dxz**2) - wp[u][1]), -max_shift)
     pose.root[1] += shift
     for leg, (u, lo, f), tgt, frot in zip(HUMANOID_LEGS, idx, targets, new_rot, strict=True):
         wp, wr = forward_kinematics(sk, pose.root, pose.rotations)
