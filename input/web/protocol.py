@@ -42,7 +42,7 @@ from engine import quat
 from input.phone_frames import arkit_to_stick, phone_to_stick
 
 __all__ = ["ControllerMessage", "Ping", "WebMessageError", "parse_message", "to_sample_fields",
-           "orientation_to_quat", "MAX_MESSAGE_BYTES", "CROUCH_DEPTH", "KINDS"]
+           "orientation_to_quat", "MAX_MESSAGE_BYTES", "CROUCH_DEPTH", "KINDS", "PageClock"]
 
 #: A reading is about 200 bytes; anything much longer is not from the page.
 MAX_MESSAGE_BYTES = 1024
@@ -167,9 +167,31 @@ def parse_message(text: str | bytes) -> ControllerMessage | Ping:
 
 
 def to_sample_fields(msg: ControllerMessage, source: str, received: float) -> dict[str, Any]:
-    """The :class:`input.sample.PoseSample` fields of a reading (``received``: the server's clock)."""
+    """The :class:`input.sample.PoseSample` fields of a reading, stamped ``received`` (the server's
+    clock at the sensor event: :class:`PageClock` maps the page's ``t`` onto it)."""
     position = np.zeros(3) if msg.position is None else msg.position.copy()
     position[1] -= CROUCH_DEPTH * msg.crouch
     return {"time": received, "source": source, "orientation": msg.orientation, "position": position,
             "angular_velocity": msg.angular_velocity, "acceleration": msg.acceleration, "touch": msg.touch,
             "mode": "device", "flick": msg.jump, "calibrate": msg.calibrate}
+
+
+class PageClock:
+    """The page's event times (``t``, ms since the epoch on the phone) on the server's clock.
+
+    Readings travel in bursts over Wi-Fi, so their arrival times bunch up and a velocity
+    taken between arrivals is noise; the sensor events' own spacing is right. The offset
+    between the two clocks is the smallest seen ``arrival − t`` (the least-delayed reading),
+    so a stamp is never later than its arrival; a page clock that jumps back or runs far
+    ahead (a phone setting its clock) restarts the estimate.
+    """
+
+    def __init__(self) -> None:
+        self.offset: float | None = None
+
+    def stamp(self, page_ms: float, arrival: float) -> float:
+        """The server-clock time of a reading whose page time is ``page_ms``, received at ``arrival``."""
+        seen = arrival - page_ms / 1000.0
+        if self.offset is None or seen < self.offset or seen > self.offset + 1.0:
+            self.offset = seen
+        return min(page_ms / 1000.0 + self.offset, arrival)

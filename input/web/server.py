@@ -39,7 +39,7 @@ from websockets.frames import CloseCode
 
 from input.source import PoseSource
 from input.web.cert import WebCertificate, load_or_create
-from input.web.protocol import ControllerMessage, Ping, WebMessageError, parse_message, to_sample_fields
+from input.web.protocol import ControllerMessage, PageClock, Ping, WebMessageError, parse_message, to_sample_fields
 
 __all__ = ["WebSource", "DEFAULT_WEB_PORT", "PAGE_FILES"]
 
@@ -99,6 +99,7 @@ class WebSource(PoseSource):
         self.name = self._status.name = f"web {host}:{self.port}"
         self._slots: dict[int, Any] = {}
         self.page_times: OrderedDict[float, float] = OrderedDict()
+        self._clocks: dict[str, PageClock] = {}  # per controller: its page's event times on our clock
         self.refused = 0
 
     def url(self, address: str | None = None) -> str:
@@ -172,6 +173,7 @@ class WebSource(PoseSource):
             self.error(f"{controller}: {type(exc).__name__}: {exc}")
         finally:
             del self._slots[slot]
+            self._clocks.pop(controller, None)
             self.disconnected(controller)
 
     def _handle(self, message: str | bytes, controller: str, bucket: list[float], now: float) -> str | None:
@@ -191,7 +193,8 @@ class WebSource(PoseSource):
         if isinstance(msg, Ping):
             return json.dumps({"pong": msg.t})
         assert isinstance(msg, ControllerMessage)
-        sample = self.offer(**to_sample_fields(msg, controller, now))
+        clock = self._clocks.setdefault(controller, PageClock())
+        sample = self.offer(**to_sample_fields(msg, controller, clock.stamp(msg.t, now)))
         if sample is not None:
             self.page_times[sample.time] = msg.t
             while len(self.page_times) > 4096:
