@@ -3,20 +3,22 @@
 Blending clips, turning and speed changes move a planted foot a little every step
 even when the root motion is exact (a blend of two planted feet at different places is
 not planted anywhere). Engines fix it in the leg IK: when the animation's contact
-labels say a foot is down, its toe tip is *locked* at the point where it touched the
-ground, and the two-bone leg solve reaches there; when the label lifts it, the lock
-fades out over ``release_time`` (smoothstep), so the foot eases back to its animated
-path instead of snapping. A lock that would stretch the leg beyond ``max_stretch``
-from the animated foot (a sharp turn, a yank) lets go the same way. When the puppet comes
-to stand, a foot left away from where the standing pose wants it takes a step there (one
-foot at a time), as a person shuffles into stance, instead of creeping or hovering.
+labels say a foot is down, its toe tip is *locked* where it touched the ground and the
+foot keeps the heading it landed with, and the two-bone leg solve reaches there; when
+the label lifts it, the lock fades out over ``release_time`` (smoothstep), so the foot
+eases back to its animated path instead of snapping. A lock that would stretch the leg
+beyond ``max_stretch`` or twist it beyond ``max_twist`` (a sharp turn, a yank) lets go the
+same way. When the puppet comes to stand, a foot left away from where the standing pose
+wants it takes a step there (one foot at a time), as a person shuffles into stance,
+instead of creeping or hovering.
 
 The toe tip is the locked point because it is what stays still longest in a step
-(heel-off rolls over it) and what an onlooker sees skate. A lock fades only once the
-toe is really off the floor (``release_height``): contact labels end while the toe
-still pushes off. Only the ground-plane position is locked; heights stay the grounding's
-(clip clearance over the real ground) plus the arc of a step, then :func:`floor_lift`
-keeps toe and heel above the floor.
+(heel-off rolls over it) and what an onlooker sees skate; the heading is locked too, or
+a foot turning with the hips would sweep its heel over the ground. A lock fades only
+once the toe is really off the floor (``release_height``): contact labels end while the
+toe still pushes off. Only the ground plane position and heading are locked; heights
+stay the grounding's (clip clearance over the real ground) plus the arc of a step, then
+:func:`floor_lift` keeps toe and heel above the floor.
 
 All functions work on arrays ``[P, L, …]`` (puppets, legs) so a crowd locks its feet
 in one call; the state lives in :class:`FootLock` on the request (hashed, replayed).
@@ -47,10 +49,12 @@ class FootLock:
         settle: written by the animation stage: the puppet is asked to stand still.
         stepping: ``[L]`` a standing puppet's foot on its way to its place.
         animated: ``[L, 3]`` last step's animated toe tips (is the standing place still moving?).
+        yaw: ``[L]`` the heading each locked foot landed with (it keeps it while planted).
         release_time: seconds a lock takes to fade after its foot lifts.
         max_stretch: metres the locked toe may be from the animated one before it lets go.
         release_height: metres the animated toe must rise before a lifted foot's lock fades.
         settle_gap: metres a standing puppet's foot may be from its place before it steps there.
+        max_twist, settle_twist: the same in heading (rad) for a moving and a standing puppet.
         step_time, step_height: how long (s) and how high (m, at most) such a step is.
         enabled: off, planted feet follow the animation (the legacy controller's behaviour).
     """
@@ -62,13 +66,19 @@ class FootLock:
     settle: bool = False
     stepping: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     animated: F = field(default_factory=lambda: np.zeros((0, 3)))
+    yaw: F = field(default_factory=lambda: np.zeros(0))
     release_time: float = 0.12
     max_stretch: float = 0.12
     release_height: float = 0.035
     settle_gap: float = 0.05
+    max_twist: float = 0.6
+    settle_twist: float = 0.25
     step_time: float = 0.3
     step_height: float = 0.08
     enabled: bool = True
+
+
+_TOE = 0.15  # m from the ankle to the toe tip: what a turn of the foot moves its end by, per radian
 
 
 def _smooth(w: F) -> F:
@@ -76,7 +86,7 @@ def _smooth(w: F) -> F:
 
 
 def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArray[np.bool_], toes: F, contacts: F,
-              clearance: F, settle: NDArray[np.bool_], still: NDArray[np.bool_], dt: float, lock: FootLock) -> tuple[F, F, NDArray[np.bool_],
+              clearance: F, twist: F, settle: NDArray[np.bool_], still: NDArray[np.bool_], dt: float, lock: FootLock) -> tuple[F, F, NDArray[np.bool_],
                                                                                             NDArray[np.bool_], F]:
     """Advance the locks one step and say where each toe should go.
 
@@ -88,6 +98,9 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArr
         clearance: ``[P, L]`` the animated toe's height above the ground: a planted toe stays
             locked until it is ``release_height`` up, even after its label lifted (labels end
             while the toe still pushes off the floor).
+        twist: ``[P, L]`` how far (rad) each locked foot's heading is from the animation's: past
+            ``max_twist`` it lets go like a stretched one (a standing puppet's steps past
+            ``settle_twist``), since a foot keeps its heading while locked.
         settle: ``[P]`` the puppet is coming to stand: a foot held more than ``settle_gap``
             from where the standing pose wants it takes a step there, one foot at a time,
             once that place has stopped moving (``still [P, L]``: the blend has settled).
@@ -101,19 +114,21 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArr
         middle of its step and setting down at the end, so feet step, never slide.
     """
     down = contacts > 0.5
-    stepping = stepping & (weights > 0.0)
+    # A step ends when the foot has arrived, or when the puppet sets off again (it plants where it is).
+    stepping = stepping & (weights > 0.0) & settle[:, None]
     shown = toes + _smooth(weights)[..., None] * (points - toes)
     shown[..., 1] = toes[..., 1]
     start = down & ~planted & ~stepping
     # A lock taken while an old one still fades starts where the foot is shown: no pop.
     points = np.where(start[..., None], shown, points)
     weights = np.where(start, 1.0, weights)
-    gap = np.linalg.norm((points - toes)[..., [0, 2]], axis=-1)
+    # How far the foot has to go, its turn counted at a toe's length from the ankle.
+    gap = np.linalg.norm((points - toes)[..., [0, 2]], axis=-1) + _TOE * np.where(start, 0.0, twist)
     held = planted | start
     # Standing, a far foot waits for its step (one foot at a time) instead of letting go.
-    stretched = (gap > lock.max_stretch) & ~settle[:, None]
+    stretched = ((gap > lock.max_stretch) | (twist > lock.max_twist)) & ~start & ~settle[:, None]
     # Standing: the farthest misplaced foot steps, if no foot of the puppet is stepping already.
-    misplaced = held & settle[:, None] & still & (gap > lock.settle_gap)
+    misplaced = held & settle[:, None] & still & ((gap > lock.settle_gap) | (twist > lock.settle_twist))
     first = misplaced & (gap >= np.max(np.where(misplaced, gap, 0.0), axis=-1, keepdims=True))
     step_now = first & ~np.any(stepping, axis=-1, keepdims=True)
     stepping = stepping | step_now

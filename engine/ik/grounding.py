@@ -103,7 +103,8 @@ HUMANOID_LEGS: tuple[Leg, ...] = (
 
 def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_rot: F, floor: F, normal: F,
                    locks: Sequence[FootLock | None] | None, dt: float, weight: F) -> F:
-    """Ankle targets ``[P, L, 3]`` with no toe or heel under the ground and planted toes locked.
+    """Ankle targets ``[P, L, 3]`` with no toe or heel under the ground and planted feet locked
+    (position and heading: ``new_rot [P, L, 4]``, the feet's rotations, is turned in place).
 
     ``floor [P, L, 3]`` is the ground point under each sole and ``normal`` its normal: toe
     and heel are kept on the positive side of that tangent plane (a foot on a slope is
@@ -129,16 +130,27 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
         if lock.weights.shape != (count,) or lock.stepping.shape != (count,) or lock.animated.shape != (count, 3):
             lock.points, lock.weights, lock.animated = np.zeros((count, 3)), np.zeros(count), toes[p].copy()
             lock.planted, lock.stepping = np.zeros(count, dtype=bool), np.zeros(count, dtype=bool)
+        # A planted foot keeps the heading it landed with while the body turns above it
+        # (a foot that turned with the hips would sweep its toe or heel over the ground).
+        fwd = quat.rotate(new_rot[p], np.array([0.0, 0.0, 1.0]))
+        yaw = np.arctan2(fwd[:, 0], fwd[:, 2])
+        lock.yaw = np.where(lock.weights > 0.0, lock.yaw, yaw) if lock.yaw.shape == (count,) else yaw
+        twist = (lock.yaw - yaw + np.pi) % (2 * np.pi) - np.pi
+        new_rot[p] = quat.mul(quat.from_axis_angle(np.array(_UP), twist * _smooth_weight(lock.weights)), new_rot[p])
+        toes[p] = targets[p] + quat.rotate(new_rot[p], tips)
         contacts = np.broadcast_to(np.asarray(lock.contacts, dtype=np.float64), (count,))
         still = np.linalg.norm((toes[p] - lock.animated)[:, [0, 2]], axis=-1) <= _STILL * max(dt, 1e-9)
         lock.animated = toes[p].copy()
         state = lock_feet(lock.points[None], lock.weights[None], lock.planted[None], lock.stepping[None],
                           toes[p][None], contacts[None], (toes[p, :, 1] - floor[p, :, 1])[None],
-                          np.array([lock.settle]), still[None], dt, lock)
+                          np.abs(twist)[None], np.array([lock.settle]), still[None], dt, lock)
         lock.points, lock.weights, lock.planted, lock.stepping = (a[0] for a in state[:4])
-        toe = state[4][0]
-        targets[p] += toe - toes[p]
+        targets[p] += state[4][0] - toes[p]
     return targets
+
+
+def _smooth_weight(w: F) -> F:
+    return w * w * (3.0 - 2.0 * w)
 
 
 def _reach_shift(hips: F, targets: F, lengths: F, shift: F, max_pelvis_shift: float) -> F:
@@ -206,9 +218,11 @@ def ground_feet(
         new_rot.append(r)
         targets.append(sub((s[0], h * weight + ch, s[2]), qrot(r, leg.sole)))
     floor = np.array([[(sl[0], h * weight, sl[2]) for sl, h in zip(sole, height, strict=True)]])
-    fixed = _lock_and_lift(skeleton, legs, np.array([targets]), np.array([new_rot]), floor, np.array([normal]),
+    rotations = np.array([new_rot])
+    fixed = _lock_and_lift(skeleton, legs, np.array([targets]), rotations, floor, np.array([normal]),
                            None if lock is None else [lock], dt, np.array([weight]))[0]
     targets = [tuple(t) for t in fixed.tolist()]
+    new_rot = [tuple(r) for r in rotations[0].tolist()]
     # Pelvis: follow the lowest foot (negative into dips, positive onto steps).
     shift = min(max(min(t[1] - a[1] for t, a in zip(targets, ankle)), -max_pelvis_shift), max_pelvis_shift)
     lengths = np.array([[np.linalg.norm(off[lo]) + np.linalg.norm(off[f]) for _, lo, f in idx]])

@@ -36,6 +36,7 @@ from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
 __all__ = ["spring_step", "wanted_velocity", "follow_velocity", "drag_reach"]
 
 F = NDArray[np.float64]
+_TURN_FROM = 0.3  # m/s: below this requested speed the puppet turns proportionally slower
 
 
 def spring_step(value: F, rate: F, goal: F, omega: float, dt: float) -> tuple[F, F]:
@@ -99,8 +100,9 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
     facing = 1.0
     if speed > 1e-3:
         turn = _wrap(float(np.arctan2(v[0], v[2])) - body.heading)
-        # A slow puppet pivots on the spot faster than a running one can swing round.
-        rate = t.turn_rate * (1.0 + 1.0 / (1.0 + speed))
+        # A slow puppet pivots on the spot faster than a running one can swing round; one
+        # coming to rest stops turning with its speed (the fading request's direction is noise).
+        rate = t.turn_rate * (1.0 + 1.0 / (1.0 + speed)) * min(1.0, speed / _TURN_FROM)
         body.heading = _wrap(body.heading + float(np.clip(turn, -rate * world.dt, rate * world.dt)))
         facing = max(float(heading_vector(body.heading) @ (v / speed)), 0.0)
     tr.rotation = yaw_rotation(body.heading)
