@@ -92,3 +92,30 @@ def test_console_entry_point(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     assert _last_json(proc.stdout)["cycles"] >= 4
     assert (tmp_path / "l.npz").is_file()
+
+
+@pytest.mark.parametrize("frames", [0, 1, 2, 3])
+@pytest.mark.parametrize("kind", ["bvh", "npz"])
+def test_too_few_frames_is_one_line_not_a_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                    kind: str, frames: int) -> None:
+    from tests.engine.io.synthetic_bvh import human_bvh
+
+    if kind == "bvh":
+        src = tmp_path / "short.bvh"
+        src.write_text(human_bvh(frames=frames))
+    else:
+        src = tmp_path / "short.npz"
+        np.savez(src, times=np.arange(frames) / 30.0, values=np.ones((frames, 3)))
+    assert main(["cycle", str(src), "-o", str(tmp_path / "out.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "frame" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_deeply_nested_joint_map_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from tests.engine.io.synthetic_bvh import human_bvh
+
+    src, jm = tmp_path / "walk.bvh", tmp_path / "map.json"
+    src.write_text(human_bvh())
+    jm.write_text("{\"a\": " + "[" * 100_000 + "]" * 100_000 + "}")
+    assert main(["cycle", str(src), "--joint-map", str(jm), "-o", str(tmp_path / "out.ppclip")]) == 2
+    assert "nested too deeply" in capsys.readouterr().err
