@@ -27,8 +27,17 @@ socket thread, but it holds the interpreter lock the simulation needs: unbounded
 flood of 62 KB bundles held the game at 34 steps/s. Per sender, so a flood from one
 address does not spend the budget of the phone that plays.
 
-An admitted sender that goes quiet for ``timeout`` seconds is reported disconnected
-(its stick lets go); its next packet reconnects it (the slot stays its own).
+An admitted sender that goes quiet for ``timeout`` seconds (2 s by default) is reported
+disconnected (its stick lets go) and its slot is released: the next phone that sends a
+valid pose stream gets it (the same phone too, after :data:`ADMIT_AFTER` samples).
+
+Spoofing: a phone is one address (``osc:IP``), and the UDP port of its first valid sample
+is remembered as its stream's. Datagrams from other ports of the same address (a forger on the LAN using
+the phone's IP, or a client that opens a socket per message such as ``oscsend``) have a
+rate limit and decoding budget of their own, so a flood of them cannot spend the phone's;
+only the proven port keeps the slot alive (an app restarted on a new port is released after
+``timeout`` and admitted again from its new port). A forger that also guesses the port is
+indistinguishable from the phone at this layer.
 """
 
 from __future__ import annotations
@@ -126,6 +135,8 @@ class OscSource(PoseSource):
         self._valid: dict[str, int] = {}  # candidate -> valid samples so far
         self._active: set[str] = set()
         self._budget: dict[str, list[int]] = {}  # sender -> what is left to decode this step
+        self._port: dict[str, int] = {}  # sender -> the UDP port of its first valid sample (its stream's)
+        self._strangers: dict[str, list[float]] = {}  # "<sender>:other" -> [tokens, last refill]
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             self._sock.bind((host, port))
@@ -159,11 +170,15 @@ class OscSource(PoseSource):
                 continue
             now = time.monotonic()
             # One id per phone address: an app restarted on a new UDP port is still the same phone.
-            self.handle_datagram(data, f"osc:{addr[0]}", now)
+            self.handle_datagram(data, f"osc:{addr[0]}", now, addr[1])
             self._expire(now)
 
-    def handle_datagram(self, data: bytes, sender: str, now: float) -> None:
-        """Validate and decode one datagram (the socket thread's work; callable from tests)."""
+    def handle_datagram(self, data: bytes, sender: str, now: float, port: int = 0) -> None:
+        """Validate and decode one datagram from ``sender``'s UDP ``port`` (the socket thread's work)."""
+        proven = self._port.get(sender)
+        if proven is not None and port != proven:
+            self._from_other_port(data, sender, now, port)
+            return
         state = self._senders.get(sender)
         if state is None:
             if len(self._admitted) >= self.max_senders:
@@ -184,15 +199,40 @@ class OscSource(PoseSource):
         if not self._affordable(data, sender):
             return
         sample = self.decoder.decode(data, sender, now)
+        if sample is not None:
+            self._port.setdefault(sender, port)  # the port of its first valid sample is the phone's
         if sender in self._valid and not self._admit(sender, sample is not None):
             return
+        self._deliver(sender, sample)
+
+    def _deliver(self, sender: str, sample: PoseSample | None) -> None:
+        """An admitted sender's datagram was decoded: it is connected, and its sample is queued."""
         if sender not in self._active:
             self._active.add(sender)
             self.connected(sender)
         if sample is not None:
             self.push(sample)
 
-    def _affordable(self, data: bytes, sender: str) -> bool:
+    def _from_other_port(self, data: bytes, sender: str, now: float, port: int) -> None:
+        """A datagram from a port other than the one ``sender`` proved (a forger of its address,
+        or a client that opens a socket per message): decoded on a rate and budget of its own,
+        so it never spends the phone's; it does not keep the phone's slot alive either."""
+        key = f"{sender}:other"
+        bucket = self._strangers.setdefault(key, [self.max_rate, now])
+        tokens = min(self.max_rate, bucket[0] + (now - bucket[1]) * self.max_rate)
+        bucket[1] = now
+        if tokens < 1.0:
+            bucket[0] = tokens
+            self.drop("rate limit", f"{sender}:{port}")
+            return
+        bucket[0] = tokens - 1.0
+        if not self._affordable(data, key, candidate=False):
+            return
+        sample = self.decoder.decode(data, sender, now)
+        if sample is not None and sender not in self._valid:  # a candidate proves itself from its own port
+            self._deliver(sender, sample)
+
+    def _affordable(self, data: bytes, sender: str, candidate: bool | None = None) -> bool:
         """Whether ``data`` is small enough, and this step's budget holds it (then spend it)."""
         if len(data) > MAX_DATAGRAM:
             self.drop("oversize packet", f"{sender}: {len(data)} bytes")
@@ -201,7 +241,9 @@ class OscSource(PoseSource):
         if problem:
             self.drop(problem, sender)
             return False
-        left = self._budget.setdefault(sender, list(CANDIDATE_BUDGET if sender in self._valid else STEP_BUDGET))
+        if candidate is None:
+            candidate = sender in self._valid
+        left = self._budget.setdefault(sender, list(CANDIDATE_BUDGET if candidate else STEP_BUDGET))
         if left[0] < 1 or left[1] < messages or left[2] < len(data):
             self.drop("over budget", sender)
             return False
@@ -234,6 +276,8 @@ class OscSource(PoseSource):
     def _forget(self, sender: str) -> None:
         self._valid.pop(sender, None)
         self._senders.pop(sender, None)
+        self._port.pop(sender, None)
+        self._strangers.pop(f"{sender}:other", None)
         self.decoder.senders.pop(sender, None)
 
     def _lock_out(self, sender: str) -> None:
@@ -246,6 +290,9 @@ class OscSource(PoseSource):
     def _expire(self, now: float) -> None:
         for sender in [s for s in self._valid if now - self._senders[s][2] > self.timeout]:
             self._forget(sender)
-        for sender in [s for s in self._active if now - self._senders[s][2] > self.timeout]:
-            self._active.discard(sender)
-            self.disconnected(sender)  # the slot stays: the admitted sender is the one that comes back
+        for sender in [s for s in self._admitted if now - self._senders[s][2] > self.timeout]:
+            self._admitted.remove(sender)  # silent: the slot goes to the next phone with a valid stream
+            self._forget(sender)
+            if sender in self._active:
+                self._active.discard(sender)
+                self.disconnected(sender)
