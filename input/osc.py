@@ -31,13 +31,12 @@ An admitted sender that goes quiet for ``timeout`` seconds (2 s by default) is r
 disconnected (its stick lets go) and its slot is released: the next phone that sends a
 valid pose stream gets it (the same phone too, after :data:`ADMIT_AFTER` samples).
 
-Spoofing: a phone is one address (``osc:IP``), and the UDP port of its first valid sample
-is remembered as its stream's. Datagrams from other ports of the same address (a forger on the LAN using
-the phone's IP, or a client that opens a socket per message such as ``oscsend``) have a
-rate limit and decoding budget of their own, so a flood of them cannot spend the phone's;
-only the proven port keeps the slot alive (an app restarted on a new port is released after
-``timeout`` and admitted again from its new port). A forger that also guesses the port is
-indistinguishable from the phone at this layer.
+Spoofing: a phone is one address (``osc:IP``), and the UDP port it was admitted from is
+remembered. Datagrams from other ports of the same address (a forger on the LAN using the
+phone's IP, or a client that opens a socket per message such as ``oscsend``) have a rate
+limit and decoding budget of their own, so a flood of them cannot spend the phone's; their
+valid poses are the phone's too (a forger able to send those could anyway), garbage from
+them keeps nothing alive. A forger that also guesses the port shares the phone's budget.
 """
 
 from __future__ import annotations
@@ -135,7 +134,7 @@ class OscSource(PoseSource):
         self._valid: dict[str, int] = {}  # candidate -> valid samples so far
         self._active: set[str] = set()
         self._budget: dict[str, list[int]] = {}  # sender -> what is left to decode this step
-        self._port: dict[str, int] = {}  # sender -> the UDP port of its first valid sample (its stream's)
+        self._port: dict[str, int] = {}  # admitted sender -> the UDP port it was admitted from
         self._strangers: dict[str, list[float]] = {}  # "<sender>:other" -> [tokens, last refill]
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
@@ -199,9 +198,7 @@ class OscSource(PoseSource):
         if not self._affordable(data, sender):
             return
         sample = self.decoder.decode(data, sender, now)
-        if sample is not None:
-            self._port.setdefault(sender, port)  # the port of its first valid sample is the phone's
-        if sender in self._valid and not self._admit(sender, sample is not None):
+        if sender in self._valid and not self._admit(sender, sample is not None, port):
             return
         self._deliver(sender, sample)
 
@@ -214,9 +211,9 @@ class OscSource(PoseSource):
             self.push(sample)
 
     def _from_other_port(self, data: bytes, sender: str, now: float, port: int) -> None:
-        """A datagram from a port other than the one ``sender`` proved (a forger of its address,
-        or a client that opens a socket per message): decoded on a rate and budget of its own,
-        so it never spends the phone's; it does not keep the phone's slot alive either."""
+        """A datagram from a port other than the one ``sender`` was admitted from (a forger of its
+        address, or a client that opens a socket per message): decoded on a rate and budget of its
+        own, so it never spends the phone's; only a valid pose keeps the slot alive."""
         key = f"{sender}:other"
         bucket = self._strangers.setdefault(key, [self.max_rate, now])
         tokens = min(self.max_rate, bucket[0] + (now - bucket[1]) * self.max_rate)
@@ -229,7 +226,8 @@ class OscSource(PoseSource):
         if not self._affordable(data, key, candidate=False):
             return
         sample = self.decoder.decode(data, sender, now)
-        if sample is not None and sender not in self._valid:  # a candidate proves itself from its own port
+        if sample is not None:  # a valid pose: the phone itself, or a forger that could send it anyway
+            self._senders[sender][2] = now
             self._deliver(sender, sample)
 
     def _affordable(self, data: bytes, sender: str, candidate: bool | None = None) -> bool:
@@ -257,8 +255,8 @@ class OscSource(PoseSource):
         self._budget = {}
         return super().drain()
 
-    def _admit(self, sender: str, valid: bool) -> bool:
-        """Count a candidate's valid sample; whether it now holds a slot."""
+    def _admit(self, sender: str, valid: bool, port: int) -> bool:
+        """Count a candidate's valid sample; whether it now holds a slot (its stream's port: ``port``)."""
         if not valid:
             return False
         self._valid[sender] += 1
@@ -267,6 +265,7 @@ class OscSource(PoseSource):
             return False
         del self._valid[sender]
         self._admitted.append(sender)
+        self._port[sender] = port
         self._budget.pop(sender, None)  # from now on an admitted sender's budget
         if len(self._admitted) >= self.max_senders:  # the slots are taken: the other candidates are out
             for other in list(self._valid):
