@@ -27,8 +27,16 @@ socket thread, but it holds the interpreter lock the simulation needs: unbounded
 flood of 62 KB bundles held the game at 34 steps/s. Per sender, so a flood from one
 address does not spend the budget of the phone that plays.
 
-An admitted sender that goes quiet for ``timeout`` seconds is reported disconnected
-(its stick lets go); its next packet reconnects it (the slot stays its own).
+An admitted sender that goes quiet for ``timeout`` seconds (2 s by default) is reported
+disconnected (its stick lets go) and its slot is released: the next phone that sends a
+valid pose stream gets it (the same phone too, after :data:`ADMIT_AFTER` samples).
+
+Spoofing: a phone is one address (``osc:IP``), and the UDP port it was admitted from is
+remembered. Datagrams from other ports of the same address (a forger on the LAN using the
+phone's IP, or a client that opens a socket per message such as ``oscsend``) have a rate
+limit and decoding budget of their own, so a flood of them cannot spend the phone's; their
+valid poses are the phone's too (a forger able to send those could anyway), garbage from
+them keeps nothing alive. A forger that also guesses the port shares the phone's budget.
 """
 
 from __future__ import annotations
@@ -126,6 +134,8 @@ class OscSource(PoseSource):
         self._valid: dict[str, int] = {}  # candidate -> valid samples so far
         self._active: set[str] = set()
         self._budget: dict[str, list[int]] = {}  # sender -> what is left to decode this step
+        self._port: dict[str, int] = {}  # admitted sender -> the UDP port it was admitted from
+        self._strangers: dict[str, list[float]] = {}  # "<sender>:other" -> [tokens, last refill]
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             self._sock.bind((host, port))
@@ -159,11 +169,15 @@ class OscSource(PoseSource):
                 continue
             now = time.monotonic()
             # One id per phone address: an app restarted on a new UDP port is still the same phone.
-            self.handle_datagram(data, f"osc:{addr[0]}", now)
+            self.handle_datagram(data, f"osc:{addr[0]}", now, addr[1])
             self._expire(now)
 
-    def handle_datagram(self, data: bytes, sender: str, now: float) -> None:
-        """Validate and decode one datagram (the socket thread's work; callable from tests)."""
+    def handle_datagram(self, data: bytes, sender: str, now: float, port: int = 0) -> None:
+        """Validate and decode one datagram from ``sender``'s UDP ``port`` (the socket thread's work)."""
+        proven = self._port.get(sender)
+        if proven is not None and port != proven:
+            self._from_other_port(data, sender, now, port)
+            return
         state = self._senders.get(sender)
         if state is None:
             if len(self._admitted) >= self.max_senders:
@@ -184,15 +198,39 @@ class OscSource(PoseSource):
         if not self._affordable(data, sender):
             return
         sample = self.decoder.decode(data, sender, now)
-        if sender in self._valid and not self._admit(sender, sample is not None):
+        if sender in self._valid and not self._admit(sender, sample is not None, port):
             return
+        self._deliver(sender, sample)
+
+    def _deliver(self, sender: str, sample: PoseSample | None) -> None:
+        """An admitted sender's datagram was decoded: it is connected, and its sample is queued."""
         if sender not in self._active:
             self._active.add(sender)
             self.connected(sender)
         if sample is not None:
             self.push(sample)
 
-    def _affordable(self, data: bytes, sender: str) -> bool:
+    def _from_other_port(self, data: bytes, sender: str, now: float, port: int) -> None:
+        """A datagram from a port other than the one ``sender`` was admitted from (a forger of its
+        address, or a client that opens a socket per message): decoded on a rate and budget of its
+        own, so it never spends the phone's; only a valid pose keeps the slot alive."""
+        key = f"{sender}:other"
+        bucket = self._strangers.setdefault(key, [self.max_rate, now])
+        tokens = min(self.max_rate, bucket[0] + (now - bucket[1]) * self.max_rate)
+        bucket[1] = now
+        if tokens < 1.0:
+            bucket[0] = tokens
+            self.drop("rate limit", f"{sender}:{port}")
+            return
+        bucket[0] = tokens - 1.0
+        if not self._affordable(data, key, candidate=False):
+            return
+        sample = self.decoder.decode(data, sender, now)
+        if sample is not None:  # a valid pose: the phone itself, or a forger that could send it anyway
+            self._senders[sender][2] = now
+            self._deliver(sender, sample)
+
+    def _affordable(self, data: bytes, sender: str, candidate: bool | None = None) -> bool:
         """Whether ``data`` is small enough, and this step's budget holds it (then spend it)."""
         if len(data) > MAX_DATAGRAM:
             self.drop("oversize packet", f"{sender}: {len(data)} bytes")
@@ -201,7 +239,9 @@ class OscSource(PoseSource):
         if problem:
             self.drop(problem, sender)
             return False
-        left = self._budget.setdefault(sender, list(CANDIDATE_BUDGET if sender in self._valid else STEP_BUDGET))
+        if candidate is None:
+            candidate = sender in self._valid
+        left = self._budget.setdefault(sender, list(CANDIDATE_BUDGET if candidate else STEP_BUDGET))
         if left[0] < 1 or left[1] < messages or left[2] < len(data):
             self.drop("over budget", sender)
             return False
@@ -215,8 +255,8 @@ class OscSource(PoseSource):
         self._budget = {}
         return super().drain()
 
-    def _admit(self, sender: str, valid: bool) -> bool:
-        """Count a candidate's valid sample; whether it now holds a slot."""
+    def _admit(self, sender: str, valid: bool, port: int) -> bool:
+        """Count a candidate's valid sample; whether it now holds a slot (its stream's port: ``port``)."""
         if not valid:
             return False
         self._valid[sender] += 1
@@ -225,6 +265,7 @@ class OscSource(PoseSource):
             return False
         del self._valid[sender]
         self._admitted.append(sender)
+        self._port[sender] = port
         self._budget.pop(sender, None)  # from now on an admitted sender's budget
         if len(self._admitted) >= self.max_senders:  # the slots are taken: the other candidates are out
             for other in list(self._valid):
@@ -234,6 +275,8 @@ class OscSource(PoseSource):
     def _forget(self, sender: str) -> None:
         self._valid.pop(sender, None)
         self._senders.pop(sender, None)
+        self._port.pop(sender, None)
+        self._strangers.pop(f"{sender}:other", None)
         self.decoder.senders.pop(sender, None)
 
     def _lock_out(self, sender: str) -> None:
@@ -246,6 +289,9 @@ class OscSource(PoseSource):
     def _expire(self, now: float) -> None:
         for sender in [s for s in self._valid if now - self._senders[s][2] > self.timeout]:
             self._forget(sender)
-        for sender in [s for s in self._active if now - self._senders[s][2] > self.timeout]:
-            self._active.discard(sender)
-            self.disconnected(sender)  # the slot stays: the admitted sender is the one that comes back
+        for sender in [s for s in self._admitted if now - self._senders[s][2] > self.timeout]:
+            self._admitted.remove(sender)  # silent: the slot goes to the next phone with a valid stream
+            self._forget(sender)
+            if sender in self._active:
+                self._active.discard(sender)
+                self.disconnected(sender)

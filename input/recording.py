@@ -196,14 +196,16 @@ class Recorder:
 
     def close(self) -> None:
         """Write the closing record, sync and close (idempotent)."""
-        if self._file is not None and self._put(_LEN.pack(0, self.frames)):
-            try:
-                os.fsync(self._file.fileno())
-                self._file.close()
-            except OSError as exc:
-                self.failed = f"recording {self.path} may be incomplete: {exc.strerror or exc}"
-                print(self.failed, file=sys.stderr)
-            self._file = None
+        if self._file is None or not self._put(_LEN.pack(0, self.frames)):
+            return
+        f, self._file = self._file, None
+        try:
+            os.fsync(f.fileno())
+            f.close()
+        except OSError as exc:
+            self.failed = f"recording {self.path} may be incomplete: {exc.strerror or exc}"
+            print(self.failed, file=sys.stderr)
+            f.close()
 
     def __enter__(self) -> Recorder:
         return self

@@ -17,6 +17,12 @@ Tables (read them with any SQLite tool, or with :func:`read_index`):
 * ``sources`` — path, size, mtime and hash of every input seen, so an unchanged file
   is not read again to learn that it is already done;
 * ``meta`` — the schema version and the options the library was built with.
+
+Trust: SQLite keeps no checksum of the values it stores, so the index is checked before
+a batch relies on it: ``PRAGMA quick_check`` at open (a damaged page is refused in one
+line), and :meth:`LibraryIndex.known_hashes` counts a take as done only while every clip
+file it names is there with the SHA-256 the index recorded. A deleted or altered clip
+file, or a flipped byte in a clip's row, makes its take be done again.
 """
 
 from __future__ import annotations
@@ -111,11 +117,19 @@ class LibraryIndex:
         self.path = libdir / INDEX_NAME
         try:
             self.con = _connect(self.path)
+            damage = [str(row[0]) for row in self.con.execute("PRAGMA quick_check").fetchall()]
+            if damage != ["ok"]:
+                self.con.close()
+                raise LibraryIndexError(f"{self.path} is damaged ({'; '.join(damage)[:120]}); move it away "
+                                        "and run cycles again to rebuild it from the clip files' sources")
             self.con.executescript(_SCHEMA)
             meta = dict(self.con.execute("SELECT key, value FROM meta").fetchall())
         except sqlite3.DatabaseError as exc:
             raise LibraryIndexError(f"{self.path} is not a library index ({exc})") from None
-        version = int(meta.get("schema", SCHEMA_VERSION))
+        schema = str(meta.get("schema", SCHEMA_VERSION))
+        if not schema.isdigit():
+            raise LibraryIndexError(f"{self.path} has schema {schema[:20]!r}, not a version number")
+        version = int(schema)
         if version > SCHEMA_VERSION:
             raise LibraryIndexError(f"{self.path} has schema {version}; this puppetphone reads up to {SCHEMA_VERSION}")
         built = meta.get("options")
@@ -130,8 +144,32 @@ class LibraryIndex:
         self.con.close()
 
     def known_hashes(self) -> set[str]:
-        """Content hashes of every take already in the index."""
-        return {h for (h,) in self.con.execute("SELECT hash FROM takes")}
+        """Content hashes of every take done: in the index, with each clip file it names intact.
+
+        A take whose clip count, clip files or their SHA-256 no longer match (a file deleted or
+        changed, a damaged row) is left out, so the batch does it again and rewrites its rows.
+        """
+        try:
+            takes = dict(self.con.execute("SELECT hash, clips FROM takes").fetchall())
+            rows = self.con.execute("SELECT take, file, sha256 FROM clips").fetchall()
+        except sqlite3.DatabaseError as exc:
+            raise LibraryIndexError(f"{self.path} is not a readable library index ({exc})") from None
+        found: dict[str, int] = {}
+        for take, file, digest in rows:
+            if take in takes and self._intact(str(file), str(digest)):
+                found[take] = found.get(take, 0) + 1
+        return {h for h, n in takes.items() if found.get(h, 0) == n}
+
+    def _intact(self, file: str, digest: str) -> bool:
+        """Whether the clip file ``file`` (relative to the library) is there with SHA-256 ``digest``."""
+        path = self.libdir / file
+        if Path(file).is_absolute() or ".." in Path(file).parts:
+            return False
+        try:
+            with open(path, "rb") as f:
+                return hashlib.file_digest(f, "sha256").hexdigest() == digest
+        except OSError:
+            return False
 
     def cached_hash(self, path: str, size: int, mtime_ns: int) -> str | None:
         """The hash recorded for ``path`` if its size and mtime are unchanged."""

@@ -41,6 +41,8 @@ __all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance
 
 INPUT_SUFFIXES = (".bvh", ".gltf", ".glb", ".csv", ".npz", ".rec")
 OUTPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".ppclip", ".glb", ".gltf")
+#: Fewer frames than this hold no two cycles of any period the extractor looks for.
+MIN_FRAMES = 4
 
 
 @dataclass(frozen=True)
@@ -297,13 +299,18 @@ def load_performance(path: str | Path, items: list[str] | None = None, **motion_
     suffix = path.suffix.lower()
     loaders = {".csv": _load_csv, ".npz": _load_npz, ".rec": _load_recording}
     if suffix in (".bvh", ".gltf", ".glb"):
-        return _load_skeletal(path, items, {k: v for k, v in motion_options.items() if v is not None})
-    if suffix not in loaders:
+        perf = _load_skeletal(path, items, {k: v for k, v in motion_options.items() if v is not None})
+    elif suffix not in loaders:
         raise TrajectoryError(f"{path}: unknown input type {suffix!r}; use one of {', '.join(INPUT_SUFFIXES)}")
-    given = sorted(k for k, v in motion_options.items() if v is not None)
-    if given:
-        raise TrajectoryError(f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to BVH/glTF input")
-    return loaders[suffix](path, items)
+    else:
+        given = sorted(k for k, v in motion_options.items() if v is not None)
+        if given:
+            raise TrajectoryError(f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to BVH/glTF input")
+        perf = loaders[suffix](path, items)
+    frames = len(perf.trajectory.times)
+    if frames < MIN_FRAMES:  # the feature and period analyses difference neighbouring frames
+        raise TrajectoryError(f"{path}: {frames} frame(s); a loop is extracted from at least {MIN_FRAMES}")
+    return perf
 
 
 def loop_clip(result: CycleResult, perf: Performance, name: str | None = None) -> Clip:

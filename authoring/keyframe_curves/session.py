@@ -24,12 +24,16 @@ from authoring.keyframe_curves.solver import CurveEdit, Drag, Hold, TangentSolve
 from engine.atomic import atomic_write_bytes
 from engine.ik import humanoid_rig
 from engine.keyframes import BezierCurves, KeyframedClip, keyframe_clip
+from engine.npz_safe import read_bounded
 
 __all__ = ["CurveSession", "CurveFileError", "save_curves", "load_curves", "keys_path"]
 
 FORMAT = "puppetphone-keyframes"
 VERSION = 1
 MAX_SIDE_FILE = 64 * 1024 * 1024
+MAX_FPS = 1000.0  # as a clip file's
+MAX_FRAMES = 1_000_000  # baked frames (an hour at 240 fps is under)
+MAX_VALUE = 1e6  # key times (s), values (m, rad) and tangent handles: far beyond any real clip
 
 
 class CurveFileError(ValueError):
@@ -72,21 +76,32 @@ def load_curves(path: str | Path) -> KeyframedClip:
     side_file = keys_path(p)
     if not side_file.exists():
         raise CurveFileError(f"{p}: no {side_file.name} beside it (open the clip to key it afresh)")
-    if side_file.stat().st_size > MAX_SIDE_FILE:
-        raise CurveFileError(f"{side_file}: larger than {MAX_SIDE_FILE} bytes")
     try:
-        side = json.loads(side_file.read_bytes().decode("utf-8"))
-    except (OSError, ValueError, RecursionError) as exc:
-        raise CurveFileError(f"{side_file}: unreadable ({type(exc).__name__})") from None
+        side = json.loads(read_bounded(side_file, MAX_SIDE_FILE).decode("utf-8"))
+    except (OSError, ValueError, RecursionError) as exc:  # not a regular file, too big, not JSON
+        raise CurveFileError(f"{side_file}: unreadable ({type(exc).__name__}: {exc})"[:300]) from None
     if not isinstance(side, dict) or side.get("format") != FORMAT:
         raise CurveFileError(f"{side_file}: not a keyframes file")
     if side.get("version") != VERSION:
         raise CurveFileError(f"{side_file}: version {side.get('version')!r} is not {VERSION}")
     if side.get("clip_sha256") != hashlib.sha256(p.read_bytes()).hexdigest():
         raise CurveFileError(f"{side_file}: belongs to another version of {p.name}")
+    fps = side.get("fps")
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0.0 < fps <= MAX_FPS:
+        raise CurveFileError(f"{side_file}: fps {repr(fps)[:30]} is not a number in (0, {MAX_FPS:g}]")
+    if not isinstance(side.get("loop"), bool):
+        raise CurveFileError(f"{side_file}: loop must be true or false")
     try:
-        curves = BezierCurves(*(np.asarray(side[k], dtype=np.float64) for k in ("times", "values", "out_x", "out_y",
-                                                                              "in_x", "in_y")))  # fmt: skip
+        arrays = [np.asarray(side[k], dtype=np.float64) for k in ("times", "values", "out_x", "out_y", "in_x", "in_y")]
+    except (KeyError, TypeError, ValueError) as exc:
+        raise CurveFileError(f"{side_file}: {exc}"[:300]) from None
+    if not all(np.isfinite(a).all() and (a.size == 0 or np.abs(a).max() <= MAX_VALUE) for a in arrays):
+        raise CurveFileError(f"{side_file}: keys hold NaN, infinite or absurd values (beyond {MAX_VALUE:g})")
+    span = float(np.ptp(arrays[0])) if arrays[0].size else 0.0
+    if span * fps > MAX_FRAMES:  # checked before baking allocates a frame per 1/fps
+        raise CurveFileError(f"{side_file}: {span:g} s of keys at {fps:g} fps is over {MAX_FRAMES} frames")
+    try:
+        curves = BezierCurves(*arrays)
         return KeyframedClip(clip.name, clip.skeleton, curves, float(side["fps"]), bool(side["loop"]),
                              clip.root_motion, dict(clip.markers))  # fmt: skip
     except (KeyError, TypeError, ValueError) as exc:

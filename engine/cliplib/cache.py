@@ -6,9 +6,10 @@ kept in ``$XDG_CACHE_HOME/puppetphone/lookup/<key>.npz``, so the next start with
 same clips skips it. The key covers everything the numbers depend on: the clips'
 content hash, the probe grid and step, the source of the modules that play and
 measure a blend, and the numpy version — a cache written by other code is never read,
-since a replay must measure exactly what the recorded session measured. A cache file
-that is unreadable or does not match is ignored and rewritten (it is a cache: losing
-it costs half a second, never a wrong answer).
+since a replay must measure exactly what the recorded session measured. Each file
+carries the SHA-256 of its key, probes and values; a cache file that is unreadable, does
+not match its probes or its checksum (damaged, or edited by hand) is ignored and
+rewritten (it is a cache: losing it costs half a second, never a wrong answer).
 """
 
 from __future__ import annotations
@@ -74,7 +75,17 @@ class MeasureCache:
             return None
         if values.dtype != np.float64 or values.shape[0] != len(probes) or not np.isfinite(values).all():
             return None
+        digest = arrays.get("sha256")
+        if digest is None or digest.dtype != np.uint8 or digest.tobytes() != self._digest(got, values):
+            return None
         return values
+
+    def _digest(self, probes: F, values: F) -> bytes:
+        """What a file's checksum must be: its key, probes and values, byte for byte."""
+        h = hashlib.sha256(self.key.encode())
+        for a in (probes, values):
+            h.update(str(a.shape).encode() + np.ascontiguousarray(a, dtype=np.float64).tobytes())
+        return h.digest()
 
     def __call__(self, probes: F, measure: Callable[[F], F]) -> F:
         cached = self._read(probes)
@@ -84,7 +95,8 @@ class MeasureCache:
         self.misses += 1
         values = np.asarray(measure(probes), dtype=np.float64)
         buf = io.BytesIO()
-        np.savez(buf, probes=probes, values=values)
+        np.savez(buf, probes=probes, values=values,
+                 sha256=np.frombuffer(self._digest(np.asarray(probes, dtype=np.float64), values), dtype=np.uint8))
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             atomic_write_bytes(self.path, buf.getvalue())

@@ -148,6 +148,27 @@ def parse_glb(data: bytes, source: str = "<glb>") -> tuple[dict[str, Any], bytes
     return doc, binary
 
 
+def _beside(base: Path, uri: Any, what: str) -> Path:
+    """The file a relative buffer URI names, refused unless it lies in the glTF file's own folder.
+
+    A glTF from anywhere must not make the reader open any file on disk: an absolute path,
+    a ``file:`` or other scheme, ``..`` or a link leading out of the folder is a :class:`GltfError`.
+    """
+    name = urllib.parse.unquote(uri) if isinstance(uri, str) else ""
+    parts = Path(name).parts
+    if (not name or Path(name).is_absolute() or ".." in parts or urllib.parse.urlsplit(uri).scheme
+            or "\\" in name):
+        raise GltfError(f"{what}: uri {str(uri)[:60]!r} is not a file beside the glTF (no absolute paths, schemes or ..)")
+    path = base / name
+    try:
+        inside = path.resolve().is_relative_to(base.resolve())
+    except (OSError, RuntimeError):
+        inside = False
+    if not inside:
+        raise GltfError(f"{what}: uri {str(uri)[:60]!r} leads out of the glTF's folder")
+    return path
+
+
 def _buffers(doc: dict[str, Any], glb_bin: bytes | None, base: Path, source: str) -> list[bytes]:
     out = []
     for i, buf in enumerate(doc.get("buffers", [])):
@@ -160,7 +181,7 @@ def _buffers(doc: dict[str, Any], glb_bin: bytes | None, base: Path, source: str
             head, _, payload = uri.partition(",")
             data = base64.b64decode(payload) if head.endswith(";base64") else urllib.parse.unquote_to_bytes(payload)
         else:
-            path = base / urllib.parse.unquote(uri)
+            path = _beside(base, uri, f"{source}: buffer {i}")
             try:
                 data = read_bounded(path, MAX_FILE)
             except OSError as exc:

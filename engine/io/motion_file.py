@@ -208,6 +208,8 @@ def load_joint_map(path: str | Path) -> dict[str, str]:
         data = json.loads(read_bounded(path, MAX_MAP_FILE).decode("utf-8"))
     except (OSError, ValueError) as exc:  # missing, too big, not UTF-8, not JSON
         raise MotionFileError(f"{path}: not a readable joint map ({type(exc).__name__}: {exc})"[:300]) from None
+    except RecursionError:
+        raise MotionFileError(f"{path}: not a readable joint map (JSON nested too deeply)") from None
     if not isinstance(data, dict) or not data or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
         raise MotionFileError(f"{path}: a joint map is a JSON object of source joint name -> puppet joint name")
     puppet = humanoid_skeleton().names

@@ -87,10 +87,10 @@ def check_objects(objects: list[dict[str, Any]]) -> None:
     """The flow objects must be this field's, part for part (a file from another version of the field is refused)."""
     from games.base import GameOptionError
 
-    want = {o["name"]: len(o["primitives"]) for o in scenery_objects()}
-    have = {o["name"]: len(o["primitives"]) for o in objects}
+    want = {o["name"]: (o["group"], len(o["primitives"])) for o in scenery_objects()}
+    have = {o["name"]: (o["group"], len(o["primitives"])) for o in objects}
     if have != want:
-        missing = sorted(set(want) - set(have)) or sorted(set(have) - set(want)) or ["primitive counts differ"]
+        missing = sorted(set(want) - set(have)) or sorted(set(have) - set(want)) or ["groups or primitive counts differ"]
         raise GameOptionError(f"flow: the file's objects are not this field's ({', '.join(missing[:3])})")
 
 
@@ -110,12 +110,13 @@ class BentScenery:
 def bent_scenery(objects: list[dict[str, Any]]) -> tuple[BentScenery, list[np.ndarray], list[np.ndarray]]:
     """The trees to draw, where each tree's trunk stands, where each rock's centre is."""
     caps, balls, trunks, rocks = [], [], [], []
+    spheres = {o["name"] for o in scenery_objects() if all(p["a"] == p["b"] for p in o["primitives"])}
     for o in objects:
         for p in o["primitives"]:
             a, b = np.array(p["a"]), np.array(p["b"])
             if o["group"].startswith("rock"):
                 rocks.append(a)
-            elif np.allclose(a, b):
+            elif o["name"] in spheres:  # what a part is comes from the field, not from where the file put its ends
                 balls.append((a, p["radius"]))
             else:
                 caps.append((a, b, p["radius"], p["color"]))

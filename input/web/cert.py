@@ -9,7 +9,8 @@ phone that trusted it once keeps trusting it. Its SHA-256 fingerprint is printed
 the user can compare it with what the phone's browser shows before accepting it.
 
 The files are written atomically (a crash never leaves half a key), the key readable
-by the user only. Unreadable or expired files are replaced by a new pair.
+by the user only. Unreadable or expired files, or a key that does not belong to the
+certificate (one of the two replaced), are replaced by a new pair, with a line saying so.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import datetime as _dt
 import ipaddress
 import os
 import ssl
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -59,19 +61,24 @@ def fingerprint(der: bytes) -> str:
     return ":".join(digest[i:i + 2] for i in range(0, len(digest), 2))
 
 
-def _usable(cert_path: Path, key_path: Path) -> bytes | None:
-    """The DER of a readable, unexpired certificate whose key loads; ``None`` otherwise."""
+def _usable(cert_path: Path, key_path: Path) -> tuple[bytes | None, str]:
+    """The DER of a readable, unexpired certificate whose key loads and belongs to it, else why not."""
     from cryptography import x509
     from cryptography.hazmat.primitives import serialization
 
+    if not cert_path.exists() and not key_path.exists():
+        return None, ""
     try:
         cert = x509.load_pem_x509_certificate(cert_path.read_bytes())
-        serialization.load_pem_private_key(key_path.read_bytes(), password=None)
+        key = serialization.load_pem_private_key(key_path.read_bytes(), password=None)
     except (OSError, ValueError, TypeError):
-        return None
+        return None, "unreadable"
+    spki = serialization.Encoding.DER, serialization.PublicFormat.SubjectPublicKeyInfo
+    if key.public_key().public_bytes(*spki) != cert.public_key().public_bytes(*spki):
+        return None, "the key does not belong to the certificate (one of them was replaced)"
     if cert.not_valid_after_utc <= _dt.datetime.now(_dt.UTC) + _dt.timedelta(days=1):
-        return None
-    return cert.public_bytes(serialization.Encoding.DER)
+        return None, "expired"
+    return cert.public_bytes(serialization.Encoding.DER), ""
 
 
 def _create(addresses: list[str]) -> tuple[bytes, bytes, bytes]:
@@ -113,9 +120,12 @@ def load_or_create(addresses: list[str], folder: Path | None = None) -> WebCerti
     """
     folder = data_folder() if folder is None else folder
     cert_path, key_path = folder / "cert.pem", folder / "key.pem"
-    der = _usable(cert_path, key_path)
+    der, why = _usable(cert_path, key_path)
     if der is not None:
         return WebCertificate(cert_path, key_path, fingerprint(der), created=False)
+    if why:
+        print(f"web: the certificate in {folder} cannot be used ({why}): made a new one; "
+              "phones must accept it again", file=sys.stderr)
     folder.mkdir(parents=True, exist_ok=True)
     cert_pem, key_pem, der = _create(addresses)
     old = os.umask(0o077)  # the key is the user's alone

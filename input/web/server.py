@@ -12,6 +12,10 @@ Safety on a LAN:
   cannot drive the game;
 - one controller per puppet: ``max_controllers`` connections hold slots ``web:1`` …;
   another phone is told every puppet is taken (``{"taken": true}``) and closed;
+- a controller silent for ``silent_after`` seconds (2 s; the page sends at least four
+  readings and a ping a second) is a frozen phone: its slot is freed at once (the stick
+  lets go) and its connection closed, so the next phone with the token gets the puppet
+  instead of waiting out the WebSocket's keep-alive (22.8 s before);
 - every message passes :func:`input.web.protocol.parse_message`; malformed ones, and
   readings beyond ``max_rate`` per second per connection (a token bucket), are counted
   with their reason and dropped, never raised. A message over 64 KiB closes the
@@ -63,6 +67,7 @@ class WebSource(PoseSource):
         port: TCP port; 0 picks a free one (read :attr:`port`).
         max_controllers: phones that may hold a puppet at once.
         max_rate: readings per second accepted per connection (a burst of one second).
+        silent_after: seconds without a message after which a controller's puppet is freed.
         certificate: the TLS certificate (default: the user's, made on first use).
         token: the session token (default: a new random one).
 
@@ -73,7 +78,7 @@ class WebSource(PoseSource):
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_WEB_PORT, max_controllers: int = 1,
                  max_rate: float = 240.0, certificate: WebCertificate | None = None, token: str | None = None,
-                 capacity: int = 256) -> None:
+                 capacity: int = 256, silent_after: float = 2.0) -> None:
         if max_controllers < 1:
             raise ValueError(f"max_controllers must be at least 1, not {max_controllers}")
         if not 0 <= port <= 65535:
@@ -84,7 +89,11 @@ class WebSource(PoseSource):
         self.host = host
         self.max_controllers = max_controllers
         self.max_rate = max_rate
+        self.silent_after = silent_after
         self.certificate = certificate or load_or_create(lan_addresses())
+        # Made here, not in the server thread: a certificate that cannot serve is an error at
+        # start (one line), never a dead thread while the game runs on without input.
+        self._ssl = self.certificate.ssl_context()
         self.token = token or secrets.token_urlsafe(16)
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self._sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -118,9 +127,9 @@ class WebSource(PoseSource):
     async def _serve(self) -> None:
         from websockets.asyncio.server import serve
 
-        async with serve(self._connection, sock=self._sock, ssl=self.certificate.ssl_context(),
+        async with serve(self._connection, sock=self._sock, ssl=self._ssl,
                          process_request=self._http, max_size=_FRAME_LIMIT, max_queue=32,
-                         ping_interval=5, ping_timeout=10, server_header="PuppetPhone"):
+                         ping_interval=5, ping_timeout=10, close_timeout=1, server_header="PuppetPhone"):
             while not self.stopping.is_set():
                 await asyncio.sleep(0.05)
 
@@ -162,7 +171,14 @@ class WebSource(PoseSource):
         bucket = [self.max_rate, time.monotonic()]
         try:
             await ws.send(json.dumps({"hello": controller}))
-            async for message in ws:
+            while True:
+                try:
+                    message = await asyncio.wait_for(ws.recv(), self.silent_after)
+                except TimeoutError:  # a frozen phone: free its puppet now, then close
+                    self.drop("silent controller", controller)
+                    self._release(slot, controller)
+                    await ws.close(4002, "silent for too long")
+                    return
                 reply = self._handle(message, controller, bucket, time.monotonic())
                 if reply is not None:
                     await ws.send(reply)
@@ -172,8 +188,12 @@ class WebSource(PoseSource):
         except Exception as exc:  # a broken connection ends this controller, never the server
             self.error(f"{controller}: {type(exc).__name__}: {exc}")
         finally:
-            del self._slots[slot]
-            self._clocks.pop(controller, None)
+            self._release(slot, controller)
+
+    def _release(self, slot: int, controller: str) -> None:
+        """Free ``slot`` (once) and tell the hub its controller is gone."""
+        self._clocks.pop(controller, None)
+        if self._slots.pop(slot, None) is not None:
             self.disconnected(controller)
 
     def _handle(self, message: str | bytes, controller: str, bucket: list[float], now: float) -> str | None:

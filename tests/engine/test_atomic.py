@@ -70,3 +70,30 @@ def test_only_a_damaged_save_of_ours_is_set_aside(tmp_path: Path) -> None:
     assert set_aside(ours, HEAD) == Path(f"{ours}.1.bad")
     assert Path(f"{ours}.bad").read_text() == "an earlier one" and not ours.exists()
     assert folder.is_dir() and foreign.read_text() == "someone's file"
+
+
+def test_kill_9_at_any_point_of_a_save_leaves_the_old_or_the_new_file(tmp_path: Path) -> None:
+    """The primitive under F5, Ctrl+S, clips add and the batch: a writer killed mid-save loses nothing earlier."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import numpy as np
+
+    target = tmp_path / "save.bin"
+    old = b"OURS\n" + b"o" * (4 << 20)
+    atomic_write_bytes(target, old)
+    writer = ("import sys\nfrom engine.atomic import atomic_write_bytes\nprint('go', flush=True)\n"
+              "while True:\n    atomic_write_bytes(sys.argv[1], b'OURS\\n' + b'n' * (4 << 20))\n")
+    delays = np.random.default_rng(30).uniform(0.0, 0.3, 6)
+    for delay in delays:
+        with subprocess.Popen([sys.executable, "-c", writer, str(target)], stdout=subprocess.PIPE) as proc:
+            assert proc.stdout is not None and proc.stdout.readline() == b"go\n"
+            time.sleep(float(delay))
+            proc.send_signal(signal.SIGKILL)
+            proc.wait(10)
+        data = target.read_bytes()
+        assert data in (old, b"OURS\n" + b"n" * (4 << 20))
+    atomic_write_bytes(target, b"OURS\nlast")  # and saving goes on after the kills
+    assert target.read_bytes() == b"OURS\nlast"

@@ -120,3 +120,18 @@ def test_a_bad_message_in_a_bundle_does_not_lose_the_good_ones(dec, osc):
     s = dec.decode(bundle(("/ZIGSIM/d/quaternion", float("nan"), 0.0, 0.0, 1.0), ("/ZIGSIM/d/arkitposition", 1.0, 2.0, 3.0)),
                    "z", 0.0)
     assert np.allclose(s.position, [1, 2, 3]) and dec.drops == ["non-finite value"]
+
+
+def test_garbage_type_tags_and_bundle_elements_print_nothing(dec, capfd, caplog):
+    """python-osc logs a warning per odd packet (1,413 lines under garbage); none reach the terminal."""
+    import logging
+
+    caplog.set_level(logging.WARNING)
+    odd_message = b"/puppetphone/pose\x00\x00\x00,X\x00\x00\x00\x00\x00\x00"
+    odd_bundle = b"#bundle\x00" + b"\x00" * 8 + (8).to_bytes(4, "big") + b"garbage!"
+    for i in range(50):
+        dec.decode(odd_message, "a", float(i))
+        dec.decode(odd_bundle, "a", float(i))
+    out, err = capfd.readouterr()
+    assert out == "" and err == "" and not [r for r in caplog.records if "pythonosc" in r.pathname]
+    assert dec.drops  # what was dropped is counted instead

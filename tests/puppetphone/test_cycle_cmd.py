@@ -96,16 +96,28 @@ def test_console_entry_point(tmp_path: Path) -> None:
     assert (tmp_path / "l.npz").is_file()
 
 
-@pytest.mark.parametrize("frames", [1, 2])
-def test_a_one_or_two_frame_bvh_is_refused_in_one_line(tmp_path: Path, frames: int,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
-    """No cycle in a frame or two: exit 3 and why, not a traceback from the part-that-loops search."""
-    from engine.humanoid import humanoid_skeleton
-    from engine.io import clip_to_bvh, write_bvh
+@pytest.mark.parametrize("frames", [0, 1, 2, 3])
+@pytest.mark.parametrize("kind", ["bvh", "npz"])
+def test_too_few_frames_is_one_line_not_a_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                    kind: str, frames: int) -> None:
+    from tests.engine.io.synthetic_bvh import human_bvh
 
-    sk = humanoid_skeleton()
-    still = Clip("still", sk, 30.0, np.tile(sk.offsets[0], (frames, 1)), quat.identity(frames, sk.num_joints))
-    write_bvh(tmp_path / "one.bvh", clip_to_bvh(still))
-    code = main(["cycle", str(tmp_path / "one.bvh"), "-o", str(tmp_path / "o.bvh"), "--json"])
+    if kind == "bvh":
+        src = tmp_path / "short.bvh"
+        src.write_text(human_bvh(frames=frames))
+    else:
+        src = tmp_path / "short.npz"
+        np.savez(src, times=np.arange(frames) / 30.0, values=np.ones((frames, 3)))
+    assert main(["cycle", str(src), "-o", str(tmp_path / "out.npz")]) == 2
     err = capsys.readouterr().err
-    assert code == 3 and len(err.strip().splitlines()) == 1 and "too few" in err, err
+    assert "frame" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_deeply_nested_joint_map_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from tests.engine.io.synthetic_bvh import human_bvh
+
+    src, jm = tmp_path / "walk.bvh", tmp_path / "map.json"
+    src.write_text(human_bvh())
+    jm.write_text("{\"a\": " + "[" * 100_000 + "]" * 100_000 + "}")
+    assert main(["cycle", str(src), "--joint-map", str(jm), "-o", str(tmp_path / "out.ppclip")]) == 2
+    assert "nested too deeply" in capsys.readouterr().err

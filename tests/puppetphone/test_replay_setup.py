@@ -19,11 +19,11 @@ from puppetphone.cli import main
 
 
 def _crafted(path: Path, game: str, setup: Any) -> Path:
-    """A recording with no frames whose header carries ``setup`` as given (its checksum fixed)."""
+    """A finished recording with no frames whose header carries ``setup`` as given (its checksum fixed)."""
     head = asdict(RecordingHeader(game=game, seed=1, dt=1 / 60))
     head["setup"] = setup
     raw = json.dumps(head, sort_keys=True).encode()
-    path.write_bytes(MAGIC + struct.pack("<II", len(raw), zlib.crc32(raw)) + raw)
+    path.write_bytes(MAGIC + struct.pack("<II", len(raw), zlib.crc32(raw)) + raw + struct.pack("<II", 0, 0))  # closed
     return path
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import sqlite3
 from pathlib import Path
 
@@ -19,8 +20,17 @@ def _outcome(digest: str, clips: int) -> TakeOutcome:
                        100, 60.0, 7, 0.5, cs)
 
 
+def _files(root: Path, outcome: TakeOutcome, files: list[str]) -> list[str]:
+    """Write the take's clip files as the batch does before it records them."""
+    for clip, rel in zip(outcome.clips, files, strict=True):
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_bytes(clip.data)
+    return files
+
+
 def test_record_and_read_back_sorted(tmp_path: Path) -> None:
     index = LibraryIndex(tmp_path, "opts")
+    _files(tmp_path, _outcome("bbb", 2), ["clips/b0.npz", "clips/b1.npz"])
     index.record(_outcome("bbb", 2), ["clips/b0.npz", "clips/b1.npz"], "CC0")
     index.record(_outcome("aaa", 0), [], "unknown")
     index.record(_outcome("bbb", 1), ["clips/b0.npz"], "CC0")  # redone: its clips replaced, not added
@@ -73,3 +83,48 @@ def test_the_library_inside_a_source_folder_is_not_a_source(tmp_path: Path) -> N
     (tmp_path / "lib" / "clips" / "take-0.npz").write_text("")
     assert [p.name for p in collect_sources([str(tmp_path)], (".npz",), exclude=tmp_path / "lib")] == ["take.npz"]
     assert len(collect_sources([str(tmp_path)], (".npz",))) == 2
+
+
+def test_a_take_counts_as_done_only_with_its_clip_files_intact(tmp_path: Path) -> None:
+    index = LibraryIndex(tmp_path, "opts")
+    for digest in ("aaa", "bbb", "ccc"):
+        outcome = _outcome(digest, 2)
+        index.record(outcome, _files(tmp_path, outcome, [f"clips/{digest}{k}.npz" for k in range(2)]), "CC0")
+    assert index.known_hashes() == {"aaa", "bbb", "ccc"}
+    (tmp_path / "clips/aaa1.npz").unlink()  # a deleted clip file
+    (tmp_path / "clips/bbb0.npz").write_bytes(b"changed")  # an altered one
+    assert index.known_hashes() == {"ccc"}
+    index.close()
+
+
+def test_a_flipped_byte_in_a_clip_row_means_the_take_is_done_again(tmp_path: Path) -> None:
+    index = LibraryIndex(tmp_path, "opts")
+    outcome = _outcome("aaa", 1)
+    index.record(outcome, _files(tmp_path, outcome, ["clips/a0.npz"]), "CC0")
+    index.close()
+    data = bytearray((tmp_path / "index.sqlite").read_bytes())
+    at = data.find(hashlib.sha256(b"x0").hexdigest().encode())
+    assert at > 0
+    data[at + 5] ^= 0x01
+    (tmp_path / "index.sqlite").write_bytes(bytes(data))
+    assert LibraryIndex(tmp_path, "opts").known_hashes() == set()
+
+
+def test_a_damaged_page_or_a_bad_schema_value_is_one_line(tmp_path: Path) -> None:
+    LibraryIndex(tmp_path, "opts").close()
+    con = sqlite3.connect(tmp_path / "index.sqlite")
+    con.execute("UPDATE meta SET value = 'abc' WHERE key = 'schema'")
+    con.commit()
+    con.close()
+    with pytest.raises(LibraryIndexError, match="not a version number"):
+        LibraryIndex(tmp_path, "opts")
+    (tmp_path / "b").mkdir()
+    index = LibraryIndex(tmp_path / "b", "opts")
+    outcome = _outcome("aaa", 3)
+    index.record(outcome, _files(tmp_path / "b", outcome, [f"clips/a{k}.npz" for k in range(3)]), "CC0")
+    index.close()
+    data = bytearray((tmp_path / "b" / "index.sqlite").read_bytes())
+    data[4096 * 2: 4096 * 2 + 12] = b"\xff" * 12  # a b-tree page's header
+    (tmp_path / "b" / "index.sqlite").write_bytes(bytes(data))
+    with pytest.raises(LibraryIndexError, match="damaged|not a library index"):
+        LibraryIndex(tmp_path / "b", "opts")

@@ -47,3 +47,22 @@ def test_a_damaged_cache_file_is_measured_again(tmp_path: Path) -> None:
     assert len(calls) == 2 and cache.hits == 1
     assert np.array_equal(cache(probes[:2], measure), probes[:2] * 2.0)  # other probes: not this entry
     assert len(calls) == 3
+
+
+def test_a_tampered_cache_file_is_measured_again(tmp_path: Path) -> None:
+    """Values edited in place (finite, right shape) must not change what the game plays."""
+    import io
+
+    from engine.npz_safe import read_npz
+
+    probes = np.linspace(0.0, 1.0, 8).reshape(4, 2)
+    measure = lambda p: p.sum(axis=1, keepdims=True) * 2.0  # noqa: E731
+    cache = MeasureCache(tmp_path, "k")
+    first = cache(probes, measure)
+    arrays = read_npz(cache.path.read_bytes())
+    arrays["values"] = arrays["values"] + 1.0
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    cache.path.write_bytes(buf.getvalue())
+    again = MeasureCache(tmp_path, "k")
+    assert np.array_equal(again(probes, measure), first) and again.misses == 1 and again.hits == 0

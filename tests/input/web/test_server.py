@@ -149,3 +149,38 @@ def test_the_link_names_lan_addresses_when_bound_to_all(certificate):
     assert link.urls == [f"https://{a}:{src.port}/?t={src.token}" for a in lan]
     assert not link.loopback_only and "--web-host 0.0.0.0" not in "\n".join(link.lines())
     assert link.fingerprint == certificate.fingerprint
+
+
+def test_a_key_that_does_not_belong_to_the_certificate_is_replaced_with_a_line(tmp_path, certificate, capsys):
+    other = load_or_create([], tmp_path / "other")
+    certificate.key_path.write_bytes(other.key_path.read_bytes())  # the key replaced, the certificate kept
+    fresh = load_or_create([], tmp_path / "web")
+    assert fresh.created and fresh.fingerprint not in (certificate.fingerprint, other.fingerprint)
+    assert "does not belong to the certificate" in capsys.readouterr().err
+    src = WebSource(port=0, certificate=fresh).start()  # and it serves
+    try:
+        with _ws(src) as phone:
+            assert json.loads(phone.recv(timeout=5)) == {"hello": "web:1"}
+    finally:
+        src.stop()
+
+
+def test_a_certificate_that_cannot_serve_is_an_error_at_start_not_a_dead_thread(tmp_path, certificate):
+    from dataclasses import replace
+
+    broken = replace(certificate, key_path=tmp_path / "missing.pem")
+    with pytest.raises(OSError):
+        WebSource(port=0, certificate=broken)
+
+
+def test_a_frozen_phone_frees_its_puppet_for_the_next(certificate):
+    src = WebSource(port=0, certificate=certificate, silent_after=0.3).start()
+    try:
+        with _ws(src) as frozen:
+            assert json.loads(frozen.recv(timeout=5)) == {"hello": "web:1"}
+            frozen.send(json.dumps(READING))
+            _wait(lambda: src.status().drop_reasons.get("silent controller") == 1)  # then nothing more from it
+            with _ws(src) as fresh:
+                assert json.loads(fresh.recv(timeout=5)) == {"hello": "web:1"}  # not {"taken": true}
+    finally:
+        src.stop()
