@@ -24,6 +24,7 @@ def open_loop(
     animation: int | str | None = None,
     units: str | None = None,
     joint_map: dict[str, str] | None = None,
+    up: str | None = None,
     retarget: bool = False,
     start: object = None,
     end: object = None,
@@ -40,11 +41,12 @@ def open_loop(
     from authoring.cycles.formats import loop_clip, performance_from_motion
     from engine.io.motion_file import load_motion, load_motion_loop, to_puppet
 
-    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map)
+    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up)
     clip = motion.clip
     if start is not None or end is not None:
         # The part is cut from the take as stored (a closed loop keeps its closing frame).
-        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=not clip.loop)
+        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, up=up,
+                             skip_tpose=not clip.loop)
         loop, note = _loop_of_part(motion, start, end)
     elif clip.loop:  # a loop our glTF writer marked as one, or a closed loop (its last pose is its first)
         loop, note = clip, f"{motion.source.name}: a {'seamless ' * motion.seamless}loop of {clip.num_frames} frames"

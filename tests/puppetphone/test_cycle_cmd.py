@@ -109,3 +109,17 @@ def test_a_one_or_two_frame_bvh_is_refused_in_one_line(tmp_path: Path, frames: i
     code = main(["cycle", str(tmp_path / "one.bvh"), "-o", str(tmp_path / "o.bvh"), "--json"])
     err = capsys.readouterr().err
     assert code == 3 and len(err.strip().splitlines()) == 1 and "too few" in err, err
+
+
+def test_a_blender_bvh_is_stood_up_and_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from engine.io.bvh import read_bvh
+    from tests.engine.io.synthetic_bvh import blender_bvh, walk_take
+
+    blender_bvh(tmp_path / "blender.bvh", walk_take(4))
+    assert main(["cycle", str(tmp_path / "blender.bvh"), "-o", str(tmp_path / "loop.bvh"), "--json"]) == 0
+    given = _last_json(capsys.readouterr().out)["input"]
+    assert given["up"] == "z" and "along z" in given["up_basis"] and 1.5 < given["height"] < 1.9
+    loop = read_bvh(tmp_path / "loop.bvh")
+    assert loop.column(0, "Yposition").min() > 70.0  # the loop written stands: hips ~0.9 m up, in cm
+    assert main(["cycle", str(tmp_path / "blender.bvh"), "-o", str(tmp_path / "l.bvh"), "--json", "--up", "y"]) == 0
+    assert _last_json(capsys.readouterr().out)["input"]["up_basis"] == "given"
