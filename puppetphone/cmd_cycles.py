@@ -62,6 +62,7 @@ def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
     lines = []
     for clip, file in zip(outcome.clips, files, strict=True):
         part = "" if len(outcome.clips) == 1 and clip.start_frame <= 5 else f" [{clip.start_s:.2f}–{clip.end_s:.2f} s]"
+        part = f" [{clip.animation}]" if clip.animation is not None else part
         speed = "" if clip.speed is None else f", {clip.speed:.2f} m/s"
         lines.append(f"looped   {name}{part}: {clip.kind}, period {clip.period:.3f} s, {clip.cycles} cycles, "
                      f"closure error {clip.closure_error:.1e}{speed}, {clip.dims} dims -> {file}")

@@ -129,13 +129,13 @@ def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int =
 Y_TO_Z = quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.float64(np.pi / 2))  # Blender: (x, y, z) -> (x, -z, y)
 
 
-def walk_take(cycles: int = 3, fps: float = 30.0) -> Clip:
-    """The built-in walk performed ``cycles`` times at ``fps``, travelling in the root track (Y up, metres)."""
-    walk = default_clips()["walk"]
+def walk_take(cycles: float = 3, fps: float = 30.0, role: str = "walk") -> Clip:
+    """A built-in cycle (the walk) performed ``cycles`` times at ``fps``, travelling in the root track (Y up, metres)."""
+    walk = default_clips()[role]
     t = np.arange(int(round(cycles * walk.duration * fps))) / fps
     pose = walk.sample(t)
     travel = np.array([walk.sample_root_motion(float(x))[0] for x in t])
-    return Clip("walk", walk.skeleton, fps, pose.root + travel, pose.rotations)
+    return Clip(role, walk.skeleton, fps, pose.root + travel, pose.rotations)
 
 
 def blender_bvh(path: Path, clip: Clip) -> Path:
