@@ -129,9 +129,10 @@ class LibraryIndex:
         """Close the connection (everything recorded is committed already)."""
         self.con.close()
 
-    def known_hashes(self) -> set[str]:
-        """Content hashes of every take already in the index."""
-        return {h for (h,) in self.con.execute("SELECT hash FROM takes")}
+    def known_hashes(self, failed: bool = True) -> set[str]:
+        """Content hashes of every take already in the index (without those that failed, unless ``failed``)."""
+        query = "SELECT hash FROM takes" + ("" if failed else " WHERE outcome != 'failed'")
+        return {h for (h,) in self.con.execute(query)}
 
     def cached_hash(self, path: str, size: int, mtime_ns: int) -> str | None:
         """The hash recorded for ``path`` if its size and mtime are unchanged."""
