@@ -37,8 +37,9 @@ def open_loop(
     Raises ``ValueError`` (a :class:`~engine.io.motion_file.MotionFileError`, a
     :class:`~authoring.cycles.extract.CycleError` or a trajectory error) saying why not.
     """
-    from authoring.cycles.extract import extract_cycle
+    from authoring.cycles.extract import CycleError, extract_cycle
     from authoring.cycles.formats import loop_clip, performance_from_motion
+    from authoring.cycles.take_range import refusal_hint
     from engine.io.motion_file import load_motion, load_motion_loop, to_puppet
 
     motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up)
@@ -52,7 +53,11 @@ def open_loop(
         loop, note = clip, f"{motion.source.name}: a {'seamless ' * motion.seamless}loop of {clip.num_frames} frames"
     else:
         perf = performance_from_motion(motion)
-        result = extract_cycle(perf.trajectory, np.random.default_rng(0))
+        try:
+            result = extract_cycle(perf.trajectory, np.random.default_rng(0))
+        except CycleError as exc:  # name the part that loops, as `cycle` does
+            hint = refusal_hint(perf, perf, 0, 0)
+            raise CycleError(f"{exc}" + (f"; {hint}" if hint else "")) from None
         loop = loop_clip(result, perf, name=clip.name)
         note = f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles"
     if retarget:

@@ -10,9 +10,10 @@ and help identical. The values go to :func:`engine.io.motion_file.load_motion` a
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
-__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options"]
+__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options", "about"]
 
 
 def add_motion_options(parser: argparse.ArgumentParser) -> None:
@@ -62,3 +63,9 @@ def export_options(args: argparse.Namespace) -> dict[str, Any]:
     if fps is not None and not 0 < fps <= 1000:
         raise ValueError(f"--fps must be in (0, 1000], got {fps:g}")
     return {"fps": fps, "closing_frame": getattr(args, "closing_frame", None)}
+
+
+def about(path: object, error: BaseException) -> str:
+    """``"PATH: why"``, without naming the file twice when the reader's message already names it."""
+    message, name = str(error), str(path)
+    return message if Path(name).name in message else f"{name}: {message}"

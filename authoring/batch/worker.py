@@ -274,7 +274,7 @@ def _extract_segment(perf: Performance, seg: Segment, k: int, name: str, options
     return ClipOut(
         segment=k, start_frame=seg.start + perf.skipped, end_frame=seg.stop + perf.skipped,
         start_s=round(float(traj.times[seg.start]) + lead, 6), end_s=round(seg.t1 + lead, 6),
-        period=round(result.period, 6), cycles=result.cycles, closure_error=float(result.closure_error),
+        period=round(result.period, 6), cycles=perf.performed or result.cycles, closure_error=float(result.closure_error),
         spread=round(result.spread, 6), speed=None if speed is None else round(speed, 4), dims=traj.dims,
         kind=kind_of(name, speed), suffix=suffix, data=data,
     )

@@ -60,6 +60,8 @@ class Performance:
             position item after the rotation items, in this order.
         heading: for skeletal input, the column of the travelling heading item: the root
             position and rotation items are heading-normalised (:mod:`authoring.cycles.heading`).
+        performed: cycles the file holds when it is one seamless cycle repeated to be measured
+            (:func:`seamless_repeats`): 1; ``None`` for a performance of its own cycles.
     """
 
     trajectory: Trajectory
@@ -71,6 +73,7 @@ class Performance:
     motion: MotionFile | None = None
     translated: tuple[int, ...] = ()
     heading: int | None = None
+    performed: int | None = None
 
 
 def _select(available: list[str], wanted: list[str] | None, what: str) -> list[str]:
@@ -120,6 +123,7 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
     clip = motion.clip
     if motion.animation is not None:
         clip = seamless_repeats(clip)
+    performed = 1 if clip is not motion.clip else None
     sk = clip.skeleton
     chosen = _select(list(sk.names), items, "joint")
     local, level, heading = normalise(clip.root, clip.rotations[:, 0])
@@ -151,7 +155,8 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
     names.append(f"{sk.names[0]}.heading")
     its.append(Item(f"{sk.names[0]}.heading", "position", column, column + 1, travel=True))
     traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, its)
-    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column)
+    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column,
+                       performed)
 
 
 def _items_from_names(names: list[str]) -> list[Item]:

@@ -55,6 +55,8 @@ class MotionFile:
             (:func:`load_motion_loop`).
         up: the file's up axis and why (the clip is stood up: +Y is up).
         height: the figure's standing height in metres (median over frames).
+        file_frames: frames as the file holds them (BVH rows; a glTF animation's most keys).
+        file_joints: joints as the file declares them (before a static root is folded away).
     """
 
     clip: Clip
@@ -68,6 +70,8 @@ class MotionFile:
     seamless: bool = False
     up: UpAxis = UpAxis("y", "the format's convention")
     height: float = 0.0
+    file_frames: int = 0
+    file_joints: int = 0
 
     def summary(self) -> dict[str, Any]:
         """What ``--json`` reports about the input."""
@@ -75,8 +79,10 @@ class MotionFile:
             "units": self.units.name, "unit_scale": self.units.scale, "units_basis": self.units.basis,
             "up": self.up.name, "up_basis": self.up.basis, "height": round(self.height, 4),
             "fps": self.clip.fps, "fps_basis": self.fps_basis, "frames": self.clip.num_frames,
-            "joints": self.clip.skeleton.num_joints,
+            "joints": self.clip.skeleton.num_joints, "file_frames": self.file_frames, "file_joints": self.file_joints,
         }
+        if self.skipped:
+            out["skipped_frames"] = self.skipped
         if self.animation is not None:
             out["animation"] = self.animation
         if self.warnings:
@@ -142,7 +148,8 @@ def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[s
         raise MotionFileError(f"{path}: the file holds no frames")
     lead = detect_tpose_frames(motion) if skip_tpose else 0
     raw = motion.to_clip(scale=1.0, skip_frames=lead)
-    return _finish(raw, path, units, up, False, joint_map, fps_basis="BVH Frame Time", skipped=lead, warnings=told)
+    return _finish(raw, path, units, up, False, joint_map, fps_basis="BVH Frame Time", skipped=lead, warnings=told,
+                   file_frames=motion.num_frames, file_joints=motion.num_joints)
 
 
 def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: float | None,
@@ -153,8 +160,10 @@ def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: 
     anim = find_animation(asset, 0 if animation is None else animation)
     index = asset.animations.index(anim)
     raw = gltf_clip(asset, index, fps=fps)
+    keys = max((len(c.times) for c in anim.channels), default=0)
     return _finish(raw, path, units, up, True, joint_map, fps_basis=animation_rate(anim, fps)[1],
-                   animation=anim.name, animations=tuple(a.name for a in asset.animations))
+                   animation=anim.name, animations=tuple(a.name for a in asset.animations),
+                   file_frames=keys, file_joints=len(asset.skins[0].joints) if asset.skins else raw.skeleton.num_joints)
 
 
 def load_motion(

@@ -74,8 +74,17 @@ def test_bvh_walk_to_clip(tmp_path: Path, mocap_dir: Path, capsys: pytest.Captur
     summary = _last_json(capsys.readouterr().out)
     assert 136 <= summary["period_frames"] <= 144  # README: ≈140 frames at 120 fps
     assert summary["skipped_frames"] >= 1  # the T-pose lead-in
+    given = summary["input"]  # counts as analysed and as in the file
+    assert given["file_frames"] == 472 and given["frames"] == 472 - given["skipped_frames"] and given["file_joints"] == 43
     clip = load_clip(out)
     assert clip.loop and clip.duration == pytest.approx(summary["period_seconds"], rel=1e-6)
+
+
+def test_a_one_cycle_gltf_loop_reports_one_cycle(tmp_path: Path, mocap_dir: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["cycle", str(mocap_dir / "Fox.glb"), "--animation", "Walk", "-o", str(tmp_path / "w.glb"), "--json"]) == 0
+    summary = _last_json(capsys.readouterr().out)
+    assert summary["cycles"] == 1 and summary["input"]["file_joints"] == 24
 
 
 def test_jump_is_refused(tmp_path: Path, mocap_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
