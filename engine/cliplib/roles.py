@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from engine import quat
-from engine.clip import Clip, RootMotion
+from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
 from engine.skeleton import Skeleton
 

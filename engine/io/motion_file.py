@@ -31,6 +31,7 @@ __all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "l
            "scaled_clip"]
 
 MOTION_SUFFIXES = (".bvh", ".gltf", ".glb")
+_CONVENTION = UpAxis("y", "the format's convention")
 MAX_MAP_FILE = 1 << 20
 
 
@@ -68,7 +69,7 @@ class MotionFile:
     skipped: int = 0
     warnings: tuple[str, ...] = ()
     seamless: bool = False
-    up: UpAxis = UpAxis("y", "the format's convention")
+    up: UpAxis = _CONVENTION
     height: float = 0.0
     file_frames: int = 0
     file_joints: int = 0

@@ -29,7 +29,7 @@ from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.skeleton import Skeleton
 
-__all__ = ["AXES", "UpAxis", "judge_up", "given_up", "stood_up", "figure_height"]
+__all__ = ["AXES", "UpAxis", "figure_height", "given_up", "judge_up", "stood_up"]
 
 AXES: dict[str, NDArray[np.float64]] = {
     name: sign * np.eye(3)[k] for k, axis in enumerate("xyz") for name, sign in ((axis, 1.0), (f"-{axis}", -1.0))

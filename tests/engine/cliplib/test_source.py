@@ -10,9 +10,9 @@ import pytest
 
 from authoring.cycles.extract import extract_cycle
 from authoring.cycles.formats import load_performance, save_loop
-from engine.clips import default_clips
 from engine.cliplib.roles import check_role, conform
 from engine.cliplib.source import read_motion
+from engine.clips import default_clips
 from engine.humanoid import humanoid_skeleton
 from engine.io import clip_to_bvh, write_bvh
 from engine.io.motion_file import to_puppet

@@ -132,7 +132,7 @@ Y_TO_Z = quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.float64(np.pi / 2)) 
 def walk_take(cycles: float = 3, fps: float = 30.0, role: str = "walk") -> Clip:
     """A built-in cycle (the walk) performed ``cycles`` times at ``fps``, travelling in the root track (Y up, metres)."""
     walk = default_clips()[role]
-    t = np.arange(int(round(cycles * walk.duration * fps))) / fps
+    t = np.arange(round(cycles * walk.duration * fps)) / fps
     pose = walk.sample(t)
     travel = np.array([walk.sample_root_motion(float(x))[0] for x in t])
     return Clip(role, walk.skeleton, fps, pose.root + travel, pose.rotations)

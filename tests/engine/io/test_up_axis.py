@@ -15,6 +15,7 @@ from engine.io.motion_file import MotionFileError, load_motion
 from engine.io.up_axis import given_up, judge_up, stood_up
 from tests.engine.io.synthetic_bvh import blender_bvh, walk_take
 
+
 def _world(clip: Clip) -> np.ndarray:
     return forward_kinematics(clip.skeleton, clip.root, clip.rotations, clip.translations)[0]
 
