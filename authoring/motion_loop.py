@@ -24,6 +24,7 @@ def open_loop(
     animation: int | str | None = None,
     units: str | None = None,
     joint_map: dict[str, str] | None = None,
+    up: str | None = None,
     retarget: bool = False,
     start: object = None,
     end: object = None,
@@ -36,21 +37,27 @@ def open_loop(
     Raises ``ValueError`` (a :class:`~engine.io.motion_file.MotionFileError`, a
     :class:`~authoring.cycles.extract.CycleError` or a trajectory error) saying why not.
     """
-    from authoring.cycles.extract import extract_cycle
+    from authoring.cycles.extract import CycleError, extract_cycle
     from authoring.cycles.formats import loop_clip, performance_from_motion
+    from authoring.cycles.take_range import refusal_hint
     from engine.io.motion_file import load_motion, load_motion_loop, to_puppet
 
-    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map)
+    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up)
     clip = motion.clip
     if start is not None or end is not None:
         # The part is cut from the take as stored (a closed loop keeps its closing frame).
-        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=not clip.loop)
+        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, up=up,
+                             skip_tpose=not clip.loop)
         loop, note = _loop_of_part(motion, start, end)
     elif clip.loop:  # a loop our glTF writer marked as one, or a closed loop (its last pose is its first)
         loop, note = clip, f"{motion.source.name}: a {'seamless ' * motion.seamless}loop of {clip.num_frames} frames"
     else:
         perf = performance_from_motion(motion)
-        result = extract_cycle(perf.trajectory, np.random.default_rng(0))
+        try:
+            result = extract_cycle(perf.trajectory, np.random.default_rng(0))
+        except CycleError as exc:  # name the part that loops, as `cycle` does
+            hint = refusal_hint(perf, perf, 0, 0)
+            raise CycleError(f"{exc}" + (f"; {hint}" if hint else "")) from None
         loop = loop_clip(result, perf, name=clip.name)
         note = f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles"
     if retarget:

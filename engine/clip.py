@@ -212,6 +212,32 @@ class Clip:
         closing = 0.5 * ((self.root[-1] - self.root[-2]) + (self.root[1] - self.root[0]))
         return self.root[-1] - self.root[0] + closing
 
+    def travel_as_root_motion(self, travel: NDArray[np.float64] | None = None) -> Clip:
+        """A loop whose root track travels, with that travel as root motion: a steady ramp on the ground.
+
+        The ramp is ``(k/F)·travel`` (ground plane; ``travel`` defaults to :meth:`root_travel`)
+        and it leaves the root track, which is also moved to start over the ground origin:
+        what stays there is the loop's own sway, surge and bob, which close at the seam, so
+        the loop plays in place and the game moves it by the ramp. The heading stays in the
+        root rotation (root motion's heading is zero).
+        """
+        if not self.loop or self.root_motion is not None:
+            raise ValueError(f"clip {self.name!r}: only a loop whose root track travels can move its travel out")
+        step = (self.root_travel() if travel is None else np.asarray(travel, dtype=np.float64)[:3]) * [1.0, 0.0, 1.0]
+        ramp = np.outer(np.arange(self.num_frames) / self.num_frames, step)
+        root = self.root - ramp - self.root[0] * [1.0, 0.0, 1.0]
+        return replace(self, root=root, root_motion=RootMotion(ramp, np.zeros(self.num_frames)))
+
+    def baked_root_motion(self) -> Clip:
+        """The root motion put back into the root track and root rotation (the inverse of extracting it)."""
+        rm = self.root_motion
+        if rm is None:
+            return self
+        yaw = quat.from_axis_angle(_UP, rm.heading)
+        rot = np.array(self.rotations)
+        rot[:, 0] = quat.mul(yaw, rot[:, 0])
+        return replace(self, root=quat.rotate(yaw, self.root) + rm.translation, rotations=rot, root_motion=None)
+
     def resampled(self, fps: float) -> Clip:
         """The same motion sampled at another frame rate.
 

@@ -343,7 +343,9 @@ def run_edit(args: argparse.Namespace) -> int:
         activity = build_edit(args.clip, runner.size, args.output, record=args.record, options=_motion_options(args))
     except (ValueError, OSError) as exc:
         runner.close()
-        print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)
+        from puppetphone.motion_args import about
+
+        print(f"cannot open {about(args.clip, exc)}", file=sys.stderr)
         return 2
     runner.push_handlers(activity)
     try:

@@ -60,6 +60,7 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
         options = motion_options(args)
         clip, joint_map = to_puppet(read_motion(args.file, **options), skeleton, options["joint_map"])
         check_role(clip, role, skeleton)
+        before = library.entries().get(role)
         entry = library.add(conform(clip, role), role, skeleton, default_clips(), source=args.file.name)
     except RoleError as exc:
         print(f"clips: {args.file.name} refused as the {args.role}: {exc}", file=sys.stderr)
@@ -68,6 +69,8 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
     how = f"retargeted to the puppet by the {joint_map} joint map, " if joint_map else ""
     print(f"added {args.file.name} as the {entry.role} ({how}{stored.num_frames} frames at {stored.fps:g} fps, "
           f"{stored.average_speed():.2f} m/s) -> {library.root / entry.file}")
+    if before is not None:
+        print(f"replaced the {entry.role} that came from {before.source or before.file}")
     return 0
 
 
@@ -99,8 +102,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"removed the {entry.role} ({entry.file}); the built-in {entry.role} plays it")
         return 0
     except (ClipLibraryError, OSError, ValueError) as exc:
+        from puppetphone.motion_args import about
+
         name = getattr(args, "file", None)
-        print(f"clips: {name.name + ': ' if name else ''}{exc}", file=sys.stderr)
+        print(f"clips: {about(name.name, exc) if name else exc}", file=sys.stderr)
         return 2
 
 

@@ -52,6 +52,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
     parser.add_argument("--start", metavar="T0", type=take_position, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)")
     parser.add_argument("--end", metavar="T1", type=take_position, help="analyse up to here (excluded): seconds or a frame")
+    parser.epilog = (f"exit codes: 0 the loop was written; {EXIT_BAD_INPUT} an unreadable input or output, or a bad "
+                     f"option; {EXIT_NO_CYCLE} no cycle in the take (why, and the part that loops if any, on "
+                     "standard error; nothing written)")
 
 
 class _Bar:
@@ -79,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
     from authoring.cycles.take_range import refusal_hint, select
     from authoring.cycles.trajectory import TrajectoryError
-    from puppetphone.motion_args import export_options, motion_options
+    from puppetphone.motion_args import about, export_options, motion_options
 
     def fail(code: int, message: str) -> int:
         print(f"cycle: {message}", file=sys.stderr)
@@ -108,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     except FileNotFoundError as exc:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:
-        return fail(EXIT_BAD_INPUT, f"cannot read {args.input}: {exc}")
+        return fail(EXIT_BAD_INPUT, f"cannot read {about(args.input, exc)}")
     if perf.clip is None and out_suffix in (".bvh", ".ppclip", ".glb", ".gltf"):
         return fail(EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH, glTF); write .csv or .npz for {args.input}")
     for warning in perf.motion.warnings if perf.motion else ():
@@ -138,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
     summary = {
         "period_frames": round(result.period_samples, 3),
         "period_seconds": round(result.period, 6),
-        "cycles": result.cycles,
+        "cycles": perf.performed or result.cycles,  # a one-cycle glTF loop is repeated to be measured
         "dims": traj.dims,
         "closure_error": result.closure_error,
         "seconds": round(seconds, 4),
@@ -152,7 +155,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.json:
         print(
             f"{perf.source.name}: period {result.period:.4f} s = {result.period_samples:.2f} frames, "
-            f"{result.cycles} cycles averaged, {traj.dims} dims, spread {result.spread:.1%}, "
+            f"{perf.performed or result.cycles} cycle(s) averaged, {traj.dims} dims, spread {result.spread:.1%}, "
             f"closure error {result.closure_error:.1e}, {seconds * 1000:.0f} ms -> {args.output}"
         )
     else:

@@ -10,8 +10,10 @@ terminal, and a summary line last::
     cycles: 6 looped (7 clips), 2 refused, 1 failed, 0 already done, in 14.2 s -> lib
 
 A take whose content is already in the index is skipped, so a second run does nothing
-and says so, and a run that was killed resumes where it stopped. Exit status: 0 when
-every take was looped, refused or skipped; 1 when some failed to be read; 2 for bad
+and says so, and a run that was killed resumes where it stopped; ``--retry-failed`` does
+the takes recorded as failed again. Exit status: 0 when every take was looped, refused or
+skipped; 3 when the run finished but some takes could not be read or analysed (listed as
+failed); 1 when the run itself failed (its workers lost: run again to resume); 2 for bad
 arguments.
 """
 
@@ -31,7 +33,8 @@ if TYPE_CHECKING:  # imported inside run(): `puppetphone --help` stays instant
 __all__ = ["configure", "run"]
 
 EXIT_BAD_INPUT = 2
-EXIT_SOME_FAILED = 1
+EXIT_RUN_FAILED = 1
+EXIT_SOME_FAILED = 3
 
 
 def configure(parser: argparse.ArgumentParser) -> None:
@@ -52,6 +55,11 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-segments", action="store_true", help="one loop per take: do not look for several activities")
     parser.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points (default 0)")
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+    parser.add_argument("--retry-failed", action="store_true",
+                        help="do again the takes a previous run recorded as failed (looped and refused ones stay)")
+    parser.epilog = (f"exit codes: 0 every take looped, refused or already done; {EXIT_SOME_FAILED} done, but some "
+                     f"takes could not be read or analysed (listed as failed); {EXIT_RUN_FAILED} the run failed "
+                     f"(run again to resume); {EXIT_BAD_INPUT} bad arguments")
 
 
 def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
@@ -62,6 +70,7 @@ def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
     lines = []
     for clip, file in zip(outcome.clips, files, strict=True):
         part = "" if len(outcome.clips) == 1 and clip.start_frame <= 5 else f" [{clip.start_s:.2f}–{clip.end_s:.2f} s]"
+        part = f" [{clip.animation}]" if clip.animation is not None else part
         speed = "" if clip.speed is None else f", {clip.speed:.2f} m/s"
         lines.append(f"looped   {name}{part}: {clip.kind}, period {clip.period:.3f} s, {clip.cycles} cycles, "
                      f"closure error {clip.closure_error:.1e}{speed}, {clip.dims} dims -> {file}")
@@ -115,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"cycles: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
-        plan = plan_batch(sources, index)
+        plan = plan_batch(sources, index, retry_failed=args.retry_failed)
         for path, reason in plan.unreadable:
             print(f"failed   {Path(path).name}: cannot read: {reason}")
         if not plan.tasks:
@@ -147,7 +156,7 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     except BatchError as exc:
         print(f"cycles: {exc}; the takes done so far are in {index.path}: run again to resume", file=sys.stderr)
-        return EXIT_SOME_FAILED
+        return EXIT_RUN_FAILED
     finally:
         index.close()
     skipped = f"{plan.already} already done" + (f", {plan.duplicates} duplicate(s)" if plan.duplicates else "")

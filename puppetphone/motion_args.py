@@ -1,7 +1,7 @@
 """Command-line options for motion files, shared by every command that reads or writes them.
 
 ``cycle``, ``cycles``, ``clips add`` and ``author edit`` take the same input options
-(``--animation``, ``--units``, ``--joint-map``), and commands that write loops the same
+(``--animation``, ``--units``, ``--up``, ``--joint-map``), and commands that write loops the same
 export options (``--fps``, ``--closing-frame``); defining them once keeps their spelling
 and help identical. The values go to :func:`engine.io.motion_file.load_motion` and
 :func:`authoring.cycles.formats.save_loop`.
@@ -10,20 +10,25 @@ and help identical. The values go to :func:`engine.io.motion_file.load_motion` a
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
-__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options"]
+__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options", "about"]
 
 
 def add_motion_options(parser: argparse.ArgumentParser) -> None:
-    """``--animation``, ``--units`` and ``--joint-map``."""
+    """``--animation``, ``--units``, ``--up`` and ``--joint-map``."""
     from engine.io.units import UNITS
+    from engine.io.up_axis import AXES
 
     parser.add_argument("--animation", metavar="NAME|INDEX",
                         help="glTF/GLB: which animation (name or 0-based index; default the first)")
     parser.add_argument("--units", choices=tuple(UNITS),
                         help="length unit of a BVH/glTF file (default: judged by the figure's leg length or size; "
                              "cmu = the CMU database's 1/0.45 inch)")
+    parser.add_argument("--up", choices=tuple(AXES), metavar="AXIS",
+                        help="the file's up axis: x, y, z, -x, -y or -z (write --up=-z); default judged by the figure "
+                             "(a Blender export keeps z up); the figure is stood up with it")
     parser.add_argument("--joint-map", metavar="FILE",
                         help="JSON object of source joint name -> puppet joint name, for a skeleton no built-in map fits")
 
@@ -47,6 +52,7 @@ def motion_options(args: argparse.Namespace) -> dict[str, Any]:
     return {
         "animation": getattr(args, "animation", None),
         "units": getattr(args, "units", None),
+        "up": getattr(args, "up", None),
         "joint_map": load_joint_map(joint_map) if joint_map else None,
     }
 
@@ -57,3 +63,9 @@ def export_options(args: argparse.Namespace) -> dict[str, Any]:
     if fps is not None and not 0 < fps <= 1000:
         raise ValueError(f"--fps must be in (0, 1000], got {fps:g}")
     return {"fps": fps, "closing_frame": getattr(args, "closing_frame", None)}
+
+
+def about(path: object, error: BaseException) -> str:
+    """``"PATH: why"``, without naming the file twice when the reader's message already names it."""
+    message, name = str(error), str(path)
+    return message if Path(name).name in message else f"{name}: {message}"

@@ -143,14 +143,16 @@ class LibraryIndex:
         """Close the connection (everything recorded is committed already)."""
         self.con.close()
 
-    def known_hashes(self) -> set[str]:
-        """Content hashes of every take done: in the index, with each clip file it names intact.
+    def known_hashes(self, failed: bool = True) -> set[str]:
+        """Content hashes of every take done: in the index, with each clip file it names intact
+        (without the takes that failed, unless ``failed``: ``cycles --retry-failed``).
 
         A take whose clip count, clip files or their SHA-256 no longer match (a file deleted or
         changed, a damaged row) is left out, so the batch does it again and rewrites its rows.
         """
+        query = "SELECT hash, clips FROM takes" + ("" if failed else " WHERE outcome != 'failed'")
         try:
-            takes = dict(self.con.execute("SELECT hash, clips FROM takes").fetchall())
+            takes = dict(self.con.execute(query).fetchall())
             rows = self.con.execute("SELECT take, file, sha256 FROM clips").fetchall()
         except sqlite3.DatabaseError as exc:
             raise LibraryIndexError(f"{self.path} is not a readable library index ({exc})") from None

@@ -109,9 +109,13 @@ class Plan:
     unreadable: list[tuple[str, str]] = field(default_factory=list)  # (path, reason)
 
 
-def plan_batch(sources: list[Path], index: LibraryIndex) -> Plan:
-    """Hash every source (or reuse the hash of an unchanged file) and keep those not in the index."""
-    known = index.known_hashes()
+def plan_batch(sources: list[Path], index: LibraryIndex, retry_failed: bool = False) -> Plan:
+    """Hash every source (or reuse the hash of an unchanged file) and keep those not in the index.
+
+    With ``retry_failed`` a take recorded as failed (unreadable, or a reader bug since fixed)
+    is done again; looped and refused takes never are.
+    """
+    known = index.known_hashes(failed=not retry_failed)
     plan = Plan()
     seen: set[str] = set()
     for path in sources:

@@ -11,6 +11,9 @@ a batch.
 Segments (:mod:`authoring.cycles.segments`): a take in which several looping
 activities are found gives one clip per activity that loops; a take of one activity is
 extracted whole, and if that is refused, from the one segment found in it.
+
+Animations: every animation of a glTF file is a take of its own (Fox's Survey, Walk and
+Run), its clips numbered on after the previous animation's and named by it.
 """
 
 from __future__ import annotations
@@ -89,6 +92,7 @@ class ClipOut:
     kind: str
     suffix: str
     data: bytes = field(repr=False)
+    animation: str | None = None
 
 
 @dataclass(frozen=True)
@@ -116,11 +120,11 @@ def warm_up() -> None:
     import engine.io.retarget  # noqa: F401
 
 
-def _load(path: Path) -> Performance:
-    """The one place a take is read (the loader that knows every input format)."""
+def _load(path: Path, animation: int | None = None) -> Performance:
+    """The one place a take is read (the loader that knows every input format); ``animation``: a glTF's."""
     from authoring.cycles.formats import load_performance
 
-    return load_performance(path)
+    return load_performance(path, animation=animation)
 
 
 def kind_of(name: str, speed: float | None) -> str:
@@ -201,10 +205,29 @@ def _process(task: TakeTask, options: BatchOptions) -> TakeOutcome:
         if options.retarget and perf.clip is None:
             return outcome("refused", "--retarget puppet needs a skeletal take (BVH)")
         try:
-            clips, reason = _extract_all(perf, options, name, workdir)
+            clips, reason = _extract_animations(path, perf, options, name, workdir)
         except Exception as exc:  # noqa: BLE001 -- an extractor or retarget bug on one take: reported, the batch goes on
             return outcome("failed", f"{type(exc).__name__}: {exc}"[:500])
     return outcome("looped" if clips else "refused", reason, tuple(clips))
+
+
+def _extract_animations(path: Path, first: Performance, options: BatchOptions, name: str,
+                        workdir: Path) -> tuple[list[ClipOut], str]:
+    """:func:`_extract_all` for every animation of a glTF file (one take each), or for the one take of any other."""
+    import dataclasses
+
+    names = first.motion.animations if first.motion is not None else ()
+    if len(names) < 2:
+        return _extract_all(first, options, name, workdir)
+    clips: list[ClipOut] = []
+    notes: list[str] = []
+    for k, animation in enumerate(names):
+        perf = first if k == 0 else _load(path, k)
+        found, reason = _extract_all(perf, options, f"{name} {animation}", workdir)
+        clips += [dataclasses.replace(c, segment=len(clips) + i, animation=animation) for i, c in enumerate(found)]
+        if reason:
+            notes.append(f"{animation}: {reason}")
+    return clips, "; ".join(notes)
 
 
 def _extract_all(perf: Performance, options: BatchOptions, name: str, workdir: Path) -> tuple[list[ClipOut], str]:
@@ -251,7 +274,7 @@ def _extract_segment(perf: Performance, seg: Segment, k: int, name: str, options
     return ClipOut(
         segment=k, start_frame=seg.start + perf.skipped, end_frame=seg.stop + perf.skipped,
         start_s=round(float(traj.times[seg.start]) + lead, 6), end_s=round(seg.t1 + lead, 6),
-        period=round(result.period, 6), cycles=result.cycles, closure_error=float(result.closure_error),
+        period=round(result.period, 6), cycles=perf.performed or result.cycles, closure_error=float(result.closure_error),
         spread=round(result.spread, 6), speed=None if speed is None else round(speed, 4), dims=traj.dims,
         kind=kind_of(name, speed), suffix=suffix, data=data,
     )

@@ -3,6 +3,11 @@
     descriptor → period (ten seeded probe points, median) → cut at the anchor's matches
     → correspondences and time alignment → average → stitch → spline fit
 
+When the probes' vote fails or its cycles align poorly, the whole pose's autocorrelation
+peak (:mod:`authoring.cycles.autocorr`) is tried as the period before anything is refused,
+and wins when its cycles spread less than half as much: a short take of a real walk can
+lead most probes to a third of its stride.
+
 The paper's stated limitation is that a performance whose cycles differ too much in
 shape or timing gives no period or a poor loop. Both are detected and reported as a
 :class:`CycleError` whose message says which and why — the extractor never returns a
@@ -25,8 +30,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from authoring.cycles.autocorr import pose_period
 from authoring.cycles.average import AlignedCycles, average_cycles
-from authoring.cycles.cutting import best_cut, consensus, try_multiples
+from authoring.cycles.cutting import Cut, best_cut, consensus, try_multiples
 from authoring.cycles.descriptor import K_DEFAULT, Descriptor
 from authoring.cycles.period import PeriodSearch, PointPeriod, match_chain, search_periods
 from authoring.cycles.spline import BezierLoop, fit_item
@@ -141,6 +147,31 @@ def _travel(traj: Trajectory, aligned: AlignedCycles) -> NDArray[np.float64]:
     return travel
 
 
+def _pose_cut(traj: Trajectory, desc: Descriptor, values: NDArray[np.float64], weights: NDArray[np.float64],
+              points: NDArray[np.int64], opt: CycleOptions, vote: float | None) -> Cut | None:
+    """The cut at the whole pose's autocorrelation period (:mod:`authoring.cycles.autocorr`), when it differs from the vote.
+
+    The chains are walked at that period from the probe points and from the earliest
+    point the descriptor allows (a short take's whole cycles start near its beginning).
+    ``None`` when the pose does not repeat strongly, agrees with the vote, or its cycles
+    cannot be cut or spread beyond ``max_spread``.
+    """
+    n, dt = traj.num_samples, traj.dt
+    found_lag = pose_period(traj, values, opt.search.min_period, n // 2)
+    if found_lag is None or (vote is not None and abs(found_lag[0] * dt - vote) <= opt.agreement * vote):
+        return None
+    starts = np.unique(np.concatenate([points, [min(opt.k, n - 1)]])).astype(np.int64)
+    rows = desc.rows(starts)
+    found = [match_chain(traj.times, rows[a], int(starts[a]), found_lag[0], opt.search) for a in range(len(starts))]
+    found = [f for f in found if f.period > 0 and len(f.matches) >= 2]
+    if not found:
+        return None
+    agree, period = consensus(found, opt.agreement)
+    cut, _ = best_cut(traj, desc, agree, period, opt.samples or max(8, round(period / dt)), weights, opt.search,
+                      opt.anchors, opt.min_cycles, opt.good_spread)
+    return cut if cut is not None and cut.spread <= opt.max_spread else None
+
+
 def extract_cycle(
     traj: Trajectory,
     rng: np.random.Generator | None = None,
@@ -193,29 +224,42 @@ def _extract(traj: Trajectory, rng: np.random.Generator, opt: CycleOptions, repo
     per = search_periods(traj.times, rows, points, opt.search)
     found = [match_chain(traj.times, rows[a], int(points[a]), int(per[a]), opt.search) for a in range(len(points)) if per[a] > 0]
     found = [f for f in found if f.period > 0 and len(f.matches) >= 2]
+    dt = traj.dt
+    settings = (opt.search, opt.anchors, opt.min_cycles, opt.good_spread)
+
+    def second_opinion(reason: str) -> Cut:
+        """The cut at the whole pose's autocorrelation period, or the refusal."""
+        cut = _pose_cut(traj, desc, values, weights, points, opt, None)
+        if cut is None:
+            raise CycleError(reason)
+        return cut
+
+    agree, period = consensus(found, opt.agreement) if found else ([], 0.0)
     if len(found) < min(opt.min_agreeing, len(points)):
-        raise CycleError(
+        cut = second_opinion(
             f"no period found: only {len(found)} of {len(points)} probe points found a repeating match "
             "(the motion may not repeat, or its repetitions differ too much in shape or timing)"
         )
-    agree, period = consensus(found, opt.agreement)
-    if len(agree) < min(opt.min_agreeing, len(points)):
+    elif len(agree) < min(opt.min_agreeing, len(points)):
         found_s = ", ".join(f"{f.period:.3g}" for f in found)
-        raise CycleError(
+        cut = second_opinion(
             f"no consistent period: the probe points disagree (periods {found_s} s; fewer than "
             f"{opt.min_agreeing} within {opt.agreement:.0%} of the median); the motion does not repeat regularly"
         )
-    dt = traj.dt
-    report("alignment", 0.5)
-    settings = (opt.search, opt.anchors, opt.min_cycles, opt.good_spread)
-    cut, most = best_cut(traj, desc, agree, period, opt.samples or max(8, round(period / dt)), weights, *settings)
-    if cut is None:
-        raise CycleError(
-            f"too few cycles: a period of {period:.3g} s was found but only {most} whole cycle(s) could be cut "
-            f"(at least {opt.min_cycles} are needed to average); perform more loops"
-        )
-    if cut.spread > opt.good_spread and opt.samples is None:
-        cut = try_multiples(traj, desc, rows, points, cut, weights, opt.search, opt.agreement, *settings[1:])
+    else:
+        report("alignment", 0.5)
+        voted, most = best_cut(traj, desc, agree, period, opt.samples or max(8, round(period / dt)), weights, *settings)
+        if voted is not None and voted.spread > opt.good_spread and opt.samples is None:
+            voted = try_multiples(traj, desc, rows, points, voted, weights, opt.search, opt.agreement, *settings[1:])
+        if voted is None or voted.spread > opt.good_spread:  # a poor alignment: is it the wrong period?
+            alt = _pose_cut(traj, desc, values, weights, points, opt, period)
+            voted = alt if alt is not None and (voted is None or alt.spread < 0.5 * voted.spread) else voted
+        if voted is None:
+            raise CycleError(
+                f"too few cycles: a period of {period:.3g} s was found but only {most} whole cycle(s) could be cut "
+                f"(at least {opt.min_cycles} are needed to average); perform more loops"
+            )
+        cut = voted
     period, anchor, aligned, spread = cut.period, cut.anchor, cut.aligned, cut.spread
     samples = len(aligned.phases) - 1
     report("average", 0.8)

@@ -35,6 +35,7 @@ from engine.clip import Clip
 from engine.io.loop_export import is_seamless
 from engine.io.motion_file import MotionFile, MotionFileError, load_motion
 from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
+from engine.root_curve import RootCurve
 
 __all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop",
            "performance_from_motion", "seamless_repeats", "is_seamless"]
@@ -61,6 +62,8 @@ class Performance:
             position item after the rotation items, in this order.
         heading: for skeletal input, the column of the travelling heading item: the root
             position and rotation items are heading-normalised (:mod:`authoring.cycles.heading`).
+        performed: cycles the file holds when it is one seamless cycle repeated to be measured
+            (:func:`seamless_repeats`): 1; ``None`` for a performance of its own cycles.
     """
 
     trajectory: Trajectory
@@ -72,6 +75,7 @@ class Performance:
     motion: MotionFile | None = None
     translated: tuple[int, ...] = ()
     heading: int | None = None
+    performed: int | None = None
 
 
 def _select(available: list[str], wanted: list[str] | None, what: str) -> list[str]:
@@ -121,6 +125,7 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
     clip = motion.clip
     if motion.animation is not None:
         clip = seamless_repeats(clip)
+    performed = 1 if clip is not motion.clip else None
     sk = clip.skeleton
     chosen = _select(list(sk.names), items, "joint")
     local, level, heading = normalise(clip.root, clip.rotations[:, 0])
@@ -152,7 +157,8 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
     names.append(f"{sk.names[0]}.heading")
     its.append(Item(f"{sk.names[0]}.heading", "position", column, column + 1, travel=True))
     traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, its)
-    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column)
+    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column,
+                       performed)
 
 
 def _items_from_names(names: list[str]) -> list[Item]:
@@ -358,6 +364,23 @@ def quat_identity() -> NDArray[np.float64]:
     return np.array([1.0, 0.0, 0.0, 0.0])
 
 
+def _in_place(clip: Clip, curve: RootCurve | None, travel: NDArray[np.float64]) -> tuple[Clip, RootCurve | None]:
+    """A travelling loop as the game plays it: its travel as root motion, its root (and root curve) in place.
+
+    Written with the travel in the root track, a walk opened in ``author edit`` would jump
+    back a stride at every seam (speeds up to 150 m/s, the figure walking off the view);
+    split like this it plays in place over the origin like the built-in cycles. The
+    extractor's root curve is ``spline + (k/n)·travel``, so taking the same ramp (and
+    start) out of both keeps it exact.
+    """
+    if not np.linalg.norm(travel[[0, 2]]) > 0:
+        return clip, curve
+    ground = travel * [1.0, 0.0, 1.0]
+    start = clip.root[0] * [1.0, 0.0, 1.0]  # the in-place root starts over the origin; so does the curve
+    return (clip.travel_as_root_motion(ground),
+            None if curve is None else RootCurve(curve.control - start, travel - ground))
+
+
 def save_loop(
     result: CycleResult, perf: Performance, path: str | Path, fps: float | None = None, closing_frame: bool | None = None
 ) -> Path:
@@ -376,7 +399,8 @@ def save_loop(
         from engine.clipfile import save_clip
 
         clip = loop_clip(result, perf)
-        return save_clip(clip, path, root_curve=loop_root_curve(result, perf, clip))
+        clip, curve = _in_place(clip, loop_root_curve(result, perf, clip), loop_travel(result, perf)[0])
+        return save_clip(clip, path, root_curve=curve)
     if suffix in (".bvh", ".glb", ".gltf"):
         from engine.io.bvh import write_bvh
         from engine.io.bvh_convert import clip_to_bvh

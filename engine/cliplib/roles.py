@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from engine import quat
-from engine.clip import Clip, RootMotion
+from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
 from engine.skeleton import Skeleton
 
@@ -160,25 +160,20 @@ def _facing_travel(clip: Clip) -> Clip:
     """A loop without root motion, turned so its travel goes along +Z from the ground origin."""
     if clip.root_motion is not None:
         return clip
-    travel = clip.root_travel() if clip.loop else clip.root[-1] - clip.root[0]
+    travel = clip.root_travel()
     angle = -float(np.arctan2(travel[0], travel[2]))
     centre = np.array([clip.root[0, 0], 0.0, clip.root[0, 2]])
     return _turned(clip, angle, centre)
 
 
 def _with_travel_root_motion(clip: Clip) -> Clip:
-    """Travel along +Z as smooth root motion (constant speed); sway, bob and surge stay in the root."""
+    """A loop's travel along +Z as smooth root motion (constant speed); sway, bob and surge stay in the root."""
     if clip.root_motion is not None:
         return clip
-    n = clip.num_frames
-    step = clip.root_travel()[2] / n if clip.loop else (clip.root[-1, 2] - clip.root[0, 2]) / max(n - 1, 1)
-    z = clip.root[0, 2] + step * np.arange(n)
-    trans = np.zeros((n, 3))
-    trans[:, 2] = z - z[0]
-    root = np.array(clip.root)
-    root[:, 2] -= z
+    out = clip.travel_as_root_motion()
+    root = np.array(out.root)
     root[:, 0] -= root[:, 0].mean()
-    return replace(clip, root=root, root_motion=RootMotion(trans, np.zeros(n)))
+    return replace(out, root=root)
 
 
 def _facing_forward(clip: Clip) -> Clip:
@@ -209,6 +204,8 @@ def _heel_strikes(clip: Clip) -> dict[str, float]:
 def conform(clip: Clip, role: str) -> Clip:
     """``clip`` in the blend space's conventions for ``role``, named after it (see the module docstring)."""
     out = clip.resampled(FPS) if abs(clip.fps - FPS) > 1e-6 else clip
+    if role in CYCLIC:  # a loop that came with root motion (a .ppclip) is turned and ramped like any other
+        out = out.baked_root_motion()
     out = replace(out, name=role)
     if role in TRAVELLING:
         from engine.cliplib.plant import plant_feet

@@ -22,7 +22,7 @@ SOURCE_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
 
 
 def read_motion(path: str | Path, animation: int | str | None = None, units: str | None = None,
-                joint_map: dict[str, str] | None = None) -> Clip:
+                joint_map: dict[str, str] | None = None, up: str | None = None) -> Clip:
     """The clip in ``path`` (a glTF's chosen animation; a CMU BVH without its T-pose lead-in).
 
     A file that already is a loop (``cycle -o loop.bvh`` closes its loop with the first
@@ -42,7 +42,7 @@ def read_motion(path: str | Path, animation: int | str | None = None, units: str
         raise ValueError(f"{path.name}: unknown motion type {suffix!r}; use one of {', '.join(SOURCE_SUFFIXES)}")
     from engine.io.motion_file import load_motion_loop
 
-    return load_motion_loop(path, animation=animation, units=units, joint_map=joint_map).clip
+    return load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up).clip
 
 
 def to_puppet(clip: Clip, skeleton: Skeleton, joint_map: dict[str, str] | None = None) -> tuple[Clip, str | None]:

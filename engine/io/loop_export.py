@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from engine import quat
 from engine.clip import Clip
 
-__all__ = ["closed", "opened", "is_seamless", "loop_at_rate", "nominal_rate"]
+__all__ = ["closed", "is_seamless", "loop_at_rate", "nominal_rate", "opened"]
 
 _SEAMLESS = 0.05  # end-to-start pose gap, as a share of the pose's range, below which an animation is a loop
 

@@ -2,10 +2,11 @@
 
 Every command that takes a motion file (``cycle``, ``cycles``, ``clips add``, ``author edit``)
 calls :func:`load_motion` with the user's options — ``animation`` (glTF: name or index,
-default the first), ``units`` (``cm|m|mm|in|cmu``, default judged by the figure), whether to
-skip a T-pose lead-in — and gets a :class:`MotionFile`: the clip in metres plus the decisions
-(unit and why, frame rate and where it came from, warnings such as a ``Frames:`` count that
-was off), which ``--json`` prints via :meth:`MotionFile.summary`. :func:`load_joint_map`
+default the first), ``units`` (``cm|m|mm|in|cmu``, default judged by the figure), ``up``
+(default judged by the figure: a Blender export keeps Z up), whether to skip a T-pose lead-in
+— and gets a :class:`MotionFile`: the clip in metres with +Y up plus the decisions (unit, up
+axis and why, the figure's height, frame rate and where it came from, warnings such as a
+``Frames:`` count that was off), which ``--json`` prints via :meth:`MotionFile.summary`. :func:`load_joint_map`
 reads a ``--joint-map`` file and :func:`to_puppet` retargets, saying which map it used.
 """
 
@@ -21,6 +22,7 @@ from engine.clip import Clip
 from engine.io.bvh import BvhError, BvhWarning, read_bvh
 from engine.io.gltf import GltfError, read_gltf
 from engine.io.units import Units, given_units, judge_units
+from engine.io.up_axis import UpAxis, figure_height, given_up, judge_up, stood_up
 from engine.npz_safe import read_bounded
 from engine.skeleton import Skeleton
 
@@ -29,6 +31,7 @@ __all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "l
            "scaled_clip"]
 
 MOTION_SUFFIXES = (".bvh", ".gltf", ".glb")
+_CONVENTION = UpAxis("y", "the format's convention")
 MAX_MAP_FILE = 1 << 20
 
 
@@ -51,6 +54,10 @@ class MotionFile:
         warnings: what was tolerated on the way (e.g. a ``Frames:`` count that was off).
         seamless: the clip is a loop read from a closed file, its closing frame dropped
             (:func:`load_motion_loop`).
+        up: the file's up axis and why (the clip is stood up: +Y is up).
+        height: the figure's standing height in metres (median over frames).
+        file_frames: frames as the file holds them (BVH rows; a glTF animation's most keys).
+        file_joints: joints as the file declares them (before a static root is folded away).
     """
 
     clip: Clip
@@ -62,14 +69,21 @@ class MotionFile:
     skipped: int = 0
     warnings: tuple[str, ...] = ()
     seamless: bool = False
+    up: UpAxis = _CONVENTION
+    height: float = 0.0
+    file_frames: int = 0
+    file_joints: int = 0
 
     def summary(self) -> dict[str, Any]:
         """What ``--json`` reports about the input."""
         out: dict[str, Any] = {
             "units": self.units.name, "unit_scale": self.units.scale, "units_basis": self.units.basis,
+            "up": self.up.name, "up_basis": self.up.basis, "height": round(self.height, 4),
             "fps": self.clip.fps, "fps_basis": self.fps_basis, "frames": self.clip.num_frames,
-            "joints": self.clip.skeleton.num_joints,
+            "joints": self.clip.skeleton.num_joints, "file_frames": self.file_frames, "file_joints": self.file_joints,
         }
+        if self.skipped:
+            out["skipped_frames"] = self.skipped
         if self.animation is not None:
             out["animation"] = self.animation
         if self.warnings:
@@ -102,7 +116,29 @@ def _units(clip: Clip, units: str | None, metric: bool, joint_map: dict[str, str
     return judge_units(clip.skeleton, metric=metric, joint_map=joint_map)
 
 
-def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[str, str] | None) -> MotionFile:
+def _stood(clip: Clip, up: str | None, joint_map: dict[str, str] | None) -> tuple[Clip, UpAxis]:
+    """The clip with its up axis (given, or judged by the figure) turned to +Y."""
+    if up is not None:
+        try:
+            axis = given_up(up)
+        except ValueError as exc:
+            raise MotionFileError(str(exc)) from None
+    else:
+        axis = judge_up(clip, joint_map)
+    return stood_up(clip, axis), axis
+
+
+def _finish(raw: Clip, path: Path, units: str | None, up: str | None, metric: bool,
+            joint_map: dict[str, str] | None, **decided: Any) -> MotionFile:
+    """The file's clip stood up and in metres, with those decisions (``decided``: the format's own)."""
+    standing, axis = _stood(raw, up, joint_map)
+    unit = _units(standing, units, metric=metric, joint_map=joint_map)
+    clip = scaled_clip(standing, unit.scale)
+    return MotionFile(clip, path, unit, up=axis, height=figure_height(clip), **decided)
+
+
+def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[str, str] | None,
+              up: str | None) -> MotionFile:
     from engine.io.bvh_convert import detect_tpose_frames
 
     with warnings.catch_warnings(record=True) as caught:
@@ -113,21 +149,22 @@ def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[s
         raise MotionFileError(f"{path}: the file holds no frames")
     lead = detect_tpose_frames(motion) if skip_tpose else 0
     raw = motion.to_clip(scale=1.0, skip_frames=lead)
-    unit = _units(raw, units, metric=False, joint_map=joint_map)
-    return MotionFile(scaled_clip(raw, unit.scale), path, unit, "BVH Frame Time", skipped=lead, warnings=told)
+    return _finish(raw, path, units, up, False, joint_map, fps_basis="BVH Frame Time", skipped=lead, warnings=told,
+                   file_frames=motion.num_frames, file_joints=motion.num_joints)
 
 
 def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: float | None,
-               joint_map: dict[str, str] | None) -> MotionFile:
+               joint_map: dict[str, str] | None, up: str | None) -> MotionFile:
     from engine.io.gltf_clip import animation_rate, find_animation, gltf_clip
 
     asset = read_gltf(path)
     anim = find_animation(asset, 0 if animation is None else animation)
     index = asset.animations.index(anim)
     raw = gltf_clip(asset, index, fps=fps)
-    unit = _units(raw, units, metric=True, joint_map=joint_map)
-    return MotionFile(scaled_clip(raw, unit.scale), path, unit, animation_rate(anim, fps)[1], anim.name,
-                      tuple(a.name for a in asset.animations))
+    keys = max((len(c.times) for c in anim.channels), default=0)
+    return _finish(raw, path, units, up, True, joint_map, fps_basis=animation_rate(anim, fps)[1],
+                   animation=anim.name, animations=tuple(a.name for a in asset.animations),
+                   file_frames=keys, file_joints=len(asset.skins[0].joints) if asset.skins else raw.skeleton.num_joints)
 
 
 def load_motion(
@@ -137,8 +174,9 @@ def load_motion(
     skip_tpose: bool = True,
     fps: float | None = None,
     joint_map: dict[str, str] | None = None,
+    up: str | None = None,
 ) -> MotionFile:
-    """Read a ``.bvh``, ``.gltf`` or ``.glb`` motion as a clip in metres.
+    """Read a ``.bvh``, ``.gltf`` or ``.glb`` motion as a clip in metres, +Y up.
 
     Args:
         path: the file.
@@ -147,6 +185,8 @@ def load_motion(
         skip_tpose: drop a BVH T-pose lead-in (CMU conversions).
         fps: glTF sampling rate (default: from the key spacing).
         joint_map: puppet joint → source joint, when given (helps judge units on odd names).
+        up: the file's up axis (``x``, ``y``, ``z``, ``-x``…); default judged by the figure
+            (:mod:`engine.io.up_axis`). The clip comes back with that axis turned to +Y.
 
     Raises:
         MotionFileError: unknown type, wrong option, or a file that cannot be read (the
@@ -163,8 +203,8 @@ def load_motion(
         if suffix == ".bvh":
             if animation is not None:
                 raise MotionFileError(f"{path}: --animation is for glTF files; a BVH holds one motion")
-            return _load_bvh(path, units, skip_tpose, joint_map)
-        return _load_gltf(path, units, animation, fps, joint_map)
+            return _load_bvh(path, units, skip_tpose, joint_map, up)
+        return _load_gltf(path, units, animation, fps, joint_map, up)
     except (BvhError, GltfError) as exc:
         raise MotionFileError(str(exc)) from None
 
@@ -174,6 +214,7 @@ def load_motion_loop(
     animation: int | str | None = None,
     units: str | None = None,
     joint_map: dict[str, str] | None = None,
+    up: str | None = None,
 ) -> MotionFile:
     """:func:`load_motion`, with a file that already is a loop read as one.
 
@@ -185,14 +226,14 @@ def load_motion_loop(
     """
     from engine.io.loop_export import is_seamless, opened
 
-    whole = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False)
+    whole = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False, up=up)
     if whole.clip.loop:
         return whole
     if is_seamless(whole.clip):
         return replace(whole, clip=opened(whole.clip), seamless=True)
     if whole.animation is not None:
         return whole
-    return load_motion(path, units=units, joint_map=joint_map)
+    return load_motion(path, units=units, joint_map=joint_map, up=up)
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:

@@ -158,7 +158,8 @@ def retarget(
     """``clip`` played by ``target``.
 
     Args:
-        clip: source motion (any skeleton, any rest pose, any up axis).
+        clip: source motion (any skeleton, any rest pose, any up axis); root motion is
+            baked into its root first, so the retargeted clip travels in its root track.
         target: the skeleton to drive, e.g. ``engine.humanoid.humanoid_skeleton()``.
         joint_map: target joint name → source joint name; guessed from the source names
             (:func:`~engine.io.joint_maps.guess_joint_map`) when ``None``.
@@ -169,6 +170,7 @@ def retarget(
             :func:`_floor_level`); off, the hips keep the scaled source height, which
             leaves the feet a few centimetres off when ankle heights differ.
     """
+    clip = clip.baked_root_motion()  # the source's world travel is what the puppet's root follows
     src = clip.skeleton
     if joint_map is None:
         _, joint_map, guessed_aims = guess_joint_map(src.names)

@@ -4,7 +4,10 @@ Neither BVH nor (in practice) glTF says reliably what its numbers measure: BVH h
 field, and a glTF exported by Blender from a centimetre BVH is a 150 m giant although glTF
 means metres. A human figure carries its own ruler, though: the leg (hip joint to ankle)
 of an adult is about 0.82 m, so the unit that makes the leg closest to that (on a log
-scale) is the file's unit. When no joint map finds the legs (a fox, a cylinder), the
+scale) is the file's unit. The units are far apart (an inch is 2.54 cm, CMU's unit 2.22
+inches), so a figure no unit makes an adult (1.4..2.0 m) is no reason to pick the least
+bad one (1.12 m and 2.16 m tall figures of one set): its lengths are scaled continuously
+to an adult's 0.82 m leg instead, and the decision says so (unit ``scaled``). When no joint map finds the legs (a fox, a cylinder), the
 figure's largest rest extent against a human height is the fallback for BVH, and glTF
 keeps its metres unless that extent is absurd for any character (beyond 0.02..50 m), and
 then picks among the metric units only (Fox.glb is a 95-unit fox: centimetres).
@@ -29,6 +32,8 @@ __all__ = ["UNITS", "Units", "judge_units", "given_units"]
 UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "cmu": 0.0254 / 0.45}
 HUMAN_LEG = 0.82  # metres, hip joint to ankle of an adult
 HUMAN_HEIGHT = 1.7
+FIT = 1.2  # a unit fits when it makes the leg 0.68..0.98 m (an adult of about 1.4..2.0 m)
+SCALED = "scaled"  # the unit's name when no unit fits: lengths scaled to an adult's leg
 _SANE_EXTENT = (0.02, 50.0)  # metres: from a mouse to a dinosaur
 
 
@@ -90,7 +95,11 @@ def judge_units(skeleton: Skeleton, metric: bool = False, joint_map: dict[str, s
     leg = _leg_length(skeleton, joint_map)
     if leg is not None:
         name = _nearest(leg, HUMAN_LEG)
-        return Units(name, UNITS[name], f"leg length {leg:.4g} file units")
+        implied = leg * UNITS[name]
+        if abs(np.log(implied / HUMAN_LEG)) <= np.log(FIT):
+            return Units(name, UNITS[name], f"leg length {leg:.4g} file units")
+        return Units(SCALED, HUMAN_LEG / leg, f"leg length {leg:.4g} file units fits no unit (in {name} a "
+                                             f"{implied:.2f} m leg): scaled to a {HUMAN_LEG:g} m leg")
     extent = rest_extent(skeleton)
     if not extent > 0:
         return Units("m", 1.0, "no extent")

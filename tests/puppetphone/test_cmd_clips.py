@@ -36,6 +36,8 @@ def test_add_list_remove_in_the_default_library(clips: Path) -> None:
     assert (clips / "data" / "puppetphone" / "clips" / "walk.ppclip").is_file()
     out = _pp("clips", "list", cwd=clips)
     assert "walk" in out.stdout and "1.30 m/s" in out.stdout and "from walk.ppclip" in out.stdout
+    out = _pp("clips", "add", "walk.ppclip", "--role", "walk", cwd=clips)
+    assert out.returncode == 0 and "replaced the walk that came from walk.ppclip" in out.stdout
     out = _pp("clips", "remove", "walk", cwd=clips)
     assert out.returncode == 0 and "the built-in walk plays it" in out.stdout
     out = _pp("clips", "remove", "walk", cwd=clips)
@@ -45,7 +47,7 @@ def test_add_list_remove_in_the_default_library(clips: Path) -> None:
 @pytest.mark.parametrize(("file", "role", "reason"), [
     ("idle.ppclip", "walk", "refused as the walk: a walk moves at 0.5–2.2 m/s; 'idle' has no forward speed"),
     ("walk.ppclip", "crouch walk", "refused as the crouch walk: a crouch_walk is crouched and 'walk' is standing"),
-    ("missing.bvh", "walk", "missing.bvh: "),
+    ("missing.bvh", "walk", "clips: no such file: missing.bvh"),  # the file named once
     ("walk.ppclip", "../evil", "is not a name"),
 ])
 def test_refusals_say_why_in_one_line(clips: Path, file: str, role: str, reason: str) -> None:

@@ -74,8 +74,17 @@ def test_bvh_walk_to_clip(tmp_path: Path, mocap_dir: Path, capsys: pytest.Captur
     summary = _last_json(capsys.readouterr().out)
     assert 136 <= summary["period_frames"] <= 144  # README: ≈140 frames at 120 fps
     assert summary["skipped_frames"] >= 1  # the T-pose lead-in
+    given = summary["input"]  # counts as analysed and as in the file
+    assert given["file_frames"] == 472 and given["frames"] == 472 - given["skipped_frames"] and given["file_joints"] == 43
     clip = load_clip(out)
     assert clip.loop and clip.duration == pytest.approx(summary["period_seconds"], rel=1e-6)
+
+
+def test_a_one_cycle_gltf_loop_reports_one_cycle(tmp_path: Path, mocap_dir: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["cycle", str(mocap_dir / "Fox.glb"), "--animation", "Walk", "-o", str(tmp_path / "w.glb"), "--json"]) == 0
+    summary = _last_json(capsys.readouterr().out)
+    assert summary["cycles"] == 1 and summary["input"]["file_joints"] == 24
 
 
 def test_jump_is_refused(tmp_path: Path, mocap_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -121,3 +130,17 @@ def test_a_deeply_nested_joint_map_is_one_line(tmp_path: Path, capsys: pytest.Ca
     jm.write_text("{\"a\": " + "[" * 100_000 + "]" * 100_000 + "}")
     assert main(["cycle", str(src), "--joint-map", str(jm), "-o", str(tmp_path / "out.ppclip")]) == 2
     assert "nested too deeply" in capsys.readouterr().err
+
+
+def test_a_blender_bvh_is_stood_up_and_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from engine.io.bvh import read_bvh
+    from tests.engine.io.synthetic_bvh import blender_bvh, walk_take
+
+    blender_bvh(tmp_path / "blender.bvh", walk_take(4))
+    assert main(["cycle", str(tmp_path / "blender.bvh"), "-o", str(tmp_path / "loop.bvh"), "--json"]) == 0
+    given = _last_json(capsys.readouterr().out)["input"]
+    assert given["up"] == "z" and "along z" in given["up_basis"] and 1.5 < given["height"] < 1.9
+    loop = read_bvh(tmp_path / "loop.bvh")
+    assert loop.column(0, "Yposition").min() > 70.0  # the loop written stands: hips ~0.9 m up, in cm
+    assert main(["cycle", str(tmp_path / "blender.bvh"), "-o", str(tmp_path / "l.bvh"), "--json", "--up", "y"]) == 0
+    assert _last_json(capsys.readouterr().out)["input"]["up_basis"] == "given"

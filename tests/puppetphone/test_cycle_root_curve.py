@@ -19,6 +19,7 @@ from engine.clip import Clip
 from engine.clipfile import ClipFileError, load_clip_curve
 from engine.humanoid import humanoid_skeleton
 from engine.io import clip_to_bvh, write_bvh
+from engine.root_curve import RootCurve
 
 
 def _straight_walk_bvh(path: Path, frames: int = 600, fps: float = 60.0) -> Path:
@@ -47,17 +48,22 @@ def test_cycle_clip_opens_with_the_extractors_control_points(tmp_path: Path) -> 
     # What the extractor fitted, in this process, on the same file.
     perf = load_performance(bvh, None)
     result = extract_cycle(perf.trajectory, np.random.default_rng(0))
-    expected = loop_root_curve(result, perf, loop_clip(result, perf))
+    world = loop_clip(result, perf)
+    curve = loop_root_curve(result, perf, world)
     fitted = result.curves[f"{perf.clip.skeleton.names[0]}.position"]
-    assert expected is not None and expected.count == fitted.segments
+    assert curve is not None and curve.count == fitted.segments
+    # The loop is stored in place (its travel is root motion): the curve loses the same ramp and start.
+    start = world.root[0] * [1.0, 0.0, 1.0]
+    expected = RootCurve(curve.control - start, curve.travel * [0.0, 1.0, 0.0])
 
     session = load_session(tmp_path / "walk.ppclip")
     root = session.clip.skeleton.names[0]
-    assert session.root_curve is not None
-    assert np.array_equal(session.root_curve.control, expected.control)
-    assert np.array_equal(session.root_curve.travel, expected.travel)
+    assert session.root_curve is not None and session.clip.root_motion is not None
+    assert np.allclose(session.root_curve.control, expected.control, atol=1e-12)
+    assert np.allclose(session.root_curve.travel, expected.travel, atol=1e-12)
+    assert session.clip.average_speed() == pytest.approx(np.linalg.norm(curve.travel) / world.duration, rel=1e-9)
     assert session.control_count(root) == fitted.segments != EditSession(session.clip).control_count(root)
-    assert np.array_equal(session.control_points(root), expected.shown())
+    assert np.allclose(session.control_points(root), expected.shown(), atol=1e-12)
     # The curve is the clip's root within the extractor's bound.
     assert np.abs(expected.positions(session.clip.num_frames) - session.clip.root).max() <= 2 * max(fitted.max_error, 1e-3)
     # Other items still get MoCurves' own fit.
@@ -110,3 +116,19 @@ def test_swaying_walk_keeps_mocurves_own_fit(tmp_path: Path, mocap_dir: Path) ->
     assert done.returncode == 0, done.stderr
     clip, curve = load_clip_curve(tmp_path / "walk.ppclip")
     assert curve is None and load_session(tmp_path / "walk.ppclip").control_count(clip.skeleton.names[0]) == clip.num_frames // 5
+
+
+def test_a_retargeted_loop_plays_in_place_with_its_travel_as_root_motion(tmp_path: Path) -> None:
+    """``cycle --retarget puppet -o walk.ppclip`` opens over the origin, without a stride-long jump at the seam."""
+    from puppetphone.cli import main
+    from tests.engine.io.synthetic_bvh import human_bvh
+
+    (tmp_path / "take.bvh").write_text(human_bvh(frames=300, fps=60.0, period=1.0, turn=6.0, turn_period=2.0))
+    assert main(["cycle", str(tmp_path / "take.bvh"), "--retarget", "puppet", "-o", str(tmp_path / "walk.ppclip")]) == 0
+    session = load_session(tmp_path / "walk.ppclip")
+    clip = session.clip
+    assert clip.root_motion is not None and clip.average_speed() > 0.5
+    steps = np.linalg.norm(np.diff(clip.root[:, [0, 2]], axis=0), axis=1)
+    seam = float(np.linalg.norm((clip.root[0] - clip.root[-1])[[0, 2]]))
+    assert seam <= 2.0 * steps.max() and np.abs(clip.root[:, [0, 2]]).max() < 0.2
+    assert session.curves()[clip.skeleton.names[0]].speeds().max() < 3.0  # was ~150 m/s: the seam's jump back

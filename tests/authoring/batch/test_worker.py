@@ -77,3 +77,34 @@ def test_kind_from_name_then_speed() -> None:
     assert kind_of("cmu_16_36_runjog.bvh", 0.1) == "run"
     assert kind_of("take_7.bvh", 1.2) == "walk" and kind_of("take_7.bvh", 2.5) == "run"
     assert kind_of("take_7.bvh", 0.05) == "in place" and kind_of("take_7.csv", None) == "unknown"
+
+
+def _two_animation_glb(clips: list) -> bytes:  # type: ignore[type-arg]
+    """One skin, one animation per clip: the documents of our writer merged (as Fox.glb holds Survey, Walk, Run)."""
+    from engine.io.gltf_write import _document, container_bytes
+
+    doc, blob = _document(clips[0])
+    for clip in clips[1:]:
+        more, extra = _document(clip)
+        blob += b"\0" * ((-len(blob)) % 4)
+        views, accessors = len(doc["bufferViews"]), len(doc["accessors"])
+        doc["bufferViews"] += [{**v, "byteOffset": v.get("byteOffset", 0) + len(blob)} for v in more["bufferViews"]]
+        doc["accessors"] += [{**a, "bufferView": a["bufferView"] + views} for a in more["accessors"]]
+        anim = more["animations"][0]
+        anim["samplers"] = [{**s, "input": s["input"] + accessors, "output": s["output"] + accessors}
+                            for s in anim["samplers"]]
+        doc["animations"].append(anim)
+        blob += extra
+    doc["buffers"][0]["byteLength"] = len(blob)
+    return container_bytes(doc, blob, binary=True)
+
+
+def test_every_animation_of_a_gltf_is_a_take() -> None:
+    from tests.engine.io.synthetic_bvh import walk_take
+
+    data = _two_animation_glb([walk_take(4, 30.0, "walk"), walk_take(4, 30.0, "run")])
+    out = process_take(_task(data, "figure.glb"), BatchOptions())
+    assert out.outcome == "looped", out.reason
+    assert [c.animation for c in out.clips] == ["walk", "run"] and [c.segment for c in out.clips] == [0, 1]
+    assert [c.kind for c in out.clips] == ["walk", "run"]
+    assert out.clips[1].speed > out.clips[0].speed > 0.5

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -9,22 +10,18 @@ import pytest
 
 from authoring.cycles.extract import extract_cycle
 from authoring.cycles.formats import load_performance, save_loop
-from engine.clip import Clip
-from engine.clips import default_clips
 from engine.cliplib.roles import check_role, conform
 from engine.cliplib.source import read_motion
+from engine.clips import default_clips
 from engine.humanoid import humanoid_skeleton
 from engine.io import clip_to_bvh, write_bvh
+from engine.io.motion_file import to_puppet
+from tests.engine.io.synthetic_bvh import blender_bvh, walk_take
 
 
-def _take(path: Path, cycles: int = 5, fps: float = 30.0) -> Path:
-    """The built-in walk performed ``cycles`` times at ``fps``, its travel in the root: a BVH take."""
-    walk = default_clips()["walk"]
-    t = np.arange(int(cycles * walk.duration * fps)) / fps
-    pose = walk.sample(t)
-    travel = np.array([walk.sample_root_motion(float(x))[0] for x in t])
-    take = Clip("take", walk.skeleton, fps, pose.root + travel, pose.rotations)
-    return write_bvh(path, clip_to_bvh(take))
+def _take(path: Path, cycles: int = 5) -> Path:
+    """The built-in walk performed ``cycles`` times at 30 fps: a BVH take."""
+    return write_bvh(path, clip_to_bvh(walk_take(cycles)))
 
 
 @pytest.fixture(scope="module")
@@ -50,3 +47,18 @@ def test_the_projects_own_bvh_loop_reads_as_a_loop_like_its_glb_and_ppclip(loops
 
 def test_a_take_is_still_no_loop(tmp_path: Path) -> None:
     assert not read_motion(_take(tmp_path / "take.bvh", cycles=3)).loop
+
+
+def test_a_closed_loop_exported_by_blender_stands_up_and_keeps_its_speed(tmp_path: Path) -> None:
+    """Z up, six channels on loose bones, the first pose repeated at the end: a walk, standing, at its speed."""
+    walk = default_clips()["walk"]
+    n = round(walk.duration * 30.0)
+    take = walk_take(2, fps=n / walk.duration)
+    closed = replace(take, root=take.root[: n + 1], rotations=take.rotations[: n + 1])
+    clip = read_motion(blender_bvh(tmp_path / "blender_loop.bvh", closed))
+    assert clip.loop and clip.num_frames == n
+    puppet, _ = to_puppet(clip)
+    check_role(puppet, "walk", humanoid_skeleton())
+    out = conform(puppet, "walk")
+    assert out.average_speed() == pytest.approx(walk.average_speed(), rel=0.01)
+    assert out.root[:, 1].min() > 0.7  # hips up, not lying on the floor

@@ -1,5 +1,8 @@
 """Human BVH files made in the test, in any naming, unit and frame count (no files shipped).
 
+Also the built-in walk as a take (:func:`walk_take`) and written as Blender's exporter
+writes it, Z up (:func:`blender_bvh`).
+
 The figure is an adult in metres (leg 0.82 m from hip joint to ankle) scaled to the file
 unit; it walks on the spot with swinging legs and arms while the root moves forward, so
 cycle extraction, units and retargeting all have something real to measure.
@@ -7,7 +10,16 @@ cycle extraction, units and retargeting all have something real to measure.
 
 from __future__ import annotations
 
+from dataclasses import replace
+from pathlib import Path
+
 import numpy as np
+
+from engine import quat
+from engine.clip import Clip
+from engine.clips import default_clips
+from engine.io.bvh import write_bvh
+from engine.io.bvh_convert import clip_to_bvh
 
 # role -> (parent role, offset in metres)
 _BONES = {
@@ -112,3 +124,44 @@ def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int =
     count = frames if frames_header is None else frames_header
     lines += ["MOTION", f"Frames: {count}", f"Frame Time: {1.0 / fps:.7f}", *rows]
     return "\n".join(lines) + "\n"
+
+
+Y_TO_Z = quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.float64(np.pi / 2))  # Blender: (x, y, z) -> (x, -z, y)
+
+
+def walk_take(cycles: float = 3, fps: float = 30.0, role: str = "walk") -> Clip:
+    """A built-in cycle (the walk) performed ``cycles`` times at ``fps``, travelling in the root track (Y up, metres)."""
+    walk = default_clips()[role]
+    t = np.arange(round(cycles * walk.duration * fps)) / fps
+    pose = walk.sample(t)
+    travel = np.array([walk.sample_root_motion(float(x))[0] for x in t])
+    return Clip(role, walk.skeleton, fps, pose.root + travel, pose.rotations)
+
+
+def blender_bvh(path: Path, clip: Clip) -> Path:
+    """``clip`` as Blender's BVH exporter writes it: Z up, metres, XYZ Euler, %.6f, six channels on unconnected bones.
+
+    Blender keeps its own axes (Z up, -Y forward) and gives bones not connected to their
+    parent (the root, the thighs, the upper arms) position channels holding their local
+    translation, which repeats the OFFSET.
+    """
+    sk = clip.skeleton
+    zup = Clip(clip.name, replace(sk, offsets=quat.rotate(Y_TO_Z, sk.offsets), tips=quat.rotate(Y_TO_Z, sk.tips)),
+               clip.fps, quat.rotate(Y_TO_Z, clip.root),
+               quat.mul(quat.mul(Y_TO_Z, clip.rotations), quat.conjugate(Y_TO_Z)))
+    bvh = clip_to_bvh(zup, order="XYZ", unit=1.0)
+    loose = {"l_upper_leg", "r_upper_leg", "l_upper_arm", "r_upper_arm"}
+    channels, columns, start = [], [], 0
+    for j, chans in enumerate(bvh.channels):
+        width = len(chans)
+        block = bvh.data[:, start : start + width]
+        if bvh.names[j] in loose:
+            chans = ("Xposition", "Yposition", "Zposition", *chans)
+            block = np.concatenate([np.tile(bvh.offsets[j], (bvh.num_frames, 1)), block], axis=1)
+        channels.append(chans)
+        columns.append(block)
+        start += width
+    data = np.round(np.concatenate(columns, axis=1), 6)
+    ends = {j: np.round(e, 6) for j, e in bvh.end_sites.items()}
+    return write_bvh(path, replace(bvh, channels=tuple(channels), data=data, offsets=np.round(bvh.offsets, 6),
+                                   end_sites=ends))

@@ -142,6 +142,17 @@ def test_cmu_asf_units_are_judged_by_the_leg_not_as_inches(tmp_path: Path) -> No
         assert load_motion(_write(tmp_path, f"{name}.bvh", human_bvh(unit=unit)), skip_tpose=False).units.name == name
 
 
+@pytest.mark.parametrize("shrink", [0.68, 1.5])
+def test_a_figure_no_unit_fits_is_scaled_continuously_and_says_so(tmp_path: Path, shrink: float) -> None:
+    """A set rescaled by its uploader (a 1.1 m figure in metres) stands as tall as the rest of its set."""
+    metres = load_motion(_write(tmp_path, "m.bvh", human_bvh(unit=1.0)), skip_tpose=False)
+    odd = load_motion(_write(tmp_path, "odd.bvh", human_bvh(unit=shrink)), skip_tpose=False)
+    assert odd.units.name == "scaled" and "fits no unit" in odd.units.basis
+    assert odd.units.scale == pytest.approx(1.0 / shrink, rel=1e-6)  # the generator's leg is an adult's 0.82 m
+    assert odd.height == pytest.approx(metres.height, rel=1e-6)
+    assert odd.summary()["units"] == "scaled"
+
+
 def test_a_gltf_exported_in_centimetres_is_judged_by_its_figure(tmp_path: Path) -> None:
     clip = load_motion(_write(tmp_path, "w.bvh", human_bvh()), skip_tpose=False).clip
     write_gltf(tmp_path / "giant.glb", scaled_clip(clip, 100.0))  # what Blender writes from a cm BVH
