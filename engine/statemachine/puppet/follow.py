@@ -36,7 +36,7 @@ from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
 __all__ = ["spring_step", "wanted_velocity", "follow_velocity", "drag_reach"]
 
 F = NDArray[np.float64]
-_TURN_FROM = 0.3  # m/s: below this requested speed the puppet turns proportionally slower
+_TURN_FROM = 0.1  # m/s: a request slower than this turns nothing; twice this turns at the full rate
 
 
 def spring_step(value: F, rate: F, goal: F, omega: float, dt: float) -> tuple[F, F]:
@@ -101,8 +101,9 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
     if speed > 1e-3:
         turn = _wrap(float(np.arctan2(v[0], v[2])) - body.heading)
         # A slow puppet pivots on the spot faster than a running one can swing round; one
-        # coming to rest stops turning with its speed (the fading request's direction is noise).
-        rate = t.turn_rate * (1.0 + 1.0 / (1.0 + speed)) * min(1.0, speed / _TURN_FROM)
+        # coming to rest stops turning (the fading request's direction is noise, and a few
+        # centimetres past the hand are not worth turning round for).
+        rate = t.turn_rate * (1.0 + 1.0 / (1.0 + speed)) * float(np.clip((speed - _TURN_FROM) / _TURN_FROM, 0.0, 1.0))
         body.heading = _wrap(body.heading + float(np.clip(turn, -rate * world.dt, rate * world.dt)))
         facing = max(float(heading_vector(body.heading) @ (v / speed)), 0.0)
     tr.rotation = yaw_rotation(body.heading)
