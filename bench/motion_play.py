@@ -134,12 +134,16 @@ class _Phone(PoseSource):
 class _Driver:
     """The sandbox with one puppet and one scripted device, stepping and recording."""
 
-    def __init__(self, device: str, controller: str, seed: int = 0) -> None:
+    def __init__(self, device: str, controller: str, seed: int = 0, fps: float = 60.0) -> None:
         from puppetphone.games import load_game, make_app
 
         if device not in DEVICES or controller not in CONTROLLERS:
             raise ValueError(f"device must be one of {DEVICES} and controller one of {CONTROLLERS}")
         self.device = device
+        # A game drawing ``fps`` frames a second handles the mouse's queued events once a frame.
+        self.burst, self._frame_steps = 1, max(1, int(round(60.0 / fps)))  # bursts start after the grab
+        self._pending: list[pygame.event.Event] = []
+        self._steps = 0
         self.source: PoseSource = _Phone() if device == "phone" else MouseSource()
         self.app: App = make_app("sandbox", seed, InputHub([self.source]), {"scene": "empty", "puppets": 1})
         self.world = self.app.world
@@ -168,8 +172,23 @@ class _Driver:
                                     touch=touch, calibrate=calibrate))
 
     def _mouse_event(self, kind: int, t: float, **attrs: object) -> None:
+        """Hand a mouse event to the source at its event time, or, drawing slowly (``burst`` steps
+        a frame), queue it for the next frame, which handles the queue at once as the game does."""
         assert isinstance(self.source, MouseSource)
-        self.source.handle_event(pygame.event.Event(kind, **attrs), self.camera, self.size, now=t)
+        if self.burst == 1:
+            self.source.handle_event(pygame.event.Event(kind, **attrs), self.camera, self.size, now=t)
+        else:
+            self._pending.append(pygame.event.Event(kind, **attrs))
+
+    def _advance(self) -> None:
+        """One simulation step (after the frame's events, when a frame starts) and its record."""
+        if self.burst > 1 and self._steps % self.burst == 0:
+            for event in self._pending:
+                self.source.handle_event(event, self.camera, self.size, now=self.time)  # type: ignore[attr-defined]
+            self._pending.clear()
+        self._steps += 1
+        self.app.step()
+        self._record()
 
     def _pixel(self, point: F) -> tuple[float, float]:
         px = self.camera.project(np.asarray(point, dtype=np.float64)[None], *self.size)[0]
@@ -193,8 +212,7 @@ class _Driver:
                 self._mouse_event(pygame.MOUSEMOTION, t, pos=px, rel=(0, 0), buttons=(1, 0, 0))
         self.time += dt
         self.clock += dt
-        self.app.step()
-        self._record()
+        self._advance()
 
     def _record(self) -> None:
         wp = self.world.try_get(self.puppet, WorldPose)
@@ -239,6 +257,7 @@ class _Driver:
             self.step(lambda t: np.zeros(2))
         self._rows.clear()
         self.clock = 0.0
+        self.burst = self._frame_steps
 
     def result(self) -> Run:
         """The steps recorded since the grab."""
@@ -348,13 +367,14 @@ Gesture = Callable[[float, F], tuple[F, float]]
 
 
 def jump(speed: float, device: str = "phone", controller: str = "spring",
-         gesture: Gesture | None = None, run_up: float = 1.5, after: float = 1.6) -> JumpResult:
+         gesture: Gesture | None = None, run_up: float = 1.5, after: float = 1.6, fps: float = 60.0) -> JumpResult:
     """Walk or run at ``speed`` m/s for ``run_up`` s, flick, and keep going for ``after`` s.
 
     ``gesture(t, ground) -> (ground, lift)`` changes the stick from the flick on (``t`` s
     since the flick; ``ground`` where the walk would be): the valid flick by default,
-    an invalid gesture for the invalid sweep."""
-    d = _Driver(device, controller)
+    an invalid gesture for the invalid sweep. ``fps`` below 60 plays a machine that draws
+    that slowly: the mouse's events arrive in bursts, handled together once a frame."""
+    d = _Driver(device, controller, fps=fps)
     d.grab()
     flick = _phone_flick if device == "phone" else _mouse_flick
     default: Gesture = lambda t, g: (g, flick(t))  # noqa: E731
@@ -377,8 +397,7 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
                 px = d._pixel(np.array([d.tip0[0] + ground[0], d.height, d.tip0[2] + ground[1]]))
                 d._mouse_event(pygame.MOUSEMOTION, sample_t, pos=px, rel=(0, 0), buttons=(1, 0, 0))
         d.time += dt
-        d.app.step()
-        d._record()
+        d._advance()
     run = d.result()
     states = run.states
     fell = "Ragdoll" in states

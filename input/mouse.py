@@ -16,7 +16,8 @@ needs the camera:
 - a quick upward stroke is a flick (jumps): the cursor rises at least ``flick_rise``
   screen heights within ``flick_window`` seconds of event time. Judged over a window,
   not between two events: events queued during a frame are handled in a burst, and a
-  slow drag's one-pixel steps handled a millisecond apart looked like flicks;
+  slow drag's one-pixel steps handled a millisecond apart looked like flicks. During
+  the stroke the stick keeps pointing where it began (a gesture, not a drag);
 - right-drag orbits the camera: camera-only, so it is left to the game loop
   (``handle_event`` returns ``False`` for it).
 
@@ -76,7 +77,7 @@ class MouseSource(PoseSource):
         self.flick_rise, self.flick_window = flick_rise, flick_window
         self.pressed = False
         self._last: tuple[float, float, float] | None = None  # x, y, time
-        self._trail: list[tuple[float, float]] = []  # (time, y) of the held drag, within the window
+        self._trail: list[tuple[float, float, float]] = []  # (time, x, y) of the held drag, within the window
         self._flicked = False
         self._status.connected = True
 
@@ -93,7 +94,7 @@ class MouseSource(PoseSource):
         if kind == MOUSEBUTTONDOWN:
             self.pressed, self._flicked = True, False
             self._last = (*event.pos, now)
-            self._trail = [(now, float(event.pos[1]))]
+            self._trail = [(now, float(event.pos[0]), float(event.pos[1]))]
             self._emit(camera, size, event.pos, now, touch=True)
             return True
         if kind == MOUSEBUTTONUP:
@@ -104,25 +105,31 @@ class MouseSource(PoseSource):
         if kind == MOUSEMOTION:
             if getattr(event, "buttons", (0, 0, 0))[2] and not self.pressed:
                 return False  # right-drag: orbiting
-            flick = self.pressed and self._stroke(float(event.pos[1]), now, size[1])
+            flick, aim = self._stroke(event.pos, now, size[1]) if self.pressed else (False, event.pos)
             self._last = (*event.pos, now)
-            self._emit(camera, size, event.pos, now, flick=flick)
+            self._emit(camera, size, aim, now, flick=flick)
             return True
         return False
 
-    def _stroke(self, y: float, now: float, height: int) -> bool:
-        """Whether the held cursor, now at ``y``, has just completed an upward flick.
+    def _stroke(self, pos: tuple[float, float], now: float, height: int) -> tuple[bool, tuple[float, float]]:
+        """Judge the held cursor, now at ``pos``: ``(flick, where the stick should point)``.
 
         The rise is measured from the lowest point of the last ``flick_window`` seconds;
-        one flick per stroke: the next needs the cursor to come back down first."""
-        self._trail = [(t, v) for t, v in self._trail if now - t <= self.flick_window] + [(now, y)]
-        rise = (max(v for _, v in self._trail) - y) / height
-        if rise >= self.flick_rise and not self._flicked:
+        one flick per stroke: the next needs the cursor to come back down first. While a
+        fast upward stroke is under way (half a flick's rise within the window) and until
+        the cursor has come back down, the stick keeps pointing where the stroke began:
+        the stroke says "jump", not "drag the puppet metres toward the horizon" (near the
+        horizon a hundred pixels are metres of ground, past the drag limit)."""
+        self._trail = [p for p in self._trail if now - p[0] <= self.flick_window] + [(now, float(pos[0]), float(pos[1]))]
+        base = max(self._trail, key=lambda p: p[2])
+        rise = (base[2] - float(pos[1])) / height
+        flick = rise >= self.flick_rise and not self._flicked
+        if flick:
             self._flicked = True
-            return True
-        if rise <= 0.25 * self.flick_rise:
+        elif rise <= 0.25 * self.flick_rise:
             self._flicked = False
-        return False
+        stroking = self._flicked or rise >= 0.5 * self.flick_rise
+        return flick, ((base[1], base[2]) if stroking else (float(pos[0]), float(pos[1])))
 
     def _plane_normal(self, camera: RayCamera) -> NDArray[np.float64]:
         if self.plane == "ground":

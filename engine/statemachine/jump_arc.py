@@ -25,9 +25,10 @@ these tolerances (fields of :class:`JumpTracker`):
   ``stop_speed``. A running puppet's stick moves forward: that is the take-off direction,
   not a turn. When a flick launched the puppet (the mouse, whose stick stays in its
   plane), the stick *leads*: it turns the jump when its ground point strays more than
-  ``turn_offset`` (0.5 m) from the jump's line for ``turn_time`` (0.15 s) —
-  :meth:`JumpTracker.lead`. A flick's own stroke comes back within that time, and a
-  hand that holds still or follows the jump stays on the line;
+  ``turn_offset`` (0.6 m) from the jump's line for ``turn_time`` (0.3 s) —
+  :meth:`JumpTracker.lead`. A flick's own stroke comes back within that time even when a
+  slow machine draws at 10 frames a second (its events then arrive in bursts, several
+  steps apart), and a hand that holds still or follows the jump stays on the line;
 - *stopping*: slower than ``stop_speed`` (0.25 m/s) in every direction for ``stop_time``
   (0.15 s) while more than 0.15 m up;
 - *pulling down*: the stick falls faster than ``slam_speed`` (6 m/s), beyond any fall
@@ -100,8 +101,8 @@ class JumpTracker:
     stop_speed: float = 0.25
     stop_time: float = 0.15
     slam_speed: float = 6.0
-    turn_offset: float = 0.5
-    turn_time: float = 0.15
+    turn_offset: float = 0.6
+    turn_time: float = 0.3
     descending: bool = False
     off_line_for: float = 0.0
     lead_origin: NDArray[np.float64] | None = None

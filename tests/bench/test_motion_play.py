@@ -93,10 +93,19 @@ MOUSE_INVALID = {
 }
 
 
+@pytest.mark.parametrize("fps", [60.0, 12.0])
 @pytest.mark.parametrize("reason", sorted(MOUSE_INVALID))
-def test_an_invalid_mouse_gesture_ends_in_the_ragdoll_with_its_reason(reason):
-    result = jump(1.0, "mouse", gesture=MOUSE_INVALID[reason])
+def test_an_invalid_mouse_gesture_ends_in_the_ragdoll_with_its_reason(reason, fps):
+    result = jump(1.0, "mouse", gesture=MOUSE_INVALID[reason], fps=fps)
     assert "Ragdoll" in result.states and result.reason == reason
+
+
+@pytest.mark.parametrize("speed", [0.0, 1.0, 2.0, 3.0, 4.0])
+def test_a_mouse_flick_lands_on_a_machine_that_draws_12_frames_a_second(speed):
+    """The mouse's events then reach the game in bursts, a frame apart: the flick's stroke lands
+    in one step, and the jump must neither drop the puppet nor be aimed by the stroke."""
+    result = jump(speed, "mouse", fps=12.0)
+    assert result.landed, (result.reason, sorted(set(result.states)))
 
 
 def test_a_slow_upward_mouse_drag_never_jumps():

@@ -87,6 +87,9 @@ class PuppetBody:
         lead: the stick's ground velocity (the feed-forward of the locomotion control).
         walk_velocity: the requested ground velocity, smoothed by the control's spring.
         walk_rate: the spring's rate of change of ``walk_velocity``.
+        recent: ``[12, 3]`` the ground velocities the puppet played over the last 0.2 s, oldest
+            first: a jump takes its momentum from before the flick's stroke (which, on a
+            slowly drawing machine, reaches the stick in one burst and jerks the request).
         air: height of the root above the ground during a jump.
         air_velocity: the puppet's velocity while airborne (ballistic jumps).
         ground_velocity: the puppet's measured ground velocity over the last step (its momentum).
@@ -109,6 +112,7 @@ class PuppetBody:
     lead: F = field(default_factory=lambda: np.zeros(3))
     walk_velocity: F = field(default_factory=lambda: np.zeros(3))
     walk_rate: F = field(default_factory=lambda: np.zeros(3))
+    recent: F = field(default_factory=lambda: np.zeros((12, 3)))
     air: float = 0.0
     air_velocity: F = field(default_factory=lambda: np.zeros(3))
     ground_velocity: F = field(default_factory=lambda: np.zeros(3))

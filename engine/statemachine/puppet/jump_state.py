@@ -54,7 +54,13 @@ def enter_jump(world: World, entity: Entity, brain: Brain) -> None:
     body.jump = None
     # The puppet's own momentum, taken before the squat slows it: a mouse flick's
     # stroke says "jump", never where to — the stick's velocity during it is a gesture.
-    body.air_velocity = body.ground_velocity.copy()
+    # The velocity it played along its heading 0.2 s ago, before the stroke began: not the
+    # last step's displacement, which sways with the gait (a run's hips swing side to side),
+    # nor the request during the stroke, which a burst of mouse events can jerk aside.
+    if body.tuning.controller == "legacy":
+        body.air_velocity = body.ground_velocity.copy()
+    else:
+        body.air_velocity = body.recent[0].copy()
     player.height = body.tuning.crouch_height + 0.12
     player.speed *= 0.5
     brain.memory["jump_apex_height"] = 0.0
