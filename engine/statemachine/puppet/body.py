@@ -87,9 +87,10 @@ class PuppetBody:
         lead: the stick's ground velocity (the feed-forward of the locomotion control).
         walk_velocity: the requested ground velocity, smoothed by the control's spring.
         walk_rate: the spring's rate of change of ``walk_velocity``.
-        recent: ``[12, 3]`` the ground velocities the puppet played over the last 0.2 s, oldest
-            first: a jump takes its momentum from before the flick's stroke (which, on a
-            slowly drawing machine, reaches the stick in one burst and jerks the request).
+        recent: ``[12, 3]`` the ground velocities asked of the puppet over the last 0.2 s (the
+            spring's ``walk_velocity``), oldest first: a jump goes where the hand was leading
+            just before the flick (a puppet still turning round after a reversal jumps the way
+            it is led), not where a stroke's burst of mouse events jerked the request.
         air: height of the root above the ground during a jump.
         air_velocity: the puppet's velocity while airborne (ballistic jumps).
         ground_velocity: the puppet's measured ground velocity over the last step (its momentum).

@@ -108,4 +108,4 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
         facing = max(float(heading_vector(body.heading) @ (v / speed)), 0.0)
     tr.rotation = yaw_rotation(body.heading)
     player.speed = speed * facing * speed_scale
-    body.recent = np.vstack([body.recent[1:], heading_vector(body.heading) * player.speed])
+    body.recent = np.vstack([body.recent[1:], body.walk_velocity])

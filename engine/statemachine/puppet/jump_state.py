@@ -54,9 +54,9 @@ def enter_jump(world: World, entity: Entity, brain: Brain) -> None:
     body.jump = None
     # The puppet's own momentum, taken before the squat slows it: a mouse flick's
     # stroke says "jump", never where to — the stick's velocity during it is a gesture.
-    # The velocity it played along its heading 0.2 s ago, before the stroke began: not the
-    # last step's displacement, which sways with the gait (a run's hips swing side to side),
-    # nor the request during the stroke, which a burst of mouse events can jerk aside.
+    # The velocity it was asked for 0.2 s ago, before the stroke began: not the last step's
+    # displacement, which sways with the gait (a run's hips swing side to side), nor the
+    # request during the stroke, which a burst of mouse events can jerk aside.
     if body.tuning.controller == "legacy":
         body.air_velocity = body.ground_velocity.copy()
     else:
@@ -84,7 +84,11 @@ def _take_off(world: World, entity: Entity, body: PuppetBody, stick: Stick | Non
         velocity = horizontal + np.array([0.0, t.flick_launch_speed, 0.0])
     body.air_velocity = velocity
     body.jump = JumpTracker.start_at(start, velocity)
-    body.jump.lead_origin = start[[0, 2]].copy()  # a launched jump's line runs through the puppet
+    # A launched jump's line runs through where the stick is at take-off: what turns the jump
+    # is the stick leaving that line, not a lag it already had (a puppet left behind by a
+    # fast drag may still jump; the mouse's flick stroke does not move the stick).
+    lead = start if stick is None else wanted_anchor(stick)
+    body.jump.lead_origin = np.array([lead[0], lead[2]], dtype=np.float64)
     body.phase, body.timer = "air", 0.0
     player = world.get(entity, LocomotionPlayer)
     player.play("mid_jump", fade=0.1)
