@@ -201,7 +201,7 @@ def play(d: Director) -> None:
     d.mark("stacking")
     d.lift_onto(middle, bottom, 10)
     # 5. The puppet walks up to the head ball, carries it up and puts it on top.
-    d.approach(puppet, head, _xz(1.0, 0.0))
+    d.approach(puppet, head, _xz(1.0, 0.0), gap=0.4)
     d.carry_onto(puppet, head, bottom)
     first = d.wait_for_snowman(1)
     d.mark("alive")

@@ -56,16 +56,18 @@ def wanted_velocity(error: F, lead: F, tuning: PuppetTuning) -> F:
 
     The catch-up gain fades in as ``d² / (d² + deadband²)`` of the distance ``d``, so a
     puppet standing at its stick does not creep toward every tremor of the hand, and
-    nothing switches at a radius; the stick's velocity fades out once the puppet is a
-    dead band ahead of it along that velocity. The result is capped at ``tuning.top_speed``.
+    nothing switches at a radius; the stick's velocity counts in full once the stick leads
+    the puppet by a dead band along it, and not at all once the puppet has caught up. The result is capped at ``tuning.top_speed``.
     """
     d2 = float(error @ error)
     band2 = tuning.follow_deadband**2
     pace = float(np.linalg.norm(lead))
-    # The feed-forward fades out once the puppet is ahead of its stick along the lead (the hand
-    # stopped and its filtered velocity still trails): a puppet never strides past the hand.
-    ahead = -float(error @ lead) / pace if pace > 1e-9 else 0.0
-    gate = float(np.clip(1.0 - ahead / tuning.follow_deadband, 0.0, 1.0))
+    # The feed-forward needs the stick to be ahead of the puppet along the lead: it fades in over
+    # the dead band and is gone once the puppet has caught up. A puppet never strides past a
+    # hand that stopped (its filtered velocity still trails), and a hand that jerks the stick
+    # out and back (a wheel notch's slide, a twitch) does not drag a standing puppet about.
+    behind = float(error @ lead) / pace if pace > 1e-9 else 0.0
+    gate = float(np.clip(behind / tuning.follow_deadband, 0.0, 1.0))
     wanted = gate * lead + tuning.catch_up_gain * (d2 / (d2 + band2) if d2 > 0.0 else 0.0) * error
     speed = float(np.linalg.norm(wanted))
     return wanted * (tuning.top_speed / speed) if speed > tuning.top_speed else wanted

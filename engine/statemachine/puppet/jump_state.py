@@ -141,8 +141,9 @@ def update_jump(world: World, entity: Entity, brain: Brain) -> None:
         point = anchor
         body.air_velocity = velocity
     else:
-        body.air_velocity = body.air_velocity - np.array([0.0, t.gravity * world.dt, 0.0])
-        tr.position = tr.position + body.air_velocity * world.dt
+        before = body.air_velocity
+        body.air_velocity = before - np.array([0.0, t.gravity * world.dt, 0.0])
+        tr.position = tr.position + 0.5 * (before + body.air_velocity) * world.dt  # exact under gravity
         velocity = body.air_velocity
         point = tr.position + np.array([0.0, t.stand_height, 0.0])
     body.air = float(tr.position[1])

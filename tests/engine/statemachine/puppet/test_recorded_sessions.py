@@ -345,17 +345,19 @@ def test_the_reason_of_a_fall_goes_once_the_puppet_is_up() -> None:
 # -- players' reports of physics that broke (issue: physics that no input can break) -------------
 def test_a_flick_while_rolling_a_ball_throws_nothing_out_of_the_field():
     """Reported: "Ragdoll (jump_invalid)", a MuJoCo QACC warning, puppet and balls thrown out of view for
-    ~30 s. Now: the invalid jump still drops the puppet, but everything stays near and it gets up again."""
+    ~30 s. Then: the invalid jump dropped the puppet, but everything stayed near. Now the mouse's upward
+    stroke is a gesture that does not drag the stick toward the horizon, so the rolling puppet is not
+    yanked at all: it stands up where the cursor is then held and stays on its feet."""
     w = replay("flick_while_rolling")
     states = [t.target for t in w.trace]
-    assert "RollSnowball" in states and "Ragdoll" in states
-    assert states[-1] == "Locomotion"  # got up and stands again before the end
+    assert "RollSnowball" in states and "Ragdoll" not in states
+    assert states[-1] == "Locomotion"
     pos, ball = w.arr("pos"), w.arr("ball")
     assert np.isfinite(pos).all() and np.isfinite(ball).all()
-    assert np.abs(pos[:, [0, 2]]).max() < 4.0 and pos[:, 1].max() < 2.0  # the puppet stays where it fell
-    fell = w.first("state", "Ragdoll")
-    speed = np.linalg.norm(np.diff(ball[fell - 1:], axis=0), axis=1) * 60
-    assert speed.max() < 3.0 and ball[fell:, 1].max() < 0.5  # m/s, m: the ball is nudged on, never flung
+    assert np.abs(pos[:, [0, 2]]).max() < 4.0 and pos[:, 1].max() < 0.01  # on its feet, near
+    rolled = w.first("state", "RollSnowball")
+    speed = np.linalg.norm(np.diff(ball[rolled:], axis=0), axis=1) * 60
+    assert speed.max() < 3.0 and ball[rolled:, 1].max() < 0.5  # m/s, m: the ball is pushed on, never flung
 
 
 def test_five_wheel_clicks_then_a_crouch_walk_stays_on_its_feet():
