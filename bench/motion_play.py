@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.app import App
+from engine.blend.locomotion import LocomotionPlayer
 from engine.clips.contacts import HEEL_OFFSET
 from engine.components import Grabbable, Puppet, Stick, Transform, WorldPose
 from engine.statemachine import Brain
@@ -164,6 +165,7 @@ class _Driver:
         self.lift = 0.0  # phone height offset / mouse cursor rise in pixels (flicks)
         self.run = Run(self.world.dt, np.zeros((0, 2, 3)), np.zeros((0, 2, 3)), np.zeros((0, 3)), [], [])
         self._rows: list[tuple[F, F, F, str, dict]] = []
+        self.airborne: list[float | None] = []  # per step: the airborne clip's time, while it plays
 
     # -- devices ------------------------------------------------------------------
     def _phone_sample(self, t: float, touch: bool | None = None, calibrate: bool = False) -> None:
@@ -223,6 +225,8 @@ class _Driver:
             heels = np.array([wp.positions[j] + quat.rotate(wp.rotations[j], HEEL_OFFSET) for j in self.feet])
         brain = self.world.get(self.puppet, Brain)
         pos = self.world.get(self.puppet, Transform).position.copy()
+        player = self.world.get(self.puppet, LocomotionPlayer)
+        self.airborne.append(player.override_time if player.override == "mid_jump" else None)
         self._rows.append((toes, heels, pos, brain.active, dict(brain.memory)))
 
     def grab(self) -> None:
@@ -256,6 +260,7 @@ class _Driver:
         for _ in range(15):
             self.step(lambda t: np.zeros(2))
         self._rows.clear()
+        self.airborne.clear()
         self.clock = 0.0
         self.burst = self._frame_steps
 
@@ -344,13 +349,18 @@ def blend_alone_slide(speed: float, seconds: float = 3.0) -> tuple[float, float]
 @dataclass(frozen=True)
 class JumpResult:
     """How one flick went: ``landed`` (Jump then Land, no fall), the reason of a fall, the apex
-    height error against the arc predicted at take-off (m) and the flick-to-take-off time (s)."""
+    height error against the arc predicted at take-off (m), the flick-to-take-off time (s),
+    the puppet's ground speed through the landing crouch (m/s) and each step's ``poses``:
+    the airborne clip's time (s) while one plays, else ``None``."""
 
     landed: bool
     reason: str | None
     apex_error: float | None
     takeoff_delay: float | None
     states: list[str]
+    landing_speed: float | None = None
+    heights: list[float] | None = None
+    poses: list[float | None] | None = None
 
 
 def _phone_flick(t: float) -> float:
@@ -412,4 +422,10 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
             top = max(float(run.position[i][1]) for i in air) + d.world.get(d.puppet, PuppetBody).tuning.stand_height
             apex_error = None if predicted is None else abs(top - predicted)
             delay = (air[0] - start) * dt
-    return JumpResult(landed, reason if fell else None, apex_error, delay, states)
+    land = [i for i, s in enumerate(states) if s == "Land"]
+    landing_speed = None
+    if len(land) > 1:
+        span = run.position[land[-1]] - run.position[land[0]]
+        landing_speed = float(np.hypot(span[0], span[2]) / ((land[-1] - land[0]) * dt))
+    return JumpResult(landed, reason if fell else None, apex_error, delay, states, landing_speed,
+                      [float(p[1]) for p in run.position], d.airborne)

@@ -54,6 +54,28 @@ def test_a_valid_flick_jumps_and_lands_from_any_speed(device, speed):
     assert result.takeoff_delay is not None and result.takeoff_delay < 0.3
 
 
+@pytest.mark.parametrize("pixels", [80.0, 250.0])
+def test_an_ordinary_hands_mouse_flick_jumps(pixels):
+    """Up and back within about 0.15 s, 80 to 250 px: a jump, landed."""
+    def flick(t, g):  # type: ignore[no-untyped-def]
+        return g, pixels * min(t / 0.06, 1.0) - pixels * min(max(t - 0.06, 0.0) / 0.08, 1.0)
+    result = jump(1.0, "mouse", gesture=flick)
+    assert result.landed, (result.reason, sorted(set(result.states)))
+
+
+def test_a_running_jump_lands_running_and_the_arc_poses_it():
+    """The horizontal speed is kept into the landing; the airborne clip is sampled by the place on
+    the arc: it tucks (clip time rising) up to the apex and opens again (falling) after it."""
+    result = jump(3.0, "phone")
+    assert result.landed and result.landing_speed is not None and result.landing_speed > 2.0
+    air = [i for i, t in enumerate(result.poses) if t is not None]
+    times = np.array([result.poses[i] for i in air])
+    heights = np.array([result.heights[i] for i in air])
+    top = int(np.argmax(heights))
+    assert int(np.argmax(times)) == pytest.approx(top, abs=2)  # the deepest tuck at the apex
+    assert times[top] > 2 * times[0] and times[top] > 2 * times[-1]
+
+
 def _ride(lift, side=lambda t: 0.0, halt=False):  # type: ignore[no-untyped-def]
     """A phone gesture riding the stick: ``lift(t)`` m up, ``side(t)`` m sideways, on top of the
     1 m/s walk (or, with ``halt``, the hand stops where it flicked)."""
