@@ -90,3 +90,22 @@ def test_scales_on_joints_with_children_reach_every_descendant():
     ua, la, hand = sk.index("l_upper_arm"), sk.index("l_lower_arm"), sk.index("l_hand")
     assert np.linalg.norm(pos[0, la] - pos[0, ua]) == pytest.approx(1.5 * 1.3 * 0.8 * np.linalg.norm(plain[la] - plain[ua]))
     assert np.linalg.norm(pos[0, hand] - pos[0, la]) == pytest.approx(1.5 * 1.3 * 0.8 * np.linalg.norm(plain[hand] - plain[la]))
+
+
+def test_inputs_of_any_float_type_are_computed_in_double_precision():
+    """float32 poses (a GPU buffer, a float32 file) give the float64 answer: the inputs are widened first.
+
+    Found by the mutation run: dropping ``dtype=np.float64`` on the scales survived (on the other inputs it
+    is equivalent: ``quat`` widens them itself)."""
+    sk = humanoid_skeleton()
+    rng = np.random.default_rng(5)
+    rots = quat.exp(rng.normal(scale=0.5, size=(sk.num_joints, 3))).astype(np.float32)
+    root = rng.normal(size=3).astype(np.float32)
+    offsets = (sk.offsets * 1.1).astype(np.float32)
+    scales = rng.uniform(0.5, 2.0, sk.num_joints).astype(np.float32)
+    pos, rot = forward_kinematics(sk, root, rots, offsets, scales)
+    ref, ref_rot = forward_kinematics(sk, root.astype(np.float64), rots.astype(np.float64),
+                                      offsets.astype(np.float64), scales.astype(np.float64))
+    assert pos.dtype == np.float64 and rot.dtype == np.float64
+    np.testing.assert_allclose(pos, ref, atol=1e-12)
+    np.testing.assert_allclose(rot, ref_rot, atol=1e-12)

@@ -138,7 +138,7 @@ def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file
     replayed = load_game("snowman").replay_setup(rec.header.setup)
     seen = []
     result = verify(lambda h: make_app("snowman", 3, h, replayed), rec, on_step=lambda a, i: seen.append(len(a.world.query(Snowball))))
-    assert result.ok, result.message
+    assert result.ok, result.message()
     assert seen[-1] == 3 and 0 in seen and not field_file.exists()  # restored, reset, restored; nothing written
 
 

@@ -21,7 +21,7 @@ def test_demo_replays_every_stage_in_order_with_matching_hashes(tmp_path: Path,
     # The recorded setup, saving to a file of the test's (a replay itself saves nowhere).
     setup = {**rec.header.setup, "save_to": str(tmp_path / "save.json")}
     result = verify(lambda hub: make_app("tasbada", rec.header.seed, hub, setup), rec)
-    assert result.ok, result.message
+    assert result.ok, result.message()
     lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("stage: ")]
     assert lines == ["stage: real", "stage: props alive", "stage: mixed", "stage: virtual"]
     # The journey was saved as it went (atomically), and names every stage.

@@ -68,6 +68,18 @@ def test_the_band_between_entering_and_leaving_a_crouch(puppet) -> None:  # type
         assert hold(h) == ["Locomotion"] * 3, h
 
 
+def test_the_thresholds_themselves_are_inside_the_band(puppet) -> None:  # type: ignore[no-untyped-def]
+    """*Below* ``crouch_enter`` crouches, *above* ``crouch_exit`` stands: at either threshold exactly nothing
+    changes. Found by the mutation run (``<`` made ``<=``, ``>`` made ``>=`` survived)."""
+    t, hold = puppet
+    assert hold(t.crouch_enter) == ["Locomotion"] * 3
+    assert hold(t.crouch_exit) == ["Locomotion"] * 3
+    assert hold(t.crouch_enter - 1e-9)[0] == "Crouch"
+    assert hold(t.crouch_enter) == ["Crouch"] * 3
+    assert hold(t.crouch_exit) == ["Crouch"] * 3
+    assert hold(t.crouch_exit + 1e-9)[0] == "Locomotion"
+
+
 def test_a_released_puppet_stands_up_from_a_crouch(puppet) -> None:  # type: ignore[no-untyped-def]
     t, hold = puppet
     assert hold(t.crouch_height)[-1] == "Crouch"
