@@ -213,7 +213,15 @@ def motionstick_system(world: World) -> None:
             elif kind == TOUCH_UP:
                 stick.touching = False
                 _release(stick)
-        wanted = _length(st, stick, sum(x.depth_delta for x in samples), cfg, None if hit is None else hit[1])
+        focus_t = None if hit is None else hit[1]
+        notches = sum(x.depth_delta for x in samples)
+        before = _length(st, stick, 0.0, cfg, focus_t)
+        wanted = _length(st, stick, notches, cfg, focus_t)
+        if notches and st.filt_x is not None:
+            # A wheel notch lowers or lifts what is held (crouch, lift): the tip's jump along the
+            # stick is not the hand moving, so the velocity filter moves with it.
+            shift = stick.direction * (wanted - before)
+            st.filt_x, st.raw_x = st.filt_x + shift, st.raw_x + shift
         bases, radii_o, heights = _obstacles(world, stick.grabbed)
         tips = [(pivot + d * shorten(pivot, d, wanted, cfg.ground_y, bases, radii_o, heights), t) for pivot, d, t in poses]
         stick.length = shorten(stick.pivot, stick.direction, wanted, cfg.ground_y, bases, radii_o, heights)

@@ -51,23 +51,23 @@ def spring_step(value: F, rate: F, goal: F, omega: float, dt: float) -> tuple[F,
     return goal + (x + k * dt) * decay, (rate - omega * k * dt) * decay
 
 
-def wanted_velocity(error: F, lead: F, tuning: PuppetTuning) -> F:
+def wanted_velocity(error: F, lead: F, tuning: PuppetTuning, lead_band: float = 0.02) -> F:
     """The ground velocity the puppet should have: the stick's, plus a catch-up on ``error``.
 
     The catch-up gain fades in as ``d² / (d² + deadband²)`` of the distance ``d``, so a
     puppet standing at its stick does not creep toward every tremor of the hand, and
     nothing switches at a radius; the stick's velocity counts in full once the stick leads
-    the puppet by a dead band along it, and not at all once the puppet has caught up. The result is capped at ``tuning.top_speed``.
+    the puppet by ``lead_band`` along it, and not at all once the puppet has caught up. The result is capped at ``tuning.top_speed``.
     """
     d2 = float(error @ error)
     band2 = tuning.follow_deadband**2
     pace = float(np.linalg.norm(lead))
     # The feed-forward needs the stick to be ahead of the puppet along the lead: it fades in over
-    # the dead band and is gone once the puppet has caught up. A puppet never strides past a
+    # the first ``lead_band`` metres and is gone once the puppet has caught up. A puppet never strides past a
     # hand that stopped (its filtered velocity still trails), and a hand that jerks the stick
     # out and back (a wheel notch's slide, a twitch) does not drag a standing puppet about.
     behind = float(error @ lead) / pace if pace > 1e-9 else 0.0
-    gate = float(np.clip(behind / tuning.follow_deadband, 0.0, 1.0))
+    gate = float(np.clip(behind / lead_band, 0.0, 1.0))
     wanted = gate * lead + tuning.catch_up_gain * (d2 / (d2 + band2) if d2 > 0.0 else 0.0) * error
     speed = float(np.linalg.norm(wanted))
     return wanted * (tuning.top_speed / speed) if speed > tuning.top_speed else wanted
@@ -84,15 +84,18 @@ def _wrap(angle: float) -> float:
 
 
 def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer,
-                    speed_scale: float = 1.0) -> None:
-    """Steer toward the stick: smooth the wanted velocity, turn toward it, request its speed."""
+                    speed_scale: float = 1.0, lead_band: float = 0.02) -> None:
+    """Steer toward the stick: smooth the wanted velocity, turn toward it, request its speed.
+
+    ``lead_band`` (m): how far the stick must lead before its velocity counts in full (see
+    :func:`wanted_velocity`); a crouched puppet asks for more, as its stick is being lowered."""
     tr = world.get(entity, Transform)
     t = body.tuning
     if body.held_by is None:
         goal = np.zeros(3)
     else:
         error = (body.target - tr.position) * np.array([1.0, 0.0, 1.0])
-        goal = wanted_velocity(error, body.lead * np.array([1.0, 0.0, 1.0]), t)
+        goal = wanted_velocity(error, body.lead * np.array([1.0, 0.0, 1.0]), t, lead_band)
     # Braking is quicker than speeding up (people stop within a step): twice the stiffness.
     braking = float(np.linalg.norm(goal)) < float(np.linalg.norm(body.walk_velocity))
     omega = t.follow_omega * (2.0 if braking else 1.0)

@@ -25,7 +25,8 @@ from engine.statemachine.puppet.follow_legacy import follow_stick_legacy
 __all__ = ["follow_stick", "update_locomotion", "update_crouch", "locomotion_fits", "wants_crouch", "wants_stand", "lifted"]
 
 
-def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0) -> None:
+def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0,
+                 lead_band: float = 0.02) -> None:
     """Steer toward the stick's ground point: set heading and requested speed (the tuning's controller).
 
     The legacy controller comes as it was: without the leg IK's foot locks either."""
@@ -35,7 +36,7 @@ def follow_stick(world: World, entity: Entity, body: PuppetBody, player: Locomot
     if body.tuning.controller == "legacy":
         follow_stick_legacy(world, entity, body, player, speed_scale)
     else:
-        follow_velocity(world, entity, body, player, speed_scale)
+        follow_velocity(world, entity, body, player, speed_scale, lead_band)
 
 
 def lifted(body: PuppetBody) -> bool:
@@ -92,5 +93,7 @@ def update_crouch(world: World, entity: Entity, brain: Brain) -> None:
     player = world.get(entity, LocomotionPlayer)
     t = body.tuning
     player.height = float(np.clip(body.target_height, t.crouch_height, t.crouch_exit))
-    follow_stick(world, entity, body, player)
+    # Crouched, the stick is being lowered notch by notch, and each wheel notch slides the held
+    # point out along the cursor's ray and back: it must lead by the dead band to make a stride.
+    follow_stick(world, entity, body, player, lead_band=t.follow_deadband)
     _ground_ik(world, entity)

@@ -25,7 +25,9 @@ from engine.ragdoll.components import Prop
 from engine.statemachine.machine import Brain
 from engine.statemachine.puppet.body import PuppetBody
 from engine.statemachine.puppet.ground_states import follow_stick, wants_crouch
-from engine.statemachine.puppet.senses import heading_vector, prop_in_front
+from engine.statemachine.puppet.senses import heading_vector, prop_in_front, yaw_rotation
+
+_PICKUP_SPREAD = 0.35  # m to the side a small ball may be for a crouched puppet to turn and pick it up
 
 __all__ = [
     "can_pick_up", "enter_pickup", "update_pickup", "pickup_done",
@@ -53,15 +55,20 @@ def can_pick_up(world: World, entity: Entity, brain: Brain) -> bool:
     t = body.tuning
     if body.held_by is None or brain.time_in_state < t.still_time or body.speed > t.still_speed:
         return False
-    ball = prop_in_front(world, entity, body, t.reach, t.carry_max_radius)
+    ball = prop_in_front(world, entity, body, t.reach, t.carry_max_radius, spread=_PICKUP_SPREAD)
     return ball is not None and ball != brain.memory.get("put_down")
 
 
 def enter_pickup(world: World, entity: Entity, brain: Brain) -> None:
     """Choose the ball and start reaching."""
     body = world.get(entity, PuppetBody)
-    body.object = prop_in_front(world, entity, body, body.tuning.reach, body.tuning.carry_max_radius)
+    body.object = prop_in_front(world, entity, body, body.tuning.reach, body.tuning.carry_max_radius,
+                                spread=_PICKUP_SPREAD)
     body.phase, body.timer = "reach", 0.0
+    if body.object is not None:  # a ball a little to the side: the puppet turns to it as it reaches
+        d = world.get(body.object, Transform).position - world.get(entity, Transform).position
+        body.heading = float(np.arctan2(d[0], d[2]))
+        world.get(entity, Transform).rotation = yaw_rotation(body.heading)
 
 
 def update_pickup(world: World, entity: Entity, brain: Brain) -> None:

@@ -69,8 +69,10 @@ def sense(world: World, entity: Entity, body: PuppetBody) -> Stick | None:
     return stick
 
 
-def prop_in_front(world: World, entity: Entity, body: PuppetBody, reach: float, max_radius: float | None = None) -> Entity | None:
-    """The nearest free prop whose surface is within ``reach`` in front of the puppet."""
+def prop_in_front(world: World, entity: Entity, body: PuppetBody, reach: float, max_radius: float | None = None,
+                  spread: float = 0.25) -> Entity | None:
+    """The nearest free prop whose surface is within ``reach`` in front of the puppet, its centre at most
+    ``spread`` (or its radius) to the side of the heading."""
     tr = world.get(entity, Transform)
     forward = heading_vector(body.heading)
     best, best_d = None, np.inf
@@ -82,6 +84,6 @@ def prop_in_front(world: World, entity: Entity, body: PuppetBody, reach: float, 
         ahead = float(d @ forward)
         side = float(np.linalg.norm(d - ahead * forward))
         gap = float(np.linalg.norm(d)) - prop.radius
-        if ahead > 0.0 and side < max(prop.radius, 0.25) and gap < reach and gap < best_d:
+        if ahead > 0.0 and side < max(prop.radius, spread) and gap < reach and gap < best_d:
             best, best_d = e, gap
     return best
