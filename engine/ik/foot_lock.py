@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["FootLock", "lock_feet", "floor_lift"]
+__all__ = ["FootLock", "lock_feet", "floor_lift", "smoothstep"]
 
 F = NDArray[np.float64]
 
@@ -77,11 +77,17 @@ class FootLock:
     step_height: float = 0.08
     enabled: bool = True
 
+    def settings(self) -> tuple[float, ...]:
+        """The lock's tuning (not its state): puppets that share it are locked in one array pass."""
+        return (self.release_time, self.max_stretch, self.release_height, self.settle_gap, self.max_twist,
+                self.settle_twist, self.step_time, self.step_height)
+
 
 _TOE = 0.15  # m from the ankle to the toe tip: what a turn of the foot moves its end by, per radian
 
 
-def _smooth(w: F) -> F:
+def smoothstep(w: F) -> F:
+    """``3w² − 2w³``: eases a weight in ``[0, 1]`` in and out with zero slope at both ends."""
     return w * w * (3.0 - 2.0 * w)
 
 
@@ -116,7 +122,7 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArr
     down = contacts > 0.5
     # A step ends when the foot has arrived, or when the puppet sets off again (it plants where it is).
     stepping = stepping & (weights > 0.0) & settle[:, None]
-    shown = toes + _smooth(weights)[..., None] * (points - toes)
+    shown = toes + smoothstep(weights)[..., None] * (points - toes)
     shown[..., 1] = toes[..., 1]
     start = down & ~planted & ~stepping
     # A lock taken while an old one still fades starts where the foot is shown: no pop.
@@ -138,7 +144,7 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArr
     rate = np.where(stepping, dt / lock.step_time, dt / lock.release_time)
     weights = np.where(fading, np.maximum(weights - rate, 0.0), weights)
     progress = 1.0 - weights
-    along = np.where(stepping, 1.0 - _smooth(np.clip((progress - 0.25) / 0.5, 0.0, 1.0)), _smooth(weights))
+    along = np.where(stepping, 1.0 - smoothstep(np.clip((progress - 0.25) / 0.5, 0.0, 1.0)), smoothstep(weights))
     targets = toes + along[..., None] * (points - toes)
     lift = np.where(stepping, np.sin(np.pi * progress) * np.minimum(0.5 * gap + 0.04, lock.step_height),
                     np.where(fading, 4.0 * weights * (1.0 - weights) * np.minimum(0.5 * gap, lock.step_height), 0.0))

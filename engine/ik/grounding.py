@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.ik._limb import solve_limb
-from engine.ik.foot_lock import FootLock, floor_lift, lock_feet
+from engine.ik.foot_lock import FootLock, floor_lift, lock_feet, smoothstep
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
 from engine.ik._vec import path_fk
 from engine.pose import Pose
@@ -123,34 +123,49 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
     toes[..., 1] += lift
     if locks is None:
         return targets
+    groups: dict[tuple[float, ...], list[int]] = {}
     for p, lock in enumerate(locks):
-        if lock is None or lock.contacts is None or not lock.enabled:
-            continue
-        count = len(legs)
-        if lock.weights.shape != (count,) or lock.stepping.shape != (count,) or lock.animated.shape != (count, 3):
-            lock.points, lock.weights, lock.animated = np.zeros((count, 3)), np.zeros(count), toes[p].copy()
-            lock.planted, lock.stepping = np.zeros(count, dtype=bool), np.zeros(count, dtype=bool)
-        # A planted foot keeps the heading it landed with while the body turns above it
-        # (a foot that turned with the hips would sweep its toe or heel over the ground).
-        fwd = quat.rotate(new_rot[p], np.array([0.0, 0.0, 1.0]))
-        yaw = np.arctan2(fwd[:, 0], fwd[:, 2])
-        lock.yaw = np.where(lock.weights > 0.0, lock.yaw, yaw) if lock.yaw.shape == (count,) else yaw
-        twist = (lock.yaw - yaw + np.pi) % (2 * np.pi) - np.pi
-        new_rot[p] = quat.mul(quat.from_axis_angle(np.array(_UP), twist * _smooth_weight(lock.weights)), new_rot[p])
-        toes[p] = targets[p] + quat.rotate(new_rot[p], tips)
-        contacts = np.broadcast_to(np.asarray(lock.contacts, dtype=np.float64), (count,))
-        still = np.linalg.norm((toes[p] - lock.animated)[:, [0, 2]], axis=-1) <= _STILL * max(dt, 1e-9)
-        lock.animated = toes[p].copy()
-        state = lock_feet(lock.points[None], lock.weights[None], lock.planted[None], lock.stepping[None],
-                          toes[p][None], contacts[None], (toes[p, :, 1] - floor[p, :, 1])[None],
-                          np.abs(twist)[None], np.array([lock.settle]), still[None], dt, lock)
-        lock.points, lock.weights, lock.planted, lock.stepping = (a[0] for a in state[:4])
-        targets[p] += state[4][0] - toes[p]
+        if lock is not None and lock.contacts is not None and lock.enabled:
+            _fit_lock(lock, toes[p])
+            groups.setdefault(lock.settings(), []).append(p)
+    for members in groups.values():  # puppets whose locks share settings: one array pass
+        _lock_group(np.array(members), [locks[p] for p in members], targets, new_rot, toes, floor, tips, dt)
     return targets
 
 
-def _smooth_weight(w: F) -> F:
-    return w * w * (3.0 - 2.0 * w)
+def _fit_lock(lock: FootLock, toes: F) -> None:
+    """Give a fresh (or resized) lock its per-leg arrays, nothing held."""
+    count = len(toes)
+    if lock.weights.shape != (count,) or lock.stepping.shape != (count,) or lock.animated.shape != (count, 3):
+        lock.points, lock.weights, lock.animated = np.zeros((count, 3)), np.zeros(count), toes.copy()
+        lock.planted, lock.stepping = np.zeros(count, dtype=bool), np.zeros(count, dtype=bool)
+    if lock.yaw.shape != (count,):
+        lock.yaw = np.full(count, np.nan)
+
+
+def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, toes: F, floor: F, tips: F,
+                dt: float) -> None:
+    """Lock the feet of puppets ``idx`` (their ``group`` of locks, one setting) in place, as arrays ``[G, L]``."""
+    weights = np.stack([g.weights for g in group])
+    # A planted foot keeps the heading it landed with while the body turns above it
+    # (a foot that turned with the hips would sweep its toe or heel over the ground).
+    fwd = quat.rotate(new_rot[idx], np.array([0.0, 0.0, 1.0]))
+    yaw = np.arctan2(fwd[..., 0], fwd[..., 2])
+    held_yaw = np.where(weights > 0.0, np.stack([g.yaw for g in group]), yaw)
+    twist = (held_yaw - yaw + np.pi) % (2 * np.pi) - np.pi
+    new_rot[idx] = quat.mul(quat.from_axis_angle(np.array(_UP), twist * smoothstep(weights)), new_rot[idx])
+    toe = targets[idx] + quat.rotate(new_rot[idx], tips)
+    animated = np.stack([g.animated for g in group])
+    still = np.linalg.norm((toe - animated)[..., [0, 2]], axis=-1) <= _STILL * max(dt, 1e-9)
+    contacts = np.stack([np.broadcast_to(np.asarray(g.contacts, dtype=np.float64), (tips.shape[0],)) for g in group])
+    points, weights, planted, stepping, placed = lock_feet(
+        np.stack([g.points for g in group]), weights, np.stack([g.planted for g in group]),
+        np.stack([g.stepping for g in group]), toe, contacts, toe[..., 1] - floor[idx, :, 1], np.abs(twist),
+        np.array([g.settle for g in group]), still, dt, group[0])
+    for k, g in enumerate(group):
+        g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
+        g.yaw, g.animated = held_yaw[k], toe[k].copy()
+    targets[idx] += placed - toe
 
 
 def _reach_shift(hips: F, targets: F, lengths: F, shift: F, max_pelvis_shift: float) -> F:
