@@ -196,16 +196,15 @@ class _Driver:
         px = self.camera.project(np.asarray(point, dtype=np.float64)[None], *self.size)[0]
         return float(px[0]), float(px[1] - self.lift)
 
-    def step(self, path: Callable[[float], F] | None = None) -> None:
-        """One 60 Hz step; the device reports ``path(t)`` (the stick's wanted ground offset at ``t`` s
-        since the drag began) at its own rate, each reading where the hand is at its event time."""
+    def step(self, hand: Callable[[float], tuple[F, float]] | None = None) -> None:
+        """One 60 Hz step; the device reports ``hand(t) -> (ground, lift)`` (the stick's wanted ground
+        offset and the hand's lift, ``t`` s since the drag began) at its own rate, each reading where
+        the hand is at its event time."""
         dt = self.world.dt
         n = int(round(RATE * dt))
-        for k in range(1, n + 1):
+        for k in range(1, n + 1) if hand is not None else ():
+            ground, self.lift = hand(self.clock + dt * k / n)
             t = self.time + dt * k / n
-            if path is None:
-                continue
-            ground = path(self.clock + dt * k / n)
             if self.device == "phone":
                 self.offset = self.offset0 + np.array([ground[0], 0.0, ground[1]])
                 self._phone_sample(t)
@@ -258,7 +257,7 @@ class _Driver:
             raise RuntimeError(f"the {self.device} did not grab the puppet")
         self.height, self.tip0 = float(stick.tip[1]), stick.tip.copy()
         for _ in range(15):
-            self.step(lambda t: np.zeros(2))
+            self.step(lambda t: (np.zeros(2), 0.0))
         self._rows.clear()
         self.airborne.clear()
         self.clock = 0.0
@@ -276,7 +275,7 @@ def drive(case: Case, device: str = "phone", controller: str = "spring", settle:
     d = _Driver(device, controller)
     d.grab()
     for _ in range(int(round((case.moving + settle) / d.world.dt))):
-        d.step(case.path)
+        d.step(lambda t: (case.path(t), 0.0))
     return d.result()
 
 
@@ -391,23 +390,13 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
     gesture = gesture or default
     dt = d.world.dt
     start = int(round(run_up / dt))
-    total = start + int(round(after / dt))
-    n = int(round(RATE * dt))
-    for k in range(1, total + 1):
-        for j in range(1, n + 1):
-            t = (k - 1 + j / n) * dt
-            ground = _WAY * speed * t
-            if t > run_up:
-                ground, d.lift = gesture(t - run_up, ground)
-            sample_t = d.time + dt * j / n
-            if device == "phone":
-                d.offset = d.offset0 + np.array([ground[0], 0.0, ground[1]])
-                d._phone_sample(sample_t)
-            else:
-                px = d._pixel(np.array([d.tip0[0] + ground[0], d.height, d.tip0[2] + ground[1]]))
-                d._mouse_event(pygame.MOUSEMOTION, sample_t, pos=px, rel=(0, 0), buttons=(1, 0, 0))
-        d.time += dt
-        d._advance()
+
+    def hand(t: float) -> tuple[F, float]:
+        ground = _WAY * speed * t
+        return gesture(t - run_up, ground) if t > run_up else (ground, 0.0)
+
+    for _ in range(start + int(round(after / dt))):
+        d.step(hand)
     run = d.result()
     states = run.states
     fell = "Ragdoll" in states
