@@ -40,6 +40,7 @@ from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
+from engine.render.skinned import SKIN_FS, SKIN_VS, SkinnedDraw
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
 from engine.render.text import TextCache, layout_text
 
@@ -98,7 +99,9 @@ class Renderer:
             "point": ctx.program(vertex_shader=h + S.POINT_VS, fragment_shader=h + S.POINT_FS),
             "text": ctx.program(vertex_shader=h + S.TEXT_VS, fragment_shader=h + S.TEXT_FS),
             "overlay": ctx.program(vertex_shader=h + S.OVERLAY_VS, fragment_shader=lit + S.OVERLAY_FS),
+            "skinned": ctx.program(vertex_shader=h + SKIN_VS, fragment_shader=lit + SKIN_FS),
         }
+        self.skinned = SkinnedDraw(ctx, p["skinned"])
         strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
                    "lines": LINE_STRIDE, "points": POINT_STRIDE}
         # Capsules and spheres have one buffer per level of detail (self._lod, below).
@@ -202,6 +205,8 @@ class Renderer:
             batches.render()
         if counts["boxes"]:
             self._vaos["boxes"].render(moderngl.TRIANGLES, instances=counts["boxes"])
+        if scene.skinned:
+            self.skinned.draw(scene.skinned)
         self._mark("objects")
         ctx.enable_only(moderngl.DEPTH_TEST)
         photo = "_photo" if scene.background is not None and scene.background_fade < 1.0 else ""
@@ -336,6 +341,7 @@ class Renderer:
         """Free every GPU object this renderer made."""
         self.text.release()
         self.shadows.release()
+        self.skinned.release()
         for batches in self._lod.values():
             batches.release()
         for v in self._vaos.values():

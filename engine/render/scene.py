@@ -20,9 +20,13 @@ Colours are sRGB in ``[0, 1]``; the renderer linearises them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:  # the scene stays free of GL: only the renderer imports moderngl
+    from engine.render.skinned import SkinnedInstance
 
 __all__ = ["RenderScene", "Rows", "Ground", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE", "BOX_STRIDE",
            "LINE_STRIDE", "POINT_STRIDE"]
@@ -169,6 +173,8 @@ class RenderScene:
     """0 shows only the photo behind objects, 1 only the sky and ground; between blends them."""
     overlays: list[Overlay] = field(default_factory=list)
     """Pictures over the 3-D view, in order (see :class:`Overlay`); the text overlay stays on top."""
+    skinned: list[SkinnedInstance] = field(default_factory=list)
+    """Skinned characters (glTF skins) in their poses, drawn lit beside the solids."""
 
     def clear(self) -> None:
         """Empty every primitive buffer (settings and background stay)."""
@@ -176,6 +182,7 @@ class RenderScene:
             rows.clear()
         self.texts.clear()
         self.overlays.clear()
+        self.skinned.clear()
 
     # -- builders ---------------------------------------------------------------------
     def add_capsules(self, a: ArrayLike, b: ArrayLike, radius: ArrayLike,
