@@ -31,7 +31,8 @@ from authoring.screen_pick import pick_point, point_on_view_plane
 from engine.camera import OrbitCamera
 from engine.fk import forward_kinematics
 from engine.render.extract import puppet_capsules
-from engine.render.scene import RenderScene
+from engine.render.scene import RenderScene, SkinnedInstance
+from engine.skinning import SkinBinding
 
 __all__ = ["EditScene", "MODES"]
 
@@ -65,8 +66,11 @@ class EditScene:
     """
 
     def __init__(self, session: EditSession, size: tuple[int, int] = (1280, 720),
-                 contact_items: tuple[str, ...] = ("l_foot", "r_foot")) -> None:  # fmt: skip
+                 contact_items: tuple[str, ...] = ("l_foot", "r_foot"),
+                 character: SkinBinding | None = None) -> None:  # fmt: skip
         self.session = session
+        self.character = character
+        """The file's own skinned character, drawn in place of the mannequin when the clip came with one."""
         self.size = size
         names = session.clip.skeleton.names
         self.items = tuple(n for j, n in enumerate(names) if j == 0 or item_chain(session.clip.skeleton, j))
@@ -97,8 +101,11 @@ class EditScene:
         scene.ground.grid_spacing = 0.25
         pose = clip.sample(self.time)
         pos, rot = forward_kinematics(clip.skeleton, pose.root, pose.rotations, pose.offsets, pose.scales)
-        a, b, r, _ = puppet_capsules(clip.skeleton, pos, rot)
-        scene.add_capsules(a, b, r, color=(0.86, 0.86, 0.9))
+        if self.character is not None:
+            scene.skinned.append(SkinnedInstance(self.character.meshes, self.character.matrices(pos, rot)))
+        else:
+            a, b, r, _ = puppet_capsules(clip.skeleton, pos, rot)
+            scene.add_capsules(a, b, r, color=(0.86, 0.86, 0.9))
         for name in self.items:
             if name != self.item:
                 scene.add_polyline(curves[name].positions, FAINT, 1.5, closed=True)

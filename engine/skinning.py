@@ -11,15 +11,19 @@ metres, Y up, whatever units or up axis the file had) says joint ``j`` stands at
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
 from engine.io.gltf import GltfAnimation, GltfAsset
 from engine.io.gltf_clip import sample_channel
+from engine.io.gltf_mesh import SkinnedMeshes
+from engine.skeleton import Skeleton
 
 __all__ = ["trs_matrices", "node_world_matrices", "skin_matrices", "blend_skin", "rigid_matrices",
-           "fit_similarity", "bind_from_engine"]
+           "fit_similarity", "bind_from_engine", "SkinBinding"]
 
 F64 = NDArray[np.float64]
 
@@ -128,3 +132,86 @@ def bind_from_engine(asset: GltfAsset, engine_rest: F64, joint_nodes: list[int],
         first[:3, :3] /= np.linalg.norm(first[:3, :3], axis=0)
         c = engine_rest[0] @ np.linalg.inv(first)
     return np.linalg.inv(engine_rest) @ c @ g[joints] @ sk.inverse_bind
+
+
+@dataclass(frozen=True)
+class SkinBinding:
+    """A glTF skin driven by an engine skeleton made from the same file (matched by joint name).
+
+    ``matrices(positions, rotations)`` turns the engine's FK output (world positions and
+    rotations of its joints) into the skin's joint matrices. It rests on one property of
+    the importers: an engine joint's world frame is the file's node frame turned by one
+    rotation for the whole figure (the up axis), placed by one move, with lengths in one
+    unit — so only the unit ``s`` and each node's own world scale stay between them:
+    ``M[j] = E[j] · diag(s·S[j]) · IBM[j]`` (``S[j]`` the node's rest world scale). A skin
+    joint the engine folded away (a static root) follows the nearest joint that stayed,
+    rigidly, as it hangs from it in the file.
+    """
+
+    meshes: SkinnedMeshes
+    drivers: NDArray[np.int64]
+    offsets: F64
+
+    @classmethod
+    def bind(cls, asset: GltfAsset, meshes: SkinnedMeshes, skeleton: Skeleton) -> SkinBinding:
+        """Match ``asset``'s skin to ``skeleton`` by joint names; ``ValueError`` naming what is missing."""
+        skin = asset.skins[meshes.skin]
+        nodes = list(skin.joints)
+        index = {name: k for k, name in enumerate(skeleton.names)}
+        engine = {n: index[asset.names[n]] for n in nodes if asset.names[n] in index}
+        used = {nodes[int(j)] for p in meshes.primitives for j in np.unique(p.joints[p.weights > 0.0])}
+        if 2 * len(used & set(engine)) < len(used):
+            missing = sorted(asset.names[n] for n in used - set(engine))
+            raise ValueError(f"the skeleton shares too few joints with the skin to drive it (missing: "
+                             f"{', '.join(missing[:6])}{'…' if len(missing) > 6 else ''})")
+        world = node_world_matrices(asset)
+        rigid = world.copy()
+        rigid[:, :3, :3] /= np.linalg.norm(world[:, :3, :3], axis=1, keepdims=True)
+        unit = _unit(asset, skeleton, engine, world)
+        drivers = np.empty(len(nodes), dtype=np.int64)
+        offsets = np.empty((len(nodes), 4, 4))
+        for row, node in enumerate(nodes):
+            anchor = node if node in engine else _nearest(asset, node, set(engine))
+            own = np.linalg.inv(rigid[node]) @ world[node]  # the node's world scale, [S 0; 0 1]
+            own[:3, :3] *= unit
+            hang = np.linalg.inv(rigid[anchor]) @ rigid[node]
+            hang[:3, 3] *= unit
+            drivers[row] = engine[anchor]
+            offsets[row] = hang @ own @ skin.inverse_bind[row]
+        return cls(meshes, drivers, offsets)
+
+    def matrices(self, positions: F64, rotations: F64) -> F64:
+        """Skin joint matrices ``[K,4,4]`` for engine world ``positions [J,3]`` and ``rotations [J,4]``."""
+        return rigid_matrices(positions[self.drivers], rotations[self.drivers]) @ self.offsets
+
+
+def _unit(asset: GltfAsset, skeleton: Skeleton, engine: dict[int, int], world: F64) -> float:
+    """Engine length per file length: the median ratio of the bones both hold."""
+    ratios = []
+    node_of = {k: n for n, k in engine.items()}
+    for k, parent in enumerate(skeleton.parents):
+        if parent < 0 or k not in node_of or int(parent) not in node_of:
+            continue
+        in_file = float(np.linalg.norm(world[node_of[k], :3, 3] - world[node_of[int(parent)], :3, 3]))
+        if in_file > 1e-9:
+            ratios.append(float(np.linalg.norm(skeleton.offsets[k])) / in_file)
+    if not ratios:
+        raise ValueError("the skeleton and the skin share no bone to measure the unit by")
+    return float(np.median(ratios))
+
+
+def _nearest(asset: GltfAsset, node: int, kept: set[int]) -> int:
+    """The closest node in ``kept`` up the parent chain, else the first found below ``node``."""
+    n = int(asset.parents[node])
+    while n >= 0:
+        if n in kept:
+            return n
+        n = int(asset.parents[n])
+    frontier = [node]
+    while frontier:
+        children = [c for c in range(asset.num_nodes) if int(asset.parents[c]) in frontier]
+        for c in children:
+            if c in kept:
+                return c
+        frontier = children
+    raise ValueError(f"skin joint {asset.names[node]!r} has no driven joint above or below it")

@@ -27,6 +27,7 @@ __all__ = ["configure_edit", "run_edit", "build_edit", "replay_edit", "edit_dige
 
 #: The name an edit session's recording gives as its game.
 EDIT_GAME = "author-edit"
+MAX_CHARACTER = 8 << 20  # bytes of a GLB a recording carries (its header holds at most 16 MB)
 
 
 def configure_edit(parser: argparse.ArgumentParser) -> None:
@@ -64,7 +65,46 @@ def _motion_setup(path: Path, size: tuple[int, int], options: dict[str, object] 
     with tempfile.TemporaryDirectory() as tmp:
         data = save_clip(clip, Path(tmp) / "clip.ppclip").read_bytes()
     return {"clip": str(path), "size": list(size), "name": path.stem + ".ppclip",
-            "ppclip": base64.b64encode(data).decode(), "side": ""}
+            "ppclip": base64.b64encode(data).decode(), "side": "", "character": _character_setup(path)}
+
+
+def _character_setup(path: Path) -> str:
+    """A GLB's bytes (base64) when it holds a skinned mesh to draw, so a replay draws it too; else ``""``."""
+    from engine.io.gltf import GltfError
+    from engine.io.gltf_mesh import read_skinned_meshes
+
+    if path.suffix.lower() != ".glb":
+        return ""
+    try:
+        meshes = read_skinned_meshes(path)
+    except GltfError:
+        return ""  # no skin or no mesh: the motion alone, drawn as the mannequin
+    if meshes.ignored:
+        print(f"{path.name}: not drawn: {', '.join(meshes.ignored)}", file=sys.stderr)
+    size = path.stat().st_size
+    if size > MAX_CHARACTER:
+        print(f"{path.name}: the character ({size >> 20} MB) is over the {MAX_CHARACTER >> 20} MB a recording "
+              f"carries: drawn live, a replay draws the mannequin", file=sys.stderr)
+        return ""
+    return base64.b64encode(path.read_bytes()).decode()
+
+
+def _character(setup: dict[str, object], skeleton):  # type: ignore[no-untyped-def]
+    """The skinned character of the set-up bound to the loop's skeleton, or None (said in one line)."""
+    from engine.io.gltf import GltfError, read_gltf
+    from engine.io.gltf_mesh import read_skinned_meshes
+    from engine.skinning import SkinBinding
+
+    if not setup.get("character"):
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "character.glb"
+        path.write_bytes(base64.b64decode(str(setup["character"])))
+        try:
+            return SkinBinding.bind(read_gltf(path), read_skinned_meshes(path), skeleton)
+        except (GltfError, ValueError) as exc:
+            print(f"the character is drawn as the mannequin: {str(exc).replace(str(path), 'the file')}", file=sys.stderr)
+            return None
 
 
 def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[no-untyped-def]
@@ -117,9 +157,11 @@ def _check_setup(setup: object) -> dict[str, object]:
     if not (isinstance(size, list) and len(size) == 2
             and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)):
         raise ValueError("the recorded window size is not two whole numbers in 0..16384")
-    for key in ("clip", "name", "ppclip", "side"):
+    for key in ("clip", "name", "ppclip", "side", "character"):
         if not isinstance(setup.get(key, ""), str):
             raise ValueError(f"the recorded {key} is not text")
+    if len(str(setup.get("character", ""))) > (MAX_CHARACTER * 4) // 3 + 4:
+        raise ValueError(f"the recorded character is over {MAX_CHARACTER >> 20} MB")
     if not setup.get("ppclip") and setup.get("clip") not in default_clips():
         raise ValueError(f"the recording names the clip {str(setup.get('clip'))[:80]!r} without carrying it; "
                          f"a replay opens only a clip the recording holds or a default clip")
@@ -294,7 +336,8 @@ def build_edit(spec: str, size: tuple[int, int], output: Path | None, *, record:
     if record is not None:
         recorder = Recorder(record, RecordingHeader(game=EDIT_GAME, seed=0, dt=EditActivity.dt, sources=["mouse"],
                                                     setup=setup))
-    return EditActivity(EditScene(session, size), session, output or default_out, InputHub(), recorder=recorder)
+    scene = EditScene(session, size, character=_character(setup, session.clip.skeleton))
+    return EditActivity(scene, session, output or default_out, InputHub(), recorder=recorder)
 
 
 def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
@@ -305,7 +348,7 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
 
     setup = _check_setup(recording.header.setup)
     session = _reopen(setup)
-    edit = EditScene(session, tuple(setup.get("size", (1280, 720))))
+    edit = EditScene(session, tuple(setup.get("size", (1280, 720))), character=_character(setup, session.clip.skeleton))
     return EditActivity(edit, session, None, InputHub(replay=ReplaySource(recording)),
                         check=HashCheck(recording) if verify else None)
 

@@ -20,15 +20,13 @@ Colours are sRGB in ``[0, 1]``; the renderer linearises them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-if TYPE_CHECKING:  # the scene stays free of GL: only the renderer imports moderngl
-    from engine.render.skinned import SkinnedInstance
+from engine.io.gltf_mesh import SkinnedMeshes
 
-__all__ = ["RenderScene", "Rows", "Ground", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE", "BOX_STRIDE",
+__all__ = ["RenderScene", "SkinnedInstance", "Rows", "Ground", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE", "BOX_STRIDE",
            "LINE_STRIDE", "POINT_STRIDE"]
 
 CAPSULE_STRIDE = 11
@@ -148,6 +146,14 @@ class Overlay:
     depth_at: tuple[float, float, float] | None = None
     photo: bool = False
     alpha: float = 1.0
+
+
+@dataclass(frozen=True)
+class SkinnedInstance:
+    """One skinned character to draw: its meshes and ``[K,4,4]`` skinning matrices (world from bind space)."""
+
+    meshes: SkinnedMeshes
+    matrices: NDArray[np.float64]
 
 
 @dataclass

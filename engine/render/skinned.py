@@ -15,8 +15,6 @@ the shader computed and compare it with the CPU reference, :func:`engine.skinnin
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import moderngl
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +22,7 @@ from numpy.typing import NDArray
 from engine.io.gltf_mesh import SkinnedMeshes, SkinnedPrimitive
 from engine.render import shaders as S
 from engine.render.gpu import set_uniform
+from engine.render.scene import SkinnedInstance
 
 __all__ = ["SkinnedInstance", "SkinnedDraw", "SKIN_VS", "SKIN_FS"]
 
@@ -80,14 +79,6 @@ void main() {
 
 _VERTEX_FMT = ("3f 3f 2f 4u2 4f", "in_pos", "in_normal", "in_uv", "in_joints", "in_weights")
 _JOINT_TEX_UNIT, _BASE_TEX_UNIT = 5, 6
-
-
-@dataclass(frozen=True)
-class SkinnedInstance:
-    """One character to draw: its meshes and ``[K,4,4]`` skinning matrices (world from bind space)."""
-
-    meshes: SkinnedMeshes
-    matrices: NDArray[np.float64]
 
 
 def _vertices(p: SkinnedPrimitive) -> bytes:

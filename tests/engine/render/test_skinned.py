@@ -18,7 +18,7 @@ from engine.io.gltf_clip import sample_channel
 from engine.io.gltf_mesh import read_skinned_meshes
 from engine.render import RenderScene
 from engine.render.headless import egl_available
-from engine.render.skinned import SkinnedInstance
+from engine.render.scene import SkinnedInstance
 from engine.skinning import node_world_matrices, skin_matrices
 
 W, H = 240, 320
