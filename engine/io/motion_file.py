@@ -270,7 +270,7 @@ def load_joint_map(path: str | Path) -> dict[str, str]:
 def to_puppet(clip: Clip, joint_map: dict[str, str] | None = None, map_name: str | None = None) -> tuple[Clip, str]:
     """``clip`` retargeted onto the puppet, and the name of the map used (a family, or ``map_name``)."""
     from engine.humanoid import humanoid_skeleton
-    from engine.io.joint_maps import guess_joint_map
+    from engine.io.joint_shape import guess_clip_joint_map
     from engine.io.retarget import retarget
 
     names = clip.skeleton.names
@@ -280,7 +280,7 @@ def to_puppet(clip: Clip, joint_map: dict[str, str] | None = None, map_name: str
             raise MotionFileError(f"joint map names source joints the file does not have: {missing[:8]}")
         return retarget(clip, humanoid_skeleton(), joint_map=joint_map, aims={}), map_name or "given"
     try:
-        family, mapping, aims = guess_joint_map(names)
+        family, mapping, aims = guess_clip_joint_map(clip)
     except ValueError as exc:
         raise MotionFileError(f"{exc}; give one with --joint-map FILE") from None
     return retarget(clip, humanoid_skeleton(), joint_map=mapping, aims=aims), family

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from engine import quat
 from engine.clip import Clip
 from engine.fk import forward_kinematics
-from engine.io.joint_maps import guess_joint_map
+from engine.io.joint_shape import guess_clip_joint_map
 from engine.skeleton import Skeleton
 
 __all__ = ["retarget", "leg_length", "RetargetWarning", "LARGE_TRANSLATION"]
@@ -162,7 +162,8 @@ def retarget(
             baked into its root first, so the retargeted clip travels in its root track.
         target: the skeleton to drive, e.g. ``engine.humanoid.humanoid_skeleton()``.
         joint_map: target joint name → source joint name; guessed from the source names
-            (:func:`~engine.io.joint_maps.guess_joint_map`) when ``None``.
+            (:func:`~engine.io.joint_maps.guess_joint_map`) when ``None``, or, for names of no
+            known family, from the figure's shape (:func:`~engine.io.joint_shape.guess_clip_joint_map`).
         aims: target leaf joint → source joint its bone points at (see ``joint_maps.AIMS``).
         root_scale: factor on the root's travel; default: target / source leg length.
         name: the new clip's name (default: the source's).
@@ -173,7 +174,7 @@ def retarget(
     clip = clip.baked_root_motion()  # the source's world travel is what the puppet's root follows
     src = clip.skeleton
     if joint_map is None:
-        _, joint_map, guessed_aims = guess_joint_map(src.names)
+        _, joint_map, guessed_aims = guess_clip_joint_map(clip)
         aims = guessed_aims if aims is None else aims
     aims = aims or {}
     tmap = {target.index(t): src.index(s) for t, s in joint_map.items()}
