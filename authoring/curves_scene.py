@@ -13,7 +13,16 @@ contacts (purple). Gestures, in pixels, like ``author edit``:
 - arrows: turn the selected joint at the current frame (left/right about the vertical,
   up/down about the view's side axis), one undo step each;
 - P / C: pin / contact the selected joint over the frames ±7 around the current one
-  (again to remove); Tab/Shift+Tab: joint; , and .: frame; Ctrl+Z/Ctrl+Y: undo/redo.
+  (again to remove); Shift+P: pin it over the whole clip; Tab/Shift+Tab: joint; , and .:
+  frame; [ and ]: previous / next key; Ctrl+Z/Ctrl+Y: undo/redo.
+
+Key poses (thesis §4.2.5, §4.3.1), on the timeline strip along the bottom
+(:mod:`authoring.curves_timeline`): a click there picks the frame, a drag of a key's diamond
+moves the key; K adds a key at the current frame (the motion does not change), Delete or X
+removes the key there. At a key's frame, dragging a joint of the puppet (or the key's dot
+on the trajectory) poses the key with the static IK: joints held at that frame stay put,
+the rig's limits and stiffness apply, and a target out of reach keeps the closest pose with
+its residual shown (§4.4).
 
 It is independent of pygame: ``puppetphone author curves`` feeds it pixels and key
 names, and the tests do the same.
@@ -26,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from authoring.curves_timeline import Timeline
 from authoring.keyframe_curves.session import CurveSession
 from authoring.screen_pick import pick_point, point_on_view_plane
 from engine import quat
@@ -40,16 +50,38 @@ F = NDArray[np.float64]
 ORANGE = (0.95, 0.55, 0.1)
 RED = (0.9, 0.1, 0.1)
 PURPLE = (0.6, 0.15, 0.85)
+JOINT_RGB = (0.1, 0.55, 0.95)
 HOLD_HALF = 7
 TURN = 0.1  # radians per arrow press
 
 
 @dataclass
 class _Gesture:
-    kind: str  # "drag" or "retime"
+    kind: str  # "drag", "retime", "pose" (a key's joint), "key" (a key along the timeline) or "scrub"
     frame: int
     anchor: F
     start_px: tuple[float, float]
+    key: int = -1
+    moved: bool = False
+
+
+def framing_camera(points: F, size: tuple[int, int], yaw: float = 1.1, pitch: float = 0.15) -> OrbitCamera:
+    """A camera that shows every point of ``points [N,3]`` with a margin, below the panel and above the timeline.
+
+    The vertical field of view (the camera's) and the window's aspect bound the distance; the
+    target sits a little above the points' centre because the panel takes the window's top.
+    """
+    cam = OrbitCamera(target=np.zeros(3), yaw=yaw, pitch=pitch, distance=1.0)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    centre = 0.5 * (lo + hi)
+    radius = max(float(np.linalg.norm(hi - lo)) * 0.5, 0.3)
+    half_v = np.radians(cam.fov_y) * 0.5
+    aspect = size[0] / max(size[1], 1)
+    half = min(half_v, float(np.arctan(np.tan(half_v) * aspect)))
+    usable = 0.72  # of the half-height: the panel's three lines and the timeline take the rest
+    cam.distance = radius / np.sin(half * usable)
+    cam.target = centre + np.array([0.0, 0.08 * radius, 0.0])
+    return cam
 
 
 class CurvesScene:
@@ -61,9 +93,43 @@ class CurvesScene:
         names = session.clip.skeleton.names
         self.joint = joint if joint in names else names[-1]
         self.frame = 0
-        self.camera = OrbitCamera(target=np.array([0.0, 0.8, 0.0]), yaw=1.1, pitch=0.15, distance=2.4)
         self.gesture: _Gesture | None = None
         self.message = ""
+        self.camera = framing_camera(self._all_joint_positions(), size)
+
+    def _all_joint_positions(self) -> F:
+        """``[N,3]`` the puppet's surface extremes over the clip (capsule ends ± radius): what the framing must show."""
+        clip = self.session.clip
+        roots, rots = clip.pose_arrays(clip.coordinates(self.frame_times()))
+        out = []
+        for f in range(0, len(roots), max(1, len(roots) // 24)):
+            pos, wrot = forward_kinematics(clip.skeleton, roots[f], rots[f])
+            a, b, r, _ = puppet_capsules(clip.skeleton, pos, wrot)
+            for end in (a, b):
+                out.append(end + r[:, None] * np.array([0.0, 1.0, 0.0]))
+                out.append(end - r[:, None] * np.array([0.0, 1.0, 0.0]))
+        return np.vstack(out)
+
+    def timeline(self) -> Timeline:
+        """The key strip's layout in the current window."""
+        return Timeline(self.size, self.session.clip.num_frames)
+
+    def key_index(self, frame: int | None = None) -> int | None:
+        """Index of the key at ``frame`` (default the current one), or None between keys."""
+        frames = self.session.key_frames()
+        f = self.frame if frame is None else frame
+        n = self.session.clip.num_frames
+        for k, kf in enumerate(frames):
+            if kf == f or (self.session.clip.loop and kf == n and f == 0):
+                return k
+        return None
+
+    def joint_positions(self) -> F:
+        """``[J,3]`` the puppet's joints at the current frame."""
+        clip = self.session.clip
+        root, rot = clip.pose_arrays(clip.coordinates([self.frame_times()[self.frame]]))
+        pos, _ = forward_kinematics(clip.skeleton, root[0], rot[0])
+        return np.asarray(pos)
 
     # -- geometry ---------------------------------------------------------------------------
     def frame_times(self) -> F:
@@ -106,52 +172,107 @@ class CurvesScene:
         sizes[keys] = 13.0
         scene.add_points(traj, sizes, col, pixels=True)
         scene.add_points(traj[self.frame][None], 16.0, (1.0, 0.9, 0.1), pixels=True)
+        if self.key_index() is not None:  # a key pose: its joints are handles for the static IK
+            scene.add_points(pos, 10.0, JOINT_RGB, pixels=True)
+        img, rect = self.timeline().picture(s.key_frames(), self.frame)
+        scene.add_overlay(img, rect)
         self._panel(scene)
 
     def _panel(self, scene: RenderScene) -> None:
         s = self.session
         clip = s.clip
         k = len(clip.curves.times)
-        scene.add_text(f"Motion Curves — {clip.name}   joint: {self.joint} [Tab]   frame {self.frame} [, .]", 12, 10, 20)
+        at = self.key_index()
+        where = f"key {at}" if at is not None else "between keys"
+        scene.add_text(f"Motion Curves — {clip.name}   joint: {self.joint} [Tab]   frame {self.frame} ({where}) [, . [ ]]",
+                       12, 10, 20)  # fmt: skip
         holds = ", ".join(f"{'contact' if h.contact else 'pin'} {h.joint} {h.first}-{h.last}" for h in s.holds) or "none"
-        scene.add_text(f"{k} keys (orange, fixed)   holds: {holds}   [P pin, C contact]", 12, 36)
-        scene.add_text(f"edits: {len(s.history)}  {' · '.join(s.history[-3:])}   drag the curve · Shift+drag re-time · "
-                       "arrows turn · Ctrl+Z/Y · Ctrl+S save", 12, 60)  # fmt: skip
+        scene.add_text(f"{k} keys [K add, X delete, drag on the timeline]   holds: {holds}   [P pin, C contact]", 12, 36)
+        tool = ("drag a joint: pose the key (IK)" if at is not None
+                else "drag the curve · Shift+drag re-time · arrows turn")  # fmt: skip
+        scene.add_text(f"edits: {len(s.history)}  {' · '.join(s.history[-3:])}   {tool} · Ctrl+Z/Y · Ctrl+S save", 12, 60)
         if self.message:
             scene.add_text(self.message, 12, 84, 18, (1.0, 0.85, 0.4))
 
     # -- time ---------------------------------------------------------------------------------
     def step(self, dt: float) -> None:
-        """Nothing plays by itself: the scene shows one frame, chosen with , and . or by dragging."""
+        """Nothing plays by itself: the scene shows one frame, chosen with , and . or on the timeline."""
 
     # -- mouse ----------------------------------------------------------------------------------
     def press(self, px: float, py: float, *, shift: bool = False) -> bool:
-        """Button down on the trajectory: start a drag (or a re-time with Shift)."""
+        """Button down: on the timeline (pick a frame, grab a key), on a key's joint (pose it), or on the trajectory."""
         p = (float(px), float(py))
+        line = self.timeline()
+        if line.contains(*p):
+            k = line.key_at(p[0], self.session.key_frames())
+            frames = self.session.key_frames()
+            if k is not None and 0 < k < len(frames) - 1:
+                self.frame = frames[k]
+                self.gesture = _Gesture("key", frames[k], np.zeros(3), p, key=k)
+            else:
+                self.frame = line.frame_at(p[0])
+                self.gesture = _Gesture("scrub", self.frame, np.zeros(3), p)
+            return True
+        key = self.key_index()
+        if key is not None and not shift:
+            j = pick_point(self.camera, self.size, self.joint_positions(), p)
+            if j is not None:
+                self.joint = self.session.clip.skeleton.names[j]
+                self.gesture = _Gesture("pose", self.frame, self.joint_positions()[j], p, key=key)
+                return True
         traj = self.trajectory()
         f = pick_point(self.camera, self.size, traj, p)
         if f is None:
             return False
-        if f in set(self._key_frames().tolist()) and not shift:
-            self.message = "a key cannot move: drag a frame between keys"
-            return False
         self.frame = f
+        key = self.key_index()
+        if key is not None and not shift:  # a key's dot on the curve: pose that key by its joint
+            self.gesture = _Gesture("pose", f, traj[f], p, key=key)
+            return True
         self.gesture = _Gesture("retime" if shift else "drag", f, traj[f], p)
         return True
 
     def move(self, px: float, py: float) -> None:
         """While dragging: re-solve from the gesture's start state towards the cursor (live preview)."""
         g = self.gesture
-        if g is None or g.kind != "drag":
+        if g is None or g.kind == "retime":
+            return
+        g.moved = g.moved or (float(px), float(py)) != g.start_px
+        if g.kind == "scrub":
+            self.frame = self.timeline().frame_at(px)
+            return
+        if g.kind == "key":
+            self._move_key(g, px, commit=False)
             return
         target = point_on_view_plane(self.camera, self.size, (float(px), float(py)), g.anchor)
+        if g.kind == "pose":
+            res = self.session.pose(g.key, self.joint, target, commit=False)
+            self.message = "" if res.reached else f"out of reach: closest pose kept (residual {res.residual * 1e3:.0f} mm)"
+            return
         res = self.session.drag(self.joint, self.frame_times()[g.frame], position=target, commit=False)
-        self.message = "" if res.reached else f"out of reach (miss {res.error * 1e3:.0f} mm): kept the last pose"
+        self.message = "" if res.reached else (
+            f"out of reach: closest kept (residual {res.closest_error * 1e3:.0f} mm)"
+            if self.session.preview is not None else f"out of reach (miss {res.error * 1e3:.0f} mm): a pin would slip")
+
+    def _move_key(self, g: _Gesture, px: float, commit: bool) -> None:
+        frame = self.timeline().frame_at(px)
+        if frame == g.frame:
+            self.session.cancel_preview()
+            return
+        try:
+            self.session.move_key(g.key, frame, commit=commit)
+            self.frame = frame
+        except ValueError as exc:
+            self.message = str(exc)
 
     def release(self, px: float, py: float) -> None:
         """Button up: the gesture becomes one undo step."""
         g, self.gesture = self.gesture, None
-        if g is None:
+        if g is None or g.kind == "scrub":
+            return
+        if g.kind == "key":
+            self.session.cancel_preview()
+            self._move_key(g, px, commit=True)
             return
         t = float(self.frame_times()[g.frame])
         if g.kind == "retime":
@@ -161,15 +282,36 @@ class CurvesScene:
             except ValueError as exc:
                 self.message = str(exc)
             return
+        if not g.moved and (float(px), float(py)) == g.start_px:
+            self.session.cancel_preview()  # a click: the joint is selected, nothing is posed
+            return
         self.move(px, py)
-        self.session.commit_preview(f"drag {self.joint}@{g.frame}")
+        if g.kind == "pose":
+            self.session.commit_preview(f"pose {self.joint}@key {g.key}")
+        else:
+            self.session.commit_preview(f"drag {self.joint}@{g.frame}")
+
+    def apply(self, op: list | tuple) -> None:  # type: ignore[type-arg]
+        """One recorded tool operation: ``press x y shift``, ``move x y``, ``release x y`` or ``key name ctrl shift``."""
+        kind = op[0]
+        if kind == "press":
+            self.press(float(op[1]), float(op[2]), shift=bool(op[3]))
+        elif kind == "move":
+            self.move(float(op[1]), float(op[2]))
+        elif kind == "release":
+            self.release(float(op[1]), float(op[2]))
+        elif kind == "key":
+            self.key(str(op[1]), ctrl=bool(op[2]), shift=bool(op[3]))
+        else:
+            raise ValueError(f"unknown operation {kind!r}")
 
     # -- keys -----------------------------------------------------------------------------------
     def key(self, name: str, *, ctrl: bool = False, shift: bool = False) -> None:
-        """A key by name: ``tab``, ``,``, ``.``, ``left``/``right``/``up``/``down``, ``p``, ``c``, ``z``/``y`` with Ctrl."""
+        """A key by name: ``tab``, ``,``, ``.``, ``[``, ``]``, arrows, ``p``, ``c``, ``k``, ``x``/``delete``, ``z``/``y`` with Ctrl."""
         s = self.session
         clip = s.clip
         names = clip.skeleton.names
+        n = clip.num_frames
         if ctrl and name == "z":
             s.undo()
         elif ctrl and name == "y":
@@ -177,12 +319,32 @@ class CurvesScene:
         elif name == "tab":
             self.joint = names[(names.index(self.joint) + (-1 if shift else 1)) % len(names)]
         elif name in (",", "."):
-            self.frame = (self.frame + (1 if name == "." else -1)) % clip.num_frames
+            self.frame = (self.frame + (1 if name == "." else -1)) % n
+        elif name in ("[", "]"):
+            frames = sorted({f % n for f in s.key_frames()})
+            later = [f for f in frames if f > self.frame] or frames[:1]
+            earlier = [f for f in frames if f < self.frame] or frames[-1:]
+            self.frame = later[0] if name == "]" else earlier[-1]
+        elif name == "k":
+            self._key_edit(lambda: s.add_key(self.frame))
+        elif name in ("x", "delete"):
+            at = self.key_index()
+            if at is None:
+                self.message = "no key here to delete: [ and ] go to a key"
+            else:
+                self._key_edit(lambda: s.delete_key(at))
         elif name in ("left", "right", "up", "down"):
             self._turn(name)
         elif name in ("p", "c"):
-            first = max(0, self.frame - HOLD_HALF)
-            s.toggle_hold(self.joint, first, min(clip.num_frames - 1, self.frame + HOLD_HALF), contact=name == "c")
+            first, last = (0, n - 1) if shift else (max(0, self.frame - HOLD_HALF), min(n - 1, self.frame + HOLD_HALF))
+            s.toggle_hold(self.joint, first, last, contact=name == "c")
+
+    def _key_edit(self, edit) -> None:  # type: ignore[no-untyped-def]
+        try:
+            edit()
+            self.message = ""
+        except ValueError as exc:
+            self.message = str(exc)
 
     def _turn(self, arrow: str) -> None:
         s = self.session

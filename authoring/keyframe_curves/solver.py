@@ -110,6 +110,8 @@ class CurveEdit:
     variables: int
     segment: int
     closest: KeyframedClip = field(repr=False)
+    closest_error: float = 0.0
+    closest_hold_error: float = 0.0
 
 
 def curve_rig(clip: KeyframedClip, limits: IKRig | None = None) -> IKRig:
@@ -332,6 +334,7 @@ class TangentSolver:
         ds, drho = residuals(pos, rot_now)
         cur = merit(ds, drho)
         best, best_clip, strikes, it = cur, clip, 0, 0
+        best_err, best_hold = error_of(ds), hold_error(drho)
         radius, box_r = st.step_radius, st.tangent_radius
         mu = 0.0  # extra damping of the step, Levenberg–Marquardt style: grows when a step fails
         done = done_of(ds, drho)
@@ -375,8 +378,10 @@ class TangentSolver:
             done = done_of(ds, drho)
             if done or cur < best * (1.0 - 1e-3):
                 best, best_clip, strikes = cur, clip, 0
+                best_err, best_hold = error_of(ds), hold_error(drho)
             else:
                 strikes += 1
                 start = seg.theta(clip)  # stalled: E_d's pull may be what holds the point short
         return CurveEdit(clip=clip if done else self.clip, reached=done, iterations=it, error=error_of(ds),
-                         hold_error=hold_error(drho), variables=n, segment=seg.k, closest=best_clip)  # fmt: skip
+                         hold_error=hold_error(drho), variables=n, segment=seg.k, closest=best_clip,
+                         closest_error=best_err, closest_hold_error=best_hold)  # fmt: skip
