@@ -292,7 +292,8 @@ class CurvesScene:
             self.session.commit_preview(f"drag {self.joint}@{g.frame}")
 
     def apply(self, op: list | tuple) -> None:  # type: ignore[type-arg]
-        """One recorded tool operation: ``press x y shift``, ``move x y``, ``release x y`` or ``key name ctrl shift``."""
+        """One recorded tool operation: ``press x y shift``, ``move x y``, ``release x y``, ``key name ctrl shift``,
+        ``orbit dx dy`` (pixels) or ``zoom factor``."""
         kind = op[0]
         if kind == "press":
             self.press(float(op[1]), float(op[2]), shift=bool(op[3]))
@@ -302,6 +303,10 @@ class CurvesScene:
             self.release(float(op[1]), float(op[2]))
         elif kind == "key":
             self.key(str(op[1]), ctrl=bool(op[2]), shift=bool(op[3]))
+        elif kind == "orbit":  # middle-button drag, in pixels
+            self.camera.orbit(-float(op[1]) * 0.01, float(op[2]) * 0.01)
+        elif kind == "zoom":
+            self.camera.zoom(float(op[1]))
         else:
             raise ValueError(f"unknown operation {kind!r}")
 

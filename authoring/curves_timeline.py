@@ -85,7 +85,7 @@ class Timeline:
         r = max(4, self.height // 4)
         yy, xx = np.mgrid[0 : self.height, -r : r + 1]
         diamond = np.abs(xx) + np.abs(yy - mid) <= r
-        for f in keys:
+        for f in sorted({f % self.frames for f in keys}):  # a loop's last key is its first
             x = int(round(self.x_of(f)))
             lo, hi = max(x - r, 0), min(x + r + 1, w)
             patch = img[:, lo:hi]

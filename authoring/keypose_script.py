@@ -18,13 +18,14 @@ from collections.abc import Iterator
 
 import numpy as np
 
-__all__ = ["walk_script", "WALK_KEYS", "HAND_DRAG_FRAME", "Op"]
+__all__ = ["walk_script", "goto_frame", "WALK_KEYS", "HAND_DRAG_FRAME", "Op"]
 
 Op = list  # ["press", x, y, shift] | ["move", x, y] | ["release", x, y] | ["key", name, ctrl, shift]
 
 WALK_KEYS = (0, 15, 30, 45)
 HAND_DRAG_FRAME = 22
 DRAG_MOVES = 6
+SIDE_YAW = float(np.pi / 2)  # the camera on +x, looking at the puppet's left side
 # Per key: joint → world target (metres), in the order they are posed; "pin" pins both feet.
 _CONTACT_L = {"l_foot": (0.09, 0.08, 0.30), "r_foot": (-0.09, 0.10, -0.28), "pin": (), "hips": (0.0, 0.85, 0.0),
               "unpin": (), "l_hand": (0.24, 0.80, -0.14), "r_hand": (-0.24, 0.82, 0.20)}  # fmt: skip
@@ -56,7 +57,8 @@ def _drag(scene, start, end) -> Iterator[list[Op]]:  # type: ignore[no-untyped-d
     yield [["release", *end]]
 
 
-def _goto(scene, frame: int) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+def goto_frame(scene, frame: int) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+    """A click on the timeline at ``frame``."""
     line = scene.timeline()
     x, y = round(line.x_of(frame), 2), round(line.top + line.height / 2, 2)
     yield [["press", x, y, False]]
@@ -79,10 +81,13 @@ def _pin_feet(scene, whole: bool) -> Iterator[list[Op]]:  # type: ignore[no-unty
 def walk_script(scene) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
     """The operations of each step, computed from the scene as it is when their turn comes."""
     for frame in WALK_KEYS[1:]:
-        yield from _goto(scene, frame)
+        yield from goto_frame(scene, frame)
         yield [["key", "k", False, False]]
+    # Pose from the side: the drags run on the view plane, which is then the walk's own plane.
+    side = round((scene.camera.yaw - SIDE_YAW) * 100.0, 2)
+    yield [["orbit", side, 0.0]]
     for frame, pose in zip(WALK_KEYS, WALK_POSES, strict=True):
-        yield from _goto(scene, frame)
+        yield from goto_frame(scene, frame)
         for joint, target in pose.items():
             if joint in ("pin", "unpin"):
                 yield from _pin_feet(scene, whole=False)
@@ -91,9 +96,10 @@ def walk_script(scene) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
             start = _screen(scene, scene.joint_positions()[j])
             # The drag runs on the view plane through the joint: aim at the target's place on it.
             yield from _drag(scene, start, _screen(scene, target))
-    yield from _goto(scene, WALK_KEYS[0])
+    yield [["orbit", -side, 0.0]]
+    yield from goto_frame(scene, WALK_KEYS[0])
     yield from _pin_feet(scene, whole=True)
     yield from _select(scene, "l_hand")
-    yield from _goto(scene, HAND_DRAG_FRAME)
+    yield from goto_frame(scene, HAND_DRAG_FRAME)
     start = _screen(scene, scene.trajectory()[HAND_DRAG_FRAME])
     yield from _drag(scene, start, (start[0], round(start[1] - 30.0, 2)))

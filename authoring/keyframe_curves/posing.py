@@ -58,7 +58,10 @@ def posing_rig(skeleton: Skeleton) -> IKRig:
 
 def pose_key(clip: KeyframedClip, k: int, joint: str | int, target: ArrayLike,
              pinned: tuple[str | int, ...] = ()) -> KeyPose:  # fmt: skip
-    """Move ``joint`` of key ``k`` towards ``target`` (world) with ``pinned`` joints held; the closest pose is kept."""
+    """Move ``joint`` of key ``k`` towards ``target`` (world) with ``pinned`` joints held; the closest pose is kept.
+
+    Dragging the root (the hips) moves it without turning it, as an animator lowers the hips.
+    """
     sk = clip.skeleton
     n = clip.curves.times.size
     if not 0 <= k < n:
@@ -67,6 +70,8 @@ def pose_key(clip: KeyframedClip, k: int, joint: str | int, target: ArrayLike,
     old = clip.curves.values[k]
     root, rot = clip.pose_arrays(old[None])
     pins = tuple(Pin(p) for p in pinned if (sk.index(p) if isinstance(p, str) else int(p)) != j)
-    res = solve_ik(posing_rig(sk), root[0], rot[0], [_Effector(j, position=target)], pins)
+    # The root dragged translates the body: it keeps its orientation (else a lowered pelvis tips the torso over).
+    keep = rot[0][0] if j == 0 else None
+    res = solve_ik(posing_rig(sk), root[0], rot[0], [_Effector(j, position=target, orientation=keep)], pins)
     channels = pose_channels(res.closest_root, res.closest_rotations, near=old)
     return KeyPose(set_key_channels(clip, k, channels), res.reached, res.error, res.pin_error)
