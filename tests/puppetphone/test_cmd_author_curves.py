@@ -22,7 +22,7 @@ def test_scripted_drag_saves_keys_and_exports(tmp_path):
     from engine.keyframes import keyframe_clip
 
     out = tmp_path / "walk_curves.ppclip"
-    done = _run(tmp_path, "walk", "--headless", "--script", "drag", "--frames", "25", "--screenshot", "after.png",
+    done = _run(tmp_path, "walk", "--headless", "--script", "drag", "--frames", "50", "--screenshot", "after.png",
                 "-o", str(out), "--export", str(tmp_path / "walk.glb"))  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "drag l_hand@15" in done.stdout
