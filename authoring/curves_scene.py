@@ -65,22 +65,31 @@ class _Gesture:
     moved: bool = False
 
 
-def framing_camera(points: F, size: tuple[int, int], yaw: float = 1.1, pitch: float = 0.15) -> OrbitCamera:
-    """A camera that shows every point of ``points [N,3]`` with a margin, below the panel and above the timeline.
+def panel_layout(size: tuple[int, int]) -> tuple[int, int]:
+    """``(font size, line step)`` of the panel: smaller in a small window, so its lines do not wrap over the puppet."""
+    font = 18 if size[0] >= 1100 else 14 if size[0] >= 760 else 12
+    return font, font + 8
 
-    The vertical field of view (the camera's) and the window's aspect bound the distance; the
-    target sits a little above the points' centre because the panel takes the window's top.
+
+def framing_camera(points: F, size: tuple[int, int], yaw: float = 1.1, pitch: float = 0.15) -> OrbitCamera:
+    """A camera that shows every point of ``points [N,3]`` between the panel and the timeline.
+
+    The points' bounding sphere is fitted, in pixels, into the band left free by the panel's
+    four lines and the key timeline (and into the width), then the target is raised so the
+    sphere's centre sits in the middle of that band rather than of the window.
     """
     cam = OrbitCamera(target=np.zeros(3), yaw=yaw, pitch=pitch, distance=1.0)
     lo, hi = points.min(axis=0), points.max(axis=0)
     centre = 0.5 * (lo + hi)
     radius = max(float(np.linalg.norm(hi - lo)) * 0.5, 0.3)
-    half_v = np.radians(cam.fov_y) * 0.5
-    aspect = size[0] / max(size[1], 1)
-    half = min(half_v, float(np.arctan(np.tan(half_v) * aspect)))
-    usable = 0.72  # of the half-height: the panel's three lines and the timeline take the rest
-    cam.distance = radius / np.sin(half * usable)
-    cam.target = centre + np.array([0.0, 0.08 * radius, 0.0])
+    w, h = size
+    focal = 0.5 * h / np.tan(np.radians(cam.fov_y) * 0.5)  # pixels per unit of depth
+    top = 10 + 4 * panel_layout(size)[1]
+    bottom = Timeline(size, 2).top - 6
+    half_band = max(0.5 * (bottom - top) - 4.0, 20.0)
+    cam.distance = float(radius * focal / min(half_band, 0.5 * w - 8.0))
+    rows_down = 0.5 * (top + bottom) - 0.5 * h  # how far below the window's middle the band's middle is
+    cam.target = centre + np.array([0.0, rows_down * cam.distance / focal, 0.0])
     return cam
 
 
@@ -172,8 +181,10 @@ class CurvesScene:
         sizes[keys] = 13.0
         scene.add_points(traj, sizes, col, pixels=True)
         scene.add_points(traj[self.frame][None], 16.0, (1.0, 0.9, 0.1), pixels=True)
-        if self.key_index() is not None:  # a key pose: its joints are handles for the static IK
-            scene.add_points(pos, 10.0, JOINT_RGB, pixels=True)
+        if self.key_index() is not None:  # a key pose: its joints are handles for the static IK,
+            toward = self.camera.eye - pos  # drawn just in front of the body so it never hides them
+            lift = (clip.skeleton.radii + 0.02)[:, None] * toward / np.linalg.norm(toward, axis=1, keepdims=True)
+            scene.add_points(pos + lift, 10.0, JOINT_RGB, pixels=True)
         img, rect = self.timeline().picture(s.key_frames(), self.frame)
         scene.add_overlay(img, rect)
         self._panel(scene)
@@ -181,18 +192,19 @@ class CurvesScene:
     def _panel(self, scene: RenderScene) -> None:
         s = self.session
         clip = s.clip
+        font, step = panel_layout(self.size)
         k = len(clip.curves.times)
         at = self.key_index()
         where = f"key {at}" if at is not None else "between keys"
-        scene.add_text(f"Motion Curves — {clip.name}   joint: {self.joint} [Tab]   frame {self.frame} ({where}) [, . [ ]]",
-                       12, 10, 20)  # fmt: skip
+        scene.add_text(f"Motion Curves — {clip.name}   {self.joint} [Tab]   frame {self.frame} ({where}) [, . [ ]]",
+                       12, 10, font + 2)  # fmt: skip
         holds = ", ".join(f"{'contact' if h.contact else 'pin'} {h.joint} {h.first}-{h.last}" for h in s.holds) or "none"
-        scene.add_text(f"{k} keys [K add, X delete, drag on the timeline]   holds: {holds}   [P pin, C contact]", 12, 36)
-        tool = ("drag a joint: pose the key (IK)" if at is not None
-                else "drag the curve · Shift+drag re-time · arrows turn")  # fmt: skip
-        scene.add_text(f"edits: {len(s.history)}  {' · '.join(s.history[-3:])}   {tool} · Ctrl+Z/Y · Ctrl+S save", 12, 60)
+        scene.add_text(f"{k} keys [K add, X delete]   holds: {holds} [P, C]", 12, 10 + step, font)
+        tool = "drag a joint: pose the key" if at is not None else "drag the curve · Shift: re-time · arrows turn"
+        scene.add_text(f"edits: {len(s.history)} ({s.history[-1] if s.history else 'none'})   {tool} · Ctrl+Z/Y/S",
+                       12, 10 + 2 * step, font)  # fmt: skip
         if self.message:
-            scene.add_text(self.message, 12, 84, 18, (1.0, 0.85, 0.4))
+            scene.add_text(self.message, 12, 10 + 3 * step, font, (1.0, 0.85, 0.4))
 
     # -- time ---------------------------------------------------------------------------------
     def step(self, dt: float) -> None:
