@@ -267,6 +267,10 @@ class CurveSession:
             self.revision += 1
         return res
 
+    def set_key(self, k: int, channels: ArrayLike) -> None:
+        """Key ``k`` takes a whole pose (channels, e.g. copied from a reference); one undo step."""
+        self._push(key_ops.set_key_channels(self.state.clip, k, channels), self.holds, f"set key {k}")
+
     def cancel_preview(self) -> None:
         """Drop a live gesture's preview."""
         if self.preview is not None:
