@@ -37,6 +37,7 @@ MAX_FPS = 1000.0  # as a clip file's
 MAX_FRAMES = 1_000_000  # baked frames (an hour at 240 fps is under)
 MAX_VALUE = 1e6  # key times (s), values (m, rad) and tangent handles: far beyond any real clip
 REST = "rest"  # the spec of a new clip holding the rest pose
+CLOSEST_HALVINGS = 4  # a drag out of reach keeps the farthest reachable point within 1/16 of the way
 
 
 def standing_root(skeleton) -> np.ndarray:  # type: ignore[no-untyped-def]
@@ -207,14 +208,14 @@ class CurveSession:
              orientation: ArrayLike | None = None, commit: bool = True) -> CurveEdit:  # fmt: skip
         """One drag from the current state, shown as the preview (and an undo step if ``commit``).
 
-        A target the solver cannot meet keeps its closest solution (§4.4), as long as the
-        holds stay within their ε there; the result's ``error`` is the residual to show.
+        A target the solver cannot meet keeps the closest solution (§4.4) that holds every pin
+        and contact within ε: the solver's nearest such iterate, or the farthest point towards
+        the target it does reach (halving the way :data:`CLOSEST_HALVINGS` times), whichever is
+        nearer. The result's ``closest_error`` is then the residual to show.
         """
         self.solver.clip = self.state.clip
         res = self.solver.drag(Drag(joint, time, position=position, orientation=orientation), self.holds)
-        clip = res.clip if res.reached else res.closest
-        if not res.reached and res.closest_hold_error > self.solver.settings.epsilon:
-            clip = self.state.clip  # the closest pose would let a pin slip: keep the clip as it was
+        clip = res.clip if res.reached else self._closest(res, joint, time, position)
         if clip is self.state.clip:
             return res
         if commit:
@@ -224,6 +225,28 @@ class CurveSession:
             self.preview = clip
             self.revision += 1
         return res
+
+    def _closest(self, res: CurveEdit, joint: str, time: float, position: ArrayLike | None) -> KeyframedClip:
+        """The nearest clip to an unreachable ``position`` with the holds kept (``res`` updated with its residual)."""
+        clip = res.closest if res.closest_hold_error <= self.solver.settings.epsilon else self.state.clip
+        if position is None:
+            return clip
+        sk = self.state.clip.skeleton
+        j = sk.index(joint)
+        goal = np.asarray(position, dtype=np.float64)
+        start = self.solver.points(np.array([time]), j, np.zeros(3))[0]
+        lo, hi = 0.0, 1.0
+        for _ in range(CLOSEST_HALVINGS):
+            mid = 0.5 * (lo + hi)
+            part = self.solver.drag(Drag(joint, time, position=start + mid * (goal - start)), self.holds)
+            if part.reached:
+                lo = mid
+                miss = float(np.linalg.norm(self.solver.points(np.array([time]), j, np.zeros(3), part.clip)[0] - goal))
+                if miss < res.closest_error:
+                    clip, res.closest_error, res.closest_hold_error = part.clip, miss, part.hold_error
+            else:
+                hi = mid
+        return clip
 
     # -- keys (the key-pose workflow, §4.3.1) -----------------------------------------------
     def key_frames(self) -> list[int]:

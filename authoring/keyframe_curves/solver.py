@@ -392,8 +392,9 @@ class TangentSolver:
         pos, jac, rot_now, rot_jac = self._linearise(seg, clip, times, joints, pts, rot_joint)
         ds, drho = residuals(pos, rot_now)
         cur = merit(ds, drho)
-        best, best_clip, strikes, it = cur, clip, 0, 0
-        best_err, best_hold = error_of(ds), hold_error(drho)
+        best, strikes, it = cur, 0, 0
+        # The closest solution kept when the target is out of reach (§4.4): the nearest iterate whose holds are within ε.
+        best_clip, best_err, best_hold = clip, error_of(ds), hold_error(drho)
         radius, box_r = st.step_radius, st.tangent_radius
         mu = 0.0  # extra damping of the step, Levenberg–Marquardt style: grows when a step fails
         done = done_of(ds, drho)
@@ -435,9 +436,10 @@ class TangentSolver:
             else:
                 radius, box_r, mu = 0.5 * radius, 0.5 * box_r, max(2.0 * mu, 1.0)
             done = done_of(ds, drho)
+            if hold_error(drho) <= st.epsilon and error_of(ds) < best_err:
+                best_clip, best_err, best_hold = clip, error_of(ds), hold_error(drho)
             if done or cur < best * (1.0 - 1e-3):
-                best, best_clip, strikes = cur, clip, 0
-                best_err, best_hold = error_of(ds), hold_error(drho)
+                best, strikes = cur, 0
             else:
                 strikes += 1
                 start = seg.theta(clip)  # stalled: E_d's pull may be what holds the point short

@@ -88,3 +88,23 @@ def test_session_key_edits_are_undo_steps_restoring_exact_arrays():
     assert s.redo() and s.redo() and s.redo() and s.clip is posed
     s.delete_key(1)
     assert s.key_frames() == [0, 60]
+
+
+def test_an_unreachable_curve_drag_keeps_its_closest_solution(walk):
+    """§4.4: a drag between keys that cannot reach keeps the closest solution (an undo step), residual reported."""
+    s = CurveSession(walk)
+    s.toggle_hold("l_foot", 0, 65)
+    s.toggle_hold("r_foot", 0, 65)  # the feet stay: the body cannot rise with the hand
+    hand, t = walk.skeleton.index("l_hand"), 15 / walk.fps
+    start = s.solver.points(np.array([t]), hand, np.zeros(3))[0]
+    target = start + np.array([0.0, 1.0, 0.0])  # a metre up, three frames from the keys, feet held
+    res = s.drag("l_hand", t, position=target)
+    assert not res.reached and s.history[-1] == "drag l_hand@15"
+    now = s.solver.points(np.array([t]), hand, np.zeros(3), s.clip)[0]
+    assert np.linalg.norm(now - target) < np.linalg.norm(start - target) - 0.05
+    assert abs(np.linalg.norm(now - target) - res.closest_error) < 1e-9
+    for foot in ("l_foot", "r_foot"):  # the closest solution keeps the pins (ε = 0.1 mm)
+        j = walk.skeleton.index(foot)
+        frames = np.arange(66) / walk.fps
+        drift = s.solver.points(frames, j, np.zeros(3), s.clip) - s.solver.points(frames, j, np.zeros(3), walk)
+        assert np.linalg.norm(drift, axis=1).max() <= 1e-4
