@@ -10,8 +10,10 @@ contacts (purple). Gestures, in pixels, like ``author edit``:
   facing the camera; the tangent solver re-solves on every move from the gesture's
   start, and the release is one undo step;
 - Shift+drag along the curve: re-time there (Eq. 4.12; right = faster, left = slower);
-- arrows: turn the selected joint at the current frame (left/right about the vertical,
-  up/down about the view's side axis), one undo step each;
+- the teal sticks along the curve are the joint's heading at every other frame (Fig. 4.4,
+  middle); drag the grip at the current frame's stick to turn the joint there in place
+  (the tangent solver between keys, the static IK at a key); the arrows turn it too (left/right
+  about the vertical, up/down about the view's side axis), one undo step each;
 - P / C: pin / contact the selected joint over the frames ±7 around the current one
   (again to remove); Shift+P: pin it over the whole clip; Tab/Shift+Tab: joint; , and .:
   frame; [ and ]: previous / next key; Ctrl+Z/Ctrl+Y: undo/redo.
@@ -35,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from authoring.curves_handles import ORIENT_RGB, bone_axis, orientation_sticks, turn_towards
 from authoring.curves_timeline import Timeline
 from authoring.keyframe_curves.session import CurveSession
 from authoring.screen_pick import pick_point, point_on_view_plane
@@ -57,7 +60,7 @@ TURN = 0.1  # radians per arrow press
 
 @dataclass
 class _Gesture:
-    kind: str  # "drag", "retime", "pose" (a key's joint), "key" (a key along the timeline) or "scrub"
+    kind: str  # "drag", "retime", "pose" (a key's joint), "orient" (the grip), "key" (on the timeline) or "scrub"
     frame: int
     anchor: F
     start_px: tuple[float, float]
@@ -104,6 +107,7 @@ class CurvesScene:
         self.frame = 0
         self.gesture: _Gesture | None = None
         self.message = ""
+        self._turn_from: tuple[F, F] = (quat.identity(), np.zeros(3))  # an orient gesture's start: rotation, base
         self.camera = framing_camera(self._all_joint_positions(), size)
 
     def _all_joint_positions(self) -> F:
@@ -181,6 +185,10 @@ class CurvesScene:
         sizes[keys] = 13.0
         scene.add_points(traj, sizes, col, pixels=True)
         scene.add_points(traj[self.frame][None], 16.0, (1.0, 0.9, 0.1), pixels=True)
+        base, tip, _ = orientation_sticks(s, self.frame_times(), clip.skeleton.index(self.joint))
+        scene.add_lines(base[::2], tip[::2], ORIENT_RGB, 2.0)  # the joint's heading along the curve
+        scene.add_lines(base[self.frame][None], tip[self.frame][None], ORIENT_RGB, 4.0)
+        scene.add_points(tip[self.frame][None], 14.0, ORIENT_RGB, pixels=True)  # the grip that turns it
         if self.key_index() is not None:  # a key pose: its joints are handles for the static IK,
             toward = self.camera.eye - pos  # drawn just in front of the body so it never hides them
             lift = (clip.skeleton.radii + 0.02)[:, None] * toward / np.linalg.norm(toward, axis=1, keepdims=True)
@@ -225,6 +233,8 @@ class CurvesScene:
                 self.frame = line.frame_at(p[0])
                 self.gesture = _Gesture("scrub", self.frame, np.zeros(3), p)
             return True
+        if not shift and self._press_grip(p):
+            return True
         key = self.key_index()
         if key is not None and not shift:
             j = pick_point(self.camera, self.size, self.joint_positions(), p)
@@ -244,6 +254,35 @@ class CurvesScene:
         self.gesture = _Gesture("retime" if shift else "drag", f, traj[f], p)
         return True
 
+    def _press_grip(self, p: tuple[float, float]) -> bool:
+        """A press on the current frame's orientation grip starts turning the joint there."""
+        j = self.session.clip.skeleton.index(self.joint)
+        t = self.frame_times()[self.frame : self.frame + 1]
+        _, tip, rot = orientation_sticks(self.session, t, j)
+        if pick_point(self.camera, self.size, tip, p) is None:
+            return False
+        if self.key_index() is not None:  # at a key the joints are handles too: the nearer one wins
+            d_grip = float(np.linalg.norm(self.camera.project(tip, *self.size)[0] - np.asarray(p)))
+            d_joint = np.linalg.norm(self.camera.project(self.joint_positions(), *self.size) - np.asarray(p), axis=1)
+            if np.nanmin(d_joint) < d_grip:
+                return False
+        self.gesture = _Gesture("orient", self.frame, tip[0], p, key=-1 if self.key_index() is None else int(self.key_index()))
+        self._turn_from = (rot[0], self.trajectory()[self.frame])
+        return True
+
+    def _orient(self, g: _Gesture, px: float, py: float) -> None:
+        """Turn the joint so its bone points at the grip's place under the cursor (live preview)."""
+        rot, base = self._turn_from
+        grip = point_on_view_plane(self.camera, self.size, (px, py), g.anchor)
+        axis = bone_axis(self.session.clip.skeleton, self.session.clip.skeleton.index(self.joint))
+        goal = turn_towards(rot, axis, grip - base)
+        if g.key >= 0:  # the joint stays where it is (in place) and turns
+            res = self.session.pose(g.key, self.joint, base, commit=False, orientation=goal)
+            self.message = "" if res.reached else f"turn out of reach: closest pose kept (residual {res.residual:.2f})"
+            return
+        out = self.session.drag(self.joint, self.frame_times()[g.frame], position=base, orientation=goal, commit=False)
+        self.message = "" if out.reached else "that turn is out of reach: closest kept"
+
     def move(self, px: float, py: float) -> None:
         """While dragging: re-solve from the gesture's start state towards the cursor (live preview)."""
         g = self.gesture
@@ -255,6 +294,9 @@ class CurvesScene:
             return
         if g.kind == "key":
             self._move_key(g, px, commit=False)
+            return
+        if g.kind == "orient":
+            self._orient(g, float(px), float(py))
             return
         target = point_on_view_plane(self.camera, self.size, (float(px), float(py)), g.anchor)
         if g.kind == "pose":
@@ -298,7 +340,9 @@ class CurvesScene:
             self.session.cancel_preview()  # a click: the joint is selected, nothing is posed
             return
         self.move(px, py)
-        if g.kind == "pose":
+        if g.kind == "orient":
+            self.session.commit_preview(f"turn {self.joint}@{g.frame}")
+        elif g.kind == "pose":
             self.session.commit_preview(f"pose {self.joint}@key {g.key}")
         else:
             self.session.commit_preview(f"drag {self.joint}@{g.frame}")

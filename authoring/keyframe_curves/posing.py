@@ -56,11 +56,12 @@ def posing_rig(skeleton: Skeleton) -> IKRig:
     return rig
 
 
-def pose_key(clip: KeyframedClip, k: int, joint: str | int, target: ArrayLike,
-             pinned: tuple[str | int, ...] = ()) -> KeyPose:  # fmt: skip
+def pose_key(clip: KeyframedClip, k: int, joint: str | int, target: ArrayLike | None,
+             pinned: tuple[str | int, ...] = (), orientation: ArrayLike | None = None) -> KeyPose:  # fmt: skip
     """Move ``joint`` of key ``k`` towards ``target`` (world) with ``pinned`` joints held; the closest pose is kept.
 
     Dragging the root (the hips) moves it without turning it, as an animator lowers the hips.
+    With ``orientation`` (a world quaternion) the joint is turned too (or only, without ``target``).
     """
     sk = clip.skeleton
     n = clip.curves.times.size
@@ -71,7 +72,7 @@ def pose_key(clip: KeyframedClip, k: int, joint: str | int, target: ArrayLike,
     root, rot = clip.pose_arrays(old[None])
     pins = tuple(Pin(p) for p in pinned if (sk.index(p) if isinstance(p, str) else int(p)) != j)
     # The root dragged translates the body: it keeps its orientation (else a lowered pelvis tips the torso over).
-    keep = rot[0][0] if j == 0 else None
+    keep = rot[0][0] if j == 0 and orientation is None else orientation
     res = solve_ik(posing_rig(sk), root[0], rot[0], [_Effector(j, position=target, orientation=keep)], pins)
     channels = pose_channels(res.closest_root, res.closest_rotations, near=old)
     return KeyPose(set_key_channels(clip, k, channels), res.reached, res.error, res.pin_error)

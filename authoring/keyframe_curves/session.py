@@ -215,7 +215,7 @@ class CurveSession:
         """
         self.solver.clip = self.state.clip
         res = self.solver.drag(Drag(joint, time, position=position, orientation=orientation), self.holds)
-        clip = res.clip if res.reached else self._closest(res, joint, time, position)
+        clip = res.clip if res.reached else self._closest(res, joint, time, None if orientation is not None else position)
         if clip is self.state.clip:
             return res
         if commit:
@@ -227,7 +227,9 @@ class CurveSession:
         return res
 
     def _closest(self, res: CurveEdit, joint: str, time: float, position: ArrayLike | None) -> KeyframedClip:
-        """The nearest clip to an unreachable ``position`` with the holds kept (``res`` updated with its residual)."""
+        """The nearest clip to an unreachable ``position`` with the holds kept (``res`` updated with its residual).
+
+        Without a position (a turn) only the solver's nearest feasible iterate is kept."""
         clip = res.closest if res.closest_hold_error <= self.solver.settings.epsilon else self.state.clip
         if position is None:
             return clip
@@ -279,9 +281,10 @@ class CurveSession:
         n = self.state.clip.num_frames
         return tuple(str(h.joint) for h in self.holds if h.first <= frame % max(n, 1) <= h.last)
 
-    def pose(self, k: int, joint: str, target: ArrayLike, commit: bool = True) -> KeyPose:
-        """Drag ``joint`` of key ``k`` towards ``target`` with the static IK (closest pose kept); preview or undo step."""
-        res = pose_key(self.state.clip, k, joint, target, self.pinned_at(self.key_frames()[k]))
+    def pose(self, k: int, joint: str, target: ArrayLike | None, commit: bool = True,
+             orientation: ArrayLike | None = None) -> KeyPose:  # fmt: skip
+        """Drag ``joint`` of key ``k`` towards ``target`` (and/or turn it) with the static IK, closest pose kept."""
+        res = pose_key(self.state.clip, k, joint, target, self.pinned_at(self.key_frames()[k]), orientation)
         if commit:
             self.preview = None
             self._push(res.clip, self.holds, f"pose {joint}@key {k}")

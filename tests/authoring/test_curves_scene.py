@@ -85,6 +85,38 @@ def test_the_timeline_adds_moves_and_deletes_keys_with_undo():
     assert "no key here" in scene.message
 
 
+def _grip_px(scene):  # type: ignore[no-untyped-def]
+    from authoring.curves_handles import orientation_sticks
+
+    j = scene.session.clip.skeleton.index(scene.joint)
+    _, tip, rot = orientation_sticks(scene.session, scene.frame_times()[scene.frame : scene.frame + 1], j)
+    return scene.camera.project(tip, *scene.size)[0], rot[0]
+
+
+def test_the_orientation_grip_turns_the_joint_in_place_between_keys_and_at_a_key():
+    from engine import quat
+
+    session = CurveSession.from_spec("walk")
+    scene = CurvesScene(session, (1280, 720))
+    scene.frame = 15  # between keys 12 and 18: the tangent solver turns it
+    px, before = _grip_px(scene)
+    hand_at = scene.trajectory()[15].copy()
+    for op in (["press", *px, False], ["move", px[0] + 30, px[1]], ["release", px[0] + 30, px[1]]):
+        scene.apply(op)
+    _, after = _grip_px(scene)
+    assert session.history == ["turn l_hand@15"] and np.degrees(quat.angle_between(before, after)) > 20.0
+    assert np.linalg.norm(scene.trajectory()[15] - hand_at) < 0.05  # turned in place, not carried off
+    rest = CurveSession.from_spec("rest")
+    rest.add_key(30)
+    scene = CurvesScene(rest, (1280, 720), "l_hand")
+    scene.frame = 30  # a key: the static IK turns it
+    px, before = _grip_px(scene)
+    for op in (["press", *px, False], ["move", px[0], px[1] - 40], ["release", px[0], px[1] - 40]):
+        scene.apply(op)
+    _, after = _grip_px(scene)
+    assert rest.history[-1] == "turn l_hand@30" and np.degrees(quat.angle_between(before, after)) > 20.0
+
+
 def test_the_camera_frames_the_whole_puppet_in_a_small_window():
     """Issue 38: the head was cropped. Every capsule surface point of the walk, at every frame,
     projects inside the window, below the panel's three lines and above the timeline."""
@@ -151,3 +183,6 @@ def test_render_shows_keys_on_the_timeline_and_joint_handles_at_a_key(viewer):
     scene.frame = 22  # between keys: no joint handles
     img2 = _shoot(viewer, scene, "between_keys")
     assert handles >= 60 and _near(img2[: line.top], (26, 140, 242), tol=45).sum() < handles // 4
+    grip, _ = _grip_px(scene)  # the teal orientation grip at the current frame's stick
+    x, y = int(round(grip[0])), int(round(grip[1]))
+    assert _near(img2[y - 5 : y + 6, x - 5 : x + 6], (26, 191, 178), tol=50).sum() >= 20
