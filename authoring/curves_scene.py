@@ -9,7 +9,9 @@ contacts (purple). Gestures, in pixels, like ``author edit``:
 - drag a point of the trajectory: the frame under the cursor follows it on the plane
   facing the camera; the tangent solver re-solves on every move from the gesture's
   start, and the release is one undo step;
-- Shift+drag along the curve: re-time there (Eq. 4.12; right = faster, left = slower);
+- Shift+drag along the curve, or drag the magenta spacing handle under the current frame
+  sideways (Fig. 4.4 right): re-time there (Eq. 4.12; right = frames apart, faster; left =
+  closer, slower), one undo step;
 - the teal sticks along the curve are the joint's heading at every other frame (Fig. 4.4,
   middle); drag the grip at the current frame's stick to turn the joint there in place
   (the tangent solver between keys, the static IK at a key); the arrows turn it too (left/right
@@ -39,10 +41,10 @@ from numpy.typing import NDArray
 
 from authoring.curves_handles import ORIENT_RGB, bone_axis, orientation_sticks, turn_towards
 from authoring.curves_timeline import Timeline
+from authoring.curves_view import framing_camera, panel_layout
 from authoring.keyframe_curves.session import CurveSession
 from authoring.screen_pick import pick_point, point_on_view_plane
 from engine import quat
-from engine.camera import OrbitCamera
 from engine.fk import forward_kinematics
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
@@ -54,6 +56,9 @@ ORANGE = (0.95, 0.55, 0.1)
 RED = (0.9, 0.1, 0.1)
 PURPLE = (0.6, 0.15, 0.85)
 JOINT_RGB = (0.1, 0.55, 0.95)
+SPACING_RGB = (0.9, 0.2, 0.75)
+SPACING_OFFSET_PX = 26.0
+SPACING_PER_PX = 2e-4  # seconds of tangent length per pixel, as Shift+drag
 HOLD_HALF = 7
 TURN = 0.1  # radians per arrow press
 
@@ -66,34 +71,6 @@ class _Gesture:
     start_px: tuple[float, float]
     key: int = -1
     moved: bool = False
-
-
-def panel_layout(size: tuple[int, int]) -> tuple[int, int]:
-    """``(font size, line step)`` of the panel: smaller in a small window, so its lines do not wrap over the puppet."""
-    font = 18 if size[0] >= 1100 else 14 if size[0] >= 760 else 12
-    return font, font + 8
-
-
-def framing_camera(points: F, size: tuple[int, int], yaw: float = 1.1, pitch: float = 0.15) -> OrbitCamera:
-    """A camera that shows every point of ``points [N,3]`` between the panel and the timeline.
-
-    The points' bounding sphere is fitted, in pixels, into the band left free by the panel's
-    four lines and the key timeline (and into the width), then the target is raised so the
-    sphere's centre sits in the middle of that band rather than of the window.
-    """
-    cam = OrbitCamera(target=np.zeros(3), yaw=yaw, pitch=pitch, distance=1.0)
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    centre = 0.5 * (lo + hi)
-    radius = max(float(np.linalg.norm(hi - lo)) * 0.5, 0.3)
-    w, h = size
-    focal = 0.5 * h / np.tan(np.radians(cam.fov_y) * 0.5)  # pixels per unit of depth
-    top = 10 + 4 * panel_layout(size)[1]
-    bottom = Timeline(size, 2).top - 6
-    half_band = max(0.5 * (bottom - top) - 4.0, 20.0)
-    cam.distance = float(radius * focal / min(half_band, 0.5 * w - 8.0))
-    rows_down = 0.5 * (top + bottom) - 0.5 * h  # how far below the window's middle the band's middle is
-    cam.target = centre + np.array([0.0, rows_down * cam.distance / focal, 0.0])
-    return cam
 
 
 class CurvesScene:
@@ -189,6 +166,8 @@ class CurvesScene:
         scene.add_lines(base[::2], tip[::2], ORIENT_RGB, 2.0)  # the joint's heading along the curve
         scene.add_lines(base[self.frame][None], tip[self.frame][None], ORIENT_RGB, 4.0)
         scene.add_points(tip[self.frame][None], 14.0, ORIENT_RGB, pixels=True)  # the grip that turns it
+        if self.key_index() is None:  # the spacing handle (Fig. 4.4 right): sideways scales the timing here
+            scene.add_points(self.spacing_handle()[None], 12.0, SPACING_RGB, pixels=True)
         if self.key_index() is not None:  # a key pose: its joints are handles for the static IK,
             toward = self.camera.eye - pos  # drawn just in front of the body so it never hides them
             lift = (clip.skeleton.radii + 0.02)[:, None] * toward / np.linalg.norm(toward, axis=1, keepdims=True)
@@ -235,6 +214,9 @@ class CurvesScene:
             return True
         if not shift and self._press_grip(p):
             return True
+        if not shift and self.key_index() is None and pick_point(self.camera, self.size, self.spacing_handle()[None], p) == 0:
+            self.gesture = _Gesture("space", self.frame, self.spacing_handle(), p)
+            return True
         key = self.key_index()
         if key is not None and not shift:
             j = pick_point(self.camera, self.size, self.joint_positions(), p)
@@ -254,6 +236,22 @@ class CurvesScene:
         self.gesture = _Gesture("retime" if shift else "drag", f, traj[f], p)
         return True
 
+    def spacing_handle(self) -> F:
+        """Where the spacing handle is drawn: :data:`SPACING_OFFSET_PX` below the current frame's point on screen."""
+        at = self.trajectory()[self.frame]
+        px = self.camera.project(at[None], *self.size)[0]
+        return point_on_view_plane(self.camera, self.size, (float(px[0]), float(px[1]) + SPACING_OFFSET_PX), at)
+
+    def _space(self, g: _Gesture, px: float, commit: bool) -> None:
+        """Eq. 4.12 by the handle's sideways travel: right moves the frames apart here (faster), left closer."""
+        sigma = (px - g.start_px[0]) * SPACING_PER_PX
+        if sigma == 0.0:
+            return
+        try:
+            self.session.retime(float(self.frame_times()[g.frame]), sigma, commit=commit)
+        except ValueError as exc:
+            self.message = str(exc)
+
     def _press_grip(self, p: tuple[float, float]) -> bool:
         """A press on the current frame's orientation grip starts turning the joint there."""
         j = self.session.clip.skeleton.index(self.joint)
@@ -261,11 +259,12 @@ class CurvesScene:
         _, tip, rot = orientation_sticks(self.session, t, j)
         if pick_point(self.camera, self.size, tip, p) is None:
             return False
-        if self.key_index() is not None:  # at a key the joints are handles too: the nearer one wins
-            d_grip = float(np.linalg.norm(self.camera.project(tip, *self.size)[0] - np.asarray(p)))
-            d_joint = np.linalg.norm(self.camera.project(self.joint_positions(), *self.size) - np.asarray(p), axis=1)
-            if np.nanmin(d_joint) < d_grip:
-                return False
+        # Handles that overlap on screen: the nearer one wins (the curve's point, the joints at a key, the spacing handle).
+        d_grip = float(np.linalg.norm(self.camera.project(tip, *self.size)[0] - np.asarray(p)))
+        others = np.vstack([self.joint_positions() if self.key_index() is not None else self.spacing_handle()[None],
+                            self.trajectory()[self.frame][None]])  # fmt: skip
+        if np.nanmin(np.linalg.norm(self.camera.project(others, *self.size) - np.asarray(p), axis=1)) < d_grip:
+            return False
         self.gesture = _Gesture("orient", self.frame, tip[0], p, key=-1 if self.key_index() is None else int(self.key_index()))
         self._turn_from = (rot[0], self.trajectory()[self.frame])
         return True
@@ -298,6 +297,9 @@ class CurvesScene:
         if g.kind == "orient":
             self._orient(g, float(px), float(py))
             return
+        if g.kind == "space":
+            self._space(g, float(px), commit=False)
+            return
         target = point_on_view_plane(self.camera, self.size, (float(px), float(py)), g.anchor)
         if g.kind == "pose":
             res = self.session.pose(g.key, self.joint, target, commit=False)
@@ -327,6 +329,10 @@ class CurvesScene:
         if g.kind == "key":
             self.session.cancel_preview()
             self._move_key(g, px, commit=True)
+            return
+        if g.kind == "space":
+            self.session.cancel_preview()
+            self._space(g, float(px), commit=True)
             return
         t = float(self.frame_times()[g.frame])
         if g.kind == "retime":

@@ -309,10 +309,16 @@ class CurveSession:
             clip, self.preview = self.preview, None
             self._push(clip, self.holds, label)
 
-    def retime(self, time: float, sigma: float) -> None:
-        """Eq. 4.12 at ``time`` by ``σ`` seconds of tangent length (one undo step)."""
+    def retime(self, time: float, sigma: float, commit: bool = True) -> None:
+        """Eq. 4.12 at ``time`` by ``σ`` seconds of tangent length (the preview, or one undo step)."""
         c = self.state.clip
-        self._push(replace(c, curves=retime_segment(c.curves, time, sigma)), self.holds, f"retime {sigma:+.3f}")
+        clip = replace(c, curves=retime_segment(c.curves, time, sigma))
+        if commit:
+            self.preview = None
+            self._push(clip, self.holds, f"retime {sigma:+.3f}")
+        else:
+            self.preview = clip
+            self.revision += 1
 
     def toggle_hold(self, joint: str, first: int, last: int, contact: bool = False) -> None:
         """Add a pin/contact on ``joint`` over frames, or remove the one it has (one undo step)."""

@@ -117,6 +117,23 @@ def test_the_orientation_grip_turns_the_joint_in_place_between_keys_and_at_a_key
     assert rest.history[-1] == "turn l_hand@30" and np.degrees(quat.angle_between(before, after)) > 20.0
 
 
+def test_the_spacing_handle_scales_the_timing_at_the_frame():
+    """Fig. 4.4 right: dragging the magenta handle under the current frame to the right moves the frames apart
+    there (Eq. 4.12, σ > 0): the time tangents around it lengthen and the undo restores them."""
+    session = CurveSession.from_spec("walk")
+    scene = CurvesScene(session, (1280, 720))
+    scene.frame = 15
+    before = session.clip.curves
+    px = scene.camera.project(scene.spacing_handle()[None], 1280, 720)[0]
+    for op in (["press", *px, False], ["move", px[0] + 50, px[1]], ["release", px[0] + 50, px[1]]):
+        scene.apply(op)
+    after = session.clip.curves
+    assert session.history == ["retime +0.010"]
+    assert after.out_x[2].min() > before.out_x[2].max() - 1e-12 and np.all(after.in_x[3] >= before.in_x[3])
+    assert np.any(after.out_x[2] > before.out_x[2]) and np.array_equal(after.values, before.values)
+    assert session.undo() and session.clip.curves is before
+
+
 def test_the_camera_frames_the_whole_puppet_in_a_small_window():
     """Issue 38: the head was cropped. Every capsule surface point of the walk, at every frame,
     projects inside the window, below the panel's three lines and above the timeline."""
