@@ -15,20 +15,30 @@ one contour search per group). Then:
 A saved file reopens here (``author flow FILE``) and bends the game:
 ``puppetphone play snowman --flow FILE``. ``--script row|centre|demo`` performs the
 thesis' kinds of edit with a scripted pointer (tests, screenshots, the figures of
-Table 3.1: it prints the clicks and solve times) and saves at the end.
+Table 3.1: it prints the clicks and solve times) and saves at the end. ``--record FILE``
+records the session (pointer and keys as tool operations, every step's state hash: the edits
+and the bent scenery); ``puppetphone replay FILE --verify`` rebuilds the scene from the
+recording and repeats the edits.
 """
 
 from __future__ import annotations
 
 import argparse
+import base64
+import hashlib
 import math
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["configure_flow", "run_flow", "FlowActivity", "open_flow", "script_events", "SCRIPTS"]
+__all__ = ["configure_flow", "run_flow", "FlowActivity", "open_flow", "script_events", "SCRIPTS", "FLOW_GAME",
+           "replay_flow", "flow_digest"]
+
+#: The name a flow session's recording gives as its game.
+FLOW_GAME = "author-flow"
 
 SCRIPTS = ("row", "centre", "demo")
 _CENTRE_GRAB = 18.0  # pixels: a press this close to the centre-point drags it
@@ -45,6 +55,8 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--script", choices=SCRIPTS, default=None,
                         help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "
                              "sketched then dragged; demo: both) and the result is saved")
+    parser.add_argument("--record", type=output_file, default=None,
+                        help="record the session (pointer, keys, every step's state) to replay it later")
     add_run_arguments(parser, screenshot_at=True)
 
 
@@ -102,16 +114,44 @@ def script_events(name: str) -> dict[int, list[tuple]]:  # type: ignore[type-arg
     return ops
 
 
+def flow_digest(activity) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+    """The session's state in parts: the edits, the bent scenery, the editor's own state (never a timing)."""
+    from engine.hashing import combine_parts
+
+    s = activity.session
+    edits = hashlib.blake2b(b"edits", digest_size=16)
+    for e in s.edits:
+        edits.update(f"{e.kind}|{e.d_max!r}".encode())
+        edits.update(np.ascontiguousarray(e.points, dtype=np.float64).tobytes())
+    bent = hashlib.blake2b(b"bent", digest_size=16)
+    for key in sorted(s.result.vertices):
+        bent.update(str(key).encode())
+        bent.update(np.ascontiguousarray(s.result.vertices[key], dtype=np.float64).tobytes())
+    ui = hashlib.blake2b(b"editor", digest_size=16)
+    stroke = np.asarray(activity.stroke or [], dtype=np.float64)
+    ui.update(stroke.tobytes())
+    ui.update(f"{activity.show_securves}|{activity.dragging_centre}|{activity.clicks}|{activity.strokes}".encode())
+    return combine_parts([("edits", edits), ("bent", bent), ("editor", ui)])
+
+
 class FlowActivity:
-    """The flow editor as the runner's activity: pointer and keys are queued and applied each step."""
+    """The flow editor as the runner's activity: pointer and keys reach it as tool operations through the hub.
+
+    Operations (a hand's or a script's) are queued with the hub and applied at the next step,
+    so a session records like a game and replays to the same bent scene. A replay saves nothing.
+    """
 
     dt = 1.0 / 60.0
 
-    def __init__(self, session, output: Path | None, script: str | None = None) -> None:  # type: ignore[no-untyped-def]
+    def __init__(self, session, output: Path | None, script: str | None = None, *, hub=None,  # type: ignore[no-untyped-def]
+                 recorder=None, check=None) -> None:  # fmt: skip
+        from input.hub import InputHub
+
         self.session, self.output = session, output
+        self.hub = hub if hub is not None else InputHub()
+        self.recorder, self.check = recorder, check
         self.camera = session.scene.camera
         self.frame = 0
-        self.queue: list[tuple] = []  # type: ignore[type-arg]
         self.script = script_events(script) if script else {}
         self.script_end = max(self.script) + 1 if self.script else 0
         self.stroke: list[tuple[float, float]] | None = None
@@ -123,20 +163,22 @@ class FlowActivity:
         self.message = ""
 
     def finished(self) -> bool:
-        return False
+        if self.check is not None and not self.check.ok:
+            return True
+        return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
 
     def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
         """Pointer and keys become queued operations (Esc and P stay the runner's)."""
         import pygame
 
         if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 1:
-            self.queue.append(("press", float(ev.pos[0]), float(ev.pos[1]), bool(pygame.key.get_mods() & pygame.KMOD_SHIFT)))
+            self.hub.tool("press", float(ev.pos[0]), float(ev.pos[1]), bool(pygame.key.get_mods() & pygame.KMOD_SHIFT))
         elif ev.type == pygame.MOUSEMOTION and ev.buttons[0]:
-            self.queue.append(("move", float(ev.pos[0]), float(ev.pos[1])))
+            self.hub.tool("move", float(ev.pos[0]), float(ev.pos[1]))
         elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 1:
-            self.queue.append(("release", float(ev.pos[0]), float(ev.pos[1])))
+            self.hub.tool("release", float(ev.pos[0]), float(ev.pos[1]))
         elif ev.type == pygame.KEYDOWN and ev.key not in (pygame.K_ESCAPE, pygame.K_p):
-            self.queue.append(("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL)))
+            self.hub.tool("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL))
         else:
             return False
         return True
@@ -200,7 +242,8 @@ class FlowActivity:
         elif ctrl and name == "y":
             self.message = "redone" if s.redo() else "nothing to redo"
         elif ctrl and name == "s":
-            self.save()
+            if self.check is None:  # a replay saves nothing
+                self.save()
         elif name == "tab":
             self.show_securves = not self.show_securves
         elif name in ("[", "]"):
@@ -220,11 +263,21 @@ class FlowActivity:
             self.message = save_or_say(lambda: save_flow(self.session, self.output), self.output)
 
     def step(self) -> None:
-        ops, self.queue = self.script.get(self.frame, []) + self.queue, []
-        for op in ops:
-            self.apply(op)
+        for op in self.script.get(self.frame, []):
+            self.hub.tool(*op)
+        frame = self.hub.drain(self.frame)
+        for op in frame.tool_operations():
+            try:
+                self.apply(tuple(op))
+            except (IndexError, TypeError):
+                raise ValueError(f"tool operation {list(op)} does not fit the flow editor") from None
         if self.script and self.frame + 1 == self.script_end:
             self.save()
+        digest, parts = flow_digest(self)
+        if self.recorder is not None:
+            self.recorder.write(frame, digest, parts)
+        if self.check is not None:
+            self.check.check(self.frame, digest, parts)
         self.frame += 1
 
     def figures(self) -> str:
@@ -269,7 +322,13 @@ def run_flow(args: argparse.Namespace) -> int:
         runner.close()
         print(f"author flow: {exc}", file=sys.stderr)
         return 2
-    activity = FlowActivity(session, args.output or default_out, args.script)
+    recorder = None
+    if args.record is not None:
+        from input.recording import Recorder, RecordingHeader
+
+        recorder = Recorder(args.record, RecordingHeader(game=FLOW_GAME, seed=0, dt=FlowActivity.dt, sources=["mouse"],
+                                                         setup=_setup(args.flow_scene, runner.size)))  # fmt: skip
+    activity = FlowActivity(session, args.output or default_out, args.script, recorder=recorder)
     runner.push_handlers(activity)
     try:
         result = runner.run(activity)
@@ -280,4 +339,40 @@ def run_flow(args: argparse.Namespace) -> int:
             print(activity.message)
     finally:
         runner.close()
+        if recorder is not None:
+            recorder.close()
+            print(f"recorded {recorder.frames} steps to {recorder.path}", file=sys.stderr)
     return 0
+
+
+def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
+    """What a recording needs to rebuild the scene: a scene's name, or a flow file's bytes (never its path)."""
+    setup: dict[str, object] = {"scene": spec, "size": list(size), "file": ""}
+    if spec not in ("snowman", "tasbada"):
+        setup["file"] = base64.b64encode(Path(spec).read_bytes()).decode()
+    return setup
+
+
+def replay_flow(recording, verify: bool = True) -> FlowActivity:  # type: ignore[no-untyped-def]
+    """The recorded flow session, rebuilt from the recording alone, checking every step."""
+    from input.hub import InputHub
+    from input.replay import HashCheck, ReplaySource
+
+    setup = recording.header.setup
+    size = setup.get("size") if isinstance(setup, dict) else None
+    if not (isinstance(size, list) and len(size) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)):
+        raise ValueError("the recorded window size is not two whole numbers in 1..16384")
+    if not isinstance(setup.get("scene"), str) or not isinstance(setup.get("file", ""), str):
+        raise ValueError("the recorded flow scene is not text")
+    if setup.get("file"):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "recorded.flow.json"
+            path.write_bytes(base64.b64decode(str(setup["file"])))
+            session, _ = open_flow(str(path), (int(size[0]), int(size[1])))
+    elif setup["scene"] == "snowman":
+        session, _ = open_flow("snowman", (int(size[0]), int(size[1])))
+    else:
+        raise ValueError(f"the recording names the scene {str(setup['scene'])[:60]!r} without carrying it")
+    return FlowActivity(session, None, hub=InputHub(replay=ReplaySource(recording)),
+                        check=HashCheck(recording) if verify else None)  # fmt: skip
