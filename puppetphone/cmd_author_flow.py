@@ -14,8 +14,8 @@ one contour search per group). Then:
 
 A saved file reopens here (``author flow FILE``) and bends the game:
 ``puppetphone play snowman --flow FILE``. ``--script row|centre|demo`` performs the
-thesis' kinds of edit with a scripted pointer (tests, screenshots, the figures of
-Table 3.1: it prints the clicks and solve times) and saves at the end. ``--record FILE``
+thesis' kinds of edit with a scripted pointer (tests, screenshots, ``bench flow``'s
+operations per edit: it prints the clicks and solve times) and saves at the end. ``--record FILE``
 records the session (pointer and keys as tool operations, every step's state hash: the edits
 and the bent scenery); ``puppetphone replay FILE --verify`` rebuilds the scene from the
 recording and repeats the edits.
@@ -281,7 +281,7 @@ class FlowActivity:
         self.frame += 1
 
     def figures(self) -> str:
-        """Clicks, strokes and solve times so far (item 7: comparable with Table 3.1)."""
+        """Clicks, strokes and solve times so far (operations of this session; no human study is compared)."""
         r = self.session.result
         med = float(np.median(self.solve_ms)) if self.solve_ms else 0.0
         return (f"{len(self.session.edits)} edits, {self.strokes} strokes, {self.clicks} clicks; "
