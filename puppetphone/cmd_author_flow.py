@@ -60,9 +60,8 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     add_run_arguments(parser, screenshot_at=True)
 
 
-def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[no-untyped-def]
-    """A session of a named scene or of a saved flow file (its edits re-applied), and its default output."""
-    from authoring.flowcurves.session import FlowSession
+def flow_setup(spec: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
+    """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet)."""
     from authoring.flowcurves.storage import load_flow
     from engine.camera import OrbitCamera
     from games.snowman.bent_scenery import flow_scene
@@ -75,15 +74,28 @@ def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[
         scene = flow_scene(tuple(doc["size"]))
         cam = doc["camera"]
         scene.camera = OrbitCamera(target=cam["target"], yaw=cam["yaw"], pitch=cam["pitch"], distance=cam["distance"])
-        session = FlowSession(scene, progress=progress)
-        for e in doc["edits"]:
-            session.add(e["kind"], e["points"], e["d_max"])
-        return session, path
+        return scene, path, doc["edits"]
     if spec == "tasbada":
         raise ValueError("tasbada has no flow scene yet: its props are drawn by the quest, not as static scenery")
     if spec != "snowman":
         raise ValueError(f"{spec!r} is neither a scene (snowman) nor a flow file")
-    return FlowSession(flow_scene(size), progress=progress), Path("snowman.flow.json")
+    return flow_scene(size), Path("snowman.flow.json"), []
+
+
+def build_session(scene, edits, progress=None, securves=None):  # type: ignore[no-untyped-def]
+    """The session of ``scene`` (its SEcurves found, unless given: the slow part) with ``edits`` re-applied."""
+    from authoring.flowcurves.session import FlowSession
+
+    session = FlowSession(scene, securves=securves, progress=progress)
+    for e in edits:
+        session.add(e["kind"], e["points"], e["d_max"])
+    return session
+
+
+def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[no-untyped-def]
+    """A session of a named scene or of a saved flow file (its edits re-applied), and its default output."""
+    scene, out, edits = flow_setup(spec, size)
+    return build_session(scene, edits, progress), out
 
 
 def _circle(centre: tuple[float, float], radius: float, n: int = 24) -> list[tuple[float, float]]:
@@ -147,7 +159,12 @@ class FlowActivity:
                  recorder=None, check=None) -> None:  # fmt: skip
         from input.hub import InputHub
 
-        self.session, self.output = session, output
+        from authoring.flowcurves.background import BackgroundSession
+
+        # ``session`` may still be building on a thread: no input is applied and no step counted until it is whole.
+        self.building = session if isinstance(session, BackgroundSession) else None
+        self.session = None if self.building is not None else session
+        self.output = output
         self.hub = hub if hub is not None else InputHub()
         self.recorder, self.check = recorder, check
         self.camera = session.scene.camera
@@ -165,6 +182,9 @@ class FlowActivity:
     def finished(self) -> bool:
         if self.check is not None and not self.check.ok:
             return True
+        if self.session is None and self.building is not None and self.building.done():
+            self._take_built()
+            return self.session is None  # the build failed: its error is the message
         return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
 
     def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
@@ -262,7 +282,19 @@ class FlowActivity:
         if self.output is not None:
             self.message = save_or_say(lambda: save_flow(self.session, self.output), self.output)
 
+    def _take_built(self) -> None:
+        try:
+            self.session = self.building.result()  # type: ignore[union-attr]
+        except Exception as exc:  # noqa: BLE001 - the build's error, said once
+            self.message = f"cannot find the SEcurves: {exc}"
+
     def step(self) -> None:
+        if self.session is None:
+            if self.building is None or not self.building.done():
+                return  # still building: the hub keeps what was typed for the first real step
+            self._take_built()
+            if self.session is None:
+                return
         for op in self.script.get(self.frame, []):
             self.hub.tool(*op)
         frame = self.hub.drain(self.frame)
@@ -282,6 +314,8 @@ class FlowActivity:
 
     def figures(self) -> str:
         """Clicks, strokes and solve times so far (operations of this session; no human study is compared)."""
+        if self.session is None:
+            return self.building.text if self.building is not None else ""
         r = self.session.result
         med = float(np.median(self.solve_ms)) if self.solve_ms else 0.0
         return (f"{len(self.session.edits)} edits, {self.strokes} strokes, {self.clicks} clicks; "
@@ -289,9 +323,12 @@ class FlowActivity:
                 f"factorisation), {len(r.vertices)} objects moved")
 
     def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
-        from authoring.flowcurves.view import draw_session
+        from authoring.flowcurves.view import draw_objects, draw_session
 
-        draw_session(scene, self.session, self.show_securves, self.stroke)
+        if self.session is None:  # the rest scene while its SEcurves are found, never a black window
+            draw_objects(scene, self.building.scene.objects if self.building is not None else [])
+        else:
+            draw_session(scene, self.session, self.show_securves, self.stroke)
         scene.add_text("Flow Curves — drag: stroke · circle: centre-point · Shift+drag: SEcurve · "
                        "Ctrl+Z/Y undo/redo · Ctrl+S save · Tab SEcurves", size=16)
         scene.add_text(self.figures(), size=16)
@@ -317,7 +354,13 @@ def run_flow(args: argparse.Namespace) -> int:
         print(f"SEcurves: {k + 1}/{n} {name}", file=sys.stderr, flush=True)
 
     try:
-        session, default_out = open_flow(args.flow_scene, runner.size, progress)
+        scene, default_out, edits = flow_setup(args.flow_scene, runner.size)
+        if args.headless:  # no window to keep alive: build it here
+            session = build_session(scene, edits, progress)
+        else:  # the window opens on the rest scene and shows the progress while the SEcurves are found
+            from authoring.flowcurves.background import BackgroundSession
+
+            session = BackgroundSession(scene, lambda found: build_session(scene, edits, securves=found))
     except (ValueError, OSError, FlowFileError) as exc:
         runner.close()
         print(f"author flow: {exc}", file=sys.stderr)
@@ -337,8 +380,12 @@ def run_flow(args: argparse.Namespace) -> int:
         print(activity.figures())
         if activity.message:
             print(activity.message)
+        if activity.session is None and activity.building is not None and activity.building.done():
+            return 2  # the SEcurves could not be found: said above
     finally:
         runner.close()
+        if activity.building is not None:
+            activity.building.stop()
         if recorder is not None:
             recorder.close()
             print(f"recorded {recorder.frames} steps to {recorder.path}", file=sys.stderr)
