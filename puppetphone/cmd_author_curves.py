@@ -139,6 +139,9 @@ class CurvesActivity:
         except pygame.error:
             mods = 0
         shift, ctrl = bool(mods & pygame.KMOD_SHIFT), bool(mods & pygame.KMOD_CTRL)
+        pointer = (pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEMOTION, pygame.MOUSEWHEEL)
+        if self._script is not None and (ev.type in pointer or (ev.type == pygame.KEYDOWN and ev.key != pygame.K_ESCAPE)):
+            return True  # a script is the hand: the real pointer (a window opening under it) must not join in
         if ev.type == pygame.MOUSEBUTTONDOWN and ev.button in (1, 3):
             self._queue(["press", ev.pos[0], ev.pos[1], shift or ev.button == 3])
         elif ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 2:
