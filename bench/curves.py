@@ -1,4 +1,6 @@
-"""Thesis Table 4.3 like for like: tangent-space solves by degrees of freedom, interpolation length and constraints.
+"""Thesis Tables 4.3 and 4.1 like for like (4.1: :mod:`bench.curves_keys`, the keys to reach a motion).
+
+Table 4.3: tangent-space solves by degrees of freedom, interpolation length and constraints.
 
 Grid: 24/72/120/168 degrees of freedom × 2/7/20-frame interpolations × the six constraint
 configurations of Table 4.3, in the order of its six tables: no constraint; one pin high
@@ -27,7 +29,7 @@ import time
 
 import numpy as np
 
-from authoring.keyframe_curves import Drag, Hold, TangentSolver
+from authoring.keyframe_curves import CurveSettings, Drag, Hold, TangentSolver
 from bench.figures import Figure
 from engine.ik import IKRig
 from engine.keyframes import BezierCurves, KeyframedClip
@@ -129,7 +131,8 @@ def build_case(config: str, dof: int, frames: int, seed: int = 0) -> tuple[Tange
     iy[:, frozen] = 0.0
     clip = KeyframedClip("bench", sk, BezierCurves(times, values, ox, oy, ix, iy), fps=FPS)
     rig = IKRig.build(sk, limits={n: (-LIMIT, LIMIT) for n in sk.names}, root_translation=True)
-    solver = TangentSolver(clip, rig, frozen=frozen)
+    # One segment's tangents, as Table 4.3 times them (every tangent broken: none linked to a neighbour).
+    solver = TangentSolver(clip, rig, CurveSettings(linked_tangents=False), frozen=frozen)
     t = (1.5 * frames) / FPS
     # Pins over the whole clip; a contact between the two keys of the dragged segment (§4.2.2).
     hold_list = [Hold(j, frames, 2 * frames, contact=True, point=TIP) if c else Hold(j, 0, 3 * frames, point=TIP)
@@ -187,4 +190,6 @@ def run() -> list[Figure]:
         figures.append(Figure("curves", f"curves_error_mm_{config}", float(np.max(err)), "mm", "tolerance", 0.1))
         if config != "none":
             figures.append(Figure("curves", f"curves_hold_error_mm_{config}", float(np.max(held)), "mm", "epsilon", 0.1))
-    return figures
+    from bench import curves_keys
+
+    return figures + curves_keys.run()  # Table 4.1 like for like: keys to reach a motion

@@ -14,21 +14,31 @@ one contour search per group). Then:
 
 A saved file reopens here (``author flow FILE``) and bends the game:
 ``puppetphone play snowman --flow FILE``. ``--script row|centre|demo`` performs the
-thesis' kinds of edit with a scripted pointer (tests, screenshots, the figures of
-Table 3.1: it prints the clicks and solve times) and saves at the end.
+thesis' kinds of edit with a scripted pointer (tests, screenshots, ``bench flow``'s
+operations per edit: it prints the clicks and solve times) and saves at the end. ``--record FILE``
+records the session (pointer and keys as tool operations, every step's state hash: the edits
+and the bent scenery); ``puppetphone replay FILE --verify`` rebuilds the scene from the
+recording and repeats the edits.
 """
 
 from __future__ import annotations
 
 import argparse
+import base64
+import hashlib
 import math
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["configure_flow", "run_flow", "FlowActivity", "open_flow", "script_events", "SCRIPTS"]
+__all__ = ["configure_flow", "run_flow", "FlowActivity", "open_flow", "script_events", "SCRIPTS", "FLOW_GAME",
+           "replay_flow", "flow_digest"]
+
+#: The name a flow session's recording gives as its game.
+FLOW_GAME = "author-flow"
 
 SCRIPTS = ("row", "centre", "demo")
 _CENTRE_GRAB = 18.0  # pixels: a press this close to the centre-point drags it
@@ -45,12 +55,13 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--script", choices=SCRIPTS, default=None,
                         help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "
                              "sketched then dragged; demo: both) and the result is saved")
+    parser.add_argument("--record", type=output_file, default=None,
+                        help="record the session (pointer, keys, every step's state) to replay it later")
     add_run_arguments(parser, screenshot_at=True)
 
 
-def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[no-untyped-def]
-    """A session of a named scene or of a saved flow file (its edits re-applied), and its default output."""
-    from authoring.flowcurves.session import FlowSession
+def flow_setup(spec: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
+    """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet)."""
     from authoring.flowcurves.storage import load_flow
     from engine.camera import OrbitCamera
     from games.snowman.bent_scenery import flow_scene
@@ -63,15 +74,28 @@ def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[
         scene = flow_scene(tuple(doc["size"]))
         cam = doc["camera"]
         scene.camera = OrbitCamera(target=cam["target"], yaw=cam["yaw"], pitch=cam["pitch"], distance=cam["distance"])
-        session = FlowSession(scene, progress=progress)
-        for e in doc["edits"]:
-            session.add(e["kind"], e["points"], e["d_max"])
-        return session, path
+        return scene, path, doc["edits"]
     if spec == "tasbada":
         raise ValueError("tasbada has no flow scene yet: its props are drawn by the quest, not as static scenery")
     if spec != "snowman":
         raise ValueError(f"{spec!r} is neither a scene (snowman) nor a flow file")
-    return FlowSession(flow_scene(size), progress=progress), Path("snowman.flow.json")
+    return flow_scene(size), Path("snowman.flow.json"), []
+
+
+def build_session(scene, edits, progress=None, securves=None):  # type: ignore[no-untyped-def]
+    """The session of ``scene`` (its SEcurves found, unless given: the slow part) with ``edits`` re-applied."""
+    from authoring.flowcurves.session import FlowSession
+
+    session = FlowSession(scene, securves=securves, progress=progress)
+    for e in edits:
+        session.add(e["kind"], e["points"], e["d_max"])
+    return session
+
+
+def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[no-untyped-def]
+    """A session of a named scene or of a saved flow file (its edits re-applied), and its default output."""
+    scene, out, edits = flow_setup(spec, size)
+    return build_session(scene, edits, progress), out
 
 
 def _circle(centre: tuple[float, float], radius: float, n: int = 24) -> list[tuple[float, float]]:
@@ -102,16 +126,49 @@ def script_events(name: str) -> dict[int, list[tuple]]:  # type: ignore[type-arg
     return ops
 
 
+def flow_digest(activity) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+    """The session's state in parts: the edits, the bent scenery, the editor's own state (never a timing)."""
+    from engine.hashing import combine_parts
+
+    s = activity.session
+    edits = hashlib.blake2b(b"edits", digest_size=16)
+    for e in s.edits:
+        edits.update(f"{e.kind}|{e.d_max!r}".encode())
+        edits.update(np.ascontiguousarray(e.points, dtype=np.float64).tobytes())
+    bent = hashlib.blake2b(b"bent", digest_size=16)
+    for key in sorted(s.result.vertices):
+        bent.update(str(key).encode())
+        bent.update(np.ascontiguousarray(s.result.vertices[key], dtype=np.float64).tobytes())
+    ui = hashlib.blake2b(b"editor", digest_size=16)
+    stroke = np.asarray(activity.stroke or [], dtype=np.float64)
+    ui.update(stroke.tobytes())
+    ui.update(f"{activity.show_securves}|{activity.dragging_centre}|{activity.clicks}|{activity.strokes}".encode())
+    return combine_parts([("edits", edits), ("bent", bent), ("editor", ui)])
+
+
 class FlowActivity:
-    """The flow editor as the runner's activity: pointer and keys are queued and applied each step."""
+    """The flow editor as the runner's activity: pointer and keys reach it as tool operations through the hub.
+
+    Operations (a hand's or a script's) are queued with the hub and applied at the next step,
+    so a session records like a game and replays to the same bent scene. A replay saves nothing.
+    """
 
     dt = 1.0 / 60.0
 
-    def __init__(self, session, output: Path | None, script: str | None = None) -> None:  # type: ignore[no-untyped-def]
-        self.session, self.output = session, output
+    def __init__(self, session, output: Path | None, script: str | None = None, *, hub=None,  # type: ignore[no-untyped-def]
+                 recorder=None, check=None) -> None:  # fmt: skip
+        from input.hub import InputHub
+
+        from authoring.flowcurves.background import BackgroundSession
+
+        # ``session`` may still be building on a thread: no input is applied and no step counted until it is whole.
+        self.building = session if isinstance(session, BackgroundSession) else None
+        self.session = None if self.building is not None else session
+        self.output = output
+        self.hub = hub if hub is not None else InputHub()
+        self.recorder, self.check = recorder, check
         self.camera = session.scene.camera
         self.frame = 0
-        self.queue: list[tuple] = []  # type: ignore[type-arg]
         self.script = script_events(script) if script else {}
         self.script_end = max(self.script) + 1 if self.script else 0
         self.stroke: list[tuple[float, float]] | None = None
@@ -123,20 +180,25 @@ class FlowActivity:
         self.message = ""
 
     def finished(self) -> bool:
-        return False
+        if self.check is not None and not self.check.ok:
+            return True
+        if self.session is None and self.building is not None and self.building.done():
+            self._take_built()
+            return self.session is None  # the build failed: its error is the message
+        return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
 
     def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
         """Pointer and keys become queued operations (Esc and P stay the runner's)."""
         import pygame
 
         if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 1:
-            self.queue.append(("press", float(ev.pos[0]), float(ev.pos[1]), bool(pygame.key.get_mods() & pygame.KMOD_SHIFT)))
+            self.hub.tool("press", float(ev.pos[0]), float(ev.pos[1]), bool(pygame.key.get_mods() & pygame.KMOD_SHIFT))
         elif ev.type == pygame.MOUSEMOTION and ev.buttons[0]:
-            self.queue.append(("move", float(ev.pos[0]), float(ev.pos[1])))
+            self.hub.tool("move", float(ev.pos[0]), float(ev.pos[1]))
         elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 1:
-            self.queue.append(("release", float(ev.pos[0]), float(ev.pos[1])))
+            self.hub.tool("release", float(ev.pos[0]), float(ev.pos[1]))
         elif ev.type == pygame.KEYDOWN and ev.key not in (pygame.K_ESCAPE, pygame.K_p):
-            self.queue.append(("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL)))
+            self.hub.tool("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL))
         else:
             return False
         return True
@@ -200,7 +262,8 @@ class FlowActivity:
         elif ctrl and name == "y":
             self.message = "redone" if s.redo() else "nothing to redo"
         elif ctrl and name == "s":
-            self.save()
+            if self.check is None:  # a replay saves nothing
+                self.save()
         elif name == "tab":
             self.show_securves = not self.show_securves
         elif name in ("[", "]"):
@@ -219,16 +282,40 @@ class FlowActivity:
         if self.output is not None:
             self.message = save_or_say(lambda: save_flow(self.session, self.output), self.output)
 
+    def _take_built(self) -> None:
+        try:
+            self.session = self.building.result()  # type: ignore[union-attr]
+        except Exception as exc:  # noqa: BLE001 - the build's error, said once
+            self.message = f"cannot find the SEcurves: {exc}"
+
     def step(self) -> None:
-        ops, self.queue = self.script.get(self.frame, []) + self.queue, []
-        for op in ops:
-            self.apply(op)
+        if self.session is None:
+            if self.building is None or not self.building.done():
+                return  # still building: the hub keeps what was typed for the first real step
+            self._take_built()
+            if self.session is None:
+                return
+        for op in self.script.get(self.frame, []):
+            self.hub.tool(*op)
+        frame = self.hub.drain(self.frame)
+        for op in frame.tool_operations():
+            try:
+                self.apply(tuple(op))
+            except (IndexError, TypeError):
+                raise ValueError(f"tool operation {list(op)} does not fit the flow editor") from None
         if self.script and self.frame + 1 == self.script_end:
             self.save()
+        digest, parts = flow_digest(self)
+        if self.recorder is not None:
+            self.recorder.write(frame, digest, parts)
+        if self.check is not None:
+            self.check.check(self.frame, digest, parts)
         self.frame += 1
 
     def figures(self) -> str:
-        """Clicks, strokes and solve times so far (item 7: comparable with Table 3.1)."""
+        """Clicks, strokes and solve times so far (operations of this session; no human study is compared)."""
+        if self.session is None:
+            return self.building.text if self.building is not None else ""
         r = self.session.result
         med = float(np.median(self.solve_ms)) if self.solve_ms else 0.0
         return (f"{len(self.session.edits)} edits, {self.strokes} strokes, {self.clicks} clicks; "
@@ -236,9 +323,12 @@ class FlowActivity:
                 f"factorisation), {len(r.vertices)} objects moved")
 
     def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
-        from authoring.flowcurves.view import draw_session
+        from authoring.flowcurves.view import draw_objects, draw_session
 
-        draw_session(scene, self.session, self.show_securves, self.stroke)
+        if self.session is None:  # the rest scene while its SEcurves are found, never a black window
+            draw_objects(scene, self.building.scene.objects if self.building is not None else [])
+        else:
+            draw_session(scene, self.session, self.show_securves, self.stroke)
         scene.add_text("Flow Curves — drag: stroke · circle: centre-point · Shift+drag: SEcurve · "
                        "Ctrl+Z/Y undo/redo · Ctrl+S save · Tab SEcurves", size=16)
         scene.add_text(self.figures(), size=16)
@@ -264,12 +354,24 @@ def run_flow(args: argparse.Namespace) -> int:
         print(f"SEcurves: {k + 1}/{n} {name}", file=sys.stderr, flush=True)
 
     try:
-        session, default_out = open_flow(args.flow_scene, runner.size, progress)
+        scene, default_out, edits = flow_setup(args.flow_scene, runner.size)
+        if args.headless:  # no window to keep alive: build it here
+            session = build_session(scene, edits, progress)
+        else:  # the window opens on the rest scene and shows the progress while the SEcurves are found
+            from authoring.flowcurves.background import BackgroundSession
+
+            session = BackgroundSession(scene, lambda found: build_session(scene, edits, securves=found))
     except (ValueError, OSError, FlowFileError) as exc:
         runner.close()
         print(f"author flow: {exc}", file=sys.stderr)
         return 2
-    activity = FlowActivity(session, args.output or default_out, args.script)
+    recorder = None
+    if args.record is not None:
+        from input.recording import Recorder, RecordingHeader
+
+        recorder = Recorder(args.record, RecordingHeader(game=FLOW_GAME, seed=0, dt=FlowActivity.dt, sources=["mouse"],
+                                                         setup=_setup(args.flow_scene, runner.size)))  # fmt: skip
+    activity = FlowActivity(session, args.output or default_out, args.script, recorder=recorder)
     runner.push_handlers(activity)
     try:
         result = runner.run(activity)
@@ -278,6 +380,46 @@ def run_flow(args: argparse.Namespace) -> int:
         print(activity.figures())
         if activity.message:
             print(activity.message)
+        if activity.session is None and activity.building is not None and activity.building.done():
+            return 2  # the SEcurves could not be found: said above
     finally:
         runner.close()
+        if activity.building is not None:
+            activity.building.stop()
+        if recorder is not None:
+            recorder.close()
+            print(f"recorded {recorder.frames} steps to {recorder.path}", file=sys.stderr)
     return 0
+
+
+def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
+    """What a recording needs to rebuild the scene: a scene's name, or a flow file's bytes (never its path)."""
+    setup: dict[str, object] = {"scene": spec, "size": list(size), "file": ""}
+    if spec not in ("snowman", "tasbada"):
+        setup["file"] = base64.b64encode(Path(spec).read_bytes()).decode()
+    return setup
+
+
+def replay_flow(recording, verify: bool = True) -> FlowActivity:  # type: ignore[no-untyped-def]
+    """The recorded flow session, rebuilt from the recording alone, checking every step."""
+    from input.hub import InputHub
+    from input.replay import HashCheck, ReplaySource
+
+    setup = recording.header.setup
+    size = setup.get("size") if isinstance(setup, dict) else None
+    if not (isinstance(size, list) and len(size) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)):
+        raise ValueError("the recorded window size is not two whole numbers in 1..16384")
+    if not isinstance(setup.get("scene"), str) or not isinstance(setup.get("file", ""), str):
+        raise ValueError("the recorded flow scene is not text")
+    if setup.get("file"):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "recorded.flow.json"
+            path.write_bytes(base64.b64decode(str(setup["file"])))
+            session, _ = open_flow(str(path), (int(size[0]), int(size[1])))
+    elif setup["scene"] == "snowman":
+        session, _ = open_flow("snowman", (int(size[0]), int(size[1])))
+    else:
+        raise ValueError(f"the recording names the scene {str(setup['scene'])[:60]!r} without carrying it")
+    return FlowActivity(session, None, hub=InputHub(replay=ReplaySource(recording)),
+                        check=HashCheck(recording) if verify else None)  # fmt: skip

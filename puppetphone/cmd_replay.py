@@ -43,7 +43,9 @@ def run(args: argparse.Namespace) -> int:
     from input.replay import ReplaySource
     from input.hub import InputHub
     from puppetphone.cmd_author import RECORD_GAME
+    from puppetphone.cmd_author_curves import CURVES_GAME
     from puppetphone.cmd_author_edit import EDIT_GAME
+    from puppetphone.cmd_author_flow import FLOW_GAME
     from puppetphone.cmd_play import run_activity
     from puppetphone.games import load_game
     from puppetphone.runargs import run_options
@@ -63,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         level = "warning" if cut_short and args.allow_truncated else "error"
         print(f"{level}: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)
     h = rec.header
-    if h.game in (EDIT_GAME, RECORD_GAME):
+    if h.game in (EDIT_GAME, RECORD_GAME, CURVES_GAME, FLOW_GAME):
         return _replay_authoring(rec, args, cut_short)
     try:
         game = load_game(h.game)
@@ -82,16 +84,19 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _replay_authoring(rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
-    """An ``author edit`` or ``author record`` session: its clip reopened from the recording, the same input."""
+    """An ``author edit``, ``record``, ``curves`` or ``flow`` session: reopened from the recording, the same input."""
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
     from puppetphone.cmd_author import replay_record
+    from puppetphone.cmd_author_curves import CURVES_GAME, replay_curves
     from puppetphone.cmd_author_edit import EDIT_GAME, replay_edit
+    from puppetphone.cmd_author_flow import FLOW_GAME, replay_flow
     from puppetphone.runargs import run_options
 
+    replays = {EDIT_GAME: replay_edit, CURVES_GAME: replay_curves, FLOW_GAME: replay_flow}
     try:
-        activity = replay_edit(rec) if rec.header.game == EDIT_GAME else replay_record(rec)
-    except (ValueError, KeyError, TypeError, OSError) as exc:
+        activity = replays.get(rec.header.game, replay_record)(rec)
+    except (ValueError, KeyError, TypeError, OSError) as exc:  # (a flow file's own error is a ValueError)
         print(f"error: cannot reopen the recorded {rec.header.game} session: {exc}", file=sys.stderr)
         return 2
     runner = Runner(run_options(args, f"PuppetPhone — replay of {args.file}"))

@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from authoring.keyframe_curves import keys as key_ops
 from authoring.keyframe_curves.limits import retime_segment
+from authoring.keyframe_curves.posing import KeyPose, pose_key
 from authoring.keyframe_curves.solver import CurveEdit, Drag, Hold, TangentSolver, curve_rig
 from engine.atomic import atomic_write_bytes
 from engine.ik import humanoid_rig
@@ -34,6 +36,17 @@ MAX_SIDE_FILE = 64 * 1024 * 1024
 MAX_FPS = 1000.0  # as a clip file's
 MAX_FRAMES = 1_000_000  # baked frames (an hour at 240 fps is under)
 MAX_VALUE = 1e6  # key times (s), values (m, rad) and tangent handles: far beyond any real clip
+REST = "rest"  # the spec of a new clip holding the rest pose
+CLOSEST_HALVINGS = 4  # a drag out of reach keeps the farthest reachable point within 1/16 of the way
+
+
+def standing_root(skeleton) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Where the root stands so the rest pose's lowest joint touches the ground."""
+    from engine import quat
+    from engine.fk import forward_kinematics
+
+    pos, _ = forward_kinematics(skeleton, np.zeros(3), quat.identity(skeleton.num_joints))
+    return np.array([0.0, -float(pos[:, 1].min()), 0.0])
 
 
 class CurveFileError(ValueError):
@@ -127,18 +140,30 @@ class CurveSession:
         self.revision = 0
 
     @classmethod
-    def from_spec(cls, spec: str) -> CurveSession:
-        """A ``.ppclip`` (with its ``.ppkeys``, or keyed afresh every 3 frames) or a default clip's name."""
+    def from_spec(cls, spec: str, every: int | None = None, duration: float = 1.0) -> CurveSession:
+        """A ``.ppclip`` (with its ``.ppkeys``, or keyed afresh), a default clip's name, or ``rest``.
+
+        ``rest`` is a new looping clip of ``duration`` seconds holding the rest pose (two keys:
+        the seam); a clip without keys is keyed every ``every`` frames (default 3 for a file,
+        which reproduces its frames, and 6 for a default clip).
+        """
         from engine.clipfile import load_clip
         from engine.clips import default_clips
 
+        if every is not None and every < 3:
+            raise ValueError("keys need at least 3 frames between them (--every 3 or more)")
         p = Path(spec)
         if p.suffix.lower() == ".ppclip":
-            return cls(load_curves(p) if keys_path(p).exists() else keyframe_clip(load_clip(p), every=3))
+            return cls(load_curves(p) if keys_path(p).exists() else keyframe_clip(load_clip(p), every=every or 3))
         clips = default_clips()
+        if spec == REST:
+            skeleton = clips["walk"].skeleton
+            if not 0.1 <= duration <= 60.0:
+                raise ValueError(f"a new clip lasts 0.1…60 s, not {duration:g}")
+            return cls(key_ops.rest_clip(skeleton, "keyposes", duration, 60.0, True, root=standing_root(skeleton)))
         if spec not in clips:
-            raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)})")
-        return cls(keyframe_clip(clips[spec], every=6))
+            raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)}) nor {REST!r}")
+        return cls(keyframe_clip(clips[spec], every=every or 6))
 
     @property
     def state(self) -> _State:
@@ -181,17 +206,102 @@ class CurveSession:
 
     def drag(self, joint: str, time: float, *, position: ArrayLike | None = None,
              orientation: ArrayLike | None = None, commit: bool = True) -> CurveEdit:  # fmt: skip
-        """One drag from the current state; a reached one becomes the preview (and an undo step if ``commit``)."""
+        """One drag from the current state, shown as the preview (and an undo step if ``commit``).
+
+        A target the solver cannot meet keeps the closest solution (§4.4) that holds every pin
+        and contact within ε: the solver's nearest such iterate, or the farthest point towards
+        the target it does reach (halving the way :data:`CLOSEST_HALVINGS` times), whichever is
+        nearer. The result's ``closest_error`` is then the residual to show.
+        """
         self.solver.clip = self.state.clip
         res = self.solver.drag(Drag(joint, time, position=position, orientation=orientation), self.holds)
-        if res.reached:
-            if commit:
-                self.preview = None
-                self._push(res.clip, self.holds, f"drag {joint}@{time * res.clip.fps:.0f}")
-            else:
-                self.preview = res.clip
-                self.revision += 1
+        clip = res.clip if res.reached else self._closest(res, joint, time, None if orientation is not None else position)
+        if clip is self.state.clip:
+            return res
+        if commit:
+            self.preview = None
+            self._push(clip, self.holds, f"drag {joint}@{time * clip.fps:.0f}")
+        else:
+            self.preview = clip
+            self.revision += 1
         return res
+
+    def _closest(self, res: CurveEdit, joint: str, time: float, position: ArrayLike | None) -> KeyframedClip:
+        """The nearest clip to an unreachable ``position`` with the holds kept (``res`` updated with its residual).
+
+        Without a position (a turn) only the solver's nearest feasible iterate is kept."""
+        clip = res.closest if res.closest_hold_error <= self.solver.settings.epsilon else self.state.clip
+        if position is None:
+            return clip
+        sk = self.state.clip.skeleton
+        j = sk.index(joint)
+        goal = np.asarray(position, dtype=np.float64)
+        start = self.solver.points(np.array([time]), j, np.zeros(3))[0]
+        lo, hi = 0.0, 1.0
+        for _ in range(CLOSEST_HALVINGS):
+            mid = 0.5 * (lo + hi)
+            part = self.solver.drag(Drag(joint, time, position=start + mid * (goal - start)), self.holds)
+            if part.reached:
+                lo = mid
+                miss = float(np.linalg.norm(self.solver.points(np.array([time]), j, np.zeros(3), part.clip)[0] - goal))
+                if miss < res.closest_error:
+                    clip, res.closest_error, res.closest_hold_error = part.clip, miss, part.hold_error
+            else:
+                hi = mid
+        return clip
+
+    # -- keys (the key-pose workflow, §4.3.1) -----------------------------------------------
+    def key_frames(self) -> list[int]:
+        """The frame of each key of the shown clip."""
+        return [int(f) for f in key_ops.key_frames(self.clip)]
+
+    def add_key(self, frame: int) -> None:
+        """A key at ``frame`` (the motion does not change); one undo step."""
+        c = self.state.clip
+        self._push(key_ops.insert_key(c, c.curves.times[0] + frame / c.fps), self.holds, f"add key {frame}")
+
+    def delete_key(self, k: int) -> None:
+        """Remove key ``k``; one undo step."""
+        frame = self.key_frames()[k]
+        self._push(key_ops.delete_key(self.state.clip, k), self.holds, f"delete key {frame}")
+
+    def move_key(self, k: int, frame: int, commit: bool = True) -> None:
+        """Slide key ``k`` to ``frame`` (the preview while dragging; an undo step with ``commit``)."""
+        c = self.state.clip
+        moved = key_ops.move_key(c, k, c.curves.times[0] + frame / c.fps)
+        if commit:
+            self.preview = None
+            self._push(moved, self.holds, f"move key {k} to {frame}")
+        else:
+            self.preview = moved
+            self.revision += 1
+
+    def pinned_at(self, frame: int) -> tuple[str, ...]:
+        """Joints held (pin or contact) at ``frame``: the static IK's pins when posing a key there."""
+        n = self.state.clip.num_frames
+        return tuple(str(h.joint) for h in self.holds if h.first <= frame % max(n, 1) <= h.last)
+
+    def pose(self, k: int, joint: str, target: ArrayLike | None, commit: bool = True,
+             orientation: ArrayLike | None = None) -> KeyPose:  # fmt: skip
+        """Drag ``joint`` of key ``k`` towards ``target`` (and/or turn it) with the static IK, closest pose kept."""
+        res = pose_key(self.state.clip, k, joint, target, self.pinned_at(self.key_frames()[k]), orientation)
+        if commit:
+            self.preview = None
+            self._push(res.clip, self.holds, f"pose {joint}@key {k}")
+        else:
+            self.preview = res.clip
+            self.revision += 1
+        return res
+
+    def set_key(self, k: int, channels: ArrayLike) -> None:
+        """Key ``k`` takes a whole pose (channels, e.g. copied from a reference); one undo step."""
+        self._push(key_ops.set_key_channels(self.state.clip, k, channels), self.holds, f"set key {k}")
+
+    def cancel_preview(self) -> None:
+        """Drop a live gesture's preview."""
+        if self.preview is not None:
+            self.preview = None
+            self.revision += 1
 
     def commit_preview(self, label: str) -> None:
         """Make a live drag's last preview one undo step."""
@@ -199,10 +309,16 @@ class CurveSession:
             clip, self.preview = self.preview, None
             self._push(clip, self.holds, label)
 
-    def retime(self, time: float, sigma: float) -> None:
-        """Eq. 4.12 at ``time`` by ``σ`` seconds of tangent length (one undo step)."""
+    def retime(self, time: float, sigma: float, commit: bool = True) -> None:
+        """Eq. 4.12 at ``time`` by ``σ`` seconds of tangent length (the preview, or one undo step)."""
         c = self.state.clip
-        self._push(replace(c, curves=retime_segment(c.curves, time, sigma)), self.holds, f"retime {sigma:+.3f}")
+        clip = replace(c, curves=retime_segment(c.curves, time, sigma))
+        if commit:
+            self.preview = None
+            self._push(clip, self.holds, f"retime {sigma:+.3f}")
+        else:
+            self.preview = clip
+            self.revision += 1
 
     def toggle_hold(self, joint: str, first: int, last: int, contact: bool = False) -> None:
         """Add a pin/contact on ``joint`` over frames, or remove the one it has (one undo step)."""

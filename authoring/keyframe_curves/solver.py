@@ -96,6 +96,7 @@ class CurveSettings:
     max_iterations: int = 40
     step_radius: float = 0.5
     tangent_radius: float = 0.4
+    linked_tangents: bool = True
 
 
 @dataclass
@@ -110,6 +111,8 @@ class CurveEdit:
     variables: int
     segment: int
     closest: KeyframedClip = field(repr=False)
+    closest_error: float = 0.0
+    closest_hold_error: float = 0.0
 
 
 def curve_rig(clip: KeyframedClip, limits: IKRig | None = None) -> IKRig:
@@ -142,6 +145,7 @@ class _Segment:
             t = float(curves.times[0] + np.mod(t - curves.times[0], clip.duration))
         self.k = k = int(curves.segment_of(t))
         t0, t1 = float(curves.times[k]), float(curves.times[k + 1])
+        self._link(clip, solver.settings.linked_tangents)
         if not t0 < t < t1:
             raise ValueError(f"time {drag.time:.4f} s is on a key: tangents cannot move a key (drag between keys)")
         self.time = t
@@ -178,7 +182,9 @@ class _Segment:
             frames = np.arange(h.first, h.last + 1) / fps
             if clip.loop:
                 frames = curves.times[0] + np.mod(frames - curves.times[0], clip.duration)
-            inside = frames[(frames > t0) & (frames < t1)]
+            seg_of = curves.segment_of(frames)
+            strictly = (frames > curves.times[seg_of]) & (frames < curves.times[seg_of + 1])
+            inside = frames[strictly & np.isin(seg_of, self.segments)]
             cap = 4 * int(cj.sum())
             if inside.size > cap:
                 inside = inside[np.round(np.linspace(0, inside.size - 1, cap)).astype(int)]
@@ -197,6 +203,48 @@ class _Segment:
                 self.hold_target.append(g)
         self.n_hold = len(self.hold_time)
         self.lo, self.hi = segment_bounds(curves, k, self.channels, rig.lower[self.channels], rig.upper[self.channels])
+        self._partner_bounds(clip, rig)
+
+    def _link(self, clip: KeyframedClip, linked: bool) -> None:
+        """The neighbouring segments whose tangents are the drag's too (unbroken tangents, thesis §4.2.2).
+
+        An unbroken tangent ``θ_{i,k}`` is one variable for both segments at key ``k``: the
+        tangent at the segment's first key is also the in-tangent of the segment before
+        (``left``), the one at its last key the out-tangent of the segment after (``right``).
+        Their stored handles move by the same change, scaled by the ratio of the key spacings
+        (a handle proportional to its spacing stays so), so a curve that was C¹ at a key stays
+        C¹ and a drag bends three segments smoothly instead of kinking one at its keys.
+        """
+        c, k = clip.curves, self.k
+        last = c.times.size - 1
+        gap = float(c.times[k + 1] - c.times[k])
+        left = k - 1 if k > 0 else (last - 1 if clip.loop else None)
+        right = k + 1 if k + 1 < last else (0 if clip.loop else None)
+        self.left = left if linked and left is not None and left != k else None
+        self.right = right if linked and right is not None and right != k else None
+        self.s_left = 0.0 if self.left is None else float(c.times[self.left + 1] - c.times[self.left]) / gap
+        self.s_right = 0.0 if self.right is None else float(c.times[self.right + 1] - c.times[self.right]) / gap
+        self.segments = np.array([j for j in (k, self.left, self.right) if j is not None], dtype=np.int64)
+
+    def _partner_bounds(self, clip: KeyframedClip, rig: IKRig) -> None:
+        """Narrow θ's bounds so the linked handles keep Eq. 4.7–4.9 in their own segments too."""
+        c, ch, nc = clip.curves, self.channels, self.channels.size
+        th0 = self.theta(clip)
+        links = []
+        if self.left is not None:  # θ blocks X_k, Y_k ↔ the left segment's in-handle (its blocks 2, 3)
+            end = self.left + 1
+            links.append((self.left, self.s_left, (0, 1), (2, 3), (c.in_x[end, ch], c.in_y[end, ch])))
+        if self.right is not None:  # θ blocks X_{k+1}, Y_{k+1} ↔ the right segment's out-handle (its blocks 0, 1)
+            links.append((self.right, self.s_right, (2, 3), (0, 1), (c.out_x[self.right, ch], c.out_y[self.right, ch])))
+        for seg, scale, mine, theirs, now in links:
+            lo_p, hi_p = segment_bounds(c, seg, ch, rig.lower[ch], rig.upper[ch])
+            for b, pb, cur in zip(mine, theirs, now, strict=True):
+                at, part = slice(b * nc, (b + 1) * nc), slice(pb * nc, (pb + 1) * nc)
+                # θ = θ0 + (partner − partner0)/scale; a start already outside stays allowed where it is.
+                lo = th0[at] + (lo_p[part] - cur) / scale
+                hi = th0[at] + (hi_p[part] - cur) / scale
+                self.lo[at] = np.maximum(self.lo[at], np.minimum(lo, th0[at]))
+                self.hi[at] = np.minimum(self.hi[at], np.maximum(hi, th0[at]))
 
     def theta(self, clip: KeyframedClip) -> F:
         """``[4C']`` current ``[X+, Y+, X−, Y−]`` of the segment's channels."""
@@ -207,8 +255,8 @@ class _Segment:
         """The other side of each optimised tangent's key (E_b), and which have one."""
         c, k, ch = clip.curves, self.k, self.channels
         last = c.times.size - 1
-        has_in = k > 0 or clip.loop
-        has_out = k + 1 < last or clip.loop
+        has_in = (k > 0 or clip.loop) and self.left is None  # a linked handle moves with θ: nothing to pull towards
+        has_out = (k + 1 < last or clip.loop) and self.right is None
         kin = k if k > 0 else last  # a loop's key 0 is its last key one period earlier
         kout = k + 1 if k + 1 < last else 0
         nc = ch.size
@@ -219,8 +267,17 @@ class _Segment:
     def with_theta(self, clip: KeyframedClip, th: F) -> KeyframedClip:
         c, k, ch = clip.curves, self.k, self.channels
         nc = ch.size
+        delta = th - self.theta(clip)
         ox, oy, ix, iy = (np.array(a) for a in (c.out_x, c.out_y, c.in_x, c.in_y))
         ox[k, ch], oy[k, ch], ix[k + 1, ch], iy[k + 1, ch] = th[:nc], th[nc : 2 * nc], th[2 * nc : 3 * nc], th[3 * nc :]
+        if self.left is not None:  # the same handle seen from the segment before
+            end, gap = self.left + 1, c.times[self.left + 1] - c.times[self.left]
+            ix[end, ch] = np.clip(ix[end, ch] + self.s_left * delta[:nc], 0.0, gap)
+            iy[end, ch] += self.s_left * delta[nc : 2 * nc]
+        if self.right is not None:  # …and from the segment after
+            r, gap = self.right, c.times[self.right + 1] - c.times[self.right]
+            ox[r, ch] = np.clip(ox[r, ch] + self.s_right * delta[2 * nc : 3 * nc], 0.0, gap)
+            oy[r, ch] += self.s_right * delta[3 * nc :]
         return replace(clip, curves=c.with_tangents(ox, oy, ix, iy))
 
 
@@ -257,16 +314,20 @@ class TangentSolver:
         kk, lam_all = curves.parameter(times)
         c_all = curves.evaluate(kk, lam_all)
         lam = lam_all[:, ch]  # [T,C']
-        gap = curves.times[k + 1] - curves.times[k]
-        a, b = curves.out_x[k, ch], curves.in_x[k + 1, ch]
-        ya, yb = curves.out_y[k, ch], curves.in_y[k + 1, ch]
-        v0, v1 = curves.values[k, ch], curves.values[k + 1, ch]
+        gap = (curves.times[kk + 1] - curves.times[kk])[:, None]  # each sample in its own segment
+        a, b = curves.out_x[kk][:, ch], curves.in_x[kk + 1][:, ch]
+        ya, yb = curves.out_y[kk][:, ch], curves.in_y[kk + 1][:, ch]
+        v0, v1 = curves.values[kk][:, ch], curves.values[kk + 1][:, ch]
         h0, tp, h1, tm = bezier_basis(lam)
         d0, dtp, d1, dtm = bezier_basis_slope(lam)
         dx = dtp * a + d1 * gap + dtm * b
         dy = d0 * v0 + dtp * ya + d1 * v1 + dtm * yb
         slope = dy / np.where(np.abs(dx) > 1e-12, dx, 1e-12)
-        dc = np.concatenate([-slope * tp, tp, -slope * tm, tm], axis=1)  # ∂c_i/∂θ per block [T,4C']
+        main = (kk == k)[:, None]
+        left = (kk == (-1 if seg.left is None else seg.left))[:, None] * seg.s_left  # θ_k as the left segment's in-handle
+        right = (kk == (-1 if seg.right is None else seg.right))[:, None] * seg.s_right  # θ_{k+1} as the right one's out
+        dc = np.concatenate([(-slope * tp) * main + (-slope * tm) * left, tp * main + tm * left,
+                             (-slope * tm) * main + (-slope * tp) * right, tm * main + tp * right], axis=1)  # fmt: skip
         nc = ch.size
         pos, js, rot_now, jo = batch_points(rig, c_all, np.asarray(joints, dtype=np.int64), np.asarray(pts), ch, rot_joint)
         jac = (np.tile(js, (1, 1, 4)) * dc[:, None, :]).reshape(3 * len(times), 4 * nc)
@@ -331,7 +392,9 @@ class TangentSolver:
         pos, jac, rot_now, rot_jac = self._linearise(seg, clip, times, joints, pts, rot_joint)
         ds, drho = residuals(pos, rot_now)
         cur = merit(ds, drho)
-        best, best_clip, strikes, it = cur, clip, 0, 0
+        best, strikes, it = cur, 0, 0
+        # The closest solution kept when the target is out of reach (§4.4): the nearest iterate whose holds are within ε.
+        best_clip, best_err, best_hold = clip, error_of(ds), hold_error(drho)
         radius, box_r = st.step_radius, st.tangent_radius
         mu = 0.0  # extra damping of the step, Levenberg–Marquardt style: grows when a step fails
         done = done_of(ds, drho)
@@ -373,10 +436,13 @@ class TangentSolver:
             else:
                 radius, box_r, mu = 0.5 * radius, 0.5 * box_r, max(2.0 * mu, 1.0)
             done = done_of(ds, drho)
+            if hold_error(drho) <= st.epsilon and error_of(ds) < best_err:
+                best_clip, best_err, best_hold = clip, error_of(ds), hold_error(drho)
             if done or cur < best * (1.0 - 1e-3):
-                best, best_clip, strikes = cur, clip, 0
+                best, strikes = cur, 0
             else:
                 strikes += 1
                 start = seg.theta(clip)  # stalled: E_d's pull may be what holds the point short
         return CurveEdit(clip=clip if done else self.clip, reached=done, iterations=it, error=error_of(ds),
-                         hold_error=hold_error(drho), variables=n, segment=seg.k, closest=best_clip)  # fmt: skip
+                         hold_error=hold_error(drho), variables=n, segment=seg.k, closest=best_clip,
+                         closest_error=best_err, closest_hold_error=best_hold)  # fmt: skip

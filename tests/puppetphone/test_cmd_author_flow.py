@@ -43,8 +43,10 @@ def _bent_file(path: Path) -> Path:
 @needs_egl
 def test_a_scripted_stroke_bends_trees_and_saves(tmp_path: Path) -> None:
     out, shot = tmp_path / "bent.flow.json", tmp_path / "after.png"
+    rec = tmp_path / "row.rec"
     done = puppetphone("author", "flow", "snowman", "--headless", "--script", "row", "--frames", "70",
-                       "--size", "1280x720", "-o", str(out), "--screenshot", str(shot), cwd=tmp_path)
+                       "--size", "1280x720", "-o", str(out), "--screenshot", str(shot), "--record", str(rec),
+                       cwd=tmp_path)  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "1 edits, 1 strokes, 1 clicks" in done.stdout
     doc = load_flow(out)
@@ -55,6 +57,12 @@ def test_a_scripted_stroke_bends_trees_and_saves(tmp_path: Path) -> None:
     assert {"tree0", "tree4"} <= moved  # the two back trees beside the stroke bend
     assert not any(g.startswith("rock") for g in moved)
     assert shot.stat().st_size > 10000
+    # The recorded session replays: the scene rebuilt from the recording, the stroke repeated, every
+    # step's edits and bent scenery matching (and a replay writes no file).
+    out.unlink()
+    again = puppetphone("replay", str(rec), "--verify", "--headless", cwd=tmp_path)
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert "replayed 70 frames, all 70 state hashes match" in again.stdout and not out.exists()
 
 
 @needs_egl

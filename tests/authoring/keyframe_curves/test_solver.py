@@ -60,11 +60,13 @@ def test_drag_hand_at_one_frame_keeps_feet_and_keys(walk):
         j = sk.index(name)
         drift = np.linalg.norm(s.points(frames, j, np.zeros(3), res.clip) - s.points(frames, j, np.zeros(3)), axis=-1)
         assert drift.max() <= eps, f"{name} left its pin by {drift.max() * 1e3:.3f} mm"
-    # No key added or moved; only the dragged segment's tangents changed.
+    # No key added or moved; only the tangents at the dragged segment's two keys changed — on both
+    # sides of each key, as unbroken tangents are one variable (§4.2.2).
     assert np.array_equal(res.clip.curves.times, walk.curves.times)
     assert np.array_equal(res.clip.curves.values, walk.curves.values)
-    changed = np.nonzero(np.any(res.clip.curves.out_y != walk.curves.out_y, axis=1))[0]
-    assert set(changed) == {res.segment} == {2}
+    changed_out = np.nonzero(np.any(res.clip.curves.out_y != walk.curves.out_y, axis=1))[0]
+    changed_in = np.nonzero(np.any(res.clip.curves.in_y != walk.curves.in_y, axis=1))[0]
+    assert res.segment == 2 and set(changed_out) == set(changed_in) == {2, 3}
     _limits_hold(s, res.clip)
     # The edit shows at the frame it was made: the baked clip has the hand there.
     baked = res.clip.bake()
@@ -149,7 +151,8 @@ def test_free_chain_with_broken_tangents_converges_in_few_iterations():
     clip = KeyframedClip("chain", sk, BezierCurves(times, values, ox, oy, ox, iy), fps=30.0)
     rig = IKRig.build(sk, limits={name: (-1.5, 1.5) for name in sk.names}, root_translation=True)
     # A 10 µm tolerance: the tail shows whether the steps converge quadratically or crawl.
-    s = TangentSolver(clip, rig, CurveSettings(tolerance=1e-5), frozen=range(3))
+    # Broken as the user breaks them: each side its own variable, E_b between them (not linked).
+    s = TangentSolver(clip, rig, CurveSettings(tolerance=1e-5, linked_tangents=False), frozen=range(3))
     t, tip = 1.5 * gap, np.array([0.0, 0.1, 0.0])
     iterations, far = [], []
     for _ in range(12):
@@ -164,3 +167,28 @@ def test_free_chain_with_broken_tangents_converges_in_few_iterations():
         iterations.append(res.iterations)
     assert np.median(far) > 0.05  # far drags: several linearisations are needed
     assert np.median(iterations) <= 3 and max(iterations) <= 5, iterations
+
+
+def _hand_path_after_drag(walk, linked: bool):  # type: ignore[no-untyped-def]
+    s = TangentSolver(walk, _solver(walk).rig, CurveSettings(linked_tangents=linked))
+    hand, t = walk.skeleton.index("l_hand"), 15 / walk.fps
+    start = s.points(np.array([t]), hand, np.zeros(3))[0]
+    res = s.drag(Drag("l_hand", t, position=start + np.array([0.0, 0.06, 0.05])),
+                 [Hold("l_foot", 0, 65), Hold("r_foot", 0, 65)])  # fmt: skip
+    assert res.reached
+    return s.points(np.arange(66 * 4) / (4 * walk.fps), hand, np.zeros(3), res.clip)
+
+
+def _sharpest_turn_deg(path):  # type: ignore[no-untyped-def]
+    d = np.diff(path, axis=0)
+    cos = np.sum(d[1:] * d[:-1], axis=1) / np.maximum(np.linalg.norm(d[1:], axis=1) * np.linalg.norm(d[:-1], axis=1), 1e-12)
+    return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max())
+
+
+def test_a_drag_bends_the_path_smoothly_through_unbroken_tangents(walk):
+    """Issue 38: one drag made a sharp spike. With every tangent broken only the dragged segment
+    moved, kinking the path at both its keys (a 114° turn between quarter-frames for this drag);
+    unbroken tangents carry the change into the neighbouring segments and the path turns at most ~52°."""
+    smooth, kinked = _hand_path_after_drag(walk, True), _hand_path_after_drag(walk, False)
+    assert _sharpest_turn_deg(smooth) < 70.0
+    assert _sharpest_turn_deg(kinked) > 90.0  # the former behaviour, for contrast
