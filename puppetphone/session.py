@@ -147,4 +147,17 @@ def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str,
     if verify is not None:
         check = HashCheck(verify)
         app.on_step_end.append(check)
-    return GameActivity(game, app, hub, game.camera(), recorder, check, view=view)
+    activity = GameActivity(game, app, hub, game.camera(), recorder, check, view=view)
+    _stream_to_phones(activity)
+    return activity
+
+
+def _stream_to_phones(activity: GameActivity) -> None:
+    """With a web source, every step's scene goes to the connected pages too (output only)."""
+    from input.web.server import WebSource
+    from input.web.viewport import PhoneViewport
+
+    for source in activity.hub.sources:
+        if isinstance(source, WebSource):
+            draw = activity.game.draw_state or activity.game.draw
+            activity.app.on_step_end.append(PhoneViewport(source, draw, lambda: activity.orbit))

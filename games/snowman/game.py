@@ -19,7 +19,7 @@ from engine.statemachine.puppet import install_puppets
 from games.base import Game
 from games.snowman.bent_scenery import prepare_flow, recorded_flow
 from games.snowman.components import SnowmanStats, StackWatch
-from games.snowman.draw import draw_snowman_game
+from games.snowman.draw import draw_snowman_game, draw_snowman_state
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
 from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
                                  start_snowballs, stick_stacked_balls)
@@ -90,5 +90,6 @@ def replay_game(recorded: dict[str, Any]) -> dict[str, Any]:
 
 
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game)
+            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game,
+            draw_state=draw_snowman_state)
 
