@@ -84,7 +84,7 @@ class GameActivity:
         """The game's view and the overlay."""
         self.game.draw(self.app.world, scene, alpha)
         fps = self.runner.fps if self.runner is not None else 0.0
-        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay)
+        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay, size)
 
     def on_event(self, event: Any, runner: Runner) -> bool:
         """Mouse to the mouse source, right-drag orbits, R / F5 / F9 become recorded commands."""
