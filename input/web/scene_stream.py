@@ -10,14 +10,16 @@ desktop's picture.
 A :class:`SceneState` is one step's primitives quantised to ``int16`` per column
 (positions and sizes in millimetres, colours in 1/255, rotations in 1/32767). A frame
 (:func:`encode_frame`) carries what changed since the state the *same phone* last got:
-per kind, a bit per row that changed, then the changed rows, as ``int8`` differences
-when every difference fits (a walking puppet moves a few centimetres a step), else as
-``int16`` values. A row that did not move costs one bit. Frame layout (little-endian)::
+per kind, a bit per row that changed and a bit per column that changed in any of them,
+then those columns of those rows, as ``int8`` differences when every difference fits (a
+walking puppet moves a few centimetres a step), else as ``int16`` values. A row that did
+not move costs one bit, a colour that did not change nothing. Frame layout (little-endian)::
 
     "PF" u8 version u8 flags u32 step f64 published (s since the epoch: latency figures only)
     f32 camera position[3] f32 camera rotation (w,x,y,z)[4] f32 fov_y (degrees)
     per kind in KINDS: u16 rows, u8 mode (0 unchanged, 1 int8 deltas, 2 int16 values)
-                       [mode > 0: ceil(rows/8) bytes of changed-row bits, then the rows]
+                       [mode > 0: u16 changed-column bits, ceil(rows/8) bytes of changed-row
+                        bits, then the changed columns of the changed rows, row by row]
 
 :func:`decode_frame` is the reader the tests and the bench use; ``page/stream.js``
 is the page's.
@@ -49,6 +51,7 @@ SCALES: dict[str, tuple[float, ...]] = {
 KINDS = tuple(SCALES)
 _HEADER = struct.Struct("<2sBBId3f4ff")
 _KIND = struct.Struct("<HB")
+_COLUMNS = struct.Struct("<H")
 
 
 class FrameError(ValueError):
@@ -108,10 +111,14 @@ def encode_frame(base: SceneState, state: SceneState) -> bytes:
             out.append(_KIND.pack(n, 0))
             continue
         delta = new[changed].astype(np.int32) - prev[changed]
+        columns = np.any(delta != 0, axis=0)
+        columns[0] |= not columns.any()  # new rows of zeros: still say which rows they are
+        delta = delta[:, columns]
         small = bool(np.all((delta >= -127) & (delta <= 127)))
         out.append(_KIND.pack(n, 1 if small else 2))
+        out.append(_COLUMNS.pack(sum(1 << int(c) for c in np.nonzero(columns)[0])))
         out.append(np.packbits(changed, bitorder="little").tobytes())
-        out.append(delta.astype("<i1").tobytes() if small else new[changed].astype("<i2").tobytes())
+        out.append(delta.astype("<i1").tobytes() if small else new[changed][:, columns].astype("<i2").tobytes())
     return b"".join(out)
 
 
@@ -139,15 +146,25 @@ def decode_frame(base: SceneState, data: bytes) -> SceneState:
         new[:keep] = old[:keep]
         if mode:
             mask_len = (n + 7) // 8
+            if at + _COLUMNS.size + mask_len > len(data):
+                raise FrameError(f"frame ends inside its {kind}")
+            (bits,) = _COLUMNS.unpack_from(data, at)
+            columns = np.array([(bits >> c) & 1 for c in range(len(scales))], dtype=bool)
+            at += _COLUMNS.size
             changed = np.unpackbits(np.frombuffer(data, np.uint8, mask_len, at), count=n, bitorder="little").astype(bool)
             at += mask_len
-            count = int(changed.sum()) * len(scales)
+            count = int(changed.sum()) * int(columns.sum())
             width = 1 if mode == 1 else 2
             if at + count * width > len(data):
                 raise FrameError(f"frame ends inside its {kind}")
-            values = np.frombuffer(data, "<i1" if mode == 1 else "<i2", count, at).reshape(-1, len(scales))
+            values = np.frombuffer(data, "<i1" if mode == 1 else "<i2", count, at).reshape(-1, int(columns.sum()))
             at += count * width
-            new[changed] = (new[changed].astype(np.int32) + values).astype(np.int16) if mode == 1 else values
+            rows_changed = new[changed]
+            if mode == 1:
+                rows_changed[:, columns] = rows_changed[:, columns].astype(np.int32) + values
+            else:
+                rows_changed[:, columns] = values
+            new[changed] = rows_changed
         rows[kind] = new
     if at != len(data):
         raise FrameError("bytes after the last kind")

@@ -19,7 +19,7 @@ const stream = new SceneStream();
 let renderer = null;
 try { renderer = new PageRenderer($("view"), { xrCompatible: true }); } catch (err) { $("fps").textContent = "view: " + err.message; }
 // What the bench and the tests read: frames drawn, the step on screen, frames per second.
-window.ppView = { drawn: 0, step: -1, fps: 0, stream };
+window.ppView = { drawn: 0, step: -1, fps: 0, stream, drawLog: [] };
 
 function setState(text, cls) { const el = $("state"); el.textContent = text; el.className = "state " + cls; }
 function setMode() {
@@ -146,7 +146,9 @@ function drawFrame(now) {
 }
 
 function countFrame(step, now) {
-  window.ppView.drawn += 1; window.ppView.step = step; fpsCount += 1;
+  const view = window.ppView;
+  if (step !== view.step) { view.drawLog.push([step, performance.timeOrigin + now]); if (view.drawLog.length > 4000) view.drawLog.shift(); }
+  view.drawn += 1; view.step = step; fpsCount += 1;
   if (now - fpsStart >= 1000) {
     window.ppView.fps = (1000 * fpsCount) / (now - fpsStart); fpsCount = 0; fpsStart = now;
     $("fps").textContent = "view: " + window.ppView.fps.toFixed(0) + " fps, step " + step;

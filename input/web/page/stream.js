@@ -43,11 +43,14 @@ function decodeFrame(base, scales, buffer) {
     const old = base.rows[kind], out = new Int16Array(n * cols);
     out.set(old.subarray(0, Math.min(n, old.length / cols) * cols));
     if (mode) {
+      const columns = dv.getUint16(at, true);
+      at += 2;
       const mask = new Uint8Array(buffer, at, (n + 7) >> 3);
       at += mask.length;
       for (let r = 0; r < n; r++) {
         if (!(mask[r >> 3] & (1 << (r & 7)))) continue;
         for (let c = 0; c < cols; c++) {
+          if (!(columns & (1 << c))) continue;
           if (mode === 1) { out[r * cols + c] += dv.getInt8(at); at += 1; }
           else { out[r * cols + c] = dv.getInt16(at, true); at += 2; }
         }

@@ -48,9 +48,9 @@ def test_a_frame_takes_the_phone_exactly_to_the_new_state_and_sends_only_what_mo
     frame = encode_frame(base, walked)
     assert same(decode_frame(base, frame), walked)
     still = encode_frame(base, quantise(scene_with(40), 3, 0.0, CAM))
-    # 20 moved capsules of 11 columns at one byte each, plus header and masks: far under a full frame.
+    # 20 moved capsules: their 6 end-point columns (not radius, colour, outline) at one byte each, plus masks.
     assert len(still) < 75, "an unchanged scene costs more than its header and row counts"
-    assert 20 * 11 <= len(frame) - len(still) < 20 * 11 + 16
+    assert 20 * 6 <= len(frame) - len(still) < 20 * 6 + 16
     full = encode_frame(SceneState.empty(), walked)
     assert same(decode_frame(SceneState.empty(), full), walked)
     assert len(full) > 2 * len(frame)
