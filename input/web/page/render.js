@@ -18,7 +18,7 @@ void main() {
   vec3 u = normalize(cross(t, w)); vec3 v = cross(w, u);
   vec3 n = u * dirEnd.x + w * dirEnd.y + v * dirEnd.z;
   vec3 p = mix(a, b, dirEnd.w) + r * n;
-  vN = n; vP = p; vC = col; vO = outline;
+  vN = n; vP = p; vC = col * col; vO = outline;
   gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
@@ -31,7 +31,7 @@ out vec3 vN; out vec3 vP; out vec3 vC; out float vO;
 vec3 rot(vec4 q, vec3 v) { vec3 u = q.yzw; return v + 2.0 * cross(u, cross(u, v) + q.x * v); }
 void main() {
   vec3 p = c + rot(q, corner * h);
-  vN = rot(q, normal); vP = p; vC = col; vO = outline;
+  vN = rot(q, normal); vP = p; vC = col * col; vO = outline;
   gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
@@ -41,17 +41,15 @@ in vec3 vN; in vec3 vP; in vec3 vC; in float vO;
 uniform vec3 sunDir; uniform vec3 sunColor; uniform float ambient; uniform vec3 eye;
 uniform vec3 sky; uniform vec3 horizon; uniform vec3 outlineColor;
 out vec4 frag;
-vec3 lin(vec3 c) { return pow(c, vec3(2.2)); }
+// Gamma 2 (squares and a square root) rather than 2.2: software GL on a phone-sized canvas is fill-bound.
 void main() {
   vec3 n = normalize(vN);
-  vec3 albedo = lin(vC);
-  float diff = max(dot(n, normalize(sunDir)), 0.0);
-  vec3 hemi = mix(lin(vec3(0.93, 0.95, 0.98)) * 0.6, lin(sky), 0.5 + 0.5 * n.y);
-  vec3 c = albedo * (sunColor * diff * 0.55 + hemi * ambient * 1.1);
-  vec3 view = normalize(eye - vP);
-  float rim = pow(1.0 - abs(dot(n, view)), 3.0);
-  c = mix(c, lin(outlineColor), clamp(vO, 0.0, 1.0) * rim);
-  frag = vec4(pow(c / (1.0 + c * 0.15), vec3(1.0 / 2.2)), 1.0);
+  float diff = max(dot(n, sunDir), 0.0);
+  vec3 hemi = mix(vec3(0.52, 0.54, 0.58), sky * sky, 0.5 + 0.5 * n.y);
+  vec3 c = vC * (sunColor * diff * 0.55 + hemi * ambient * 1.1);
+  float rim = 1.0 - abs(dot(n, normalize(eye - vP)));
+  c = mix(c, outlineColor * outlineColor, clamp(vO, 0.0, 1.0) * rim * rim * rim);
+  frag = vec4(sqrt(c / (1.0 + c * 0.15)), 1.0);
 }`;
 
 const GROUND_VS = `#version 300 es
@@ -74,7 +72,7 @@ void main() {
 
 const SKY_VS = `#version 300 es
 const vec2 P[3] = vec2[3](vec2(-1.0, -1.0), vec2(3.0, -1.0), vec2(-1.0, 3.0));
-out vec2 ndc; void main() { ndc = P[gl_VertexID]; gl_Position = vec4(ndc, 0.999, 1.0); }`;
+out vec2 ndc; void main() { ndc = P[gl_VertexID]; gl_Position = vec4(ndc, 1.0, 1.0); }`;
 
 const SKY_FS = `#version 300 es
 precision highp float;
@@ -102,7 +100,7 @@ function compile(gl, vs, fs) {
 }
 
 // A unit capsule: a sphere split at its equator, lower half at end a (w 0), upper at end b (w 1).
-function capsuleMesh(seg = 16, rings = 6) {
+function capsuleMesh(seg = 10, rings = 3) {
   const v = [], idx = [];
   const ring = (lat, end) => { for (let j = 0; j <= seg; j++) { const lon = (j / seg) * 2 * Math.PI;
     v.push(Math.cos(lat) * Math.cos(lon), Math.sin(lat), Math.cos(lat) * Math.sin(lon), end); } };
@@ -247,25 +245,6 @@ class PageRenderer {
     const viewProj = mul4(proj, view);
     gl.enable(gl.DEPTH_TEST); gl.disable(gl.CULL_FACE);
     if (!xr || xr.first) { gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT); }
-    if (!xr) {
-      const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
-      gl.useProgram(this.sky.prog);
-      gl.uniformMatrix3fv(this.sky.u.basis, false, new Float32Array([0, 1, 2].flatMap((c) => [basis[0][c], basis[1][c], basis[2][c]])));
-      gl.uniform2f(this.sky.u.tanHalf, t * aspect, t);
-      gl.uniform3fv(this.sky.u.sky, look.sky); gl.uniform3fv(this.sky.u.horizon, look.horizon);
-      gl.depthMask(false); gl.bindVertexArray(this.skyVao); gl.drawArrays(gl.TRIANGLES, 0, 3); gl.depthMask(true);
-      const g = look.ground, half = 40;
-      gl.useProgram(this.ground.prog);
-      gl.bindVertexArray(this.groundVao);
-      gl.bindBuffer(gl.ARRAY_BUFFER, this.groundBuf);
-      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-half, -half, half, -half, -half, half, half, half]), gl.DYNAMIC_DRAW);
-      const u = this.ground.u;
-      gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g.height);
-      gl.uniform3fv(u.color, g.color); gl.uniform3fv(u.gridColor, g.grid_color);
-      gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0); gl.uniform1f(u.spacing, g.grid_spacing);
-      gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform1f(u.alpha, 1);
-      gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
-    }
     const round = roundRows(frame.rows);
     if (round.length) {
       gl.useProgram(this.capsule.prog);
@@ -284,7 +263,34 @@ class PageRenderer {
       gl.bindBuffer(gl.ARRAY_BUFFER, this.boxInst); gl.bufferData(gl.ARRAY_BUFFER, boxes, gl.DYNAMIC_DRAW);
       gl.drawArraysInstanced(gl.TRIANGLES, 0, 36, boxes.length / 14);
     }
+    if (!xr) this.backdrop(frame, look, viewProj, eye, basis);
     gl.bindVertexArray(null);
+  }
+
+  // Ground, then sky, after the objects: the depth test skips every pixel they already cover.
+  backdrop(frame, look, viewProj, eye, basis) {
+    const gl = this.gl;
+    {
+      const g = look.ground, half = 40;
+      gl.useProgram(this.ground.prog);
+      gl.bindVertexArray(this.groundVao);
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.groundBuf);
+      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-half, -half, half, -half, -half, half, half, half]), gl.DYNAMIC_DRAW);
+      const u = this.ground.u;
+      gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g.height);
+      gl.uniform3fv(u.color, g.color); gl.uniform3fv(u.gridColor, g.grid_color);
+      gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0); gl.uniform1f(u.spacing, g.grid_spacing);
+      gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform1f(u.alpha, 1);
+      gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
+    }
+    const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
+    gl.useProgram(this.sky.prog);
+    gl.uniformMatrix3fv(this.sky.u.basis, false, new Float32Array([0, 1, 2].flatMap((c) => [basis[0][c], basis[1][c], basis[2][c]])));
+    gl.uniform2f(this.sky.u.tanHalf, t * aspect, t);
+    gl.uniform3fv(this.sky.u.sky, look.sky); gl.uniform3fv(this.sky.u.horizon, look.horizon);
+    gl.depthFunc(gl.LEQUAL); gl.depthMask(false);
+    gl.bindVertexArray(this.skyVao); gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.depthMask(true); gl.depthFunc(gl.LESS);
   }
 }
 
