@@ -132,17 +132,20 @@ function confirmCalibration() {
   setTimeout(() => { $("calibrated").hidden = true; }, 1500);
 }
 
-// The magic window: draw the newest frames, interpolated, at the display's rate.
-let fpsCount = 0, fpsStart = performance.now();
+// The magic window: draw the newest frames, interpolated, at the display's rate. A phone (or a
+// software renderer) that cannot keep 30 fps draws fewer pixels, stretched, rather than fewer frames.
+let fpsCount = 0, fpsStart = performance.now(), resolution = 1;
+const MIN_RESOLUTION = 0.5;
 function drawFrame(now) {
   if (state.kind !== "xr") requestAnimationFrame(drawFrame);
   if (!renderer || !stream.extras) return;
-  const canvas = $("view"), w = Math.round(canvas.clientWidth * devicePixelRatio), h = Math.round(canvas.clientHeight * devicePixelRatio);
+  const canvas = $("view"), px = Math.min(devicePixelRatio, 2) * resolution;
+  const w = Math.round(canvas.clientWidth * px), h = Math.round(canvas.clientHeight * px);
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
   const frame = stream.sample(now);
   if (!frame) return;
   renderer.draw(frame, stream.extras);
-  countFrame(frame.step, now);
+  countFrame(frame.step, performance.now());  // not rAF's time: that is the frame's start, before the message came
 }
 
 function countFrame(step, now) {
@@ -150,8 +153,11 @@ function countFrame(step, now) {
   if (step !== view.step) { view.drawLog.push([step, performance.timeOrigin + now]); if (view.drawLog.length > 4000) view.drawLog.shift(); }
   view.drawn += 1; view.step = step; fpsCount += 1;
   if (now - fpsStart >= 1000) {
-    window.ppView.fps = (1000 * fpsCount) / (now - fpsStart); fpsCount = 0; fpsStart = now;
-    $("fps").textContent = "view: " + window.ppView.fps.toFixed(0) + " fps, step " + step;
+    view.fps = (1000 * fpsCount) / (now - fpsStart); fpsCount = 0; fpsStart = now;
+    if (view.fps < 40 && resolution > MIN_RESOLUTION) resolution = Math.max(MIN_RESOLUTION, resolution * 0.85);
+    else if (view.fps > 55 && resolution < 1) resolution = Math.min(1, resolution / 0.85);
+    view.resolution = resolution;
+    $("fps").textContent = "view: " + view.fps.toFixed(0) + " fps, step " + step + (resolution < 1 ? ", " + Math.round(100 * resolution) + " % resolution" : "");
   }
 }
 

@@ -174,7 +174,7 @@ function roundRows(rows) {
 
 class PageRenderer {
   constructor(canvas, options = {}) {
-    const gl = canvas.getContext("webgl2", { antialias: false, alpha: true, xrCompatible: !!options.xrCompatible });
+    const gl = canvas.getContext("webgl2", { antialias: false, alpha: false, desynchronized: true, xrCompatible: !!options.xrCompatible });
     if (!gl) throw new Error("WebGL2 is not available");
     this.gl = gl; this.canvas = canvas;
     this.capsule = compile(gl, CAPSULE_VS, LIT_FS);
