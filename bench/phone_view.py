@@ -10,6 +10,9 @@
   headless Chromium at 390×844; the page notes, per frame, the engine's publication
   time (end of the step) and when it received the frame, and when it first drew that
   step. Both clocks are this machine's system clock.
+- **Step → client latency** on loopback, the same session with a Python WebSocket client
+  in place of the browser (it decodes and acknowledges at once): the engine's and the
+  network's part of the latency, without the page's main thread.
 - **Page frame rate** at 390×844 in headless Chromium's software WebGL2 (SwiftShader),
   the median of three one-second counts while the stream runs.
 """
@@ -24,7 +27,7 @@ import numpy as np
 
 from bench.figures import Figure
 
-__all__ = ["run", "stream_bytes", "page_latency"]
+__all__ = ["run", "stream_bytes", "page_latency", "client_latency"]
 
 STEP_MS = 1000.0 / 60.0
 PHONE = (390, 844)
@@ -101,6 +104,7 @@ def page_latency(steps: int = 600) -> dict[str, object]:
                 time.sleep(0.3)
                 received = browser.evaluate("ppView.stream.log")
                 drawn = browser.evaluate("ppView.drawLog")
+                resolution = float(browser.evaluate("ppView.resolution || 1"))
                 frames = browser.evaluate("ppView.stream.frames")
         finally:
             activity.close()
@@ -108,7 +112,61 @@ def page_latency(steps: int = 600) -> dict[str, object]:
     recv = np.array([r - p for s, p, r in received if s > 120])
     draw = np.array([t - published[s] for s, t in drawn if s in published and s > 120])
     return {"received_ms": recv, "drawn_ms": draw, "fps": float(np.median(fps[-3:])), "frames": frames,
-            "steps": steps}
+            "steps": steps, "resolution": resolution}
+
+
+def client_latency(steps: int = 600) -> np.ndarray:
+    """Publication → receipt (ms) of each frame by a Python client that acknowledges every frame at once."""
+    import json
+    import ssl
+    import threading
+
+    from websockets.sync.client import connect
+
+    from engine.pacing import RealTimePacer
+    from input.hub import InputHub
+    from input.web.cert import load_or_create
+    from input.web.scene_glb import read_scene_glb
+    from input.web.scene_stream import decode_frame
+    from input.web.server import WebSource
+    from puppetphone.session import build_activity
+
+    tls = ssl.create_default_context()
+    tls.check_hostname, tls.verify_mode = False, ssl.CERT_NONE  # loopback, the engine's own certificate
+    latencies: list[float] = []
+    with tempfile.TemporaryDirectory(prefix="pp-view-bench-") as folder:
+        src = WebSource(port=0, certificate=load_or_create([], Path(folder)), max_rate=1000.0)
+        hub = InputHub([src]).start()
+        activity = build_activity("snowman", 0, hub)
+        stop = threading.Event()
+
+        def client() -> None:
+            with connect(f"wss://127.0.0.1:{src.port}/ws?t={src.token}", ssl=tls, max_size=None) as ws:
+                ws.recv()  # hello
+                state = None
+                while not stop.is_set():
+                    try:
+                        data = ws.recv(timeout=0.5)
+                    except TimeoutError:
+                        continue
+                    now = time.time()
+                    state = read_scene_glb(data)[1] if state is None else decode_frame(state, data)
+                    ws.send(json.dumps({"ack": state.step}))
+                    if state.published and state.step > 120:
+                        latencies.append(1000.0 * (now - state.published))
+
+        th = threading.Thread(target=client, daemon=True)
+        th.start()
+        try:
+            pacer = RealTimePacer(activity.dt, wake=hub.arrived)
+            for _ in range(steps):
+                pacer.wait()
+                activity.step()
+        finally:
+            stop.set()
+            th.join(2.0)
+            activity.close()
+    return np.array(latencies)
 
 
 def run() -> list[Figure]:
@@ -125,6 +183,11 @@ def run() -> list[Figure]:
         Figure("phone-view", "crowd50_bytes_per_puppet_step", b["crowd_coded"] / b["crowd_puppets"], "B",
                "raw float32 rows (straw man)", b["crowd_raw"] / b["crowd_puppets"]),
     ]
+    net = client_latency()
+    figures += [
+        Figure("phone-view", "step_to_client_p50_ms", float(np.percentile(net, 50)), "ms", "two steps", 2 * STEP_MS),
+        Figure("phone-view", "step_to_client_p99_ms", float(np.percentile(net, 99)), "ms", "two steps", 2 * STEP_MS),
+    ]
     if find_chromium() is None:
         print("phone-view: no chromium (apt-get install chromium): the page figures are left out")
         return figures
@@ -136,6 +199,7 @@ def run() -> list[Figure]:
         Figure("phone-view", "step_to_drawn_p50_ms", float(np.percentile(drawn, 50)), "ms", "two steps", 2 * STEP_MS),
         Figure("phone-view", "step_to_drawn_p99_ms", float(np.percentile(drawn, 99)), "ms", "two steps", 2 * STEP_MS),
         Figure("phone-view", "page_fps_390x844", lat["fps"], "fps", "goal", 30.0),
+        Figure("phone-view", "page_resolution_scale", lat["resolution"], "ratio", "full resolution", 1.0),
         Figure("phone-view", "frames_sent_per_step", float(lat["frames"]) / float(lat["steps"]), "ratio",
                "one per step", 1.0),
     ]
