@@ -9,17 +9,20 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import input.web
 from engine.render.scene import RenderScene
 from input.web.scene_glb import read_scene_glb, scene_glb
 from input.web.scene_stream import (KINDS, CameraPose, FrameError, SceneState, decode_frame, encode_frame,
                                     quantise)
 
 CAM = CameraPose((0.0, 1.5, 4.0), (1.0, 0.0, 0.0, 0.0), 60.0)
-PAGE = __import__("pathlib").Path(__import__("input.web", fromlist=["x"]).__file__).parent / "page"
+PAGE = Path(input.web.__file__).parent / "page"
+needs_node = pytest.mark.skipif(shutil.which("node") is None, reason="no node executable: apt-get install nodejs")
 
 
 def scene_with(n_capsules: int, shift: float = 0.0, moved: int | None = None) -> RenderScene:
@@ -97,7 +100,7 @@ def test_the_glb_is_a_gltf_with_a_ground_mesh_and_the_rows_the_first_frame_build
     assert same(decode_frame(back, encode_frame(back, nxt)), nxt)
 
 
-@pytest.mark.skipif(shutil.which("node") is None, reason="no node executable: apt-get install nodejs")
+@needs_node
 def test_the_pages_reader_decodes_the_engines_frames_to_the_same_rows(tmp_path):
     scene = scene_with(15)
     first = quantise(scene, 1, 0.0, CAM)
@@ -124,3 +127,27 @@ console.log(JSON.stringify({{ step: state.step, rows: out }}));
     assert page["step"] == 9
     for kind in KINDS:
         assert page["rows"][kind] == states[-1].rows[kind].reshape(-1).tolist(), kind
+
+
+@needs_node
+def test_the_page_blends_between_frames_and_holds_the_last_one_when_the_next_is_late(tmp_path):
+    scene = scene_with(2)
+    first = quantise(scene, 1, 0.0, CAM)
+    moved = quantise(scene_with(2, 0.1, 2), 2, 0.0, CAM)  # both capsules 10 cm along every axis
+    (tmp_path / "0.bin").write_bytes(scene_glb(first, scene))
+    (tmp_path / "1.bin").write_bytes(encode_frame(first, moved))
+    script = f"""
+const fs = require("fs"); const {{ SceneStream }} = require({json.dumps(str(PAGE / "stream.js"))});
+globalThis.performance = {{ timeOrigin: 0 }};
+const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
+const s = new SceneStream(); s.receive(buf(0), 1000); s.receive(buf(1), 1020);
+const x = (t) => s.sample(t).rows.capsules[0];
+console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    at_arrival, halfway, done, late = json.loads(res.stdout)
+    a0, a1 = first.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
+    assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
+    assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
+    assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), "a late frame must hold, not run on"
