@@ -81,3 +81,12 @@ def test_an_acknowledging_page_gets_frames_delta_coded_against_what_it_has(sourc
         assert steps == list(range(2, 12))
         assert np.array_equal(state.rows["capsules"][0, [2, 5]], [110, 110])
         assert max(sizes) < 80, f"one moved capsule should cost a few bytes over the header, got {max(sizes)}"
+
+
+@pytest.mark.parametrize("bad", ['{"ack": -1}', '{"ack": 1.5}', '{"ack": true}', '{"ack": 1, "seq": 2}'])
+def test_an_ack_is_a_step_number_or_it_is_dropped_as_malformed(bad):
+    from input.web.protocol import Ack, WebMessageError, parse_message
+
+    assert parse_message('{"ack": 42}') == Ack(42)
+    with pytest.raises(WebMessageError):
+        parse_message(bad)
