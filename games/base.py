@@ -80,8 +80,10 @@ class Game:
         name: the name on the command line.
         install: plugin that builds the simulation (scene, puppets, rules).
         draw: fills a render scene from the world, interpolated by ``alpha``.
-        draw_state: the same without decoration a viewer can draw itself (falling snow):
-            what is streamed to the phone every step (``None``: ``draw``).
+        draw_state: what is streamed to the phone every step (``None``: ``draw``): the game's
+            drawing without what would cost too much on the wire (snowman: the 900 falling
+            flakes move every step; the tracks are cells in grid order, so a new one shifts
+            every row after it).
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
         controls: the start screen's help lines.

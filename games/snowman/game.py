@@ -33,6 +33,7 @@ CONTROLS = (
     "mouse: wheel down while holding = crouch (crouch-walk to roll a snowball), wheel up = lift",
     "mouse: a quick upward flick while holding = jump; right-drag orbits the camera",
     "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
+    "phone (web, --source web): scan the QR code, look through the phone; its Calibrate button redoes 'this is the screen'",
     "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
     "keys: R new field, F5 save the field, F9 restore it, P pause, H or F1 help, Esc quit",
