@@ -42,6 +42,7 @@ import secrets
 import socket
 import time
 from collections import OrderedDict
+from dataclasses import dataclass, field
 from importlib import resources
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
@@ -67,6 +68,14 @@ PAGE_FILES = {"/": ("index.html", "text/html; charset=utf-8"), "/index.html": ("
 FRAMES_IN_FLIGHT = 2
 _TOKEN_PAGES = {"/", "/index.html", "/ws"}
 _FRAME_LIMIT = 64 * 1024  # bytes: a larger WebSocket message closes the connection unread
+
+
+@dataclass
+class _Acks:
+    """What one page has acknowledged: the newest scene step it has, and a wake for its sender."""
+
+    step: int = -1
+    arrived: asyncio.Event = field(default_factory=asyncio.Event)
 
 
 def _page(name: str) -> bytes:
@@ -209,7 +218,7 @@ class WebSource(PoseSource):
         self._slots[slot] = ws
         self.connected(controller)
         bucket = [self.max_rate, time.monotonic()]
-        acked = [-1, asyncio.Event()]  # the newest step the page has, and a wake for the sender
+        acked = _Acks()
         wake = asyncio.Event()
         sender = None
         try:
@@ -226,8 +235,8 @@ class WebSource(PoseSource):
                     return
                 reply = self._handle(message, controller, bucket, time.monotonic())
                 if isinstance(reply, Ack):
-                    acked[0] = max(int(acked[0]), reply.step)
-                    acked[1].set()  # type: ignore[union-attr]  # the list holds (int, Event)
+                    acked.step = max(acked.step, reply.step)
+                    acked.arrived.set()
                 elif reply is not None:
                     await ws.send(reply)
         except ConnectionClosed as exc:
@@ -241,18 +250,18 @@ class WebSource(PoseSource):
                 sender.cancel()
             self._release(slot, controller)
 
-    async def _stream(self, ws: Any, wake: asyncio.Event, acked: list[Any]) -> None:
+    async def _stream(self, ws: Any, wake: asyncio.Event, acked: _Acks) -> None:
         """Send one page the scene: the GLB once, then the newest state while few frames are unacknowledged."""
         sent: list[int] = []
         base: SceneState | None = None
         while True:
             await wake.wait()
             wake.clear()
-            while sent and sent[0] <= acked[0]:
+            while sent and sent[0] <= acked.step:
                 sent.pop(0)
             if len(sent) >= FRAMES_IN_FLIGHT:
-                acked[1].clear()
-                await acked[1].wait()
+                acked.arrived.clear()
+                await acked.arrived.wait()
                 wake.set()  # look again: the newest state is still there to send
                 continue
             latest = self._latest
