@@ -18,6 +18,7 @@ BENCHES: dict[str, str] = {
     "cycles-batch": "bench.cycles_batch",
     "mocurves": "bench.mocurves",
     "input-latency": "bench.input_latency",
+    "phone-view": "bench.phone_view",
     "snowman": "bench.snowman",
     "render": "bench.render",
     "state-hash": "bench.state_hash",

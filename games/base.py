@@ -80,6 +80,10 @@ class Game:
         name: the name on the command line.
         install: plugin that builds the simulation (scene, puppets, rules).
         draw: fills a render scene from the world, interpolated by ``alpha``.
+        draw_state: what is streamed to the phone every step (``None``: ``draw``): the game's
+            drawing without what would cost too much on the wire (snowman: the 900 falling
+            flakes move every step; the tracks are cells in grid order, so a new one shifts
+            every row after it).
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
         controls: the start screen's help lines.
@@ -99,3 +103,4 @@ class Game:
     options: dict[str, str] = field(default_factory=dict)
     prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup
     replay_setup: Callable[[dict[str, Any]], dict[str, Any]] = dict
+    draw_state: Callable[[World, RenderScene, float], None] | None = None

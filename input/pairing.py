@@ -18,7 +18,7 @@ from typing import Any
 from input.hid import enumerate_supported
 from input.osc import DEFAULT_PORT
 
-__all__ = ["PairingInfo", "pairing_info", "lan_addresses", "qr_ascii", "serial_ports"]
+__all__ = ["PairingInfo", "pairing_info", "lan_addresses", "qr_ascii", "qr_matrix", "serial_ports"]
 
 
 @dataclass
@@ -110,6 +110,17 @@ def qr_ascii(text: str) -> str:
     out = io.StringIO()
     qr.print_ascii(out=out, invert=True)
     return out.getvalue()
+
+
+def qr_matrix(text: str) -> Any:
+    """A QR code of ``text`` as a boolean ``[n, n]`` array (True: a dark module), with a quiet zone of 4."""
+    import numpy as np
+    import qrcode
+
+    qr = qrcode.QRCode(border=4)
+    qr.add_data(text)
+    qr.make(fit=True)
+    return np.array(qr.get_matrix(), dtype=bool)
 
 
 def pairing_info(port: int = DEFAULT_PORT, bind_host: str = "0.0.0.0") -> PairingInfo:

@@ -23,8 +23,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("game", help="snowman, tasbada or sandbox")
     add_source_arguments(parser)
     add_run_arguments(parser)
-    parser.add_argument("--view", choices=("orbit", "phone"), default="orbit",
-                        help="phone: see the scene from the held controller (web, OSC or SpaceMouse); V switches")
+    parser.add_argument("--view", choices=("orbit", "phone", "none"), default="orbit",
+                        help="phone: see the scene from the held controller (web, OSC or SpaceMouse); V switches; "
+                             "none: no desktop window at all (with --source web the phones are the only views)")
     parser.add_argument("--record", type=output_file, default=None,
                         help="record the session's input and state hashes (an existing file is replaced)")
     parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
@@ -113,6 +114,11 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    if args.view == "none":
+        if args.screenshot is not None:
+            print("error: --view none draws nothing: drop --screenshot or choose another view", file=sys.stderr)
+            return 2
+        args.headless = True  # no window, no GL: the session runs paced by its live source
     if not args.headless:
         from engine.render.window import NoDisplayError
         from engine.runner import check_display

@@ -24,6 +24,7 @@ from engine.statemachine.puppet.words import describe_puppet
 from games.base import Game
 from games.common import Notice
 from input.hub import InputHub
+from puppetphone.web_pairing import draw_web_pairing, web_pairing_lines
 
 __all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "HELP_KEYS", "COLORS",
            "MAX_PUPPET_LINES"]
@@ -63,8 +64,11 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
     for src in hub.sources:
         if type(src).__name__ == "OscSource" and not any(st.packets > 0 for st in hub.statuses()):
             lines += _pairing_lines(src)
+    lines += web_pairing_lines(hub)
     for st in hub.statuses():
-        light = "[live]" if st.connected and st.packets_per_s > 0 else ("[idle]" if st.connected else "[gone]")
+        # A source nothing has reached yet is waiting, not gone: "[gone]" is for a phone that was there.
+        light = "[live]" if st.connected and st.packets_per_s > 0 else (
+            "[idle]" if st.connected else ("[gone]" if st.packets else "[waiting for a phone]"))
         err = f"  {st.last_error}" if st.last_error else ""
         lines.append(f"{light} {st.name}: {st.packets_per_s:5.1f} packets/s, dropped {st.dropped}{err}")
         if st.locked_out:
@@ -118,9 +122,11 @@ def _pairing_lines(source: object) -> list[str]:
 
 
 def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fps: float, paused: bool,
-                 state: OverlayState | None = None) -> None:
-    """Add the overlay's lines, the help (if shown) and the notice (if any) to the scene."""
+                 state: OverlayState | None = None, size: tuple[int, int] = (0, 0)) -> None:
+    """Add the overlay's lines, the help (if shown), the notice (if any) and, while a web source waits
+    for its phone, the QR code (``size``: the window's, to keep it square) to the scene."""
     state = state or OverlayState()
+    draw_web_pairing(scene, hub, size)
     for line in overlay_lines(world, game, hub, fps, paused, state):
         scene.add_text(line, size=_SIZE, color=COLORS["text"])
     for line in help_lines(game, state):

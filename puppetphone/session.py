@@ -84,7 +84,7 @@ class GameActivity:
         """The game's view and the overlay."""
         self.game.draw(self.app.world, scene, alpha)
         fps = self.runner.fps if self.runner is not None else 0.0
-        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay)
+        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay, size)
 
     def on_event(self, event: Any, runner: Runner) -> bool:
         """Mouse to the mouse source, right-drag orbits, R / F5 / F9 become recorded commands."""
@@ -147,4 +147,17 @@ def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str,
     if verify is not None:
         check = HashCheck(verify)
         app.on_step_end.append(check)
-    return GameActivity(game, app, hub, game.camera(), recorder, check, view=view)
+    activity = GameActivity(game, app, hub, game.camera(), recorder, check, view=view)
+    _stream_to_phones(activity)
+    return activity
+
+
+def _stream_to_phones(activity: GameActivity) -> None:
+    """With a web source, every step's scene goes to the connected pages too (output only)."""
+    from input.web.server import WebSource
+    from input.web.viewport import PhoneViewport
+
+    for source in activity.hub.sources:
+        if isinstance(source, WebSource):
+            draw = activity.game.draw_state or activity.game.draw
+            activity.app.on_step_end.append(PhoneViewport(source, draw, lambda: activity.orbit))

@@ -21,7 +21,7 @@ from games.snowman.bent_scenery import BentScenery
 from games.snowman.scenery import draw_snowfall, draw_trees
 from games.snowman.snow import SnowField
 
-__all__ = ["draw_snowman_game", "draw_snowmen"]
+__all__ = ["draw_snowman_game", "draw_snowman_state", "draw_snowmen"]
 
 _TWIG = (0.35, 0.22, 0.12)
 _COAL = (0.08, 0.08, 0.09)
@@ -109,8 +109,8 @@ def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[i
         scene.add_spheres(c, r, color=col, outline=out)
 
 
-def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
-    """The whole game view."""
+def draw_snowman_state(world: World, scene: RenderScene, alpha: float) -> None:
+    """Puppets, snowballs, snowmen, sticks and trees: what the phone is streamed (no tracks, no falling snow)."""
     from engine.components import Stick
 
     draw_world(world, scene, alpha)
@@ -118,6 +118,11 @@ def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
     outlined |= {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None}
     draw_snowmen(world, scene, alpha, outlined)
     draw_trees(scene, world.try_resource(BentScenery))
+
+
+def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
+    """The whole game view: the state, the tracks in the snow, falling snow."""
+    draw_snowman_state(world, scene, alpha)
     field = world.try_resource(SnowField)
     if field is not None:
         marks = field.marks()

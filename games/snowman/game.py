@@ -19,7 +19,7 @@ from engine.statemachine.puppet import install_puppets
 from games.base import Game
 from games.snowman.bent_scenery import prepare_flow, recorded_flow
 from games.snowman.components import SnowmanStats, StackWatch
-from games.snowman.draw import draw_snowman_game
+from games.snowman.draw import draw_snowman_game, draw_snowman_state
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
 from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
                                  start_snowballs, stick_stacked_balls)
@@ -33,6 +33,7 @@ CONTROLS = (
     "mouse: wheel down while holding = crouch (crouch-walk to roll a snowball), wheel up = lift",
     "mouse: a quick upward flick while holding = jump; right-drag orbits the camera",
     "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
+    "phone (web, --source web): scan the QR code, look through the phone; its Calibrate button redoes 'this is the screen'",
     "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
     "keys: R new field, F5 save the field, F9 restore it, P pause, H or F1 help, Esc quit",
@@ -90,5 +91,6 @@ def replay_game(recorded: dict[str, Any]) -> dict[str, Any]:
 
 
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game)
+            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game,
+            draw_state=draw_snowman_state)
 

@@ -17,6 +17,8 @@ or, in WebXR ``immersive-ar``, ``"kind": "xr"`` with ``"q": [x, y, z, w]`` and
 looking along -Z). ``t`` is the page's clock (``performance.timeOrigin + now()``,
 milliseconds since the epoch) when the sensor event fired: it is used for latency
 figures only, never by the simulation. ``{"ping": t}`` asks for ``{"pong": t}``.
+``{"ack": step}`` says the page has received the scene frame of that step (the
+server's back-pressure, :mod:`input.web.server`); it never reaches the simulation.
 
 Conversion (:func:`to_sample_fields`): DeviceOrientation angles are the intrinsic
 Z-X'-Y'' rotation of the W3C spec, device → Earth (X east, Y north, Z up), so the
@@ -41,7 +43,7 @@ from numpy.typing import NDArray
 from engine import quat
 from input.phone_frames import arkit_to_stick, phone_to_stick
 
-__all__ = ["ControllerMessage", "Ping", "WebMessageError", "parse_message", "to_sample_fields",
+__all__ = ["ControllerMessage", "Ping", "Ack", "WebMessageError", "parse_message", "to_sample_fields",
            "orientation_to_quat", "MAX_MESSAGE_BYTES", "CROUCH_DEPTH", "KINDS", "PageClock"]
 
 #: A reading is about 200 bytes; anything much longer is not from the page.
@@ -64,6 +66,13 @@ class Ping:
     """A page measuring its round trip: echo ``t`` back."""
 
     t: float
+
+
+@dataclass(frozen=True)
+class Ack:
+    """The page has the scene frame of ``step``: the server may send it another."""
+
+    step: int
 
 
 @dataclass(frozen=True)
@@ -114,7 +123,7 @@ def orientation_to_quat(alpha: float, beta: float, gamma: float) -> F:
     return quat.normalize(quat.mul(quat.mul(rz, rx), ry))
 
 
-def parse_message(text: str | bytes) -> ControllerMessage | Ping:
+def parse_message(text: str | bytes) -> ControllerMessage | Ping | Ack:
     """Check one WebSocket message from the page.
 
     Raises:
@@ -132,6 +141,11 @@ def parse_message(text: str | bytes) -> ControllerMessage | Ping:
         raise WebMessageError("not a JSON object")
     if set(msg) == {"ping"}:
         return Ping(_number(msg["ping"], "ping", 1e16))
+    if set(msg) == {"ack"}:
+        step = msg["ack"]
+        if isinstance(step, bool) or not isinstance(step, int) or not 0 <= step < 2**32:
+            raise WebMessageError("ack must be a step number")
+        return Ack(step)
     unknown = set(msg) - _KEYS
     if unknown:
         raise WebMessageError(f"unknown field {min(unknown)[:20]!r}")

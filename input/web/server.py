@@ -21,6 +21,14 @@ Safety on a LAN:
   with their reason and dropped, never raised. A message over 64 KiB closes the
   connection in the WebSocket layer before it is read (counted as "message too big").
 
+The phone is also the viewport (:mod:`input.web.viewport`): after every step the
+engine thread hands :meth:`WebSource.publish` the quantised scene; each connection
+sends its page the scene as a GLB once (:mod:`input.web.scene_glb`), then a frame
+delta-coded against what *that* page last got (:mod:`input.web.scene_stream`). A
+connection never queues: it holds only the newest state, and sends while fewer than
+:data:`FRAMES_IN_FLIGHT` frames wait for the page's ``{"ack": step}``, so a slow phone
+(or Wi-Fi) gets fewer frames, each the latest, rather than a growing backlog.
+
 :attr:`WebSource.page_times` remembers, for the latest readings, the page's clock at
 the sensor event, keyed by the sample's receive time: the latency bench reads it.
 """
@@ -34,6 +42,7 @@ import secrets
 import socket
 import time
 from collections import OrderedDict
+from dataclasses import dataclass, field
 from importlib import resources
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
@@ -43,16 +52,30 @@ from websockets.frames import CloseCode
 
 from input.source import PoseSource
 from input.web.cert import WebCertificate, load_or_create
-from input.web.protocol import ControllerMessage, PageClock, Ping, WebMessageError, parse_message, to_sample_fields
+from input.web.protocol import Ack, ControllerMessage, PageClock, Ping, WebMessageError, parse_message, to_sample_fields
+from input.web.scene_glb import scene_glb
+from input.web.scene_stream import SceneState, encode_frame
 
-__all__ = ["WebSource", "DEFAULT_WEB_PORT", "PAGE_FILES"]
+__all__ = ["WebSource", "DEFAULT_WEB_PORT", "PAGE_FILES", "FRAMES_IN_FLIGHT"]
 
 DEFAULT_WEB_PORT = 8443
+_JS = "text/javascript; charset=utf-8"
 #: The page's files and their content types (served from the package, no build step).
 PAGE_FILES = {"/": ("index.html", "text/html; charset=utf-8"), "/index.html": ("index.html", "text/html; charset=utf-8"),
-              "/app.js": ("app.js", "text/javascript; charset=utf-8"), "/style.css": ("style.css", "text/css; charset=utf-8")}
+              "/app.js": ("app.js", _JS), "/stream.js": ("stream.js", _JS), "/render.js": ("render.js", _JS),
+              "/placement.js": ("placement.js", _JS), "/style.css": ("style.css", "text/css; charset=utf-8")}
+#: Scene frames a connection may have sent and not yet had acknowledged.
+FRAMES_IN_FLIGHT = 2
 _TOKEN_PAGES = {"/", "/index.html", "/ws"}
 _FRAME_LIMIT = 64 * 1024  # bytes: a larger WebSocket message closes the connection unread
+
+
+@dataclass
+class _Acks:
+    """What one page has acknowledged: the newest scene step it has, and a wake for its sender."""
+
+    step: int = -1
+    arrived: asyncio.Event = field(default_factory=asyncio.Event)
 
 
 def _page(name: str) -> bytes:
@@ -110,6 +133,31 @@ class WebSource(PoseSource):
         self.page_times: OrderedDict[float, float] = OrderedDict()
         self._clocks: dict[str, PageClock] = {}  # per controller: its page's event times on our clock
         self.refused = 0
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._latest: tuple[SceneState, Any] | None = None
+        self._wakes: set[asyncio.Event] = set()
+        self.frames_sent = 0
+        self.frame_bytes = 0
+
+    @property
+    def viewers(self) -> int:
+        """Pages connected to watch the scene (each controller's page is one)."""
+        return len(self._wakes)
+
+    def publish(self, state: SceneState, look: Any) -> None:
+        """Hand the pages the newest scene (engine thread); ``look`` is the scene whose ground,
+        sun and sky the GLB carries. Older states not yet sent are simply replaced."""
+        self._latest = (state, look)
+        loop = self._loop
+        if loop is not None and self._wakes:
+            try:
+                loop.call_soon_threadsafe(self._wake_all)
+            except RuntimeError:  # the server loop has just closed
+                pass
+
+    def _wake_all(self) -> None:
+        for wake in self._wakes:
+            wake.set()
 
     def url(self, address: str | None = None) -> str:
         """The controller page's address with the session token (what the QR code carries)."""
@@ -127,6 +175,7 @@ class WebSource(PoseSource):
     async def _serve(self) -> None:
         from websockets.asyncio.server import serve
 
+        self._loop = asyncio.get_running_loop()
         async with serve(self._connection, sock=self._sock, ssl=self._ssl,
                          process_request=self._http, max_size=_FRAME_LIMIT, max_queue=32,
                          ping_interval=5, ping_timeout=10, close_timeout=1, server_header="PuppetPhone"):
@@ -169,8 +218,13 @@ class WebSource(PoseSource):
         self._slots[slot] = ws
         self.connected(controller)
         bucket = [self.max_rate, time.monotonic()]
+        acked = _Acks()
+        wake = asyncio.Event()
+        sender = None
         try:
             await ws.send(json.dumps({"hello": controller}))
+            self._wakes.add(wake)
+            sender = asyncio.create_task(self._stream(ws, wake, acked))
             while True:
                 try:
                     message = await asyncio.wait_for(ws.recv(), self.silent_after)
@@ -180,7 +234,10 @@ class WebSource(PoseSource):
                     await ws.close(4002, "silent for too long")
                     return
                 reply = self._handle(message, controller, bucket, time.monotonic())
-                if reply is not None:
+                if isinstance(reply, Ack):
+                    acked.step = max(acked.step, reply.step)
+                    acked.arrived.set()
+                elif reply is not None:
                     await ws.send(reply)
         except ConnectionClosed as exc:
             if exc.sent is not None and exc.sent.code == CloseCode.MESSAGE_TOO_BIG:
@@ -188,7 +245,38 @@ class WebSource(PoseSource):
         except Exception as exc:  # a broken connection ends this controller, never the server
             self.error(f"{controller}: {type(exc).__name__}: {exc}")
         finally:
+            self._wakes.discard(wake)
+            if sender is not None:
+                sender.cancel()
             self._release(slot, controller)
+
+    async def _stream(self, ws: Any, wake: asyncio.Event, acked: _Acks) -> None:
+        """Send one page the scene: the GLB once, then the newest state while few frames are unacknowledged."""
+        sent: list[int] = []
+        base: SceneState | None = None
+        while True:
+            await wake.wait()
+            wake.clear()
+            while sent and sent[0] <= acked.step:
+                sent.pop(0)
+            if len(sent) >= FRAMES_IN_FLIGHT:
+                acked.arrived.clear()
+                await acked.arrived.wait()
+                wake.set()  # look again: the newest state is still there to send
+                continue
+            latest = self._latest
+            if latest is None or (base is not None and latest[0].step == base.step):
+                continue
+            state, look = latest
+            data = scene_glb(state, look) if base is None else encode_frame(base, state)
+            try:
+                await ws.send(data)
+            except ConnectionClosed:
+                return  # the reading loop sees the close and releases the slot
+            base = state
+            sent.append(state.step)
+            self.frames_sent += 1
+            self.frame_bytes += len(data)
 
     def _release(self, slot: int, controller: str) -> None:
         """Free ``slot`` (once) and tell the hub its controller is gone."""
@@ -196,8 +284,8 @@ class WebSource(PoseSource):
         if self._slots.pop(slot, None) is not None:
             self.disconnected(controller)
 
-    def _handle(self, message: str | bytes, controller: str, bucket: list[float], now: float) -> str | None:
-        """One message of one connection: queue its sample, answer a ping, or count and drop it."""
+    def _handle(self, message: str | bytes, controller: str, bucket: list[float], now: float) -> str | Ack | None:
+        """One message of one connection: queue its sample, answer a ping, pass an ack on, or count and drop it."""
         tokens = min(self.max_rate, bucket[0] + (now - bucket[1]) * self.max_rate)
         bucket[1] = now
         if tokens < 1.0:
@@ -212,6 +300,8 @@ class WebSource(PoseSource):
             return None
         if isinstance(msg, Ping):
             return json.dumps({"pong": msg.t})
+        if isinstance(msg, Ack):
+            return msg
         assert isinstance(msg, ControllerMessage)
         clock = self._clocks.setdefault(controller, PageClock())
         sample = self.offer(**to_sample_fields(msg, controller, clock.stamp(msg.t, now)))

@@ -28,7 +28,8 @@ def test_overlay_shows_state_and_pairing_until_a_packet_arrives():
         assert "physics_recoveries 0" in lines[0]
         assert any(f"port {osc.port}" in line for line in lines)
         assert any("--osc-host 0.0.0.0" in line for line in lines)
-        assert any("[idle]" in line or "[gone]" in line for line in lines)
+        assert any("[idle]" in line or "[waiting for a phone]" in line for line in lines)
+        assert not any("[gone]" in line for line in lines), "nothing has come yet: waiting, not gone"
     finally:
         hub.close()
 

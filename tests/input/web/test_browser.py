@@ -25,10 +25,10 @@ pytestmark = pytest.mark.skipif(find_chromium() is None,
                                 reason="no chromium executable: apt-get install chromium (.ci/run installs it)")
 
 
-def start_play(tmp_path: Path, frames: int, *extra: str) -> tuple[subprocess.Popen[str], str]:
-    """``puppetphone play sandbox --source web`` on a free port; the process and its controller link."""
+def start_play(tmp_path: Path, frames: int, *extra: str, game: str = "sandbox") -> tuple[subprocess.Popen[str], str]:
+    """``puppetphone play GAME --source web`` on a free port; the process and its controller link."""
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path / "data")}
-    proc = subprocess.Popen([sys.executable, "-m", "puppetphone", "play", "sandbox", "--source", "web", "--web-port", "0", "--headless",
+    proc = subprocess.Popen([sys.executable, "-m", "puppetphone", "play", game, "--source", "web", "--web-port", "0", "--headless",
                              "--frames", str(frames), *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env=env)
     assert proc.stderr is not None
@@ -51,9 +51,7 @@ def drive(browser: Chromium, url: str, shot: Path | None = None) -> None:
     browser.wait_for("document.getElementById('state').textContent.startsWith('connected: web:1')")
     browser.click("enable")  # the user gesture iOS needs for its permission prompt
     browser.wait_for("document.getElementById('mode').textContent.includes('orientation 3-DoF')")
-    browser.touch("touch", "touchStart")  # the first tap calibrates: "this is the screen"
-    browser.touch("touch", "touchEnd")
-    time.sleep(0.2)
+    calibrate(browser)
     browser.orientation(0.0, -10.0, 0.0)  # point down at the puppet
     time.sleep(0.2)
     browser.touch("touch", "touchStart")  # grab
@@ -64,6 +62,14 @@ def drive(browser: Chromium, url: str, shot: Path | None = None) -> None:
     if shot is not None:
         browser.screenshot(shot)
     browser.touch("touch", "touchEnd")  # drop
+
+
+def calibrate(browser: Chromium) -> None:
+    """Answer the page's calibration prompt ("point at the screen"), and see it confirmed."""
+    browser.wait_for("!document.getElementById('calib').hidden")
+    browser.click("calib-ok")
+    browser.wait_for("!document.getElementById('calibrated').hidden")
+    time.sleep(0.2)
 
 
 def replay_in_process(rec: Path) -> tuple[list[int], float, set[str]]:

@@ -30,5 +30,5 @@ def test_web_imports_only_engine_input_and_libraries():
 def test_the_page_ships_with_the_package():
     page = resources.files("input.web").joinpath("page")
     html = page.joinpath("index.html").read_text()
-    for name in ("app.js", "style.css"):
+    for name in ("app.js", "stream.js", "render.js", "placement.js", "style.css"):
         assert name in html and page.joinpath(name).is_file()

@@ -1,0 +1,126 @@
+// PuppetPhone scene stream: the GLB a page gets once, then delta-coded frames (input/web/scene_stream.py).
+// The reader mirrors scene_stream.decode_frame; interpolation runs one frame behind the newest so a late
+// frame never stalls the picture (the last one simply holds).
+"use strict";
+
+const KINDS = ["capsules", "spheres", "boxes", "lines", "points"];
+const HEADER_BYTES = 48;
+
+// The scene and the first rows, from the GLB the server sends on connect.
+function readSceneGlb(buffer) {
+  const dv = new DataView(buffer);
+  if (dv.getUint32(0, true) !== 0x46546c67) throw new Error("not a GLB");
+  const jsLen = dv.getUint32(12, true);
+  const doc = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 20, jsLen)));
+  const binStart = 20 + jsLen + 8;
+  const extras = doc.scenes[0].extras.puppetphone;
+  const rows = {}, scales = {};
+  for (const kind of KINDS) {
+    const info = extras.rows[kind];
+    scales[kind] = info.scales;
+    if (info.accessor === null) { rows[kind] = new Int16Array(0); continue; }
+    const view = doc.bufferViews[doc.accessors[info.accessor].bufferView];
+    rows[kind] = new Int16Array(buffer.slice(binStart + view.byteOffset, binStart + view.byteOffset + view.byteLength));
+  }
+  const cam = extras.camera;
+  return { extras, scales, state: { step: extras.step, published: 0, camera: { p: cam.position, q: cam.rotation, fov: cam.fov_y }, rows } };
+}
+
+// The state after one frame, from the state the page held (``base``).
+function decodeFrame(base, scales, buffer) {
+  const dv = new DataView(buffer);
+  if (buffer.byteLength < HEADER_BYTES || dv.getUint8(0) !== 0x50 || dv.getUint8(1) !== 0x46 || dv.getUint8(2) !== 1)
+    throw new Error("not a version 1 scene frame");
+  const step = dv.getUint32(4, true), published = dv.getFloat64(8, true);
+  const f = (i) => dv.getFloat32(16 + 4 * i, true);
+  const camera = { p: [f(0), f(1), f(2)], q: [f(3), f(4), f(5), f(6)], fov: f(7) };
+  let at = HEADER_BYTES;
+  const rows = {};
+  for (const kind of KINDS) {
+    const cols = scales[kind].length;
+    const n = dv.getUint16(at, true), mode = dv.getUint8(at + 2);
+    at += 3;
+    const old = base.rows[kind], out = new Int16Array(n * cols);
+    out.set(old.subarray(0, Math.min(n, old.length / cols) * cols));
+    if (mode) {
+      const columns = dv.getUint16(at, true);
+      at += 2;
+      const mask = new Uint8Array(buffer, at, (n + 7) >> 3);
+      at += mask.length;
+      for (let r = 0; r < n; r++) {
+        if (!(mask[r >> 3] & (1 << (r & 7)))) continue;
+        for (let c = 0; c < cols; c++) {
+          if (!(columns & (1 << c))) continue;
+          if (mode === 1) { out[r * cols + c] += dv.getInt8(at); at += 1; }
+          else { out[r * cols + c] = dv.getInt16(at, true); at += 2; }
+        }
+      }
+    }
+    rows[kind] = out;
+  }
+  if (at !== buffer.byteLength) throw new Error("bytes after the last kind");
+  return { step, published, camera, rows };
+}
+
+// Quantised rows to float rows (metres, colours in [0, 1]).
+function toFloat(rows, scales) {
+  const out = {};
+  for (const kind of KINDS) {
+    const s = scales[kind], src = rows[kind], dst = new Float32Array(src.length), cols = s.length;
+    for (let i = 0; i < src.length; i++) dst[i] = src[i] / s[i % cols];
+    out[kind] = dst;
+  }
+  return out;
+}
+
+function nlerpQuat(a, b, t) {
+  const d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], s = d < 0 ? -1 : 1;
+  const q = [0, 1, 2, 3].map((i) => a[i] * (1 - t) + s * b[i] * t);
+  const n = Math.hypot(q[0], q[1], q[2], q[3]) || 1;
+  return q.map((v) => v / n);
+}
+
+// Holds the newest two frames and blends between them by arrival time.
+class SceneStream {
+  constructor() { this.scales = null; this.extras = null; this.state = null; this.prev = null; this.cur = null; this.log = []; this.frames = 0; this.bytes = 0; }
+
+  // One binary WebSocket message: the GLB or a frame. Returns the step the page now has.
+  receive(buffer, now) {
+    let state;
+    if (new DataView(buffer).getUint32(0, true) === 0x46546c67) {
+      const glb = readSceneGlb(buffer);
+      this.scales = glb.scales; this.extras = glb.extras; state = glb.state;
+    } else {
+      state = decodeFrame(this.state, this.scales, buffer);
+    }
+    this.state = state;
+    const rows = toFloat(state.rows, this.scales);
+    const interval = this.cur ? Math.min(Math.max(now - this.cur.arrived, 1000 / 60), 100) : 1000 / 60;
+    this.prev = this.cur;
+    this.cur = { rows, camera: state.camera, arrived: now, interval, step: state.step };
+    this.frames += 1; this.bytes += buffer.byteLength;
+    if (state.published) this.log.push([state.step, state.published * 1000, performance.timeOrigin + now]);
+    if (this.log.length > 4000) this.log.shift();
+    return state.step;
+  }
+
+  // The rows and camera to draw at ``now`` (ms): prev → cur over the arrival interval.
+  sample(now) {
+    const cur = this.cur, prev = this.prev;
+    if (!cur) return null;
+    if (!prev) return { rows: cur.rows, camera: cur.camera, step: cur.step };
+    const t = Math.min(Math.max((now - cur.arrived) / cur.interval, 0), 1);
+    const rows = {};
+    for (const kind of KINDS) {
+      const a = prev.rows[kind], b = cur.rows[kind];
+      if (a.length !== b.length || t >= 1) { rows[kind] = b; continue; }
+      const out = new Float32Array(b.length);
+      for (let i = 0; i < b.length; i++) out[i] = a[i] + (b[i] - a[i]) * t;
+      rows[kind] = out;
+    }
+    const p = [0, 1, 2].map((i) => prev.camera.p[i] + (cur.camera.p[i] - prev.camera.p[i]) * t);
+    return { rows, camera: { p, q: nlerpQuat(prev.camera.q, cur.camera.q, t), fov: cur.camera.fov }, step: cur.step };
+  }
+}
+
+if (typeof module !== "undefined") module.exports = { SceneStream, decodeFrame, readSceneGlb, toFloat, KINDS };

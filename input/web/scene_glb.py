@@ -1,0 +1,107 @@
+"""The scene a phone gets once, on connect: a GLB of the field and of everything on it.
+
+Written with the project's glTF container (:func:`engine.io.gltf_write.container_bytes`),
+so any glTF tool can open it: the ground is a real mesh (a square of the field's size
+with its snow colour as material), and the primitives of the step the phone joined
+at ride in ``SHORT`` accessors, one per kind, quantised as
+:mod:`input.web.scene_stream` does (the first delta frame builds on exactly these
+rows). Scene extras carry what the page lights and clears with: sun, sky, horizon,
+the column scales and the frame version.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+from dataclasses import asdict
+
+import numpy as np
+
+from engine.io.gltf_write import container_bytes
+from engine.render.scene import RenderScene
+from input.web.scene_stream import FRAME_VERSION, KINDS, SCALES, SceneState
+
+__all__ = ["scene_glb", "read_scene_glb", "FIELD_HALF_SIZE"]
+
+#: Half the side of the ground square the page draws (metres); the desktop's ground is unbounded.
+FIELD_HALF_SIZE = 40.0
+
+
+def _ground_mesh(half: float, height: float) -> tuple[bytes, bytes]:
+    pos = np.array([[-half, height, -half], [half, height, -half], [half, height, half], [-half, height, half]],
+                   dtype="<f4")
+    idx = np.array([0, 2, 1, 0, 3, 2], dtype="<u2")
+    return pos.tobytes(), idx.tobytes()
+
+
+def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
+    """The GLB a phone starts from: ground mesh, ``state``'s rows, lighting in the scene's extras."""
+    chunks: list[bytes] = []
+    views: list[dict] = []  # type: ignore[type-arg]
+    accessors: list[dict] = []  # type: ignore[type-arg]
+
+    def add(raw: bytes, component: int, count: int, kind: str, **extra: object) -> int:
+        offset = sum(len(c) for c in chunks)
+        chunks.append(raw + b"\0" * ((-len(raw)) % 4))
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(raw)})
+        accessors.append({"bufferView": len(views) - 1, "componentType": component, "count": count,
+                          "type": kind, **extra})
+        return len(accessors) - 1
+
+    g = scene.ground
+    pos, idx = _ground_mesh(FIELD_HALF_SIZE, g.height)
+    p_acc = add(pos, 5126, 4, "VEC3", min=[-FIELD_HALF_SIZE, g.height, -FIELD_HALF_SIZE],
+                max=[FIELD_HALF_SIZE, g.height, FIELD_HALF_SIZE])
+    i_acc = add(idx, 5123, 6, "SCALAR")
+    rows = {}
+    for kind in KINDS:
+        data = state.rows[kind]
+        rows[kind] = {"accessor": add(data.astype("<i2").tobytes(), 5122, int(data.size) or 1, "SCALAR")
+                      if data.size else None, "rows": int(len(data)), "columns": len(SCALES[kind]),
+                      "scales": list(SCALES[kind])}
+    blob = b"".join(chunks)
+    cam = state.camera
+    doc = {
+        "asset": {"version": "2.0", "generator": "PuppetPhone scene stream"},
+        "scene": 0,
+        "scenes": [{"name": "field", "nodes": [0], "extras": {"puppetphone": {
+            "version": FRAME_VERSION, "step": state.step, "rows": rows, "ground": asdict(g), "sun": asdict(scene.sun),
+            "sky": list(scene.sky_color), "horizon": list(scene.horizon_color),
+            "outline": list(scene.outline_color),
+            "camera": {"position": list(cam.position), "rotation": list(cam.rotation), "fov_y": cam.fov_y}}}}],
+        "nodes": [{"name": "ground", "mesh": 0}],
+        "meshes": [{"name": "ground", "primitives": [{"attributes": {"POSITION": p_acc}, "indices": i_acc,
+                                                       "material": 0}]}],
+        "materials": [{"name": "snow", "pbrMetallicRoughness": {"baseColorFactor": [*g.color, 1.0],
+                                                                 "metallicFactor": 0.0, "roughnessFactor": 0.9}}],
+        "buffers": [{"byteLength": len(blob)}],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+    return container_bytes(doc, blob, binary=True)
+
+
+def read_scene_glb(data: bytes) -> tuple[dict, SceneState]:  # type: ignore[type-arg]
+    """The scene extras and the starting :class:`SceneState` of a GLB from :func:`scene_glb` (tests, bench)."""
+    from input.web.scene_stream import CameraPose
+
+    magic, _version, total = struct.unpack_from("<4sII", data)
+    if magic != b"glTF" or total != len(data):
+        raise ValueError("not a whole GLB")
+    js_len, _ = struct.unpack_from("<I4s", data, 12)
+    doc = json.loads(data[20:20 + js_len])
+    blob = data[20 + js_len + 8:]
+    extras = doc["scenes"][0]["extras"]["puppetphone"]
+    rows = {}
+    for kind in KINDS:
+        info = extras["rows"][kind]
+        if info["accessor"] is None:
+            rows[kind] = np.zeros((0, info["columns"]), dtype=np.int16)
+            continue
+        view = doc["bufferViews"][doc["accessors"][info["accessor"]]["bufferView"]]
+        raw = np.frombuffer(blob, "<i2", view["byteLength"] // 2, view["byteOffset"])
+        rows[kind] = raw.reshape(info["rows"], info["columns"]).astype(np.int16)
+    cam = extras["camera"]
+    state = SceneState(extras["step"], 0.0, CameraPose(tuple(cam["position"]), tuple(cam["rotation"]), cam["fov_y"]),
+                       rows)
+    return extras, state

@@ -1,0 +1,65 @@
+"""The phone is the viewport: after every step, the game's drawing goes to the phones that watch.
+
+:class:`PhoneViewport` hangs on ``App.on_step_end``. When at least one page is
+connected it draws the world once into a scratch :class:`RenderScene` (the game's own
+state drawing: puppets, props, snowmen, sticks, scenery; the falling snow and the
+tracks in the snow are left out, see :attr:`games.base.Game.draw_state`),
+quantises it (:func:`input.web.scene_stream.quantise`) with the camera the phone is
+(the held controller's view, :func:`input.controller_view.controller_camera`, or the
+game's starting camera before the first reading) and hands it to the
+:class:`~input.web.server.WebSource`, whose connections each send it at their own pace.
+
+It only reads the world: the drawing writes display-only components at most
+(``Appearance``, not hashed), so a session with phones watching records and replays
+exactly as one without.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from engine import quat
+from engine.camera import Camera
+from engine.ecs import World
+from engine.render.scene import RenderScene
+from input.controller_view import controller_camera
+from input.web.scene_stream import CameraPose, quantise
+from input.web.server import WebSource
+
+__all__ = ["PhoneViewport", "camera_pose"]
+
+
+def camera_pose(camera: Camera) -> CameraPose:
+    """A camera's eye, orientation (camera → world) and vertical field of view."""
+    q = quat.from_matrix(camera.rotation)
+    return CameraPose(tuple(float(v) for v in camera.eye), tuple(float(v) for v in q),  # type: ignore[arg-type]
+                      float(camera.fov_y))
+
+
+class PhoneViewport:
+    """Publish the scene to ``source``'s pages after every step (see the module docstring).
+
+    Args:
+        source: the web source whose connected pages draw the scene.
+        draw: the game's state drawing ``(world, scene, alpha)``.
+        fallback: the camera used while no controller drives a stick.
+    """
+
+    def __init__(self, source: WebSource, draw: Callable[[World, RenderScene, float], None],
+                 fallback: Callable[[], Camera]) -> None:
+        self.source = source
+        self.draw = draw
+        self.fallback = fallback
+        self._scene = RenderScene()
+
+    def __call__(self, world: World) -> None:
+        """``on_step_end``: draw and publish, only when a page watches."""
+        if not self.source.viewers:
+            return
+        scene = self._scene
+        scene.clear()
+        self.draw(world, scene, 1.0)
+        camera = controller_camera(world) or self.fallback()
+        state = quantise(scene, world.frame, time.time(), camera_pose(camera))
+        self.source.publish(state, scene)

@@ -1,0 +1,153 @@
+"""The scene stream's format: quantised rows, delta frames, the GLB a phone starts from, and the page's reader.
+
+The page's own decoder (``page/stream.js``) runs under node on frames the engine
+encoded, so a change on one side that the other does not follow fails here.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import input.web
+from engine.render.scene import RenderScene
+from input.web.scene_glb import read_scene_glb, scene_glb
+from input.web.scene_stream import (KINDS, CameraPose, FrameError, SceneState, decode_frame, encode_frame,
+                                    quantise)
+
+CAM = CameraPose((0.0, 1.5, 4.0), (1.0, 0.0, 0.0, 0.0), 60.0)
+PAGE = Path(input.web.__file__).parent / "page"
+needs_node = pytest.mark.skipif(shutil.which("node") is None, reason="no node executable: apt-get install nodejs")
+
+
+def scene_with(n_capsules: int, shift: float = 0.0, moved: int | None = None) -> RenderScene:
+    rng = np.random.default_rng(3)
+    a = rng.uniform(-3, 3, (n_capsules, 3))
+    b = a + rng.uniform(-0.3, 0.3, (n_capsules, 3))
+    if moved is not None:
+        a[:moved] += shift
+        b[:moved] += shift
+    s = RenderScene()
+    s.add_capsules(a, b, 0.05, color=(0.85, 0.45, 0.3))
+    s.add_sphere([1.0, 0.3, -2.0], 0.3)
+    s.add_box([2.0, 0.5, 0.0], [0.2, 0.5, 0.3], rotation=(0.92388, 0.0, 0.38268, 0.0))
+    s.add_line([0.0, 1.0, 0.0], [0.5, 0.2, 0.0], color=(1.0, 0.55, 0.15))
+    s.add_points(np.array([[0.5, 0.2, 0.0]]), size=0.05)
+    return s
+
+
+def same(x: SceneState, y: SceneState) -> bool:
+    return all(np.array_equal(x.rows[k], y.rows[k]) for k in KINDS)
+
+
+def test_a_frame_takes_the_phone_exactly_to_the_new_state_and_sends_only_what_moved():
+    base = quantise(scene_with(40), 1, 0.0, CAM)
+    walked = quantise(scene_with(40, shift=0.02, moved=20), 2, 0.0, CAM)  # 2 cm: int8 differences
+    frame = encode_frame(base, walked)
+    assert same(decode_frame(base, frame), walked)
+    still = encode_frame(base, quantise(scene_with(40), 3, 0.0, CAM))
+    # 20 moved capsules: their 6 end-point columns (not radius, colour, outline) at one byte each, plus masks.
+    assert len(still) < 75, "an unchanged scene costs more than its header and row counts"
+    assert 20 * 6 <= len(frame) - len(still) < 20 * 6 + 16
+    full = encode_frame(SceneState.empty(), walked)
+    assert same(decode_frame(SceneState.empty(), full), walked)
+    assert len(full) > 2 * len(frame)
+
+
+def test_a_jump_too_big_for_a_byte_is_sent_as_whole_values_and_rows_can_come_and_go():
+    base = quantise(scene_with(10), 1, 0.0, CAM)
+    jumped = quantise(scene_with(10, shift=1.5, moved=3), 2, 0.0, CAM)
+    assert same(decode_frame(base, encode_frame(base, jumped)), jumped)
+    fewer = quantise(scene_with(4), 3, 0.0, CAM)
+    more = quantise(scene_with(25), 4, 0.0, CAM)
+    assert same(decode_frame(jumped, encode_frame(jumped, fewer)), fewer)
+    assert same(decode_frame(fewer, encode_frame(fewer, more)), more)
+
+
+def test_quantisation_keeps_millimetres_and_clamps_what_is_far_away():
+    s = RenderScene()
+    s.add_capsule([0.0004, 1.2344, -7.0], [0.0, 40.0, 0.0], 0.05)
+    rows = quantise(s, 0, 0.0, CAM).rows["capsules"][0]
+    assert rows[:3].tolist() == [0, 1234, -7000]
+    assert rows[4] == 32767  # 40 m is past the int16 range of millimetres: clamped, never wrapped
+
+
+@pytest.mark.parametrize("cut", ["short", "magic", "trailing"])
+def test_bytes_that_are_not_a_frame_are_refused_with_a_reason(cut):
+    base = quantise(scene_with(5), 1, 0.0, CAM)
+    frame = encode_frame(SceneState.empty(), quantise(scene_with(5, 0.01, 2), 2, 0.0, CAM))
+    bad = {"short": frame[:-3], "magic": b"XX" + frame[2:], "trailing": frame + b"\0"}[cut]
+    with pytest.raises(FrameError):
+        decode_frame(SceneState.empty() if cut != "magic" else base, bad)
+
+
+def test_the_glb_is_a_gltf_with_a_ground_mesh_and_the_rows_the_first_frame_builds_on():
+    scene = scene_with(12)
+    state = quantise(scene, 7, 0.0, CAM)
+    glb = scene_glb(state, scene)
+    assert glb[:4] == b"glTF" and len(glb) % 4 == 0
+    extras, back = read_scene_glb(glb)
+    assert same(back, state) and back.step == 7
+    assert extras["ground"]["color"] == list(scene.ground.color)
+    doc = json.loads(glb[20:20 + int.from_bytes(glb[12:16], "little")])
+    assert doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] == 0
+    nxt = quantise(scene_with(12, 0.01, 5), 8, 0.0, CAM)
+    assert same(decode_frame(back, encode_frame(back, nxt)), nxt)
+
+
+@needs_node
+def test_the_pages_reader_decodes_the_engines_frames_to_the_same_rows(tmp_path):
+    scene = scene_with(15)
+    first = quantise(scene, 1, 0.0, CAM)
+    states = [quantise(scene_with(15, 0.02 * i, 8), 1 + i, 0.0, CAM) for i in range(1, 4)]
+    states.append(quantise(scene_with(3, 2.0, 3), 9, 0.0, CAM))  # int16 values, fewer rows
+    blobs = [scene_glb(first, scene)]
+    prev = first
+    for s in states:
+        blobs.append(encode_frame(prev, s))
+        prev = s
+    for i, blob in enumerate(blobs):
+        (tmp_path / f"{i}.bin").write_bytes(blob)
+    script = f"""
+const fs = require("fs"); const {{ readSceneGlb, decodeFrame, KINDS }} = require({json.dumps(str(PAGE / "stream.js"))});
+const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
+const glb = readSceneGlb(buf(0)); let state = glb.state;
+for (let i = 1; i < {len(blobs)}; i++) state = decodeFrame(state, glb.scales, buf(i));
+const out = {{}}; for (const k of KINDS) out[k] = Array.from(state.rows[k]);
+console.log(JSON.stringify({{ step: state.step, rows: out }}));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    page = json.loads(res.stdout)
+    assert page["step"] == 9
+    for kind in KINDS:
+        assert page["rows"][kind] == states[-1].rows[kind].reshape(-1).tolist(), kind
+
+
+@needs_node
+def test_the_page_blends_between_frames_and_holds_the_last_one_when_the_next_is_late(tmp_path):
+    scene = scene_with(2)
+    first = quantise(scene, 1, 0.0, CAM)
+    moved = quantise(scene_with(2, 0.1, 2), 2, 0.0, CAM)  # both capsules 10 cm along every axis
+    (tmp_path / "0.bin").write_bytes(scene_glb(first, scene))
+    (tmp_path / "1.bin").write_bytes(encode_frame(first, moved))
+    script = f"""
+const fs = require("fs"); const {{ SceneStream }} = require({json.dumps(str(PAGE / "stream.js"))});
+globalThis.performance = {{ timeOrigin: 0 }};
+const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
+const s = new SceneStream(); s.receive(buf(0), 1000); s.receive(buf(1), 1020);
+const x = (t) => s.sample(t).rows.capsules[0];
+console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    at_arrival, halfway, done, late = json.loads(res.stdout)
+    a0, a1 = first.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
+    assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
+    assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
+    assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), "a late frame must hold, not run on"
