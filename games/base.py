@@ -27,7 +27,7 @@ from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.render.scene import RenderScene
 
-__all__ = ["Game", "GameSetup", "GameOptionError", "parse_settings"]
+__all__ = ["Game", "GameSetup", "GameOptionError", "describe_options", "parse_settings"]
 
 
 class GameOptionError(ValueError):
@@ -72,6 +72,20 @@ def parse_settings(pairs: list[str], declared: dict[str, str], game: str) -> dic
     return options
 
 
+def describe_options(game: "Game") -> list[str]:
+    """``--set help``: one line per option: its type or range, what it does, its default.
+
+    An option whose default is empty says in its help what leaving it unset means.
+    """
+    if not game.options:
+        return [f"{game.name}: no options"]
+    lines = [f"{game.name}:"]
+    for key, default in game.options.items():
+        shown = f"; default {default}" if default else ""
+        lines.append(f"  {key:<8} {game.option_help.get(key, 'text')}{shown}")
+    return lines
+
+
 @dataclass(frozen=True)
 class Game:
     """A playable game.
@@ -84,6 +98,8 @@ class Game:
         status: overlay lines (counters, stage) read from the world.
         controls: the start screen's help lines.
         options: the options ``--set key=value`` may give, with their defaults.
+        option_help: per option, its type and range and what it does, one line
+            (``play GAME --set help`` prints them beside the defaults).
         prepare: reads the outside world for a live session: options in, the
             :class:`GameSetup` values out (plain JSON; raises :class:`GameOptionError`).
         replay_setup: the setup a replay uses, from the one recorded (for instance
@@ -97,5 +113,6 @@ class Game:
     status: Callable[[World], list[str]] = _no_lines
     controls: tuple[str, ...] = field(default_factory=tuple)
     options: dict[str, str] = field(default_factory=dict)
+    option_help: dict[str, str] = field(default_factory=dict)
     prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup
     replay_setup: Callable[[dict[str, Any]], dict[str, Any]] = dict

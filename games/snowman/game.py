@@ -72,6 +72,12 @@ def status(world: World) -> list[str]:
     return lines
 
 
+OPTION_HELP = {
+    "field": "PATH: the saved field F5 writes and F9 restores (unset: ~/.local/share/puppetphone/snowman_field.json)",
+    "flow": "FILE: a flow file from `author flow`: play in the field it bent (unset: the field as shipped)",
+}
+
+
 def prepare_game(options: dict[str, str]) -> dict[str, Any]:
     """The saved field, and the bent scenery of a flow file when ``flow`` names one."""
     setup = prepare(options)
@@ -90,5 +96,5 @@ def replay_game(recorded: dict[str, Any]) -> dict[str, Any]:
 
 
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game)
+            options={"field": "", "flow": ""}, option_help=OPTION_HELP, prepare=prepare_game, replay_setup=replay_game)
 

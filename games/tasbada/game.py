@@ -59,6 +59,17 @@ CONTROLS = (
 )
 
 
+OPTION_HELP = {
+    "save": "PATH: the progress file (unset: $TASBADA_SAVE, else the user's data folder)",
+    "photo": "IMAGE: the backdrop (unset: $TASBADA_PHOTO, else the save's photo, else a webcam, else the shipped room)",
+    "selfie": "IMAGE: the player's selfie (unset: $TASBADA_SELFIE, else the shipped one)",
+    "webcam": "auto|off: a live webcam backdrop when no photo is given",
+    "pose": "auto|off: find the player's pose in the selfie (MediaPipe, the [pose] extra) or pose by hand",
+    "light": "DEGREES, any finite number: where shadows fall on the floor (0 right, 90 back, 180 left; "
+             "unset: measured from the photo)",
+}
+
+
 def prepare(options: dict[str, str]) -> dict[str, Any]:
     """Read the save file (a damaged one is set aside) and choose the pictures."""
     if options["webcam"] not in ("auto", "off"):
@@ -216,5 +227,5 @@ def _camera() -> OrbitCamera:
 
 GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
             options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto",
-                     "light": ""}, prepare=prepare,
+                     "light": ""}, option_help=OPTION_HELP, prepare=prepare,
             replay_setup=replay_setup)
