@@ -125,6 +125,28 @@ class RunResult:
     screenshot: Path | None = None
 
 
+class _RateMeter:
+    """Frames per second of wall time over half-second windows (the rate so far until the first one ends).
+
+    Headless, a frame is a step: the HUD of a screenshot shows how fast the run went, not 0.
+    """
+
+    WINDOW = 0.5
+
+    def __init__(self, now: float) -> None:
+        self._t0, self._frames, self.rate = now, 0, 0.0
+        self._measured = False
+
+    def tick(self, now: float) -> None:
+        """One more frame, at ``now``."""
+        self._frames += 1
+        elapsed = now - self._t0
+        if elapsed >= self.WINDOW:
+            self.rate, self._frames, self._t0, self._measured = self._frames / elapsed, 0, now, True
+        elif not self._measured and elapsed > 0:
+            self.rate = self._frames / elapsed
+
+
 class _BaseKeys:
     """The bottom of the event stack: quit, pause and single step."""
 
@@ -228,6 +250,7 @@ class Runner:
         wake = getattr(activity, "input_wake", None)
         pacer = RealTimePacer(activity.dt, clock=self._wall, wake=wake) if self.options.pace else None
         steps = 0
+        meter = _RateMeter(self._wall())
         if self.options.screenshot_at == 0:
             self._take_screenshot(activity)
         while self._limit(steps) > 0 and not activity.finished() and not self._stopped:
@@ -235,6 +258,8 @@ class Runner:
                 pacer.wait()
             activity.step()
             steps += 1
+            meter.tick(self._wall())
+            self.fps = meter.rate
             self._after_step(activity, steps)
         return steps
 
@@ -242,7 +267,7 @@ class Runner:
         assert self.clock is not None
         last = self._wall()
         steps = 0
-        fps_frames, fps_t0 = 0, last
+        meter = _RateMeter(last)
         while not self._stopped and self._limit(steps) > 0 and not activity.finished():
             for event in self.viewer.poll_events():
                 self.dispatch(event)
@@ -260,15 +285,17 @@ class Runner:
                 steps += 1
                 self._after_step(activity, steps)
             self.draw(activity)
-            fps_frames += 1
-            if now - fps_t0 >= 0.5:
-                self.fps, fps_frames, fps_t0 = fps_frames / (now - fps_t0), 0, now
+            meter.tick(now)
+            self.fps = meter.rate
         return steps
 
-    def draw(self, activity: Activity) -> None:
-        """Draw the activity's current state into the target (and show it in a window)."""
+    def draw(self, activity: Activity, complete: bool = False) -> None:
+        """Draw the activity's current state into the target (and show it in a window).
+
+        ``complete`` (always so headless): a frame that waits for background work rather than show it unfinished.
+        """
         self.open()
-        scene = RenderScene()
+        scene = RenderScene(complete=complete or self.options.headless)
         alpha = self.clock.alpha if self.clock is not None else 0.0
         activity.draw(scene, alpha, self.viewer.size)
         self.viewer.camera = activity.camera
@@ -277,7 +304,7 @@ class Runner:
     def _take_screenshot(self, activity: Activity) -> None:
         from engine.render.target import save_image
 
-        self.draw(activity)
+        self.draw(activity, complete=True)
         assert self.options.screenshot is not None
         self._shot = save_image(self.viewer.read_pixels(), self.options.screenshot)
 

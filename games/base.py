@@ -54,6 +54,10 @@ def _no_lines(world: World) -> list[str]:
     return []
 
 
+def _nothing_to_close(world: World) -> None:
+    return None
+
+
 def _options_as_setup(options: dict[str, str]) -> dict[str, Any]:
     return dict(options)
 
@@ -96,7 +100,9 @@ class Game:
         draw: fills a render scene from the world, interpolated by ``alpha``.
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
-        controls: the start screen's help lines.
+        controls: the start screen's help lines; a line that starts with a source kind and a
+            colon (``mouse:``, ``osc:``, ``web:``, ``hid:``, ``serial:``) is shown only while that
+            source drives the game.
         options: the options ``--set key=value`` may give, with their defaults.
         option_help: per option, its type and range and what it does, one line
             (``play GAME --set help`` prints them beside the defaults).
@@ -104,6 +110,8 @@ class Game:
             :class:`GameSetup` values out (plain JSON; raises :class:`GameOptionError`).
         replay_setup: the setup a replay uses, from the one recorded (for instance
             without the paths a live game saves to: replays never write a user's files).
+        close: releases what the game holds outside the simulation when the session ends
+            (a webcam, a worker thread that must finish before the process exits).
     """
 
     name: str
@@ -116,3 +124,4 @@ class Game:
     option_help: dict[str, str] = field(default_factory=dict)
     prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup
     replay_setup: Callable[[dict[str, Any]], dict[str, Any]] = dict
+    close: Callable[[World], None] = _nothing_to_close

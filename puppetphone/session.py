@@ -84,7 +84,7 @@ class GameActivity:
         """The game's view and the overlay."""
         self.game.draw(self.app.world, scene, alpha)
         fps = self.runner.fps if self.runner is not None else 0.0
-        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay)
+        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay, size)
 
     def on_event(self, event: Any, runner: Runner) -> bool:
         """Mouse to the mouse source, right-drag orbits, R / F5 / F9 become recorded commands."""
@@ -113,8 +113,9 @@ class GameActivity:
         return False
 
     def close(self) -> None:
-        """Stop the devices and close the recording (everything written is already flushed)."""
+        """Stop the devices, let the game release what it holds, close the recording (already flushed)."""
         self.hub.close()
+        self.game.close(self.app.world)
         if self.recorder is not None:
             self.recorder.close()
 

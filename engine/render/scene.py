@@ -169,6 +169,9 @@ class RenderScene:
     """0 shows only the photo behind objects, 1 only the sky and ground; between blends them."""
     overlays: list[Overlay] = field(default_factory=list)
     """Pictures over the 3-D view, in order (see :class:`Overlay`); the text overlay stays on top."""
+    complete: bool = False
+    """Draw everything, waiting for what is still being built in the background (a game's cut-out
+    props): set for headless frames and screenshots, which nobody watches fill in."""
 
     def clear(self) -> None:
         """Empty every primitive buffer (settings and background stay)."""

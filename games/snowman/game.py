@@ -32,8 +32,10 @@ CONTROLS = (
     "mouse: press on the puppet (or a snowball) to grab it, drag to walk or run it, release to let go",
     "mouse: wheel down while holding = crouch (crouch-walk to roll a snowball), wheel up = lift",
     "mouse: a quick upward flick while holding = jump; right-drag orbits the camera",
-    "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
-    "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
+    "osc: point the phone at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
+    "web: hold the big area to grab, release to drop; Jump jumps; the Crouch slider (or a lower phone) crouches",
+    "hid: SpaceMouse button 1 or the DualShock/DualSense cross grabs; push the cap or tilt the pad to walk it",
+    "serial: the IMU's touch value grabs; tilt the board to walk the puppet, lower it to crouch",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
     "keys: R new field, F5 save the field, F9 restore it, P pause, H or F1 help, Esc quit",
 )

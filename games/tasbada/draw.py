@@ -159,7 +159,7 @@ def draw(world: World, scene: RenderScene, alpha: float) -> None:
     reality = world.resource(Reality)
     now = (world.frame - 1 + alpha) * world.dt if world.frame > 0 else 0.0
     f = dissolve(q, now)
-    layers = reality.frame(q, now, _gaze(world, q))
+    layers = reality.frame(q, now, _gaze(world, q), wait=scene.complete)
     scene.set_background(layers.background, f)
     for rgba, rect, at in layers.props:
         scene.add_overlay(rgba, rect, depth_at=at, photo=True, alpha=1.0 - f)

@@ -225,7 +225,14 @@ def _camera() -> OrbitCamera:
     return game_camera()
 
 
+def close(world: World) -> None:
+    """Let the props' worker finish and free the webcam."""
+    reality = world.try_resource(Reality)
+    if reality is not None:
+        reality.close()
+
+
 GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
             options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto",
                      "light": ""}, option_help=OPTION_HELP, prepare=prepare,
-            replay_setup=replay_setup)
+            replay_setup=replay_setup, close=close)
