@@ -31,7 +31,7 @@ from games.common import Notice
 from input.hub import InputHub
 
 __all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "text_scale", "source_kinds",
-           "HELP_KEYS", "COLORS", "MAX_PUPPET_LINES", "SOURCE_TAGS"]
+           "HELP_KEYS", "COLORS", "MAX_PUPPET_LINES", "SOURCE_TAGS", "TIP_STEPS", "NO_VIEW"]
 
 #: Puppets named one per line in the overlay; the others are summed up in one line.
 MAX_PUPPET_LINES = 4
@@ -49,15 +49,32 @@ SOURCE_TAGS = ("mouse", "osc", "web", "hid", "serial")
 _NOTICE_ANCHOR = (0.5, 0.8)
 
 
+#: What V says when no source can be seen from (the mouse's stick is held at the view's own eye).
+NO_VIEW = "V: no held controller to see from (the mouse has no view of its own; a phone or SpaceMouse has)"
+
+#: How long a tip (:meth:`OverlayState.tell`) stays, in simulation steps (2 s at 60 Hz).
+TIP_STEPS = 120
+
+
 @dataclass
 class OverlayState:
-    """What the player chose to see; the window's, not the world's (a replay does not repeat it)."""
+    """What the player chose to see; the window's, not the world's (a replay does not repeat it).
+
+    ``tip``: why a key did nothing (V with the mouse), shown like a notice until step
+    ``tip_until``. It is the window's answer to a key, never simulation state.
+    """
 
     help_visible: bool = True
+    tip: str = ""
+    tip_until: int = 0
 
     def toggle_help(self) -> None:
         """Hide the help if it is shown, show it if hidden."""
         self.help_visible = not self.help_visible
+
+    def tell(self, text: str, frame: int) -> None:
+        """Show ``text`` from step ``frame`` for :data:`TIP_STEPS` steps."""
+        self.tip, self.tip_until = text, frame + TIP_STEPS
 
 
 def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: bool,
@@ -164,6 +181,8 @@ def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fp
     for line in help_lines(game, state, source_kinds(hub)):
         scene.add_text(line, size=_scaled(_SIZE - 2, scale), color=COLORS["help"])
     shown = notice(world)
+    if shown is None and state.tip and world.frame < state.tip_until:
+        shown = (state.tip, 1.0)
     if shown is not None:
         scene.add_text(shown[0], size=_scaled(_NOTICE_SIZE, scale), color=COLORS["notice"], anchor=_NOTICE_ANCHOR,
                        alpha=shown[1])

@@ -144,3 +144,23 @@ def test_the_overlay_text_scales_with_a_small_window():
     _, small = _help_drawn("mouse", (640, 360))
     assert [t.text for t in big.texts] == [t.text for t in small.texts]
     assert all(s.size <= b.size / 2 + 1 for s, b in zip(small.texts, big.texts))
+
+
+def test_v_with_the_mouse_says_why_nothing_happens_and_the_tip_goes_away():
+    import pygame
+
+    from input.mouse import MouseSource
+    from puppetphone.overlay import NO_VIEW, TIP_STEPS
+
+    session = build_activity("snowman", 0, InputHub([MouseSource()]), setup={})
+    assert session.on_event(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_v), None)
+    assert session.view == "orbit"
+
+    def drawn() -> list[str]:
+        scene = RenderScene()
+        draw_overlay(scene, session.app.world, session.game, session.hub, 60.0, False, session.overlay)
+        return texts(scene)
+
+    assert NO_VIEW in drawn() and "no held controller to see from" in NO_VIEW
+    session.app.run_steps(TIP_STEPS)
+    assert NO_VIEW not in drawn()
