@@ -28,6 +28,42 @@ class NoDisplayError(RuntimeError):
     """A window was asked for where there is no display to show it."""
 
 
+def _open_display() -> None:
+    """Start SDL's video; if it fell back to an invisible driver though X is there, ask for x11 by name.
+
+    SDL picks its driver itself and, when X11 fails for a moment (an X server still starting,
+    a bad ``XDG_RUNTIME_DIR``), quietly chooses ``offscreen``: a window nobody sees. Then x11
+    is tried once explicitly; if that fails too, the error says what SDL said each time.
+    """
+    import os
+
+    import pygame
+
+    pygame.display.init()
+    driver = pygame.display.get_driver()
+    if driver not in INVISIBLE_DRIVERS:
+        return
+    first = pygame.get_error() or "no reason given"
+    pygame.display.quit()
+    explicit = os.environ.get("SDL_VIDEODRIVER", "").lower()
+    if os.environ.get("DISPLAY") and explicit != "x11":
+        os.environ["SDL_VIDEODRIVER"] = "x11"
+        try:
+            pygame.display.init()
+            return
+        except pygame.error as exc:
+            retry = f"; x11 asked for explicitly: {exc}"
+        finally:
+            if explicit:
+                os.environ["SDL_VIDEODRIVER"] = explicit
+            else:
+                del os.environ["SDL_VIDEODRIVER"]
+    else:
+        retry = ""
+    raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver; SDL said: {first}{retry}): a window "
+                         "cannot be shown here; use --headless to run without one")
+
+
 class WindowTarget:
     """An on-screen target; ``closed`` turns true when the user closes the window."""
 
@@ -35,12 +71,7 @@ class WindowTarget:
                  vsync: bool = True) -> None:
         import pygame
 
-        pygame.display.init()
-        driver = pygame.display.get_driver()
-        if driver in INVISIBLE_DRIVERS:
-            pygame.display.quit()
-            raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver): a window cannot be shown "
-                                 "here; use --headless to run without one")
+        _open_display()
         gl = pygame
         pygame.display.gl_set_attribute(gl.GL_CONTEXT_MAJOR_VERSION, 3)
         pygame.display.gl_set_attribute(gl.GL_CONTEXT_MINOR_VERSION, 3)

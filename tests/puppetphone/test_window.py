@@ -113,3 +113,41 @@ def test_no_display_refuses_at_once_and_suggests_headless(tmp_path: Path) -> Non
         assert done.returncode == 2, (args, done.stdout, done.stderr)
         assert "no display" in done.stderr and "--headless" in done.stderr
         assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_an_invisible_driver_fallback_names_sdls_error_and_tries_x11_by_name(tmp_path: Path) -> None:
+    for number in range(700, 800):  # a display nobody serves: SDL falls back to an invisible driver
+        if not Path(f"/tmp/.X11-unix/X{number}").exists():
+            break
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env.update(DISPLAY=f":{number}", XDG_DATA_HOME=str(tmp_path / "data"))
+    done = subprocess.run([sys.executable, "-m", "puppetphone", "play", "snowman", "--frames", "5"], env=env,
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    ours = done.stderr.strip().splitlines()[-1]  # SDL's drivers may print their own lines before it
+    assert ours.startswith("error: no display (SDL chose its ")
+    assert "SDL said: " in ours and "x11 asked for explicitly: " in ours and "--headless" in ours
+
+
+@needs_x
+def test_a_passing_offscreen_fallback_is_retried_with_x11_and_opens_the_window(display: str,
+                                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    import pygame
+
+    from engine.render import window
+
+    monkeypatch.setenv("DISPLAY", display)
+    monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)
+    real, calls = pygame.display.get_driver, []
+
+    def first_offscreen() -> str:
+        calls.append(1)
+        return "offscreen" if len(calls) == 1 else real()
+
+    monkeypatch.setattr(pygame.display, "get_driver", first_offscreen)
+    try:
+        window._open_display()
+        assert real() == "x11"
+    finally:
+        pygame.display.quit()
+    assert "SDL_VIDEODRIVER" not in os.environ  # the retry leaves the environment as it found it
