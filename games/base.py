@@ -103,6 +103,8 @@ class Game:
         controls: the start screen's help lines; a line that starts with a source kind and a
             colon (``mouse:``, ``osc:``, ``web:``, ``hid:``, ``serial:``) is shown only while that
             source drives the game.
+        controls_now: the lines of ``controls`` that apply in the world's present state
+            (tasbada: the current stage's); ``None``: all of them.
         options: the options ``--set key=value`` may give, with their defaults.
         option_help: per option, its type and range and what it does, one line
             (``play GAME --set help`` prints them beside the defaults).
@@ -120,6 +122,7 @@ class Game:
     camera: Callable[[], OrbitCamera]
     status: Callable[[World], list[str]] = _no_lines
     controls: tuple[str, ...] = field(default_factory=tuple)
+    controls_now: Callable[[World], tuple[str, ...]] | None = None
     options: dict[str, str] = field(default_factory=dict)
     option_help: dict[str, str] = field(default_factory=dict)
     prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup

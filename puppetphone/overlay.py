@@ -112,16 +112,18 @@ def _tag(line: str) -> str | None:
     return head if colon and head in SOURCE_TAGS else None
 
 
-def help_lines(game: Game, state: OverlayState, kinds: set[str] | None = None) -> list[str]:
+def help_lines(game: Game, state: OverlayState, kinds: set[str] | None = None, world: World | None = None) -> list[str]:
     """The game's controls while the help is shown, with how to hide them.
 
     ``kinds``: the active sources (:func:`source_kinds`); a control tagged with another
-    source is left out. ``None`` shows every line.
+    source is left out. ``None`` shows every line. With ``world``, only the lines the game
+    says apply now (``Game.controls_now``).
     """
     if not state.help_visible or not game.controls:
         return []
-    shown = [line for line in game.controls if kinds is None or _tag(line) in (None, *kinds)]
-    return [f"{HELP_KEYS} hides this help:", *shown]  # the way out first: a small window cuts the end
+    lines = game.controls_now(world) if world is not None and game.controls_now is not None else game.controls
+    shown = [line for line in lines if kinds is None or _tag(line) in (None, *kinds)]
+    return [f"{HELP_KEYS} hides this help:", *shown] if shown else []  # the way out first: a small window cuts the end
 
 
 def text_scale(size: tuple[int, int]) -> float:
@@ -178,7 +180,7 @@ def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fp
     scale = text_scale(size)
     for line in overlay_lines(world, game, hub, fps, paused, state):
         scene.add_text(line, size=_scaled(_SIZE, scale), color=COLORS["text"])
-    for line in help_lines(game, state, source_kinds(hub)):
+    for line in help_lines(game, state, source_kinds(hub), world):
         scene.add_text(line, size=_scaled(_SIZE - 2, scale), color=COLORS["help"])
     shown = notice(world)
     if shown is None and state.tip and world.frame < state.tip_until:
