@@ -41,6 +41,8 @@ __all__ = ["Activity", "EventHandler", "NoDisplayError", "RunOptions", "RunResul
 
 #: Real time a window frame may add at most (a stall drops time beyond this).
 MAX_FRAME_TIME = 0.25
+#: Wall seconds between two writes of ``RunOptions.hud_dump``.
+HUD_DUMP_INTERVAL = 0.1
 
 
 class Activity(Protocol):
@@ -96,6 +98,8 @@ class RunOptions:
         screenshot: write the final frame here (PNG or JPEG by suffix).
         screenshot_at: write ``screenshot`` after this step instead of at the end.
         pace: headless only — hold each step to wall time (a live device drives it).
+        hud_dump: write the text of every drawn frame's overlay here (replaced atomically a few
+            times a second): what the HUD says, for scripts and tests that drive a real window.
     """
 
     headless: bool = False
@@ -106,6 +110,7 @@ class RunOptions:
     height: int = 720
     title: str = "PuppetPhone"
     pace: bool = False
+    hud_dump: Path | None = None
 
     def __post_init__(self) -> None:
         if self.frames is not None and self.frames < 0:
@@ -185,6 +190,7 @@ class Runner:
         self._wall = wall
         self._stopped = False
         self._shot: Path | None = None
+        self._hud_at = -math.inf
 
     # -- event stack ---------------------------------------------------------------------
     def push_handlers(self, handler: EventHandler) -> None:
@@ -300,6 +306,24 @@ class Runner:
         activity.draw(scene, alpha, self.viewer.size)
         self.viewer.camera = activity.camera
         self.viewer.draw(scene)
+        if self.options.hud_dump is not None:
+            self._dump_hud(scene)
+
+    def _dump_hud(self, scene: RenderScene) -> None:
+        """The overlay's lines and the step they show, to ``hud_dump`` (temp file + rename; at most 10 a second)."""
+        now = self._wall()
+        if now - self._hud_at < HUD_DUMP_INTERVAL:
+            return
+        self._hud_at = now
+        path = self.options.hud_dump
+        assert path is not None
+        tmp = path.with_name(path.name + ".tmp")
+        try:
+            tmp.write_text("\n".join(t.text for t in scene.texts) + "\n", encoding="utf-8")
+            os.replace(tmp, path)
+        except OSError as exc:  # a HUD file is a convenience: the session goes on without it
+            print(f"hud dump: {exc}", file=sys.stderr)
+            self.options.hud_dump = None
 
     def _take_screenshot(self, activity: Activity) -> None:
         from engine.render.target import save_image
