@@ -47,3 +47,29 @@ def test_a_snowman_grabbed_anywhere_on_its_body_stands_as_it_stood(shape: Snowma
         bot.release()
         bot.wait(1.0)
     assert grabbed >= 3
+
+
+def test_a_ball_carried_low_through_a_big_one_rides_over_it_and_leaves_it_where_it_was() -> None:
+    """It plowed the big ball 5 m aside (27 m two notches up); now it passes over, and let go there it stacks."""
+    from engine.ragdoll.components import Prop
+    from games.snowman.components import Stacked
+    from games.snowman.rules import spawn_ball
+
+    mouse = MouseSource()
+    app = make_app("snowman", 0, InputHub([mouse]))
+    big = spawn_ball(app.world, np.array([1.4, 0.45, 0.9]), 0.45)
+    small = spawn_ball(app.world, np.array([-1.3, 0.22, 1.3]), 0.22)
+    app.step()
+    bot = MouseBot(app, mouse, camera())
+    bot.press_on(small)
+    before = app.world.get(big, Transform).position.copy()
+    heights = []
+    bot.on_step.append(lambda a: heights.append(float(a.world.get(small, Transform).position[1])))
+    bot.drag_path([np.array([1.4, 0.0, 0.9])], 1.2)  # straight at the big ball, not lifted
+    bot.wait(0.5)
+    top = before[1] + app.world.get(big, Prop).radius
+    assert max(heights) > top, "the carried ball did not ride over"
+    assert np.linalg.norm((app.world.get(big, Transform).position - before)[[0, 2]]) < 0.02, "the big ball was shoved"
+    bot.release()
+    bot.wait(1.5)
+    assert app.world.has(small, Stacked) or not app.world.alive(small)  # on top (or already part of a snowman)
