@@ -116,4 +116,5 @@ def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
 
 
 GAME = Game(name="sandbox", install=install, draw=draw_world, camera=camera,
-            options={"scene": "empty", "puppets": "1"}, option_help=OPTION_HELP, prepare=prepare, replay_setup=replay_setup)
+            options={"scene": "empty", "puppets": "1"}, option_help=OPTION_HELP, prepare=prepare,
+            replay_setup=replay_setup)

@@ -121,7 +121,7 @@ class Reality:
         return compose(self._photo_pil, sprites, q, now, self._selfie_pil, self.color, gaze)
 
     def close(self) -> None:
-        """Wait for the props being built (a process that ends under a running OpenCV call aborts) and free the webcam."""
+        """Wait for the props being built (a process ending under a running OpenCV call aborts); free the webcam."""
         if self._building is not None:
             self._building[1].join()
             self._building = None

@@ -152,7 +152,7 @@ def _play_snowman(display: str, tmp: Path) -> None:
 
     cam = camera()
     field = tmp / "field.json"
-    puppet, big, small = _snowman_field(field)
+    _, big, small = _snowman_field(field)
     w = Window(display, tmp, ["play", "snowman", "--set", f"field={field}"])
     try:
         # Start: the puppet stands on snow in the middle, the help is up but leaves it in sight.
@@ -166,7 +166,8 @@ def _play_snowman(display: str, tmp: Path) -> None:
 
         # Help: H hides it (the hint to bring it back stays), F1 shows it again.
         w.key("h")
-        w.wait(lambda: "mouse: press on the puppet" not in w.hud() and "H / F1: help" in w.hud(), 10, "the help to hide")
+        w.wait(lambda: "mouse: press on the puppet" not in w.hud() and "H / F1: help" in w.hud(), 10,
+               "the help to hide")
         w.key("F1")
         w.sees("mouse: press on the puppet")
 
@@ -304,7 +305,8 @@ def _tasbada_to_the_cages(display: str, tmp: Path) -> None:
     home = min((c.home for _, c in app.world.query(Creature)), key=lambda h: np.linalg.norm(h - tr.position))
     cam = game_camera()
     cont = menu_buttons([REAL, PROPS_ALIVE, MIXED], True)[-1].rect
-    w = Window(display, tmp, ["play", "tasbada", *[a for k in ("save", "webcam", "pose") for a in ("--set", f"{k}={options[k]}")]])
+    sets = [a for k in ("save", "webcam", "pose") for a in ("--set", f"{k}={options[k]}")]
+    w = Window(display, tmp, ["play", "tasbada", *sets])
     try:
         w.sees("stage 0/4: menu")
         w.move(((cont[0] + cont[2]) / 2 * SIZE[0], (cont[1] + cont[3]) / 2 * SIZE[1]))

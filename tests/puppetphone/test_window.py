@@ -9,7 +9,6 @@ frame that never reaches the window (a black window) fails here.
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 import sys
 import time

@@ -54,7 +54,7 @@ def test_a_headless_replay_screenshot_shows_the_living_props_and_exits_cleanly(t
     shot = np.asarray(Image.open(tmp_path / "s.png").convert("RGB"), dtype=np.int32)
     h, w = shot.shape[:2]
     jug = shot[int(0.5 * h): int(0.85 * h), int(0.45 * w): int(0.7 * w)]
-    pupils_and_mouth = (jug < 70).all(axis=2)  # the photo's orange jug has no near-black pixel; the living one has a face
+    pupils_and_mouth = (jug < 70).all(axis=2)  # the photo's orange jug has no near-black pixel; the living one a face
     assert pupils_and_mouth.sum() > 300, f"no living jug: {pupils_and_mouth.sum()} face pixels"
     banner = shot[int(0.9 * h): int(0.96 * h), int(0.1 * w): int(0.8 * w)]
     assert banner.mean() > 85, "the 'waking up the things you marked' banner darkens the floor"
