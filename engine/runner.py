@@ -148,7 +148,7 @@ class _RateMeter:
         elapsed = now - self._t0
         if elapsed >= self.WINDOW:
             self.rate, self._frames, self._t0, self._measured = self._frames / elapsed, 0, now, True
-        elif not self._measured and elapsed > 0:
+        elif not self._measured and elapsed >= 0.1 * self.WINDOW:  # the first few frames alone say little
             self.rate = self._frames / elapsed
 
 

@@ -20,6 +20,8 @@ from engine.render.offscreen import OffscreenBuffers
 
 __all__ = ["WindowTarget", "NoDisplayError"]
 
+#: Tries of x11 by name after SDL fell back to an invisible driver, and the pause between them (s).
+X11_ATTEMPTS, X11_PAUSE = 3, 0.3
 #: SDL video drivers that open no visible window.
 INVISIBLE_DRIVERS = ("dummy", "offscreen", "evdev")
 
@@ -36,6 +38,7 @@ def _open_display() -> None:
     is tried once explicitly; if that fails too, the error says what SDL said each time.
     """
     import os
+    import time
 
     import pygame
 
@@ -46,20 +49,22 @@ def _open_display() -> None:
     first = pygame.get_error() or "no reason given"
     pygame.display.quit()
     explicit = os.environ.get("SDL_VIDEODRIVER", "").lower()
+    retry = ""
     if os.environ.get("DISPLAY") and explicit != "x11":
         os.environ["SDL_VIDEODRIVER"] = "x11"
         try:
-            pygame.display.init()
-            return
-        except pygame.error as exc:
-            retry = f"; x11 asked for explicitly: {exc}"
+            for attempt in range(X11_ATTEMPTS):  # an X server still starting refuses for a moment
+                try:
+                    pygame.display.init()
+                    return
+                except pygame.error as exc:
+                    retry = f"; x11 asked for explicitly, {attempt + 1} times: {exc}"
+                    time.sleep(X11_PAUSE)
         finally:
             if explicit:
                 os.environ["SDL_VIDEODRIVER"] = explicit
             else:
                 del os.environ["SDL_VIDEODRIVER"]
-    else:
-        retry = ""
     raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver; SDL said: {first}{retry}): a window "
                          "cannot be shown here; use --headless to run without one")
 

@@ -106,9 +106,12 @@ def test_version(tmp_path: Path) -> None:
 
 
 @needs_egl
-def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_shows_a_real_fps(tmp_path: Path) -> None:
+def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_shows_a_real_fps(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import re
     import time
 
+    monkeypatch.setenv("PUPPETPHONE_HUD_DUMP", str(tmp_path / "hud.txt"))
     for size in ("1280x720", "640x360"):
         started = time.monotonic()
         done = puppetphone("play", "snowman", "--headless", "--frames", "90", "--size", size, "--screenshot",
@@ -116,6 +119,8 @@ def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_show
         assert done.returncode == 0, done.stderr
         # The mouse is a person's hand: a headless run with it is paced to real time (90 steps: 1.5 s).
         assert time.monotonic() - started > 1.4
+        fps = float(re.search(r"([0-9.]+) fps", (tmp_path / "hud.txt").read_text(encoding="utf-8")).group(1))
+        assert 20.0 < fps < 75.0, f"the HUD says {fps} fps for a run paced at 60 steps a second"
         shot = np.asarray(Image.open(tmp_path / f"{size}.png").convert("RGB"), dtype=np.float64) / 255.0
         r, g, b = shot[..., 0], shot[..., 1], shot[..., 2]
         h, w = r.shape

@@ -103,28 +103,27 @@ def test_an_invisible_driver_fallback_names_sdls_error_and_tries_x11_by_name(tmp
     assert done.returncode == 2, done.stderr
     ours = done.stderr.strip().splitlines()[-1]  # SDL's drivers may print their own lines before it
     assert ours.startswith("error: no display (SDL chose its ")
-    assert "SDL said: " in ours and "x11 asked for explicitly: " in ours and "--headless" in ours
+    assert "SDL said: " in ours and "x11 asked for explicitly, 3 times: " in ours and "--headless" in ours
+
+
+_FIRST_OFFSCREEN = """
+import os, pygame
+from engine.render import window
+real, calls = pygame.display.get_driver, []
+def first_offscreen():
+    calls.append(1)
+    return "offscreen" if len(calls) == 1 else real()
+pygame.display.get_driver = first_offscreen
+window._open_display()
+print(real(), os.environ.get("SDL_VIDEODRIVER", "unset"))
+"""
 
 
 @needs_x
-def test_a_passing_offscreen_fallback_is_retried_with_x11_and_opens_the_window(display: str,
-                                                                              monkeypatch: pytest.MonkeyPatch) -> None:
-    import pygame
-
-    from engine.render import window
-
-    monkeypatch.setenv("DISPLAY", display)
-    monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)
-    real, calls = pygame.display.get_driver, []
-
-    def first_offscreen() -> str:
-        calls.append(1)
-        return "offscreen" if len(calls) == 1 else real()
-
-    monkeypatch.setattr(pygame.display, "get_driver", first_offscreen)
-    try:
-        window._open_display()
-        assert real() == "x11"
-    finally:
-        pygame.display.quit()
-    assert "SDL_VIDEODRIVER" not in os.environ  # the retry leaves the environment as it found it
+def test_a_passing_offscreen_fallback_is_retried_with_x11_and_opens_the_window(display: str, tmp_path: Path) -> None:
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env["DISPLAY"] = display
+    done = subprocess.run([sys.executable, "-c", _FIRST_OFFSCREEN], env=env, cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[-2:] == ["x11", "unset"]  # x11 by name, the environment left as it was found
