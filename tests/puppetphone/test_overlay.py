@@ -130,7 +130,8 @@ def _help_drawn(source_kind: str, size: tuple[int, int] = (1280, 720)) -> tuple[
         hub.close()
 
 
-def test_the_help_shows_only_the_controls_of_the_source_in_use():
+def test_the_help_shows_only_the_controls_of_the_source_in_use(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))  # the web source keeps its certificate there
     mouse, _ = _help_drawn("mouse")
     web, _ = _help_drawn("web")
     assert any(line.startswith("mouse:") for line in mouse) and not any(line.startswith("web:") for line in mouse)
