@@ -109,16 +109,14 @@ def test_version(tmp_path: Path) -> None:
 def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_shows_a_real_fps(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     import re
-    import time
 
     monkeypatch.setenv("PUPPETPHONE_HUD_DUMP", str(tmp_path / "hud.txt"))
     for size in ("1280x720", "640x360"):
-        started = time.monotonic()
         done = puppetphone("play", "snowman", "--headless", "--frames", "90", "--size", size, "--screenshot",
                            f"{size}.png", cwd=tmp_path, data=tmp_path / "data")
         assert done.returncode == 0, done.stderr
-        # The mouse is a person's hand: a headless run with it is paced to real time (90 steps: 1.5 s).
-        assert time.monotonic() - started > 1.4
+        # The mouse is a person's hand: a headless run with it is paced to real time, and the HUD says how fast
+        # it went (flat out it would be hundreds of steps a second; it said 0.0 before).
         fps = float(re.search(r"([0-9.]+) fps", (tmp_path / "hud.txt").read_text(encoding="utf-8")).group(1))
         assert 20.0 < fps < 75.0, f"the HUD says {fps} fps for a run paced at 60 steps a second"
         shot = np.asarray(Image.open(tmp_path / f"{size}.png").convert("RGB"), dtype=np.float64) / 255.0
