@@ -27,14 +27,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from authoring.mocurves import LAYERS, EditSession, RetimeDrag, item_chain, plane_from_stroke
+from authoring.mocurves.curves import MoCurve
 from authoring.screen_pick import pick_point, point_on_view_plane
 from engine.camera import OrbitCamera
+from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene, SkinnedInstance
 from engine.skinning import SkinBinding
 
-__all__ = ["EditScene", "MODES"]
+__all__ = ["EditScene", "MODES", "speed_lines"]
 
 F = NDArray[np.float64]
 MODES = ("points", "arrows", "timing", "contact")
@@ -43,6 +45,21 @@ FAINT = (0.55, 0.6, 0.7)
 RED = (0.9, 0.1, 0.1)
 PURPLE = (0.6, 0.15, 0.85)
 WHITE = (1.0, 1.0, 1.0)
+
+
+def speed_lines(clip: Clip, curve: MoCurve) -> list[str]:
+    """The two speeds an animator reads, apart: how fast the character travels, how fast the item moves.
+
+    One range "0.41–4.84 m/s" for a walk mixed them up; the root's is the cycle's travel over
+    its period, the item's is along its curve in the character's frame (the body carried along).
+    """
+    travel = clip.average_speed()
+    root = (f"root: travels {travel:.2f} m/s (the cycle's travel ÷ its {clip.duration:.2f} s)" if travel > 1e-3
+            else "root: stays in place (no travel over the cycle)")
+    speeds = curve.speeds()
+    item = (f"{curve.item}: {speeds.min():.2f}–{speeds.max():.2f} m/s along its curve, relative to the body "
+            "(a planted foot slides back at about the root's speed; fastest mid-swing)")
+    return [root, item]
 
 
 @dataclass
@@ -138,12 +155,14 @@ class EditScene:
         curve = s.curves()[self.item]
         scene.add_text(f"MoCurves — {s.clip.name}   mode: {self.mode.upper()}   [1-4]", 12, 10, 20)
         scene.add_text(f"item: {self.item} [Tab]   layer: {self.layer} [L]   τ = {s.tau} [ ]   σ = {s.sigma:.3g} [- =]", 12, 36)
-        scene.add_text(f"t = {self.time:5.2f} / {s.clip.duration:.2f} s {'playing' if self.playing else 'paused'} [Space]   "
-                       f"speed {curve.speeds().min():.2f}–{curve.speeds().max():.2f} m/s", 12, 60)  # fmt: skip
+        scene.add_text(f"t = {self.time:5.2f} / {s.clip.duration:.2f} s {'playing' if self.playing else 'paused'} "
+                       "[Space]", 12, 60)
+        for k, line in enumerate(speed_lines(s.state.clip, curve)):
+            scene.add_text(line, 12, 84 + 22 * k)
         hist = s.history[-3:]
-        scene.add_text(f"edits: {len(s.history)}  {' · '.join(hist)}   undo Ctrl+Z  redo Ctrl+Y  save Ctrl+S", 12, 84)
+        scene.add_text(f"edits: {len(s.history)}  {' · '.join(hist)}   undo Ctrl+Z  redo Ctrl+Y  save Ctrl+S", 12, 128)
         if self.message:
-            scene.add_text(self.message, 12, 108, 18, (1.0, 0.85, 0.4))
+            scene.add_text(self.message, 12, 152, 18, (1.0, 0.85, 0.4))
 
     # -- mouse ------------------------------------------------------------------------------------
     def press(self, px: float, py: float, *, shift: bool = False) -> bool:

@@ -39,6 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from authoring.cycles import CycleError, CycleResult, Item, Trajectory, extract_cycle
+from authoring.joint_pick import joint_at
 from authoring.mocurves.curves import item_chain
 from engine import quat
 from engine.camera import OrbitCamera
@@ -51,13 +52,16 @@ from engine.render.scene import RenderScene
 from engine.root_curve import RootCurve
 from engine.skeleton import Skeleton
 
-__all__ = ["DRIVES", "RecordScene", "drag_rotation", "mouse_point"]
+__all__ = ["DRIVES", "PERFORM", "READY_HINT", "RecordScene", "drag_rotation", "mouse_point"]
 
 F = NDArray[np.float64]
 DRIVES = ("translation", "rotation", "pose", "scale")
 _WIDTH = {"translation": 3, "rotation": 4, "pose": 7, "scale": 1}  # numbers in one performed value
 PERFORMANCE = (0.95, 0.55, 0.1)  # orange: what was performed
 CYCLE = (0.1, 0.75, 0.25)  # green: the extracted cycle (paper Fig. 9)
+#: How a take is performed (the first take of a newcomer who did not hold the button did not move).
+PERFORM = "hold the left button and drag (or move the device)"
+READY_HINT = f"R records: a count-down, then {PERFORM}; click a joint of the figure to drive it"
 
 
 def mouse_point(camera: OrbitCamera, px: float, py: float, size: tuple[int, int], through: F) -> F:
@@ -103,13 +107,7 @@ class RecordScene:
                  root_curve: RootCurve | None = None) -> None:
         if drive not in DRIVES:
             raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
-        if item not in skeleton.names:
-            raise ValueError(f"no joint {item!r}; the character has {', '.join(skeleton.names)}")
-        joint = skeleton.index(item)
-        self.chain = item_chain(skeleton, joint)
-        if drive in ("translation", "pose") and joint != 0 and self.chain is None:
-            raise ValueError(f"{item}'s position follows its parents: drive the root, a hand or a foot by "
-                             f"{drive}, or {item!r} by rotation")
+        joint, self.chain = _drivable(skeleton, item, drive)
         if base is not None and (base.skeleton.names != skeleton.names or not base.loop):
             raise ValueError("the base clip must be a looping clip of the same skeleton")
         self.skeleton = skeleton
@@ -123,7 +121,7 @@ class RecordScene:
         self.phase = "ready"
         self.time = 0.0  # playback time of the cycle
         self.timer = 0.0
-        self.message = "press R to record"
+        self.message = READY_HINT
         self.result: CycleResult | None = None
         self.candidate: Clip | None = None
         self.root_curve = root_curve if base is not None else None
@@ -179,6 +177,26 @@ class RecordScene:
         if want > 3:
             v = np.concatenate([v[:-4], quat.normalize(v[-4:])])
         self._value = v
+
+    def choose(self, px: float, py: float, size: tuple[int, int]) -> bool:
+        """A click on the figure while ready: drive the joint under the cursor; whether one was there."""
+        if self.phase != "ready":
+            return False
+        root, rot = self._pose(self.time, None)
+        wpos, wrot = forward_kinematics(self.skeleton, root, rot, scales=self._scales(self.time, None))
+        ends = np.array([wpos[kids[0]] if (kids := self.skeleton.children(j))
+                         else wpos[j] + quat.rotate(wrot[j], self.skeleton.tips[j]) for j in range(len(wpos))])
+        picked = joint_at(self.camera, wpos, ends, px, py, size)
+        if picked is None:
+            return False
+        name = self.skeleton.names[picked]
+        try:
+            self.joint, self.chain = _drivable(self.skeleton, name, self.drive)
+        except ValueError as exc:
+            self.message = str(exc)
+            return True
+        self.message = f"driving {name} by {self.drive}. {READY_HINT}"
+        return True
 
     # -- the workflow ------------------------------------------------------------------
     def start(self) -> None:
@@ -237,6 +255,10 @@ class RecordScene:
         self.phase = "preview"
         assert take is not None
         values = np.asarray(take.values)
+        if len(values) and np.ptp(values, axis=0).max() < 1e-9:
+            self.result, self.candidate = None, None
+            self.message = f"the performance did not move: {PERFORM} while it records — R to retry"
+            return
         item = self.skeleton.names[self.joint]
         items = {"translation": (Item(f"{item}.translation", "position", 0, 3),),
                  "rotation": (Item(f"{item}.rotation", "rotation", 0, 4),),
@@ -385,12 +407,24 @@ class RecordScene:
         if self.phase == "preview" and self.result is not None:
             scene.add_polyline(self._joint_path(np.asarray(self._performed), rotation), PERFORMANCE, 1.5)
             scene.add_polyline(self._joint_path(self.result.loop, rotation), CYCLE, 4.0, closed=True)
-        title = {"ready": "ready", "countdown": f"get ready… {max(self.timer, 0.0):.0f}",
-                 "recording": f"recording {self.timer:4.1f} s — perform several loops, Space to stop",
+        title = {"ready": "ready", "countdown": f"get ready… {max(self.timer, 0.0):.0f} — then {PERFORM}",
+                 "recording": f"recording {self.timer:4.1f} s — {PERFORM}, several loops; Space stops",
                  "preview": "preview"}[self.phase]
         scene.add_text(f"{self.skeleton.names[self.joint]} · {self.drive} · {title}", size=22)
         if self.message:
             scene.add_text(self.message, size=16)
+
+
+def _drivable(skeleton: Skeleton, item: str, drive: str) -> tuple[int, object]:
+    """``item``'s joint index and IK chain, or ``ValueError`` when ``drive`` cannot move it."""
+    if item not in skeleton.names:
+        raise ValueError(f"no joint {item!r}; the character has {', '.join(skeleton.names)}")
+    joint = skeleton.index(item)
+    chain = item_chain(skeleton, joint)
+    if drive in ("translation", "pose") and joint != 0 and chain is None:
+        raise ValueError(f"{item}'s position follows its parents: drive the root, a hand or a foot by "
+                         f"{drive}, or {item!r} by rotation")
+    return joint, chain
 
 
 def _sample_loop(loop: F, phase: F, drive: str) -> F:

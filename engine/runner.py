@@ -41,6 +41,8 @@ __all__ = ["Activity", "EventHandler", "NoDisplayError", "RunOptions", "RunResul
 
 #: Real time a window frame may add at most (a stall drops time beyond this).
 MAX_FRAME_TIME = 0.25
+#: Wall seconds between two writes of ``RunOptions.hud_dump``.
+HUD_DUMP_INTERVAL = 0.1
 
 
 class Activity(Protocol):
@@ -96,6 +98,8 @@ class RunOptions:
         screenshot: write the final frame here (PNG or JPEG by suffix).
         screenshot_at: write ``screenshot`` after this step instead of at the end.
         pace: headless only — hold each step to wall time (a live device drives it).
+        hud_dump: write the text of every drawn frame's overlay here (replaced atomically a few
+            times a second): what the HUD says, for scripts and tests that drive a real window.
     """
 
     headless: bool = False
@@ -106,6 +110,7 @@ class RunOptions:
     height: int = 720
     title: str = "PuppetPhone"
     pace: bool = False
+    hud_dump: Path | None = None
 
     def __post_init__(self) -> None:
         if self.frames is not None and self.frames < 0:
@@ -123,6 +128,28 @@ class RunResult:
     steps: int
     quit: bool = False
     screenshot: Path | None = None
+
+
+class _RateMeter:
+    """Frames per second of wall time over half-second windows (the rate so far until the first one ends).
+
+    Headless, a frame is a step: the HUD of a screenshot shows how fast the run went, not 0.
+    """
+
+    WINDOW = 0.5
+
+    def __init__(self, now: float) -> None:
+        self._t0, self._frames, self.rate = now, 0, 0.0
+        self._measured = False
+
+    def tick(self, now: float) -> None:
+        """One more frame, at ``now``."""
+        self._frames += 1
+        elapsed = now - self._t0
+        if elapsed >= self.WINDOW:
+            self.rate, self._frames, self._t0, self._measured = self._frames / elapsed, 0, now, True
+        elif not self._measured and elapsed >= 0.1 * self.WINDOW:  # the first few frames alone say little
+            self.rate = self._frames / elapsed
 
 
 class _BaseKeys:
@@ -163,6 +190,7 @@ class Runner:
         self._wall = wall
         self._stopped = False
         self._shot: Path | None = None
+        self._hud_at = -math.inf
 
     # -- event stack ---------------------------------------------------------------------
     def push_handlers(self, handler: EventHandler) -> None:
@@ -228,6 +256,7 @@ class Runner:
         wake = getattr(activity, "input_wake", None)
         pacer = RealTimePacer(activity.dt, clock=self._wall, wake=wake) if self.options.pace else None
         steps = 0
+        meter = _RateMeter(self._wall())
         if self.options.screenshot_at == 0:
             self._take_screenshot(activity)
         while self._limit(steps) > 0 and not activity.finished() and not self._stopped:
@@ -235,6 +264,8 @@ class Runner:
                 pacer.wait()
             activity.step()
             steps += 1
+            meter.tick(self._wall())
+            self.fps = meter.rate
             self._after_step(activity, steps)
         return steps
 
@@ -242,7 +273,7 @@ class Runner:
         assert self.clock is not None
         last = self._wall()
         steps = 0
-        fps_frames, fps_t0 = 0, last
+        meter = _RateMeter(last)
         while not self._stopped and self._limit(steps) > 0 and not activity.finished():
             for event in self.viewer.poll_events():
                 self.dispatch(event)
@@ -260,24 +291,44 @@ class Runner:
                 steps += 1
                 self._after_step(activity, steps)
             self.draw(activity)
-            fps_frames += 1
-            if now - fps_t0 >= 0.5:
-                self.fps, fps_frames, fps_t0 = fps_frames / (now - fps_t0), 0, now
+            meter.tick(now)
+            self.fps = meter.rate
         return steps
 
-    def draw(self, activity: Activity) -> None:
-        """Draw the activity's current state into the target (and show it in a window)."""
+    def draw(self, activity: Activity, complete: bool = False) -> None:
+        """Draw the activity's current state into the target (and show it in a window).
+
+        ``complete`` (always so headless): a frame that waits for background work rather than show it unfinished.
+        """
         self.open()
-        scene = RenderScene()
+        scene = RenderScene(complete=complete or self.options.headless)
         alpha = self.clock.alpha if self.clock is not None else 0.0
         activity.draw(scene, alpha, self.viewer.size)
         self.viewer.camera = activity.camera
         self.viewer.draw(scene)
+        if self.options.hud_dump is not None:
+            self._dump_hud(scene)
+
+    def _dump_hud(self, scene: RenderScene) -> None:
+        """The overlay's lines and the step they show, to ``hud_dump`` (temp file + rename; at most 10 a second)."""
+        now = self._wall()
+        if now - self._hud_at < HUD_DUMP_INTERVAL:
+            return
+        self._hud_at = now
+        path = self.options.hud_dump
+        assert path is not None
+        tmp = path.with_name(path.name + ".tmp")
+        try:
+            tmp.write_text("\n".join(t.text for t in scene.texts) + "\n", encoding="utf-8")
+            os.replace(tmp, path)
+        except OSError as exc:  # a HUD file is a convenience: the session goes on without it
+            print(f"hud dump: {exc}", file=sys.stderr)
+            self.options.hud_dump = None
 
     def _take_screenshot(self, activity: Activity) -> None:
         from engine.render.target import save_image
 
-        self.draw(activity)
+        self.draw(activity, complete=True)
         assert self.options.screenshot is not None
         self._shot = save_image(self.viewer.read_pixels(), self.options.screenshot)
 

@@ -27,7 +27,7 @@ from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.render.scene import RenderScene
 
-__all__ = ["Game", "GameSetup", "GameOptionError", "parse_settings"]
+__all__ = ["Game", "GameSetup", "GameOptionError", "describe_options", "parse_settings"]
 
 
 class GameOptionError(ValueError):
@@ -54,6 +54,10 @@ def _no_lines(world: World) -> list[str]:
     return []
 
 
+def _nothing_to_close(world: World) -> None:
+    return None
+
+
 def _options_as_setup(options: dict[str, str]) -> dict[str, Any]:
     return dict(options)
 
@@ -72,6 +76,20 @@ def parse_settings(pairs: list[str], declared: dict[str, str], game: str) -> dic
     return options
 
 
+def describe_options(game: "Game") -> list[str]:
+    """``--set help``: one line per option: its type or range, what it does, its default.
+
+    An option whose default is empty says in its help what leaving it unset means.
+    """
+    if not game.options:
+        return [f"{game.name}: no options"]
+    lines = [f"{game.name}:"]
+    for key, default in game.options.items():
+        shown = f"; default {default}" if default else ""
+        lines.append(f"  {key:<8} {game.option_help.get(key, 'text')}{shown}")
+    return lines
+
+
 @dataclass(frozen=True)
 class Game:
     """A playable game.
@@ -86,12 +104,20 @@ class Game:
             every row after it).
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
-        controls: the start screen's help lines.
+        controls: the start screen's help lines; a line that starts with a source kind and a
+            colon (``mouse:``, ``osc:``, ``web:``, ``hid:``, ``serial:``) is shown only while that
+            source drives the game.
+        controls_now: the lines of ``controls`` that apply in the world's present state
+            (tasbada: the current stage's); ``None``: all of them.
         options: the options ``--set key=value`` may give, with their defaults.
+        option_help: per option, its type and range and what it does, one line
+            (``play GAME --set help`` prints them beside the defaults).
         prepare: reads the outside world for a live session: options in, the
             :class:`GameSetup` values out (plain JSON; raises :class:`GameOptionError`).
         replay_setup: the setup a replay uses, from the one recorded (for instance
             without the paths a live game saves to: replays never write a user's files).
+        close: releases what the game holds outside the simulation when the session ends
+            (a webcam, a worker thread that must finish before the process exits).
     """
 
     name: str
@@ -100,7 +126,10 @@ class Game:
     camera: Callable[[], OrbitCamera]
     status: Callable[[World], list[str]] = _no_lines
     controls: tuple[str, ...] = field(default_factory=tuple)
+    controls_now: Callable[[World], tuple[str, ...]] | None = None
     options: dict[str, str] = field(default_factory=dict)
+    option_help: dict[str, str] = field(default_factory=dict)
     prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup
     replay_setup: Callable[[dict[str, Any]], dict[str, Any]] = dict
     draw_state: Callable[[World, RenderScene, float], None] | None = None
+    close: Callable[[World], None] = _nothing_to_close

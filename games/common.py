@@ -14,7 +14,7 @@ from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
-__all__ = ["draw_world", "draw_sticks", "draw_height_cues", "height_cues", "CUE_COLOR",
+__all__ = ["draw_world", "draw_sticks", "draw_height_cues", "draw_walk_target", "height_cues", "CUE_COLOR",
            "Notice", "post_notice", "NOTICE_SECONDS"]
 
 NOTICE_SECONDS = 2.0
@@ -118,6 +118,24 @@ def draw_height_cues(world: World, scene: RenderScene, alpha: float) -> None:
         ring = foot + np.c_[r * np.cos(_RING), np.zeros_like(_RING), r * np.sin(_RING)]
         scene.add_polyline(ring, CUE_COLOR, width=3.0)
         scene.add_points(foot[None], size=0.08, color=CUE_COLOR)
+
+
+def draw_walk_target(world: World, scene: RenderScene, alpha: float) -> None:
+    """Under each held puppet, a line on the floor from its feet to where the stick leads it and a ring there.
+
+    On a photo's floor, dragging the cursor down walks the avatar toward the camera, and how far
+    it is from a cage is hard to judge from its size alone; the ring on the floor shows it.
+    """
+    from engine.statemachine.puppet.body import PuppetBody
+
+    for e, body, tr in world.query(PuppetBody, Transform):
+        if body.held_by is None:
+            continue
+        feet = np.array([tr.position[0], 0.015, tr.position[2]])
+        goal = np.array([body.target[0], 0.015, body.target[2]])
+        scene.add_line(feet, goal, CUE_COLOR, width=2.0)
+        scene.add_polyline(goal + np.c_[0.25 * np.cos(_RING), np.zeros_like(_RING), 0.25 * np.sin(_RING)], CUE_COLOR,
+                           width=3.0)
 
 
 def draw_world(world: World, scene: RenderScene, alpha: float) -> None:

@@ -51,6 +51,12 @@ SCENES: dict[str, Callable[[World], None]] = {
 }
 
 
+OPTION_HELP = {
+    "scene": f"{'|'.join(SCENES)}: what stands beside the puppet",
+    "puppets": f"whole number 1–{MAX_PUPPETS}: the grabbable puppet plus a wandering crowd (same as --puppets N)",
+}
+
+
 def prepare(options: dict[str, str]) -> dict[str, Any]:
     """Check the options (nothing outside the program is read)."""
     if options["scene"] not in SCENES:
@@ -110,4 +116,5 @@ def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
 
 
 GAME = Game(name="sandbox", install=install, draw=draw_world, camera=camera,
-            options={"scene": "empty", "puppets": "1"}, prepare=prepare, replay_setup=replay_setup)
+            options={"scene": "empty", "puppets": "1"}, option_help=OPTION_HELP, prepare=prepare,
+            replay_setup=replay_setup)

@@ -82,8 +82,11 @@ class InputHub:
 
     @property
     def live(self) -> bool:
-        """Whether frames come from live devices (the game loop then paces to real time)."""
-        return self.replay is None and any(s.threaded for s in self.sources)
+        """Whether frames come from live devices or a person's mouse (the game loop then paces to real time).
+
+        A source fed by a script from the main thread (a test's, a bench's) is not live: it runs flat out.
+        """
+        return self.replay is None and any(s.threaded or s.person for s in self.sources)
 
     def add(self, source: PoseSource) -> PoseSource:
         """Register another live source."""

@@ -130,7 +130,10 @@ def _grab(world: World, st: StickState, stick: Stick, target: Entity) -> None:
     rel = anchor - stick.pivot
     st.held_length = float(np.linalg.norm(rel))
     st.depth = float(rel @ st.plane_normal) if st.plane_normal is not None else st.held_length
-    tip = stick.pivot + stick.direction * st.held_length
+    # A held plane (the mouse): the tip is where the ray meets the anchor's plane, as in every later step
+    # (:func:`_length`), so the grab offset lies in that plane. Measured along the ray instead, a press above
+    # the anchor (a snowman's middle ball over its hips) held it lower than it stood: it crouched at once.
+    tip = stick.pivot + stick.direction * _length(st, stick, 0.0, StickConfig(), None, holding=True)
     inv = quat.conjugate(stick.orientation)
     stick.grab_offset = quat.rotate(inv, anchor - tip)
     stick.grab_rotation = quat.normalize(quat.mul(inv, tr.rotation))
@@ -143,8 +146,9 @@ def _release(stick: Stick) -> None:
         stick.grabbed, stick.released = None, stick.grabbed
 
 
-def _length(st: StickState, stick: Stick, depth_delta: float, cfg: StickConfig, focus_t: float | None) -> float:
-    if stick.grabbed is None:
+def _length(st: StickState, stick: Stick, depth_delta: float, cfg: StickConfig, focus_t: float | None,
+            holding: bool = False) -> float:
+    if stick.grabbed is None and not holding:
         return focus_t if focus_t is not None else cfg.idle_length
     if depth_delta:
         st.depth = max(cfg.min_depth, st.depth + depth_delta)

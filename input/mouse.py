@@ -64,6 +64,7 @@ class MouseSource(PoseSource):
     """
 
     threaded = False
+    person = True
 
     def __init__(self, wheel_step: float = 0.1, flick_rise: float = 0.08, flick_window: float = 0.15,
                  plane: str = "ground") -> None:

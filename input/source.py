@@ -64,6 +64,8 @@ class PoseSource:
     """
 
     threaded = True
+    #: A person drives it in real time though it has no device thread (the mouse): a run is paced for it.
+    person = False
 
     def __init__(self, name: str, capacity: int = 256) -> None:
         self.name = name

@@ -14,7 +14,7 @@ import sys
 __all__ = ["main", "COMMANDS"]
 
 COMMANDS: dict[str, tuple[str, str]] = {
-    "play": ("puppetphone.cmd_play", "play a game (snowman or tasbada)"),
+    "play": ("puppetphone.cmd_play", "play a game (snowman, tasbada or sandbox)"),
     "replay": ("puppetphone.cmd_replay", "replay a recording, optionally verifying every state hash"),
     "author": ("puppetphone.cmd_author", "authoring scenes: record cycles by acting, edit them with MoCurves"),
     "cycle": ("puppetphone.cmd_cycle", "extract one clean loop from a performed motion"),

@@ -220,7 +220,9 @@ class RecordActivity:
     def _apply(self, op: tuple) -> object:  # type: ignore[type-arg]
         """One tool operation; returns a pointer position when the operation is one."""
         scene, kind = self.scene, op[0]
-        if kind == "press":
+        if kind == "press" and scene.choose(float(op[1]), float(op[2]), self.size):
+            self.rest = scene.rest_value()  # a click on the figure while ready picks the joint to drive
+        elif kind == "press":
             self.press, self.rest = (float(op[1]), float(op[2]), scene.item_position()), scene.rest_value()
         elif kind == "release":
             self.press = None

@@ -30,8 +30,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
                         help="record the session's input and state hashes (an existing file is replaced)")
     parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
-                        help="a game option (snowman: field=PATH; tasbada: save, photo, selfie, webcam; "
-                             "sandbox: scene, puppets); repeatable")
+                        help="a game option, repeatable; --set help lists every game's options with their types, "
+                             "ranges and defaults")
     parser.add_argument("--clips", type=Path, default=None, metavar="DIR",
                         help="play the authored clips of this library (default: $XDG_DATA_HOME/puppetphone/clips "
                              "when live; an empty or missing library means the built-in clips)")
@@ -97,8 +97,21 @@ def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-un
     return 0, result
 
 
+def print_option_help() -> None:
+    """``--set help``: every game's options with their types, ranges and defaults."""
+    from games.base import describe_options
+    from puppetphone.games import GAMES, load_game
+
+    print("game options (--set KEY=VALUE, repeatable):")
+    for name in GAMES:
+        print("\n".join(describe_options(load_game(name))))
+
+
 def run(args: argparse.Namespace) -> int:
     """Build the session and run it."""
+    if "help" in args.settings:
+        print_option_help()
+        return 0
     from games.base import GameOptionError, parse_settings
     from input.factory import make_hub
     from input.recording import RecordingError

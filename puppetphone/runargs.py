@@ -7,13 +7,14 @@ starts, with the sub-command's usage and one line saying what is wrong.
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 from engine.render.target import image_format
 from engine.runner import RunOptions
 from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
 
-__all__ = ["add_run_arguments", "run_options", "steps", "image_path"]
+__all__ = ["add_run_arguments", "run_options", "steps", "image_path", "HUD_DUMP_ENV"]
 
 #: Steps: zero or more.
 steps = int_range(0)
@@ -43,9 +44,14 @@ def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = 
                         help=f"window or image size, sides up to {MAX_WINDOW} (default 1280x720)")
 
 
+#: The environment variable that names a file for the HUD's text (``RunOptions.hud_dump``).
+HUD_DUMP_ENV = "PUPPETPHONE_HUD_DUMP"
+
+
 def run_options(args: argparse.Namespace, title: str, *, pace: bool = False) -> RunOptions:
-    """The runner's options from parsed arguments."""
+    """The runner's options from parsed arguments (and ``$PUPPETPHONE_HUD_DUMP``)."""
     width, height = args.size
+    hud = os.environ.get(HUD_DUMP_ENV)
     return RunOptions(headless=args.headless, frames=args.frames, screenshot=args.screenshot,
                       screenshot_at=getattr(args, "screenshot_at", None), width=width, height=height,
-                      title=title, pace=pace)
+                      title=title, pace=pace, hud_dump=Path(hud) if hud else None)

@@ -30,7 +30,7 @@ from input.recording import Recorder, Recording, RecordingHeader
 from input.replay import HashCheck
 from input.sample import RESET, RESTORE, SAVE
 from puppetphone.games import load_game, make_app
-from puppetphone.overlay import OverlayState, draw_overlay
+from puppetphone.overlay import NO_VIEW, OverlayState, draw_overlay, source_kinds
 
 __all__ = ["GameActivity", "build_activity"]
 
@@ -98,6 +98,9 @@ class GameActivity:
             self.overlay.toggle_help()
             return True
         if event.type == pygame.KEYDOWN and event.key == pygame.K_v:
+            if self.view == "orbit" and self.hub.replay is None and source_kinds(self.hub) <= {"mouse"}:
+                self.overlay.tell(NO_VIEW, self.app.world.frame)
+                return True
             self.view = "orbit" if self.view == "phone" else "phone"
             return True
         if event.type == pygame.MOUSEBUTTONDOWN and event.button == 3:
@@ -113,8 +116,9 @@ class GameActivity:
         return False
 
     def close(self) -> None:
-        """Stop the devices and close the recording (everything written is already flushed)."""
+        """Stop the devices, let the game release what it holds, close the recording (already flushed)."""
         self.hub.close()
+        self.game.close(self.app.world)
         if self.recorder is not None:
             self.recorder.close()
 

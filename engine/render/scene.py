@@ -181,6 +181,9 @@ class RenderScene:
     """Pictures over the 3-D view, in order (see :class:`Overlay`); the text overlay stays on top."""
     skinned: list[SkinnedInstance] = field(default_factory=list)
     """Skinned characters (glTF skins) in their poses, drawn lit beside the solids."""
+    complete: bool = False
+    """Draw everything, waiting for what is still being built in the background (a game's cut-out
+    props): set for headless frames and screenshots, which nobody watches fill in."""
 
     def clear(self) -> None:
         """Empty every primitive buffer (settings and background stay)."""

@@ -20,12 +20,53 @@ from engine.render.offscreen import OffscreenBuffers
 
 __all__ = ["WindowTarget", "NoDisplayError"]
 
+#: Tries of x11 by name after SDL fell back to an invisible driver, and the pause between them (s).
+X11_ATTEMPTS, X11_PAUSE = 3, 0.3
 #: SDL video drivers that open no visible window.
 INVISIBLE_DRIVERS = ("dummy", "offscreen", "evdev")
 
 
 class NoDisplayError(RuntimeError):
     """A window was asked for where there is no display to show it."""
+
+
+def _open_display() -> None:
+    """Start SDL's video; if it fell back to an invisible driver though X is there, ask for x11 by name.
+
+    SDL picks its driver itself and, when X11 fails for a moment (an X server still starting,
+    a bad ``XDG_RUNTIME_DIR``), quietly chooses ``offscreen``: a window nobody sees. Then x11
+    is tried once explicitly; if that fails too, the error says what SDL said each time.
+    """
+    import os
+    import time
+
+    import pygame
+
+    pygame.display.init()
+    driver = pygame.display.get_driver()
+    if driver not in INVISIBLE_DRIVERS:
+        return
+    first = pygame.get_error() or "no reason given"
+    pygame.display.quit()
+    explicit = os.environ.get("SDL_VIDEODRIVER", "").lower()
+    retry = ""
+    if os.environ.get("DISPLAY") and explicit != "x11":
+        os.environ["SDL_VIDEODRIVER"] = "x11"
+        try:
+            for attempt in range(X11_ATTEMPTS):  # an X server still starting refuses for a moment
+                try:
+                    pygame.display.init()
+                    return
+                except pygame.error as exc:
+                    retry = f"; x11 asked for explicitly, {attempt + 1} times: {exc}"
+                    time.sleep(X11_PAUSE)
+        finally:
+            if explicit:
+                os.environ["SDL_VIDEODRIVER"] = explicit
+            else:
+                del os.environ["SDL_VIDEODRIVER"]
+    raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver; SDL said: {first}{retry}): a window "
+                         "cannot be shown here; use --headless to run without one")
 
 
 class WindowTarget:
@@ -35,12 +76,7 @@ class WindowTarget:
                  vsync: bool = True) -> None:
         import pygame
 
-        pygame.display.init()
-        driver = pygame.display.get_driver()
-        if driver in INVISIBLE_DRIVERS:
-            pygame.display.quit()
-            raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver): a window cannot be shown "
-                                 "here; use --headless to run without one")
+        _open_display()
         gl = pygame
         pygame.display.gl_set_attribute(gl.GL_CONTEXT_MAJOR_VERSION, 3)
         pygame.display.gl_set_attribute(gl.GL_CONTEXT_MINOR_VERSION, 3)

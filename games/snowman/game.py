@@ -32,9 +32,11 @@ CONTROLS = (
     "mouse: press on the puppet (or a snowball) to grab it, drag to walk or run it, release to let go",
     "mouse: wheel down while holding = crouch (crouch-walk to roll a snowball), wheel up = lift",
     "mouse: a quick upward flick while holding = jump; right-drag orbits the camera",
-    "phone (OSC, port 9000): point at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
-    "phone (web, --source web): scan the QR code, look through the phone; its Calibrate button redoes 'this is the screen'",
-    "HID: SpaceMouse or DualShock/DualSense (--source hid); serial IMU (--source serial:PORT)",
+    "osc: point the phone at the screen and tap to calibrate, touch and hold to grab; see `puppetphone devices`",
+    "web: scan the QR code and look through the phone; hold the big area to grab, release to drop; Jump jumps",
+    "web: the Crouch slider (or a lower phone) crouches; the Calibrate button redoes 'this is the screen'",
+    "hid: SpaceMouse button 1 or the DualShock/DualSense cross grabs; push the cap or tilt the pad to walk it",
+    "serial: the IMU's touch value grabs; tilt the board to walk the puppet, lower it to crouch",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
     "keys: R new field, F5 save the field, F9 restore it, P pause, H or F1 help, Esc quit",
 )
@@ -73,6 +75,12 @@ def status(world: World) -> list[str]:
     return lines
 
 
+OPTION_HELP = {
+    "field": "PATH: the saved field F5 writes and F9 restores (unset: ~/.local/share/puppetphone/snowman_field.json)",
+    "flow": "FILE: a flow file from `author flow`: play in the field it bent (unset: the field as shipped)",
+}
+
+
 def prepare_game(options: dict[str, str]) -> dict[str, Any]:
     """The saved field, and the bent scenery of a flow file when ``flow`` names one."""
     setup = prepare(options)
@@ -91,6 +99,6 @@ def replay_game(recorded: dict[str, Any]) -> dict[str, Any]:
 
 
 GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": "", "flow": ""}, prepare=prepare_game, replay_setup=replay_game,
+            options={"field": "", "flow": ""}, option_help=OPTION_HELP, prepare=prepare_game, replay_setup=replay_game,
             draw_state=draw_snowman_state)
 

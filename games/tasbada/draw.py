@@ -21,7 +21,7 @@ from engine.components import Puppet, Stick, Transform, WorldPose
 from engine.ecs import World
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
-from games.common import draw_height_cues
+from games.common import CUE_COLOR, draw_height_cues, draw_walk_target
 from games.tasbada.objects import CREATURE_COLORS, Creature, Crystal, Gate, avatar_position
 from games.tasbada.quest import MENU, MIXED, PROPS_ALIVE, REAL, VIRTUAL, Quest
 from games.tasbada.reality import Reality
@@ -56,6 +56,8 @@ def _cage(scene: RenderScene, home: np.ndarray, sink: float) -> None:
         return
     ang = np.linspace(0, 2 * np.pi, 10, endpoint=False)
     base = home + np.c_[0.36 * np.cos(ang), np.zeros(10), 0.36 * np.sin(ang)]
+    ring = np.linspace(0, 2 * np.pi, 33)  # the cage's footprint on the floor: where to lead the avatar
+    scene.add_polyline(home + np.c_[0.5 * np.cos(ring), np.full(33, 0.015), 0.5 * np.sin(ring)], CUE_COLOR, width=3.0)
     top = base + np.array([0.0, h, 0.0])
     scene.add_capsules(base, top, 0.022, (0.35, 0.33, 0.38))
     scene.add_capsules(top, np.roll(top, 1, axis=0), 0.03, (0.45, 0.42, 0.5))
@@ -159,7 +161,7 @@ def draw(world: World, scene: RenderScene, alpha: float) -> None:
     reality = world.resource(Reality)
     now = (world.frame - 1 + alpha) * world.dt if world.frame > 0 else 0.0
     f = dissolve(q, now)
-    layers = reality.frame(q, now, _gaze(world, q))
+    layers = reality.frame(q, now, _gaze(world, q), wait=scene.complete)
     scene.set_background(layers.background, f)
     for rgba, rect, at in layers.props:
         scene.add_overlay(rgba, rect, depth_at=at, photo=True, alpha=1.0 - f)
@@ -182,6 +184,7 @@ def draw(world: World, scene: RenderScene, alpha: float) -> None:
         a, b, r, _ = puppet_capsules(puppet.skeleton, pos, rot)
         scene.add_capsules(a, b, r, reality.color, outline=e == focus)
     draw_height_cues(world, scene, alpha)
+    draw_walk_target(world, scene, alpha)
     gate_pos = None
     for _, _g, tf in world.query(Gate, Transform):
         gate_pos = tf.position

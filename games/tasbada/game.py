@@ -44,7 +44,7 @@ from games.tasbada.picker import panel_aspect
 from games.tasbada.pose import default_keypoints
 from games.tasbada.pose import validate as validate_pose
 from games.tasbada.posing import selfie_pose_system
-from games.tasbada.quest import MIXED, PROPS_ALIVE, STAGES, VIRTUAL, Mark, Quest
+from games.tasbada.quest import MIXED, PROPS_ALIVE, REAL, STAGES, VIRTUAL, Mark, Quest
 from games.tasbada.reality import SHIPPED_PHOTO, SHIPPED_SELFIE, Reality
 from games.tasbada.save import SAVE_HEADS, SaveError, checked_progress, default_save_path, load_progress
 from games.tasbada.view import game_camera
@@ -57,6 +57,25 @@ CONTROLS = (
     "Stage 3: grab your avatar and walk it to the cages, over the crystals, then through the gate.",
     "Menu (bottom right): restart from any stage you reached. Progress is saved as you go.",
 )
+
+
+OPTION_HELP = {
+    "save": "PATH: the progress file (unset: $TASBADA_SAVE, else the user's data folder)",
+    "photo": "IMAGE: the backdrop (unset: $TASBADA_PHOTO, else the save's photo, else a webcam, else the shipped room)",
+    "selfie": "IMAGE: the player's selfie (unset: $TASBADA_SELFIE, else the shipped one)",
+    "webcam": "auto|off: a live webcam backdrop when no photo is given",
+    "pose": "auto|off: find the player's pose in the selfie (MediaPipe, the [pose] extra) or pose by hand",
+    "light": "DEGREES, any finite number: where shadows fall on the floor (0 right, 90 back, 180 left; "
+             "unset: measured from the photo)",
+}
+
+
+def controls_now(world: World) -> tuple[str, ...]:
+    """The current stage's line (the menu's too in the first stage): the whole list covered the pose picker's title."""
+    stage = world.resource(Quest).stage
+    by_stage = {REAL: 0, PROPS_ALIVE: 1, MIXED: 2}
+    now = (CONTROLS[by_stage[stage]],) if stage in by_stage else ()
+    return now + (CONTROLS[-1],) if stage == REAL else now
 
 
 def prepare(options: dict[str, str]) -> dict[str, Any]:
@@ -214,7 +233,15 @@ def _camera() -> OrbitCamera:
     return game_camera()
 
 
+def close(world: World) -> None:
+    """Let the props' worker finish and free the webcam."""
+    reality = world.try_resource(Reality)
+    if reality is not None:
+        reality.close()
+
+
 GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
+            controls_now=controls_now,
             options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto",
-                     "light": ""}, prepare=prepare,
-            replay_setup=replay_setup)
+                     "light": ""}, option_help=OPTION_HELP, prepare=prepare,
+            replay_setup=replay_setup, close=close)

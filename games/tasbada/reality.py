@@ -114,14 +114,17 @@ class Reality:
         self._sprites = (key, job[0])
         return job[0]
 
-    def frame(self, q: Quest, now: float, gaze: float) -> Layers:
-        """This frame's backdrop, living props and interface."""
+    def frame(self, q: Quest, now: float, gaze: float, wait: bool = False) -> Layers:
+        """This frame's backdrop, living props and interface (``wait``: the props even if they must be built now)."""
         self._live(q)
-        sprites = None if q.stage == REAL else self.sprites(q)
+        sprites = None if q.stage == REAL else self.sprites(q, wait)
         return compose(self._photo_pil, sprites, q, now, self._selfie_pil, self.color, gaze)
 
     def close(self) -> None:
-        """Free the webcam."""
+        """Wait for the props being built (a process ending under a running OpenCV call aborts); free the webcam."""
+        if self._building is not None:
+            self._building[1].join()
+            self._building = None
         if self.webcam is not None:
             self.webcam.close()
             self.webcam = None

@@ -98,3 +98,18 @@ def test_each_mode_renders_and_edits(viewer):
     for _ in range(4):
         edit.key("z", ctrl=True)
     assert session.clip is walk
+
+
+def test_the_panel_shows_the_walking_speed_and_the_items_speed_apart():
+    from engine.render.scene import RenderScene
+
+    walk = default_clips()["walk"]  # as `author edit walk` opens it
+    edit = EditScene(EditSession(walk), (1280, 720))
+    scene = RenderScene()
+    edit.draw(scene)
+    texts = [t.text for t in scene.texts]
+    root = next(t for t in texts if t.startswith("root: "))
+    assert f"travels {walk.average_speed():.2f} m/s" in root and 0.8 < walk.average_speed() < 2.0
+    item = next(t for t in texts if t.startswith(f"{edit.item}: "))
+    assert "along its curve" in item and "relative to the body" in item
+    assert not any(t.count("m/s") == 1 and "speed " in t for t in texts)  # the old mixed "speed a–b m/s" is gone

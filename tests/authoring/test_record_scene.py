@@ -265,3 +265,30 @@ def test_an_accepted_root_layer_keeps_the_extracted_curve_for_mocurves(tmp_path:
     session = load_session(path)
     assert session.root_curve is not None and np.array_equal(session.root_curve.control, fitted.closed_control())
     assert session.control_count(sk.names[0]) == fitted.segments
+
+
+def test_a_click_on_the_figure_picks_the_joint_to_drive_and_the_ready_line_says_how_to_perform() -> None:
+    from engine.fk import forward_kinematics
+
+    sk = humanoid_skeleton()
+    scene = RecordScene(sk, "r_upper_arm", "rotation", countdown=0.5)
+    assert "hold the left button" in scene.message and "click a joint" in scene.message
+    size = (1280, 720)
+    root, rot = scene._pose(scene.time, None)
+    wpos, _ = forward_kinematics(sk, root, rot)
+    j, child = sk.index("l_lower_arm"), sk.index("l_hand")
+    middle = scene.camera.project((wpos[j] + wpos[child]) / 2, *size)[0]  # the middle of the left forearm
+    assert scene.choose(float(middle[0]), float(middle[1]), size)
+    assert scene.joint == j and "driving l_lower_arm" in scene.message
+    assert not scene.choose(5.0, 5.0, size) and scene.joint == j  # the sky picks nothing
+    scene.key("r")
+    assert not scene.choose(float(middle[0]), float(middle[1]), size)  # not while counting down
+
+
+def test_a_take_that_never_moved_says_to_hold_the_button() -> None:
+    scene = RecordScene(humanoid_skeleton(), "r_upper_arm", "rotation", countdown=0.1, take_seconds=2.0)
+    scene.key("r")
+    for _ in range(int(2.5 * FPS)):
+        scene.step(1.0 / FPS)
+    assert scene.phase == "preview" and scene.candidate is None
+    assert "did not move" in scene.message and "hold the left button" in scene.message

@@ -38,3 +38,24 @@ def test_replay_without_headless_needs_a_display_and_says_how_to_do_without(tmp_
     assert done.returncode == 2 and "no display" in done.stderr and "--headless" in done.stderr
     done = run(["replay", str(REPO / "tests" / "data" / "puppet_jump_stop.rec"), "--headless"], tmp_path)
     assert done.returncode == 0 and "replayed 100 frames" in done.stdout
+
+
+def test_top_level_help_names_every_game(tmp_path: Path) -> None:
+    from puppetphone.games import GAMES
+
+    done = run(["--help"], tmp_path)
+    play_line = next(line for line in done.stdout.splitlines() if line.strip().startswith("play"))
+    assert all(name in play_line for name in GAMES), play_line
+
+
+def test_set_help_lists_every_games_options_with_types_ranges_and_defaults(tmp_path: Path) -> None:
+    from puppetphone.games import GAMES, load_game
+
+    done = run(["play", "snowman", "--set", "help"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    for name in GAMES:
+        assert f"\n{name}:\n" in done.stdout
+        for key in load_game(name).options:
+            line = next(li for li in done.stdout.splitlines() if li.strip().startswith(key + " "))
+            assert len(line.split()) > 3, line  # a type or range and what it does, not the bare name
+    assert "empty|small_ball|big_ball" in done.stdout and "1–1000" in done.stdout and "default auto" in done.stdout

@@ -41,8 +41,10 @@ def texts(scene: RenderScene) -> list[str]:
 def test_h_and_f1_hide_and_bring_back_the_help():
     import pygame
 
-    session = build_activity("snowman", 0, InputHub(), setup={})  # a fresh field that saves nowhere
-    controls = list(session.game.controls)
+    from input.mouse import MouseSource
+
+    session = build_activity("snowman", 0, InputHub([MouseSource()]), setup={})  # a fresh field that saves nowhere
+    controls = [line for line in session.game.controls if not line.startswith(("osc:", "web:", "hid:", "serial:"))]
     assert controls and session.overlay.help_visible  # shown at the start
 
     def drawn() -> list[str]:
@@ -114,3 +116,53 @@ def test_a_crowd_is_summed_up_in_one_line():
     assert named[0] == "puppet: standing" and len(named) == 4
     summary = [line for line in lines if line.startswith("and 8 more: ")]
     assert len(summary) == 1 and any(word in summary[0] for word in ("walking", "running", "standing"))
+
+
+def _help_drawn(source_kind: str, size: tuple[int, int] = (1280, 720)) -> tuple[list[str], RenderScene]:
+    from input.factory import make_hub
+
+    hub = make_hub(source_kind, web_port=0, osc_port=0)
+    session = build_activity("snowman", 0, hub, setup={})
+    try:
+        scene = RenderScene()
+        draw_overlay(scene, session.app.world, session.game, hub, 60.0, False, session.overlay, size)
+        return texts(scene), scene
+    finally:
+        hub.close()
+
+
+def test_the_help_shows_only_the_controls_of_the_source_in_use(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))  # the web source keeps its certificate there
+    mouse, _ = _help_drawn("mouse")
+    web, _ = _help_drawn("web")
+    assert any(line.startswith("mouse:") for line in mouse) and not any(line.startswith("web:") for line in mouse)
+    assert any(line.startswith("web:") for line in web) and not any(line.startswith("mouse:") for line in web)
+    assert not any(line.startswith(("osc:", "hid:", "serial:")) for line in mouse + web)
+    assert any(line.startswith("keys:") for line in web)  # the game's own lines stay
+
+
+def test_the_overlay_text_scales_with_a_small_window():
+    _, big = _help_drawn("mouse", (1280, 720))
+    _, small = _help_drawn("mouse", (640, 360))
+    assert [t.text for t in big.texts] == [t.text for t in small.texts]
+    assert all(s.size <= b.size / 2 + 1 for s, b in zip(small.texts, big.texts))
+
+
+def test_v_with_the_mouse_says_why_nothing_happens_and_the_tip_goes_away():
+    import pygame
+
+    from input.mouse import MouseSource
+    from puppetphone.overlay import NO_VIEW, TIP_STEPS
+
+    session = build_activity("snowman", 0, InputHub([MouseSource()]), setup={})
+    assert session.on_event(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_v), None)
+    assert session.view == "orbit"
+
+    def drawn() -> list[str]:
+        scene = RenderScene()
+        draw_overlay(scene, session.app.world, session.game, session.hub, 60.0, False, session.overlay)
+        return texts(scene)
+
+    assert NO_VIEW in drawn() and "no held controller to see from" in NO_VIEW
+    session.app.run_steps(TIP_STEPS)
+    assert NO_VIEW not in drawn()

@@ -103,3 +103,26 @@ def test_version(tmp_path: Path) -> None:
     done = puppetphone("--version", cwd=tmp_path, data=tmp_path)
     assert done.returncode == 0 and done.stdout.startswith("puppetphone ")
     assert len(done.stdout.splitlines()) == 1
+
+
+@needs_egl
+def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_shows_a_real_fps(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import re
+
+    monkeypatch.setenv("PUPPETPHONE_HUD_DUMP", str(tmp_path / "hud.txt"))
+    for size in ("1280x720", "640x360"):
+        done = puppetphone("play", "snowman", "--headless", "--frames", "90", "--size", size, "--screenshot",
+                           f"{size}.png", cwd=tmp_path, data=tmp_path / "data")
+        assert done.returncode == 0, done.stderr
+        # The mouse is a person's hand: a headless run with it is paced to real time, and the HUD says how fast
+        # it went (flat out it would be hundreds of steps a second; it said 0.0 before).
+        fps = float(re.search(r"([0-9.]+) fps", (tmp_path / "hud.txt").read_text(encoding="utf-8")).group(1))
+        assert 20.0 < fps < 75.0, f"the HUD says {fps} fps for a run paced at 60 steps a second"
+        shot = np.asarray(Image.open(tmp_path / f"{size}.png").convert("RGB"), dtype=np.float64) / 255.0
+        r, g, b = shot[..., 0], shot[..., 1], shot[..., 2]
+        h, w = r.shape
+        puppet = (r > g + 0.25) & (r > b + 0.25)
+        assert puppet[h // 4: 3 * h // 4, w // 3: 2 * w // 3].sum() > 0.0004 * h * w, f"{size}: the puppet is hidden"
+        panels = (np.ptp(shot, axis=2) < 0.03) & (shot.mean(axis=2) < 0.35)  # the text's dark panels
+        assert panels.mean() < 0.2, f"{size}: the overlay covers {panels.mean():.0%} of the window"

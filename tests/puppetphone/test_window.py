@@ -9,38 +9,16 @@ frame that never reaches the window (a black window) fails here.
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
-needs_x = pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("import")),
-                                reason="needs Xvfb and ImageMagick's import (Debian xvfb imagemagick)")
-
-SCREEN = (1280, 800)
-
-
-@pytest.fixture(scope="module")
-def display() -> Iterator[str]:
-    """A fresh Xvfb display; its name. Xvfb picks a free number itself (``-displayfd``), so tests
-    running in parallel (pytest -n) never race for the same one."""
-    read_end, write_end = os.pipe()
-    server = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", f"{SCREEN[0]}x{SCREEN[1]}x24",
-                               "-nolisten", "tcp"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              pass_fds=(write_end,))
-    os.close(write_end)
-    with os.fdopen(read_end) as announced:
-        number = announced.readline().strip()  # written once the server accepts connections
-    assert number.isdigit() and server.poll() is None, "Xvfb did not start"
-    yield f":{number}"
-    server.terminate()
-    server.wait(10)
+from tests.puppetphone.xvfb import SCREEN, needs_x
 
 
 def _grab(display: str, path: Path) -> np.ndarray:
@@ -112,3 +90,40 @@ def test_no_display_refuses_at_once_and_suggests_headless(tmp_path: Path) -> Non
         assert done.returncode == 2, (args, done.stdout, done.stderr)
         assert "no display" in done.stderr and "--headless" in done.stderr
         assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_an_invisible_driver_fallback_names_sdls_error_and_tries_x11_by_name(tmp_path: Path) -> None:
+    for number in range(700, 800):  # a display nobody serves: SDL falls back to an invisible driver
+        if not Path(f"/tmp/.X11-unix/X{number}").exists():
+            break
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env.update(DISPLAY=f":{number}", XDG_DATA_HOME=str(tmp_path / "data"))
+    done = subprocess.run([sys.executable, "-m", "puppetphone", "play", "snowman", "--frames", "5"], env=env,
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    ours = done.stderr.strip().splitlines()[-1]  # SDL's drivers may print their own lines before it
+    assert ours.startswith("error: no display (SDL chose its ")
+    assert "SDL said: " in ours and "x11 asked for explicitly, 3 times: " in ours and "--headless" in ours
+
+
+_FIRST_OFFSCREEN = """
+import os, pygame
+from engine.render import window
+real, calls = pygame.display.get_driver, []
+def first_offscreen():
+    calls.append(1)
+    return "offscreen" if len(calls) == 1 else real()
+pygame.display.get_driver = first_offscreen
+window._open_display()
+print(real(), os.environ.get("SDL_VIDEODRIVER", "unset"))
+"""
+
+
+@needs_x
+def test_a_passing_offscreen_fallback_is_retried_with_x11_and_opens_the_window(display: str, tmp_path: Path) -> None:
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env["DISPLAY"] = display
+    done = subprocess.run([sys.executable, "-c", _FIRST_OFFSCREEN], env=env, cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[-2:] == ["x11", "unset"]  # x11 by name, the environment left as it was found

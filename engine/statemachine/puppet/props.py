@@ -18,11 +18,18 @@ from engine.statemachine.puppet.senses import wanted_anchor
 __all__ = ["held_props_system"]
 
 
+#: Gap kept between a held ball and the balls it passes (m): at contact distance a moving kinematic
+#: ball shoves the other one (a low carry plowed a big ball metres aside).
+CLEARANCE = 0.03
+
+
 def _clear_of_others(point: np.ndarray, entity: int, radius: float, props: list) -> np.ndarray:  # type: ignore[type-arg]
-    """Keep a held ball out of the ground and out of every other ball (slide it over their surface).
+    """Keep a held ball out of the ground and out of every other ball: it passes over them.
 
     A held ball is moved kinematically; letting it sink into another would hand the
-    physics an unresolvable overlap.
+    physics an unresolvable overlap, and pushing it around the other's side shoves that
+    one along. Where the two would overlap the held ball rises to ride over the other's
+    top (its ground position is the stick's), ``CLEARANCE`` above its surface.
     """
     p = np.array(point, dtype=np.float64)
     for _ in range(3):
@@ -30,12 +37,12 @@ def _clear_of_others(point: np.ndarray, entity: int, radius: float, props: list)
         for e, other, otr in props:
             if e == entity:
                 continue
+            need = radius + other.radius + CLEARANCE
             d = p - otr.position
-            dist = float(np.linalg.norm(d))
-            need = radius + other.radius + 0.005
-            if dist < need:
-                d = d / dist if dist > 1e-9 else np.array([0.0, 1.0, 0.0])
-                p = otr.position + d * need
+            if float(np.linalg.norm(d)) >= need:
+                continue
+            across = float(np.hypot(d[0], d[2]))
+            p[1] = otr.position[1] + np.sqrt(max(need * need - across * across, 0.0))
     return p
 
 

@@ -103,3 +103,31 @@ def test_the_bubble_is_drawn_over_the_nearest_3d_thing(mixed) -> None:
     img = _render(app, viewer, _on_ray(viewer, px, 3.5))  # a box right in front of the camera, under the bubble
     x, y = int(px[0]), int(px[1])
     assert np.abs(img[y, x] - PAPER).max() < 12, img[y, x]
+
+
+def test_a_held_avatar_shows_on_the_floor_where_it_is_led_and_each_cage_its_footprint(mixed) -> None:
+    from engine.components import Transform
+    from engine.statemachine.puppet.body import PuppetBody
+    from games.common import CUE_COLOR
+    from games.tasbada.objects import Creature
+
+    app, viewer = mixed
+    (e, body, tr), = app.world.query(PuppetBody, Transform)
+    cue = np.array(CUE_COLOR) * 255
+
+    def cue_pixels_near(point: np.ndarray, img: np.ndarray, r: int = 14) -> int:
+        x, y = viewer.camera.project(point[None], W, H)[0].astype(int)
+        patch = img[max(y - r, 0): y + r, max(x - r, 0): x + r]
+        return int((np.abs(patch - cue).max(axis=2) < 40).sum())
+
+    goal = np.array([tr.position[0] + 0.25, 0.0, tr.position[2] + 1.2])  # led toward the camera
+    before = _render(app, viewer, None)
+    body.held_by, body.target = 10_000, goal
+    try:
+        held = _render(app, viewer, None)
+    finally:
+        body.held_by = None
+    ring_edge = goal + np.array([0.25, 0.0, 0.0])
+    assert cue_pixels_near(ring_edge, held) > cue_pixels_near(ring_edge, before) + 40
+    homes = [c.home for _, c in app.world.query(Creature)]
+    assert homes and all(cue_pixels_near(h + np.array([0.0, 0.0, 0.5]), before) > 3 for h in homes)
