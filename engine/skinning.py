@@ -79,7 +79,8 @@ def blend_skin(positions: NDArray[np.floating], joints: NDArray[np.integer], wei
                matrices: F64) -> F64:
     """Skinned positions ``[V,3]``: ``Σ_k w_k · M[j_k] · [p, 1]``, in double precision."""
     p = np.concatenate([np.asarray(positions, dtype=np.float64), np.ones((len(positions), 1))], axis=1)
-    blended = np.einsum("vk,vkij->vij", np.asarray(weights, dtype=np.float64), matrices[np.asarray(joints, dtype=np.int64)])
+    per_vertex = matrices[np.asarray(joints, dtype=np.int64)]
+    blended = np.einsum("vk,vkij->vij", np.asarray(weights, dtype=np.float64), per_vertex)
     return np.einsum("vij,vj->vi", blended, p)[:, :3]
 
 

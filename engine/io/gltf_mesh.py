@@ -73,7 +73,8 @@ def _int(value: Any, what: str, limit: int, source: str) -> int:
     return value
 
 
-def _texture(doc: dict[str, Any], buffers: list[bytes], material: dict[str, Any], source: str) -> NDArray[np.uint8] | None:
+def _texture(doc: dict[str, Any], buffers: list[bytes], material: dict[str, Any],
+             source: str) -> NDArray[np.uint8] | None:
     """The base colour image of ``material``, decoded, or None when it has none or it lives outside the file."""
     info = material.get("pbrMetallicRoughness", {}).get("baseColorTexture")
     if info is None:

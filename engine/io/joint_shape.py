@@ -72,7 +72,8 @@ def _limb(chain: list[int], pos: F64) -> tuple[int, int, int] | None:
     return chain[i], chain[i + 1], chain[i + 2]
 
 
-def guess_roles_by_shape(names: tuple[str, ...] | list[str], parents: NDArray[np.int64], positions: F64) -> dict[str, str]:
+def guess_roles_by_shape(names: tuple[str, ...] | list[str], parents: NDArray[np.int64],
+                         positions: F64) -> dict[str, str]:
     """Puppet role → joint name, from world ``positions [J,3]`` of a pose where the figure stands.
 
     Y up is tried first, then Z up; the first under which the shape is a standing humanoid wins.
@@ -102,7 +103,8 @@ def _roles(names: tuple[str, ...] | list[str], parents: NDArray[np.int64], pos: 
         raise ValueError("the skeleton is flat: no joint stands above another")
     across = max(float(np.ptp(pos[:, a])) for a in (0, 1, 2) if a != up_axis)
     if height < 0.6 * across:  # even arms spread in a T-pose span about the height
-        raise ValueError(f"the figure is {across / height:.1f} times wider or longer than tall: not a standing humanoid")
+        raise ValueError(f"the figure is {across / height:.1f} times wider or longer than tall: "
+                         f"not a standing humanoid")
     h = pos[:, up_axis] - pos[leaves, up_axis].min()
     by_height = sorted(leaves, key=lambda j: h[j])
     first = by_height[0]

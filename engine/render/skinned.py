@@ -131,7 +131,8 @@ class SkinnedDraw:
     def _gpu(self, meshes: SkinnedMeshes) -> list[_PrimitiveGPU]:
         key = id(meshes)
         if key not in self._meshes:  # the meshes object is kept with its copies, so its id stays its own
-            self._meshes[key] = (meshes, [_PrimitiveGPU(self.ctx, p, self.lit, self.feedback) for p in meshes.primitives])
+            prims = [_PrimitiveGPU(self.ctx, p, self.lit, self.feedback) for p in meshes.primitives]
+            self._meshes[key] = (meshes, prims)
         return self._meshes[key][1]
 
     def _upload_joints(self, matrices: NDArray[np.float64]) -> int:

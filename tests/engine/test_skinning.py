@@ -12,8 +12,8 @@ from engine.fk import forward_kinematics
 from engine.io.gltf import read_gltf
 from engine.io.gltf_clip import load_gltf_clips
 from engine.io.gltf_mesh import read_skinned_meshes
-from engine.skinning import SkinBinding, blend_skin, fit_similarity, node_world_matrices, skin_matrices
 from engine.skeleton import Skeleton
+from engine.skinning import SkinBinding, blend_skin, fit_similarity, node_world_matrices, skin_matrices
 
 
 # CesiumMan's engine clip differs from its file by up to ~3 mm (its skeleton comes out 0.03 %

@@ -3,39 +3,16 @@
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
-import pytest
 from PIL import Image
 
-needs_x = pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("import")),
-                             reason="needs Xvfb and ImageMagick's import (Debian xvfb imagemagick)")  # fmt: skip
-SCREEN = (1280, 800)
-
-
-@pytest.fixture(scope="module")
-def display() -> Iterator[str]:
-    """A fresh Xvfb display; its name."""
-    for number in range(121, 160):
-        if not Path(f"/tmp/.X11-unix/X{number}").exists() and not Path(f"/tmp/.X{number}-lock").exists():
-            break
-    name = f":{number}"
-    server = subprocess.Popen(["Xvfb", name, "-screen", "0", f"{SCREEN[0]}x{SCREEN[1]}x24", "-nolisten", "tcp"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
-    deadline = time.monotonic() + 20
-    while not Path(f"/tmp/.X11-unix/X{number}").exists():
-        assert server.poll() is None and time.monotonic() < deadline, "Xvfb did not start"
-        time.sleep(0.1)
-    yield name
-    server.terminate()
-    server.wait(10)
+from tests.puppetphone.xvfb import SCREEN, needs_x
 
 
 @needs_x

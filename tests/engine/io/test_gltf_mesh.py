@@ -41,7 +41,8 @@ def _two_bone_doc() -> tuple[dict[str, Any], bytes]:
         ],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}, "indices": 3}]}],
         "skins": [{"joints": [1, 2], "inverseBindMatrices": 4}],
-        "nodes": [{"mesh": 0, "skin": 0}, {"children": [2]}, {"translation": [0, 0.5, 0], "rotation": [0, 0, 0.3826834, 0.9238795]}],
+        "nodes": [{"mesh": 0, "skin": 0}, {"children": [2]},
+                  {"translation": [0, 0.5, 0], "rotation": [0, 0, 0.3826834, 0.9238795]}],
         "scenes": [{"nodes": [0, 1]}],
     }
     return doc, blob
