@@ -407,7 +407,8 @@ def _record(args: argparse.Namespace) -> int:
         from input.factory import make_hub
 
         try:
-            hub = make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud).start()
+            hub = make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
+                           silent_after=args.silent_after).start()
         except (ValueError, OSError) as exc:
             runner.close()
             print(f"author record: cannot open {args.source}: {exc}", file=sys.stderr)
