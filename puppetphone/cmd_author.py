@@ -212,7 +212,7 @@ class RecordActivity:
         if self.output is None or self.scene.clip is None:
             return False
         clip, curve = self.scene.clip, self.scene.root_curve
-        said = save_or_say(lambda: save_clip(clip, self.output, root_curve=curve), self.output)
+        said = save_or_say(lambda path: save_clip(clip, path, root_curve=curve), self.output)
         saved = said.startswith("saved")
         self.scene.message = message.format(output=self.output) if saved else said
         return saved

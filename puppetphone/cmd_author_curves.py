@@ -82,7 +82,7 @@ class CurvesActivity:
         from authoring.keyframe_curves.session import save_curves
         from puppetphone.saving import save_or_say
 
-        self.scene.message = save_or_say(lambda: save_curves(self.scene.session.clip, self.output), self.output)
+        self.scene.message = save_or_say(lambda path: save_curves(self.scene.session.clip, path), self.output)
 
     def _scripted(self) -> None:
         """Frame 1: pin the feet and aim at frame 15; frames 2–21: drag the hand there in 20 moves."""
