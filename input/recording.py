@@ -20,7 +20,8 @@ from the record before (a type appears or goes). Two bytes name a differing part
 enough (the 16-byte hash decides whether a step matches).
 
 The header holds ``format`` (this module's :data:`FORMAT_VERSION`), ``engine_version``,
-``game``, ``seed``, ``dt``, ``sources`` and ``setup`` — the game's explicit set-up (options,
+``libraries`` (the versions of the libraries that change numbers, :mod:`input.library_versions`;
+absent in recordings made before, which read as ``{}``), ``game``, ``seed``, ``dt``, ``sources`` and ``setup`` — the game's explicit set-up (options,
 a save's contents: see :mod:`games.base`), so a replay needs nothing but the file.
 
 Why a recording is append-only rather than written to a temporary file and renamed like every
@@ -68,6 +69,7 @@ from engine.ecs import World
 from engine.hashing import PART_DIGEST_SIZE, part_digests
 from engine.npz_safe import read_bounded
 from input.codec import CodecError, decode_frame, encode_frame
+from input.library_versions import libraries_problem, running_versions
 from input.sample import InputFrame
 
 __all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording",
@@ -113,6 +115,7 @@ class RecordingHeader:
     format: int = FORMAT_VERSION
     engine_version: str = field(default_factory=_engine_version)
     extra: dict[str, Any] = field(default_factory=dict)
+    libraries: dict[str, str] = field(default_factory=running_versions)
 
 
 @dataclass
@@ -280,7 +283,7 @@ def _read_header(f: io.BufferedIOBase | BinaryIO, name: str) -> RecordingHeader:
     problem = _header_problem(d)
     if problem:
         raise RecordingError(f"{name} has a bad header: {problem}")
-    header = RecordingHeader(**d)
+    header = RecordingHeader(**{"libraries": {}, **d})  # an older file recorded no versions: none, not ours
     if header.format > FORMAT_VERSION:
         raise RecordingError(f"{name} is format {header.format}; this build reads up to {FORMAT_VERSION}")
     return header
@@ -314,6 +317,8 @@ def _header_problem(d: object) -> str:
         return "sources must be a list of names"
     if not isinstance(d.get("engine_version", ""), str) or not isinstance(d.get("extra", {}), dict):
         return "engine_version must be a string and extra an object"
+    if "libraries" in d and (problem := libraries_problem(d["libraries"])):
+        return problem
     if not isinstance(d.get("setup", {}), dict):
         return "setup must be an object (the game checks its values when it rebuilds the session)"
     return ""
