@@ -252,3 +252,22 @@ def test_devices_pipes_and_huge_header_claims_are_refused_without_reading(tmp_pa
     big.write_bytes(MAGIC + struct.pack("<II", 2**32 - 1, 0))
     with pytest.raises(RecordingError, match="claims"):
         read_recording(big)
+
+
+def test_a_growing_recording_is_fsynced_every_second_and_at_its_close(make_app, tmp_path, monkeypatch):
+    """At most a second of play is in the OS's cache alone when the power goes (broken on purpose:
+    without the periodic fsync only the close synced, 1 call for 150 records)."""
+    import os
+
+    from input.recording import FSYNC_EVERY
+
+    synced: list[int] = []
+    real = os.fsync
+    monkeypatch.setattr(os, "fsync", lambda fd: (synced.append(fd), real(fd))[1])
+    src = Fed("m")
+    app = make_app(InputHub([src]))
+    rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
+    app.run_steps(150)
+    assert len(synced) == 150 // FSYNC_EVERY == 2
+    rec.close()
+    assert len(synced) == 3 and read_recording(tmp_path / "s.rec").complete
