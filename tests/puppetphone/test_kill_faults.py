@@ -228,3 +228,29 @@ def test_fuzz_kill_9_campaign(tmp_path: Path, save: str) -> None:
         _author_edit(tmp_path, points)
     else:
         _cycles(tmp_path, points, count=max(8, len(points) + 2))
+
+
+def test_kill_9_during_record_leaves_every_frame_before_it_replaying(tmp_path: Path) -> None:
+    """A growing ``--record`` is append-only (see input/recording.py for why): a kill keeps every complete
+    record, and the replay says the file was cut instead of calling it complete."""
+    from input.recording import read_recording
+
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
+    rec = tmp_path / "s.rec"
+    for delay in _kill_points(1, longest=0.5):  # one: every cut position is read in tests/input/test_recording.py
+        with subprocess.Popen([sys.executable, "-m", "puppetphone", "play", "sandbox", "--headless", "--frames", "1000000",
+                               "--record", str(rec)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) as proc:
+            deadline = time.monotonic() + 120  # a deadline for the test, not a measured time
+            while not (rec.exists() and rec.stat().st_size > 2000):  # past its header and a few records
+                assert proc.poll() is None and time.monotonic() < deadline
+                time.sleep(0.05)
+            time.sleep(delay)
+            proc.send_signal(signal.SIGKILL)
+            proc.wait(30)
+        cut = read_recording(rec)
+        assert not cut.complete and cut.cut and len(cut) > 0
+        check = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless",
+                                "--allow-truncated"], env=env, capture_output=True, text=True, timeout=300)
+        assert check.returncode == 0, check.stderr
+        assert "ended without its closing record" in check.stderr or "cut inside" in check.stderr
+        assert f"all {len(cut)} state hashes match" in check.stdout
