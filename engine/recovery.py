@@ -24,7 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["recovery_folder", "free_recovery_path", "Rescue", "Saved"]
+__all__ = ["Rescue", "Saved", "free_recovery_path", "recovery_folder"]
 
 
 def recovery_folder() -> Path:

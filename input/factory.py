@@ -23,8 +23,15 @@ from input.hub import InputHub
 from input.osc import DEFAULT_PORT
 from input.web.server import DEFAULT_WEB_PORT
 
-__all__ = ["add_source_arguments", "make_hub", "silent_after", "SOURCE_KINDS", "DEFAULT_HOST", "DEFAULT_SILENT_AFTER",
-           "SILENT_AFTER_RANGE"]
+__all__ = [
+    "DEFAULT_HOST",
+    "DEFAULT_SILENT_AFTER",
+    "SILENT_AFTER_RANGE",
+    "SOURCE_KINDS",
+    "add_source_arguments",
+    "make_hub",
+    "silent_after",
+]
 
 SOURCE_KINDS = ("mouse", "osc", "hid", "serial", "web", "replay:FILE")
 #: Where OSC listens unless told otherwise: this machine only (a LAN phone needs 0.0.0.0).

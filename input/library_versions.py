@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-__all__ = ["NUMERIC_LIBRARIES", "running_versions", "version_difference", "libraries_problem"]
+__all__ = ["NUMERIC_LIBRARIES", "libraries_problem", "running_versions", "version_difference"]
 
 #: The distributions whose version can change a state hash: exactly the ones constraints.txt pins.
 NUMERIC_LIBRARIES = ("numpy", "scipy", "mujoco", "mujoco-core", "mujoco-studio", "osqp", "daqp", "cma",

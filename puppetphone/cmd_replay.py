@@ -41,10 +41,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Replay (and optionally verify) a recording; returns the exit code."""
     from games.base import GameOptionError
-    from input.recording import RecordingError, read_recording
-    from input.replay import ReplaySource
     from input.hub import InputHub
     from input.library_versions import version_difference
+    from input.recording import RecordingError, read_recording
+    from input.replay import ReplaySource
     from puppetphone.cmd_author import RECORD_GAME
     from puppetphone.cmd_author_edit import EDIT_GAME
     from puppetphone.cmd_play import run_activity

@@ -45,7 +45,7 @@ def full_disk(where: Path, free: int = 4096) -> Iterator[Path]:
             os.truncate(filler, max(0, filler.stat().st_size - (free - room)))
         yield where
     finally:
-        subprocess.run([umount, "-l", str(where)], capture_output=True)
+        subprocess.run([umount, "-l", str(where)], capture_output=True, check=False)
 
 
 @contextmanager
@@ -63,11 +63,12 @@ def read_only_folder(where: Path) -> Iterator[Path]:
     mount, umount = shutil.which("mount"), shutil.which("umount")
     if mount is None or umount is None:
         pytest.skip("running as root: a read-only folder does not stop root's writes (and no mount(8))")
-    made = subprocess.run([mount, "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(where)], capture_output=True, text=True)
+    made = subprocess.run([mount, "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(where)], capture_output=True, text=True,
+                          check=False)
     if made.returncode != 0:
         pytest.skip("running as root: a read-only folder does not stop root's writes "
                     f"(and a read-only tmpfs cannot be mounted: {made.stderr.strip() or 'not permitted'})")
     try:
         yield where
     finally:
-        subprocess.run([umount, "-l", str(where)], capture_output=True)
+        subprocess.run([umount, "-l", str(where)], capture_output=True, check=False)

@@ -15,7 +15,7 @@ import json
 from collections.abc import Callable, Sequence
 from typing import Any
 
-__all__ = ["COLUMNS", "row_sum", "typed", "intact"]
+__all__ = ["COLUMNS", "intact", "row_sum", "typed"]
 
 _T = {"TEXT": str, "INTEGER": int, "REAL": float}
 

@@ -34,11 +34,11 @@ import numpy as np
 
 from engine.app import App
 from engine.atomic import WriteError, atomic_write_bytes, set_aside
-from engine.recovery import Rescue
 from engine.npz_safe import read_bounded
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
+from engine.recovery import Rescue
 from engine.render.components import Appearance
 from engine.statemachine.puppet import PuppetBody, spawn_puppet
 from games.common import post_notice
@@ -358,7 +358,7 @@ def field_commands(world: World) -> None:
                 continue
             data = json.dumps(slot.saved).encode("utf-8")
             slot.rescue = slot.rescue or Rescue(slot.path)
-            saved = slot.rescue.save(lambda path: atomic_write_bytes(path, data, expect_head=FIELD_HEADS))
+            saved = slot.rescue.save(lambda path, data=data: atomic_write_bytes(path, data, expect_head=FIELD_HEADS))
             if saved.recovered:  # the game goes on; the field is on disk all the same, and in the slot for F9
                 _tell(world, f"field NOT saved to its file: kept in {saved.path}",
                       f" ({saved.why}; play it with --set field={saved.path})")

@@ -27,7 +27,7 @@ from puppetphone.cli import build_parser
 
 def _cli(*args: str, data: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(data)}
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], env=env, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "puppetphone", *args], env=env, capture_output=True, text=True, check=False,
                           timeout=120)
 
 

@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def _replay(path: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(path), "--verify", "--headless"],
-                          env={**os.environ, "SDL_VIDEODRIVER": "dummy"}, capture_output=True, text=True, timeout=300)
+                          env={**os.environ, "SDL_VIDEODRIVER": "dummy"}, capture_output=True, text=True, check=False, timeout=300)
 
 
 def _with_header(path: Path, edit) -> None:  # type: ignore[no-untyped-def]

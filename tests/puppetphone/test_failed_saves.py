@@ -36,7 +36,7 @@ def _env(data: Path, **extra: str) -> dict[str, str]:
 
 
 def _puppetphone(*args: str, data: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], env=_env(data), capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "puppetphone", *args], env=_env(data), capture_output=True, text=True, check=False,
                           timeout=300)
 
 
@@ -70,7 +70,7 @@ def _in_window(display: str, args: list[str], data: Path, keys: list[str], said:
         window = ""
         while not window:
             assert proc.poll() is None and time.monotonic() < deadline, log_err.read_text()
-            found = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", ""], env=env, capture_output=True, text=True)
+            found = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", ""], env=env, capture_output=True, text=True, check=False)
             window = found.stdout.split()[-1] if found.stdout.split() else ""  # the only client of this X server
             time.sleep(0.2)
         subprocess.run(["xdotool", "windowfocus", "--sync", window], env=env, check=True, timeout=30)

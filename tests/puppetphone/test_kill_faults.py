@@ -67,8 +67,8 @@ def _campaign(n: int | None = None) -> list[float]:
 
 def _clips_add(tmp_path: Path, points: list[float]) -> None:
     from engine.clipfile import save_clip
-    from engine.clips import default_clips
     from engine.cliplib.library import ClipLibrary, clip_digest
+    from engine.clips import default_clips
 
     walk = default_clips()["walk"]
     a, b = tmp_path / "walk_a.ppclip", tmp_path / "walk_b.ppclip"
@@ -83,7 +83,7 @@ def _clips_add(tmp_path: Path, points: list[float]) -> None:
         assert lib.entries()["walk"].sha256 == clip_digest(lib.load()["walk"])
     assert 1 <= len(added) <= 2
     listed = subprocess.run([sys.executable, "-m", "puppetphone", "clips", "list", "--clips", str(library)],
-                            capture_output=True, text=True, timeout=120)
+                            capture_output=True, text=True, check=False, timeout=120)
     assert listed.returncode == 0 and "walk" in listed.stdout, listed.stderr
 
 
@@ -161,7 +161,7 @@ def _author_edit(tmp_path: Path, points: list[float]) -> None:
         seen.add(clip_digest(session.clip))
     assert len(seen) > 1  # the kills did land between different saves
     again = subprocess.run([sys.executable, "-m", "puppetphone", "author", "edit", str(out), "--headless", "--frames",
-                            "1"], capture_output=True, text=True, timeout=120, env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
+                            "1"], capture_output=True, text=True, check=False, timeout=120, env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
     assert again.returncode == 0, again.stderr
 
 
@@ -206,7 +206,7 @@ def _cycles(tmp_path: Path, points: list[float], count: int) -> None:
         now = _done_takes(lib)
         assert done <= now, f"takes lost by the kill: {sorted(done - now)}"
         done = now
-    finished = subprocess.run(argv, capture_output=True, text=True, timeout=600)
+    finished = subprocess.run(argv, capture_output=True, text=True, check=False, timeout=600)
     assert finished.returncode == 0, finished.stderr
     assert len(_done_takes(lib)) == count and done <= _done_takes(lib)
 
@@ -250,7 +250,7 @@ def test_kill_9_during_record_leaves_every_frame_before_it_replaying(tmp_path: P
         cut = read_recording(rec)
         assert not cut.complete and cut.cut and len(cut) > 0
         check = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless",
-                                "--allow-truncated"], env=env, capture_output=True, text=True, timeout=300)
+                                "--allow-truncated"], env=env, capture_output=True, text=True, check=False, timeout=300)
         assert check.returncode == 0, check.stderr
         assert "ended without its closing record" in check.stderr or "cut inside" in check.stderr
         assert f"all {len(cut)} state hashes match" in check.stdout
