@@ -1,24 +1,56 @@
 """Building an :class:`InputHub` from the command line's ``--source`` choice.
 
 ``--source mouse|osc|hid|serial[:PORT]|web|replay:FILE`` plus ``--osc-host``,
-``--osc-port``, ``--serial-port``, ``--baud``, ``--web-host`` and ``--web-port``. :func:`add_source_arguments`
-adds these options to a parser (``play`` uses it) and :func:`make_hub` builds the
-hub they describe; it does not start the sources.
+``--osc-port``, ``--serial-port``, ``--baud``, ``--web-host``, ``--web-port`` and
+``--silent-after``. :func:`add_source_arguments` adds these options to a parser (``play``
+and ``author record`` use it) and :func:`make_hub` builds the hub they describe; it does
+not start the sources.
+
+``--silent-after SECONDS`` is how long an OSC or web controller may stay silent before its
+puppet is released to the next phone (2 s by default: the web page sends at least four
+readings a second and a phone app tens). It is refused (exit 2) outside
+:data:`SILENT_AFTER_RANGE`: below a quarter second a phone on a busy Wi-Fi would lose its
+puppet between two readings; past a minute a frozen phone would hold it as long as the old
+WebSocket keep-alive did.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 
 from input.hub import InputHub
 from input.osc import DEFAULT_PORT
 from input.web.server import DEFAULT_WEB_PORT
 
-__all__ = ["add_source_arguments", "make_hub", "SOURCE_KINDS", "DEFAULT_HOST"]
+__all__ = [
+    "DEFAULT_HOST",
+    "DEFAULT_SILENT_AFTER",
+    "SILENT_AFTER_RANGE",
+    "SOURCE_KINDS",
+    "add_source_arguments",
+    "make_hub",
+    "silent_after",
+]
 
 SOURCE_KINDS = ("mouse", "osc", "hid", "serial", "web", "replay:FILE")
 #: Where OSC listens unless told otherwise: this machine only (a LAN phone needs 0.0.0.0).
 DEFAULT_HOST = "127.0.0.1"
+#: Seconds of silence after which an OSC or web controller's puppet goes to the next phone.
+DEFAULT_SILENT_AFTER = 2.0
+SILENT_AFTER_RANGE = (0.25, 60.0)
+
+
+def silent_after(text: str) -> float:
+    """``--silent-after``: seconds in :data:`SILENT_AFTER_RANGE` (argparse turns a refusal into exit 2)."""
+    lo, hi = SILENT_AFTER_RANGE
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not math.isfinite(value) or not lo <= value <= hi:
+        raise argparse.ArgumentTypeError(f"{text} s is out of range: must be from {lo} to {hi} seconds")
+    return value
 
 
 def add_source_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,11 +66,16 @@ def add_source_arguments(parser: argparse.ArgumentParser) -> None:
                         help="web controller bind address; phones on the LAN need 0.0.0.0 (default 127.0.0.1)")
     parser.add_argument("--web-port", type=int, default=DEFAULT_WEB_PORT,
                         help=f"web controller HTTPS port, 0 for any free one (default {DEFAULT_WEB_PORT})")
+    lo, hi = SILENT_AFTER_RANGE
+    parser.add_argument("--silent-after", type=silent_after, default=DEFAULT_SILENT_AFTER, metavar="SECONDS",
+                        help="an OSC or web controller silent this long loses its puppet to the next phone "
+                             f"({lo}..{hi:g}, default {DEFAULT_SILENT_AFTER:g})")
 
 
 def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int = DEFAULT_PORT,
              osc_senders: int = 1, serial_port: str | None = None, baud: int = 115200,
-             web_host: str = DEFAULT_HOST, web_port: int = DEFAULT_WEB_PORT) -> InputHub:
+             web_host: str = DEFAULT_HOST, web_port: int = DEFAULT_WEB_PORT,
+             silent_after: float = DEFAULT_SILENT_AFTER) -> InputHub:
     """The hub for one ``--source`` value (sources not yet started).
 
     Raises:
@@ -54,7 +91,8 @@ def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int 
     if kind == "osc":
         from input.osc import OscSource
 
-        return InputHub([OscSource(host=osc_host, port=int(arg) if arg else osc_port, max_senders=osc_senders)])
+        return InputHub([OscSource(host=osc_host, port=int(arg) if arg else osc_port, max_senders=osc_senders,
+                                   timeout=silent_after)])
     if kind == "hid":
         from input.hid import HidSource
 
@@ -69,7 +107,7 @@ def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int 
     if kind == "web":
         from input.web.server import WebSource
 
-        return InputHub([WebSource(host=web_host, port=int(arg) if arg else web_port)])
+        return InputHub([WebSource(host=web_host, port=int(arg) if arg else web_port, silent_after=silent_after)])
     if kind == "replay":
         from input.replay import replay_hub
 

@@ -20,12 +20,24 @@ from the record before (a type appears or goes). Two bytes name a differing part
 enough (the 16-byte hash decides whether a step matches).
 
 The header holds ``format`` (this module's :data:`FORMAT_VERSION`), ``engine_version``,
-``game``, ``seed``, ``dt``, ``sources`` and ``setup`` — the game's explicit set-up (options,
-a save's contents: see :mod:`games.base`), so a replay needs nothing but the file. The file is append-only and flushed after
-every step, so a crash or a cut at any byte loses at most the frame being written:
-:func:`read_recording` returns every complete, checksummed record before the cut
-and says why it stopped (the replay prints that as a warning). A write that fails (a full
-disk) stops the recording with one line on the terminal; the session itself plays on.
+``libraries`` (the versions of the libraries that change numbers, :mod:`input.library_versions`;
+absent in recordings made before, which read as ``{}``), ``game``, ``seed``, ``dt``, ``sources`` and ``setup`` — the game's explicit set-up (options,
+a save's contents: see :mod:`games.base`), so a replay needs nothing but the file.
+
+Why a recording is append-only rather than written to a temporary file and renamed like every
+other save (:mod:`engine.atomic`): it grows for the whole session, and a file that grows cannot
+be renamed into place atomically at every step (that would rewrite the whole recording 60
+times a second). Appending loses nothing instead: every record is flushed to the OS after its
+step and the file is fsynced every :data:`FSYNC_EVERY` records, so a crash, a ``kill -9`` or a
+power cut at any byte loses at most the last second; :func:`read_recording` returns every
+complete, checksummed record before the cut and says why it stopped (the replay prints that as
+a warning, "ended without its closing record"), never a silently shorter "complete" file.
+
+A write that fails (a full disk, the folder made read-only) does not stop the recording: what is
+already on disk is copied to the user's recovery folder (:mod:`engine.recovery`) and the
+recording goes on there, with one line on the terminal naming the new file, which ends with
+its closing record like any finished recording. Only when that fails too does the recording
+stop (one line); the session itself plays on either way.
 
 Size per minute of play (60 steps/s; measured by ``tests/input/test_recording.py``
 and the figures in the closing report):
@@ -57,6 +69,7 @@ from engine.ecs import World
 from engine.hashing import PART_DIGEST_SIZE, part_digests
 from engine.npz_safe import read_bounded
 from input.codec import CodecError, decode_frame, encode_frame
+from input.library_versions import libraries_problem, running_versions
 from input.sample import InputFrame
 
 __all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording",
@@ -72,6 +85,8 @@ MAGIC = b"PPREC\n"
 MAX_RECORDING = 512 << 20
 MAX_HEADER = 16 << 20
 MIN_DT, MAX_DT = 1e-4, 1.0
+#: Records between two fsyncs of a growing recording (one second at 60 steps/s).
+FSYNC_EVERY = 60
 _LEN = struct.Struct("<II")
 
 
@@ -100,6 +115,7 @@ class RecordingHeader:
     format: int = FORMAT_VERSION
     engine_version: str = field(default_factory=_engine_version)
     extra: dict[str, Any] = field(default_factory=dict)
+    libraries: dict[str, str] = field(default_factory=running_versions)
 
 
 @dataclass
@@ -164,20 +180,51 @@ class Recorder:
             self.bytes += _LEN.size + len(payload)
 
     def _put(self, data: bytes) -> bool:
-        """Write and flush; a failure (full disk) stops the recording with one line, never the session."""
+        """Write and flush (fsync every :data:`FSYNC_EVERY` records); a failure moves the recording to the
+        recovery folder, or stops it with one line, never the session."""
         assert self._file is not None
         try:
             self._file.write(data)
             self._file.flush()
+            if (self.frames + 1) % FSYNC_EVERY == 0:
+                os.fsync(self._file.fileno())
         except OSError as exc:
-            self.failed = f"recording {self.path} stopped after {self.frames} frames: {exc.strerror or exc}"
-            print(self.failed, file=sys.stderr)
+            why = exc.strerror or str(exc)
             try:
                 self._file.close()
             except OSError:
-                pass  # the data that did not fit is lost either way; the frames before it are on disk
+                pass  # what did not fit is written again below, after the part that did
             self._file = None
+            return self._go_on_elsewhere(data, why)
+        return True
+
+    def _go_on_elsewhere(self, data: bytes, why: str) -> bool:
+        """Copy what is on disk so far to the recovery folder and go on there; ``False`` when that fails too."""
+        from engine.recovery import free_recovery_path
+
+        target = free_recovery_path(self.path.name, avoid=self.path)
+        try:
+            with open(self.path, "rb") as f:
+                written = f.read(self.bytes)  # every record before this one was flushed whole
+            if len(written) != self.bytes:
+                raise OSError(f"only {len(written)} of its {self.bytes} bytes can be read back")
+            target.parent.mkdir(parents=True, exist_ok=True)
+            moved = open(target, "wb")  # noqa: SIM115 - kept open while recording
+            try:
+                moved.write(written + data)
+                moved.flush()
+                os.fsync(moved.fileno())
+            except OSError:
+                moved.close()
+                raise
+        except OSError as exc:
+            self.failed = (f"recording {self.path} stopped after {self.frames} frames: {why} "
+                           f"(and not in {target.parent} either: {exc.strerror or exc})")
+            print(self.failed, file=sys.stderr)
             return False
+        print(f"recording {self.path}: {why} after {self.frames} frames; it goes on in {target} "
+              f"(replay that file)", file=sys.stderr)
+        self.path, self._file = target, moved
         return True
 
     def _parts_block(self, parts: dict[str, bytes]) -> bytes:
@@ -236,7 +283,7 @@ def _read_header(f: io.BufferedIOBase | BinaryIO, name: str) -> RecordingHeader:
     problem = _header_problem(d)
     if problem:
         raise RecordingError(f"{name} has a bad header: {problem}")
-    header = RecordingHeader(**d)
+    header = RecordingHeader(**{"libraries": {}, **d})  # an older file recorded no versions: none, not ours
     if header.format > FORMAT_VERSION:
         raise RecordingError(f"{name} is format {header.format}; this build reads up to {FORMAT_VERSION}")
     return header
@@ -270,6 +317,8 @@ def _header_problem(d: object) -> str:
         return "sources must be a list of names"
     if not isinstance(d.get("engine_version", ""), str) or not isinstance(d.get("extra", {}), dict):
         return "engine_version must be a string and extra an object"
+    if "libraries" in d and (problem := libraries_problem(d["libraries"])):
+        return problem
     if not isinstance(d.get("setup", {}), dict):
         return "setup must be an object (the game checks its values when it rebuilds the session)"
     return ""

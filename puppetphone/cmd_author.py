@@ -212,7 +212,7 @@ class RecordActivity:
         if self.output is None or self.scene.clip is None:
             return False
         clip, curve = self.scene.clip, self.scene.root_curve
-        said = save_or_say(lambda: save_clip(clip, self.output, root_curve=curve), self.output)
+        said = save_or_say(lambda path: save_clip(clip, path, root_curve=curve), self.output)
         saved = said.startswith("saved")
         self.scene.message = message.format(output=self.output) if saved else said
         return saved
@@ -409,7 +409,8 @@ def _record(args: argparse.Namespace) -> int:
         from input.factory import make_hub
 
         try:
-            hub = make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud).start()
+            hub = make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
+                           silent_after=args.silent_after).start()
         except (ValueError, OSError) as exc:
             runner.close()
             print(f"author record: cannot open {args.source}: {exc}", file=sys.stderr)

@@ -171,7 +171,7 @@ class CurvesActivity:
             s.size = (int(op[1]), int(op[2]))
         elif kind == "key" and op[2] and op[1] == "s":
             if self.output is not None:
-                s.message = save_or_say(lambda: save_curves(s.session.clip, self.output), self.output)
+                s.message = save_or_say(lambda path: save_curves(s.session.clip, path), self.output)
         else:
             s.apply(op)
 
@@ -181,7 +181,7 @@ class CurvesActivity:
         from puppetphone.saving import save_or_say
 
         if self.output is not None:
-            self.scene.message = save_or_say(lambda: save_curves(self.scene.session.clip, self.output), self.output)
+            self.scene.message = save_or_say(lambda path: save_curves(self.scene.session.clip, path), self.output)
 
     def step(self) -> None:
         if self._script is not None:

@@ -293,7 +293,7 @@ class EditActivity:
             edit.size = (int(op[1]), int(op[2]))
         elif kind == "key" and op[2] and op[1] == "s":
             if self.output is not None:
-                edit.message = save_or_say(lambda: save_session(self.session, self.output), self.output)
+                edit.message = save_or_say(lambda path: save_session(self.session, path), self.output)
         elif kind == "key":
             edit.key(op[1], ctrl=bool(op[2]), shift=bool(op[3]))
 

@@ -280,7 +280,7 @@ class FlowActivity:
         from puppetphone.saving import save_or_say
 
         if self.output is not None:
-            self.message = save_or_say(lambda: save_flow(self.session, self.output), self.output)
+            self.message = save_or_say(lambda path: save_flow(self.session, path), self.output)
 
     def _take_built(self) -> None:
         try:

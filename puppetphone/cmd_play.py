@@ -146,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     source = resolve_source(args.source, args.game)
     try:
         hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
-                       args.web_host, args.web_port)
+                       args.web_host, args.web_port, args.silent_after)
     except (ValueError, OSError, RecordingError) as exc:
         print(f"cannot open input {source!r}: {exc}", file=sys.stderr)
         return 2

@@ -9,7 +9,9 @@ reproduce its recording is a failure. Exit codes: 0 every step replayed and matc
 1 a state hash differs, or the file is damaged or cut short after its header; 2 the file
 cannot be replayed at all (not a regular file, not a recording, damaged header, unknown
 game, no display). A recording cut short (a session killed mid-write) replays up to its
-last complete frame with a warning and exit 0 only under ``--allow-truncated``.
+last complete frame with a warning and exit 0 only under ``--allow-truncated``. A recording
+made with other versions of the numerical libraries says so in one line first ("recorded with
+mujoco 4.0.0, running 3.17.0: hashes may differ"; :mod:`input.library_versions`).
 """
 
 from __future__ import annotations
@@ -39,9 +41,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Replay (and optionally verify) a recording; returns the exit code."""
     from games.base import GameOptionError
+    from input.hub import InputHub
+    from input.library_versions import version_difference
     from input.recording import RecordingError, read_recording
     from input.replay import ReplaySource
-    from input.hub import InputHub
     from puppetphone.cmd_author import RECORD_GAME
     from puppetphone.cmd_author_curves import CURVES_GAME
     from puppetphone.cmd_author_edit import EDIT_GAME
@@ -65,6 +68,8 @@ def run(args: argparse.Namespace) -> int:
         level = "warning" if cut_short and args.allow_truncated else "error"
         print(f"{level}: {args.file}: {rec.problem}; replaying the {len(rec)} complete frames", file=sys.stderr)
     h = rec.header
+    if differ := version_difference(h.libraries):
+        print(f"note: {differ}", file=sys.stderr)
     if h.game in (EDIT_GAME, RECORD_GAME, CURVES_GAME, FLOW_GAME):
         return _replay_authoring(rec, args, cut_short)
     try:

@@ -24,6 +24,15 @@ def data_dir() -> Path | None:
     return None
 
 
+@pytest.fixture(autouse=True)
+def _users_data_folder(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """Every test gets its own ``$XDG_DATA_HOME``: no test reads or writes the real user's saves,
+    clips, certificate or recovery folder (a failed save's recovered copy lands here)."""
+    data = tmp_path_factory.mktemp("xdg-data")
+    monkeypatch.setenv("XDG_DATA_HOME", str(data))
+    return data
+
+
 @pytest.fixture
 def mocap_dir() -> Path:
     """The real mocap folder; skips with the reason when it is absent (a user's fresh clone)."""

@@ -1,8 +1,9 @@
 """Real file-system faults for the save tests: a tiny, full disk (a tmpfs) and a read-only folder.
 
 A tmpfs can only be mounted with the right to mount (root, as in CI's container); a
-read-only folder only stops a writer that is not root. Where a fault cannot be made, the
-test that needs it is skipped with the reason, never passed without trying.
+read-only folder stops a writer that is not root by its mode, and root by a read-only
+mount. Where a fault cannot be made, the test that needs it is skipped with the reason,
+never passed without trying.
 """
 
 from __future__ import annotations
@@ -44,17 +45,30 @@ def full_disk(where: Path, free: int = 4096) -> Iterator[Path]:
             os.truncate(filler, max(0, filler.stat().st_size - (free - room)))
         yield where
     finally:
-        subprocess.run([umount, "-l", str(where)], capture_output=True)
+        subprocess.run([umount, "-l", str(where)], capture_output=True, check=False)
 
 
 @contextmanager
 def read_only_folder(where: Path) -> Iterator[Path]:
-    """A folder nobody but root may write in (skipped when the tests run as root)."""
-    if os.geteuid() == 0:
-        pytest.skip("running as root: a read-only folder does not stop root's writes")
+    """A folder the writer may not write in: mode 0555, or for root (whom modes do not stop) a
+    read-only tmpfs mounted there (skipped when neither can be made)."""
     where.mkdir(parents=True, exist_ok=True)
-    where.chmod(0o555)
+    if os.geteuid() != 0:
+        where.chmod(0o555)
+        try:
+            yield where
+        finally:
+            where.chmod(0o755)
+        return
+    mount, umount = shutil.which("mount"), shutil.which("umount")
+    if mount is None or umount is None:
+        pytest.skip("running as root: a read-only folder does not stop root's writes (and no mount(8))")
+    made = subprocess.run([mount, "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(where)], capture_output=True, text=True,
+                          check=False)
+    if made.returncode != 0:
+        pytest.skip("running as root: a read-only folder does not stop root's writes "
+                    f"(and a read-only tmpfs cannot be mounted: {made.stderr.strip() or 'not permitted'})")
     try:
         yield where
     finally:
-        where.chmod(0o755)
+        subprocess.run([umount, "-l", str(where)], capture_output=True, check=False)

@@ -20,42 +20,73 @@ Tables (read them with any SQLite tool, or with :func:`read_index`):
 
 Trust: SQLite keeps no checksum of the values it stores, so the index is checked before
 a batch relies on it: ``PRAGMA quick_check`` at open (a damaged page is refused in one
-line), and :meth:`LibraryIndex.known_hashes` counts a take as done only while every clip
-file it names is there with the SHA-256 the index recorded. A deleted or altered clip
-file, or a flipped byte in a clip's row, makes its take be done again.
+line), every row of every table carries ``row_sum`` (:mod:`authoring.batch.row_sums`),
+checked on every read, and :meth:`LibraryIndex.known_hashes` counts a take as done only
+while its rows are intact and every clip file it names is there with the SHA-256 the index
+recorded. A flipped byte in a row of ``takes`` or ``clips`` (or a deleted or altered clip
+file) makes its take be done again, said in one line (:attr:`LibraryIndex.notices`); in
+``sources`` the file is read again instead of trusting its hash; in ``meta`` (the schema
+and options) the index is refused in one line. :func:`read_index` (``clips add``, the games)
+refuses an index with any damaged row (of any table) in one line. An index of schema 1 (before the row
+sums) gets them at its next batch, its rows taken as they are.
 """
 
 from __future__ import annotations
 
 import hashlib
 import sqlite3
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from authoring.batch.row_sums import COLUMNS, intact, row_sum, typed
 from authoring.batch.worker import TakeOutcome
 
 __all__ = ["INDEX_NAME", "SCHEMA_VERSION", "ClipEntry", "LibraryIndex", "LibraryIndexError", "TakeEntry", "read_index"]
 
 INDEX_NAME = "index.sqlite"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2  # 2: a row_sum in every row
 
 _SCHEMA = """
-CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL, row_sum TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS takes (
     hash TEXT PRIMARY KEY, source TEXT NOT NULL, licence TEXT NOT NULL,
     outcome TEXT NOT NULL CHECK (outcome IN ('looped', 'refused', 'failed')), reason TEXT NOT NULL,
-    frames INTEGER NOT NULL, fps REAL NOT NULL, dims INTEGER NOT NULL, clips INTEGER NOT NULL, seconds REAL NOT NULL
+    frames INTEGER NOT NULL, fps REAL NOT NULL, dims INTEGER NOT NULL, clips INTEGER NOT NULL, seconds REAL NOT NULL,
+    row_sum TEXT NOT NULL
 );
 CREATE TABLE IF NOT EXISTS clips (
     file TEXT PRIMARY KEY, take TEXT NOT NULL REFERENCES takes (hash), segment INTEGER NOT NULL,
     start_frame INTEGER NOT NULL, end_frame INTEGER NOT NULL, start_s REAL NOT NULL, end_s REAL NOT NULL,
     kind TEXT NOT NULL, period REAL NOT NULL, cycles INTEGER NOT NULL, closure_error REAL NOT NULL,
     spread REAL NOT NULL, speed REAL, dims INTEGER NOT NULL, source TEXT NOT NULL, licence TEXT NOT NULL,
-    sha256 TEXT NOT NULL
+    sha256 TEXT NOT NULL, row_sum TEXT NOT NULL
 );
 CREATE INDEX IF NOT EXISTS clips_kind ON clips (kind, speed);
-CREATE TABLE IF NOT EXISTS sources (path TEXT PRIMARY KEY, size INTEGER NOT NULL, mtime_ns INTEGER NOT NULL, hash TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS sources (path TEXT PRIMARY KEY, size INTEGER NOT NULL, mtime_ns INTEGER NOT NULL,
+                                    hash TEXT NOT NULL, row_sum TEXT NOT NULL);
 """
+
+
+def _insert(con: sqlite3.Connection, table: str, values: tuple[object, ...], verb: str = "INSERT OR REPLACE") -> None:
+    """One row with its checksum (values given their columns' types first, so the sum is of what is stored)."""
+    row = typed(table, values)
+    con.execute(f"{verb} INTO {table} VALUES ({', '.join('?' * (len(row) + 1))})", (*row, row_sum(table, row)))
+
+
+def _add_row_sums(con: sqlite3.Connection) -> None:
+    """Schema 1 -> 2: a ``row_sum`` column in every table, filled from the rows as they are."""
+    with con:
+        for table, columns in COLUMNS.items():
+            if "row_sum" in [r[1] for r in con.execute(f"PRAGMA table_info({table})")]:
+                continue
+            con.execute(f"ALTER TABLE {table} ADD COLUMN row_sum TEXT NOT NULL DEFAULT ''")
+            names = ", ".join(name for name, _ in columns)
+            for rowid, *values in con.execute(f"SELECT rowid, {names} FROM {table}").fetchall():
+                row = typed(table, values)
+                con.execute(f"UPDATE {table} SET row_sum = ? WHERE rowid = ?", (row_sum(table, row), rowid))
+        con.execute("DELETE FROM meta WHERE key = 'schema'")
+        _insert(con, "meta", ("schema", str(SCHEMA_VERSION)))
 
 
 class LibraryIndexError(ValueError):
@@ -123,21 +154,28 @@ class LibraryIndex:
                 raise LibraryIndexError(f"{self.path} is damaged ({'; '.join(damage)[:120]}); move it away "
                                         "and run cycles again to rebuild it from the clip files' sources")
             self.con.executescript(_SCHEMA)
-            meta = dict(self.con.execute("SELECT key, value FROM meta").fetchall())
+            meta_rows = self.con.execute("SELECT * FROM meta").fetchall()
         except sqlite3.DatabaseError as exc:
             raise LibraryIndexError(f"{self.path} is not a library index ({exc})") from None
-        schema = str(meta.get("schema", SCHEMA_VERSION))
+        meta = {str(row[0]): str(row[1]) for row in meta_rows}
+        schema = meta.get("schema", str(SCHEMA_VERSION))
         if not schema.isdigit():
             raise LibraryIndexError(f"{self.path} has schema {schema[:20]!r}, not a version number")
         version = int(schema)
         if version > SCHEMA_VERSION:
             raise LibraryIndexError(f"{self.path} has schema {version}; this puppetphone reads up to {SCHEMA_VERSION}")
+        if version >= 2 and (bad := [str(row[0])[:40] for row in meta_rows if not intact("meta", row)]):
+            raise LibraryIndexError(f"{self.path}: its {', '.join(map(repr, bad))} setting is damaged (checksum "
+                                    "mismatch); move the index away and run cycles again to rebuild it")
         built = meta.get("options")
         if built is not None and built != options_key:
             raise LibraryIndexError(f"{self.libdir} was built with {built}; use the same options or another -o")
+        if version < 2 and meta:
+            _add_row_sums(self.con)
         with self.con:
-            self.con.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (str(SCHEMA_VERSION),))
-            self.con.execute("INSERT OR IGNORE INTO meta VALUES ('options', ?)", (options_key,))
+            _insert(self.con, "meta", ("schema", str(SCHEMA_VERSION)), "INSERT OR IGNORE")
+            _insert(self.con, "meta", ("options", options_key), "INSERT OR IGNORE")
+        self.notices: list[str] = []  # one line per kind of damage found while reading (``cycles`` prints them)
 
     def close(self) -> None:
         """Close the connection (everything recorded is committed already)."""
@@ -150,17 +188,30 @@ class LibraryIndex:
         A take whose clip count, clip files or their SHA-256 no longer match (a file deleted or
         changed, a damaged row) is left out, so the batch does it again and rewrites its rows.
         """
-        query = "SELECT hash, clips FROM takes" + ("" if failed else " WHERE outcome != 'failed'")
+        query = "SELECT * FROM takes" + ("" if failed else " WHERE outcome != 'failed'")
         try:
-            takes = dict(self.con.execute(query).fetchall())
-            rows = self.con.execute("SELECT take, file, sha256 FROM clips").fetchall()
+            take_rows = self.con.execute(query).fetchall()
+            clip_rows = self.con.execute("SELECT * FROM clips").fetchall()
         except sqlite3.DatabaseError as exc:
             raise LibraryIndexError(f"{self.path} is not a readable library index ({exc})") from None
+        takes = {str(row[0]): int(row[8]) for row in take_rows if intact("takes", row)}
+        damaged = len(take_rows) - len(takes)
         found: dict[str, int] = {}
-        for take, file, digest in rows:
-            if take in takes and self._intact(str(file), str(digest)):
+        for row in clip_rows:
+            take, file, digest = str(row[1]), str(row[0]), str(row[16])
+            if not intact("clips", row):
+                damaged += 1
+            elif take in takes and self._intact(file, digest):
                 found[take] = found.get(take, 0) + 1
+        if damaged:
+            self._notice(f"{damaged} damaged row(s) in takes/clips (checksum mismatch): their takes are done again")
         return {h for h, n in takes.items() if found.get(h, 0) == n}
+
+    def _notice(self, line: str) -> None:
+        """Say a damage once, on the terminal and in :attr:`notices`."""
+        if line not in self.notices:
+            self.notices.append(line)
+            print(f"cycles: {self.path}: {line}", file=sys.stderr)
 
     def _intact(self, file: str, digest: str) -> bool:
         """Whether the clip file ``file`` (relative to the library) is there with SHA-256 ``digest``."""
@@ -175,13 +226,16 @@ class LibraryIndex:
 
     def cached_hash(self, path: str, size: int, mtime_ns: int) -> str | None:
         """The hash recorded for ``path`` if its size and mtime are unchanged."""
-        row = self.con.execute("SELECT hash FROM sources WHERE path = ? AND size = ? AND mtime_ns = ?",
+        row = self.con.execute("SELECT * FROM sources WHERE path = ? AND size = ? AND mtime_ns = ?",
                                (path, size, mtime_ns)).fetchone()
-        return None if row is None else str(row[0])
+        if row is not None and not intact("sources", row):
+            self._notice("a damaged row in sources (checksum mismatch): its file is read again")
+            return None
+        return None if row is None else str(row[3])
 
     def remember_source(self, path: str, size: int, mtime_ns: int, digest: str) -> None:
         """Note a source's hash (committed with the next take, or by :meth:`commit`)."""
-        self.con.execute("INSERT OR REPLACE INTO sources VALUES (?, ?, ?, ?)", (path, size, mtime_ns, digest))
+        _insert(self.con, "sources", (path, size, mtime_ns, digest))
 
     def commit(self) -> None:
         """Commit pending source notes."""
@@ -191,18 +245,13 @@ class LibraryIndex:
         """One take and its clips, in one transaction (``files`` already written, relative to the library)."""
         with self.con:
             self.con.execute("DELETE FROM clips WHERE take = ?", (outcome.digest,))
-            self.con.execute(
-                "INSERT OR REPLACE INTO takes VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                (outcome.digest, outcome.source, licence, outcome.outcome, outcome.reason, outcome.frames,
-                 outcome.fps, outcome.dims, len(outcome.clips), outcome.seconds),
-            )
+            _insert(self.con, "takes", (outcome.digest, outcome.source, licence, outcome.outcome, outcome.reason,
+                                        outcome.frames, outcome.fps, outcome.dims, len(outcome.clips), outcome.seconds))
             for clip, file in zip(outcome.clips, files, strict=True):
-                self.con.execute(
-                    "INSERT OR REPLACE INTO clips VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    (file, outcome.digest, clip.segment, clip.start_frame, clip.end_frame, clip.start_s, clip.end_s,
-                     clip.kind, clip.period, clip.cycles, clip.closure_error, clip.spread, clip.speed, clip.dims,
-                     outcome.source, licence, hashlib.sha256(clip.data).hexdigest()),
-                )
+                _insert(self.con, "clips", (file, outcome.digest, clip.segment, clip.start_frame, clip.end_frame,
+                                            clip.start_s, clip.end_s, clip.kind, clip.period, clip.cycles,
+                                            clip.closure_error, clip.spread, clip.speed, clip.dims, outcome.source,
+                                            licence, hashlib.sha256(clip.data).hexdigest()))
 
 
 def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
@@ -218,14 +267,32 @@ def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
     try:
         con = sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=30.0)
         try:
-            cur = con.execute("SELECT * FROM takes ORDER BY source, hash")
-            names = [d[0] for d in cur.description]
-            takes = [TakeEntry(**dict(zip(names, row, strict=True))) for row in cur]
-            cur = con.execute("SELECT * FROM clips ORDER BY source, start_frame, file")
-            names = [d[0] for d in cur.description]
-            clips = [ClipEntry(**dict(zip(names, row, strict=True)), path=libdir / row[0]) for row in cur]
+            _checked_rows(con, "meta", "key", path)
+            _checked_rows(con, "sources", "path", path)
+            takes = [TakeEntry(**row) for row in _checked_rows(con, "takes", "source, hash", path)]
+            clips = [ClipEntry(**row, path=libdir / str(row["file"]))
+                     for row in _checked_rows(con, "clips", "source, start_frame, file", path)]
         finally:
             con.close()
     except sqlite3.DatabaseError as exc:
         raise LibraryIndexError(f"{path} is not a readable library index ({exc})") from None
     return takes, clips
+
+
+def _checked_rows(con: sqlite3.Connection, table: str, order: str, path: Path) -> list[dict[str, object]]:
+    """Every row of ``table`` as a dict of its columns, each checked against its ``row_sum``
+    (an index of schema 1 has none to check).
+
+    Raises:
+        LibraryIndexError: a row whose values are not what was written.
+    """
+    cur = con.execute(f"SELECT * FROM {table} ORDER BY {order}")
+    names = [d[0] for d in cur.description]
+    summed = names[-1] == "row_sum"
+    out = []
+    for row in cur:
+        if summed and not intact(table, row):
+            raise LibraryIndexError(f"{path}: a row of {table} ({str(row[0])[:60]!r}) is damaged (checksum mismatch); "
+                                    "run cycles again on the same sources to redo its take")
+        out.append(dict(zip(names[:-1] if summed else names, row[:-1] if summed else row, strict=True)))
+    return out

@@ -3,7 +3,10 @@
 :func:`save_session` writes the edited clip with the engine's own format (versioned,
 checksummed, atomic; with the root's fitted curve when the session has one) and, beside it, ``<name>.mocurves.json`` with what a clip cannot hold:
 the scale tracks and the pinned keypoints. The side file records the clip's SHA-256 so a
-pair that does not belong together is refused instead of silently mismatched; every value
+pair that does not belong together is refused instead of silently mismatched; it also keeps
+the entry of the clip it replaces (``previous``), because the two files are two atomic writes:
+a save killed or out of disk space between them leaves the old clip, which then still opens
+with its own session; every value
 in it is checked against the clip (shapes, ranges, types), and whatever is wrong with it
 is a :class:`SessionFileError`. JSON floats
 round-trip exactly (``repr``), so a reload is bit-for-bit.
@@ -84,10 +87,48 @@ def save_session(session: EditSession, path: str | Path) -> Path:
         "tau": session.tau,
         "sigma": session.sigma,
     }
-    # Side file first: a crash between the two leaves the old clip with a side file that
-    # no longer matches it, which load refuses loudly, never a silently wrong pairing.
+    # Side file first, carrying the entry of the clip still on disk: a kill or a full disk
+    # between the two writes leaves the old clip with a side file that still opens it as it
+    # was saved ("previous"), never a pair that is refused or silently mismatched.
+    before = _entry_on_disk(p)
+    if before is not None and before["clip_sha256"] != side["clip_sha256"]:
+        side["previous"] = before
     atomic_write_bytes(side_path(p), json.dumps(side).encode())
     return atomic_write_bytes(p, data)
+
+
+def _read_side(side_file: Path) -> Any:
+    """The decoded side file (``None`` when there is none; raises :class:`SessionFileError` when unreadable)."""
+    if not side_file.exists():
+        return None
+    try:
+        return json.loads(read_bounded(side_file, MAX_SIDE_FILE).decode("utf-8"))
+    except (OSError, ValueError, RecursionError) as exc:
+        raise SessionFileError(f"{side_file}: unreadable session file ({type(exc).__name__}: {exc})"[:300]) from None
+
+
+def _entry_for(side: Any, digest: str) -> dict[str, Any] | None:
+    """The side file's entry for the clip with ``digest``: its own, or the one it kept of the clip before."""
+    if not isinstance(side, dict):
+        return None
+    for entry in (side, side.get("previous")):
+        if isinstance(entry, dict) and entry.get("clip_sha256") == digest:
+            return {k: v for k, v in entry.items() if k != "previous"}
+    return None
+
+
+def _entry_on_disk(p: Path) -> dict[str, Any] | None:
+    """What the clip at ``p`` opens with now: its side file's entry, or "the clip alone" (``None``: no clip)."""
+    try:
+        clip, _curve = load_clip_curve(p)
+    except (OSError, ValueError):
+        return None
+    digest = _clip_digest(clip)
+    try:
+        entry = _entry_for(_read_side(side_path(p)), digest)
+    except SessionFileError:
+        entry = None
+    return entry or {"format": SIDE_FORMAT, "version": SIDE_VERSION, "clip_sha256": digest, "plain": True}
 
 
 def load_session(path: str | Path) -> EditSession:
@@ -97,17 +138,17 @@ def load_session(path: str | Path) -> EditSession:
     if not clip.loop:
         raise ValueError(f"{p}: clip {clip.name!r} is not a loop; MoCurves edit cycles")
     side_file = side_path(p)
-    if not side_file.exists():
+    side = _read_side(side_file)
+    if side is None:
+        return EditSession(clip, root_curve=root_curve)
+    entry = _entry_for(side, _clip_digest(clip))
+    if entry is not None and entry.get("plain") is True:  # saved over a clip that had no session: it opens alone
         return EditSession(clip, root_curve=root_curve)
     try:
-        side = json.loads(read_bounded(side_file, MAX_SIDE_FILE).decode("utf-8"))
-    except (OSError, ValueError, RecursionError) as exc:
-        raise SessionFileError(f"{side_file}: unreadable session file ({type(exc).__name__}: {exc})"[:300]) from None
-    try:
-        scales, tau, sigma, pins = _side_values(side, clip)
+        scales, tau, sigma, pins = _side_values(side if entry is None else entry, clip)
     except SessionFileError as exc:
         raise SessionFileError(f"{side_file}: {exc}") from None
-    if side.get("clip_sha256") != _clip_digest(clip):
+    if entry is None:
         raise SessionFileError(f"{side_file}: belongs to another version of {p.name}; move it away to open the clip alone")
     return EditSession(clip, scales, tau=tau, sigma=sigma, pins=pins, root_curve=root_curve)
 

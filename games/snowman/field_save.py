@@ -14,6 +14,9 @@ restores from there) and written to disk atomically: the game option ``field``
 :func:`prepare` reads that file before the game is built; the field it holds goes into
 the game's setup (``F9`` brings it back), which the recording's header carries, so
 replays restore the same field without reading anyone's disk; replays never write it.
+An F5 that its file refuses (a full disk, a read-only folder, a folder in the way) writes
+the field to the user's recovery folder instead and shows that path on screen
+(:mod:`engine.recovery`); the game plays on either way.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from engine.npz_safe import read_bounded
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
+from engine.recovery import Rescue
 from engine.render.components import Appearance
 from engine.statemachine.puppet import PuppetBody, spawn_puppet
 from games.common import post_notice
@@ -74,6 +78,7 @@ class FieldSlot:
 
     path: Path | None = None
     saved: dict[str, Any] | None = None
+    rescue: Rescue | None = None  # F5 when ``path`` refuses the save: the recovery folder (engine.recovery)
 
 
 def spawn_first_puppet(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
@@ -351,13 +356,16 @@ def field_commands(world: World) -> None:
             if slot.path is None:
                 _tell(world, "field saved")
                 continue
-            try:
-                atomic_write_bytes(slot.path, json.dumps(slot.saved).encode("utf-8"), expect_head=FIELD_HEADS)
-            except WriteError as exc:  # the game goes on; the field stays in the slot for F9
-                _tell(world, "field NOT saved to disk (F9 still restores it)",
-                      f": {exc}; start with --set field=PATH to save elsewhere")
-                continue
-            _tell(world, "field saved", f" to {slot.path}")
+            data = json.dumps(slot.saved).encode("utf-8")
+            slot.rescue = slot.rescue or Rescue(slot.path)
+            saved = slot.rescue.save(lambda path, data=data: atomic_write_bytes(path, data, expect_head=FIELD_HEADS))
+            if saved.recovered:  # the game goes on; the field is on disk all the same, and in the slot for F9
+                _tell(world, f"field NOT saved to its file: kept in {saved.path}",
+                      f" ({saved.why}; play it with --set field={saved.path})")
+            elif saved.path is None:  # nowhere at all: the field stays in the slot for F9, F5 tries again
+                _tell(world, "field NOT saved to disk (F9 still restores it, F5 tries again)", f": {saved.why}")
+            else:
+                _tell(world, "field saved", f" to {slot.path}")
         elif kind == RESTORE:
             if slot.saved is None:
                 _tell(world, "nothing saved to restore (F5 saves the field)")

@@ -13,17 +13,21 @@ recorded ``InputFrame``) and moves the quest along:
 - **virtual** — reached when the gate has been open for a moment.
 
 Each stage change prints ``stage: <name>`` (output only) and marks the progress for
-saving; the save itself happens in :func:`save_system` outside the hashed state.
+saving; the save itself happens in :func:`save_system` outside the hashed state. A save
+that its file refuses (a full disk, a read-only folder) goes to the user's recovery folder
+instead, with one line naming it (:mod:`engine.recovery`); the journey goes on either way.
 """
 
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 
 from engine.components import Stick
 from engine.ecs import World
+from engine.recovery import Rescue
 from engine.render.components import Appearance
 from games.common import post_notice
 from games.tasbada import marking, narrator, objects
@@ -47,6 +51,7 @@ class SaveSlot:
         self.photo = photo
         self.dirty = False
         self.error = ""
+        self.rescue: Rescue | None = None  # where progress goes when ``path`` refuses it (engine.recovery)
 
 
 class AvatarLook:
@@ -282,12 +287,12 @@ def save_system(world: World) -> None:
     from games.tasbada.save import progress_of, save_progress
 
     slot.dirty = False
-    try:
-        save_progress(slot.path, progress_of(world.resource(Quest), slot.photo))  # type: ignore[arg-type]
-    except OSError as exc:  # a WriteError: one line; the journey goes on and the next change tries again
-        if not slot.error:
-            print(f"tasbada: progress NOT saved: {exc}; start with --set save=PATH to save elsewhere", file=sys.stderr)
-            post_notice(world, "progress NOT saved (see the terminal)")
-        slot.error = str(exc)
-    else:
-        slot.error = ""
+    slot.rescue = slot.rescue or Rescue(Path(slot.path))  # type: ignore[arg-type]
+    progress = progress_of(world.resource(Quest), slot.photo)
+    saved = slot.rescue.save(lambda path: save_progress(path, progress))
+    if saved.why and saved.why != slot.error:  # one line per new trouble; the journey goes on either way
+        line = saved.line("progress", slot.rescue.target)
+        hint = f"; play on from it with --set save={saved.path}" if saved.path else ""
+        print(f"tasbada: {line}{hint}", file=sys.stderr)
+        post_notice(world, f"progress kept in {saved.path}" if saved.path else "progress NOT saved (see the terminal)")
+    slot.error = saved.why

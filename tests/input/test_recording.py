@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -134,20 +136,48 @@ def test_a_closing_record_that_does_not_match_is_damage(make_app, tmp_path):
     assert "damaged closing record" in read_recording(path).problem
 
 
-def test_a_full_disk_stops_the_recording_with_one_line_and_the_session_plays_on(make_app, tmp_path, capsys):
+def _record_400_steps(make_app, path: Path) -> tuple[Recorder, object]:  # type: ignore[no-untyped-def]
+    src = Fed("m")
+    app = make_app(InputHub([src]))
+    rec = Recorder(path, RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
+    for i in range(400):  # ~100 bytes a record: the disk fills long before the end
+        src.push(PoseSample(time=i / 60, source="osc:1", orientation=quat.from_axis_angle([1, 0, 0], 0.01 * i)))
+        app.step()
+    rec.close()
+    return rec, app
+
+
+def test_a_full_disk_moves_the_recording_to_the_recovery_folder_whole(make_app, tmp_path, capsys, monkeypatch):
+    """Nothing is lost: the frames already on the full disk and every later one end up, in order and
+    closed, in the recovery folder (broken on purpose: with the move removed the recording stopped
+    at frame ~77 of 400)."""
+    from tests.faults import full_disk
+
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    with full_disk(tmp_path / "disk", free=8192) as disk:
+        rec, app = _record_400_steps(make_app, disk / "s.rec")
+        assert app.world.frame == 400 and not rec.failed and rec.frames == 400
+        err = capsys.readouterr().err
+        assert err.count("it goes on in") == 1 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+        moved = tmp_path / "data" / "puppetphone" / "recovered" / "s.rec"
+        assert rec.path == moved and str(moved) in err
+        whole = read_recording(moved)
+        assert whole.complete and len(whole) == 400
+        cut = read_recording(disk / "s.rec")  # the first part stays where it was, said to be cut
+        assert not cut.complete and cut.cut
+        assert cut.hashes == whole.hashes[: len(cut)]
+
+
+def test_a_full_disk_everywhere_stops_the_recording_with_one_line_and_the_session_plays_on(make_app, tmp_path, capsys,
+                                                                                            monkeypatch):
     from tests.faults import full_disk
 
     with full_disk(tmp_path / "disk", free=8192) as disk:
-        src = Fed("m")
-        app = make_app(InputHub([src]))
-        rec = Recorder(disk / "s.rec", RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
-        for i in range(400):  # ~100 bytes a record: the disk fills long before the end
-            src.push(PoseSample(time=i / 60, source="osc:1", orientation=quat.from_axis_angle([1, 0, 0], 0.01 * i)))
-            app.step()
-        rec.close()
+        monkeypatch.setenv("XDG_DATA_HOME", str(disk / "data"))  # the recovery folder is on the full disk too
+        rec, app = _record_400_steps(make_app, disk / "s.rec")
         assert app.world.frame == 400 and rec.failed and 0 < rec.frames < 400
         err = capsys.readouterr().err
-        assert err.count("stopped after") == 1 and "Traceback" not in err
+        assert err.count("stopped after") == 1 and "Traceback" not in err and len(err.strip().splitlines()) == 1
         r = read_recording(disk / "s.rec")
         assert not r.complete and len(r) <= rec.frames
 
@@ -222,3 +252,22 @@ def test_devices_pipes_and_huge_header_claims_are_refused_without_reading(tmp_pa
     big.write_bytes(MAGIC + struct.pack("<II", 2**32 - 1, 0))
     with pytest.raises(RecordingError, match="claims"):
         read_recording(big)
+
+
+def test_a_growing_recording_is_fsynced_every_second_and_at_its_close(make_app, tmp_path, monkeypatch):
+    """At most a second of play is in the OS's cache alone when the power goes (broken on purpose:
+    without the periodic fsync only the close synced, 1 call for 150 records)."""
+    import os
+
+    from input.recording import FSYNC_EVERY
+
+    synced: list[int] = []
+    real = os.fsync
+    monkeypatch.setattr(os, "fsync", lambda fd: (synced.append(fd), real(fd))[1])
+    src = Fed("m")
+    app = make_app(InputHub([src]))
+    rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
+    app.run_steps(150)
+    assert len(synced) == 150 // FSYNC_EVERY == 2
+    rec.close()
+    assert len(synced) == 3 and read_recording(tmp_path / "s.rec").complete

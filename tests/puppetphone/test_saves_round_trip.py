@@ -99,3 +99,9 @@ def test_recording(tmp_path: Path) -> None:
         app.run_steps(20)
     back = read_recording(tmp_path / "s.rec")
     assert back.complete and back.hashes == hashes and back.header.setup == {"puppets": 1} and back.header.seed == 4
+    assert back.header == rec.header and back.header.libraries["mujoco"] != "none"  # every field, the versions too
+    again = tmp_path / "again.rec"
+    with Recorder(again, back.header) as copy:  # written again from what was read: the same bytes
+        for frame, digest, parts in zip(back.frames, back.hashes, back.parts, strict=True):
+            copy.write(frame, digest, parts)
+    assert again.read_bytes() == (tmp_path / "s.rec").read_bytes()

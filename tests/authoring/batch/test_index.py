@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import sqlite3
+import struct
 from pathlib import Path
 
 import pytest
@@ -128,3 +129,78 @@ def test_a_damaged_page_or_a_bad_schema_value_is_one_line(tmp_path: Path) -> Non
     (tmp_path / "b" / "index.sqlite").write_bytes(bytes(data))
     with pytest.raises(LibraryIndexError, match="damaged|not a library index"):
         LibraryIndex(tmp_path / "b", "opts")
+
+
+def _flip(path: Path, needle: bytes) -> None:
+    """Flip one bit inside the only place ``needle`` is stored in the file."""
+    data = bytearray(path.read_bytes())
+    assert data.count(needle) == 1, f"{needle!r} is stored {data.count(needle)} times"
+    data[data.find(needle) + len(needle) - 1] ^= 0x01
+    path.write_bytes(bytes(data))
+
+
+def _library(root: Path) -> None:
+    """An index with a row of every kind, each holding one value found nowhere else in the file."""
+    index = LibraryIndex(root, "opts-only-here")
+    outcome = _outcome("aaa", 1)
+    index.record(outcome, _files(root, outcome, ["clips/a0.npz"]), "CC0")  # its spread, 0.1, is the only 0.1
+    refused = TakeOutcome("/d/bbb.bvh", "bbb", "refused", "a reason only here", 100, 60.0, 7, 0.5, ())
+    index.record(refused, [], "CC0")
+    index.remember_source("/d/aaa.bvh", 10, 20, "f" * 64)
+    index.commit()
+    index.close()
+
+
+@pytest.mark.parametrize(("table", "needle"), [("meta", b"opts-only-here"), ("takes", b"a reason only here"),
+                                               ("clips", struct.pack(">d", 0.1)), ("sources", b"f" * 64)])
+def test_a_flipped_byte_in_any_row_of_any_table_is_noticed_in_one_line(tmp_path: Path, capsys, table: str,
+                                                                        needle: bytes) -> None:  # type: ignore[no-untyped-def]
+    """Broken on purpose: with the row sums unchecked, the flipped reason, spread and source hash read back
+    as valid values (every case but meta's options passes silently)."""
+    _library(tmp_path)
+    _flip(tmp_path / "index.sqlite", needle)
+    with pytest.raises(LibraryIndexError, match=f"a row of {table} .*damaged|setting is damaged") as refused:
+        read_index(tmp_path)
+    assert "\n" not in str(refused.value)
+    if table == "meta":
+        with pytest.raises(LibraryIndexError, match="'options' setting is damaged"):
+            LibraryIndex(tmp_path, "opts-only-here")
+        return
+    index = LibraryIndex(tmp_path, "opts-only-here")
+    known = index.known_hashes()
+    if table == "sources":
+        assert known == {"aaa", "bbb"} and index.cached_hash("/d/aaa.bvh", 10, 20) is None  # read again, not trusted
+    else:
+        assert known == {"aaa", "bbb"} - {"takes": {"bbb"}, "clips": {"aaa"}}[table]
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "checksum mismatch" in lines[0], lines
+    index.close()
+
+
+def test_an_index_from_before_the_row_sums_gets_them_and_keeps_its_takes(tmp_path: Path) -> None:
+    con = sqlite3.connect(tmp_path / "index.sqlite")
+    con.executescript("""
+        CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+        CREATE TABLE takes (hash TEXT PRIMARY KEY, source TEXT NOT NULL, licence TEXT NOT NULL, outcome TEXT NOT NULL,
+            reason TEXT NOT NULL, frames INTEGER NOT NULL, fps REAL NOT NULL, dims INTEGER NOT NULL,
+            clips INTEGER NOT NULL, seconds REAL NOT NULL);
+        CREATE TABLE clips (file TEXT PRIMARY KEY, take TEXT NOT NULL, segment INTEGER NOT NULL,
+            start_frame INTEGER NOT NULL, end_frame INTEGER NOT NULL, start_s REAL NOT NULL, end_s REAL NOT NULL,
+            kind TEXT NOT NULL, period REAL NOT NULL, cycles INTEGER NOT NULL, closure_error REAL NOT NULL,
+            spread REAL NOT NULL, speed REAL, dims INTEGER NOT NULL, source TEXT NOT NULL, licence TEXT NOT NULL,
+            sha256 TEXT NOT NULL);
+        CREATE TABLE sources (path TEXT PRIMARY KEY, size INTEGER NOT NULL, mtime_ns INTEGER NOT NULL, hash TEXT NOT NULL);
+        INSERT INTO meta VALUES ('schema', '1'), ('options', 'opts');
+        INSERT INTO takes VALUES ('aaa', '/d/aaa.bvh', 'CC0', 'refused', 'no period', 100, 60, 7, 0, 0.5);
+    """)
+    con.commit()
+    con.close()
+    assert [t.hash for t in read_index(tmp_path)[0]] == ["aaa"]  # read as it is, nothing to check yet
+    index = LibraryIndex(tmp_path, "opts")
+    assert index.known_hashes() == {"aaa"} and not index.notices
+    index.close()
+    takes, _ = read_index(tmp_path)
+    assert takes[0].fps == 60.0 and takes[0].reason == "no period"
+    _flip(tmp_path / "index.sqlite", b"no period")  # and from now on a change is noticed
+    with pytest.raises(LibraryIndexError, match="a row of takes"):
+        read_index(tmp_path)

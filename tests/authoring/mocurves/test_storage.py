@@ -97,3 +97,51 @@ def test_a_saved_session_reopens_unedited_and_again_after_a_second_save(name, tm
     back = load_session(path)
     again = load_session(save_session(back, tmp_path / f"{name}_2.ppclip"))
     assert again.clip.num_frames == back.clip.num_frames and again.scales.tobytes() == back.scales.tobytes()
+
+
+def _fill_leaving(folder, room: int) -> None:  # type: ignore[no-untyped-def]
+    """Fill the disk under ``folder`` up to ``room`` free bytes."""
+    import os
+
+    fd = os.open(folder / ".more", os.O_WRONLY | os.O_CREAT, 0o600)
+    try:
+        while os.write(fd, b"\0" * 4096):
+            pass
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+    os.truncate(folder / ".more", max(0, (folder / ".more").stat().st_size - room))
+
+
+@pytest.mark.parametrize("first", ["an edit", "the clip alone"])
+def test_a_disk_full_between_the_side_file_and_the_clip_leaves_the_earlier_save_opening(walk, tmp_path, first):
+    """A real full disk with room for the small side file and not for the clip: the side file is
+    replaced, the clip is not. Broken on purpose: without ``previous`` in the side file the earlier
+    save was refused ("belongs to another version ... move it away")."""
+    from engine.atomic import WriteError
+    from engine.clipfile import save_clip
+    from tests.faults import full_disk
+
+    with full_disk(tmp_path / "disk", free=200 << 10) as disk:
+        path = disk / "walk_edit.ppclip"
+        s = EditSession(walk, tau=3, sigma=0.2)
+        if first == "an edit":
+            s.scale_arrow("l_foot", 20, 0.3)
+            save_session(s, path)
+        else:  # a clip from `cycle`, no session file yet
+            save_clip(walk, path)
+        before = load_session(path)
+        s.retime("hips", {3: 0.1})
+        s.tau = 7
+        _fill_leaving(disk, 20 << 10)  # the side file (~13 KB) fits, the clip (~26 KB) does not
+        with pytest.raises(WriteError, match="space"):
+            save_session(s, path)
+        assert json.loads((disk / "walk_edit.mocurves.json").read_text())["tau"] == 7  # the side file did go
+        back = load_session(path)  # and the clip still opens as it was saved
+        assert back.clip.rotations.tobytes() == before.clip.rotations.tobytes()
+        assert back.scales.tobytes() == before.scales.tobytes() and back.tau == before.tau
+        (disk / ".more").unlink()
+        save_session(s, path)  # room again: the new pair opens as the new save
+        again = load_session(path)
+        assert again.tau == 7 and again.clip.rotations.tobytes() == s.clip.rotations.tobytes()
