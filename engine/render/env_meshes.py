@@ -17,7 +17,7 @@ __all__ = ["ground_rings", "sky_sphere", "ridge_strip", "cone_mesh", "grid_trian
 def grid_triangles(rows: int, cols: int, wrap: bool = True) -> NDArray[np.int32]:
     """Triangles of a ``rows × cols`` vertex grid (row-major), columns wrapping around when ``wrap``."""
     tris = []
-    span = cols if wrap else cols - 1
+    span = cols if wrap else cols - 1  # the last column joins the first when wrapping
     for i in range(rows - 1):
         for k in range(span):
             k1 = (k + 1) % cols
@@ -41,7 +41,9 @@ def ground_rings(rings: int = 40, segments: int = 64, inner: float = 0.002) -> t
 
 def sky_sphere(segments: int = 48) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """Unit directions ``[V,3]`` on rings of elevation, closest near the horizon, and triangles."""
-    elevation = np.radians([-90, -20, -2, 0, 2, 5, 9, 15, 24, 36, 52, 70, 90])
+    # Below -4 degrees the ground (150 m out) and the ridge's foot always cover the sky:
+    # no rings there, so looking down does not rasterise a screenful of hidden sky.
+    elevation = np.radians([-4, -1, 0, 2, 5, 9, 15, 24, 36, 52, 70, 90])
     angle = 2 * np.pi * np.arange(segments) / segments
     e, a = np.meshgrid(elevation, angle, indexing="ij")
     dirs = np.stack([np.cos(e) * np.cos(a), np.sin(e), np.cos(e) * np.sin(a)], axis=-1).reshape(-1, 3)

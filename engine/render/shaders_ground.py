@@ -219,7 +219,7 @@ void main() {
     float gx = texture(u_marks, uv + vec2(u_marks_texel.x, 0.0)).r - texture(u_marks, uv - vec2(u_marks_texel.x, 0.0)).r;
     float gz = texture(u_marks, uv + vec2(0.0, u_marks_texel.y)).r - texture(u_marks, uv - vec2(0.0, u_marks_texel.y)).r;
     vec3 n = normalize(vec3(gx * u_groove, 1.0, gz * u_groove));
-    float light = clamp(max(dot(n, u_sun_dir), 0.0) / max(u_sun_dir.y, 0.2), 0.6, 1.12);
+    float light = clamp(max(dot(n, u_sun_dir), 0.0) / max(u_sun_dir.y, 0.2), 0.72, 1.12);
     vec3 floor_tint = vec3(0.84, 0.88, 0.95);           // packed, shaded snow at the bottom
     vec3 k = mix(vec3(1.0), floor_tint, smoothstep(0.0, 1.0, m)) * mix(1.0, light, smoothstep(0.0, 0.4, m));
     k = mix(k, vec3(1.0), fog_amount(length(u_eye - v_pos)));
@@ -268,7 +268,7 @@ void main() {
     vec2 g = dot(ball, ball) < dot(heel, heel) ? -ball / vec2(0.58, 0.95) : -heel / vec2(0.42, 0.72);
     vec2 gw = v_dir * g.x + vec2(-v_dir.y, v_dir.x) * g.y;
     float wall = m * (1.0 - m) * 4.0;
-    float k = 1.0 - 0.2 * m + 0.35 * wall * dot(normalize(gw + 1e-5), normalize(u_sun_dir.xz + 1e-5));
+    float k = 1.0 - 0.12 * m + 0.25 * wall * dot(normalize(gw + 1e-5), normalize(u_sun_dir.xz + 1e-5));
     k = mix(1.0, k, v_strength * (1.0 - fog_amount(length(u_eye - v_pos))));
     f_color = vec4(vec3(0.5 * k) * vec3(0.97, 0.985, 1.0), 1.0);
 }
