@@ -59,7 +59,7 @@ def ridge_strip(segments: int = 160, seed: int = 3) -> tuple[NDArray[np.float32]
     rng = np.random.default_rng(seed)
     a = 2 * np.pi * np.arange(segments) / segments
     crest = 7.0 + sum(amp * np.sin(k * a + rng.uniform(0, 2 * np.pi)) for k, amp in ((2, 3.0), (5, 2.2), (11, 1.2), (23, 0.6)))
-    forest = 1.5 + 0.25 * crest + 0.8 * np.sin(37 * a + 1.0) * np.sin(53 * a)
+    forest = 2.5 + 0.3 * crest + 0.8 * np.sin(37 * a + 1.0) * np.sin(53 * a)
     crest = np.maximum(crest, forest + 1.5)
     rows = [(np.full(segments, -6.0), 0.0), (forest, 0.0), (forest + 0.4, 0.8), (crest, 1.0)]
     verts = np.concatenate([np.stack([np.cos(a), np.sin(a), h, np.full(segments, s)], axis=-1) for h, s in rows])

@@ -136,7 +136,7 @@ void main() {
     const vec3 forest = vec3(0.012, 0.03, 0.035);
     vec3 albedo = mix(forest, vec3(0.62, 0.68, 0.80), in_ridge.w);
     vec3 c = albedo * (u_sky_lin * u_ambient + u_sun_color * 0.45);
-    v_color = finish(mix(c, u_horizon_lin * SKY_GAIN, 0.35 + 0.2 * in_ridge.w));
+    v_color = finish(mix(c, u_horizon_lin * SKY_GAIN, 0.22 + 0.3 * in_ridge.w));
     gl_Position = u_view_proj * vec4(p, 1.0);
 }
 """
@@ -220,7 +220,7 @@ void main() {
     float gz = texture(u_marks, uv + vec2(0.0, u_marks_texel.y)).r - texture(u_marks, uv - vec2(0.0, u_marks_texel.y)).r;
     vec3 n = normalize(vec3(gx * u_groove, 1.0, gz * u_groove));
     float light = clamp(max(dot(n, u_sun_dir), 0.0) / max(u_sun_dir.y, 0.2), 0.72, 1.12);
-    vec3 floor_tint = vec3(0.84, 0.88, 0.95);           // packed, shaded snow at the bottom
+    vec3 floor_tint = vec3(0.76, 0.82, 0.92);           // packed, shaded snow at the bottom
     vec3 k = mix(vec3(1.0), floor_tint, smoothstep(0.0, 1.0, m)) * mix(1.0, light, smoothstep(0.0, 0.4, m));
     k = mix(k, vec3(1.0), fog_amount(length(u_eye - v_pos)));
     f_color = vec4(0.5 * k, 1.0);
