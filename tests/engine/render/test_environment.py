@@ -60,7 +60,7 @@ def test_a_tree_has_the_pointed_silhouette_of_a_conifer(gl):
     # Pointed: the top tenth of the tree is a narrow spire (round tiers, the old "green
     # snowman", were half as wide as the tree there).
     spire = width[top: top + (bottom - top) // 10]
-    assert spire.max() < 0.25 * widest
+    assert spire.max() < 0.2 * widest
     # Whorls: going down, the width grows, then steps back in where a tier's skirt ends
     # above the next tier (at least two such steps).
     profile = width[top:bottom]
