@@ -91,11 +91,11 @@ def test_a_rolled_ball_leaves_a_soft_continuous_groove(gl):
     px = np.round(cam.project(np.c_[xs, np.zeros_like(xs), np.zeros_like(xs)], W, H)).astype(int)
     along = darker[px[:, 1], px[:, 0]]
     assert along.min() > 4 and along.mean() > 8
-    # Across it (a column through the middle) the shade comes and goes over several pixels: soft edges.
+    # Across it (a column through the middle) the shade comes and goes over several pixels:
+    # soft edges, no pixel-to-pixel jump of more than a third of the groove's depth.
     x0, y0 = px[20]
     column = darker[max(y0 - 30, 0): y0 + 30, x0]
-    graded = np.sum((column > 0.15 * column.max()) & (column < 0.85 * column.max()))
-    assert graded >= 4
+    assert np.abs(np.diff(column)).max() < 0.35 * (column.max() - column.min())
     # Fresh snow beside the track is untouched.
     beside = np.round(cam.project(np.array([[0.0, 0.0, 1.2]]), W, H)).astype(int)[0]
     assert abs(darker[beside[1], beside[0]]) < 2
