@@ -231,7 +231,13 @@ class Runner:
         self._note = (f"quality: {mode}{level}", self._wall() + _NOTE_SECONDS)
 
     def _apply_quality(self) -> None:
-        if self.viewer is not None:
+        if self.viewer is None:
+            return
+        ctx = getattr(self.viewer.target, "ctx", None)
+        if ctx is None:  # a stand-in viewer without GL (tests)
+            self.viewer.renderer.set_quality(self.quality.quality)
+            return
+        with ctx:
             self.viewer.renderer.set_quality(self.quality.quality)
 
     def run(self, activity: Activity) -> RunResult:

@@ -172,12 +172,12 @@ class Renderer:
         self._mark_t = now
 
     def set_quality(self, quality: Quality) -> None:
-        """Draw from the next frame on at ``quality`` (shadow buffers are remade if their sizes change)."""
+        """Draw from the next frame on at ``quality`` (shadow buffers are remade if their sizes change:
+        the context must be current, as for :meth:`render`)."""
         if (quality.shadow_map, quality.shadow_mask) != (self.shadows.map_size, self.shadows.mask_size):
-            with self.ctx:  # may be called between frames, with another context current
-                self.shadows.release()
-                self.shadows = Shadows(self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask,
-                                       self._inst["cones"])
+            self.shadows.release()
+            self.shadows = Shadows(self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask,
+                                   self._inst["cones"])
         self.quality = quality
 
     def _scene_target(self, framebuffer: moderngl.Framebuffer) -> tuple[moderngl.Framebuffer, tuple[int, int]]:

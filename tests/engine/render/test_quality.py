@@ -54,7 +54,8 @@ def test_low_shades_a_quarter_of_the_pixels_and_keeps_the_text_sharp():
         viewer.camera = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), pitch=0.2, distance=4.0)
         images = {}
         for name in ("high", "low"):
-            viewer.renderer.set_quality(QUALITIES[name])
+            with viewer.target.ctx:
+                viewer.renderer.set_quality(QUALITIES[name])
             viewer.draw(scene)
             images[name] = viewer.read_pixels().astype(np.int32)
         low, high = images["low"], images["high"]
@@ -64,8 +65,9 @@ def test_low_shades_a_quarter_of_the_pixels_and_keeps_the_text_sharp():
         assert not np.array_equal(high[60:][0::2], high[60:][1::2])
         # The text is drawn at full size after the scale-up: its pixels are those of high.
         assert np.abs(low[4:22, 4:60] - high[4:22, 4:60]).max() < 40
-        # The capsule is in the same place at both levels.
-        red = lambda im: (im[..., 0] - im[..., 2]) > 80  # noqa: E731
-        assert abs(int(red(low).sum()) - int(red(high).sum())) < 0.1 * red(high).sum()
+        # The capsule is in the same place at both levels (about as big: low may draw it with fewer facets).
+        spots = [np.argwhere((im[..., 0] - im[..., 2]) > 80) for im in (low, high)]
+        assert np.abs(spots[0].mean(axis=0) - spots[1].mean(axis=0)).max() < 2.0
+        assert abs(len(spots[0]) - len(spots[1])) < 0.2 * len(spots[1])
     finally:
         viewer.close()
