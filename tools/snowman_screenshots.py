@@ -41,7 +41,7 @@ __all__ = ["STAGES", "take_screenshots"]
 
 OUT = REPO / "docs" / "screenshots"
 DELAY = 45  # frames after a stage is first seen: let it show
-FIELD_CAMERA = OrbitCamera(target=[0.0, 0.9, 0.0], yaw=0.6, pitch=0.16, distance=10.0)
+FIELD_CAMERA = OrbitCamera(target=[0.0, 0.9, 0.0], yaw=0.15, pitch=0.15, distance=10.5)
 """Low over the field, so the far ridge and the sky show above the snow."""
 
 

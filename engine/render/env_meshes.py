@@ -26,7 +26,8 @@ def grid_triangles(rows: int, cols: int, wrap: bool = True) -> NDArray[np.int32]
     return np.array(tris, dtype=np.int32)
 
 
-def ground_rings(rings: int = 40, segments: int = 64, inner: float = 0.002) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
+def ground_rings(rings: int = 40, segments: int = 64,
+                 inner: float = 0.002) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """Vertices ``[V,3]`` (unit direction x, z; radius as a fraction of the ground's extent) and triangles.
 
     The first ring has radius 0 (the centre under the camera), then radii grow
@@ -58,7 +59,8 @@ def ridge_strip(segments: int = 160, seed: int = 3) -> tuple[NDArray[np.float32]
     """
     rng = np.random.default_rng(seed)
     a = 2 * np.pi * np.arange(segments) / segments
-    crest = 7.0 + sum(amp * np.sin(k * a + rng.uniform(0, 2 * np.pi)) for k, amp in ((2, 3.0), (5, 2.2), (11, 1.2), (23, 0.6)))
+    waves = ((2, 3.0), (5, 2.2), (11, 1.2), (23, 0.6))
+    crest = 7.0 + sum(amp * np.sin(k * a + rng.uniform(0, 2 * np.pi)) for k, amp in waves)
     forest = 2.5 + 0.3 * crest + 0.8 * np.sin(37 * a + 1.0) * np.sin(53 * a)
     crest = np.maximum(crest, forest + 1.5)
     rows = [(np.full(segments, -6.0), 0.0), (forest, 0.0), (forest + 0.4, 0.8), (crest, 1.0)]
@@ -79,6 +81,7 @@ def cone_mesh(segments: int = 20, rings: int = 4) -> tuple[NDArray[np.float32], 
     side = np.stack([np.cos(aa), np.sin(aa), tt, np.zeros_like(tt)], axis=-1).reshape(-1, 4)
     tris = grid_triangles(rings + 1, segments)  # counter-clockwise seen from outside
     base = len(side)
-    disc = np.concatenate([[[0.0, 0.0, 0.0, 1.0]], np.stack([np.cos(a), np.sin(a), np.zeros(segments), np.ones(segments)], -1)])
+    rim = np.stack([np.cos(a), np.sin(a), np.zeros(segments), np.ones(segments)], -1)
+    disc = np.concatenate([[[0.0, 0.0, 0.0, 1.0]], rim])
     disc_tris = np.array([(base, base + 1 + k, base + 1 + (k + 1) % segments) for k in range(segments)], dtype=np.int32)
     return (np.concatenate([side, disc]).astype(np.float32), np.concatenate([tris, disc_tris]).astype(np.int32))

@@ -92,7 +92,8 @@ class Environment:
         """The ground's program for this combination of per-pixel features (compiled once, on first use)."""
         key = "ground" + "".join(f for f, on in (("_detail", detail), ("_grid", grid), ("_photo", photo)) if on)
         if key not in self._programs:
-            defines = "".join(f"#define {d} 1\n" for d, on in (("DETAIL", detail), ("GRID", grid), ("PHOTO", photo)) if on)
+            wanted = (("DETAIL", detail), ("GRID", grid), ("PHOTO", photo))
+            defines = "".join(f"#define {d} 1\n" for d, on in wanted if on)
             fs = S.HEADER + defines + S.LIGHTING + E.BACKGROUND + G.GROUND_MESH_FS
             prog = self._programs[key] = self.ctx.program(vertex_shader=self._ground_vs, fragment_shader=fs)
             for name, value in self._common.items():

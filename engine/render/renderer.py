@@ -131,8 +131,8 @@ class Renderer:
             self._vaos["boxes" + suffix] = ctx.vertex_array(
                 p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
         vbo, ibo = self._keep(mesh_buffers(ctx, cone_mesh()))
-        self._vaos["cones"] = ctx.vertex_array(p["cone"], [(vbo, "4f", "in_vert"), (self._inst["cones"].buf, *CAPSULE_FMT)],
-                                               ibo, 4, skip_errors=True)
+        self._vaos["cones"] = ctx.vertex_array(
+            p["cone"], [(vbo, "4f", "in_vert"), (self._inst["cones"].buf, *CAPSULE_FMT)], ibo, 4, skip_errors=True)
         unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
             [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
         self._vaos["text"] = ctx.vertex_array(p["text"], [(unit, "2f", "in_corner")])

@@ -216,8 +216,9 @@ void main() {
     vec2 uv = u_uv_rect.xy + v_uv * u_uv_rect.zw;
     float m = texture(u_marks, uv).r;
     if (m < 0.01) discard;
-    float gx = texture(u_marks, uv + vec2(u_marks_texel.x, 0.0)).r - texture(u_marks, uv - vec2(u_marks_texel.x, 0.0)).r;
-    float gz = texture(u_marks, uv + vec2(0.0, u_marks_texel.y)).r - texture(u_marks, uv - vec2(0.0, u_marks_texel.y)).r;
+    vec2 dx = vec2(u_marks_texel.x, 0.0), dz = vec2(0.0, u_marks_texel.y);
+    float gx = texture(u_marks, uv + dx).r - texture(u_marks, uv - dx).r;
+    float gz = texture(u_marks, uv + dz).r - texture(u_marks, uv - dz).r;
     vec3 n = normalize(vec3(gx * u_groove, 1.0, gz * u_groove));
     float light = clamp(max(dot(n, u_sun_dir), 0.0) / max(u_sun_dir.y, 0.2), 0.72, 1.12);
     vec3 floor_tint = vec3(0.76, 0.82, 0.92);           // packed, shaded snow at the bottom

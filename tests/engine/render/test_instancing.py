@@ -1,7 +1,6 @@
 """Instanced drawing: a crowd costs the same number of draw calls as one puppet (one per mesh kind and level)."""
 
 import moderngl
-import numpy as np
 import pytest
 
 from bench.render import demo_scene
