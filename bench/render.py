@@ -16,7 +16,10 @@ of 3 repeats of several frames each (:func:`cpu_frame_time`):
   so no peer figure is printed: the line says it was skipped.
 - ``render_fps_snowman_<quality>``: the loaded snowman game's frame at each level,
   against the 30 fps goal; ``sky_ground_ms_<quality>``: the same frame with nothing in
-  it, against a clear of the screen, measured in the same run (the floor of any frame).
+  it, against a clear of the screen, measured in the same run (the floor of any frame);
+  ``flat_fill_ms_1280x720``: a clear plus one flat-colour triangle over the screen, the
+  least any per-pixel pass costs on this rasteriser (what a drawn sky and ground can
+  approach, not beat).
 
 These machines are shared, so wall-clock frame rates swing with other people's load. The
 bench therefore also reads each thread's CPU time per frame from ``/proc`` (Linux): the
@@ -109,6 +112,15 @@ def unloaded_frame_time(frame, frames: int = 40) -> float | None:  # type: ignor
     return used.get(main, 0.0) + (max(workers) if workers else 0.0)
 
 
+_FILL_VS = """#version 330 core
+void main() { gl_Position = vec4(vec2((gl_VertexID << 1) & 2, gl_VertexID & 2) * 2.0 - 1.0, 0.5, 1.0); }
+"""
+_FILL_FS = """#version 330 core
+out vec4 f_color;
+void main() { f_color = vec4(0.8, 0.85, 0.9, 1.0); }
+"""
+
+
 def cpu_frame_time(frame, frames: int = 6, repeats: int = 3) -> float:  # type: ignore[no-untyped-def]
     """Median over ``repeats`` of the process CPU seconds per frame of ``frame`` (after two warm-up frames).
 
@@ -173,9 +185,22 @@ def quality_figures() -> list[Figure]:
         target.end()
         target.ctx.finish()
 
+    ctx = target.ctx
+    flat = ctx.program(vertex_shader=_FILL_VS, fragment_shader=_FILL_FS)
+    fill_vao = ctx.vertex_array(flat, [])
+
+    def fill() -> None:
+        """A clear, then one flat-colour triangle over the screen: the floor of any per-pixel pass."""
+        target.begin().clear(0.5, 0.5, 0.5, 1.0, depth=1.0)
+        fill_vao.render(vertices=3)
+        target.end()
+        ctx.finish()
+
     figures = []
     try:
-        t_clear = cpu_frame_time(clear)
+        t_clear, t_fill = cpu_frame_time(clear), cpu_frame_time(fill)
+        figures.append(Figure("render", "flat_fill_ms_1280x720", t_fill * 1e3, "ms", "clear of the screen",
+                              t_clear * 1e3))
         for name, quality in QUALITIES.items():
             renderer.set_quality(quality)
             t_game = cpu_frame_time(game_frame)
@@ -187,6 +212,8 @@ def quality_figures() -> list[Figure]:
         t_crowd = cpu_frame_time(lambda: draw(crowd, crowd_camera), frames=3)
         figures.append(Figure("render", f"render_fps_{BIG_CROWD}_puppets", 1.0 / t_crowd, "fps", "30 fps goal", 30.0))
     finally:
+        fill_vao.release()
+        flat.release()
         renderer.release()
         target.close()
     print(_peer_line(), file=sys.stderr)
