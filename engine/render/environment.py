@@ -112,7 +112,7 @@ class Environment:
     def draw_ground(self, scene: RenderScene, detail: bool, photo: bool, uniforms: dict[str, Any]) -> None:
         """The ground mesh (``uniforms``: centre, extent and the ground's colours)."""
         g = scene.ground
-        prog = self.ground_program(detail and g.snow > 0, g.grid, photo)
+        prog = self.ground_program(detail, g.grid, photo)
         for name, value in uniforms.items():
             set_uniform(prog, name, value)
         key = next(k for k, p in self._programs.items() if p is prog)
@@ -138,7 +138,8 @@ class Environment:
 
     def draw_decals(self, scene: RenderScene, shadow_rect: tuple[float, float, float, float] | None,
                     mask: moderngl.Texture | None) -> None:
-        """Ground shadow, snow track and footprints, each over the rectangle it covers.
+        """Ground shadow (``None``: the ground read it itself), snow track and footprints, each over the
+        rectangle it covers.
 
         They modulate what the ground drew (``2·src·dst``) where the depth buffer still
         holds the ground: objects in front keep their pixels. Polygon offset keeps the

@@ -279,19 +279,26 @@ class Renderer:
         photo = scene.background is not None and scene.background_fade < 1.0
         g = scene.ground
         eye = camera.eye
+        # With per-pixel snow detail the ground reads its shadow mask itself (one more fetch in a
+        # pass it pays anyway); otherwise the shadow is a decal over the casters' rectangle only.
+        detail = self.quality.ground_detail and g.snow > 0
+        self.shadows.mask.use(location=4)
         if g.visible:
-            self.env.draw_ground(scene, self.quality.ground_detail, photo, {
+            self.env.draw_ground(scene, detail, photo, {
                 "u_center": (float(eye[0]), 0.0, float(eye[2])), "u_extent": min(camera.far * 0.9, 150.0),
                 "u_height": float(g.height), "u_ground_lin": _linear(g.color), "u_snow": float(g.snow),
                 "u_grid_spacing": float(g.grid_spacing), "u_grid_lin": _linear(g.grid_color),
-                "u_grid_strength": float(g.grid_strength), "u_noise": 3})
+                "u_grid_strength": float(g.grid_strength), "u_noise": 3, "u_ground_mask": 4,
+                "u_rect": rect if rect is not None else (0.0, 0.0, 1.0, 1.0),
+                "u_shadow_strength": 0.9 if rect is not None else 0.0})
         self.env.draw_sky(scene, photo, float(g.height))
         if photo:
             ctx.depth_func = "<="
             self._vaos["sky_photo"].render(moderngl.TRIANGLES, vertices=3)
             ctx.depth_func = "<"
         if g.visible:
-            self.env.draw_decals(scene, rect, self.shadows.mask if rect is not None else None)
+            decal = rect if rect is not None and not detail else None
+            self.env.draw_decals(scene, decal, self.shadows.mask if decal is not None else None)
         ctx.enable_only(moderngl.DEPTH_TEST)
 
     def _upscale(self, framebuffer: moderngl.Framebuffer) -> None:

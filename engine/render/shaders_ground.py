@@ -55,6 +55,9 @@ uniform vec3 u_grid_lin;
 uniform float u_snow;
 uniform float u_grid_spacing;
 uniform float u_grid_strength;
+uniform sampler2D u_ground_mask;    // DETAIL: the ground shadow is read here, not drawn as a decal
+uniform vec4 u_rect;
+uniform float u_shadow_strength;
 in vec3 v_pos;
 in vec3 v_lin;
 in vec3 v_color;
@@ -65,6 +68,11 @@ void main() {
     vec3 to_eye = u_eye - v_pos;
     float dist = length(to_eye);
 #ifdef DETAIL
+    vec2 muv = (v_pos.xz - u_rect.xy) / u_rect.zw;
+    if (u_shadow_strength > 0.0 && all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) {
+        vec3 sun = u_sun_color * u_sun_dir.y;
+        c *= 1.0 - texture(u_ground_mask, muv).r * u_shadow_strength * sun / (sun + u_sky_lin * u_ambient * 1.6);
+    }
     if (dist < 14.0) {
         float near = 1.0 - dist / 14.0;
         vec4 drift = texture(u_noise, v_pos.xz * 0.08);
