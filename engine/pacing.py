@@ -94,20 +94,28 @@ class TimeKeeper:
     :meth:`behind` says so in words for the screen, and the first time it happens in a
     run a line goes to stderr; otherwise the window says nothing.
 
+    The first ``grace`` seconds of a run are not judged: the first frames compile shaders
+    and fill caches, and a stall there says nothing about the game.
+
     Args:
         max_frame: the runner's catch-up limit, named in the message.
         span: seconds of history judged.
         keep: the share of wall time the game must keep to count as on time.
+        grace: seconds at the start not judged.
     """
 
-    def __init__(self, max_frame: float, span: float = 2.0, keep: float = 0.98) -> None:
+    def __init__(self, max_frame: float, span: float = 2.0, keep: float = 0.98, grace: float = 1.0) -> None:
         self.max_frame, self.span, self.keep = max_frame, span, keep
+        self._grace = grace
         self._frames: list[tuple[float, float]] = []
         self.dropped_total = 0.0
         self._warned = False
 
     def frame(self, elapsed: float, dropped: float) -> None:
         """One frame of ``elapsed`` wall seconds, ``dropped`` of which the game did not run."""
+        if self._grace > 0:
+            self._grace -= elapsed
+            return
         self._frames.append((elapsed, dropped))
         self.dropped_total += dropped
         total = 0.0
