@@ -5,7 +5,9 @@ fragment work, so the lever that matters is how many pixels are shaded: ``low`` 
 ``medium`` draw the 3-D scene into a smaller buffer and scale it up (the overlay text is
 drawn at full size afterwards, so it stays sharp). Each level also bounds the shadow
 work (map and mask sizes) and how coarse a round solid may be drawn (silhouette error).
-``high`` adds the per-pixel snow detail near the camera.
+``high`` adds the per-pixel snow detail near the camera; ``low`` lets only the solids
+nearest the camera cast shadows (600 of them: a crowd's near rows), bounding the shadow
+work whatever the crowd's size.
 
 ``auto`` is :class:`QualityGovernor`: it starts at ``medium``, steps down as soon as the
 median of the last frames misses the 30 fps budget, and steps up only when a level's
@@ -37,10 +39,13 @@ class Quality:
     """Largest outline error a round solid's mesh may have, in (full-size) pixels."""
     ground_detail: bool
     """Per-pixel snow drifts and sparkle near the camera (else the snow is shaded per vertex)."""
+    max_casters: int | None = None
+    """Capsules and spheres drawn into the shadow map, nearest the camera first (``None``: all).
+    A crowd is vertex-bound on a software rasteriser, and the shadow map draws it a second time."""
 
 
 QUALITIES = {
-    "low": Quality("low", 0.5, 512, 128, 2.0, False),
+    "low": Quality("low", 0.5, 512, 128, 2.0, False, max_casters=600),
     "medium": Quality("medium", 0.75, 1024, 256, 1.0, False),
     "high": Quality("high", 1.0, 1024, 256, 1.0, True),
 }

@@ -226,7 +226,8 @@ class Renderer:
         light_vp = light_matrix(scene) if scene.sun.shadows else None
         rect = ground_rect(scene) if light_vp is not None else None
         if light_vp is not None and rect is not None:
-            self.shadows.render(scene, {kind: (rows[kind], levels[kind]) for kind in self._lod}, light_vp, rect)
+            n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
+            self.shadows.render(scene, {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}, light_vp, rect)
         self._mark("shadows")
 
         target.use()
