@@ -1,4 +1,4 @@
-"""Real-time pacing for headless runs driven by a live source.
+"""Real-time pacing: for headless runs driven by a live source, and the window's account of lost time.
 
 A headless run with a phone must not race ahead of the phone, so the game loop
 waits for each step's slot; with a replay source it runs as fast as it can (no
@@ -18,11 +18,12 @@ same frames in the same order.
 
 from __future__ import annotations
 
+import sys
 import threading
 import time
 from collections.abc import Callable
 
-__all__ = ["RealTimePacer"]
+__all__ = ["RealTimePacer", "TimeKeeper"]
 
 
 class RealTimePacer:
@@ -82,3 +83,63 @@ class RealTimePacer:
         """Readings from here on belong to the next step: only they may wake it."""
         if self._wake is not None:
             self._wake.clear()
+
+
+class TimeKeeper:
+    """How far a window's game time falls behind wall time, over the last few seconds.
+
+    The runner tells it each frame's wall duration and how much of it was dropped (a
+    stall longer than the catch-up limit, or steps beyond the clock's cap). While the
+    game kept less than ``keep`` of the wall time of the last ``span`` seconds,
+    :meth:`behind` says so in words for the screen, and the first time it happens in a
+    run a line goes to stderr; otherwise the window says nothing.
+
+    The first ``grace`` seconds of a run are not judged: the first frames compile shaders
+    and fill caches, and a stall there says nothing about the game.
+
+    Args:
+        max_frame: the runner's catch-up limit, named in the message.
+        span: seconds of history judged.
+        keep: the share of wall time the game must keep to count as on time.
+        grace: seconds at the start not judged.
+    """
+
+    def __init__(self, max_frame: float, span: float = 2.0, keep: float = 0.98, grace: float = 1.0) -> None:
+        self.max_frame, self.span, self.keep = max_frame, span, keep
+        self._grace = grace
+        self._frames: list[tuple[float, float]] = []
+        self.dropped_total = 0.0
+        self._warned = False
+
+    def frame(self, elapsed: float, dropped: float) -> None:
+        """One frame of ``elapsed`` wall seconds, ``dropped`` of which the game did not run."""
+        if self._grace > 0:
+            self._grace -= elapsed
+            return
+        self._frames.append((elapsed, dropped))
+        self.dropped_total += dropped
+        total = 0.0
+        for i in range(len(self._frames) - 1, -1, -1):
+            total += self._frames[i][0]
+            if total >= self.span:
+                del self._frames[:i]
+                break
+
+    def kept(self) -> float:
+        """Share of the recent wall time the game kept (1 when nothing was dropped)."""
+        wall = sum(e for e, _ in self._frames)
+        return 1.0 if wall <= 0 else 1.0 - sum(d for _, d in self._frames) / wall
+
+    def behind(self) -> str | None:
+        """What to tell the player while the game runs slower than real time, else ``None``."""
+        kept = self.kept()
+        if kept >= self.keep:
+            return None
+        wall = sum(e for e, _ in self._frames)
+        fps = len(self._frames) / wall if wall > 0 else 0.0
+        text = (f"too slow to keep time: the game runs at {kept:.2f}x real time ({fps:.1f} fps, "
+                f"frames over {self.max_frame * 1000:.0f} ms); G lowers the quality")
+        if not self._warned:
+            self._warned = True
+            print(f"puppetphone: {text}", file=sys.stderr)
+        return text

@@ -9,11 +9,18 @@ and draws itself. The runner owns everything around it:
   interpolated with its ``alpha``); headless, steps run back to back, or paced to wall
   time (:class:`~engine.pacing.RealTimePacer`) when a live device drives the session.
   Either way the activity's own time is ``steps × dt``: at 8 rendered frames a second a
-  3 s countdown still takes 3 s, and a performer's tempo is kept;
+  3 s countdown still takes 3 s, and a performer's tempo is kept. A slow frame is followed
+  by as many steps as it lasted (frames are dropped, not time) up to
+  :data:`MAX_FRAME_TIME`; only a longer stall drops time, and then the window says so
+  (:class:`~engine.pacing.TimeKeeper`) until the game keeps time again. How many steps
+  run per frame varies; each step is the same fixed ``dt`` with its own recorded input,
+  so the simulation never depends on the frame rate;
+- the **drawing quality** (:mod:`engine.render.quality`): ``--quality`` fixes it, or
+  ``auto`` lets the measured frame time choose; ``G`` cycles low, medium, high, auto;
 - the **event stack**: window events go to the handlers pushed last first (tools and
   overlays before the game, as in pyglet's handler stack); a handler that returns true
   consumes the event. The runner's own handler sits at the bottom: Esc and closing the
-  window quit, ``P`` pauses, ``.`` single-steps while paused;
+  window quit, ``P`` pauses, ``.`` single-steps while paused, ``G`` changes the quality;
 - the **common options**: ``--headless --frames --screenshot --screenshot-at``, window
   size and title.
 
@@ -33,16 +40,18 @@ from typing import Any, Protocol
 
 from engine.camera import Camera
 from engine.clock import FixedStepClock
-from engine.pacing import RealTimePacer
+from engine.pacing import RealTimePacer, TimeKeeper
 from engine.render.scene import RenderScene
 from engine.render.window import INVISIBLE_DRIVERS, NoDisplayError
 
-__all__ = ["Activity", "EventHandler", "NoDisplayError", "RunOptions", "RunResult", "Runner", "check_display"]
+__all__ = ["Activity", "EventHandler", "NoDisplayError", "RunOptions", "RunResult", "Runner", "check_display",
+           "MAX_FRAME_TIME"]
 
-#: Real time a window frame may add at most (a stall drops time beyond this).
+#: Real time a window frame may add at most (a stall drops time beyond this): 2.5 frames at 10 fps.
 MAX_FRAME_TIME = 0.25
 #: Wall seconds between two writes of ``RunOptions.hud_dump``.
 HUD_DUMP_INTERVAL = 0.1
+_NOTE_SECONDS = 2.0
 
 
 class Activity(Protocol):
@@ -100,6 +109,8 @@ class RunOptions:
         pace: headless only — hold each step to wall time (a live device drives it).
         hud_dump: write the text of every drawn frame's overlay here (replaced atomically a few
             times a second): what the HUD says, for scripts and tests that drive a real window.
+        quality: ``low``, ``medium``, ``high`` or ``auto`` (:mod:`engine.render.quality`;
+            headless, ``auto`` is ``high``: nobody waits for those frames).
     """
 
     headless: bool = False
@@ -111,8 +122,12 @@ class RunOptions:
     title: str = "PuppetPhone"
     pace: bool = False
     hud_dump: Path | None = None
+    quality: str = "auto"
 
     def __post_init__(self) -> None:
+        from engine.render.quality import parse_quality
+
+        self.quality = parse_quality(self.quality)
         if self.frames is not None and self.frames < 0:
             raise ValueError(f"frames must be zero or more, not {self.frames}")
         if self.screenshot_at is not None and self.screenshot_at < 0:
@@ -167,6 +182,9 @@ class _BaseKeys:
         if event.type == pygame.KEYDOWN and event.key == pygame.K_PERIOD and runner.clock.paused:
             runner.clock.request_step()
             return True
+        if event.type == pygame.KEYDOWN and event.key == pygame.K_g:
+            runner.cycle_quality()
+            return True
         return False
 
 
@@ -191,6 +209,11 @@ class Runner:
         self._stopped = False
         self._shot: Path | None = None
         self._hud_at = -math.inf
+        from engine.render.quality import QualityGovernor
+
+        self.quality = QualityGovernor("high" if options.headless and options.quality == "auto" else options.quality)
+        self.keeper = TimeKeeper(MAX_FRAME_TIME)
+        self._note: tuple[str, float] | None = None
 
     # -- event stack ---------------------------------------------------------------------
     def push_handlers(self, handler: EventHandler) -> None:
@@ -226,6 +249,24 @@ class Runner:
         o = self.options
         self.viewer = Viewer.create(headless=o.headless, width=o.width, height=o.height,
                                     **({} if o.headless else {"title": o.title}))
+        self._apply_quality()
+
+    def cycle_quality(self) -> None:
+        """The quality key: the next of low, medium, high, auto, said on screen for a moment."""
+        mode = self.quality.cycle()
+        self._apply_quality()
+        level = "" if mode != "auto" else f" (now {self.quality.level})"
+        self._note = (f"quality: {mode}{level}", self._wall() + _NOTE_SECONDS)
+
+    def _apply_quality(self) -> None:
+        if self.viewer is None:
+            return
+        ctx = getattr(self.viewer.target, "ctx", None)
+        if ctx is None:  # a stand-in viewer without GL (tests)
+            self.viewer.renderer.set_quality(self.quality.quality)
+            return
+        with ctx:
+            self.viewer.renderer.set_quality(self.quality.quality)
 
     def run(self, activity: Activity) -> RunResult:
         """Run ``activity`` until it finishes, ``frames`` steps ran, or the user quits."""
@@ -282,8 +323,14 @@ class Runner:
             if self._stopped:
                 break
             now = self._wall()
-            due = self.clock.advance(min(now - last, MAX_FRAME_TIME))
+            elapsed, dropped_before = now - last, self.clock.dropped_time
+            due = self.clock.advance(min(elapsed, MAX_FRAME_TIME))
             last = now
+            if not self.clock.paused:
+                lost = elapsed - min(elapsed, MAX_FRAME_TIME) + self.clock.dropped_time - dropped_before
+                self.keeper.frame(elapsed, lost)
+            if self.quality.frame(elapsed):
+                self._apply_quality()
             for _ in range(min(due, self._limit(steps))):
                 if activity.finished():
                     break
@@ -304,6 +351,7 @@ class Runner:
         scene = RenderScene(complete=complete or self.options.headless)
         alpha = self.clock.alpha if self.clock is not None else 0.0
         activity.draw(scene, alpha, self.viewer.size)
+        self._draw_notes(scene)
         self.viewer.camera = activity.camera
         self.viewer.draw(scene)
         if self.options.hud_dump is not None:
@@ -324,6 +372,14 @@ class Runner:
         except OSError as exc:  # a HUD file is a convenience: the session goes on without it
             print(f"hud dump: {exc}", file=sys.stderr)
             self.options.hud_dump = None
+
+    def _draw_notes(self, scene: RenderScene) -> None:
+        """The runner's own words on screen: a quality change, and that the game is behind real time."""
+        if self._note is not None and self._wall() < self._note[1]:
+            scene.add_text(self._note[0], size=22, anchor=(0.5, 0.12))
+        behind = self.keeper.behind()
+        if behind is not None:
+            scene.add_text(behind, size=20, color=(1.0, 0.8, 0.45), anchor=(0.5, 0.94))
 
     def _take_screenshot(self, activity: Activity) -> None:
         from engine.render.target import save_image

@@ -1,4 +1,4 @@
-"""The options every session shares (``--headless --frames --screenshot --size``), parsed once.
+"""The options every session shares (``--headless --frames --screenshot --size --quality``), parsed once.
 
 Values are checked by argparse types, so a wrong one stops the command before anything
 starts, with the sub-command's usage and one line saying what is wrong.
@@ -10,11 +10,12 @@ import argparse
 import os
 from pathlib import Path
 
+from engine.render.quality import parse_quality
 from engine.render.target import image_format
 from engine.runner import RunOptions
 from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
 
-__all__ = ["add_run_arguments", "run_options", "steps", "image_path", "HUD_DUMP_ENV"]
+__all__ = ["add_run_arguments", "run_options", "steps", "image_path", "HUD_DUMP_ENV", "quality_name"]
 
 #: Steps: zero or more.
 steps = int_range(0)
@@ -30,6 +31,14 @@ def image_path(text: str) -> Path:
     return path
 
 
+def quality_name(text: str) -> str:
+    """A ``--quality`` value, refused before the session starts when it is none of the levels."""
+    try:
+        return parse_quality(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = False) -> None:
     """Add the shared session options to a sub-command."""
     parser.add_argument("--headless", action="store_true",
@@ -42,6 +51,9 @@ def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = 
                             help="take the screenshot after step N instead of at the end")
     parser.add_argument("--size", type=window_size, default=(1280, 720), metavar="WxH",
                         help=f"window or image size, sides up to {MAX_WINDOW} (default 1280x720)")
+    parser.add_argument("--quality", type=quality_name, default="auto", metavar="LEVEL",
+                        help="drawing quality: low, medium, high or auto (default: chosen from the measured "
+                             "frame time in a window, high headless; G changes it while playing)")
 
 
 #: The environment variable that names a file for the HUD's text (``RunOptions.hud_dump``).
@@ -54,4 +66,5 @@ def run_options(args: argparse.Namespace, title: str, *, pace: bool = False) -> 
     hud = os.environ.get(HUD_DUMP_ENV)
     return RunOptions(headless=args.headless, frames=args.frames, screenshot=args.screenshot,
                       screenshot_at=getattr(args, "screenshot_at", None), width=width, height=height,
-                      title=title, pace=pace, hud_dump=Path(hud) if hud else None)
+                      title=title, pace=pace, hud_dump=Path(hud) if hud else None,
+                      quality=getattr(args, "quality", "auto"))

@@ -9,7 +9,9 @@ so a re-recorded demo still gives the right pictures):
 - ``carrying`` — the puppet carries the head ball;
 - ``alive`` — the first snowman has come alive;
 - ``building`` — the snowman rolls a ball of its own;
-- ``second`` — the last frame: two snowmen standing.
+- ``second`` — the last frame: two snowmen standing;
+- ``field`` — the same moment from lower down: the conifers, the tracks and footprints,
+  the horizon.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from engine.camera import OrbitCamera
 from engine.components import Stick, Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
@@ -38,6 +41,8 @@ __all__ = ["STAGES", "take_screenshots"]
 
 OUT = REPO / "docs" / "screenshots"
 DELAY = 45  # frames after a stage is first seen: let it show
+FIELD_CAMERA = OrbitCamera(target=[0.0, 0.9, 0.0], yaw=0.15, pitch=0.15, distance=10.5)
+"""Low over the field, so the far ridge and the sky show above the snow."""
 
 
 def _rolling_big(world: World) -> bool:
@@ -102,7 +107,7 @@ def _save_jpeg(runner: Runner, view: _DemoView, path: Path) -> None:
 
 
 def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> list[Path]:
-    """Replay the demo through the runner and write one JPEG per stage plus the last frame."""
+    """Replay the demo through the runner and write one JPEG per stage, the last frame and the field view."""
     out.mkdir(parents=True, exist_ok=True)
     rec = read_recording(DEMO_PATH)
     activity = build_activity("snowman", rec.header.seed, InputHub(replay=ReplaySource(rec)),
@@ -124,6 +129,9 @@ def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> li
     try:
         runner.run(view)
         written.append(out / "snowman_second.jpg")
+        _save_jpeg(runner, view, written[-1])
+        view.camera = FIELD_CAMERA
+        written.append(out / "snowman_field.jpg")
         _save_jpeg(runner, view, written[-1])
     finally:
         runner.close()

@@ -22,7 +22,7 @@ from engine.render.meshes import capsule_mesh
 __all__ = ["CAPSULE_LEVELS", "SPHERE_LEVELS", "LEVELS", "LIMITS", "SILHOUETTE_ERROR_PX", "level_limits",
            "choose_levels", "choose_levels_orthographic", "level_meshes"]
 
-CAPSULE_LEVELS: tuple[tuple[int, int], ...] = ((8, 2), (12, 3), (16, 4), (24, 6))
+CAPSULE_LEVELS: tuple[tuple[int, int], ...] = ((6, 2), (8, 2), (12, 3), (16, 4), (24, 6))
 """(segments around, rings per end cap) from coarse to fine."""
 SPHERE_LEVELS: tuple[tuple[int, int], ...] = ((10, 3), (14, 4), (20, 6), (28, 8))
 SILHOUETTE_ERROR_PX = 1.0

@@ -6,16 +6,18 @@ Passes, in order (each kind of primitive is one instanced draw call):
    (:mod:`engine.render.shadows`), both fitted around the casters each frame.
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.
-3. **objects** — capsules, spheres, boxes, lit by sun, sky ambient and shadow; capsules
+3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
    and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`).
-4. **ground** — a large quad under the camera: procedural snow (drift shading, sparkle),
-   anti-aliased grid, soft shadows, distance fog.
-5. **sky** — a gradient with a sun glow (and the background photo, faded) on the pixels
-   nothing else covered (depth test at the far plane).
-6. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
-7. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
+4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
+   and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
+   ground over the rectangles they cover: soft shadow, snow track, footprints.
+5. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
+6. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
    depth (a real prop in front of or behind 3-D objects) or over everything (an interface).
-8. **text** — the overlay, in pixels.
+7. **text** — the overlay, in pixels, always at the window's full size.
+
+The :class:`~engine.render.quality.Quality` level sets how many pixels passes 1-6 shade
+(a smaller buffer, scaled up before the text), the shadow resolutions and the detail.
 
 Opaque passes run nearest-first because on a software rasteriser (llvmpipe) fragment
 shading is the cost: the early depth test then skips ground and sky under the puppets.
@@ -36,10 +38,13 @@ from engine.camera import Camera
 from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
+from engine.render.env_meshes import cone_mesh
+from engine.render.environment import Environment
 from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
-from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
+from engine.render.quality import QUALITIES, Quality
+from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, CONE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
 from engine.render.skinned import SKIN_FS, SKIN_VS, SkinnedDraw
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
 from engine.render.text import TextCache, layout_text
@@ -49,7 +54,15 @@ __all__ = ["Renderer"]
 _LINE_FMT = ("3f 3f 3f 1f/i", "i_p0", "i_p1", "i_color", "i_width")
 _POINT_FMT = ("3f 1f 3f 1f", "i_pos", "i_size", "i_color", "i_pixels")
 _SOLIDS = ("capsules", "spheres", "boxes")
-_KINDS = (*_SOLIDS, "lines", "points")
+_KINDS = (*_SOLIDS, "cones", "lines", "points")
+# Nearest texel, fetched by integer address: on llvmpipe a filtered full-screen fetch cost
+# 6.5 ms a frame at 1280x720, more than the pixels the smaller buffer saved.
+_UPSCALE_FS = """
+uniform sampler2D u_tex;
+uniform vec2 u_ratio;           // source texels per target pixel
+out vec4 f_color;
+void main() { f_color = texelFetch(u_tex, ivec2(gl_FragCoord.xy * u_ratio), 0); }
+"""
 
 
 def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArray[np.float32]:
@@ -63,7 +76,7 @@ def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArr
     """
     if len(rows) < 2:
         return rows
-    centre = 0.5 * (rows[:, 0:3] + rows[:, 3:6]) if rows.shape[1] != BOX_STRIDE else rows[:, 0:3]
+    centre = 0.5 * (rows[:, 0:3] + rows[:, 3:6]) if rows.shape[1] != BOX_STRIDE else rows[:, 0:3]  # cones too
     return rows[np.argsort(np.sum((centre - eye) ** 2, axis=1), kind="stable")]
 
 
@@ -77,11 +90,10 @@ class Renderer:
 
     Args:
         ctx: an OpenGL 3.3 core context.
-        shadow_size: side of the object shadow map in texels.
-        mask_size: side of the ground shadow mask in texels.
+        quality: the level drawn at (``high`` by default; :meth:`set_quality` changes it).
     """
 
-    def __init__(self, ctx: moderngl.Context, shadow_size: int = 1024, mask_size: int = 256) -> None:
+    def __init__(self, ctx: moderngl.Context, quality: Quality = QUALITIES["high"]) -> None:
         self.ctx = ctx
         h, lit = S.HEADER, S.HEADER + S.LIGHTING
         p = self._programs = {
@@ -89,10 +101,8 @@ class Renderer:
             "capsule_flat": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=h + S.FLAT_FS),
             "box": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=lit + S.LIT_FS),
             "box_flat": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.FLAT_FS),
-            "ground": ctx.program(vertex_shader=h + E.GROUND_VS, fragment_shader=lit + E.BACKGROUND + E.GROUND_FS),
-            "ground_photo": ctx.program(vertex_shader=h + E.GROUND_VS,
-                                        fragment_shader=h + E.PHOTO_DEFINE + S.LIGHTING + E.BACKGROUND + E.GROUND_FS),
-            "sky": ctx.program(vertex_shader=h + E.SKY_VS, fragment_shader=lit + E.BACKGROUND + E.SKY_FS),
+            "cone": ctx.program(vertex_shader=h + S.CONE_VS, fragment_shader=lit + S.LIT_FS),
+            "upscale": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + _UPSCALE_FS),
             "sky_photo": ctx.program(vertex_shader=h + E.SKY_VS,
                                      fragment_shader=h + E.PHOTO_DEFINE + S.LIGHTING + E.BACKGROUND + E.SKY_FS),
             "line": ctx.program(vertex_shader=h + S.LINE_VS, fragment_shader=h + S.LINE_FS),
@@ -103,9 +113,9 @@ class Renderer:
         }
         self.skinned = SkinnedDraw(ctx, p["skinned"])
         strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
-                   "lines": LINE_STRIDE, "points": POINT_STRIDE}
+                   "lines": LINE_STRIDE, "points": POINT_STRIDE, "cones": CONE_STRIDE}
         # Capsules and spheres have one buffer per level of detail (self._lod, below).
-        self._inst = {k: Instances(ctx, 4 * strides[k]) for k in ("boxes", "lines", "points")}
+        self._inst = {k: Instances(ctx, 4 * strides[k]) for k in ("boxes", "cones", "lines", "points")}
         self._outline_inst = {k: Instances(ctx, 4 * strides[k]) for k in _SOLIDS}
         self._buffers: list[moderngl.Buffer] = []
         self._vaos: dict[str, moderngl.VertexArray] = {}
@@ -123,18 +133,22 @@ class Renderer:
                                    ("_flat", "box_flat", self._outline_inst["boxes"])):
             self._vaos["boxes" + suffix] = ctx.vertex_array(
                 p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
-        quad, unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
-            [-1, -1, 1, -1, -1, 1, 1, 1], [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
-        for name in ("ground", "ground_photo"):
-            self._vaos[name] = ctx.vertex_array(p[name], [(quad, "2f", "in_corner")])
+        vbo, ibo = self._keep(mesh_buffers(ctx, cone_mesh()))
+        self._vaos["cones"] = ctx.vertex_array(
+            p["cone"], [(vbo, "4f", "in_vert"), (self._inst["cones"].buf, *CAPSULE_FMT)], ibo, 4, skip_errors=True)
+        unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
+            [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
         self._vaos["text"] = ctx.vertex_array(p["text"], [(unit, "2f", "in_corner")])
         self._vaos["overlay"] = ctx.vertex_array(p["overlay"], [(unit, "2f", "in_corner")])
         self._vaos["lines"] = ctx.vertex_array(
             p["line"], [(seg, "2f", "in_corner"), (self._inst["lines"].buf, *_LINE_FMT)], skip_errors=True)
         self._vaos["points"] = ctx.vertex_array(p["point"], [(self._inst["points"].buf, *_POINT_FMT)], skip_errors=True)
-        for name in ("sky", "sky_photo"):
+        for name in ("sky_photo", "upscale"):
             self._vaos[name] = ctx.vertex_array(p[name], [])
-        self.shadows = Shadows(ctx, self._inst["boxes"], shadow_size, mask_size)
+        self.env = Environment(ctx)
+        self.quality = quality
+        self.shadows = Shadows(ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask, self._inst["cones"])
+        self._scaled: tuple[moderngl.Framebuffer, moderngl.Texture] | None = None
         self._blank = ctx.texture((1, 1), 3, bytes([255, 255, 255]))
         noise = snow_noise()
         self._noise = ctx.texture(noise.shape[:2][::-1], 4, noise.tobytes())
@@ -160,18 +174,51 @@ class Renderer:
             self.timings[name] = now - self._mark_t
         self._mark_t = now
 
+    def set_quality(self, quality: Quality) -> None:
+        """Draw from the next frame on at ``quality`` (shadow buffers are remade if their sizes change:
+        the context must be current, as for :meth:`render`)."""
+        if (quality.shadow_map, quality.shadow_mask) != (self.shadows.map_size, self.shadows.mask_size):
+            self.shadows.release()
+            self.shadows = Shadows(self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask,
+                                   self._inst["cones"])
+        self.quality = quality
+
+    def _scene_target(self, framebuffer: moderngl.Framebuffer) -> tuple[moderngl.Framebuffer, tuple[int, int]]:
+        """Where the 3-D passes draw: ``framebuffer`` itself at full quality, else a smaller buffer."""
+        w, h = framebuffer.size
+        s = self.quality.scale
+        if s >= 1.0:
+            return framebuffer, (w, h)
+        size = (max(1, round(w * s)), max(1, round(h * s)))
+        if self._scaled is None or self._scaled[1].size != size:
+            self._release_scaled()
+            tex = self.ctx.texture(size, 4)
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            self._scaled = (self.ctx.framebuffer([tex], self.ctx.depth_renderbuffer(size)), tex)
+        return self._scaled[0], size
+
+    def _release_scaled(self) -> None:
+        if self._scaled is not None:
+            fbo, tex = self._scaled
+            fbo.depth_attachment.release()
+            fbo.release()
+            tex.release()
+            self._scaled = None
+
     # -- frame ------------------------------------------------------------------------
     def render(self, scene: RenderScene, camera: Camera, framebuffer: moderngl.Framebuffer) -> None:
         """Draw ``scene`` seen by ``camera`` into ``framebuffer`` (cleared first)."""
         ctx = self.ctx
-        w, h = framebuffer.size
+        target, (w, h) = self._scene_target(framebuffer)
         vp = camera.view_projection(w / h)
         self._mark(None)
         eye = np.asarray(camera.eye, dtype=np.float64)
-        rows = {k: _nearest_first(getattr(scene, k).data, eye) if k in _SOLIDS else getattr(scene, k).data
+        rows = {k: _nearest_first(getattr(scene, k).data, eye) if k in (*_SOLIDS, "cones") else getattr(scene, k).data
                 for k in _KINDS}
-        counts = {k: self._inst[k].upload(rows[k]) for k in ("boxes", "lines", "points")}
-        px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0))
+        counts = {k: self._inst[k].upload(rows[k]) for k in ("boxes", "cones", "lines", "points")}
+        # Coarser meshes where fewer pixels are drawn, or where the level allows a larger outline error.
+        px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0)) / self.quality.silhouette_px
         levels = {kind: choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind]) for kind in self._lod}
         for kind, batches in self._lod.items():
             batches.upload(rows[kind], levels[kind])
@@ -182,17 +229,17 @@ class Renderer:
         light_vp = light_matrix(scene) if scene.sun.shadows else None
         rect = ground_rect(scene) if light_vp is not None else None
         if light_vp is not None and rect is not None:
-            self.shadows.render(scene, {kind: (rows[kind], levels[kind]) for kind in self._lod}, light_vp, rect)
+            n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
+            self.shadows.render(scene, {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}, light_vp, rect)
         self._mark("shadows")
 
-        framebuffer.use()
-        framebuffer.viewport = (0, 0, w, h)
-        framebuffer.clear(*scene.horizon_color, 1.0, depth=1.0)
-        self._set_frame_uniforms(scene, camera, vp, light_vp, rect, (w, h))
+        target.use()
+        target.viewport = (0, 0, w, h)
+        target.clear(*scene.horizon_color, 1.0, depth=1.0)
+        self._set_frame_uniforms(scene, camera, vp, light_vp, (w, h))
         self.shadows.depth.use(location=1)
         self._background_texture(scene).use(location=2)
         self._noise.use(location=3)
-        self.shadows.mask.use(location=4)
 
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         ctx.front_face = "ccw"
@@ -203,23 +250,17 @@ class Renderer:
         ctx.cull_face = "back"
         for batches in self._lod.values():
             batches.render()
-        if counts["boxes"]:
-            self._vaos["boxes"].render(moderngl.TRIANGLES, instances=counts["boxes"])
+        for kind in ("boxes", "cones"):
+            if counts[kind]:
+                self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
         if scene.skinned:
             self.skinned.draw(scene.skinned)
         self._mark("objects")
-        ctx.enable_only(moderngl.DEPTH_TEST)
-        photo = "_photo" if scene.background is not None and scene.background_fade < 1.0 else ""
-        if scene.ground.visible:
-            self._vaos["ground" + photo].render(moderngl.TRIANGLE_STRIP)
-        self._mark("ground")
-        ctx.depth_func = "<="
-        self._vaos["sky" + photo].render(moderngl.TRIANGLES, vertices=3)
-        ctx.depth_func = "<"
-        self._mark("sky")
+        self._draw_environment(scene, camera, rect if light_vp is not None else None)
+        self._mark("environment")
 
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
-        framebuffer.depth_mask = False
+        target.depth_mask = False
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
         if counts["lines"]:
             self._vaos["lines"].render(moderngl.TRIANGLE_STRIP, vertices=4, instances=counts["lines"])
@@ -227,14 +268,59 @@ class Renderer:
             self._vaos["points"].render(moderngl.POINTS, vertices=counts["points"])
         self._mark("lines_points")
         self._draw_overlays(scene, vp)
-        self._draw_text(scene, (w, h))
-        framebuffer.depth_mask = True
+        target.depth_mask = True
+        if target is not framebuffer:
+            self._upscale(framebuffer)
+        self._mark("upscale")
+        ctx.enable_only(moderngl.BLEND)
+        self._draw_text(scene, framebuffer.size)
         ctx.enable_only(moderngl.NOTHING)
         self._mark("text")
 
+    def _draw_environment(self, scene: RenderScene, camera: Camera,
+                          rect: tuple[float, float, float, float] | None) -> None:
+        """Ground, ridge, sky and sun, then the decals on the ground (see :mod:`engine.render.environment`)."""
+        ctx = self.ctx
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        photo = scene.background is not None and scene.background_fade < 1.0
+        g = scene.ground
+        eye = camera.eye
+        # With per-pixel snow detail the ground reads its shadow mask itself (one more fetch in a
+        # pass it pays anyway); otherwise the shadow is a decal over the casters' rectangle only.
+        detail = self.quality.ground_detail and g.snow > 0
+        self.shadows.mask.use(location=4)
+        if g.visible:
+            self.env.draw_ground(scene, detail, photo, {
+                "u_center": (float(eye[0]), 0.0, float(eye[2])), "u_extent": min(camera.far * 0.9, 150.0),
+                "u_height": float(g.height), "u_ground_lin": _linear(g.color), "u_snow": float(g.snow),
+                "u_grid_spacing": float(g.grid_spacing), "u_grid_lin": _linear(g.grid_color),
+                "u_grid_strength": float(g.grid_strength), "u_noise": 3, "u_ground_mask": 4,
+                "u_rect": rect if rect is not None else (0.0, 0.0, 1.0, 1.0),
+                "u_shadow_strength": 0.9 if rect is not None else 0.0})
+        self.env.draw_sky(scene, photo, float(g.height))
+        if photo:
+            ctx.depth_func = "<="
+            self._vaos["sky_photo"].render(moderngl.TRIANGLES, vertices=3)
+            ctx.depth_func = "<"
+        if g.visible:
+            decal = rect if rect is not None and not detail else None
+            self.env.draw_decals(scene, decal, self.shadows.mask if decal is not None else None)
+        ctx.enable_only(moderngl.DEPTH_TEST)
+
+    def _upscale(self, framebuffer: moderngl.Framebuffer) -> None:
+        """Stretch the smaller 3-D buffer over ``framebuffer`` (nearest texel)."""
+        assert self._scaled is not None
+        framebuffer.use()
+        framebuffer.viewport = (0, 0, *framebuffer.size)
+        self.ctx.enable_only(moderngl.NOTHING)
+        self._scaled[1].use(location=0)
+        set_uniform(self._programs["upscale"], "u_tex", 0)
+        (sw, sh), (w, h) = self._scaled[1].size, framebuffer.size
+        set_uniform(self._programs["upscale"], "u_ratio", (sw / w, sh / h))
+        self._vaos["upscale"].render(moderngl.TRIANGLES, vertices=3)
+
     def _set_frame_uniforms(self, scene: RenderScene, camera: Camera, vp: NDArray[np.float64],
-                            light_vp: NDArray[np.float64] | None, rect: tuple[float, float, float, float] | None,
-                            size: tuple[int, int]) -> None:
+                            light_vp: NDArray[np.float64] | None, size: tuple[int, int]) -> None:
         w, h = size
         sun = scene.sun
         L = np.asarray(sun.direction, dtype=np.float64)
@@ -269,16 +355,7 @@ class Renderer:
         for prog in self._programs.values():
             for name, value in common.items():
                 set_uniform(prog, name, value)
-        g = scene.ground
-        for name, value in (("u_center", (eye[0], 0.0, eye[2])), ("u_extent", min(camera.far * 0.9, 150.0)),
-                            ("u_height", float(g.height)), ("u_ground_lin", _linear(g.color)),
-                            ("u_snow", float(g.snow)), ("u_grid_on", 1.0 if g.grid else 0.0),
-                            ("u_grid_spacing", float(g.grid_spacing)), ("u_grid_lin", _linear(g.grid_color)),
-                            ("u_grid_strength", float(g.grid_strength)), ("u_noise", 3), ("u_ground_mask", 4),
-                            ("u_rect", rect if rect is not None else (0.0, 0.0, 1.0, 1.0)),
-                            ("u_shadow_strength", 0.9)):
-            set_uniform(self._programs["ground"], name, value)
-            set_uniform(self._programs["ground_photo"], name, value)
+        self.env.set_common(common)
         outline = tuple(float(c) for c in scene.outline_color)
         for name in ("capsule_flat", "box_flat"):
             set_uniform(self._programs[name], "u_color", outline)
@@ -330,6 +407,7 @@ class Renderer:
         self.ctx.disable(moderngl.DEPTH_TEST)
         prog = self._programs["text"]
         set_uniform(prog, "u_tex", 0)
+        set_uniform(prog, "u_viewport", (float(size[0]), float(size[1])))
         for piece in layout_text(scene.texts, size, self.text):
             tex = self.text.texture(piece.text, piece.size, piece.color)
             tex.use(location=0)
@@ -342,6 +420,8 @@ class Renderer:
         self.text.release()
         self.shadows.release()
         self.skinned.release()
+        self.env.release()
+        self._release_scaled()
         for batches in self._lod.values():
             batches.release()
         for v in self._vaos.values():

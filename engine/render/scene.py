@@ -12,7 +12,12 @@ Row layouts (float32):
   ``a == b``, which lets both share one shader);
 - boxes: ``center[3] half_extents[3] rotation(w,x,y,z)[4] color[3] outline``;
 - lines: ``p0[3] p1[3] color[3] width_px``;
-- points: ``pos[3] size color[3] pixels`` (``pixels`` 1: size in pixels, 0: in metres).
+- points: ``pos[3] size color[3] pixels`` (``pixels`` 1: size in pixels, 0: in metres);
+- cones: ``base[3] apex[3] radius color[3] snow`` (conifer tiers; ``snow`` whitens the upper side);
+- prints: ``x z heading_cos heading_sin half_length half_width strength`` (footprints on the ground).
+
+The ground may also carry :class:`GroundMarks`: a grid of how much snow each cell lost
+(a track), drawn as a soft groove.
 
 Colours are sRGB in ``[0, 1]``; the renderer linearises them.
 """
@@ -26,13 +31,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine.io.gltf_mesh import SkinnedMeshes
 
-__all__ = ["RenderScene", "SkinnedInstance", "Rows", "Ground", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE", "BOX_STRIDE",
-           "LINE_STRIDE", "POINT_STRIDE"]
+__all__ = ["RenderScene", "SkinnedInstance", "Rows", "Ground", "GroundMarks", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE",
+           "BOX_STRIDE", "LINE_STRIDE", "POINT_STRIDE", "CONE_STRIDE", "PRINT_STRIDE"]
 
 CAPSULE_STRIDE = 11
 BOX_STRIDE = 14
 LINE_STRIDE = 10
 POINT_STRIDE = 8
+CONE_STRIDE = 11
+PRINT_STRIDE = 7
 
 
 class Rows:
@@ -94,6 +101,25 @@ class Ground:
     grid_color: tuple[float, float, float] = (0.55, 0.62, 0.72)
     grid_strength: float = 0.35
     visible: bool = True
+
+
+@dataclass
+class GroundMarks:
+    """A track in the snow: ``amount [Nz, Nx]`` in [0, 1] (row ``k`` at ``z0 + (k + 0.5)·cell``), how much of
+    its snow each cell lost; drawn as a soft groove, deepest where ``amount`` is 1."""
+
+    amount: NDArray[np.float32]
+    x0: float
+    z0: float
+    cell: float
+
+    def __post_init__(self) -> None:
+        a = np.asarray(self.amount, dtype=np.float32)
+        if a.ndim != 2 or min(a.shape) < 1:
+            raise ValueError(f"marks must be a 2-D grid, got shape {a.shape}")
+        if not self.cell > 0:
+            raise ValueError(f"marks cell must be positive, got {self.cell}")
+        self.amount = np.clip(a, 0.0, 1.0)
 
 
 @dataclass
@@ -165,6 +191,10 @@ class RenderScene:
     boxes: Rows = field(default_factory=lambda: Rows(BOX_STRIDE, 16))
     lines: Rows = field(default_factory=lambda: Rows(LINE_STRIDE, 256))
     points: Rows = field(default_factory=lambda: Rows(POINT_STRIDE, 256))
+    cones: Rows = field(default_factory=lambda: Rows(CONE_STRIDE, 32))
+    prints: Rows = field(default_factory=lambda: Rows(PRINT_STRIDE, 64))
+    marks: GroundMarks | None = None
+    """The snow track, if any (see :class:`GroundMarks`)."""
     texts: list[TextLine] = field(default_factory=list)
     ground: Ground = field(default_factory=Ground)
     sun: Sun = field(default_factory=Sun)
@@ -187,8 +217,9 @@ class RenderScene:
 
     def clear(self) -> None:
         """Empty every primitive buffer (settings and background stay)."""
-        for rows in (self.capsules, self.spheres, self.boxes, self.lines, self.points):
+        for rows in (self.capsules, self.spheres, self.boxes, self.lines, self.points, self.cones, self.prints):
             rows.clear()
+        self.marks = None
         self.texts.clear()
         self.overlays.clear()
         self.skinned.clear()
@@ -215,6 +246,22 @@ class RenderScene:
                    color: ArrayLike = (0.95, 0.95, 0.97), outline: bool = False) -> None:
         """Append one sphere."""
         self.add_spheres(center, radius, color, outline)
+
+    def add_cones(self, base: ArrayLike, apex: ArrayLike, radius: ArrayLike,
+                  color: ArrayLike = (0.16, 0.36, 0.24), snow: ArrayLike = 0.0) -> None:
+        """Append ``N`` cones from a base disc of ``radius`` at ``base [N,3]`` to ``apex [N,3]``; ``snow`` in [0, 1]."""
+        a = np.asarray(base, dtype=np.float64).reshape(-1, 3)
+        self._fill_capsule_rows(self.cones, len(a), a, apex, radius, color, np.clip(np.asarray(snow, float), 0, 1))
+
+    def add_prints(self, xz: ArrayLike, heading: ArrayLike, length: float = 0.26, width: float = 0.11,
+                   strength: ArrayLike = 1.0) -> None:
+        """Append ``N`` footprints at ``xz [N,2]`` pointing along ``heading [N]`` (radians from +x towards +z)."""
+        p = _col(xz, np.asarray(xz).reshape(-1, 2).shape[0], 2, "xz")
+        n = len(p)
+        h = _col(heading, n, 1, "heading")
+        rows = self.prints.extend(n)
+        rows[:, 0:2], rows[:, 2], rows[:, 3] = p, np.cos(h), np.sin(h)
+        rows[:, 4], rows[:, 5], rows[:, 6] = 0.5 * length, 0.5 * width, np.clip(_col(strength, n, 1, "strength"), 0, 1)
 
     def add_boxes(self, center: ArrayLike, half_extents: ArrayLike, rotation: ArrayLike = (1.0, 0.0, 0.0, 0.0),
                   color: ArrayLike = (0.7, 0.6, 0.5), outline: ArrayLike = False) -> None:
@@ -314,7 +361,7 @@ class RenderScene:
 
     # -- views ------------------------------------------------------------------------
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-        """``(lo [3], hi [3])`` of every shadow caster (capsules, spheres, boxes), ``None`` if empty."""
+        """``(lo [3], hi [3])`` of every shadow caster (capsules, spheres, cones, boxes), ``None`` if empty."""
         los, his = [], []
         for rows in (self.capsules, self.spheres):
             d = rows.data
@@ -322,6 +369,11 @@ class RenderScene:
                 r = d[:, 6:7]
                 los.append(np.minimum(d[:, 0:3], d[:, 3:6]) - r)
                 his.append(np.maximum(d[:, 0:3], d[:, 3:6]) + r)
+        c = self.cones.data
+        if len(c):
+            r = c[:, 6:7]
+            los.append(np.minimum(c[:, 0:3], c[:, 3:6]) - r)
+            his.append(np.maximum(c[:, 0:3], c[:, 3:6]) + r)
         b = self.boxes.data
         if len(b):
             r = np.linalg.norm(b[:, 3:6], axis=1, keepdims=True)

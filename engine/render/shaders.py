@@ -16,7 +16,7 @@ the ground (:mod:`engine.render.shadows`).
 
 from __future__ import annotations
 
-__all__ = ["HEADER", "LIGHTING", "CAPSULE_VS", "BOX_VS", "LIT_FS", "FLAT_FS", "DEPTH_FS", "LINE_VS",
+__all__ = ["HEADER", "LIGHTING", "CAPSULE_VS", "CONE_VS", "BOX_VS", "LIT_FS", "FLAT_FS", "DEPTH_FS", "LINE_VS",
            "LINE_FS", "POINT_VS", "POINT_FS", "TEXT_VS", "TEXT_FS", "OVERLAY_VS", "OVERLAY_FS"]
 
 HEADER = "#version 330 core\n"
@@ -120,6 +120,47 @@ void main() {
     v_pos = c + n * r;
     v_normal = n;
     v_color = i_color;
+    float fog = length(v_pos - u_cam) * u_fog_density;
+    v_fog = fog / (1.0 + fog);
+    gl_Position = u_view_proj * vec4(v_pos, 1.0);
+}
+"""
+
+# Cones (conifer tiers): base centre i_a, apex i_b, base radius i_r; i_outline is the
+# snow on the tier (0..1), which whitens its upper side in a ragged band.
+CONE_VS = """
+uniform mat4 u_view_proj;
+uniform vec3 u_cam;
+uniform float u_fog_density;
+in vec4 in_vert;                // cos, sin round the axis; height fraction; 1 on the base disc
+in vec3 i_a;
+in vec3 i_b;
+in float i_r;
+in vec3 i_color;
+in float i_outline;
+out vec3 v_pos;
+out vec3 v_normal;
+out vec3 v_color;
+out float v_fog;
+void main() {
+    vec3 axis = i_b - i_a;
+    float h = max(length(axis), 1e-6);
+    vec3 y = axis / h;
+    vec3 helper = abs(y.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 x = normalize(cross(helper, y));
+    vec3 z = cross(x, y);
+    vec2 cs = in_vert.xy;
+    float t = in_vert.z;
+    float seed = dot(i_a, vec3(12.9, 0.0, 78.2));
+    float angle = atan(cs.y, cs.x);
+    // A ragged skirt: every other spoke of the rim hangs lower and reaches further.
+    float spike = in_vert.w < 0.5 && t < 0.01 ? 0.5 + 0.5 * cos(angle * 9.0 + seed) : 0.0;
+    vec3 radial = x * cs.x + z * cs.y;
+    float r = i_r * (1.0 - t) * (1.0 + 0.12 * spike);
+    v_pos = i_a + axis * t + radial * r - y * (0.10 * h * spike);
+    v_normal = in_vert.w > 0.5 ? -y : normalize(radial * h + y * i_r);
+    float snow = i_outline * smoothstep(0.2, 0.5, t + 0.22 * sin(angle * 5.0 + seed) + 0.15 * spike);
+    v_color = mix(i_color, vec3(0.93, 0.95, 0.99), snow);
     float fog = length(v_pos - u_cam) * u_fog_density;
     v_fog = fog / (1.0 + fog);
     gl_Position = u_view_proj * vec4(v_pos, 1.0);

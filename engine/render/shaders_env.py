@@ -1,4 +1,6 @@
-"""GLSL 3.30 core sources for the environment: snowy ground, sky, background photo, shadow mask.
+"""GLSL 3.30 core sources: the background photo, the sky over a photo, the ground shadow mask.
+
+The ground and the sky without a photo are per-vertex: :mod:`engine.render.shaders_ground`.
 
 The fragment stages here are compiled after :data:`engine.render.shaders.LIGHTING`
 (and :data:`BACKGROUND` where a photo may show), whose helpers they use.
@@ -6,21 +8,7 @@ The fragment stages here are compiled after :data:`engine.render.shaders.LIGHTIN
 
 from __future__ import annotations
 
-__all__ = ["GROUND_VS", "PHOTO_DEFINE", "BACKGROUND", "GROUND_FS", "MASK_FS", "FULLSCREEN_VS",
-           "SKY_VS", "SKY_FS"]
-
-GROUND_VS = """
-uniform mat4 u_view_proj;
-uniform vec3 u_center;
-uniform float u_extent;
-uniform float u_height;
-in vec2 in_corner;
-out vec3 v_pos;
-void main() {
-    v_pos = vec3(u_center.x + in_corner.x * u_extent, u_height, u_center.z + in_corner.y * u_extent);
-    gl_Position = u_view_proj * vec4(v_pos, 1.0);
-}
-"""
+__all__ = ["PHOTO_DEFINE", "BACKGROUND", "MASK_FS", "FULLSCREEN_VS", "SKY_VS", "SKY_FS"]
 
 # Background photo helpers: sample the photo "cover"-fitted to the viewport. The ground
 # and sky blend it in only where compiled with ``#define PHOTO`` (see PHOTO_DEFINE):
@@ -36,70 +24,6 @@ vec3 photo_linear() {
     vec2 uv = gl_FragCoord.xy / u_viewport;
     uv = (uv - 0.5) * u_bg_scale + 0.5;
     return to_linear(texture(u_background, vec2(uv.x, 1.0 - uv.y)).rgb);
-}
-"""
-
-GROUND_FS = """
-uniform vec3 u_ground_lin;
-uniform vec3 u_grid_lin;
-uniform float u_snow;
-uniform float u_grid_on;
-uniform float u_grid_spacing;
-uniform float u_grid_strength;
-uniform sampler2D u_noise;       // tileable: r height, gb slope, a random per texel
-uniform sampler2D u_ground_mask; // blurred planar shadow of the casters
-uniform vec4 u_rect;             // where the mask lies on the ground: x0, z0, width, depth
-uniform float u_shadow_strength;
-in vec3 v_pos;
-out vec4 f_color;
-
-void main() {
-    vec2 xz = v_pos.xz;
-    vec3 to_eye = u_eye - v_pos;
-    float dist = length(to_eye);
-    // Drifts: one fetch of the precomputed tileable 1/f noise (height and its slope).
-    // The ground is nearly flat, so the sun term is linearised around the up normal:
-    // n.L ~ L.y - slope.L.xz. That saves a normalize and the general lighting per pixel,
-    // which matters because the ground is most of the screen.
-    // Far away the fog hides the drifts, and skipping the fetch there saves whole pixel blocks.
-    vec4 drift = dist < 45.0 ? texture(u_noise, xz * 0.08) : vec4(0.5);
-    vec2 slope = (drift.gb - 0.5) * (0.6 * u_snow) * clamp(1.5 - dist / 30.0, 0.0, 1.0);  // no shimmer far off
-    vec3 albedo = u_ground_lin * (1.0 - 0.08 * u_snow * (1.0 - drift.r));
-    vec2 muv = (xz - u_rect.xy) / u_rect.zw;
-    float sh = 1.0;
-    if (u_shadows_on > 0.5 && all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) {
-        sh = 1.0 - texture(u_ground_mask, muv).r * u_shadow_strength;
-    }
-    vec3 L = u_sun_dir;
-    float ndl = max(L.y - dot(slope, L.xz), 0.0);
-    vec3 c = albedo * (u_sky_lin * u_ambient + u_sun_color * (ndl * sh));
-    // Sparkle: a few random cells act as ice crystals that glint towards the viewer.
-    if (dist < 14.0) {
-        ivec2 cell = ivec2(floor(xz * 45.0));
-        vec4 rnd = texelFetch(u_noise, cell & 255, 0);
-        if (rnd.a > 0.97) {
-            vec3 cn = normalize(vec3(rnd.g - 0.5, 0.6, rnd.b - 0.5));
-            vec3 refl = reflect(-normalize(u_sun_dir), cn);
-            float g = max(dot(refl, to_eye / dist), 0.0);
-            g = g * g; g = g * g; g = g * g; g = g * g; g = g * g;   // ^32
-            c += u_sun_color * g * 1.5 * sh * (1.0 - dist / 14.0) * u_snow;
-        }
-    }
-    if (u_grid_on > 0.5 && dist < 60.0) {
-        vec2 gp = xz / u_grid_spacing;
-        vec2 w = fwidth(gp);
-        vec2 gl = abs(fract(gp - 0.5) - 0.5) / max(w, 1e-4);
-        float line = 1.0 - min(min(gl.x, gl.y), 1.0);
-        float fade = clamp(1.0 - max(w.x, w.y) * 3.0, 0.0, 1.0);
-        c = mix(c, u_grid_lin * (0.6 + 0.4 * sh), line * u_grid_strength * fade);
-    }
-    c = mix(c, u_horizon_lin * SKY_GAIN, fog_amount(dist));
-#ifdef PHOTO
-    // On a photo, keep the ground's shadows so puppets still sit on something.
-    vec3 photo = photo_linear() * mix(0.55, 1.0, sh);
-    c = mix(photo, c, u_fade);
-#endif
-    f_color = vec4(finish(c), 1.0);
 }
 """
 

@@ -21,6 +21,7 @@ from engine.camera import look_at
 from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
+from engine.render.env_meshes import cone_mesh
 from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
 from engine.render.lod import LEVELS, LIMITS, choose_levels_orthographic, level_meshes
 from engine.render.scene import CAPSULE_STRIDE, RenderScene
@@ -95,13 +96,14 @@ class Shadows:
 
     Args:
         ctx: the context.
-        boxes: the renderer's box instance buffer (shared, not copied). Capsules and
+        boxes, cones: the renderer's box and cone instance buffers (shared, not copied). Capsules and
             spheres come with each frame, since their level of detail in the shadow
             map depends on its texels as well as on the camera's.
         map_size: side of the object shadow map; mask_size: side of the ground mask.
     """
 
-    def __init__(self, ctx: moderngl.Context, boxes: Instances, map_size: int = 1024, mask_size: int = 512) -> None:
+    def __init__(self, ctx: moderngl.Context, boxes: Instances, map_size: int = 1024, mask_size: int = 512,
+                 cones: Instances | None = None) -> None:
         if map_size < 16 or mask_size < 16:
             raise ValueError(f"shadow sizes must be at least 16, got {map_size} and {mask_size}")
         self.ctx = ctx
@@ -110,6 +112,7 @@ class Shadows:
         progs = self._programs = {
             "capsule_depth": ctx.program(vertex_shader=h + S.CAPSULE_VS, fragment_shader=h + S.DEPTH_FS),
             "box_depth": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.DEPTH_FS),
+            "cone_depth": ctx.program(vertex_shader=h + S.CONE_VS, fragment_shader=h + S.DEPTH_FS),
             "mask": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + E.MASK_FS),
         }
         # Casters at the coarsest level whose outline stays within a shadow-map texel.
@@ -121,6 +124,13 @@ class Shadows:
                                                              (boxes.buf, *BOX_FMT)], self._buffers[1], 4,
                                          skip_errors=True)
         self._mask_vao = ctx.vertex_array(progs["mask"], [])
+        self._cones = cones
+        self._cone_vao = None
+        if cones is not None:
+            self._buffers += list(mesh_buffers(ctx, cone_mesh()))
+            self._cone_vao = ctx.vertex_array(progs["cone_depth"], [(self._buffers[2], "4f", "in_vert"),
+                                                                   (cones.buf, *CAPSULE_FMT)], self._buffers[3], 4,
+                                              skip_errors=True)
         self.depth = ctx.depth_texture((map_size, map_size))
         self.depth.compare_func = "<="
         self.depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
@@ -146,7 +156,7 @@ class Shadows:
         self._depth_fbo.clear(depth=1.0)
         ctx.enable_only(moderngl.DEPTH_TEST)
         texels_per_metre = self.map_size * float(np.linalg.norm(light_vp[0, :3])) / 2.0
-        for prog in (self._programs["capsule_depth"], self._programs["box_depth"]):
+        for prog in (self._programs["capsule_depth"], self._programs["box_depth"], self._programs["cone_depth"]):
             set_uniform(prog, "u_view_proj", light_vp)
             set_uniform(prog, "u_inflate_px", 0.0)
         for kind, (rows, on_screen) in casters.items():
@@ -155,6 +165,8 @@ class Shadows:
             self._lod[kind].render()
         if self._boxes.count:
             self._box_vao.render(moderngl.TRIANGLES, instances=self._boxes.count)
+        if self._cone_vao is not None and self._cones is not None and self._cones.count:
+            self._cone_vao.render(moderngl.TRIANGLES, instances=self._cones.count)
         self._mask_fbo.use()
         ctx.enable_only(moderngl.NOTHING)
         mask = self._programs["mask"]
@@ -178,5 +190,7 @@ class Shadows:
             batches.release()
         self._box_vao.release()
         self._mask_vao.release()
+        if self._cone_vao is not None:
+            self._cone_vao.release()
         for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo, self.mask):
             obj.release()

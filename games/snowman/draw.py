@@ -13,9 +13,10 @@ import numpy as np
 from engine import quat
 from engine.components import Puppet, WorldPose
 from engine.ecs import World
-from engine.render.scene import RenderScene
+from engine.render.scene import GroundMarks, RenderScene
 from games.common import draw_world
 from games.snowman.components import Snowman
+from games.snowman.footprints import draw_footprints
 from games.snowman.rig import bezier_spine, middle_ball_parameter
 from games.snowman.bent_scenery import BentScenery
 from games.snowman.scenery import draw_snowfall, draw_trees
@@ -118,6 +119,7 @@ def draw_snowman_state(world: World, scene: RenderScene, alpha: float) -> None:
     outlined |= {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None}
     draw_snowmen(world, scene, alpha, outlined)
     draw_trees(scene, world.try_resource(BentScenery))
+    scene.ground.grid = False  # a field of snow, not a floor
 
 
 def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
@@ -125,8 +127,7 @@ def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
     draw_snowman_state(world, scene, alpha)
     field = world.try_resource(SnowField)
     if field is not None:
-        marks = field.marks()
-        if len(marks):
-            marks[:, 1] = 0.004
-            scene.add_points(marks, size=field.cell * 1.4, color=(0.74, 0.8, 0.88))
+        taken = 1.0 - field.depth / field.initial_depth  # [x, z] → the marks' [z, x]
+        scene.marks = GroundMarks(taken.T.astype(np.float32), -field.size / 2, -field.size / 2, field.cell)
+    draw_footprints(world, scene)
     draw_snowfall(scene, (world.frame + alpha) * world.dt)

@@ -350,6 +350,7 @@ def field_commands(world: World) -> None:
     for kind, _source in frame.events:
         if kind == RESET:
             restore(world, start_snapshot())
+            _forget_prints(world)
             _tell(world, "new field")
         elif kind == SAVE:
             slot.saved = snapshot(world)
@@ -372,9 +373,18 @@ def field_commands(world: World) -> None:
                 continue
             try:
                 restore(world, slot.saved)
+                _forget_prints(world)
                 _tell(world, "field restored")
             except FieldError as exc:
                 _tell(world, "cannot restore the saved field", f": {exc}")
+
+
+def _forget_prints(world: World) -> None:
+    """A new or restored field starts without footprints (they are drawn only, never saved)."""
+    from games.snowman.footprints import Footprints
+
+    if world.try_resource(Footprints) is not None:
+        world.insert_resource(Footprints())
 
 
 def _tell(world: World, message: str, detail: str = "") -> None:

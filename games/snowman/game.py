@@ -20,6 +20,7 @@ from games.base import Game
 from games.snowman.bent_scenery import prepare_flow, recorded_flow
 from games.snowman.components import SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game, draw_snowman_state
+from games.snowman.footprints import Footprints, leave_footprints
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
 from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
                                  start_snowballs, stick_stacked_balls)
@@ -39,6 +40,7 @@ CONTROLS = (
     "serial: the IMU's touch value grabs; tilt the board to walk the puppet, lower it to crouch",
     "stack 2 or 3 balls, largest at the bottom, and the snowman comes alive (a 2-ball one needs a small head on top)",
     "keys: R new field, F5 save the field, F9 restore it, P pause, H or F1 help, Esc quit",
+    "G: drawing quality, low / medium / high / auto (auto follows the frame rate; --quality sets it at start)",
 )
 
 
@@ -49,6 +51,7 @@ def install(app: App) -> None:
     world.insert_resource(SnowField(size=24.0, cell=0.15, initial_depth=0.12))
     world.insert_resource(SnowmanStats())
     world.insert_resource(StackWatch())
+    world.insert_resource(Footprints())
     build_scenery(world)
     spawn_first_puppet(world)
     app.add_plugin(install_field_slot)
@@ -59,6 +62,7 @@ def install(app: App) -> None:
     app.add_system("rules", grow_snowballs)
     app.add_system("rules", start_snowballs)
     app.add_system("rules", assemble_snowmen)
+    app.add_system("rules", leave_footprints)
 
 
 def camera() -> OrbitCamera:

@@ -1,4 +1,4 @@
-"""The snowy field: obstacles (rocks and pine trees) and the falling snow.
+"""The snowy field: obstacles (rocks and conifers) and the falling snow.
 
 Obstacles are entities with an ``Obstacle`` (the MotionStick stops at them) and a
 render ``Shape``. The snowfall is drawn only — flakes are placed from a fixed seed
@@ -14,7 +14,7 @@ from engine.ecs import World
 from engine.render.components import Appearance, Shape
 from engine.render.scene import RenderScene
 
-__all__ = ["build_scenery", "draw_snowfall", "draw_trees", "TREES", "ROCKS"]
+__all__ = ["build_scenery", "draw_snowfall", "draw_trees", "conifer_tiers", "TREES", "ROCKS"]
 
 TREES = ((-5.0, -4.5, 1.0), (6.0, -5.5, 1.2), (-7.5, 3.0, 0.9), (7.0, 4.5, 1.1), (-2.5, -8.0, 1.3), (3.5, 8.0, 1.0))
 ROCKS = ((3.2, -2.4, 0.45), (-3.8, 2.6, 0.35), (1.0, 5.5, 0.4))
@@ -65,12 +65,32 @@ def _tree_primitives() -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
 _TREE_CAPSULES, _TREE_SNOW = _tree_primitives()
 
 
+def conifer_tiers(a: np.ndarray, b: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cones ``(base, apex, radius)`` drawn for tier capsules ``a → b`` of radius ``r``.
+
+    The capsule is the tier's body (what the flow editor bends); the cone hangs a skirt
+    below it and rises to a point well above it, so consecutive tiers overlap like the
+    whorls of a spruce, and a bent tier leans along its bent axis.
+    """
+    axis = b - a
+    length = np.linalg.norm(axis, axis=1, keepdims=True)
+    up = np.where(length > 1e-9, axis / np.maximum(length, 1e-9), [0.0, 1.0, 0.0])
+    return a - 0.25 * r[:, None] * up, b + 1.6 * r[:, None] * up, 1.15 * r
+
+
 def draw_trees(scene: RenderScene, bent=None) -> None:  # type: ignore[no-untyped-def]
-    """Pine trees: a trunk and three snowy tiers each (``bent``: as a flow file deformed them)."""
+    """Conifers: a trunk and three snowy tiers each (``bent``: as a flow file deformed them).
+
+    The rows come four to a tree, trunk first (:func:`_tree_primitives`, and a bent
+    field's parts in :func:`~games.snowman.bent_scenery.scenery_objects` order); the snow
+    caps of the field's data are drawn as the snow on the tiers, not as balls.
+    """
     a, b, r, col = _TREE_CAPSULES if bent is None else bent.capsules
-    scene.add_capsules(a, b, r, color=col)
-    centre, radius = _TREE_SNOW if bent is None else bent.spheres
-    scene.add_spheres(centre, radius, color=(0.95, 0.97, 1.0))
+    trunk = np.arange(len(a)) % 4 == 0
+    scene.add_capsules(a[trunk], b[trunk], r[trunk], color=col[trunk])
+    base, apex, radius = conifer_tiers(a[~trunk], b[~trunk], r[~trunk])
+    tier = (np.arange(len(a)) % 4)[~trunk] - 1
+    scene.add_cones(base, apex, radius, color=col[~trunk], snow=0.45 + 0.15 * tier)
 
 
 def draw_snowfall(scene: RenderScene, time: float) -> None:

@@ -100,9 +100,3 @@ class SnowField:
             self.depth[cells] = patch
             r = float(np.cbrt(r**3 + 3.0 * taken / (4.0 * np.pi)))
         return r
-
-    def marks(self) -> NDArray[np.float64]:
-        """World ``[M,3]`` centres of cells that lost most of their snow (the tracks to draw)."""
-        idx = np.argwhere(self.depth < 0.7 * self.initial_depth)
-        xz = (idx + 0.5) * self.cell - self.size / 2
-        return np.column_stack([xz[:, 0], np.zeros(len(xz)), xz[:, 1]])

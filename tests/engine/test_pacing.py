@@ -104,3 +104,19 @@ def test_early_steps_keep_the_rate_and_never_burst():
 def test_rejects_an_early_window_of_a_whole_step():
     with pytest.raises(ValueError):
         RealTimePacer(0.01, early=0.01)
+
+
+def test_the_time_keeper_judges_the_last_seconds_after_the_first_one() -> None:
+    from engine.pacing import TimeKeeper
+
+    keeper = TimeKeeper(0.25, span=2.0)
+    keeper.frame(1.5, 1.25)  # the first frame: shaders compiling, not judged
+    for _ in range(5):
+        keeper.frame(0.1, 0.0)
+    assert keeper.behind() is None and keeper.kept() == 1.0
+    for _ in range(5):
+        keeper.frame(0.5, 0.25)  # stalls: half of each frame dropped
+    assert keeper.kept() < 0.6 and "too slow to keep time" in (keeper.behind() or "")
+    for _ in range(25):
+        keeper.frame(0.1, 0.0)  # two seconds on time: the stalls have left the window
+    assert keeper.behind() is None

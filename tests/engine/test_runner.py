@@ -46,6 +46,7 @@ class FakeWindow:
         self.events = events or []
         self.target = types.SimpleNamespace(closed=False)
         self.camera = None
+        self.renderer = types.SimpleNamespace(quality=None, set_quality=lambda q: setattr(self.renderer, "quality", q))
 
     def poll_events(self) -> list:
         out, self.events = self.events, []
@@ -197,3 +198,61 @@ def test_a_paced_headless_run_starts_steps_early_for_readings_but_keeps_the_rate
     slots = t[0] + Counter.dt * np.arange(1, len(t))
     np.testing.assert_allclose(t[1:] - slots, -Counter.dt / 2, atol=1e-9)  # each half a step early
     np.testing.assert_allclose(np.diff(t)[1:], Counter.dt, atol=1e-9)  # and still one step per dt
+
+
+class Renders(FakeWindow):
+    """A fake window that also keeps the text each frame would show."""
+
+    def __init__(self, wall: list[float], frame_time: float, events: list | None = None) -> None:
+        super().__init__(wall, frame_time, events)
+        self.texts: list[list[str]] = []
+
+    def draw(self, scene: RenderScene) -> None:
+        self.texts.append([t.text for t in scene.texts])
+        super().draw(scene)
+
+
+def _run_for(runner: Runner, wall: list[float], seconds: float) -> Counter:
+    activity = Counter()
+    start, original = wall[0], activity.step
+
+    def step() -> None:
+        original()
+        if wall[0] - start >= seconds:
+            runner.stop()
+
+    activity.step = step  # type: ignore[method-assign]
+    runner.run(activity)
+    return activity
+
+
+def test_down_to_ten_fps_the_window_keeps_time_and_says_nothing(capsys) -> None:
+    wall = [100.0]
+    runner = Runner(RunOptions(), wall=lambda: wall[0])
+    runner.viewer = Renders(wall, 0.1)
+    activity = _run_for(runner, wall, 4.0)
+    assert abs(activity.steps - 240) <= 7
+    assert not any("too slow" in t for frame in runner.viewer.texts for t in frame)
+    assert "too slow" not in capsys.readouterr().err
+
+
+def test_below_the_catch_up_limit_the_window_says_it_cannot_keep_time(capsys) -> None:
+    wall = [100.0]
+    runner = Runner(RunOptions(), wall=lambda: wall[0])
+    runner.viewer = Renders(wall, 0.4)  # 2.5 fps: each frame 0.15 s over MAX_FRAME_TIME
+    activity = _run_for(runner, wall, 4.0)
+    assert activity.steps < 0.7 * 240  # time was dropped ...
+    said = [t for frame in runner.viewer.texts[3:] for t in frame if "too slow" in t]
+    assert said and "0.62x real time" in said[-1]  # ... and the window said how much
+    assert capsys.readouterr().err.count("too slow to keep time") == 1  # once on the terminal
+
+
+def test_the_quality_key_cycles_the_level_and_tells_the_player() -> None:
+    pygame = pytest.importorskip("pygame")
+    wall = [100.0]
+    key = types.SimpleNamespace(type=pygame.KEYDOWN, key=pygame.K_g)
+    runner = Runner(RunOptions(quality="medium", frames=3), wall=lambda: wall[0])
+    runner.viewer = Renders(wall, 0.02, [key])
+    runner.run(Counter())
+    assert runner.quality.mode == "high" and runner.viewer.renderer.quality.name == "high"
+    assert any("quality: high" in t for frame in runner.viewer.texts for t in frame)

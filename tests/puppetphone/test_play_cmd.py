@@ -88,6 +88,7 @@ def _umask() -> int:
     (["play", "snowman", "--headless", "--frames", "-5"], "-5 is out of range"),
     (["play", "snowman", "--headless", "--size", "0x0"], "out of range"),
     (["play", "snowman", "--headless", "--screenshot", "x.bmp"], "use .png or .jpg"),
+    (["replay", "x.rec", "--headless", "--quality", "ultra"], "quality must be one of low, medium, high, auto"),
     (["author", "edit", "walk", "--headless", "--bogus"], "usage: puppetphone author edit"),
     (["play", "snowman", "--bogus"], "usage: puppetphone play"),
     (["author", "edit", "walk", "--headless", "--export", "x.fbx"], "cannot export x.fbx: use one of .ppclip"),

@@ -59,9 +59,14 @@ def test_a_snowman_is_drawn_on_its_joints(shape):
     assert any(np.allclose(r[0:3], pos[sk.index("r_upper_leg")]) for r in capsules)
 
 
-def test_trees_are_a_trunk_and_three_tiers_each():
+def test_trees_are_a_trunk_and_three_overlapping_cone_tiers_each():
     scene = RenderScene()
     draw_trees(scene)
-    assert len(scene.capsules) == 4 * len(TREES) and len(scene.spheres) == 3 * len(TREES)
-    trunks = scene.capsules.data[::4]
+    assert len(scene.capsules) == len(TREES) and len(scene.cones) == 3 * len(TREES) and len(scene.spheres) == 0
+    trunks = scene.capsules.data
     assert np.allclose(trunks[:, [0, 2]], [(x, z) for x, z, _ in TREES])
+    tiers = scene.cones.data.reshape(len(TREES), 3, -1)
+    base_y, apex_y, radius = tiers[..., 1], tiers[..., 4], tiers[..., 6]
+    # Narrower going up, each tier's skirt below the apex of the one beneath (whorls, not a stack).
+    assert np.all(np.diff(radius, axis=1) < 0) and np.all(base_y[:, 1:] < apex_y[:, :-1])
+    assert np.all(base_y[:, 0] < trunks[:, 4])  # the lowest skirt hides the top of the trunk

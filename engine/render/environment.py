@@ -1,0 +1,201 @@
+"""The environment passes: ground, far ridge, sky and sun, then the decals on the ground.
+
+The ground and the sky are shaded per vertex (see :mod:`engine.render.shaders_ground`
+for why), so together they cost about one clear of the screen; the ground shadow, the
+snow track and the footprints are each drawn over the bounded rectangle they cover.
+Per-pixel variants of the ground exist for what per-vertex light cannot show: the fine
+snow near the camera (``detail``, quality high), grid lines, the background photo.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import moderngl
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.render import env_meshes
+from engine.render import shaders as S
+from engine.render import shaders_env as E
+from engine.render import shaders_ground as G
+from engine.render.gpu import Instances, mesh_buffers, set_uniform
+from engine.render.scene import PRINT_STRIDE, GroundMarks, RenderScene
+
+__all__ = ["Environment", "marks_rect", "soften_marks"]
+
+_PRINT_FMT = ("2f 2f 2f 1f/i", "i_xz", "i_dir", "i_half", "i_strength")
+RIDGE_RADIUS = 130.0
+"""Distance of the far hills (inside the ground's extent, so they stand on it)."""
+
+
+def soften_marks(amount: NDArray[np.float32]) -> NDArray[np.uint8]:
+    """The track grid blurred by one cell ([1, 2, 1] both ways) as 8-bit: with bilinear
+    filtering, a soft groove with no cell corners."""
+    a = np.pad(np.asarray(amount, dtype=np.float32), 1, mode="edge")
+    a = 0.25 * a[:-2] + 0.5 * a[1:-1] + 0.25 * a[2:]
+    a = 0.25 * a[:, :-2] + 0.5 * a[:, 1:-1] + 0.25 * a[:, 2:]
+    return np.clip(a * 255.0 + 0.5, 0, 255).astype(np.uint8)
+
+
+def marks_rect(marks: GroundMarks, threshold: float = 0.02) -> tuple[float, float, float, float] | None:
+    """``(x0, z0, width, depth)`` around the cells with a mark (one cell of margin), ``None`` without any."""
+    rows = np.nonzero(marks.amount.max(axis=1) > threshold)[0]
+    cols = np.nonzero(marks.amount.max(axis=0) > threshold)[0]
+    if len(rows) == 0:
+        return None
+    c = marks.cell
+    x0, x1 = marks.x0 + (cols[0] - 1) * c, marks.x0 + (cols[-1] + 2) * c
+    z0, z1 = marks.z0 + (rows[0] - 1) * c, marks.z0 + (rows[-1] + 2) * c
+    return float(x0), float(z0), float(x1 - x0), float(z1 - z0)
+
+
+class Environment:
+    """GPU objects and draws of the environment for one context."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        h, lit = S.HEADER, S.HEADER + S.LIGHTING
+        self._ground_vs = lit + G.GROUND_MESH_VS
+        self._programs: dict[str, moderngl.Program] = {
+            "sky": ctx.program(vertex_shader=lit + G.SKY_DOME_VS, fragment_shader=h + G.COLOR_FS),
+            "ridge": ctx.program(vertex_shader=lit + G.RIDGE_VS, fragment_shader=h + G.COLOR_FS),
+            "sun": ctx.program(vertex_shader=lit + G.SUN_VS, fragment_shader=lit + G.SUN_FS),
+            "shadow": ctx.program(vertex_shader=h + G.DECAL_VS, fragment_shader=lit + G.SHADOW_DECAL_FS),
+            "marks": ctx.program(vertex_shader=h + G.DECAL_VS, fragment_shader=lit + G.MARKS_FS),
+            "prints": ctx.program(vertex_shader=h + G.PRINT_VS, fragment_shader=lit + G.PRINT_FS),
+        }
+        self._buffers: list[moderngl.Buffer] = []
+        self._ground_mesh = self._keep(*mesh_buffers(ctx, env_meshes.ground_rings()))
+        self._vaos: dict[str, moderngl.VertexArray] = {}
+        for name, mesh, fmt in (("sky", env_meshes.sky_sphere(), ("3f", "in_dir")),
+                                ("ridge", env_meshes.ridge_strip(), ("4f", "in_ridge"))):
+            vbo, ibo = self._keep(*mesh_buffers(ctx, mesh))
+            self._vaos[name] = ctx.vertex_array(self._programs[name], [(vbo, *fmt)], ibo, 4)
+        square, unit = self._keep(ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype=np.float32).tobytes()),
+                                  ctx.buffer(np.array([0, 0, 1, 0, 0, 1, 1, 1], dtype=np.float32).tobytes()))
+        self._vaos["sun"] = ctx.vertex_array(self._programs["sun"], [(square, "2f", "in_corner")])
+        for name in ("shadow", "marks"):
+            self._vaos[name] = ctx.vertex_array(self._programs[name], [(unit, "2f", "in_corner")])
+        self._prints = Instances(ctx, 4 * PRINT_STRIDE)
+        self._vaos["prints"] = ctx.vertex_array(self._programs["prints"], [(square, "2f", "in_corner"),
+                                                                          (self._prints.buf, *_PRINT_FMT)])
+        self._marks_tex: moderngl.Texture | None = None
+        self._marks_src: bytes = b""
+        self._common: dict[str, Any] = {}
+
+    def _keep(self, *bufs: moderngl.Buffer) -> tuple[moderngl.Buffer, ...]:
+        self._buffers += list(bufs)
+        return bufs
+
+    def ground_program(self, detail: bool, grid: bool, photo: bool) -> moderngl.Program:
+        """The ground's program for this combination of per-pixel features (compiled once, on first use)."""
+        key = "ground" + "".join(f for f, on in (("_detail", detail), ("_grid", grid), ("_photo", photo)) if on)
+        if key not in self._programs:
+            wanted = (("DETAIL", detail), ("GRID", grid), ("PHOTO", photo))
+            defines = "".join(f"#define {d} 1\n" for d, on in wanted if on)
+            fs = S.HEADER + defines + S.LIGHTING + E.BACKGROUND + G.GROUND_MESH_FS
+            prog = self._programs[key] = self.ctx.program(vertex_shader=self._ground_vs, fragment_shader=fs)
+            for name, value in self._common.items():
+                set_uniform(prog, name, value)
+            vbo, ibo = self._ground_mesh
+            self._vaos[key] = self.ctx.vertex_array(prog, [(vbo, "3f", "in_ring")], ibo, 4)
+        return self._programs[key]
+
+    def set_common(self, uniforms: dict[str, Any]) -> None:
+        """The frame's shared uniforms (camera, sun, fog), on every program and on any compiled later."""
+        self._common = dict(uniforms)
+        for prog in self._programs.values():
+            for name, value in uniforms.items():
+                set_uniform(prog, name, value)
+
+    def draw_ground(self, scene: RenderScene, detail: bool, photo: bool, uniforms: dict[str, Any]) -> None:
+        """The ground mesh (``uniforms``: centre, extent and the ground's colours)."""
+        g = scene.ground
+        prog = self.ground_program(detail, g.grid, photo)
+        for name, value in uniforms.items():
+            set_uniform(prog, name, value)
+        key = next(k for k, p in self._programs.items() if p is prog)
+        self._vaos[key].render(moderngl.TRIANGLES)
+
+    def draw_sky(self, scene: RenderScene, photo: bool, ground_height: float) -> None:
+        """The far ridge, the sky and the sun (without a photo behind; with one, the caller draws its sky)."""
+        ctx = self.ctx
+        if not photo and scene.ground.visible:
+            set_uniform(self._programs["ridge"], "u_radius", RIDGE_RADIUS)
+            set_uniform(self._programs["ridge"], "u_height", ground_height)
+            self._vaos["ridge"].render(moderngl.TRIANGLES)
+        if photo:
+            return
+        ctx.depth_func = "<="
+        self._vaos["sky"].render(moderngl.TRIANGLES)
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        set_uniform(self._programs["sun"], "u_sun_size", 0.09)
+        self._vaos["sun"].render(moderngl.TRIANGLE_STRIP)
+        ctx.disable(moderngl.BLEND)
+        ctx.depth_func = "<"
+
+    def draw_decals(self, scene: RenderScene, shadow_rect: tuple[float, float, float, float] | None,
+                    mask: moderngl.Texture | None) -> None:
+        """Ground shadow (``None``: the ground read it itself), snow track and footprints, each over the
+        rectangle it covers.
+
+        They modulate what the ground drew (``2·src·dst``) where the depth buffer still
+        holds the ground: objects in front keep their pixels. Polygon offset keeps the
+        decals above the ground mesh, whose triangles are not theirs.
+        """
+        ctx = self.ctx
+        height = float(scene.ground.height)
+        ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND)
+        ctx.depth_func = "<="
+        ctx.blend_func = moderngl.DST_COLOR, moderngl.SRC_COLOR
+        ctx.polygon_offset = -2.0, -8.0
+        if shadow_rect is not None and mask is not None:
+            prog = self._programs["shadow"]
+            mask.use(location=4)
+            for name, value in (("u_rect", shadow_rect), ("u_height", height), ("u_ground_mask", 4),
+                                ("u_shadow_strength", 0.9)):
+                set_uniform(prog, name, value)
+            self._vaos["shadow"].render(moderngl.TRIANGLE_STRIP)
+        if scene.marks is not None:
+            self._draw_marks(scene.marks, height)
+        if self._prints.upload(scene.prints.data):
+            set_uniform(self._programs["prints"], "u_height", height)
+            self._vaos["prints"].render(moderngl.TRIANGLE_STRIP, instances=self._prints.count)
+        ctx.polygon_offset = 0.0, 0.0
+        ctx.depth_func = "<"
+
+    def _draw_marks(self, marks: GroundMarks, height: float) -> None:
+        rect = marks_rect(marks)
+        if rect is None:
+            return
+        img = soften_marks(marks.amount)
+        raw = img.tobytes()
+        nz, nx = img.shape
+        if self._marks_tex is None or self._marks_tex.size != (nx, nz):
+            if self._marks_tex is not None:
+                self._marks_tex.release()
+            self._marks_tex = self.ctx.texture((nx, nz), 1, raw)
+            self._marks_tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            self._marks_tex.repeat_x = self._marks_tex.repeat_y = False
+        elif raw != self._marks_src:
+            self._marks_tex.write(raw)
+        self._marks_src = raw
+        self._marks_tex.use(location=5)
+        # The decal's rectangle in the texture's uv (texel centres at (i + 0.5) / n).
+        w, d = marks.cell * nx, marks.cell * nz
+        prog = self._programs["marks"]
+        u0, v0 = (rect[0] - marks.x0) / w, (rect[1] - marks.z0) / d
+        for name, value in (("u_rect", rect), ("u_height", height), ("u_marks", 5),
+                            ("u_marks_texel", (1.0 / nx, 1.0 / nz)), ("u_groove", 1.6),
+                            ("u_uv_rect", (u0, v0, rect[2] / w, rect[3] / d))):
+            set_uniform(prog, name, value)
+        self._vaos["marks"].render(moderngl.TRIANGLE_STRIP)
+
+    def release(self) -> None:
+        """Free the GPU objects."""
+        for obj in (*self._vaos.values(), *self._buffers, *self._programs.values(), self._prints.buf):
+            obj.release()
+        if self._marks_tex is not None:
+            self._marks_tex.release()

@@ -1,0 +1,117 @@
+"""Drawing quality levels, and the governor that picks one from the measured frame time.
+
+On a software rasteriser (llvmpipe, a laptop without a GPU) a frame's cost is almost all
+fragment work, so the lever that matters is how many pixels are shaded: ``low`` and
+``medium`` draw the 3-D scene into a smaller buffer and scale it up (the overlay text is
+drawn at full size afterwards, so it stays sharp). Each level also bounds the shadow
+work (map and mask sizes) and how coarse a round solid may be drawn (silhouette error).
+``high`` adds the per-pixel snow detail near the camera; ``low`` lets only the solids
+nearest the camera cast shadows (600 of them: a crowd's near rows), bounding the shadow
+work whatever the crowd's size.
+
+``auto`` is :class:`QualityGovernor`: it starts at ``medium``, steps down as soon as the
+median of the last frames misses the 30 fps budget, and steps up only when a level's
+frames would still fit with room to spare at the level above (estimated by the ratio of
+the shaded pixels), never back to a level it has left for being too slow. It is display
+only: the simulation never sees the quality.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Quality", "QUALITIES", "QUALITY_NAMES", "QualityGovernor", "parse_quality"]
+
+
+@dataclass(frozen=True)
+class Quality:
+    """One level: the fraction of the pixels shaded, the shadow resolutions, the detail allowed."""
+
+    name: str
+    scale: float
+    """Side of the 3-D drawing buffer as a fraction of the window's (text is always full size)."""
+    shadow_map: int
+    shadow_mask: int
+    silhouette_px: float
+    """Largest outline error a round solid's mesh may have, in (full-size) pixels."""
+    ground_detail: bool
+    """Per-pixel snow drifts and sparkle near the camera (else the snow is shaded per vertex)."""
+    max_casters: int | None = None
+    """Capsules and spheres drawn into the shadow map, nearest the camera first (``None``: all).
+    A crowd is vertex-bound on a software rasteriser, and the shadow map draws it a second time."""
+
+
+QUALITIES = {
+    "low": Quality("low", 0.5, 512, 128, 2.0, False, max_casters=600),
+    "medium": Quality("medium", 0.75, 1024, 256, 1.0, False),
+    "high": Quality("high", 1.0, 1024, 256, 1.0, True),
+}
+QUALITY_NAMES = ("low", "medium", "high", "auto")
+
+
+def parse_quality(text: str) -> str:
+    """``text`` as a quality name (``ValueError`` naming the choices otherwise)."""
+    name = text.strip().lower()
+    if name not in QUALITY_NAMES:
+        raise ValueError(f"quality must be one of {', '.join(QUALITY_NAMES)}, not {text!r}")
+    return name
+
+
+class QualityGovernor:
+    """Chooses the level from frame durations (seconds) while ``auto``; fixed otherwise.
+
+    Args:
+        mode: ``low``, ``medium``, ``high`` or ``auto``.
+        budget: the frame time to stay under (1/30 s).
+        window: frames per decision (the median of these).
+    """
+
+    ORDER = ("low", "medium", "high")
+
+    def __init__(self, mode: str = "auto", budget: float = 1.0 / 30.0, window: int = 12) -> None:
+        self.mode = parse_quality(mode)
+        self.budget, self.window = budget, window
+        self.level = "medium" if self.mode == "auto" else self.mode
+        self._times: deque[float] = deque(maxlen=window)
+        self._too_slow: set[str] = set()
+
+    @property
+    def quality(self) -> Quality:
+        """The level to draw the next frame at."""
+        return QUALITIES[self.level]
+
+    def cycle(self) -> str:
+        """Next mode in ``low → medium → high → auto`` (the quality key); returns it."""
+        self.mode = QUALITY_NAMES[(QUALITY_NAMES.index(self.mode) + 1) % len(QUALITY_NAMES)]
+        self._times.clear()
+        self._too_slow.clear()
+        if self.mode != "auto":
+            self.level = self.mode
+        return self.mode
+
+    def frame(self, seconds: float) -> bool:
+        """Record one frame's duration; true when the level changed."""
+        if self.mode != "auto":
+            return False
+        self._times.append(seconds)
+        if len(self._times) < self.window:
+            return False
+        median = float(np.median(self._times))
+        i = self.ORDER.index(self.level)
+        if median > self.budget and i > 0:
+            self._too_slow.add(self.level)
+            return self._set(self.ORDER[i - 1])
+        if i + 1 < len(self.ORDER):
+            up = self.ORDER[i + 1]
+            grow = (QUALITIES[up].scale / QUALITIES[self.level].scale) ** 2
+            if up not in self._too_slow and median * grow < 0.8 * self.budget:
+                return self._set(up)
+        return False
+
+    def _set(self, level: str) -> bool:
+        self.level = level
+        self._times.clear()
+        return True
