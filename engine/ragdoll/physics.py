@@ -11,8 +11,11 @@ Control is *command* based: :meth:`drive` stores a ragdoll's target pose and wei
 and :meth:`step` applies the commands of every ragdoll in one vectorised pass
 (:mod:`engine.ragdoll._control` over :mod:`engine.ragdoll._layout`) before running ``substeps`` MuJoCo steps in C.
 
-Adding a ragdoll or prop at run time regenerates the MJCF and recompiles; every body
-that existed keeps its exact state, carried over by name (:mod:`engine.ragdoll._carry`).
+Ragdolls live in a pool of slots compiled once (:mod:`engine.ragdoll._pool`): a ragdoll joining
+or leaving the simulation borrows or returns a slot (a state copy and a sleep flag), never a
+compile. The model is recompiled only when the pool grows (in chunks, doubling) or a prop is
+added or removed; every body that existed keeps its exact state, carried over by name
+(:mod:`engine.ragdoll._carry`).
 Snowballs change radius in place (geom size, bounds, mass, inertia, ``mj_setConst``).
 Each step is guarded (:mod:`engine.ragdoll._guard`): velocities are bounded, and a step
 MuJoCo cannot take is undone and counted in :attr:`PhysicsWorld.recoveries`.
@@ -33,10 +36,11 @@ from engine.ragdoll._carry import restore, snapshot
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step, velocity_limits
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
-from engine.ragdoll._layout import Layout, build_layout
+from engine.ragdoll._layout import Layout, build_layout, select
+from engine.ragdoll._pool import INITIAL, RagdollPool, kind_of, park, settle, wake
 from engine.ragdoll._readback import Readback
 from engine.ragdoll._slots import PropSlot, RagdollSlot
-from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec, build_mjcf, prop_name, ragdoll_fragment
+from engine.ragdoll.mjcf import PropSpec, RagdollSpec, build_mjcf, prop_name, rd_name
 from engine.ragdoll.profile import RagdollProfile
 from engine.skeleton import Skeleton
 
@@ -70,6 +74,11 @@ class PhysicsWorld(Readback):
         self._ragdolls: dict[int, RagdollSlot] = {}
         self._props: dict[int, PropSlot] = {}
         self._dirty = False
+        self._sized = True
+        self._moved = False
+        self._pool = RagdollPool()
+        self._reach: dict[bytes, float] = {}
+        self._pool_layout: Layout | None = None
         self._digest = b""
         self._ke: _F | None = None
         self._read: tuple[_F, _F] | None = None
@@ -94,9 +103,12 @@ class PhysicsWorld(Readback):
             raise ValueError(f"profile has {profile.num_joints} joints, skeleton {skeleton.num_joints}")
         off = np.array(skeleton.offsets if offsets is None else offsets, dtype=np.float64).reshape(-1, 3)
         r, q = self._checked(key, root, rotations, skeleton.num_joints)
-        self._ragdolls[key] = RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q),
-                                           reach(skeleton, profile, off))
-        self._dirty = True
+        spec = RagdollSpec(key, skeleton, profile, off)
+        kind = kind_of(spec)
+        if kind not in self._reach:  # a crowd is a few kinds of ragdoll many times over
+            self._reach[kind] = reach(skeleton, profile, off)
+        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind)
+        self._sized = False
 
     def add_prop(self, key: int, radius: float, mass: float, position: ArrayLike,
                  rotation: ArrayLike | None = None, velocity: ArrayLike | None = None, friction: float = 1.0) -> None:
@@ -113,7 +125,10 @@ class PhysicsWorld(Readback):
 
     def remove(self, key: int) -> None:
         """Remove a ragdoll or prop (no error if absent)."""
-        if self._ragdolls.pop(key, None) is not None or self._props.pop(key, None) is not None:
+        slot = self._ragdolls.pop(key, None)
+        if slot is not None and slot.pool >= 0:
+            self._give_back(slot)
+        if self._props.pop(key, None) is not None:
             self._dirty = True
 
     def has_ragdoll(self, key: int) -> bool:
@@ -136,30 +151,46 @@ class PhysicsWorld(Readback):
 
     # -- building -----------------------------------------------------------------------
     def ensure_built(self) -> None:
-        """Recompile the model if ragdolls or props were added or removed, keeping every state."""
-        if not self._dirty:
-            return
+        """Compile the model when the pool must grow or props were added or removed (keeping every
+        state), then lend pool slots to ragdolls that joined the simulation and park those that left."""
+        if self._dirty or not self._sized:
+            self._size_pool()
+        if self._dirty:
+            self._compile()
+        if self._moved:
+            self._assign()
+
+    def _size_pool(self) -> None:
+        """At first sight of a crowd of a kind, room for ``min(its ragdolls, INITIAL)`` at once
+        (see :mod:`._pool`), so that its first falls compile nothing."""
+        self._sized = True
+        counts: dict[bytes, int] = {}
+        first: dict[bytes, RagdollSlot] = {}
+        for k in sorted(self._ragdolls):
+            s = self._ragdolls[k]
+            counts[s.kind] = counts.get(s.kind, 0) + 1
+            first.setdefault(s.kind, s)
+        for kind, n in counts.items():  # a lone ragdoll gets its slot at its first fall (one compile)
+            if n > 1 and self._pool.count(kind) == 0 and self._pool.grow_to(first[kind].spec, min(n, INITIAL)):
+                self._dirty = True
+
+    def _compile(self) -> None:
+        """Compile the pool and the props into a new model, carrying every state over by name."""
         self._dirty = False
+        self._moved = True
         old = snapshot(self.model, self.data)
         self._ke = self._read = None
-        if not any(s.in_model for s in self._ragdolls.values()) and not self._props:
-            self.model = self.data = self.layout = None
+        if not self._pool.slots and not self._props:
+            self.model = self.data = self.layout = self._pool_layout = None
             return
-        rd: list[RagdollFragment] = []
-        for k in sorted(self._ragdolls):
-            slot = self._ragdolls[k]
-            if not slot.in_model:
-                continue
-            if slot.fragment is None:  # rendered once per ragdoll, reused by every rebuild
-                slot.fragment = ragdoll_fragment(slot.spec)
-            rd.append(slot.fragment)
+        rd = [s.fragment for s in self._pool.slots]
         pr = [self._props[k].spec for k in sorted(self._props)]
-        xml = build_mjcf(rd, pr, self.timestep, self.ground_friction)
+        xml = build_mjcf(rd, pr, self.timestep, self.ground_friction, sleep=bool(rd))
         m = self.model = mujoco.MjModel.from_xml_string(xml)
         d = self.data = mujoco.MjData(m)
         self._digest = hashlib.blake2b(xml.encode(), digest_size=16).digest()
         self.rebuilds += 1
-        self.layout = build_layout(m, rd)
+        pool = self._pool_layout = build_layout(m, rd)
         for key, ps in self._props.items():
             n = prop_name(key)
             j = m.joint(n).id
@@ -167,13 +198,65 @@ class PhysicsWorld(Readback):
             ps.geom, ps.body = m.geom(n).id, m.body(n).id
         self._limit = velocity_limits(m)
         self._owners = np.full(m.nv, -1, dtype=np.int64)
-        for p, (a, b) in enumerate(self.layout.dofs):
+        for p, (a, b) in enumerate(pool.dofs):
             self._owners[a:b] = p
         for k, ps in enumerate(self._props.values()):
-            self._owners[ps.dadr:ps.dadr + 6] = len(self.layout.keys) + k
+            self._owners[ps.dadr:ps.dadr + 6] = len(pool.keys) + k
         restore(m, d, old)
-        for key, slot in self._ragdolls.items():
-            if slot.in_model and not slot.placed:
+        m.tree_sleep_policy[:] = int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER)  # props and borrowed slots
+        for i, ps_ in enumerate(self._pool.slots):
+            if ps_.owner is None:
+                park(m, d, pool, i)
+            else:
+                wake(m, d, pool, i)
+        for ps in self._props.values():
+            if ps.init is not None:
+                pos, rot, vel = ps.init
+                d.qpos[ps.qadr:ps.qadr + 7] = np.concatenate([pos, rot])
+                d.qvel[ps.dadr:ps.dadr + 6] = vel
+                ps.init = None
+
+    def _assign(self) -> None:
+        """Park the slots of ragdolls that left, lend slots to those that joined (growing the pool
+        by doubling when a kind has too few), and place the newcomers (see :mod:`._pool`)."""
+        self._moved = False
+        order = sorted(self._ragdolls)
+        for k in order:
+            slot = self._ragdolls[k]
+            if not slot.in_model and slot.pool >= 0:
+                self._give_back(slot)
+        short: dict[bytes, int] = {}
+        for k in order:
+            slot = self._ragdolls[k]
+            if slot.in_model and slot.pool < 0:
+                short[slot.kind] = short.get(slot.kind, 0) + 1
+        for k in order:
+            slot = self._ragdolls[k]
+            need = short.pop(slot.kind, 0)
+            if need > self._pool.free(slot.kind):
+                have = self._pool.count(slot.kind)
+                self._pool.grow_to(slot.spec, max(2 * have, have - self._pool.free(slot.kind) + need))
+                self._dirty = True
+        if self._dirty:
+            self._compile()
+            self._moved = False
+        self._ke = self._read = None
+        if self.model is None or self.data is None or self._pool_layout is None:
+            self.layout = None
+            return
+        m, d, pool = self.model, self.data, self._pool_layout
+        for k in order:
+            slot = self._ragdolls[k]
+            if slot.in_model and slot.pool < 0:
+                taken = self._pool.take(slot.kind, k)
+                assert taken is not None
+                slot.pool = taken
+                wake(m, d, pool, taken)
+        keys = [k for k in order if self._ragdolls[k].pool >= 0]
+        self.layout = select(pool, [self._ragdolls[k].pool for k in keys], keys)
+        for key in keys:
+            slot = self._ragdolls[key]
+            if not slot.placed:
                 # joining from outside: where its animation was a step ago, moving as it moved then
                 # (as if it had been simulated all along), so it keeps its momentum
                 last, prev = slot.cmd.last, slot.prev
@@ -182,13 +265,16 @@ class PhysicsWorld(Readback):
                 else:
                     self._place(key, last[0], last[1], prev)
                 slot.cmd.last, slot.placed = last, True
-        for ps in self._props.values():
-            if ps.init is not None:
-                pos, rot, vel = ps.init
-                d.qpos[ps.qadr:ps.qadr + 7] = np.concatenate([pos, rot])
-                d.qvel[ps.dadr:ps.dadr + 6] = vel
-                ps.init = None
+        settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
         mujoco.mj_forward(m, d)
+
+    def _give_back(self, slot: RagdollSlot) -> None:
+        """Return a ragdoll's pool slot: parked, asleep, free for the next one of its kind."""
+        if self.model is not None and self.data is not None and self._pool_layout is not None:
+            park(self.model, self.data, self._pool_layout, slot.pool)
+        self._pool.release(slot.pool)
+        slot.pool = -1
+        self._moved = True
 
     # -- commands -------------------------------------------------------------------------
     def _checked(self, key: int, root: ArrayLike, rotations: ArrayLike, n: int) -> tuple[_F, _F]:
@@ -361,11 +447,11 @@ class PhysicsWorld(Readback):
         for slot, want in zip(slots, wanted, strict=True):
             if slot.in_model != bool(want):
                 slot.in_model, slot.placed = bool(want), False
-                self._dirty = True
+                self._moved = True
 
     def _centre(self, slot: RagdollSlot) -> _F:
         """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
-        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._dirty:
+        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._moved:
             rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
             return np.asarray(self.data.qpos[rq:rq + 3])
         return slot.cmd.root
@@ -378,6 +464,20 @@ class PhysicsWorld(Readback):
         else:
             pos, vel = self.data.qpos[ps.qadr:ps.qadr + 3], self.data.qvel[ps.dadr:ps.dadr + 3]
         return np.asarray(pos), ps.spec.radius + float(np.linalg.norm(vel[:3])) * LOOKAHEAD
+
+    def mujoco_name(self, key: int, part: str) -> str:
+        """MuJoCo's name of a part (joint name, ``<joint>_hold``, ``pin``…) of the pool slot lent to
+        ragdoll ``key`` (slots are named by their place in the pool, not by the puppet)."""
+        self.ensure_built()
+        slot = self._slot(key)
+        if slot.pool < 0:
+            raise KeyError(f"ragdoll {key} is not simulated now: it has no MuJoCo bodies")
+        return rd_name(slot.pool, part)
+
+    def asleep(self) -> int:
+        """How many pool slots are parked asleep (free, costing no dynamics)."""
+        self.ensure_built()
+        return 0 if self.data is None else int(np.count_nonzero(np.asarray(self.data.tree_asleep) >= 0))
 
     def in_model(self, key: int) -> bool:
         """Whether ragdoll ``key`` is simulated this step (animated ragdolls alone are not)."""
@@ -452,8 +552,13 @@ class PhysicsWorld(Readback):
         mujoco.mj_getState(m, d, state, _STATE)
         parts: list[bytes | np.ndarray] = [self._digest, state, m.actuator_gainprm[:, 0], m.actuator_biasprm[:, :3],
                                            m.eq_solref, m.geom_size[:, 0], m.body_mass, m.geom_contype]
+        pooled = bool(self._pool.slots)
+        if pooled:  # (a model of props alone hashes as it did before the pool)
+            parts += [m.tree_sleep_policy, d.tree_asleep]
         for k in sorted(self._ragdolls):
             c = self._ragdolls[k].cmd
+            if pooled:
+                parts.append(np.array([self._ragdolls[k].pool]))
             parts += [c.root, c.rot, np.array([c.muscle, c.pin, c.support, c.kinematic]), c.hold_target,
                       (c.hold or "").encode(), b"L" if c.last is None else c.last[0].tobytes() + c.last[1].tobytes()]
         return b"".join(p if isinstance(p, bytes) else np.ascontiguousarray(p).tobytes() for p in parts)
