@@ -30,14 +30,14 @@ from engine.cliplib.library import set_digest
 F = NDArray[np.float64]
 
 __all__ = [
-    "PUPPET_PLACEMENT",
     "PUPPET_AXES",
-    "puppet_blend_space",
+    "PUPPET_PLACEMENT",
     "build_locomotion",
-    "puppet_locomotion",
     "builtin_cache",
     "height_mapping",
     "install_puppet_locomotion",
+    "puppet_blend_space",
+    "puppet_locomotion",
 ]
 
 PUPPET_AXES: tuple[str, ...] = ("velocity", "height")

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, rd_name
 
-__all__ = ["Layout", "build_layout", "bone_axes"]
+__all__ = ["Layout", "bone_axes", "build_layout"]
 
 I = NDArray[np.int64]
 F = NDArray[np.float64]
@@ -89,7 +89,7 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
     """The flat layout of the rendered ragdolls (in the order given) inside compiled model ``m``."""
     acc: dict[str, list[np.ndarray]] = {}
 
-    def put(name: str, value: np.ndarray | list[float] | list[int] | float | int) -> None:
+    def put(name: str, value: np.ndarray | list[float] | list[int] | float) -> None:
         acc.setdefault(name, []).append(np.atleast_1d(np.asarray(value)))
 
     starts = [0]

@@ -12,7 +12,9 @@ step (MuJoCo skips sleeping trees in every stage; ~2-3 µs per parked ragdoll pe
 
 Slots are added in chunks (:func:`grow_to`): the first build holds enough for
 ``min(ragdolls of the kind, INITIAL)``, and only when more are needed at once than the pool holds
-does it double (one compile, carrying every state by name), never once per join.
+does it double (one compile, carrying every state by name), never once per join, up to
+:data:`MAX_SLOTS`; past that the simulated ragdolls are served first and the animated ones that
+would only be pushed by them wait outside (:attr:`PhysicsWorld.left_out`).
 """
 
 from __future__ import annotations
@@ -27,10 +29,11 @@ import numpy as np
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, ragdoll_fragment, rd_name
 
-__all__ = ["RagdollPool", "PoolSlot", "kind_of", "park", "wake", "update_sleep", "settle", "INITIAL", "CHUNK"]
+__all__ = ["CHUNK", "INITIAL", "MAX_SLOTS", "PoolSlot", "RagdollPool", "kind_of", "park", "settle", "update_sleep", "wake"]
 
 CHUNK = 4  # slots: the pool grows in multiples of this
 INITIAL = 32  # slots of a kind compiled at the first build at most (a crowd's first falls fit)
+MAX_SLOTS = 128  # slots of a kind at most: compiling 128 costs ~1.4 s, 256 ~7 s, ~1000 cannot be allocated
 _TEMPLATE = -1  # the key a kind's template is rendered under before its names are replaced
 _AWAKE = -(1 + mujoco.mjMINAWAKE)
 _PARK = np.array([0.0, -50.0, 0.0])  # m: under the field, out of every contact

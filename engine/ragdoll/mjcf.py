@@ -227,8 +227,8 @@ def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequenc
         f'  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="{SIMULATED_BITS[0]}" '
         f'conaffinity="{SIMULATED_BITS[1]}"/></default>',
         # sleeping parks the pool's free ragdoll slots (engine.ragdoll._pool); nothing falls asleep by itself
-        f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"'
-        + ('><flag sleep="enable"/></option>' if sleep else "/>"),
+        (f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"'
+         + ('><flag sleep="enable"/></option>' if sleep else "/>")),
         "  <worldbody>",
         f'    <geom name="ground" type="plane" size="0 0 1" zaxis="0 1 0" contype="{GROUND_BITS[0]}" conaffinity="{GROUND_BITS[1]}" friction="{_f(ground_friction)} 0.005 0.002"/>',
         *body,

@@ -29,7 +29,7 @@ from engine.statemachine.puppet.machine import puppet_machine
 from engine.statemachine.puppet.props import held_props_system
 from engine.statemachine.puppet.senses import sense, yaw_rotation
 
-__all__ = ["install_puppets", "spawn_puppet", "brain_system", "apply_pose_overrides", "PuppetMachine"]
+__all__ = ["PuppetMachine", "apply_pose_overrides", "brain_system", "install_puppets", "spawn_puppet"]
 
 
 class PuppetMachine:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from engine import quat
-from engine.ragdoll import physics as physics_module
+from engine.ragdoll import _building as building_module
 from engine.ragdoll import default_profile
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
@@ -69,7 +69,7 @@ def test_a_parked_slot_stays_where_it_was_parked(skeleton: Skeleton) -> None:
 
 def test_the_pool_grows_by_doubling_when_more_fall_at_once(skeleton: Skeleton,
                                                           monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(physics_module, "INITIAL", 4)
+    monkeypatch.setattr(building_module, "INITIAL", 4)
     pw = _crowd(skeleton, 10)
     _drive(pw, skeleton, set())
     pw.step()
