@@ -305,6 +305,9 @@ class PhysicsWorld(Readback, Building):
         for slot, g in zip(slots, ghost, strict=True):
             slot.ghost = bool(g)
         apply_commands(L, self.model, d, [s.cmd for s in slots], self.dt, ghost)
+        if d.ntree_awake == 0:  # every pool slot parked and no prop: nothing in MuJoCo can move
+            self._ke = self._read = None
+            return
         reason = guarded_step(self.model, self.data, self.substeps, self._limit, self._owners)
         if reason is None:
             project_twist(self.layout, self.data)

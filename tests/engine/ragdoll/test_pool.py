@@ -108,3 +108,16 @@ def test_a_joining_ragdoll_keeps_its_place_and_motion(skeleton: Skeleton) -> Non
     assert m is not None
     tree = m.body_treeid[m.body(pw.mujoco_name(3, "hips")).id]  # lying still, it must still answer its muscles
     assert m.tree_sleep_policy[tree] == mujoco.mjtSleepPolicy.mjSLEEP_NEVER
+
+
+def test_a_crowd_standing_steps_no_mujoco_at_all(skeleton: Skeleton) -> None:
+    pw = _crowd(skeleton, 3)
+    _drive(pw, skeleton, set())
+    pw.step()
+    assert pw.data is not None
+    t = pw.data.time
+    pw.step()
+    assert pw.data.time == t  # every slot parked: the step skipped mj_step
+    _drive(pw, skeleton, {2})
+    pw.step()
+    assert pw.data.time == pytest.approx(t + pw.dt)
