@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 
@@ -29,13 +30,13 @@ HEAVY = ("numpy", "scipy.spatial", "scipy.sparse", "scipy.linalg", "scipy.optimi
 def child_cpu_s(args: list[str]) -> float:
     """Process CPU seconds (user + system) of one child process running ``args``."""
     env = dict(os.environ, SDL_VIDEODRIVER="dummy")
-    proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
-    _, status, usage = os.wait4(proc.pid, 0)
-    err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
-    if proc.stderr:
-        proc.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise RuntimeError(f"{' '.join(args)} failed: {err.strip()[-300:]}")
+    with tempfile.TemporaryFile() as err:
+        proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=err, env=env)
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here: tell Popen
+        if proc.returncode != 0:
+            err.seek(0)
+            raise RuntimeError(f"{' '.join(args)} failed: {err.read().decode(errors='replace').strip()[-300:]}")
     return usage.ru_utime + usage.ru_stime
 
 
