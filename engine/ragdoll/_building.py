@@ -4,7 +4,7 @@
 A mixin, apart because it is the one place that compiles: :meth:`Building._compile` renders the
 pool (:mod:`engine.ragdoll._pool`) and the props into one model, carrying every state by name;
 :meth:`Building._assign` lends slots to ragdolls that joined the simulation, parks those that
-left, and grows the pool in chunks when more need it at once than it holds.
+left, and grows the pool (by what is needed and a quarter more) when more need it at once than it holds.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from engine.ragdoll._carry import restore, snapshot
 from engine.ragdoll._guard import velocity_limits
 from engine.ragdoll._layout import Layout, build_layout, select
-from engine.ragdoll._pool import INITIAL, MAX_SLOTS, RagdollPool, park, settle, wake
+from engine.ragdoll._pool import CHUNK, INITIAL, MAX_SLOTS, RagdollPool, park, settle, wake
 from engine.ragdoll._slots import PropSlot, RagdollSlot
 from engine.ragdoll.mjcf import build_mjcf, prop_name
 
@@ -111,7 +111,7 @@ class Building:
 
     def _assign(self) -> None:
         """Park the slots of ragdolls that left, lend slots to those that joined (growing the pool
-        by doubling when a kind has too few), and place the newcomers (see :mod:`._pool`)."""
+        when a kind has too few: to what is needed and a quarter more), and place the newcomers (see :mod:`._pool`)."""
         self._moved = False
         order = sorted(self._ragdolls)
         for k in order:
@@ -130,7 +130,9 @@ class Building:
             need = short.pop(slot.kind, 0)
             free, have = self._pool.free(slot.kind), self._pool.count(slot.kind)
             if need > free and have < MAX_SLOTS:
-                self._pool.grow_to(slot.spec, min(MAX_SLOTS, max(2 * have, have - free + need)))
+                # a quarter of headroom over what is needed now (more joiners usually follow a fall):
+                # compiling is superlinear in the pool's size, so doubling would cost more than it saves
+                self._pool.grow_to(slot.spec, min(MAX_SLOTS, max(have + CHUNK, -(-5 * (have - free + need) // 4))))
                 self._dirty = True
         room = {kind: 0 for kind in {self._ragdolls[k].kind for k in joining}}
         self.left_out = 0

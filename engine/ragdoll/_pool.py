@@ -10,9 +10,10 @@ velocity are copied in and the slot is woken; a puppet that leaves gives the slo
 put to sleep with MuJoCo's sleeping (``mjENBL_SLEEP``), so its bodies cost almost nothing per
 step (MuJoCo skips sleeping trees in every stage; ~2-3 µs per parked ragdoll per substep here).
 
-Slots are added in chunks (:func:`grow_to`): the first build holds enough for
+Slots are added in chunks (:func:`grow_to`): the first build of a crowd holds enough for
 ``min(ragdolls of the kind, INITIAL)``, and only when more are needed at once than the pool holds
-does it double (one compile, carrying every state by name), never once per join, up to
+does it grow, to what is needed and a quarter more (one compile, carrying every state by name;
+compiling is superlinear in the pool's size, so doubling cost more than it saved), never once per join, up to
 :data:`MAX_SLOTS`; past that the simulated ragdolls are served first and the animated ones that
 would only be pushed by them wait outside (:attr:`PhysicsWorld.left_out`).
 """
@@ -32,7 +33,7 @@ from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, ragdoll_fragment, 
 __all__ = ["CHUNK", "INITIAL", "MAX_SLOTS", "PoolSlot", "RagdollPool", "kind_of", "park", "settle", "update_sleep", "wake"]
 
 CHUNK = 4  # slots: the pool grows in multiples of this
-INITIAL = 32  # slots of a kind compiled at the first build at most (a crowd's first falls fit)
+INITIAL = 96  # slots of a kind compiled at a crowd's first build at most: ten of a hundred falling pull ~60 in
 MAX_SLOTS = 128  # slots of a kind at most: compiling 128 costs ~1.4 s, 256 ~7 s, ~1000 cannot be allocated
 _TEMPLATE = -1  # the key a kind's template is rendered under before its names are replaced
 _AWAKE = -(1 + mujoco.mjMINAWAKE)

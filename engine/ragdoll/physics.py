@@ -13,7 +13,7 @@ and :meth:`step` applies the commands of every ragdoll in one vectorised pass
 
 Ragdolls live in a pool of slots compiled once (:mod:`engine.ragdoll._pool`): a ragdoll joining
 or leaving the simulation borrows or returns a slot (a state copy and a sleep flag), never a
-compile. The model is recompiled only when the pool grows (in chunks, doubling) or a prop is
+compile. The model is recompiled only when the pool grows (in chunks, with headroom) or a prop is
 added or removed; every body that existed keeps its exact state, carried over by name
 (:mod:`engine.ragdoll._carry`).
 Snowballs change radius in place (geom size, bounds, mass, inertia, ``mj_setConst``).
