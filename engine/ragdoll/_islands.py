@@ -9,8 +9,9 @@ limp, held) and every prop, and an animated ragdoll only while one of those is n
 it: bounding spheres (the ragdoll's reach around its root, a prop's radius plus how
 far it travels in :data:`LOOKAHEAD`) closer than :data:`ENTER`, kept until farther
 than :data:`LEAVE` (the hysteresis keeps a puppet walking beside a ball from
-recompiling the model every step). A crowd walking on an empty field is then no
-MuJoCo work at all; membership changes recompile the model, carrying every state.
+swapping pool slots every step). A crowd walking on an empty field is then no
+MuJoCo work at all; joining or leaving borrows or returns a slot of the ragdoll pool
+(:mod:`engine.ragdoll._pool`), a state copy, not a compile.
 
 Puppets can also end up inside each other (two dropped on one spot, one walked into
 another as it falls): MuJoCo would push them apart at 10⁵ m/s. A simulated ragdoll whose

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, rd_name
 
-__all__ = ["Layout", "build_layout", "bone_axes"]
+__all__ = ["Layout", "bone_axes", "build_layout"]
 
 I = NDArray[np.int64]
 F = NDArray[np.float64]
@@ -89,7 +89,7 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
     """The flat layout of the rendered ragdolls (in the order given) inside compiled model ``m``."""
     acc: dict[str, list[np.ndarray]] = {}
 
-    def put(name: str, value: np.ndarray | list[float] | list[int] | float | int) -> None:
+    def put(name: str, value: np.ndarray | list[float] | list[int] | float) -> None:
         acc.setdefault(name, []).append(np.atleast_1d(np.asarray(value)))
 
     starts = [0]
@@ -160,3 +160,35 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         hold_eq=hold_eq, hold_joint=hold_joint,
         **{n: cat(n, np.int64) for n in ints}, **{n: cat(n, np.float64) for n in floats},
     )
+
+
+_PER_RAGDOLL = ("root_q", "root_d", "dofs", "pin_eq", "pin_mocap", "hold_mocap")
+_GROUPS = {  # owner array -> the arrays laid out by it (and which of them index flat joints)
+    "ball_owner": ("ball_src", "ball_q", "ball_d", "ball_c", "ball_axis", "ball_twist", "ball_cone", "ball_lead"),
+    "hinge_owner": ("hinge_src", "hinge_q", "hinge_d", "hinge_c", "hinge_axis", "hinge_range", "hinge_lead"),
+    "act_owner": ("act", "act_kp", "act_kv"),
+    "body_owner": ("body",),
+    "geom_owner": ("geom",),
+}
+
+
+def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
+    """The layout of some ragdolls of a pool (``slots``, lent to puppets ``keys`` in that order):
+    the same flat arrays restricted to them, owners and flat joint indices renumbered."""
+    idx = np.asarray(slots, dtype=np.int64)
+    sizes = np.diff(pool.starts)[idx]
+    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    fields: dict[str, object] = {n: getattr(pool, n)[idx] for n in _PER_RAGDOLL}
+    for owner, names in _GROUPS.items():
+        own = getattr(pool, owner)
+        lo, hi = np.searchsorted(own, idx, "left"), np.searchsorted(own, idx, "right")
+        rows = np.concatenate([np.arange(a, b) for a, b in zip(lo, hi, strict=True)] or [np.zeros(0, np.int64)])
+        new_owner = np.repeat(np.arange(len(idx)), hi - lo)
+        fields[owner] = new_owner
+        for n in names:
+            fields[n] = getattr(pool, n)[rows]
+        if owner in ("ball_owner", "hinge_owner"):
+            src = names[0]
+            fields[src] = fields[src] - pool.starts[idx][new_owner] + starts[new_owner]
+    return Layout(keys=list(keys), starts=starts, hold_eq=[pool.hold_eq[i] for i in slots],
+                  hold_joint=[pool.hold_joint[i] for i in slots], **fields)  # type: ignore[arg-type]

@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.ragdoll._control import Command
-from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec
+from engine.ragdoll.mjcf import PropSpec, RagdollSpec
 
 __all__ = ["RagdollSlot", "PropSlot"]
 
@@ -22,9 +22,10 @@ class RagdollSlot:
     spec: RagdollSpec
     cmd: Command
     reach: float
+    kind: bytes  # which pool slots fit it (:func:`engine.ragdoll._pool.kind_of`)
     placed: bool = False
-    fragment: RagdollFragment | None = None
-    in_model: bool = True
+    in_model: bool = False  # simulated this step (animated and alone: left out, see _islands)
+    pool: int = -1  # the pool slot lent to it while in the model
     prev: tuple[_F, _F] | None = None  # out of the model: the target before the last step's
     ghost: bool = False  # inside another ragdoll: touches only the ground and props
 

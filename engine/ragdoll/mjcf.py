@@ -198,8 +198,9 @@ def ragdoll_fragment(spec: RagdollSpec) -> RagdollFragment:
 
 
 def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequence[PropSpec], timestep: float,
-               ground_friction: float = 1.0) -> str:
-    """The whole physics scene as an MJCF string, ragdolls (specs or rendered) and props in the order given."""
+               ground_friction: float = 1.0, sleep: bool = False) -> str:
+    """The whole physics scene as an MJCF string, ragdolls (specs or rendered) and props in the order given
+    (``sleep``: enable MuJoCo's sleeping, with which the ragdoll pool parks its free slots)."""
     body: list[str] = []
     contact: list[str] = []
     equality: list[str] = []
@@ -225,7 +226,9 @@ def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequenc
         # switches them to animated or ghost
         f'  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="{SIMULATED_BITS[0]}" '
         f'conaffinity="{SIMULATED_BITS[1]}"/></default>',
-        f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"/>',
+        # sleeping parks the pool's free ragdoll slots (engine.ragdoll._pool); nothing falls asleep by itself
+        (f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"'
+         + ('><flag sleep="enable"/></option>' if sleep else "/>")),
         "  <worldbody>",
         f'    <geom name="ground" type="plane" size="0 0 1" zaxis="0 1 0" contype="{GROUND_BITS[0]}" conaffinity="{GROUND_BITS[1]}" friction="{_f(ground_friction)} 0.005 0.002"/>',
         *body,

@@ -11,8 +11,11 @@ Control is *command* based: :meth:`drive` stores a ragdoll's target pose and wei
 and :meth:`step` applies the commands of every ragdoll in one vectorised pass
 (:mod:`engine.ragdoll._control` over :mod:`engine.ragdoll._layout`) before running ``substeps`` MuJoCo steps in C.
 
-Adding a ragdoll or prop at run time regenerates the MJCF and recompiles; every body
-that existed keeps its exact state, carried over by name (:mod:`engine.ragdoll._carry`).
+Ragdolls live in a pool of slots compiled once (:mod:`engine.ragdoll._pool`): a ragdoll joining
+or leaving the simulation borrows or returns a slot (a state copy and a sleep flag), never a
+compile. The model is recompiled only when the pool grows (in chunks, with headroom) or a prop is
+added or removed; every body that existed keeps its exact state, carried over by name
+(:mod:`engine.ragdoll._carry`).
 Snowballs change radius in place (geom size, bounds, mass, inertia, ``mj_setConst``).
 Each step is guarded (:mod:`engine.ragdoll._guard`): velocities are bounded, and a step
 MuJoCo cannot take is undone and counted in :attr:`PhysicsWorld.recoveries`.
@@ -20,7 +23,6 @@ MuJoCo cannot take is undone and counted in :attr:`PhysicsWorld.recoveries`.
 
 from __future__ import annotations
 
-import hashlib
 import warnings
 
 import mujoco
@@ -29,14 +31,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.pose import Pose
-from engine.ragdoll._carry import restore, snapshot
+from engine.ragdoll._building import Building
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
-from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step, velocity_limits
+from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
-from engine.ragdoll._layout import Layout, build_layout
+from engine.ragdoll._layout import Layout
+from engine.ragdoll._pool import RagdollPool, kind_of
 from engine.ragdoll._readback import Readback
 from engine.ragdoll._slots import PropSlot, RagdollSlot
-from engine.ragdoll.mjcf import PropSpec, RagdollFragment, RagdollSpec, build_mjcf, prop_name, ragdoll_fragment
+from engine.ragdoll.mjcf import PropSpec, RagdollSpec, rd_name
 from engine.ragdoll.profile import RagdollProfile
 from engine.skeleton import Skeleton
 
@@ -46,7 +49,7 @@ _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 _F = NDArray[np.float64]
 
 
-class PhysicsWorld(Readback):
+class PhysicsWorld(Readback, Building):
     """The physics resource: ragdolls and props keyed by their entity id.
 
     Args:
@@ -70,6 +73,12 @@ class PhysicsWorld(Readback):
         self._ragdolls: dict[int, RagdollSlot] = {}
         self._props: dict[int, PropSlot] = {}
         self._dirty = False
+        self._sized = True
+        self._moved = False
+        self._pool = RagdollPool()
+        self._reach: dict[bytes, float] = {}
+        self.left_out = 0  # ragdolls that should have joined at the last change but the full pool had no room
+        self._pool_layout: Layout | None = None
         self._digest = b""
         self._ke: _F | None = None
         self._read: tuple[_F, _F] | None = None
@@ -94,9 +103,12 @@ class PhysicsWorld(Readback):
             raise ValueError(f"profile has {profile.num_joints} joints, skeleton {skeleton.num_joints}")
         off = np.array(skeleton.offsets if offsets is None else offsets, dtype=np.float64).reshape(-1, 3)
         r, q = self._checked(key, root, rotations, skeleton.num_joints)
-        self._ragdolls[key] = RagdollSlot(RagdollSpec(key, skeleton, profile, off), Command(r, q),
-                                           reach(skeleton, profile, off))
-        self._dirty = True
+        spec = RagdollSpec(key, skeleton, profile, off)
+        kind = kind_of(spec)
+        if kind not in self._reach:  # a crowd is a few kinds of ragdoll many times over
+            self._reach[kind] = reach(skeleton, profile, off)
+        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind)
+        self._sized = False
 
     def add_prop(self, key: int, radius: float, mass: float, position: ArrayLike,
                  rotation: ArrayLike | None = None, velocity: ArrayLike | None = None, friction: float = 1.0) -> None:
@@ -113,7 +125,10 @@ class PhysicsWorld(Readback):
 
     def remove(self, key: int) -> None:
         """Remove a ragdoll or prop (no error if absent)."""
-        if self._ragdolls.pop(key, None) is not None or self._props.pop(key, None) is not None:
+        slot = self._ragdolls.pop(key, None)
+        if slot is not None and slot.pool >= 0:
+            self._give_back(slot)
+        if self._props.pop(key, None) is not None:
             self._dirty = True
 
     def has_ragdoll(self, key: int) -> bool:
@@ -136,59 +151,14 @@ class PhysicsWorld(Readback):
 
     # -- building -----------------------------------------------------------------------
     def ensure_built(self) -> None:
-        """Recompile the model if ragdolls or props were added or removed, keeping every state."""
-        if not self._dirty:
-            return
-        self._dirty = False
-        old = snapshot(self.model, self.data)
-        self._ke = self._read = None
-        if not any(s.in_model for s in self._ragdolls.values()) and not self._props:
-            self.model = self.data = self.layout = None
-            return
-        rd: list[RagdollFragment] = []
-        for k in sorted(self._ragdolls):
-            slot = self._ragdolls[k]
-            if not slot.in_model:
-                continue
-            if slot.fragment is None:  # rendered once per ragdoll, reused by every rebuild
-                slot.fragment = ragdoll_fragment(slot.spec)
-            rd.append(slot.fragment)
-        pr = [self._props[k].spec for k in sorted(self._props)]
-        xml = build_mjcf(rd, pr, self.timestep, self.ground_friction)
-        m = self.model = mujoco.MjModel.from_xml_string(xml)
-        d = self.data = mujoco.MjData(m)
-        self._digest = hashlib.blake2b(xml.encode(), digest_size=16).digest()
-        self.rebuilds += 1
-        self.layout = build_layout(m, rd)
-        for key, ps in self._props.items():
-            n = prop_name(key)
-            j = m.joint(n).id
-            ps.qadr, ps.dadr = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
-            ps.geom, ps.body = m.geom(n).id, m.body(n).id
-        self._limit = velocity_limits(m)
-        self._owners = np.full(m.nv, -1, dtype=np.int64)
-        for p, (a, b) in enumerate(self.layout.dofs):
-            self._owners[a:b] = p
-        for k, ps in enumerate(self._props.values()):
-            self._owners[ps.dadr:ps.dadr + 6] = len(self.layout.keys) + k
-        restore(m, d, old)
-        for key, slot in self._ragdolls.items():
-            if slot.in_model and not slot.placed:
-                # joining from outside: where its animation was a step ago, moving as it moved then
-                # (as if it had been simulated all along), so it keeps its momentum
-                last, prev = slot.cmd.last, slot.prev
-                if last is None:
-                    self._place(key, slot.cmd.root, slot.cmd.rot)
-                else:
-                    self._place(key, last[0], last[1], prev)
-                slot.cmd.last, slot.placed = last, True
-        for ps in self._props.values():
-            if ps.init is not None:
-                pos, rot, vel = ps.init
-                d.qpos[ps.qadr:ps.qadr + 7] = np.concatenate([pos, rot])
-                d.qvel[ps.dadr:ps.dadr + 6] = vel
-                ps.init = None
-        mujoco.mj_forward(m, d)
+        """Compile the model when the pool must grow or props were added or removed (keeping every
+        state), then lend pool slots to ragdolls that joined the simulation and park those that left."""
+        if self._dirty or not self._sized:
+            self._size_pool()
+        if self._dirty:
+            self._compile()
+        if self._moved:
+            self._assign()
 
     # -- commands -------------------------------------------------------------------------
     def _checked(self, key: int, root: ArrayLike, rotations: ArrayLike, n: int) -> tuple[_F, _F]:
@@ -335,6 +305,9 @@ class PhysicsWorld(Readback):
         for slot, g in zip(slots, ghost, strict=True):
             slot.ghost = bool(g)
         apply_commands(L, self.model, d, [s.cmd for s in slots], self.dt, ghost)
+        if d.ntree_awake == 0:  # every pool slot parked and no prop: nothing in MuJoCo can move
+            self._ke = self._read = None
+            return
         reason = guarded_step(self.model, self.data, self.substeps, self._limit, self._owners)
         if reason is None:
             project_twist(self.layout, self.data)
@@ -361,11 +334,11 @@ class PhysicsWorld(Readback):
         for slot, want in zip(slots, wanted, strict=True):
             if slot.in_model != bool(want):
                 slot.in_model, slot.placed = bool(want), False
-                self._dirty = True
+                self._moved = True
 
     def _centre(self, slot: RagdollSlot) -> _F:
         """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
-        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._dirty:
+        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._moved:
             rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
             return np.asarray(self.data.qpos[rq:rq + 3])
         return slot.cmd.root
@@ -378,6 +351,20 @@ class PhysicsWorld(Readback):
         else:
             pos, vel = self.data.qpos[ps.qadr:ps.qadr + 3], self.data.qvel[ps.dadr:ps.dadr + 3]
         return np.asarray(pos), ps.spec.radius + float(np.linalg.norm(vel[:3])) * LOOKAHEAD
+
+    def mujoco_name(self, key: int, part: str) -> str:
+        """MuJoCo's name of a part (joint name, ``<joint>_hold``, ``pin``…) of the pool slot lent to
+        ragdoll ``key`` (slots are named by their place in the pool, not by the puppet)."""
+        self.ensure_built()
+        slot = self._slot(key)
+        if slot.pool < 0:
+            raise KeyError(f"ragdoll {key} is not simulated now: it has no MuJoCo bodies")
+        return rd_name(slot.pool, part)
+
+    def asleep(self) -> int:
+        """How many pool slots are parked asleep (free, costing no dynamics)."""
+        self.ensure_built()
+        return 0 if self.data is None else int(np.count_nonzero(np.asarray(self.data.tree_asleep) >= 0))
 
     def in_model(self, key: int) -> bool:
         """Whether ragdoll ``key`` is simulated this step (animated ragdolls alone are not)."""
@@ -452,8 +439,13 @@ class PhysicsWorld(Readback):
         mujoco.mj_getState(m, d, state, _STATE)
         parts: list[bytes | np.ndarray] = [self._digest, state, m.actuator_gainprm[:, 0], m.actuator_biasprm[:, :3],
                                            m.eq_solref, m.geom_size[:, 0], m.body_mass, m.geom_contype]
+        pooled = bool(self._pool.slots)
+        if pooled:  # (a model of props alone hashes as it did before the pool)
+            parts += [m.tree_sleep_policy, d.tree_asleep]
         for k in sorted(self._ragdolls):
             c = self._ragdolls[k].cmd
+            if pooled:
+                parts.append(np.array([self._ragdolls[k].pool]))
             parts += [c.root, c.rot, np.array([c.muscle, c.pin, c.support, c.kinematic]), c.hold_target,
                       (c.hold or "").encode(), b"L" if c.last is None else c.last[0].tobytes() + c.last[1].tobytes()]
         return b"".join(p if isinstance(p, bytes) else np.ascontiguousarray(p).tobytes() for p in parts)

@@ -20,7 +20,7 @@ from engine.humanoid import humanoid_skeleton
 from engine.ik.system import IKRequest, install_ik
 from engine.posing import install_fk
 from engine.ragdoll.components import Ragdoll, RagdollMode
-from engine.ragdoll.profile import default_profile
+from engine.ragdoll.profile import RagdollProfile, default_profile
 from engine.ragdoll.system import install_physics
 from engine.skeleton import Skeleton
 from engine.statemachine.machine import Brain, StateMachine, step_machine
@@ -29,7 +29,7 @@ from engine.statemachine.puppet.machine import puppet_machine
 from engine.statemachine.puppet.props import held_props_system
 from engine.statemachine.puppet.senses import sense, yaw_rotation
 
-__all__ = ["install_puppets", "spawn_puppet", "brain_system", "apply_pose_overrides", "PuppetMachine"]
+__all__ = ["PuppetMachine", "apply_pose_overrides", "brain_system", "install_puppets", "spawn_puppet"]
 
 
 class PuppetMachine:
@@ -70,6 +70,18 @@ def install_puppets(app: App) -> None:
     app.add_plugin(install_fk)
 
 
+_PROFILES: dict[tuple[object, ...], RagdollProfile] = {}
+
+
+def _profile(sk: Skeleton) -> RagdollProfile:
+    """The default ragdoll profile of a skeleton, made once per skeleton shape: a profile is
+    immutable, and a crowd of a thousand would otherwise build a thousand equal ones (~2 ms each)."""
+    key = (sk.names, *(np.asarray(a, dtype=np.float64).tobytes() for a in (sk.parents, sk.offsets, sk.radii, sk.tips)))
+    if key not in _PROFILES:
+        _PROFILES[key] = default_profile(sk)
+    return _PROFILES[key]
+
+
 def spawn_puppet(
     world: World,
     position: ArrayLike = (0.0, 0.0, 0.0),
@@ -102,7 +114,7 @@ def spawn_puppet(
         LocalPose(rest_root, rotations),
         LocomotionPlayer(library_key=library_key, scale=scale),
         IKRequest(grounding=True),
-        Ragdoll(default_profile(sk), mode=RagdollMode.ANIMATED),
+        Ragdoll(_profile(sk), mode=RagdollMode.ANIMATED),
         PoseOverride(),
         PuppetBody(tuning=tuning, heading=float(heading), target=pos.copy(), target_height=tuning.stand_height),
         Grabbable(radius=0.45 * tuning.stand_height, kind="puppet", offset=np.array([0.0, tuning.stand_height, 0.0])),

@@ -22,7 +22,7 @@ def test_held_chest_hangs_and_swings(make_app: Callable[..., tuple[App, int]], s
     for _ in range(180):
         app.step()
     pos = pw.body_positions(e)
-    site = pw.data.site("rd1_chest_hold").xpos
+    site = pw.data.site(pw.mujoco_name(e, "chest_hold")).xpos
     assert np.linalg.norm(site - target) < 0.1  # held by the spring, sagging a little under the weight
     assert pos[foot, 1] < pos[chest, 1] - 0.8  # the rest dangles below
     # move the hand sideways: the legs lag behind, then swing
@@ -36,7 +36,7 @@ def test_held_chest_hangs_and_swings(make_app: Callable[..., tuple[App, int]], s
     assert xs_arr.max() > 0.8  # swung past the hand's new position
     rd.release()
     app.step()
-    assert not pw.data.eq_active[pw.model.eq("rd1_chest_hold").id]
+    assert not pw.data.eq_active[pw.model.eq(pw.mujoco_name(e, "chest_hold")).id]
     with pytest.raises(KeyError, match="holdable"):
         rd.grab("l_foot", target)
 

@@ -1,0 +1,183 @@
+"""Building the physics model and lending its pool slots: the half of
+:class:`~engine.ragdoll.physics.PhysicsWorld` that changes what MuJoCo holds.
+
+A mixin, apart because it is the one place that compiles: :meth:`Building._compile` renders the
+pool (:mod:`engine.ragdoll._pool`) and the props into one model, carrying every state by name;
+:meth:`Building._assign` lends slots to ragdolls that joined the simulation, parks those that
+left, and grows the pool (by what is needed and a quarter more) when more need it at once than it holds.
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+import mujoco
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.ragdoll._carry import restore, snapshot
+from engine.ragdoll._guard import velocity_limits
+from engine.ragdoll._layout import Layout, build_layout, select
+from engine.ragdoll._pool import CHUNK, INITIAL, MAX_SLOTS, RagdollPool, park, settle, wake
+from engine.ragdoll._slots import PropSlot, RagdollSlot
+from engine.ragdoll.mjcf import build_mjcf, prop_name
+
+__all__ = ["Building"]
+
+_F = NDArray[np.float64]
+
+
+class Building:
+    """Compiling the pool and props, and lending pool slots (state lives on the physics world)."""
+
+    model: mujoco.MjModel | None
+    data: mujoco.MjData | None
+    layout: Layout | None
+    timestep: float
+    ground_friction: float
+    rebuilds: int
+    left_out: int
+    _ragdolls: dict[int, RagdollSlot]
+    _props: dict[int, PropSlot]
+    _pool: RagdollPool
+    _pool_layout: Layout | None
+    _dirty: bool
+    _sized: bool
+    _moved: bool
+    _digest: bytes
+    _ke: _F | None
+    _read: tuple[_F, _F] | None
+    _limit: _F
+    _owners: NDArray[np.int64]
+
+    def _place(self, key: int, root: _F, rot: _F, before: tuple[_F, _F] | None = None) -> None:
+        raise NotImplementedError
+
+    def _size_pool(self) -> None:
+        """At first sight of a crowd of a kind, room for ``min(its ragdolls, INITIAL)`` at once
+        (see :mod:`._pool`), so that its first falls compile nothing."""
+        self._sized = True
+        counts: dict[bytes, int] = {}
+        first: dict[bytes, RagdollSlot] = {}
+        for k in sorted(self._ragdolls):
+            s = self._ragdolls[k]
+            counts[s.kind] = counts.get(s.kind, 0) + 1
+            first.setdefault(s.kind, s)
+        for kind, n in counts.items():  # a lone ragdoll gets its slot at its first fall (one compile)
+            if n > 1 and self._pool.count(kind) == 0 and self._pool.grow_to(first[kind].spec, min(n, INITIAL)):
+                self._dirty = True
+
+    def _compile(self) -> None:
+        """Compile the pool and the props into a new model, carrying every state over by name."""
+        self._dirty = False
+        self._moved = True
+        old = snapshot(self.model, self.data)
+        self._ke = self._read = None
+        if not self._pool.slots and not self._props:
+            self.model = self.data = self.layout = self._pool_layout = None
+            return
+        rd = [s.fragment for s in self._pool.slots]
+        pr = [self._props[k].spec for k in sorted(self._props)]
+        xml = build_mjcf(rd, pr, self.timestep, self.ground_friction, sleep=bool(rd))
+        m = self.model = mujoco.MjModel.from_xml_string(xml)
+        d = self.data = mujoco.MjData(m)
+        self._digest = hashlib.blake2b(xml.encode(), digest_size=16).digest()
+        self.rebuilds += 1
+        pool = self._pool_layout = build_layout(m, rd)
+        for key, ps in self._props.items():
+            n = prop_name(key)
+            j = m.joint(n).id
+            ps.qadr, ps.dadr = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+            ps.geom, ps.body = m.geom(n).id, m.body(n).id
+        self._limit = velocity_limits(m)
+        self._owners = np.full(m.nv, -1, dtype=np.int64)
+        for p, (a, b) in enumerate(pool.dofs):
+            self._owners[a:b] = p
+        for k, ps in enumerate(self._props.values()):
+            self._owners[ps.dadr:ps.dadr + 6] = len(pool.keys) + k
+        restore(m, d, old)
+        m.tree_sleep_policy[:] = int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER)  # props and borrowed slots
+        for i, ps_ in enumerate(self._pool.slots):
+            if ps_.owner is None:
+                park(m, d, pool, i)
+            else:
+                wake(m, d, pool, i)
+        for ps in self._props.values():
+            if ps.init is not None:
+                pos, rot, vel = ps.init
+                d.qpos[ps.qadr:ps.qadr + 7] = np.concatenate([pos, rot])
+                d.qvel[ps.dadr:ps.dadr + 6] = vel
+                ps.init = None
+
+    def _assign(self) -> None:
+        """Park the slots of ragdolls that left, lend slots to those that joined (growing the pool
+        when a kind has too few: to what is needed and a quarter more), and place the newcomers (see :mod:`._pool`)."""
+        self._moved = False
+        order = sorted(self._ragdolls)
+        for k in order:
+            slot = self._ragdolls[k]
+            if not slot.in_model and slot.pool >= 0:
+                self._give_back(slot)
+        # simulated ragdolls first, then the animated ones near them; past MAX_SLOTS of a kind the
+        # rest stay out this step (an animated one then passes through, it does not crash the game)
+        joining = sorted((k for k in order if self._ragdolls[k].in_model and self._ragdolls[k].pool < 0),
+                         key=lambda k: (self._ragdolls[k].cmd.kinematic, k))
+        short: dict[bytes, int] = {}
+        for k in joining:
+            short[self._ragdolls[k].kind] = short.get(self._ragdolls[k].kind, 0) + 1
+        for k in joining:
+            slot = self._ragdolls[k]
+            need = short.pop(slot.kind, 0)
+            free, have = self._pool.free(slot.kind), self._pool.count(slot.kind)
+            if need > free and have < MAX_SLOTS:
+                # a quarter of headroom over what is needed now (more joiners usually follow a fall):
+                # compiling is superlinear in the pool's size, so doubling would cost more than it saves
+                self._pool.grow_to(slot.spec, min(MAX_SLOTS, max(have + CHUNK, -(-5 * (have - free + need) // 4))))
+                self._dirty = True
+        room = {kind: 0 for kind in {self._ragdolls[k].kind for k in joining}}
+        self.left_out = 0
+        for k in joining:
+            slot = self._ragdolls[k]
+            if room[slot.kind] >= self._pool.free(slot.kind):
+                slot.in_model = False
+                self.left_out += 1
+            else:
+                room[slot.kind] += 1
+        if self._dirty:
+            self._compile()
+            self._moved = False
+        self._ke = self._read = None
+        if self.model is None or self.data is None or self._pool_layout is None:
+            self.layout = None
+            return
+        m, d, pool = self.model, self.data, self._pool_layout
+        for k in order:
+            slot = self._ragdolls[k]
+            if slot.in_model and slot.pool < 0:
+                taken = self._pool.take(slot.kind, k)
+                assert taken is not None
+                slot.pool = taken
+                wake(m, d, pool, taken)
+        keys = [k for k in order if self._ragdolls[k].pool >= 0]
+        self.layout = select(pool, [self._ragdolls[k].pool for k in keys], keys)
+        for key in keys:
+            slot = self._ragdolls[key]
+            if not slot.placed:
+                # joining from outside: where its animation was a step ago, moving as it moved then
+                # (as if it had been simulated all along), so it keeps its momentum
+                last, prev = slot.cmd.last, slot.prev
+                if last is None:
+                    self._place(key, slot.cmd.root, slot.cmd.rot)
+                else:
+                    self._place(key, last[0], last[1], prev)
+                slot.cmd.last, slot.placed = last, True
+        settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
+        mujoco.mj_forward(m, d)
+
+    def _give_back(self, slot: RagdollSlot) -> None:
+        """Return a ragdoll's pool slot: parked, asleep, free for the next one of its kind."""
+        if self.model is not None and self.data is not None and self._pool_layout is not None:
+            park(self.model, self.data, self._pool_layout, slot.pool)
+        self._pool.release(slot.pool)
+        slot.pool = -1
+        self._moved = True

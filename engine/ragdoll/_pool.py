@@ -1,0 +1,195 @@
+"""The ragdoll pool: MuJoCo bodies compiled once and lent to puppets, so joining costs no compile.
+
+Compiling MJCF is the slow part of physics (a 17-body ragdoll costs ~8 ms, 400 of them 33 s and
+1000 run out of memory), and a crowd changes who is simulated every time a ball rolls by or a
+puppet falls. So the model holds a *pool* of ragdoll slots per kind of ragdoll (same skeleton,
+profile and bone offsets render the same bodies), each under its own stable names
+(``rd<slot>_…``). A puppet that must be simulated borrows a free slot of its kind: its pose and
+velocity are copied in and the slot is woken; a puppet that leaves gives the slot back, which is
+*parked*: no contacts (``contype = conaffinity = 0``), no muscles, no constraints, at rest, and
+put to sleep with MuJoCo's sleeping (``mjENBL_SLEEP``), so its bodies cost almost nothing per
+step (MuJoCo skips sleeping trees in every stage; ~2-3 µs per parked ragdoll per substep here).
+
+Slots are added in chunks (:func:`grow_to`): the first build of a crowd holds enough for
+``min(ragdolls of the kind, INITIAL)``, and only when more are needed at once than the pool holds
+does it grow, to what is needed and a quarter more (one compile, carrying every state by name;
+compiling is superlinear in the pool's size, so doubling cost more than it saved), never once per join, up to
+:data:`MAX_SLOTS`; past that the simulated ragdolls are served first and the animated ones that
+would only be pushed by them wait outside (:attr:`PhysicsWorld.left_out`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from engine.ragdoll._layout import Layout
+from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, ragdoll_fragment, rd_name
+
+__all__ = ["CHUNK", "INITIAL", "MAX_SLOTS", "PoolSlot", "RagdollPool", "kind_of", "park", "settle", "update_sleep", "wake"]
+
+CHUNK = 4  # slots: the pool grows in multiples of this
+INITIAL = 96  # slots of a kind compiled at a crowd's first build at most: ten of a hundred falling pull ~60 in
+MAX_SLOTS = 128  # slots of a kind at most: compiling 128 costs ~1.4 s, 256 ~7 s, ~1000 cannot be allocated
+_TEMPLATE = -1  # the key a kind's template is rendered under before its names are replaced
+_AWAKE = -(1 + mujoco.mjMINAWAKE)
+_PARK = np.array([0.0, -50.0, 0.0])  # m: under the field, out of every contact
+
+
+def kind_of(spec: RagdollSpec) -> bytes:
+    """What makes two ragdolls' bodies identical: skeleton, profile and bone offsets."""
+    sk, pr = spec.skeleton, spec.profile
+    h = hashlib.blake2b(digest_size=16)
+    h.update("\0".join(sk.names).encode())
+    parts = [np.asarray(sk.parents), np.asarray(sk.tips, dtype=np.float64), spec.offsets, pr.radii, pr.masses,
+             pr.hinge_axis, pr.hinge_range, pr.cone, pr.twist]
+    for a in parts:
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    h.update(repr((pr.kinds, pr.holdable, pr.frequency, pr.damping_ratio, pr.joint_damping, pr.friction)).encode())
+    return h.digest()
+
+
+@dataclass
+class PoolSlot:
+    """One compiled ragdoll in the model, free or lent to puppet ``owner``."""
+
+    kind: bytes
+    fragment: RagdollFragment
+    owner: int | None = None
+
+
+class RagdollPool:
+    """The slots in compile order (slot ``i`` is named ``rd<i>_…`` in MuJoCo)."""
+
+    def __init__(self) -> None:
+        self.slots: list[PoolSlot] = []
+        self._templates: dict[bytes, RagdollFragment] = {}
+
+    def count(self, kind: bytes) -> int:
+        """Slots of a kind."""
+        return sum(s.kind == kind for s in self.slots)
+
+    def free(self, kind: bytes) -> int:
+        """Free slots of a kind."""
+        return sum(s.kind == kind and s.owner is None for s in self.slots)
+
+    def grow_to(self, spec: RagdollSpec, size: int) -> bool:
+        """Make room for ``size`` slots of ``spec``'s kind (rounded up to :data:`CHUNK`); whether it grew."""
+        kind = kind_of(spec)
+        have = self.count(kind)
+        want = -(-size // CHUNK) * CHUNK
+        if have >= want:
+            return False
+        if kind not in self._templates:  # rendered once per kind: only names differ between slots
+            self._templates[kind] = ragdoll_fragment(dataclasses.replace(spec, key=_TEMPLATE))
+        tpl = self._templates[kind]
+        old = rd_name(_TEMPLATE, "")
+        for _ in range(want - have):
+            i = len(self.slots)
+            new = rd_name(i, "")
+            frag = RagdollFragment(dataclasses.replace(tpl.spec, key=i),
+                                   *(tuple(line.replace(old, new) for line in lines)
+                                     for lines in (tpl.body, tpl.contact, tpl.equality, tpl.actuator)),
+                                   tpl.kp, tpl.kv)
+            self.slots.append(PoolSlot(kind, frag))
+        return True
+
+    def take(self, kind: bytes, owner: int) -> int | None:
+        """Lend the lowest free slot of a kind to ``owner`` (``None`` when the kind has none free)."""
+        for i, s in enumerate(self.slots):
+            if s.kind == kind and s.owner is None:
+                s.owner = owner
+                return i
+        return None
+
+    def release(self, i: int) -> None:
+        """Give slot ``i`` back."""
+        self.slots[i].owner = None
+
+
+def update_sleep(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+    """Recompute MuJoCo's awake arrays from ``d.tree_asleep`` (its ``mj_updateSleep``, which the
+    bindings do not expose): without it a tree put to sleep by hand is simulated anyway and woken
+    at the next step as "perturbed"."""
+    awake = np.asarray(d.tree_asleep) < 0
+    d.tree_awake[:] = awake
+    d.ntree_awake = int(awake.sum())
+    tree = m.body_treeid
+    mocap = m.body_mocapid[m.body_rootid] >= 0
+    state = np.where(tree < 0, np.where(mocap, int(mujoco.mjtSleepState.mjS_AWAKE), int(mujoco.mjtSleepState.mjS_STATIC)),
+                     awake[np.maximum(tree, 0)].astype(np.int32))
+    d.body_awake[:] = state
+    ind = np.nonzero(state != 0)[0]
+    d.body_awake_ind[:len(ind)] = ind
+    d.nbody_awake = len(ind)
+    par = np.nonzero(state[m.body_parentid] != 0)[0]
+    par = par[par > 0]
+    d.parent_awake_ind[:len(par)] = par
+    d.nparent_awake = len(par)
+    b = m.dof_bodyid
+    dofs = np.nonzero((tree[b] >= 0) & (state[b] == 1))[0]
+    d.dof_awake_ind[:len(dofs)] = dofs
+    d.nv_awake = len(dofs)
+
+
+def _slot_ids(m: mujoco.MjModel, pool: Layout, slot: int) -> tuple[int, np.ndarray, np.ndarray]:
+    """The tree, actuators and equality constraints of pool slot ``slot`` (``pool``: the layout of every slot)."""
+    acts = pool.act[pool.act_owner == slot]
+    eqs = np.array([int(pool.pin_eq[slot]), *pool.hold_eq[slot].values()], dtype=np.int64)
+    return int(m.body_treeid[pool.body[pool.starts[slot]]]), acts, eqs
+
+
+def park(m: mujoco.MjModel, d: mujoco.MjData, pool: Layout, slot: int) -> None:
+    """Take slot ``slot`` out of the simulation: under the field at rest, nothing touching it,
+    no muscle or constraint (:func:`settle` then puts it to sleep)."""
+    tree, acts, eqs = _slot_ids(m, pool, slot)
+    b0, nb = int(m.tree_bodyadr[tree]), int(m.tree_bodynum[tree])
+    v0, nv = int(m.tree_dofadr[tree]), int(m.tree_dofnum[tree])
+    geoms = np.nonzero((m.geom_bodyid >= b0) & (m.geom_bodyid < b0 + nb))[0]
+    m.geom_contype[geoms] = 0
+    m.geom_conaffinity[geoms] = 0
+    m.actuator_gainprm[acts, 0] = 0.0
+    m.actuator_biasprm[acts, :3] = 0.0
+    d.eq_active[eqs] = 0
+    d.xfrc_applied[b0:b0 + nb] = 0.0
+    d.qfrc_applied[v0:v0 + nv] = 0.0
+    jnts = np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]
+    for j in jnts:  # the rest pose, parked apart from every other slot
+        q = int(m.jnt_qposadr[j])
+        if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+            d.qpos[q:q + 7] = [*(_PARK + [4.0 * slot, 0.0, 0.0]), 1.0, 0.0, 0.0, 0.0]
+        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
+            d.qpos[q:q + 4] = [1.0, 0.0, 0.0, 0.0]
+        else:
+            d.qpos[q] = 0.0
+    d.qvel[v0:v0 + nv] = 0.0
+    d.qacc_warmstart[v0:v0 + nv] = 0.0
+    m.tree_sleep_policy[tree] = int(mujoco.mjtSleepPolicy.mjSLEEP_ALLOWED)
+    d.tree_asleep[tree] = _AWAKE  # until :func:`settle` puts it to sleep where it now is
+
+
+def wake(m: mujoco.MjModel, d: mujoco.MjData, pool: Layout, slot: int) -> None:
+    """Put slot ``slot`` back into the simulation (it never falls asleep by itself: a ragdoll lying
+    still must still answer its muscles; :func:`settle` applies it)."""
+    tree, _, _ = _slot_ids(m, pool, slot)
+    m.tree_sleep_policy[tree] = int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER)
+    d.tree_asleep[tree] = _AWAKE
+
+
+def settle(m: mujoco.MjModel, d: mujoco.MjData, free: list[int], pool: Layout) -> None:
+    """Put the free slots ``free`` to sleep where :func:`park` left them, everything else awake.
+
+    MuJoCo wakes a sleeping tree whose body poses do not match its ``qpos`` (it takes that for a
+    push from outside), so the parked poses go through kinematics awake first, then sleep.
+    """
+    trees = np.array([int(m.body_treeid[pool.body[pool.starts[i]]]) for i in free], dtype=np.int64)
+    asleep = np.asarray(d.tree_asleep)
+    asleep[trees[asleep[trees] >= 0]] = _AWAKE
+    update_sleep(m, d)
+    mujoco.mj_kinematics(m, d)
+    d.tree_asleep[trees] = trees  # each a sleep cycle of one tree
+    update_sleep(m, d)

@@ -1,0 +1,123 @@
+"""The ragdoll pool: joining and leaving the simulation is a state copy and a sleep flag, never a compile."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from engine import quat
+from engine.ragdoll import _building as building_module
+from engine.ragdoll import default_profile
+from engine.ragdoll.physics import PhysicsWorld
+from engine.skeleton import Skeleton
+
+
+def _crowd(skeleton: Skeleton, n: int) -> PhysicsWorld:
+    pw = PhysicsWorld()
+    pr = default_profile(skeleton)
+    for k in range(n):
+        pw.add_ragdoll(k + 1, skeleton, pr, [6.0 * k, 1.0, 0.0], quat.identity(skeleton.num_joints))
+    return pw
+
+
+def _drive(pw: PhysicsWorld, skeleton: Skeleton, falling: set[int]) -> None:
+    """Keys in ``falling`` go limp (simulated); the others stand, animated, too far apart to touch."""
+    rot = quat.identity(skeleton.num_joints)
+    for k in pw.ragdoll_keys:
+        root = np.array([6.0 * (k - 1), 1.0, 0.0])
+        if k in falling:
+            pw.drive(k, root, rot, 0.0, 0.0)
+        else:
+            pw.drive(k, root, rot, 1.0, 1.0, kinematic=True)
+
+
+def test_joining_and_leaving_compiles_nothing(skeleton: Skeleton) -> None:
+    pw = _crowd(skeleton, 6)
+    _drive(pw, skeleton, set())
+    pw.step()
+    assert pw.rebuilds == 1 and pw.model is not None and pw.data is not None
+    assert pw.asleep() == 8 and pw.data.ntree_awake == 0  # 6 rounded up to a chunk, all parked
+    for falling in ({1, 2}, {2, 3, 4}, set(), {1, 6}, {5}):
+        _drive(pw, skeleton, falling)
+        pw.step()
+        assert {k for k in pw.ragdoll_keys if pw.in_model(k)} == falling
+        assert pw.data.ntree_awake == len(falling)  # the parked slots cost no dynamics
+    assert pw.rebuilds == 1
+
+
+def test_a_parked_slot_stays_where_it_was_parked(skeleton: Skeleton) -> None:
+    pw = _crowd(skeleton, 2)
+    _drive(pw, skeleton, {1})
+    for _ in range(30):
+        pw.step()
+    d = pw.data
+    assert d is not None
+    parked = np.asarray(d.tree_asleep) >= 0
+    assert parked.sum() == 3
+    before = d.qpos.copy()
+    for _ in range(30):
+        pw.step()
+    m = pw.model
+    assert m is not None
+    for t in np.nonzero(parked)[0]:  # asleep: not one number of a parked ragdoll moved under gravity
+        b0 = m.tree_bodyadr[t]
+        j = np.nonzero(m.jnt_bodyid == b0)[0][0]
+        q = m.jnt_qposadr[j]
+        np.testing.assert_array_equal(d.qpos[q:q + 7], before[q:q + 7])
+
+
+def test_the_pool_grows_once_when_more_fall_at_once(skeleton: Skeleton,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(building_module, "INITIAL", 4)
+    pw = _crowd(skeleton, 10)
+    _drive(pw, skeleton, set())
+    pw.step()
+    assert pw.rebuilds == 1 and pw.asleep() == 4
+    _drive(pw, skeleton, set(range(1, 7)))  # six at once: one growth, to 8 (six and a quarter, in chunks of 4)
+    for _ in range(3):
+        pw.step()
+    assert pw.rebuilds == 2 and pw.model is not None
+    assert pw.model.ntree == 8 and pw.asleep() == 2
+
+
+def test_a_fall_replays_bit_for_bit(skeleton: Skeleton) -> None:
+    def run() -> list[bytes]:
+        pw = _crowd(skeleton, 4)
+        out = []
+        for step in range(40):
+            _drive(pw, skeleton, {2, 3} if 5 <= step < 30 else set())
+            pw.step()
+            out.append(pw.state_bytes())
+        return out
+
+    a, b = run(), run()
+    assert a == b
+    assert len(set(a)) > 20  # the state did change: a fall, then the slots parked again
+
+
+def test_a_joining_ragdoll_keeps_its_place_and_motion(skeleton: Skeleton) -> None:
+    pw = _crowd(skeleton, 3)
+    _drive(pw, skeleton, set())
+    pw.step()
+    _drive(pw, skeleton, {3})
+    pw.step()
+    root = pw.pose(3).root
+    assert abs(root[0] - 12.0) < 0.01 and abs(root[1] - 1.0) < 0.05  # where its animation was, not parked
+    m = pw.model
+    assert m is not None
+    tree = m.body_treeid[m.body(pw.mujoco_name(3, "hips")).id]  # lying still, it must still answer its muscles
+    assert m.tree_sleep_policy[tree] == mujoco.mjtSleepPolicy.mjSLEEP_NEVER
+
+
+def test_a_crowd_standing_steps_no_mujoco_at_all(skeleton: Skeleton) -> None:
+    pw = _crowd(skeleton, 3)
+    _drive(pw, skeleton, set())
+    pw.step()
+    assert pw.data is not None
+    t = pw.data.time
+    pw.step()
+    assert pw.data.time == t  # every slot parked: the step skipped mj_step
+    _drive(pw, skeleton, {2})
+    pw.step()
+    assert pw.data.time == pytest.approx(t + pw.dt)
