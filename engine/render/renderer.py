@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import moderngl
@@ -161,6 +162,12 @@ class Renderer:
         self.timings: dict[str, float] = {}
         self._mark_t = 0.0
 
+    def _skinned_casters(self, scene: RenderScene) -> Callable[[NDArray[np.float64]], None] | None:
+        """The skinned characters' draw into the shadow map, when the scene has any."""
+        if not scene.skinned:
+            return None
+        return lambda light_vp: self.skinned.draw_depth(scene.skinned, light_vp)
+
     def _keep(self, bufs: tuple[moderngl.Buffer, ...]) -> tuple[moderngl.Buffer, ...]:
         self._buffers += list(bufs)
         return bufs
@@ -230,7 +237,8 @@ class Renderer:
         rect = ground_rect(scene) if light_vp is not None else None
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
-            self.shadows.render(scene, {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}, light_vp, rect)
+            self.shadows.render(scene, {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}, light_vp, rect,
+                                more_casters=self._skinned_casters(scene))
         self._mark("shadows")
 
         target.use()

@@ -181,6 +181,21 @@ class SkinnedInstance:
     meshes: SkinnedMeshes
     matrices: NDArray[np.float64]
 
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(lo, hi)`` around the posed character, from about 128 skinned vertices of each primitive
+        (padded by a tenth of the extent for the vertices between the samples): what the sun's
+        shadow frustum must hold, at a fraction of skinning the whole mesh."""
+        points = []
+        for prim in self.meshes.primitives:
+            step = max(1, len(prim.positions) // 128)
+            m = np.einsum("vk,vkij->vij", prim.weights[::step].astype(np.float64),
+                          np.asarray(self.matrices, dtype=np.float64)[prim.joints[::step].astype(np.int64)])
+            points.append(np.einsum("vij,vj->vi", m[:, :3, :3], prim.positions[::step].astype(np.float64)) + m[:, :3, 3])
+        every = np.vstack(points)
+        lo, hi = every.min(axis=0), every.max(axis=0)
+        pad = 0.1 * (hi - lo).max()
+        return lo - pad, hi + pad
+
 
 @dataclass
 class RenderScene:
@@ -361,8 +376,13 @@ class RenderScene:
 
     # -- views ------------------------------------------------------------------------
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-        """``(lo [3], hi [3])`` of every shadow caster (capsules, spheres, cones, boxes), ``None`` if empty."""
+        """``(lo [3], hi [3])`` of every shadow caster (capsules, spheres, cones, boxes, skinned characters),
+        ``None`` if empty."""
         los, his = [], []
+        for character in self.skinned:
+            lo, hi = character.bounds()
+            los.append(lo[None])
+            his.append(hi[None])
         for rows in (self.capsules, self.spheres):
             d = rows.data
             if len(d):

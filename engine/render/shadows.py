@@ -13,6 +13,8 @@ so their resolution goes where the puppets are.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import moderngl
 import numpy as np
 from numpy.typing import NDArray
@@ -142,11 +144,13 @@ class Shadows:
         self._mask_fbo = ctx.framebuffer([self.mask])
 
     def render(self, scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
-               light_vp: NDArray[np.float64], rect: tuple[float, float, float, float]) -> None:
+               light_vp: NDArray[np.float64], rect: tuple[float, float, float, float],
+               more_casters: Callable[[NDArray[np.float64]], None] | None = None) -> None:
         """Draw the object shadow map and the ground mask for this frame.
 
         ``casters`` maps "capsules" and "spheres" to the scene's rows and the level each
-        is drawn at for the camera. In the shadow map a caster is one level coarser than
+        is drawn at for the camera; ``more_casters(light_vp)`` draws what else casts (skinned
+        characters) into the bound depth map. In the shadow map a caster is one level coarser than
         on screen (or coarser still if its texels allow): a coarser caster's faces lie
         inside the surface drawn, which keeps the PCF taps on curved, sun-facing surfaces
         from shadowing the surface itself in blotches (acne); a finer one stands outside it.
@@ -167,6 +171,8 @@ class Shadows:
             self._box_vao.render(moderngl.TRIANGLES, instances=self._boxes.count)
         if self._cone_vao is not None and self._cones is not None and self._cones.count:
             self._cone_vao.render(moderngl.TRIANGLES, instances=self._cones.count)
+        if more_casters is not None:
+            more_casters(light_vp)
         self._mask_fbo.use()
         ctx.enable_only(moderngl.NOTHING)
         mask = self._programs["mask"]

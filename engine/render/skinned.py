@@ -93,11 +93,12 @@ class _PrimitiveGPU:
     """Buffers, vertex arrays and base-colour texture of one primitive."""
 
     def __init__(self, ctx: moderngl.Context, prim: SkinnedPrimitive, lit: moderngl.Program,
-                 feedback: moderngl.Program) -> None:
+                 feedback: moderngl.Program, depth: moderngl.Program) -> None:
         self.vbo = ctx.buffer(_vertices(prim))
         self.ibo = ctx.buffer(np.ascontiguousarray(prim.indices, dtype=np.uint32).tobytes())
         self.lit = ctx.vertex_array(lit, [(self.vbo, *_VERTEX_FMT)], self.ibo, 4, skip_errors=True)
         self.feedback = ctx.vertex_array(feedback, [(self.vbo, *_VERTEX_FMT)], skip_errors=True)
+        self.depth = ctx.vertex_array(depth, [(self.vbo, *_VERTEX_FMT)], self.ibo, 4, skip_errors=True)
         img = prim.texture if prim.texture is not None else np.full((1, 1, 4), 255, dtype=np.uint8)
         self.texture = ctx.texture((img.shape[1], img.shape[0]), 4, np.ascontiguousarray(img).tobytes())
         if prim.texture is not None:
@@ -107,7 +108,7 @@ class _PrimitiveGPU:
         self.vertices = len(prim.positions)
 
     def release(self) -> None:
-        for obj in (self.lit, self.feedback, self.vbo, self.ibo, self.texture):
+        for obj in (self.lit, self.feedback, self.depth, self.vbo, self.ibo, self.texture):
             obj.release()
 
 
@@ -122,6 +123,7 @@ class SkinnedDraw:
         self.ctx = ctx
         self.lit = lit
         self.feedback = ctx.program(vertex_shader=S.HEADER + SKIN_VS, varyings=["v_pos"])
+        self.depth = ctx.program(vertex_shader=S.HEADER + SKIN_VS, fragment_shader=S.HEADER + S.DEPTH_FS)
         self._meshes: dict[int, tuple[SkinnedMeshes, list[_PrimitiveGPU]]] = {}
         self._joints: moderngl.Texture | None = None
         # Transform feedback still issues a draw call, which needs a bound framebuffer (a
@@ -131,7 +133,7 @@ class SkinnedDraw:
     def _gpu(self, meshes: SkinnedMeshes) -> list[_PrimitiveGPU]:
         key = id(meshes)
         if key not in self._meshes:  # the meshes object is kept with its copies, so its id stays its own
-            prims = [_PrimitiveGPU(self.ctx, p, self.lit, self.feedback) for p in meshes.primitives]
+            prims = [_PrimitiveGPU(self.ctx, p, self.lit, self.feedback, self.depth) for p in meshes.primitives]
             self._meshes[key] = (meshes, prims)
         return self._meshes[key][1]
 
@@ -147,24 +149,36 @@ class SkinnedDraw:
             self._joints.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self._joints.write(cols.tobytes())
         self._joints.use(location=_JOINT_TEX_UNIT)
-        for prog in (self.lit, self.feedback):
+        for prog in (self.lit, self.feedback, self.depth):
             set_uniform(prog, "u_joint_tex", _JOINT_TEX_UNIT)
             set_uniform(prog, "u_joint_count", k)
         return k
 
+    @staticmethod
+    def _by_mesh(instances: list[SkinnedInstance]) -> list[tuple[SkinnedMeshes, NDArray[np.float64]]]:
+        """The instances grouped by mesh: each mesh once, with the ``[n,K,4,4]`` matrices of its instances."""
+        groups: dict[int, list[SkinnedInstance]] = {}
+        for inst in instances:
+            groups.setdefault(id(inst.meshes), []).append(inst)
+        return [(g[0].meshes, np.stack([np.asarray(i.matrices, dtype=np.float64) for i in g])) for g in groups.values()]
+
     def draw(self, instances: list[SkinnedInstance]) -> None:
         """Draw every instance (depth-tested, back faces culled as the caller set); one draw per mesh primitive."""
-        by_mesh: dict[int, list[SkinnedInstance]] = {}
-        for inst in instances:
-            by_mesh.setdefault(id(inst.meshes), []).append(inst)
-        for group in by_mesh.values():
-            matrices = np.stack([np.asarray(i.matrices, dtype=np.float64) for i in group])
+        for meshes, matrices in self._by_mesh(instances):
             self._upload_joints(matrices)
             set_uniform(self.lit, "u_base", _BASE_TEX_UNIT)
-            for prim in self._gpu(group[0].meshes):
+            for prim in self._gpu(meshes):
                 prim.texture.use(location=_BASE_TEX_UNIT)
                 set_uniform(self.lit, "u_base_factor", prim.color)
-                prim.lit.render(moderngl.TRIANGLES, instances=len(group))
+                prim.lit.render(moderngl.TRIANGLES, instances=len(matrices))
+
+    def draw_depth(self, instances: list[SkinnedInstance], view_proj: NDArray[np.float64]) -> None:
+        """Draw every instance's depth only, seen through ``view_proj`` (the sun's shadow map)."""
+        set_uniform(self.depth, "u_view_proj", view_proj)
+        for meshes, matrices in self._by_mesh(instances):
+            self._upload_joints(matrices)
+            for prim in self._gpu(meshes):
+                prim.depth.render(moderngl.TRIANGLES, instances=len(matrices))
 
     def skinned_positions(self, instance: SkinnedInstance) -> list[NDArray[np.float32]]:
         """What the vertex shader computes for each primitive's vertices ``[V,3]`` (transform feedback)."""
@@ -188,6 +202,7 @@ class SkinnedDraw:
                 p.release()
         self._meshes.clear()
         self.feedback.release()
+        self.depth.release()
         self._scratch.release()
         if self._joints is not None:
             self._joints.release()

@@ -103,13 +103,14 @@ def test_a_textured_character_shows_where_the_camera_projects_it(gl, mocap_dir: 
     cam = OrbitCamera(target=np.array([0.0, 0.8, 0.0]), yaw=0.0, pitch=0.1, distance=2.6)
     gl.camera = cam
     empty = RenderScene()
+    empty.sun.shadows = False  # the silhouette alone (its shadow is the next test's)
     gl.draw(empty)
     background = gl.read_pixels().astype(np.int32)
     scene = RenderScene()
+    scene.sun.shadows = False
     scene.skinned.append(SkinnedInstance(meshes, skin_matrices(asset, node_world_matrices(asset))))
     gl.draw(scene)
     image = gl.read_pixels().astype(np.int32)
-    Path("/tmp/skinned_cesium.png").parent.mkdir(exist_ok=True)
     changed = np.abs(image - background).sum(axis=2) > 40
     # The figure covers a tall, narrow region around the screen centre, from the feet to the head.
     ys, xs = np.nonzero(changed)
@@ -122,3 +123,23 @@ def test_a_textured_character_shows_where_the_camera_projects_it(gl, mocap_dir: 
     assert len(np.unique(colours, axis=0)) > 40
     # Nothing drawn far to the side of the figure.
     assert not changed[:, : W // 8].any() and not changed[:, -W // 8:].any()
+
+
+def test_a_character_casts_its_shadow_on_the_ground(gl, mocap_dir: Path) -> None:
+    path = mocap_dir / "CesiumMan.glb"
+    asset = read_gltf(path)
+    meshes = read_skinned_meshes(path)
+    gl.camera = OrbitCamera(target=np.array([0.0, 0.6, 0.0]), yaw=0.6, pitch=0.5, distance=3.5)
+
+    def frame(character: bool, shadows: bool) -> np.ndarray:
+        scene = RenderScene()
+        scene.sun.shadows = shadows
+        if character:
+            scene.skinned.append(SkinnedInstance(meshes, skin_matrices(asset, node_world_matrices(asset))))
+        gl.draw(scene)
+        return gl.read_pixels().astype(np.int32)
+
+    empty = frame(False, False)
+    figure = np.abs(frame(True, False) - empty).sum(axis=2) > 30  # the character's own pixels
+    darker = (frame(True, False) - frame(True, True)).sum(axis=2) > 30  # what the sun's shadow darkens
+    assert (darker & ~figure).sum() > 300  # on the ground beside the figure, not only on itself
