@@ -46,8 +46,8 @@ from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.quality import QUALITIES, Quality
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, CONE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
-from engine.render.skinned import SKIN_FS, SKIN_VS, SkinnedDraw
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
+from engine.render.skinned import SKIN_FS, SKIN_VS, SkinnedDraw
 from engine.render.text import TextCache, layout_text
 
 __all__ = ["Renderer"]

@@ -31,8 +31,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine.io.gltf_mesh import SkinnedMeshes
 
-__all__ = ["RenderScene", "SkinnedInstance", "Rows", "Ground", "GroundMarks", "Sun", "TextLine", "Overlay", "CAPSULE_STRIDE",
-           "BOX_STRIDE", "LINE_STRIDE", "POINT_STRIDE", "CONE_STRIDE", "PRINT_STRIDE"]
+__all__ = ["RenderScene", "SkinnedInstance", "Rows", "Ground", "GroundMarks", "Sun", "TextLine", "Overlay",
+           "CAPSULE_STRIDE", "BOX_STRIDE", "LINE_STRIDE", "POINT_STRIDE", "CONE_STRIDE", "PRINT_STRIDE"]
 
 CAPSULE_STRIDE = 11
 BOX_STRIDE = 14
@@ -190,7 +190,8 @@ class SkinnedInstance:
             step = max(1, len(prim.positions) // 128)
             m = np.einsum("vk,vkij->vij", prim.weights[::step].astype(np.float64),
                           np.asarray(self.matrices, dtype=np.float64)[prim.joints[::step].astype(np.int64)])
-            points.append(np.einsum("vij,vj->vi", m[:, :3, :3], prim.positions[::step].astype(np.float64)) + m[:, :3, 3])
+            rest = prim.positions[::step].astype(np.float64)
+            points.append(np.einsum("vij,vj->vi", m[:, :3, :3], rest) + m[:, :3, 3])
         every = np.vstack(points)
         lo, hi = every.min(axis=0), every.max(axis=0)
         pad = 0.1 * (hi - lo).max()
