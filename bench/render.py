@@ -14,6 +14,8 @@ of 3 repeats of several frames each (:func:`cpu_frame_time`):
   without a GPU falls to), against the 30 fps goal. The named peer, Panda3D drawing 100
   actors off-screen, is not installed here (no ``[peers]`` extra in this environment),
   so no peer figure is printed: the line says it was skipped.
+- ``render_fps_skinned_<n>``: 1, 10 and 100 skinned glTF characters against as many
+  mannequins in the same poses (:mod:`bench.render_skinned`).
 - ``render_fps_snowman_<quality>``: the loaded snowman game's frame at each level,
   against the 30 fps goal; ``sky_ground_ms_<quality>``: the same frame with nothing in
   it, against a clear of the screen, measured in the same run (the floor of any frame);
@@ -250,4 +252,6 @@ def run() -> list[Figure]:
         figures.append(Figure("render", "fps_unloaded_1280x720", 1.0 / t_free, "fps", "30 fps target", 30.0))
     figures.append(Figure("render", "capsules_drawn", float(len(scene.capsules)), "count"))
     figures.append(Figure("render", f"render_fps_{CROWD}_puppets", 1.0 / t_crowd, "fps", "30 fps target", 30.0))
-    return figures + quality_figures()
+    from bench.render_skinned import run as skinned_figures
+
+    return figures + quality_figures() + skinned_figures()
