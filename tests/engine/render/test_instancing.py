@@ -49,9 +49,9 @@ def test_at_low_quality_only_the_nearest_solids_cast_shadows(monkeypatch):
     seen = {}
     original = Shadows.render
 
-    def recording(self, scene, casters, light_vp, rect):
+    def recording(self, scene, casters, light_vp, rect, **more):
         seen.update({kind: rows for kind, (rows, _) in casters.items()})
-        return original(self, scene, casters, light_vp, rect)
+        return original(self, scene, casters, light_vp, rect, **more)
 
     monkeypatch.setattr(Shadows, "render", recording)
     viewer = Viewer(make_target(True, 160, 90, samples=0))
