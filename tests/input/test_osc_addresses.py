@@ -212,3 +212,16 @@ def test_the_log_filter_is_installed_once_and_drops_only_python_osc_lines(monkey
                                None)
     outside = logging.LogRecord("x", logging.WARNING, "/somewhere/else.py", 1, "m", None, None)
     assert not ours[0].filter(inside) and ours[0].filter(outside)
+
+
+def test_a_device_name_with_capitals_is_not_an_address_pattern(dec, osc) -> None:  # type: ignore[no-untyped-def]
+    """ZIG SIM puts the device's name or id in the address: ``/XPHONE/quaternion`` is a reading."""
+    message, _ = osc
+    s = dec.decode(message("/XPHONE/quaternion", 0.0, 0.0, 0.0, 1.0), "z", 0.0)
+    assert s is not None and dec.drops == []
+
+
+def test_a_long_sender_name_is_cut_in_the_detail(dec, osc) -> None:  # type: ignore[no-untyped-def]
+    message, _ = osc
+    assert dec.decode(message("/puppetphone/gyro", 0.0, 500.0, 0.0), "s" * 300, 0.0) is None
+    assert dec.drops[0][0] == "invalid sample" and len(dec.drops[0][1]) == 200
