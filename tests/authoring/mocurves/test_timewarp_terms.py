@@ -73,6 +73,19 @@ def test_the_first_keypoint_drags_its_copy_at_the_seam() -> None:
     np.testing.assert_allclose(np.diff(t), T / N, atol=1e-6)  # a pure shift
 
 
+@pytest.mark.parametrize("key", [1, N - 1])
+def test_one_drag_elsewhere_is_a_pure_shift_and_the_seam_follows(key: int) -> None:
+    """One keypoint dragged 0.02 s: every energy but E_C is zero for a shift, so the warp is one."""
+    t = _tw().solve({key: key * T / N + 0.02})
+    np.testing.assert_allclose(t, _tw().times + 0.02, atol=1e-6)
+
+
+def test_a_qp_that_does_not_finish_is_refused_with_its_status() -> None:
+    """The active set needs several iterations when the drag asks for time to run backwards."""
+    with pytest.raises(TimeWarpError, match="time-warp QP not solved: iteration limit"):
+        TimeWarp(30, 1.0, max_iter=1).solve({10: 10 / 30, 12: 4 / 30})
+
+
 def test_the_minimum_gap_holds() -> None:
     """Keypoint 6 asked to show keypoint 2's time: without a minimum the gaps before it close to 0."""
     tw = _tw()
