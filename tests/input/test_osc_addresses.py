@@ -119,7 +119,7 @@ def test_gyrosc_button_takes_one_or_two_values(dec, osc) -> None:  # type: ignor
 
 @pytest.mark.parametrize("address", ["/ZIGSIM/d/touchradius1", "/ZIGSIM/d/touchforce1", "/d/touch01"])
 def test_zigsim_touch_radius_and_force_count_as_a_finger_down(dec, osc, address) -> None:  # type: ignore[no-untyped-def]
-    message, bundle = osc
+    _message, bundle = osc
     assert dec.decode(bundle((address, 0.5)), "z", 0.0).touch is True
     assert dec.decode(bundle((address, 0.5, 0.1, 0.2)), "z", 0.1).touch is False  # three values: not a finger
     assert dec.drops == [("wrong arity", f"{address}: wrong arity: 3 arguments, expected 1..2")]

@@ -14,9 +14,9 @@ import pytest
 
 from engine import quat
 from engine.clip import Clip, RootMotion
-from engine.clips import default_clips
 from engine.cliplib import roles
 from engine.cliplib.roles import RoleError, check_role, check_set, conform, normalise_role
+from engine.clips import default_clips
 from engine.humanoid import humanoid_skeleton
 
 SK = humanoid_skeleton()

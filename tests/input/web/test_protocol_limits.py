@@ -8,8 +8,15 @@ import json
 import numpy as np
 import pytest
 
-from input.web.protocol import (CROUCH_DEPTH, MAX_MESSAGE_BYTES, ControllerMessage, PageClock, WebMessageError,
-                                parse_message, to_sample_fields)
+from input.web.protocol import (
+    CROUCH_DEPTH,
+    MAX_MESSAGE_BYTES,
+    ControllerMessage,
+    PageClock,
+    WebMessageError,
+    parse_message,
+    to_sample_fields,
+)
 
 READING = {"seq": 3, "t": 1.7e12, "kind": "orientation", "o": [0.0, 0.0, 0.0]}
 XR = {"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0, 1], "p": [0.0, 0.0, 0.0]}

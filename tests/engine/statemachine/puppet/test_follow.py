@@ -62,7 +62,7 @@ def test_the_spring_takes_a_step_change_without_overshoot_ninety_percent_in_3_89
         path.append(float(value[2]))
     assert np.all(np.diff(path) > 0.0) and max(path) < 2.0
     t90 = 3.89 / 20.0
-    assert path[int(round(t90 / DT)) - 1] == pytest.approx(1.8, abs=0.02)
+    assert path[round(t90 / DT) - 1] == pytest.approx(1.8, abs=0.02)
 
 
 # --- the wanted velocity -------------------------------------------------------------------------

@@ -19,8 +19,13 @@ from engine.ik.system import IKRequest
 from engine.statemachine.machine import Brain
 from engine.statemachine.puppet import ground_states
 from engine.statemachine.puppet.body import PuppetBody, PuppetTuning
-from engine.statemachine.puppet.ground_states import (follow_stick, lifted, locomotion_fits, update_crouch,
-                                                      update_locomotion)
+from engine.statemachine.puppet.ground_states import (
+    follow_stick,
+    lifted,
+    locomotion_fits,
+    update_crouch,
+    update_locomotion,
+)
 
 T = PuppetTuning()
 _AT = np.array([1.0, 0.9, 2.0])
@@ -71,7 +76,7 @@ def test_lifted_means_held_clearly_above_standing_height() -> None:
 
 
 def test_a_released_puppet_always_fits_the_ground_states() -> None:
-    world, e, body, *_ = _puppet(held=False, ahead=np.array([50.0, 0.0, 0.0]), height=5.0)
+    world, e, _body, *_ = _puppet(held=False, ahead=np.array([50.0, 0.0, 0.0]), height=5.0)
     assert locomotion_fits(world, e, None)  # type: ignore[arg-type]
 
 
@@ -103,7 +108,7 @@ def test_a_lifted_puppet_leaves_the_ground_states_even_at_its_stick() -> None:
     (True, T.crouch_enter - 0.2, T.crouch_enter),  # never lower than the crouch's entry in Locomotion
 ])
 def test_locomotion_stands_tall_or_dips_with_the_stick(held: bool, height: float, asked: float | None) -> None:
-    world, e, body, player, ik, brain = _puppet(held=held, height=height)
+    world, e, _body, player, ik, brain = _puppet(held=held, height=height)
     brain.memory["put_down"] = True
     update_locomotion(world, e, brain)
     assert player.height == (None if asked is None else pytest.approx(asked))
@@ -113,7 +118,7 @@ def test_locomotion_stands_tall_or_dips_with_the_stick(held: bool, height: float
 
 @pytest.mark.parametrize(("height", "asked"), [(0.1, T.crouch_height), (0.62, 0.62), (0.95, T.crouch_exit)])
 def test_crouch_holds_the_hips_as_low_as_the_stick_within_the_crouch(height: float, asked: float) -> None:
-    world, e, body, player, ik, brain = _puppet(height=height)
+    world, e, _body, player, ik, brain = _puppet(height=height)
     assert T.crouch_height < 0.62 < T.crouch_exit
     update_crouch(world, e, brain)
     assert player.height == pytest.approx(asked)
@@ -121,7 +126,7 @@ def test_crouch_holds_the_hips_as_low_as_the_stick_within_the_crouch(height: flo
 
 
 def test_crouched_the_stick_must_lead_by_the_dead_band(followers: list) -> None:
-    world, e, body, player, ik, brain = _puppet(height=0.6)
+    world, e, _body, _player, _ik, brain = _puppet(height=0.6)
     update_crouch(world, e, brain)
     update_locomotion(world, e, brain)
     assert [c[1][5] for c in followers] == [T.follow_deadband, 0.02]
