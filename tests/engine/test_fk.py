@@ -48,6 +48,10 @@ def test_per_puppet_offsets():
     sk = humanoid_skeleton()
     offsets = np.stack([sk.offsets, sk.offsets * 2.0])
     pos, _ = forward_kinematics(sk, np.zeros((2, 3)), quat.identity(2, sk.num_joints), offsets)
+    own, _ = forward_kinematics(sk, np.zeros(3), quat.identity(sk.num_joints))
+    # Found by the mutation run: offsets read as NaN passed, as assert_allclose takes NaN == NaN.
+    assert np.all(np.isfinite(pos))
+    np.testing.assert_allclose(pos[0], own, atol=1e-12)
     np.testing.assert_allclose(pos[1], pos[0] * 2.0, atol=1e-12)
 
 
