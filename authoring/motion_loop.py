@@ -25,6 +25,7 @@ def open_loop(
     units: str | None = None,
     joint_map: dict[str, str] | None = None,
     up: str | None = None,
+    height: float | None = None,
     retarget: bool = False,
     start: object = None,
     end: object = None,
@@ -42,11 +43,11 @@ def open_loop(
     from authoring.cycles.take_range import refusal_hint
     from engine.io.motion_file import load_motion, load_motion_loop, to_puppet
 
-    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up)
+    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height)
     clip = motion.clip
     if start is not None or end is not None:
         # The part is cut from the take as stored (a closed loop keeps its closing frame).
-        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, up=up,
+        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height,
                              skip_tpose=not clip.loop)
         loop, note = _loop_of_part(motion, start, end)
     elif clip.loop:  # a loop our glTF writer marked as one, or a closed loop (its last pose is its first)
@@ -60,6 +61,8 @@ def open_loop(
             raise CycleError(f"{exc}" + (f"; {hint}" if hint else "")) from None
         loop = loop_clip(result, perf, name=clip.name)
         note = f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles"
+    if motion.unit_note:
+        note += f"; {motion.unit_note}"
     if retarget:
         loop, family = to_puppet(loop, joint_map)
         note += f", retargeted to the puppet with the {family!r} map"

@@ -313,7 +313,7 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
 def _motion_options(args: argparse.Namespace) -> dict[str, object]:
     from puppetphone.motion_args import motion_options
 
-    given = [f"--{k}" for k in ("animation", "units", "joint_map", "retarget", "start", "end")
+    given = [f"--{k}" for k in ("animation", "units", "height", "joint_map", "retarget", "start", "end")
              if getattr(args, k, None) is not None and getattr(args, k, None) is not False]
     if given and Path(args.clip).suffix.lower() not in (".bvh", ".gltf", ".glb"):
         raise ValueError(f"{', '.join(g.replace('_', '-') for g in given)} only apply to a BVH/glTF/GLB file")
