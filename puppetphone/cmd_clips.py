@@ -67,7 +67,7 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
         print(f"clips: {args.file.name} refused as the {args.role}: {exc}", file=sys.stderr)
         return 2
     if size_note:
-        print(f"note: {size_note}")
+        print(f"note: {args.file.name}: {size_note}")
     stored = library.load()[entry.role]
     how = f"retargeted to the puppet by the {joint_map} joint map, " if joint_map else ""
     print(f"added {args.file.name} as the {entry.role} ({how}{stored.num_frames} frames at {stored.fps:g} fps, "

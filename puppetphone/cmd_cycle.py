@@ -117,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
     for warning in perf.motion.warnings if perf.motion else ():
         print(f"cycle: warning: {warning}", file=sys.stderr)
     if perf.motion and perf.motion.unit_note:
-        print(f"cycle: note: {perf.motion.unit_note}", file=sys.stderr)
+        print(f"cycle: note: {perf.source.name}: {perf.motion.unit_note}", file=sys.stderr)
     traj = perf.trajectory
     big = traj.num_samples * traj.dims >= _PROGRESS_SAMPLES
     bar = _Bar(big and not args.no_progress and sys.stderr.isatty())

@@ -76,12 +76,14 @@ class MotionFile:
 
     @property
     def unit_note(self) -> str | None:
-        """A line for the user when the size was not read off a unit of a human figure (scaled, or judged by extent)."""
+        """What to tell the user when the size was not read off a unit of a human figure (scaled, or judged by extent).
+
+        The caller names the file in front of it."""
         u = self.units
         if u.target is not None:
-            return f"{self.source.name}: {u.basis} (every length times {u.scale:.4g})"
+            return f"{u.basis} (every length times {u.scale:.4g})"
         if u.basis.startswith("no legs"):
-            return f"{self.source.name}: unit {u.name} judged without legs ({u.basis}); --units or --height overrides"
+            return f"unit {u.name} judged without legs ({u.basis}); --units or --height overrides"
         return None
 
     def summary(self) -> dict[str, Any]:

@@ -52,7 +52,7 @@ def test_a_hand_no_unit_fits_is_scaled_to_a_hand_and_says_so(tmp_path: Path) -> 
     given, stderr = _cycle_json(path)
     assert given["units"] == "scaled" and given["scaled_to"] == "a 0.19 m hand"
     assert given["unit_scale"] == pytest.approx(1 / 3.0, rel=1e-6)
-    assert "note: hand.bvh: " in stderr and "scaled to a 0.19 m hand" in stderr
+    assert "note: hand.bvh: " in stderr and "scaled to a 0.19 m hand" in stderr and stderr.count("hand.bvh") == 1
 
 
 def test_two_files_of_one_set_come_out_equally_tall(tmp_path: Path) -> None:
