@@ -313,11 +313,12 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
 
 
 def _motion_options(args: argparse.Namespace) -> dict[str, object]:
+    from engine.io.motion_file import MOTION_SUFFIXES
     from puppetphone.motion_args import motion_options
 
     given = [f"--{k}" for k in ("animation", "units", "height", "joint_map", "retarget", "start", "end", "items")
              if getattr(args, k, None) is not None and getattr(args, k, None) is not False]
-    if given and Path(args.clip).suffix.lower() not in (".bvh", ".gltf", ".glb"):
+    if given and Path(args.clip).suffix.lower() not in MOTION_SUFFIXES:
         raise ValueError(f"{', '.join(g.replace('_', '-') for g in given)} only apply to a BVH/glTF/GLB file")
     return {**motion_options(args), "retarget": bool(getattr(args, "retarget", False)),
             "start": getattr(args, "start", None), "end": getattr(args, "end", None),

@@ -14,11 +14,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from engine.clip import Clip
+from engine.io.formats import motion_format, suffixes
 from engine.skeleton import Skeleton
 
 __all__ = ["SOURCE_SUFFIXES", "read_motion", "read_source", "to_puppet"]
 
-SOURCE_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
+SOURCE_SUFFIXES = suffixes(skeletal=True, readable=True)
+"""What ``clips add`` reads: every clip format of :data:`engine.io.formats.FORMATS`."""
 
 
 def read_motion(path: str | Path, animation: int | str | None = None, units: str | None = None,
@@ -44,16 +46,11 @@ def read_source(path: str | Path, animation: int | str | None = None, units: str
     stated size, or one judged by its extent because it has no legs.
     """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix == ".ppclip":
-        from engine.clipfile import load_clip
-
-        return load_clip(path), None
-    if suffix not in SOURCE_SUFFIXES:
-        raise ValueError(f"{path.name}: unknown motion type {suffix!r}; use one of {', '.join(SOURCE_SUFFIXES)}")
-    from engine.io.motion_file import load_motion_loop
-
-    motion = load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height)
+    fmt = motion_format(path)
+    if fmt is None or fmt.read is None:
+        raise ValueError(f"{path.name}: unknown motion type {path.suffix.lower()!r}; "
+                         f"use one of {', '.join(SOURCE_SUFFIXES)}")
+    motion = fmt.read(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height)
     return motion.clip, motion.unit_note
 
 

@@ -20,6 +20,7 @@ from typing import Any
 
 from engine.clip import Clip
 from engine.io.bvh import BvhError, BvhWarning, read_bvh
+from engine.io.formats import motion_format, suffixes
 from engine.io.gltf import GltfError, read_gltf
 from engine.io.units import Units, given_height, given_units, judge_units
 from engine.io.up_axis import UpAxis, figure_height, given_up, judge_up, stood_up
@@ -30,7 +31,8 @@ __all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "l
            "to_puppet",
            "scaled_clip"]
 
-MOTION_SUFFIXES = (".bvh", ".gltf", ".glb")
+MOTION_SUFFIXES = suffixes(foreign=True)
+"""Files from other tools (BVH, glTF, GLB): :data:`engine.io.formats.FORMATS` says which."""
 _CONVENTION = UpAxis("y", "the format's convention")
 MAX_MAP_FILE = 1 << 20
 
@@ -220,11 +222,12 @@ def load_motion(
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
-    suffix = path.suffix.lower()
-    if suffix not in MOTION_SUFFIXES:
-        raise MotionFileError(f"{path}: not a motion file ({suffix or 'no suffix'}); use one of {', '.join(MOTION_SUFFIXES)}")
+    fmt = motion_format(path)
+    if fmt is None or not fmt.foreign:
+        raise MotionFileError(f"{path}: not a motion file ({path.suffix.lower() or 'no suffix'}); "
+                              f"use one of {', '.join(MOTION_SUFFIXES)}")
     try:
-        if suffix == ".bvh":
+        if fmt.name == "bvh":
             if animation is not None:
                 raise MotionFileError(f"{path}: --animation is for glTF files; a BVH holds one motion")
             return _load_bvh(path, units, skip_tpose, joint_map, up, height)

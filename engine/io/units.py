@@ -37,7 +37,7 @@ from engine import quat
 from engine.fk import forward_kinematics
 from engine.skeleton import Skeleton
 
-__all__ = ["UNITS", "Units", "judge_units", "given_units", "given_height"]
+__all__ = ["UNITS", "Units", "given_height", "given_units", "judge_units"]
 
 UNITS: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "cmu": 0.0254 / 0.45}
 HUMAN_LEG = 0.82  # metres, hip joint to ankle of an adult
