@@ -267,6 +267,7 @@ def run_curves(args: argparse.Namespace) -> int:
     from authoring.keyframe_curves.session import CurveSession
     from authoring.mocurves import export_clip
     from authoring.mocurves.storage import EXPORT_SUFFIXES
+    from engine.io.formats import FORMATS
     from engine.io.gltf_cubic import write_gltf_cubic
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
@@ -305,7 +306,7 @@ def run_curves(args: argparse.Namespace) -> int:
             activity.save()
             print(f"saved {args.output}")
         for path in args.export:
-            if path.suffix.lower() in (".glb", ".gltf"):
+            if path.suffix.lower() in FORMATS["gltf"].suffixes:
                 write_gltf_cubic(path, session.clip)  # keys and tangents, CUBICSPLINE
             else:
                 export_clip(session.clip.bake(), path)  # BVH and .ppclip are sampled

@@ -44,6 +44,8 @@ def configure_edit(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--start", metavar="T0", type=take_position, help="a take: extract the loop from here "
                         "(seconds, or a frame: 480f)")
     parser.add_argument("--end", metavar="T1", type=take_position, help="a take: ...up to here (excluded)")
+    parser.add_argument("--items", metavar="JOINT", nargs="+", help="a take: extract the loop from these joints' "
+                        "motion only (the legs of a dance whose arms vary); the others keep their mean pose")
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
@@ -354,14 +356,16 @@ def replay_edit(recording, verify: bool = True):  # type: ignore[no-untyped-def]
 
 
 def _motion_options(args: argparse.Namespace) -> dict[str, object]:
+    from engine.io.motion_file import MOTION_SUFFIXES
     from puppetphone.motion_args import motion_options
 
-    given = [f"--{k}" for k in ("animation", "units", "joint_map", "retarget", "start", "end")
+    given = [f"--{k}" for k in ("animation", "units", "height", "joint_map", "retarget", "start", "end", "items")
              if getattr(args, k, None) is not None and getattr(args, k, None) is not False]
-    if given and Path(args.clip).suffix.lower() not in (".bvh", ".gltf", ".glb"):
+    if given and Path(args.clip).suffix.lower() not in MOTION_SUFFIXES:
         raise ValueError(f"{', '.join(g.replace('_', '-') for g in given)} only apply to a BVH/glTF/GLB file")
     return {**motion_options(args), "retarget": bool(getattr(args, "retarget", False)),
-            "start": getattr(args, "start", None), "end": getattr(args, "end", None)}
+            "start": getattr(args, "start", None), "end": getattr(args, "end", None),
+            "items": getattr(args, "items", None)}
 
 
 def run_edit(args: argparse.Namespace) -> int:

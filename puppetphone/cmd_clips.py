@@ -50,7 +50,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
     from engine.clips import default_clips
     from engine.cliplib.roles import RoleError, check_role, conform, normalise_role
-    from engine.cliplib.source import read_motion, to_puppet
+    from engine.cliplib.source import read_source, to_puppet
     from engine.humanoid import humanoid_skeleton
     from puppetphone.motion_args import motion_options
 
@@ -58,13 +58,16 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
     try:
         role = normalise_role(args.role)
         options = motion_options(args)
-        clip, joint_map = to_puppet(read_motion(args.file, **options), skeleton, options["joint_map"])
+        source, size_note = read_source(args.file, **options)
+        clip, joint_map = to_puppet(source, skeleton, options["joint_map"])
         check_role(clip, role, skeleton)
         before = library.entries().get(role)
         entry = library.add(conform(clip, role), role, skeleton, default_clips(), source=args.file.name)
     except RoleError as exc:
         print(f"clips: {args.file.name} refused as the {args.role}: {exc}", file=sys.stderr)
         return 2
+    if size_note:
+        print(f"note: {args.file.name}: {size_note}")
     stored = library.load()[entry.role]
     how = f"retargeted to the puppet by the {joint_map} joint map, " if joint_map else ""
     print(f"added {args.file.name} as the {entry.role} ({how}{stored.num_frames} frames at {stored.fps:g} fps, "

@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
 
     from authoring.cycles.extract import CycleError, CycleOptions, extract_cycle
     from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
+    from engine.io.formats import suffixes
     from authoring.cycles.take_range import refusal_hint, select
     from authoring.cycles.trajectory import TrajectoryError
     from puppetphone.motion_args import about, export_options, motion_options
@@ -112,10 +113,12 @@ def run(args: argparse.Namespace) -> int:
         return fail(EXIT_BAD_INPUT, str(exc))
     except (TrajectoryError, ValueError) as exc:
         return fail(EXIT_BAD_INPUT, f"cannot read {about(args.input, exc)}")
-    if perf.clip is None and out_suffix in (".bvh", ".ppclip", ".glb", ".gltf"):
+    if perf.clip is None and out_suffix in suffixes(skeletal=True):
         return fail(EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH, glTF); write .csv or .npz for {args.input}")
     for warning in perf.motion.warnings if perf.motion else ():
         print(f"cycle: warning: {warning}", file=sys.stderr)
+    if perf.motion and perf.motion.unit_note:
+        print(f"cycle: note: {perf.source.name}: {perf.motion.unit_note}", file=sys.stderr)
     traj = perf.trajectory
     big = traj.num_samples * traj.dims >= _PROGRESS_SAMPLES
     bar = _Bar(big and not args.no_progress and sys.stderr.isatty())

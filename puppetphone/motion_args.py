@@ -1,7 +1,7 @@
 """Command-line options for motion files, shared by every command that reads or writes them.
 
 ``cycle``, ``cycles``, ``clips add`` and ``author edit`` take the same input options
-(``--animation``, ``--units``, ``--up``, ``--joint-map``), and commands that write loops the same
+(``--animation``, ``--units`` or ``--height``, ``--up``, ``--joint-map``), and commands that write loops the same
 export options (``--fps``, ``--closing-frame``); defining them once keeps their spelling
 and help identical. The values go to :func:`engine.io.motion_file.load_motion` and
 :func:`authoring.cycles.formats.save_loop`.
@@ -17,7 +17,7 @@ __all__ = ["add_motion_options", "add_export_options", "motion_options", "export
 
 
 def add_motion_options(parser: argparse.ArgumentParser) -> None:
-    """``--animation``, ``--units``, ``--up`` and ``--joint-map``."""
+    """``--animation``, ``--units``, ``--height``, ``--up`` and ``--joint-map``."""
     from engine.io.units import UNITS
     from engine.io.up_axis import AXES
 
@@ -25,7 +25,10 @@ def add_motion_options(parser: argparse.ArgumentParser) -> None:
                         help="glTF/GLB: which animation (name or 0-based index; default the first)")
     parser.add_argument("--units", choices=tuple(UNITS),
                         help="length unit of a BVH/glTF file (default: judged by the figure's leg length or size; "
-                             "cmu = the CMU database's 1/0.45 inch)")
+                             "cmu = the CMU database's 1/0.45 inch; a figure no unit fits is scaled to an adult's "
+                             "size and says so)")
+    parser.add_argument("--height", type=float, metavar="METRES",
+                        help="instead of --units: scale the figure so it stands this tall (any size, not a unit's)")
     parser.add_argument("--up", choices=tuple(AXES), metavar="AXIS",
                         help="the file's up axis: x, y, z, -x, -y or -z (write --up=-z); default judged by the figure "
                              "(a Blender export keeps z up); the figure is stood up with it")
@@ -52,6 +55,7 @@ def motion_options(args: argparse.Namespace) -> dict[str, Any]:
     return {
         "animation": getattr(args, "animation", None),
         "units": getattr(args, "units", None),
+        "height": getattr(args, "height", None),
         "up": getattr(args, "up", None),
         "joint_map": load_joint_map(joint_map) if joint_map else None,
     }

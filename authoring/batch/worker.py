@@ -179,6 +179,18 @@ def process_take(task: TakeTask, options: BatchOptions) -> TakeOutcome:
         return _process(task, options)
 
 
+def _without_path(error: BaseException, path: Path) -> str:
+    """The reader's message without the file's path in front (the take's line names it; a sent take's path is a temp file)."""
+    message = str(error)
+    if not message.startswith(str(path)):
+        return message
+    rest = message[len(str(path)):]
+    line, colon, why = rest.lstrip(":").partition(":")
+    if colon and line.strip().isdigit():  # "PATH:12: why" -> "line 12: why"
+        return f"line {line.strip()}:{why}"
+    return rest.lstrip(": ")
+
+
 def _process(task: TakeTask, options: BatchOptions) -> TakeOutcome:
     t0 = time.perf_counter()
     name = Path(task.source).name
@@ -191,7 +203,7 @@ def _process(task: TakeTask, options: BatchOptions) -> TakeOutcome:
                 path.write_bytes(task.data)
             perf = _load(path)
         except (OSError, ValueError) as exc:  # TrajectoryError and the format errors are ValueErrors
-            return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {exc}"[:500], 0, 0.0, 0,
+            return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {_without_path(exc, path)}"[:500], 0, 0.0, 0,
                                time.perf_counter() - t0)
         except Exception as exc:  # noqa: BLE001 -- a reader bug must not stop the batch; the reason names it
             return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {type(exc).__name__}: {exc}"[:500],

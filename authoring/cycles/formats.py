@@ -32,6 +32,7 @@ from authoring.cycles.heading import normalise, restore
 from authoring.cycles.trajectory import Item, Trajectory, TrajectoryError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
+from engine.io.formats import motion_format, suffixes
 from engine.io.loop_export import is_seamless
 from engine.io.motion_file import MotionFile, MotionFileError, load_motion
 from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
@@ -40,8 +41,10 @@ from engine.root_curve import RootCurve
 __all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop",
            "performance_from_motion", "seamless_repeats", "is_seamless"]
 
-INPUT_SUFFIXES = (".bvh", ".gltf", ".glb", ".csv", ".npz", ".rec")
-OUTPUT_SUFFIXES = (".bvh", ".csv", ".npz", ".ppclip", ".glb", ".gltf")
+INPUT_SUFFIXES = suffixes(foreign=True, readable=True) + suffixes(skeletal=False, readable=True)
+"""What ``cycle`` and ``cycles`` read: files from other tools and every trajectory format."""
+OUTPUT_SUFFIXES = suffixes(writable=True)
+"""What ``cycle`` writes a loop to: every writable format of :data:`engine.io.formats.FORMATS`."""
 #: Fewer frames than this hold no two cycles of any period the extractor looks for.
 MIN_FRAMES = 4
 
@@ -302,17 +305,17 @@ def load_performance(path: str | Path, items: list[str] | None = None, **motion_
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
-    suffix = path.suffix.lower()
-    loaders = {".csv": _load_csv, ".npz": _load_npz, ".rec": _load_recording}
-    if suffix in (".bvh", ".gltf", ".glb"):
+    fmt = motion_format(path)
+    loaders = {"csv": _load_csv, "npz": _load_npz, "rec": _load_recording}  # the trajectory formats, by name
+    if fmt is not None and fmt.foreign:
         perf = _load_skeletal(path, items, {k: v for k, v in motion_options.items() if v is not None})
-    elif suffix not in loaders:
-        raise TrajectoryError(f"{path}: unknown input type {suffix!r}; use one of {', '.join(INPUT_SUFFIXES)}")
+    elif fmt is None or fmt.name not in loaders:
+        raise TrajectoryError(f"{path}: unknown input type {path.suffix.lower()!r}; use one of {', '.join(INPUT_SUFFIXES)}")
     else:
         given = sorted(k for k, v in motion_options.items() if v is not None)
         if given:
             raise TrajectoryError(f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to BVH/glTF input")
-        perf = loaders[suffix](path, items)
+        perf = loaders[fmt.name](path, items)
     frames = len(perf.trajectory.times)
     if frames < MIN_FRAMES:  # the feature and period analyses difference neighbouring frames
         raise TrajectoryError(f"{path}: {frames} frame(s); a loop is extracted from at least {MIN_FRAMES}")
@@ -391,17 +394,17 @@ def save_loop(
     frame unless ``closing_frame`` is False (glTF loops always repeat their first key).
     """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in OUTPUT_SUFFIXES:
-        raise TrajectoryError(f"{path}: unknown output type {suffix!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
-    if suffix == ".ppclip":
+    fmt = motion_format(path)
+    if fmt is None or path.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise TrajectoryError(f"{path}: unknown output type {path.suffix.lower()!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
+    if fmt.name == "ppclip":
         from authoring.cycles.root_curve import loop_root_curve
         from engine.clipfile import save_clip
 
         clip = loop_clip(result, perf)
         clip, curve = _in_place(clip, loop_root_curve(result, perf, clip), loop_travel(result, perf)[0])
         return save_clip(clip, path, root_curve=curve)
-    if suffix in (".bvh", ".glb", ".gltf"):
+    if fmt.skeletal:  # BVH, glTF: another tool's loop, at a whole number of frames
         from engine.io.bvh import write_bvh
         from engine.io.bvh_convert import clip_to_bvh
         from engine.io.gltf_write import write_gltf
@@ -410,10 +413,10 @@ def save_loop(
         clip = loop_clip(result, perf)
         travel, turn = loop_travel(result, perf)
         clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]
-        if suffix != ".bvh":
+        if fmt.name != "bvh":
             return write_gltf(path, clip)
         return write_bvh(path, clip_to_bvh(closed(clip, travel, turn) if closing_frame is not False else clip))
-    if suffix == ".csv":
+    if fmt.name == "csv":
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(["time", *perf.names])

@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from authoring.cycles.extract import CycleError, extract_cycle
-from authoring.cycles.formats import Performance, load_performance, save_loop
+from authoring.cycles.formats import Performance, load_performance, performance_from_motion, save_loop
+from authoring.cycles.periodic_part import leg_joints, steps_part
 from authoring.cycles.segments import Segment, best_segment, cut, looping_segments
 from authoring.cycles.trajectory import TrajectoryError
 
@@ -95,16 +96,41 @@ def _describe(perf: Performance, seg: Segment, offset: int, period: float, cycle
 
 
 def refusal_hint(perf: Performance, analysed: Performance, offset: int = 0, seed: int = 0) -> str | None:
-    """When a take was refused: the best-looping segment in ``analysed`` as a ``--start/--end`` to try.
+    """When a take was refused: the best-looping part of ``analysed`` as a ``--start/--end`` to try.
 
-    ``analysed`` is ``perf`` or a part of it starting at trajectory sample ``offset``;
-    ``None`` when no part loops either.
+    ``analysed`` is ``perf`` or a part of it starting at trajectory sample ``offset``. The
+    segments whose whole pose repeats come first; when there are none (a dance that turns
+    and varies its arms), the part where the feet repeat (:mod:`.periodic_part`) is offered
+    if the extractor loops it, whole or by the legs alone (then with ``--items``). ``None``
+    when no part loops either way.
     """
     best = best_segment(looping_segments(analysed.trajectory, seed=seed))
-    if best is None:
+    if best is not None:
+        seg, result = best
+        return _describe(perf, seg, offset, result.period, result.cycles)
+    return _steps_hint(perf, analysed, offset, seed)
+
+
+def _steps_hint(perf: Performance, analysed: Performance, offset: int, seed: int) -> str | None:
+    """The ``--start/--end`` (and ``--items``, for the legs alone) of the part where the feet repeat, if it loops."""
+    part = steps_part(analysed, offset)
+    legs = leg_joints(analysed)
+    if part is None or legs is None or perf.motion is None:
         return None
-    seg, result = best
-    return _describe(perf, seg, offset, result.period, result.cycles)
+    seg = Segment(part.start, part.stop, 0.0, 0.0, part.period, 1.0 - part.correlation)
+    whole_legs = performance_from_motion(perf.motion, list(legs))
+    for items, source in ((None, analysed.trajectory), (legs, whole_legs.trajectory)):
+        first = part.start + (offset if items else 0)
+        try:
+            result = extract_cycle(cut(source, first, first + part.stop - part.start), np.random.default_rng(seed))
+        except (CycleError, TrajectoryError):
+            continue
+        said = _describe(perf, seg, offset, result.period, result.cycles)
+        if items is None:
+            return f"the steps repeat there: {said}"
+        return (f"the whole pose varies, but the steps repeat: {said.replace(' loop ', ' loop by the legs ')} "
+                f"--items {' '.join(items)}")
+    return None
 
 
 def cycle_of_take(take: Path, start: Bound | None, end: Bound | None, out: Path, seed: int = 0) -> Path:

@@ -32,7 +32,7 @@ from engine import quat
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
 from engine.clipfile import load_clip_curve, save_clip
-from engine.io import clip_to_bvh, write_bvh, write_gltf
+from engine.io.formats import motion_format, suffixes
 from engine.npz_safe import read_bounded
 
 __all__ = ["save_session", "load_session", "side_path", "export_clip", "bake_root_motion", "SessionFileError", "EXPORT_SUFFIXES"]
@@ -41,7 +41,8 @@ SIDE_FORMAT = "puppetphone-mocurves"
 SIDE_VERSION = 1
 MAX_SIDE_FILE = 64 << 20
 MAX_SCALE = 100.0
-EXPORT_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
+EXPORT_SUFFIXES = suffixes(skeletal=True, writable=True)
+"""What ``--export`` writes: every clip format of :data:`engine.io.formats.FORMATS`."""
 _UP = np.array([0.0, 1.0, 0.0])
 
 
@@ -199,11 +200,7 @@ def bake_root_motion(clip: Clip) -> Clip:
 def export_clip(clip: Clip, path: str | Path) -> Path:
     """Write ``clip`` as ``.ppclip``, ``.bvh`` or ``.glb``/``.gltf`` (by suffix), atomically."""
     p = Path(path)
-    suffix = p.suffix.lower()
-    if suffix == ".ppclip":
-        return save_clip(clip, p)
-    if suffix == ".bvh":
-        return write_bvh(p, clip_to_bvh(bake_root_motion(clip)))
-    if suffix in (".glb", ".gltf"):
-        return write_gltf(p, bake_root_motion(clip))
-    raise ValueError(f"{p}: export to one of {', '.join(EXPORT_SUFFIXES)}")
+    fmt = motion_format(p)
+    if fmt is None or fmt.write is None:
+        raise ValueError(f"{p}: export to one of {', '.join(EXPORT_SUFFIXES)}")
+    return fmt.write(clip if fmt.root_motion else bake_root_motion(clip), p)

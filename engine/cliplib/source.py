@@ -14,15 +14,17 @@ from __future__ import annotations
 from pathlib import Path
 
 from engine.clip import Clip
+from engine.io.formats import motion_format, suffixes
 from engine.skeleton import Skeleton
 
-__all__ = ["SOURCE_SUFFIXES", "read_motion", "to_puppet"]
+__all__ = ["SOURCE_SUFFIXES", "read_motion", "read_source", "to_puppet"]
 
-SOURCE_SUFFIXES = (".ppclip", ".bvh", ".glb", ".gltf")
+SOURCE_SUFFIXES = suffixes(skeletal=True, readable=True)
+"""What ``clips add`` reads: every clip format of :data:`engine.io.formats.FORMATS`."""
 
 
 def read_motion(path: str | Path, animation: int | str | None = None, units: str | None = None,
-                joint_map: dict[str, str] | None = None, up: str | None = None) -> Clip:
+                joint_map: dict[str, str] | None = None, up: str | None = None, height: float | None = None) -> Clip:
     """The clip in ``path`` (a glTF's chosen animation; a CMU BVH without its T-pose lead-in).
 
     A file that already is a loop (``cycle -o loop.bvh`` closes its loop with the first
@@ -32,17 +34,24 @@ def read_motion(path: str | Path, animation: int | str | None = None, units: str
         ValueError: not a motion file this build reads, or a damaged one (the message says which).
         OSError: the file cannot be opened.
     """
+    return read_source(path, animation, units, joint_map, up, height)[0]
+
+
+def read_source(path: str | Path, animation: int | str | None = None, units: str | None = None,
+                joint_map: dict[str, str] | None = None, up: str | None = None,
+                height: float | None = None) -> tuple[Clip, str | None]:
+    """:func:`read_motion`'s clip and the note to show the user about its size (``None``: read in a unit as a human).
+
+    The note is :attr:`~engine.io.motion_file.MotionFile.unit_note`: a figure scaled to a
+    stated size, or one judged by its extent because it has no legs.
+    """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix == ".ppclip":
-        from engine.clipfile import load_clip
-
-        return load_clip(path)
-    if suffix not in SOURCE_SUFFIXES:
-        raise ValueError(f"{path.name}: unknown motion type {suffix!r}; use one of {', '.join(SOURCE_SUFFIXES)}")
-    from engine.io.motion_file import load_motion_loop
-
-    return load_motion_loop(path, animation=animation, units=units, joint_map=joint_map, up=up).clip
+    fmt = motion_format(path)
+    if fmt is None or fmt.read is None:
+        raise ValueError(f"{path.name}: unknown motion type {path.suffix.lower()!r}; "
+                         f"use one of {', '.join(SOURCE_SUFFIXES)}")
+    motion = fmt.read(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height)
+    return motion.clip, motion.unit_note
 
 
 def to_puppet(clip: Clip, skeleton: Skeleton, joint_map: dict[str, str] | None = None) -> tuple[Clip, str | None]:

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.atomic import atomic_write_bytes
+from engine.io.formats import FORMATS
 from engine.keyframes import BezierCurves, KeyframedClip
 
 __all__ = ["write_gltf_cubic", "read_gltf_cubic"]
@@ -61,7 +62,7 @@ def write_gltf_cubic(path: str | os.PathLike[str], clip: KeyframedClip) -> Path:
     from engine.io import gltf_write
 
     p = Path(path)
-    if p.suffix.lower() not in (".glb", ".gltf"):
+    if p.suffix.lower() not in FORMATS["gltf"].suffixes:
         raise ValueError(f"{p}: write_gltf_cubic needs a .glb or .gltf path")
     doc, blob = gltf_write._document(clip.bake())
     buf = gltf_write._Bin()

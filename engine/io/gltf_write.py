@@ -28,6 +28,7 @@ import numpy as np
 
 from engine import quat
 from engine.atomic import atomic_write_bytes
+from engine.io.formats import FORMATS
 from engine.clip import Clip
 from engine.fk import forward_kinematics
 
@@ -146,6 +147,6 @@ def write_gltf(path: str | os.PathLike[str], clip: Clip) -> Path:
     """Write ``clip`` as ``.glb`` (binary) or ``.gltf`` (JSON, embedded buffer), atomically."""
     p = Path(path)
     suffix = p.suffix.lower()
-    if suffix not in (".glb", ".gltf"):
+    if suffix not in FORMATS["gltf"].suffixes:
         raise ValueError(f"{p}: write_gltf needs a .glb or .gltf path")
     return atomic_write_bytes(p, gltf_bytes(clip, binary=suffix == ".glb"))

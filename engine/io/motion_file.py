@@ -20,8 +20,9 @@ from typing import Any
 
 from engine.clip import Clip
 from engine.io.bvh import BvhError, BvhWarning, read_bvh
+from engine.io.formats import motion_format, suffixes
 from engine.io.gltf import GltfError, read_gltf
-from engine.io.units import Units, given_units, judge_units
+from engine.io.units import Units, given_height, given_units, judge_units
 from engine.io.up_axis import UpAxis, figure_height, given_up, judge_up, stood_up
 from engine.npz_safe import read_bounded
 from engine.skeleton import Skeleton
@@ -30,7 +31,8 @@ __all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "l
            "to_puppet",
            "scaled_clip"]
 
-MOTION_SUFFIXES = (".bvh", ".gltf", ".glb")
+MOTION_SUFFIXES = suffixes(foreign=True)
+"""Files from other tools (BVH, glTF, GLB): :data:`engine.io.formats.FORMATS` says which."""
 _CONVENTION = UpAxis("y", "the format's convention")
 MAX_MAP_FILE = 1 << 20
 
@@ -74,6 +76,18 @@ class MotionFile:
     file_frames: int = 0
     file_joints: int = 0
 
+    @property
+    def unit_note(self) -> str | None:
+        """What to tell the user when the size was not read off a unit of a human figure (scaled, or judged by extent).
+
+        The caller names the file in front of it."""
+        u = self.units
+        if u.target is not None:
+            return f"{u.basis} (every length times {u.scale:.4g})"
+        if u.basis.startswith("no legs"):
+            return f"unit {u.name} judged without legs ({u.basis}); --units or --height overrides"
+        return None
+
     def summary(self) -> dict[str, Any]:
         """What ``--json`` reports about the input."""
         out: dict[str, Any] = {
@@ -82,6 +96,8 @@ class MotionFile:
             "fps": self.clip.fps, "fps_basis": self.fps_basis, "frames": self.clip.num_frames,
             "joints": self.clip.skeleton.num_joints, "file_frames": self.file_frames, "file_joints": self.file_joints,
         }
+        if self.units.target is not None:
+            out["scaled_to"] = self.units.target
         if self.skipped:
             out["skipped_frames"] = self.skipped
         if self.animation is not None:
@@ -107,7 +123,15 @@ def scaled_clip(clip: Clip, k: float) -> Clip:
                    translations=None if clip.translations is None else clip.translations * k)
 
 
-def _units(clip: Clip, units: str | None, metric: bool, joint_map: dict[str, str] | None) -> Units:
+def _units(clip: Clip, units: str | None, metric: bool, joint_map: dict[str, str] | None,
+           height: float | None = None) -> Units:
+    if height is not None:
+        if units is not None:
+            raise MotionFileError("give --units or --height, not both")
+        try:
+            return given_height(height, figure_height(clip))
+        except ValueError as exc:
+            raise MotionFileError(str(exc)) from None
     if units is not None:
         try:
             return given_units(units)
@@ -129,16 +153,16 @@ def _stood(clip: Clip, up: str | None, joint_map: dict[str, str] | None) -> tupl
 
 
 def _finish(raw: Clip, path: Path, units: str | None, up: str | None, metric: bool,
-            joint_map: dict[str, str] | None, **decided: Any) -> MotionFile:
+            joint_map: dict[str, str] | None, height: float | None, **decided: Any) -> MotionFile:
     """The file's clip stood up and in metres, with those decisions (``decided``: the format's own)."""
     standing, axis = _stood(raw, up, joint_map)
-    unit = _units(standing, units, metric=metric, joint_map=joint_map)
+    unit = _units(standing, units, metric=metric, joint_map=joint_map, height=height)
     clip = scaled_clip(standing, unit.scale)
     return MotionFile(clip, path, unit, up=axis, height=figure_height(clip), **decided)
 
 
 def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[str, str] | None,
-              up: str | None) -> MotionFile:
+              up: str | None, height: float | None) -> MotionFile:
     from engine.io.bvh_convert import detect_tpose_frames
 
     with warnings.catch_warnings(record=True) as caught:
@@ -149,12 +173,12 @@ def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[s
         raise MotionFileError(f"{path}: the file holds no frames")
     lead = detect_tpose_frames(motion) if skip_tpose else 0
     raw = motion.to_clip(scale=1.0, skip_frames=lead)
-    return _finish(raw, path, units, up, False, joint_map, fps_basis="BVH Frame Time", skipped=lead, warnings=told,
+    return _finish(raw, path, units, up, False, joint_map, height, fps_basis="BVH Frame Time", skipped=lead, warnings=told,
                    file_frames=motion.num_frames, file_joints=motion.num_joints)
 
 
 def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: float | None,
-               joint_map: dict[str, str] | None, up: str | None) -> MotionFile:
+               joint_map: dict[str, str] | None, up: str | None, height: float | None) -> MotionFile:
     from engine.io.gltf_clip import animation_rate, find_animation, gltf_clip
 
     asset = read_gltf(path)
@@ -162,7 +186,7 @@ def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: 
     index = asset.animations.index(anim)
     raw = gltf_clip(asset, index, fps=fps)
     keys = max((len(c.times) for c in anim.channels), default=0)
-    return _finish(raw, path, units, up, True, joint_map, fps_basis=animation_rate(anim, fps)[1],
+    return _finish(raw, path, units, up, True, joint_map, height, fps_basis=animation_rate(anim, fps)[1],
                    animation=anim.name, animations=tuple(a.name for a in asset.animations),
                    file_frames=keys, file_joints=len(asset.skins[0].joints) if asset.skins else raw.skeleton.num_joints)
 
@@ -175,6 +199,7 @@ def load_motion(
     fps: float | None = None,
     joint_map: dict[str, str] | None = None,
     up: str | None = None,
+    height: float | None = None,
 ) -> MotionFile:
     """Read a ``.bvh``, ``.gltf`` or ``.glb`` motion as a clip in metres, +Y up.
 
@@ -187,6 +212,7 @@ def load_motion(
         joint_map: puppet joint → source joint, when given (helps judge units on odd names).
         up: the file's up axis (``x``, ``y``, ``z``, ``-x``…); default judged by the figure
             (:mod:`engine.io.up_axis`). The clip comes back with that axis turned to +Y.
+        height: scale the figure to stand this tall, metres (``--height``; instead of ``units``).
 
     Raises:
         MotionFileError: unknown type, wrong option, or a file that cannot be read (the
@@ -196,15 +222,16 @@ def load_motion(
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"no such file: {path}")
-    suffix = path.suffix.lower()
-    if suffix not in MOTION_SUFFIXES:
-        raise MotionFileError(f"{path}: not a motion file ({suffix or 'no suffix'}); use one of {', '.join(MOTION_SUFFIXES)}")
+    fmt = motion_format(path)
+    if fmt is None or not fmt.foreign:
+        raise MotionFileError(f"{path}: not a motion file ({path.suffix.lower() or 'no suffix'}); "
+                              f"use one of {', '.join(MOTION_SUFFIXES)}")
     try:
-        if suffix == ".bvh":
+        if fmt.name == "bvh":
             if animation is not None:
                 raise MotionFileError(f"{path}: --animation is for glTF files; a BVH holds one motion")
-            return _load_bvh(path, units, skip_tpose, joint_map, up)
-        return _load_gltf(path, units, animation, fps, joint_map, up)
+            return _load_bvh(path, units, skip_tpose, joint_map, up, height)
+        return _load_gltf(path, units, animation, fps, joint_map, up, height)
     except (BvhError, GltfError) as exc:
         raise MotionFileError(str(exc)) from None
 
@@ -215,6 +242,7 @@ def load_motion_loop(
     units: str | None = None,
     joint_map: dict[str, str] | None = None,
     up: str | None = None,
+    height: float | None = None,
 ) -> MotionFile:
     """:func:`load_motion`, with a file that already is a loop read as one.
 
@@ -226,14 +254,15 @@ def load_motion_loop(
     """
     from engine.io.loop_export import is_seamless, opened
 
-    whole = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False, up=up)
+    whole = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False, up=up,
+                        height=height)
     if whole.clip.loop:
         return whole
     if is_seamless(whole.clip):
         return replace(whole, clip=opened(whole.clip), seamless=True)
     if whole.animation is not None:
         return whole
-    return load_motion(path, units=units, joint_map=joint_map, up=up)
+    return load_motion(path, units=units, joint_map=joint_map, up=up, height=height)
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:

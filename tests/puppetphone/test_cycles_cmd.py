@@ -106,8 +106,9 @@ def test_bad_file_is_reported_and_the_batch_goes_on(tmp_path: Path) -> None:
     r = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "lib"), "--jobs", "1")
     assert r.returncode == 3 and "Traceback" not in r.stderr  # done, some takes unreadable (1: the run failed)
     lines = r.stdout.splitlines()
-    assert any(line.startswith("failed   broken.bvh: cannot read") for line in lines)
+    assert any(line.startswith("failed   broken.bvh: cannot read: line ") for line in lines)
     assert any(line.startswith("failed   empty.csv: cannot read") for line in lines)
+    assert all(line.count("broken.bvh") <= 1 and line.count("empty.csv") <= 1 for line in lines)  # the file named once
     m = SUMMARY.match(lines[-1])
     assert m and int(m[1]) == 3 and int(m[4]) == 2
     # A rerun leaves the failed takes alone; --retry-failed reads them again (as after a reader fix).

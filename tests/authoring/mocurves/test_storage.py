@@ -47,10 +47,11 @@ def test_exports_to_bvh_and_gltf_carry_the_travel(walk, tmp_path):
     assert baked.root_motion is None
     assert baked.root[-1, 2] - baked.root[0, 2] == pytest.approx(walk.root_motion.translation[-1, 2], abs=1e-9)
     bvh = read_bvh(export_clip(walk, tmp_path / "walk.bvh"))
-    assert bvh.data.shape[0] == walk.num_frames
-    # Root Z position (cm) runs forward with the travel: the BVH walks.
+    assert bvh.data.shape[0] == walk.num_frames + 1  # a loop is closed: its first pose again, a cycle on
+    # Root Z position (cm) runs forward with the travel: the BVH walks, a whole cycle's travel to the closing frame.
     z = bvh.data[:, list(bvh.channels[0]).index("Zposition")]
-    assert z[-1] - z[0] == pytest.approx(100 * walk.root_motion.translation[-1, 2], rel=1e-6)
+    assert z[-2] - z[0] == pytest.approx(100 * walk.root_motion.translation[-1, 2], rel=1e-6)
+    assert z[-1] - z[0] == pytest.approx(100 * walk.cycle_travel()[0][2], rel=1e-6)
     asset = read_gltf(export_clip(walk, tmp_path / "walk.glb"))
     assert len(asset.animations) == 1
     assert export_clip(walk, tmp_path / "w.ppclip").exists()

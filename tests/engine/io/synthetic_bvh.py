@@ -165,3 +165,36 @@ def blender_bvh(path: Path, clip: Clip) -> Path:
     ends = {j: np.round(e, 6) for j, e in bvh.end_sites.items()}
     return write_bvh(path, replace(bvh, channels=tuple(channels), data=data, offsets=np.round(bvh.offsets, 6),
                                    end_sites=ends))
+
+
+# finger -> (knuckle offset from the wrist, three phalanx lengths), metres; the middle finger's tip is 0.19 m out
+_HAND = {"Thumb": ((0.025, 0.02, 0.0), (0.04, 0.032, 0.028)), "Index": ((0.02, 0.09, 0.0), (0.043, 0.026, 0.022)),
+         "Middle": ((0.0, 0.092, 0.0), (0.046, 0.028, 0.024)), "Ring": ((-0.018, 0.088, 0.0), (0.042, 0.027, 0.022)),
+         "Pinky": ((-0.034, 0.08, 0.0), (0.033, 0.02, 0.02))}
+
+
+def hand_bvh(unit: float = 100.0, frames: int = 90, fps: float = 30.0, period: float = 1.0) -> str:
+    """BVH text of a right hand alone (a hand-tracking capture): a wrist and five three-joint fingers that curl.
+
+    An adult's hand, 0.19 m from the wrist to the middle fingertip, in ``unit`` file units per
+    metre; the fingers close and open every ``period`` seconds.
+    """
+    lines = ["HIERARCHY", "ROOT RightHand", "{", "  OFFSET 0 0 0",
+             "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"]
+    for finger, (knuckle, bones) in _HAND.items():
+        offsets = [knuckle, *((0.0, b, 0.0) for b in bones[:-1])]
+        for k, off in enumerate(offsets):
+            pad = "  " * (k + 1)
+            o = np.array(off) * unit
+            lines += [f"{pad}JOINT RightHand{finger}{k + 1}", pad + "{", f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
+                      f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation"]
+        pad = "  " * (len(offsets) + 1)
+        lines += [f"{pad}End Site", pad + "{", f"{pad}  OFFSET 0 {bones[-1] * unit:.6f} 0", pad + "}"]
+        lines += ["  " * k + "}" for k in range(len(offsets), 0, -1)]
+    lines.append("}")
+    rows = []
+    for f in range(frames):
+        curl = 30.0 * (1 - np.cos(2 * np.pi * f / (fps * period)))
+        rows.append(" ".join(["0 0 0 0 0 0"] + [f"0 {curl:.4f} 0"] * 15))
+    lines += ["MOTION", f"Frames: {frames}", f"Frame Time: {1.0 / fps:.7f}", *rows]
+    return "\n".join(lines) + "\n"
