@@ -65,9 +65,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
     """The per-take lines: one per clip, or one with the reason."""
     name = Path(outcome.source).name
+    lines = [f"note     {name}: {outcome.note}"] if outcome.note else []
     if outcome.outcome != "looped":
-        return [f"{outcome.outcome:<8} {name}: {outcome.reason}"]
-    lines = []
+        return [*lines, f"{outcome.outcome:<8} {name}: {outcome.reason}"]
     for clip, file in zip(outcome.clips, files, strict=True):
         part = "" if len(outcome.clips) == 1 and clip.start_frame <= 5 else f" [{clip.start_s:.2f}–{clip.end_s:.2f} s]"
         part = f" [{clip.animation}]" if clip.animation is not None else part

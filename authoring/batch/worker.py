@@ -108,6 +108,8 @@ class TakeOutcome:
     dims: int
     seconds: float
     clips: tuple[ClipOut, ...] = ()
+    note: str = ""
+    """How the figure was sized when no unit fitted it (a hand, a figure without legs), else empty."""
 
 
 def warm_up() -> None:
@@ -210,9 +212,11 @@ def _process(task: TakeTask, options: BatchOptions) -> TakeOutcome:
                                0, 0.0, 0, time.perf_counter() - t0)
         traj = perf.trajectory
 
+        note = (perf.motion.unit_note or "") if perf.motion is not None else ""
+
         def outcome(kind: str, reason: str, clips: tuple[ClipOut, ...] = ()) -> TakeOutcome:
             return TakeOutcome(task.source, task.digest, kind, reason, traj.num_samples, 1.0 / traj.dt, traj.dims,
-                               time.perf_counter() - t0, clips)
+                               time.perf_counter() - t0, clips, note)
 
         if options.retarget and perf.clip is None:
             return outcome("refused", "--retarget puppet needs a skeletal take (BVH)")

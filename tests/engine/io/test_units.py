@@ -10,6 +10,7 @@ shared Khronos Fox.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -89,3 +90,16 @@ def test_height_scales_to_a_stated_height_instead_of_a_unit(tmp_path: Path) -> N
     r = subprocess.run([sys.executable, "-m", "puppetphone", "cycle", str(path), "-o", str(tmp_path / "x.bvh"),
                         "--height", "1.5", "--units", "cm"], check=False, capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "give --units or --height, not both" in r.stderr
+
+
+def test_a_library_run_says_how_it_sized_a_take_no_unit_fits(tmp_path: Path) -> None:
+    """`cycles` names the scaling on the take's own line, as `cycle` does on stderr."""
+    takes = tmp_path / "takes"
+    takes.mkdir()
+    _write(takes, "hand.bvh", hand_bvh(unit=3.0))
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
+    done = subprocess.run([sys.executable, "-m", "puppetphone", "cycles", str(takes), "-o", str(tmp_path / "lib"),
+                           "--jobs", "1", "--no-progress"], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode in (0, 3), done.stderr
+    notes = [line for line in done.stdout.splitlines() if line.startswith("note")]
+    assert len(notes) == 1 and "hand.bvh" in notes[0] and "scaled to a 0.19 m hand" in notes[0], done.stdout
