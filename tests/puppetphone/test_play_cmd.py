@@ -91,7 +91,7 @@ def _umask() -> int:
     (["replay", "x.rec", "--headless", "--quality", "ultra"], "quality must be one of low, medium, high, auto"),
     (["author", "edit", "walk", "--headless", "--bogus"], "usage: puppetphone author edit"),
     (["play", "snowman", "--bogus"], "usage: puppetphone play"),
-    (["author", "edit", "walk", "--headless", "--export", "x.fbx"], "cannot export x.fbx: use one of .ppclip"),
+    (["author", "edit", "walk", "--headless", "--export", "x.fbx"], "cannot export x.fbx: use one of .bvh, .glb, .gltf, .ppclip"),
     (["author", "edit", str(Path(__file__).resolve().parents[2] / "README.md"), "--headless"], "is not a clip file"),
     (["cycle", "in.bvh", "-o", "out.ppclip", "--plot", "x.gif"], "use .png or .jpg"),
 ])
