@@ -121,7 +121,13 @@ class MouseSource(PoseSource):
         the cursor has come back down, the stick keeps pointing where the stroke began:
         the stroke says "jump", not "drag the puppet metres toward the horizon" (near the
         horizon a hundred pixels are metres of ground, past the drag limit)."""
-        self._trail = [p for p in self._trail if now - p[0] <= self.flick_window] + [(now, float(pos[0]), float(pos[1]))]
+        start = now - self.flick_window
+        older = [p for p in self._trail if p[0] < start]
+        # Where the cursor rested when the window began counts too: a flick's first move after
+        # a pause must rise from the resting point, or it lifts the puppet off its feet before
+        # the second move is judged a flick (and a puppet in the air does not jump).
+        rested = [(start, older[-1][1], older[-1][2])] if older else []
+        self._trail = rested + [p for p in self._trail if p[0] >= start] + [(now, float(pos[0]), float(pos[1]))]
         base = max(self._trail, key=lambda p: p[2])
         rise = (base[2] - float(pos[1])) / height
         flick = rise >= self.flick_rise and not self._flicked

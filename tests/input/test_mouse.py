@@ -84,3 +84,25 @@ def test_quick_upward_drag_is_one_flick():
     mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(400, 199), rel=(0, -1), buttons=(1, 0, 0)), cam, size, now=1.0)
     flicks = [s.flick for s in mouse.drain()]
     assert flicks == [False, True, False, False, False]
+
+
+def test_a_flick_after_a_pause_is_judged_from_where_the_cursor_rested():
+    """The press, a rest longer than the flick window, then a quick rise: the first move already
+    flicks, and the stick keeps pointing where the cursor rested (before, the first move lifted the
+    puppet and the flick came one move late, to a puppet already off its feet)."""
+    cam, size = PinholeCamera(), (640, 360)
+    mouse = MouseSource()
+    mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(320, 200), button=1), cam, size, now=0.0)
+    first = mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(320, 170), rel=(0, -30), buttons=(1, 0, 0)), cam, size,
+                               now=0.6)
+    assert first
+    press, move = mouse.drain()
+    assert move.flick  # 30 px of 360 within the window: a flick at once
+    assert np.allclose(move.orientation, press.orientation) and np.allclose(move.position, press.position)
+    # A slow drag is still a drag: 2 px a step, 0.05 s apart, never 0.08 of the height within 0.15 s.
+    mouse.handle_event(ev(pygame.MOUSEBUTTONUP, pos=(320, 170), button=1), cam, size, now=0.7)
+    mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(320, 200), button=1), cam, size, now=2.0)
+    for k in range(1, 30):
+        mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(320, 200 - 2 * k), rel=(0, -2), buttons=(1, 0, 0)), cam, size,
+                           now=2.0 + 0.05 * k)
+    assert not any(s.flick for s in mouse.drain())
