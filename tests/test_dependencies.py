@@ -76,4 +76,4 @@ def test_readme_and_ci_install_with_the_constraints() -> None:
     ci = (ROOT / ".ci" / "run").read_text()
     assert "grep -m1 -E \"^pip install -e '\\.\\[test\\]'\" README.md" in ci
     assert "-c constraints-floor.txt" in ci and "PUPPETPHONE_STRICT_SKIPS=1" in ci
-    assert ".[test,pose]' -c constraints.txt" in ci
+    assert ".[test,pose,peers]' -c constraints.txt" in ci  # the side environment: pose tests and the FK peer
