@@ -71,7 +71,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     configure_edit(edit)
     from puppetphone.cmd_author_curves import configure_curves
 
-    curves_help = "edit a keyframed clip's motion curves through its tangents (thesis ch. 4)"
+    curves_help = "author a keyframed clip: pose its keys, shape its motion curves and their timing (thesis ch. 4)"
     curves = sub.add_parser("curves", help=curves_help, description=curves_help)
     curves.set_defaults(_parser=curves)
     configure_curves(curves)

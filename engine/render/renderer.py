@@ -111,8 +111,9 @@ class Renderer:
             "text": ctx.program(vertex_shader=h + S.TEXT_VS, fragment_shader=h + S.TEXT_FS),
             "overlay": ctx.program(vertex_shader=h + S.OVERLAY_VS, fragment_shader=lit + S.OVERLAY_FS),
             "skinned": ctx.program(vertex_shader=h + SKIN_VS, fragment_shader=lit + SKIN_FS),
+            "skinned_flat": ctx.program(vertex_shader=h + SKIN_VS, fragment_shader=h + S.FLAT_FS),
         }
-        self.skinned = SkinnedDraw(ctx, p["skinned"])
+        self.skinned = SkinnedDraw(ctx, p["skinned"], p["skinned_flat"])
         strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
                    "lines": LINE_STRIDE, "points": POINT_STRIDE, "cones": CONE_STRIDE}
         # Capsules and spheres have one buffer per level of detail (self._lod, below).
@@ -255,6 +256,8 @@ class Renderer:
         for kind in _SOLIDS:
             if outlined[kind]:
                 self._vaos[kind + "_flat"].render(moderngl.TRIANGLES, instances=outlined[kind])
+        if any(c.outline for c in scene.skinned):
+            self.skinned.draw_outline(scene.skinned)
         ctx.cull_face = "back"
         for batches in self._lod.values():
             batches.render()
@@ -365,7 +368,7 @@ class Renderer:
                 set_uniform(prog, name, value)
         self.env.set_common(common)
         outline = tuple(float(c) for c in scene.outline_color)
-        for name in ("capsule_flat", "box_flat"):
+        for name in ("capsule_flat", "box_flat", "skinned_flat"):
             set_uniform(self._programs[name], "u_color", outline)
             set_uniform(self._programs[name], "u_inflate_px", float(scene.outline_width))
 

@@ -180,6 +180,8 @@ class SkinnedInstance:
 
     meshes: SkinnedMeshes
     matrices: NDArray[np.float64]
+    outline: bool = False
+    """Drawn with the scene's outline round it (a held or grabbable character), as outlined capsules are."""
 
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(lo, hi)`` around the posed character, from about 128 skinned vertices of each primitive

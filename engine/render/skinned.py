@@ -32,6 +32,8 @@ uniform vec3 u_cam;
 uniform float u_fog_density;
 uniform sampler2D u_joint_tex;  // RGBA32F: texel (c, row) is column c of a joint's matrix
 uniform int u_joint_count;
+uniform float u_inflate_px;     // the outline pass: grow along the normal by this many pixels
+uniform float u_px_scale;
 in vec3 in_pos;
 in vec3 in_normal;
 in vec2 in_uv;
@@ -50,8 +52,9 @@ void main() {
     mat4 m = in_weights.x * joint_matrix(in_joints.x) + in_weights.y * joint_matrix(in_joints.y)
            + in_weights.z * joint_matrix(in_joints.z) + in_weights.w * joint_matrix(in_joints.w);
     vec4 p = m * vec4(in_pos, 1.0);
-    v_pos = p.xyz;
     v_normal = mat3(m) * in_normal;  // rigid joints with a uniform scale: no inverse-transpose needed
+    if (u_inflate_px > 0.0) p.xyz += normalize(v_normal) * (u_inflate_px * u_px_scale * length(p.xyz - u_cam));
+    v_pos = p.xyz;
     v_uv = in_uv;
     float fog = length(v_pos - u_cam) * u_fog_density;
     v_fog = fog / (1.0 + fog);
@@ -93,12 +96,13 @@ class _PrimitiveGPU:
     """Buffers, vertex arrays and base-colour texture of one primitive."""
 
     def __init__(self, ctx: moderngl.Context, prim: SkinnedPrimitive, lit: moderngl.Program,
-                 feedback: moderngl.Program, depth: moderngl.Program) -> None:
+                 feedback: moderngl.Program, depth: moderngl.Program, flat: moderngl.Program) -> None:
         self.vbo = ctx.buffer(_vertices(prim))
         self.ibo = ctx.buffer(np.ascontiguousarray(prim.indices, dtype=np.uint32).tobytes())
         self.lit = ctx.vertex_array(lit, [(self.vbo, *_VERTEX_FMT)], self.ibo, 4, skip_errors=True)
         self.feedback = ctx.vertex_array(feedback, [(self.vbo, *_VERTEX_FMT)], skip_errors=True)
         self.depth = ctx.vertex_array(depth, [(self.vbo, *_VERTEX_FMT)], self.ibo, 4, skip_errors=True)
+        self.flat = ctx.vertex_array(flat, [(self.vbo, *_VERTEX_FMT)], self.ibo, 4, skip_errors=True)
         img = prim.texture if prim.texture is not None else np.full((1, 1, 4), 255, dtype=np.uint8)
         self.texture = ctx.texture((img.shape[1], img.shape[0]), 4, np.ascontiguousarray(img).tobytes())
         if prim.texture is not None:
@@ -108,20 +112,21 @@ class _PrimitiveGPU:
         self.vertices = len(prim.positions)
 
     def release(self) -> None:
-        for obj in (self.lit, self.feedback, self.depth, self.vbo, self.ibo, self.texture):
+        for obj in (self.lit, self.feedback, self.depth, self.flat, self.vbo, self.ibo, self.texture):
             obj.release()
 
 
 class SkinnedDraw:
     """Draws :class:`SkinnedInstance` lists; GPU copies of each mesh are made once and kept.
 
-    ``lit`` must be compiled from :data:`SKIN_VS` and ``LIGHTING`` + :data:`SKIN_FS` so the
-    renderer's frame uniforms (camera, sun, shadow map) reach it with the other programs'.
+    ``lit`` must be compiled from :data:`SKIN_VS` and ``LIGHTING`` + :data:`SKIN_FS`, ``flat`` from
+    :data:`SKIN_VS` and the flat outline shader, so the renderer's frame uniforms (camera, sun,
+    shadow map, outline colour and width) reach them with the other programs'.
     """
 
-    def __init__(self, ctx: moderngl.Context, lit: moderngl.Program) -> None:
+    def __init__(self, ctx: moderngl.Context, lit: moderngl.Program, flat: moderngl.Program) -> None:
         self.ctx = ctx
-        self.lit = lit
+        self.lit, self.flat = lit, flat
         self.feedback = ctx.program(vertex_shader=S.HEADER + SKIN_VS, varyings=["v_pos"])
         self.depth = ctx.program(vertex_shader=S.HEADER + SKIN_VS, fragment_shader=S.HEADER + S.DEPTH_FS)
         self._meshes: dict[int, tuple[SkinnedMeshes, list[_PrimitiveGPU]]] = {}
@@ -133,7 +138,8 @@ class SkinnedDraw:
     def _gpu(self, meshes: SkinnedMeshes) -> list[_PrimitiveGPU]:
         key = id(meshes)
         if key not in self._meshes:  # the meshes object is kept with its copies, so its id stays its own
-            prims = [_PrimitiveGPU(self.ctx, p, self.lit, self.feedback, self.depth) for p in meshes.primitives]
+            programs = (self.lit, self.feedback, self.depth, self.flat)
+            prims = [_PrimitiveGPU(self.ctx, p, *programs) for p in meshes.primitives]
             self._meshes[key] = (meshes, prims)
         return self._meshes[key][1]
 
@@ -149,7 +155,7 @@ class SkinnedDraw:
             self._joints.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self._joints.write(cols.tobytes())
         self._joints.use(location=_JOINT_TEX_UNIT)
-        for prog in (self.lit, self.feedback, self.depth):
+        for prog in (self.lit, self.feedback, self.depth, self.flat):
             set_uniform(prog, "u_joint_tex", _JOINT_TEX_UNIT)
             set_uniform(prog, "u_joint_count", k)
         return k
@@ -171,6 +177,14 @@ class SkinnedDraw:
                 prim.texture.use(location=_BASE_TEX_UNIT)
                 set_uniform(self.lit, "u_base_factor", prim.color)
                 prim.lit.render(moderngl.TRIANGLES, instances=len(matrices))
+
+    def draw_outline(self, instances: list[SkinnedInstance]) -> None:
+        """The outlined instances, grown along their normals in the flat outline colour (the caller culls
+        front faces, so only a rim round the silhouette shows, as the mannequin's outline does)."""
+        for meshes, matrices in self._by_mesh([i for i in instances if i.outline]):
+            self._upload_joints(matrices)
+            for prim in self._gpu(meshes):
+                prim.flat.render(moderngl.TRIANGLES, instances=len(matrices))
 
     def draw_depth(self, instances: list[SkinnedInstance], view_proj: NDArray[np.float64]) -> None:
         """Draw every instance's depth only, seen through ``view_proj`` (the sun's shadow map)."""

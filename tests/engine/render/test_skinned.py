@@ -143,3 +143,29 @@ def test_a_character_casts_its_shadow_on_the_ground(gl, mocap_dir: Path) -> None
     figure = np.abs(frame(True, False) - empty).sum(axis=2) > 30  # the character's own pixels
     darker = (frame(True, False) - frame(True, True)).sum(axis=2) > 30  # what the sun's shadow darkens
     assert (darker & ~figure).sum() > 300  # on the ground beside the figure, not only on itself
+
+
+def test_an_outlined_character_gets_a_rim_in_the_outline_colour(gl, mocap_dir: Path) -> None:
+    path = mocap_dir / "CesiumMan.glb"
+    asset = read_gltf(path)
+    meshes = read_skinned_meshes(path)
+    matrices = skin_matrices(asset, node_world_matrices(asset))
+    gl.camera = OrbitCamera(target=np.array([0.0, 0.8, 0.0]), yaw=0.0, pitch=0.1, distance=2.6)
+
+    def frame(outline: bool) -> np.ndarray:
+        scene = RenderScene()
+        scene.sun.shadows = False
+        scene.skinned.append(SkinnedInstance(meshes, matrices, outline=outline))
+        gl.draw(scene)
+        return gl.read_pixels().astype(np.int32)
+
+    empty = RenderScene()
+    empty.sun.shadows = False
+    gl.draw(empty)
+    background = gl.read_pixels().astype(np.int32)
+    plain, outlined = frame(False), frame(True)
+    figure = np.abs(plain - background).sum(axis=2) > 30
+    rim = np.abs(outlined - plain).sum(axis=2) > 30
+    assert rim.sum() > 200 and not (rim & figure).sum() > 0.05 * rim.sum()  # round the figure, not over it
+    colour = outlined[rim].mean(axis=0)
+    assert colour[0] > 200 and 150 < colour[1] < 230 and colour[2] < 120  # the scene's outline yellow-orange
