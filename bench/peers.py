@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from bench.figures import Figure
+from bench.figures import Figure, median_time
 from engine import quat
 from engine.blend.puppet import puppet_locomotion
 from engine.fk import forward_kinematics
@@ -39,17 +39,7 @@ _BENCH = "peers"
 
 def cpu_time(fn: Callable[[], Any], repeats: int = REPEATS) -> float:
     """Median thread CPU seconds per call of ``fn``."""
-    fn()
-    t0 = time.thread_time()
-    fn()
-    inner = max(1, int(SAMPLE_S / max(time.thread_time() - t0, 1e-7)))
-    samples = []
-    for _ in range(repeats):
-        t0 = time.thread_time()
-        for _ in range(inner):
-            fn()
-        samples.append((time.thread_time() - t0) / inner)
-    return float(np.median(samples))
+    return median_time(fn, repeats=repeats, min_time=SAMPLE_S, clock=time.thread_time)
 
 
 def pinocchio_model(sk: Skeleton) -> Any:
