@@ -24,7 +24,7 @@ from authoring.keyframe_curves import keys as key_ops
 from authoring.keyframe_curves.limits import retime_segment
 from authoring.keyframe_curves.posing import KeyPose, pose_key
 from authoring.keyframe_curves.solver import CurveEdit, Drag, Hold, TangentSolver, curve_rig
-from engine.atomic import atomic_write_bytes
+from authoring.paired_save import entry_for, write_pair
 from engine.clipfile import MAX_FILE as MAX_CLIP_FILE
 from engine.ik import humanoid_rig
 from engine.keyframes import BezierCurves, KeyframedClip, keyframe_clip
@@ -77,24 +77,8 @@ def save_curves(clip: KeyframedClip, path: str | Path) -> Path:
     side = {"format": FORMAT, "version": VERSION, "clip_sha256": hashlib.sha256(data).hexdigest(),
             "fps": clip.fps, "loop": clip.loop,
             **{k: np.asarray(getattr(c, k)).tolist() for k in ("times", "values", "out_x", "out_y", "in_x", "in_y")}}  # fmt: skip
-    # Side file first, carrying the entry of the clip still on disk ("previous"): a kill or a full
-    # disk between the two atomic writes leaves the old clip with keys that still open it.
-    before = _entry_on_disk(p)
-    if before is not None and before["clip_sha256"] != side["clip_sha256"]:
-        side["previous"] = before
-    atomic_write_bytes(keys_path(p), json.dumps(side).encode())
-    atomic_write_bytes(p, data)
+    write_pair(p, data, keys_path(p), side, _entry_on_disk(p))  # keys first (authoring.paired_save)
     return p
-
-
-def _entry_for(side: Any, digest: str) -> dict[str, Any] | None:
-    """The side file's entry for the clip with ``digest``: its own, or the one it kept of the clip before."""
-    if not isinstance(side, dict):
-        return None
-    for entry in (side, side.get("previous")):
-        if isinstance(entry, dict) and entry.get("clip_sha256") == digest:
-            return {k: v for k, v in entry.items() if k != "previous"}
-    return None
 
 
 def _entry_on_disk(p: Path) -> dict[str, Any] | None:
@@ -104,7 +88,7 @@ def _entry_on_disk(p: Path) -> dict[str, Any] | None:
         side = json.loads(read_bounded(keys_path(p), MAX_SIDE_FILE).decode("utf-8"))
     except (OSError, ValueError, RecursionError):
         return None
-    return _entry_for(side, digest)
+    return entry_for(side, digest)
 
 
 def load_curves(path: str | Path) -> KeyframedClip:
@@ -124,7 +108,7 @@ def load_curves(path: str | Path) -> KeyframedClip:
         raise CurveFileError(f"{side_file}: not a keyframes file")
     if side.get("version") != VERSION:
         raise CurveFileError(f"{side_file}: version {side.get('version')!r} is not {VERSION}")
-    side = _entry_for(side, hashlib.sha256(p.read_bytes()).hexdigest())
+    side = entry_for(side, hashlib.sha256(p.read_bytes()).hexdigest())
     if side is None:
         raise CurveFileError(f"{side_file}: belongs to another version of {p.name}")
     fps = side.get("fps")

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from authoring.mocurves.session import EditSession
+from authoring.paired_save import entry_for, write_pair
 from engine import quat
-from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
 from engine.clipfile import load_clip_curve, save_clip
 from engine.io.formats import motion_format, suffixes
@@ -88,14 +88,9 @@ def save_session(session: EditSession, path: str | Path) -> Path:
         "tau": session.tau,
         "sigma": session.sigma,
     }
-    # Side file first, carrying the entry of the clip still on disk: a kill or a full disk
-    # between the two writes leaves the old clip with a side file that still opens it as it
-    # was saved ("previous"), never a pair that is refused or silently mismatched.
-    before = _entry_on_disk(p)
-    if before is not None and before["clip_sha256"] != side["clip_sha256"]:
-        side["previous"] = before
-    atomic_write_bytes(side_path(p), json.dumps(side).encode())
-    return atomic_write_bytes(p, data)
+    # Side file first, carrying the entry of the clip still on disk (authoring.paired_save): a
+    # kill or a full disk between the two writes never leaves a pair that is refused or mismatched.
+    return write_pair(p, data, side_path(p), side, _entry_on_disk(p))
 
 
 def _read_side(side_file: Path) -> Any:
@@ -108,16 +103,6 @@ def _read_side(side_file: Path) -> Any:
         raise SessionFileError(f"{side_file}: unreadable session file ({type(exc).__name__}: {exc})"[:300]) from None
 
 
-def _entry_for(side: Any, digest: str) -> dict[str, Any] | None:
-    """The side file's entry for the clip with ``digest``: its own, or the one it kept of the clip before."""
-    if not isinstance(side, dict):
-        return None
-    for entry in (side, side.get("previous")):
-        if isinstance(entry, dict) and entry.get("clip_sha256") == digest:
-            return {k: v for k, v in entry.items() if k != "previous"}
-    return None
-
-
 def _entry_on_disk(p: Path) -> dict[str, Any] | None:
     """What the clip at ``p`` opens with now: its side file's entry, or "the clip alone" (``None``: no clip)."""
     try:
@@ -126,7 +111,7 @@ def _entry_on_disk(p: Path) -> dict[str, Any] | None:
         return None
     digest = _clip_digest(clip)
     try:
-        entry = _entry_for(_read_side(side_path(p)), digest)
+        entry = entry_for(_read_side(side_path(p)), digest)
     except SessionFileError:
         entry = None
     return entry or {"format": SIDE_FORMAT, "version": SIDE_VERSION, "clip_sha256": digest, "plain": True}
@@ -142,7 +127,7 @@ def load_session(path: str | Path) -> EditSession:
     side = _read_side(side_file)
     if side is None:
         return EditSession(clip, root_curve=root_curve)
-    entry = _entry_for(side, _clip_digest(clip))
+    entry = entry_for(side, _clip_digest(clip))
     if entry is not None and entry.get("plain") is True:  # saved over a clip that had no session: it opens alone
         return EditSession(clip, root_curve=root_curve)
     try:

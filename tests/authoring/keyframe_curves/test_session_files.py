@@ -43,22 +43,22 @@ def test_a_good_side_file_still_loads(saved) -> None:  # type: ignore[no-untyped
 def test_a_save_cut_between_its_two_files_leaves_the_earlier_save_openable(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
     """The keys are written first, then the clip: a kill or a full disk in between must not strand
     the clip on disk with keys of a version that never landed (the fault issue 30 found in MoCurves)."""
-    import authoring.keyframe_curves.session as session
+    import authoring.paired_save as paired
 
     first = CurveSession.from_spec("walk").clip
     path = save_curves(first, tmp_path / "walk.ppclip")
     second = CurveSession.from_spec("run").clip
-    real_write = session.atomic_write_bytes
+    real_write = paired.atomic_write_bytes
 
     def disk_full_on_the_clip(target, data):  # type: ignore[no-untyped-def]
         if Path(target).suffix == ".ppclip":
             raise OSError(28, "No space left on device")
         return real_write(target, data)
 
-    monkeypatch.setattr(session, "atomic_write_bytes", disk_full_on_the_clip)
+    monkeypatch.setattr(paired, "atomic_write_bytes", disk_full_on_the_clip)
     with pytest.raises(OSError):
         save_curves(second, path)
-    monkeypatch.setattr(session, "atomic_write_bytes", real_write)
+    monkeypatch.setattr(paired, "atomic_write_bytes", real_write)
     reopened = load_curves(path)
     assert reopened.fps == first.fps and reopened.curves.times.shape == first.curves.times.shape
     assert json.loads(keys_path(path).read_text())["previous"]["clip_sha256"]  # the earlier entry rode along
