@@ -22,6 +22,7 @@ from engine.humanoid import humanoid_skeleton
 from engine.io.bvh import BvhError, parse_bvh
 from engine.io.gltf import GltfError, read_gltf
 from engine.io.gltf_clip import load_gltf_clips
+from engine.io.gltf_mesh import read_skinned_meshes
 from engine.io.gltf_write import write_gltf
 
 pytestmark = pytest.mark.fuzz
@@ -136,3 +137,25 @@ def test_fuzz_our_own_gltf_as_json(campaign, mutations, fuzz_budget, tmp_path):
         path.write_bytes(data)
         c.run(_check_gltf, path)
     c.check("gltf (our writer's)")
+
+
+def _check_skinned(path: Path) -> None:
+    """Whatever reads must be drawable: finite, weights summing to one, every index in range."""
+    meshes = read_skinned_meshes(path)
+    joints = len(read_gltf(path).skins[meshes.skin].joints)
+    for prim in meshes.primitives:
+        _finite(prim.positions, prim.normals, prim.uv, prim.weights)
+        assert np.allclose(prim.weights.sum(axis=1), 1.0, atol=1e-5)
+        assert int(prim.joints.max()) < joints and int(prim.indices.max()) < len(prim.positions)
+
+
+def test_fuzz_skinned_mesh_bytes(campaign, mutations, fuzz_budget, mocap_dir, tmp_path):
+    """The skinned-mesh reader (characters drawn in the renderer) over a real skinned GLB."""
+    good = (mocap_dir / "RiggedFigure.glb").read_bytes()
+    cases, seed = fuzz_budget(600)
+    c = campaign((GltfError,))
+    path = tmp_path / "m.glb"
+    for data in mutations(good, cases, seed):
+        path.write_bytes(data)
+        c.run(_check_skinned, path)
+    c.check("skinned gltf mesh")
