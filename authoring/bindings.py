@@ -75,7 +75,8 @@ class Bindings:
         elif kind in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
             return Resize(int(size[0]), int(size[1]))
         elif kind == pygame.KEYDOWN and ev.key != pygame.K_ESCAPE:
-            return Key(pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL), bool(ev.mod & pygame.KMOD_SHIFT))
+            mod = getattr(ev, "mod", 0)  # (a posted event may carry no modifiers)
+            return Key(pygame.key.name(ev.key), bool(mod & pygame.KMOD_CTRL), bool(mod & pygame.KMOD_SHIFT))
         return None
 
     def queue(self, op: Operation) -> None:
