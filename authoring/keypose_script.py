@@ -18,6 +18,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from authoring.bindings import ORBIT_RADIANS_PER_PIXEL
+
 __all__ = ["walk_script", "goto_frame", "WALK_KEYS", "HAND_DRAG_FRAME", "Op"]
 
 Op = list  # ["press", x, y, shift] | ["move", x, y] | ["release", x, y] | ["key", name, ctrl, shift]
@@ -84,7 +86,7 @@ def walk_script(scene) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
         yield from goto_frame(scene, frame)
         yield [["key", "k", False, False]]
     # Pose from the side: the drags run on the view plane, which is then the walk's own plane.
-    side = round((scene.camera.yaw - SIDE_YAW) * 100.0, 2)
+    side = round((scene.camera.yaw - SIDE_YAW) / ORBIT_RADIANS_PER_PIXEL, 2)
     yield [["orbit", side, 0.0]]
     for frame, pose in zip(WALK_KEYS, WALK_POSES, strict=True):
         yield from goto_frame(scene, frame)

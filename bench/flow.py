@@ -106,14 +106,17 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
     """Operations and update times of the editor's scripted row and centre-point edits."""
     from authoring.flowcurves.securves import compute_securves
     from authoring.flowcurves.session import FlowSession
-    from puppetphone.cmd_author_flow import FlowActivity
+    from authoring.flow_tool import FlowTool
+    from authoring.session import Session
+    from input.hub import InputHub
 
     securves = compute_securves(scene, SceneDeformer(scene).rasters)
     out = []
     for name, label in (("row", "row_of_trees"), ("centre", "centre_point")):
-        activity = FlowActivity(FlowSession(flow_scene(), securves=securves), None, name)
-        while activity.frame < activity.script_end:
-            activity.step()
+        activity = FlowTool(FlowSession(flow_scene(), securves=securves), None, name)
+        session = Session(activity, InputHub(), script=activity.script_steps())
+        while session.frame < activity.script_end:
+            session.step()
         out.append(Figure("flow", f"flow_ops_{label}", activity.clicks, "operations per edit"))  # no human baseline
         out.append(Figure("flow", f"flow_update_ms_{label}", float(np.median(activity.solve_ms)), "ms",
                           "one frame at 60 Hz", 1000.0 / 60.0))

@@ -12,14 +12,27 @@ Submodules with device specifics are imported lazily by :func:`make_hub`:
 ``input.osc``, ``input.hid``, ``input.serial_source``, ``input.mouse``.
 """
 
-from input.factory import add_source_arguments, make_hub
-from input.hub import InputHub
-from input.motionstick import StickConfig, StickState, motionstick_system, spawn_stick
-from input.plugin import input_plugin, install_input
-from input.recording import Recorder, Recording, RecordingError, RecordingHeader, read_recording
-from input.replay import HashCheck, ReplaySource, replay_hub, verify
-from input.sample import InputFrame, PoseSample, SourceStatus
-from input.source import PoseSource
+from importlib import import_module
+from typing import Any
+
+# Each public name → its submodule, imported on first use (PEP 562): parsing ``puppetphone --help``
+# reads ``input.factory`` without loading the hub, numpy or the device servers.
+_WHERE = {
+    "add_source_arguments": "factory", "make_hub": "factory", "InputHub": "hub",
+    "StickConfig": "motionstick", "StickState": "motionstick", "motionstick_system": "motionstick",
+    "spawn_stick": "motionstick", "input_plugin": "plugin", "install_input": "plugin",
+    "Recorder": "recording", "Recording": "recording", "RecordingError": "recording",
+    "RecordingHeader": "recording", "read_recording": "recording", "HashCheck": "replay",
+    "ReplaySource": "replay", "replay_hub": "replay", "verify": "replay", "InputFrame": "sample",
+    "PoseSample": "sample", "SourceStatus": "sample", "PoseSource": "source",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        return getattr(import_module(f"input.{_WHERE[name]}"), name)
+    raise AttributeError(f"module 'input' has no attribute {name!r}")
+
 
 __all__ = [
     "PoseSample", "InputFrame", "SourceStatus", "PoseSource", "InputHub",

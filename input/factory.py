@@ -18,10 +18,13 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from input.hub import InputHub
-from input.osc import DEFAULT_PORT
-from input.web.server import DEFAULT_WEB_PORT
+if TYPE_CHECKING:
+    from input.hub import InputHub
+    from input.source import PoseSource
 
 __all__ = [
     "DEFAULT_HOST",
@@ -30,10 +33,15 @@ __all__ = [
     "SOURCE_KINDS",
     "add_source_arguments",
     "make_hub",
+    "open_hub",
     "silent_after",
+    "SourceOptions",
+    "SOURCES",
 ]
 
-SOURCE_KINDS = ("mouse", "osc", "hid", "serial", "web", "replay:FILE")
+#: The OSC and web defaults, repeated here so parsing ``--help`` imports neither server (a test checks they agree).
+DEFAULT_PORT = 9000
+DEFAULT_WEB_PORT = 8443
 #: Where OSC listens unless told otherwise: this machine only (a LAN phone needs 0.0.0.0).
 DEFAULT_HOST = "127.0.0.1"
 #: Seconds of silence after which an OSC or web controller's puppet goes to the next phone.
@@ -72,6 +80,68 @@ def add_source_arguments(parser: argparse.ArgumentParser) -> None:
                              f"({lo}..{hi:g}, default {DEFAULT_SILENT_AFTER:g})")
 
 
+@dataclass(frozen=True)
+class SourceOptions:
+    """The device options of the command line, as every source kind's builder reads them."""
+
+    arg: str = ""
+    osc_host: str = DEFAULT_HOST
+    osc_port: int = DEFAULT_PORT
+    osc_senders: int = 1
+    serial_port: str | None = None
+    baud: int = 115200
+    web_host: str = DEFAULT_HOST
+    web_port: int = DEFAULT_WEB_PORT
+    silent_after: float = DEFAULT_SILENT_AFTER
+
+
+def _mouse(o: SourceOptions) -> PoseSource:
+    from input.mouse import MouseSource
+
+    return MouseSource()
+
+
+def _osc(o: SourceOptions) -> PoseSource:
+    from input.osc import OscSource
+
+    return OscSource(host=o.osc_host, port=int(o.arg) if o.arg else o.osc_port, max_senders=o.osc_senders,
+                     timeout=o.silent_after)
+
+
+def _hid(o: SourceOptions) -> PoseSource:
+    from input.hid import HidSource
+
+    return HidSource()
+
+
+def _serial(o: SourceOptions) -> PoseSource:
+    from input.serial_source import SerialSource
+
+    port = o.arg or o.serial_port
+    if not port:
+        raise ValueError("--source serial needs a port: --source serial:/dev/ttyUSB0 or --serial-port")
+    return SerialSource(port, baudrate=o.baud)
+
+
+def _web(o: SourceOptions) -> PoseSource:
+    from input.web.server import WebSource
+
+    return WebSource(host=o.web_host, port=int(o.arg) if o.arg else o.web_port, silent_after=o.silent_after)
+
+
+#: Every live source kind by its ``--source`` name: adding a device is a builder and one line here.
+SOURCES: dict[str, Callable[[SourceOptions], PoseSource]] = {
+    "mouse": _mouse, "osc": _osc, "hid": _hid, "serial": _serial, "web": _web,
+}
+SOURCE_KINDS = (*SOURCES, "replay:FILE")
+
+
+def open_hub(args: argparse.Namespace) -> InputHub:
+    """The hub of a parsed command line's ``--source`` and device options (not started): every option passed."""
+    return make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
+                    args.web_host, args.web_port, args.silent_after)
+
+
 def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int = DEFAULT_PORT,
              osc_senders: int = 1, serial_port: str | None = None, baud: int = 115200,
              web_host: str = DEFAULT_HOST, web_port: int = DEFAULT_WEB_PORT,
@@ -83,35 +153,16 @@ def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int 
         OSError: the OSC or web port cannot be bound (or the web certificate cannot be kept).
         input.recording.RecordingError: an unreadable replay file.
     """
+    from input.hub import InputHub
+
     kind, _, arg = source.partition(":")
-    if kind == "mouse":
-        from input.mouse import MouseSource
-
-        return InputHub([MouseSource()])
-    if kind == "osc":
-        from input.osc import OscSource
-
-        return InputHub([OscSource(host=osc_host, port=int(arg) if arg else osc_port, max_senders=osc_senders,
-                                   timeout=silent_after)])
-    if kind == "hid":
-        from input.hid import HidSource
-
-        return InputHub([HidSource()])
-    if kind == "serial":
-        from input.serial_source import SerialSource
-
-        port = arg or serial_port
-        if not port:
-            raise ValueError("--source serial needs a port: --source serial:/dev/ttyUSB0 or --serial-port")
-        return InputHub([SerialSource(port, baudrate=baud)])
-    if kind == "web":
-        from input.web.server import WebSource
-
-        return InputHub([WebSource(host=web_host, port=int(arg) if arg else web_port, silent_after=silent_after)])
     if kind == "replay":
         from input.replay import replay_hub
 
         if not arg:
             raise ValueError("--source replay needs a file: --source replay:session.rec")
         return replay_hub(arg)
-    raise ValueError(f"unknown input source {source!r}; choose {', '.join(SOURCE_KINDS)}")
+    if kind not in SOURCES:
+        raise ValueError(f"unknown input source {source!r}; choose {', '.join(SOURCE_KINDS)}")
+    options = SourceOptions(arg, osc_host, osc_port, osc_senders, serial_port, baud, web_host, web_port, silent_after)
+    return InputHub([SOURCES[kind](options)])

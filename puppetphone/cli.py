@@ -31,7 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every available sub-command."""
     parser = argparse.ArgumentParser(prog="puppetphone", description="Bring virtual puppets to life by hand.")
-    parser.add_argument("--version", action="version", version=f"puppetphone {_version()}")
+    parser.add_argument("--version", action=_VersionAction, nargs=0, help="show the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (module_name, help_text) in COMMANDS.items():
         try:
@@ -44,6 +44,15 @@ def build_parser() -> argparse.ArgumentParser:
         p.set_defaults(_run=module.run, _parser=p)
         module.configure(p)
     return parser
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: the installed distribution's version, looked up only when asked (importlib.metadata is slow)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: object,
+                 option_string: str | None = None) -> None:
+        print(f"puppetphone {_version()}")
+        parser.exit()
 
 
 def _version() -> str:

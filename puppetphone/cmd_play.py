@@ -74,13 +74,13 @@ def announce_web(hub) -> None:  # type: ignore[no-untyped-def]
 
 
 def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-untyped-def]
-    """Run a game activity through the runner; ``(exit code, run result)``."""
+    """Run a game's session through the runner; ``(exit code, run result)``."""
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
 
-    runner = Runner(options, clock=activity.app.clock)
+    runner = Runner(options, clock=activity.simulation.app.clock)
     runner.push_handlers(activity)
-    activity.runner = runner
+    activity.simulation.fps = lambda: runner.fps
     activity.hub.start()
     try:
         result = runner.run(activity)

@@ -45,12 +45,8 @@ def run(args: argparse.Namespace) -> int:
     from input.library_versions import version_difference
     from input.recording import RecordingError, read_recording
     from input.replay import ReplaySource
-    from puppetphone.cmd_author import RECORD_GAME
-    from puppetphone.cmd_author_curves import CURVES_GAME
-    from puppetphone.cmd_author_edit import EDIT_GAME
-    from puppetphone.cmd_author_flow import FLOW_GAME
     from puppetphone.cmd_play import run_activity
-    from puppetphone.games import load_game
+    from puppetphone.registry import load_game, lookup
     from puppetphone.runargs import run_options
     from puppetphone.session import build_activity
 
@@ -70,8 +66,13 @@ def run(args: argparse.Namespace) -> int:
     h = rec.header
     if differ := version_difference(h.libraries):
         print(f"note: {differ}", file=sys.stderr)
-    if h.game in (EDIT_GAME, RECORD_GAME, CURVES_GAME, FLOW_GAME):
-        return _replay_authoring(rec, args, cut_short)
+    try:
+        entry = lookup(h.game)
+    except ValueError as exc:
+        print(f"error: cannot rebuild the recorded session: {exc}", file=sys.stderr)
+        return 2
+    if entry.kind == "tool":
+        return _replay_tool(entry, rec, args, cut_short)
     try:
         game = load_game(h.game)
         activity = build_activity(h.game, h.seed, InputHub(replay=ReplaySource(rec)), setup=game.replay_setup(h.setup),
@@ -88,36 +89,36 @@ def run(args: argparse.Namespace) -> int:
     return _verdict(activity.check, result.steps, rec, args, cut_short)  # type: ignore[attr-defined]
 
 
-def _replay_authoring(rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
-    """An ``author edit``, ``record``, ``curves`` or ``flow`` session: reopened from the recording, the same input."""
+def _replay_tool(entry, rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
+    """A tool's session: reopened from the recording by its registered tool, fed the recorded input."""
+    from authoring.session import tool_session
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
-    from puppetphone.cmd_author import replay_record
-    from puppetphone.cmd_author_curves import CURVES_GAME, replay_curves
-    from puppetphone.cmd_author_edit import EDIT_GAME, replay_edit
-    from puppetphone.cmd_author_flow import FLOW_GAME, replay_flow
+    from input.hub import InputHub
+    from input.replay import ReplaySource
+    from puppetphone.registry import load_tool
     from puppetphone.runargs import run_options
 
-    replays = {EDIT_GAME: replay_edit, CURVES_GAME: replay_curves, FLOW_GAME: replay_flow}
     try:
-        activity = replays.get(rec.header.game, replay_record)(rec)
+        session = tool_session(load_tool(entry), rec, InputHub(replay=ReplaySource(rec)))
     except (ValueError, KeyError, TypeError, OSError) as exc:  # (a flow file's own error is a ValueError)
         print(f"error: cannot reopen the recorded {rec.header.game} session: {exc}", file=sys.stderr)
         return 2
     runner = Runner(run_options(args, f"PuppetPhone — replay of {args.file}"))
     try:
-        result = runner.run(activity)
+        result = runner.run(session)
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except ValueError as exc:  # a tool operation the scene cannot take: the file was made to lie
-        print(f"error: {args.file}: step {activity.frame}: {exc}", file=sys.stderr)
+        print(f"error: {args.file}: step {session.frame}: {exc}", file=sys.stderr)
         return 2
     finally:
         runner.close()
+        session.close()
     if result.screenshot is not None:
         print(f"screenshot: {result.screenshot}")
-    return _verdict(activity.check, result.steps, rec, args, cut_short)
+    return _verdict(session.check, result.steps, rec, args, cut_short)
 
 
 def _verdict(check, steps: int, rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]

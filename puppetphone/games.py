@@ -1,35 +1,23 @@
 """The games the launcher knows, and how an app is assembled for one of them.
 
-A game module (``games/<name>/game.py``) exposes a :class:`games.base.Game`; the
+A game module (``games/<name>/game.py``, registered in :mod:`puppetphone.registry`) exposes a
+:class:`games.base.Game`; the
 launcher builds the simulation from its plugins plus the input plugin, so
 ``play``, ``replay --verify`` and the tests all assemble the same app.
 """
 
 from __future__ import annotations
 
-import importlib
-
 from typing import Any
 
 from engine.app import App
-from games.base import Game, GameSetup
+from games.base import GameSetup
 from input.hub import InputHub
 from input.plugin import input_plugin
+from puppetphone.registry import GAMES, load_game
 
 __all__ = ["GAMES", "load_game", "make_app"]
 
-GAMES: dict[str, str] = {
-    "snowman": "games.snowman.game",
-    "tasbada": "games.tasbada.game",
-    "sandbox": "games.sandbox",
-}
-
-
-def load_game(name: str) -> Game:
-    """The game object of a registered game; ``ValueError`` lists the known ones."""
-    if name not in GAMES:
-        raise ValueError(f"unknown game {name!r}; games are {', '.join(GAMES)}")
-    return importlib.import_module(GAMES[name]).GAME  # type: ignore[no-any-return]
 
 
 def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None = None) -> App:

@@ -13,23 +13,26 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options", "about"]
+__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options", "about", "UNIT_NAMES",
+           "UP_AXES"]
+
+# The choices of ``--units`` and ``--up``, spelled here so parsing imports neither numpy nor the readers
+# (a test checks them against ``engine.io.units.UNITS`` and ``engine.io.up_axis.AXES``).
+UNIT_NAMES = ("m", "cm", "mm", "in", "cmu")
+UP_AXES = ("x", "-x", "y", "-y", "z", "-z")
 
 
 def add_motion_options(parser: argparse.ArgumentParser) -> None:
     """``--animation``, ``--units``, ``--height``, ``--up`` and ``--joint-map``."""
-    from engine.io.units import UNITS
-    from engine.io.up_axis import AXES
-
     parser.add_argument("--animation", metavar="NAME|INDEX",
                         help="glTF/GLB: which animation (name or 0-based index; default the first)")
-    parser.add_argument("--units", choices=tuple(UNITS),
+    parser.add_argument("--units", choices=UNIT_NAMES,
                         help="length unit of a BVH/glTF file (default: judged by the figure's leg length or size; "
                              "cmu = the CMU database's 1/0.45 inch; a figure no unit fits is scaled to an adult's "
                              "size and says so)")
     parser.add_argument("--height", type=float, metavar="METRES",
                         help="instead of --units: scale the figure so it stands this tall (any size, not a unit's)")
-    parser.add_argument("--up", choices=tuple(AXES), metavar="AXIS",
+    parser.add_argument("--up", choices=UP_AXES, metavar="AXIS",
                         help="the file's up axis: x, y, z, -x, -y or -z (write --up=-z); default judged by the figure "
                              "(a Blender export keeps z up); the figure is stood up with it")
     parser.add_argument("--joint-map", metavar="FILE",

@@ -9,11 +9,12 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from engine.render.quality import parse_quality
-from engine.render.target import image_format
-from engine.runner import RunOptions
 from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
+
+if TYPE_CHECKING:  # the engine's modules load numpy and GL: imported when a session starts, not to parse
+    from engine.runner import RunOptions
 
 __all__ = ["add_run_arguments", "run_options", "steps", "image_path", "HUD_DUMP_ENV", "quality_name"]
 
@@ -23,6 +24,8 @@ steps = int_range(0)
 
 def image_path(text: str) -> Path:
     """A screenshot or plot file to write: ``.png`` or ``.jpg``, refused before the session starts."""
+    from engine.render.target import image_format
+
     path = output_file(text)
     try:
         image_format(path)
@@ -33,6 +36,8 @@ def image_path(text: str) -> Path:
 
 def quality_name(text: str) -> str:
     """A ``--quality`` value, refused before the session starts when it is none of the levels."""
+    from engine.render.quality import parse_quality
+
     try:
         return parse_quality(text)
     except ValueError as exc:
@@ -62,6 +67,8 @@ HUD_DUMP_ENV = "PUPPETPHONE_HUD_DUMP"
 
 def run_options(args: argparse.Namespace, title: str, *, pace: bool = False) -> RunOptions:
     """The runner's options from parsed arguments (and ``$PUPPETPHONE_HUD_DUMP``)."""
+    from engine.runner import RunOptions
+
     width, height = args.size
     hud = os.environ.get(HUD_DUMP_ENV)
     return RunOptions(headless=args.headless, frames=args.frames, screenshot=args.screenshot,

@@ -1,132 +1,141 @@
-"""A game session as the runner's activity: the app, its input, recording and verification.
+"""A game as a session's simulation: the app, its view, its keys; ``play`` and ``replay`` build it here.
 
-:class:`GameActivity` is what ``play`` and ``replay`` hand to :class:`engine.runner.Runner`:
-one step is ``App.step``; drawing is the game's view plus the overlay; its event layer
-feeds the mouse source, orbits the camera (right-drag) and turns R / F5 / F9 into
-recorded input commands (reset, save, restore), so replays repeat them; H or F1 hides
-and shows the help; V switches between the orbit camera and the view from the held
+:func:`build_activity` returns the one :class:`authoring.session.Session` that every tool uses too,
+holding a :class:`GameSimulation`: each step the session drains the hub and hands the frame to the
+app (whose input stage reads exactly that frame), steps it, hashes the world, records or verifies.
+The bindings are the session's (:mod:`authoring.bindings`): the left button and the wheel go to the
+mouse source (grab, walk, crouch), right-drag orbits the camera (a recorded operation, so a replay
+shows the same view); R / F5 / F9 become recorded input commands (reset, save, restore); H or F1
+hides and shows the help; V switches between the orbit camera and the view from the held
 controller (``--view phone``: :func:`input.controller_view.controller_camera`).
 
-A replay is the same activity built from a recording's header (game, seed, setup) with
-a replay hub; :class:`input.replay.HashCheck` compares every step's state hash with the recorded one
-and ends the activity at the first difference.
+A replay is the same session built from a recording's header (game, seed, setup) with a replay
+hub; the session compares every step's state hash with the recorded one and ends at the first
+difference.
 """
 
 from __future__ import annotations
 
-import threading
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from authoring.bindings import orbit_camera
+from authoring.operations import Key, Operation, Orbit
+from authoring.session import KeyUse, Session
 from engine.app import App
 from engine.camera import Camera, OrbitCamera
+from engine.hashing import part_digests
 from engine.render.scene import RenderScene
-from engine.runner import Runner
 from games.base import Game
 from input.controller_view import controller_camera
 from input.hub import InputHub
-from input.recording import Recorder, Recording, RecordingHeader
-from input.replay import HashCheck
-from input.sample import RESET, RESTORE, SAVE
-from puppetphone.games import load_game, make_app
+from input.recording import Recording
+from input.sample import RESET, RESTORE, SAVE, InputFrame, SourceStatus
+from puppetphone.games import make_app
 from puppetphone.overlay import NO_VIEW, OverlayState, draw_overlay, source_kinds
+from puppetphone.registry import load_game
 
-__all__ = ["GameActivity", "build_activity"]
+__all__ = ["GameSimulation", "build_activity"]
+
+#: Keys that become recorded input commands.
+COMMAND_KEYS = {"r": RESET, "f5": SAVE, "f9": RESTORE}
 
 
-@dataclass
-class GameActivity:
-    """One game session (see the module docstring)."""
+class _Handed:
+    """The app's frame source: the frame the session drained for this step (an empty one for any other)."""
 
-    game: Game
-    app: App
-    hub: InputHub
-    orbit: OrbitCamera
-    recorder: Recorder | None = None
-    check: HashCheck | None = None
-    runner: Runner | None = None
-    overlay: OverlayState = field(default_factory=OverlayState)
-    view: str = "orbit"
-    _orbiting: bool = field(default=False, repr=False)
+    name = "session"
 
-    @property
-    def camera(self) -> Camera:
-        """The camera drawn with: the held controller's view in ``phone`` view (while one drives), else the orbit."""
-        if self.view == "phone":
-            phone = controller_camera(self.app.world)
-            if phone is not None:
-                return phone
-        return self.orbit
+    def __init__(self) -> None:
+        self.frame = InputFrame()
+
+    def frame_at(self, index: int) -> InputFrame | None:
+        return self.frame if self.frame.frame == index else InputFrame(frame=index)
+
+    def status(self) -> SourceStatus:
+        return SourceStatus(self.name, connected=True)
+
+
+class GameSimulation:
+    """One game's app as a session's simulation (see the module docstring).
+
+    Args:
+        hub: the session's hub (its sources and statuses are what the overlay shows).
+    """
+
+    def __init__(self, game: Game, app: App, handed: _Handed, hub: InputHub, orbit: OrbitCamera,
+                 view: str = "orbit") -> None:
+        self.game, self.app, self.hub, self.orbit, self.view = game, app, hub, orbit, view
+        self._handed = handed
+        self.overlay = OverlayState()
+        self.fps: Callable[[], float] = lambda: 0.0  # the runner's drawn frame rate, once one runs it
 
     @property
     def dt(self) -> float:
         """The game's fixed step."""
         return self.app.world.dt
 
-    def step(self) -> None:
-        """One simulation step."""
+    @property
+    def camera(self) -> Camera:
+        """The held controller's view in ``phone`` view (while one drives), else the orbit camera."""
+        if self.view == "phone":
+            phone = controller_camera(self.app.world)
+            if phone is not None:
+                return phone
+        return self.orbit
+
+    def on_key(self, key: Key, hub: InputHub) -> KeyUse:
+        """R / F5 / F9 into the hub as commands; H / F1 help; V view; the rest is the runner's."""
+        if key.name in COMMAND_KEYS:
+            hub.command(COMMAND_KEYS[key.name])
+        elif key.name in ("h", "f1"):
+            self.overlay.toggle_help()
+        elif key.name == "v":
+            if self.view == "orbit" and hub.replay is None and source_kinds(hub) <= {"mouse"}:
+                self.overlay.tell(NO_VIEW, self.app.world.frame)
+            else:
+                self.view = "orbit" if self.view == "phone" else "phone"
+        else:
+            return "pass"
+        return "done"
+
+    def apply(self, op: Operation) -> None:
+        """Right-drag orbits the camera; a game takes no other operation (its pointer is the mouse source)."""
+        if isinstance(op, Orbit):
+            orbit_camera(self.orbit, op)
+
+    def advance(self, frame: InputFrame) -> None:
+        """The app's step, its input stage reading ``frame``."""
+        self._handed.frame = frame
         self.app.step()
 
-    @property
-    def input_wake(self) -> threading.Event | None:
-        """Set when a live reading arrives: the paced runner starts the step early for it (none in a replay)."""
-        return self.hub.arrived if self.hub.replay is None else None
+    def digest(self) -> tuple[str, dict[str, bytes]]:
+        """The world's state hash and its parts (what a game's recording has always stored)."""
+        return part_digests(self.app.world)
 
-    def finished(self) -> bool:
-        """A replay ends after its last recorded frame or at the first hash that differs."""
-        if self.check is not None and not self.check.ok:
-            return True
-        replay = self.hub.replay
-        return replay is not None and self.app.world.frame > replay.last_frame  # type: ignore[attr-defined]
+    def ready(self) -> bool:
+        """A game steps at once."""
+        return True
+
+    def ended(self) -> bool:
+        """A game ends when its window closes or its replay runs out."""
+        return False
 
     def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
         """The game's view and the overlay."""
         self.game.draw(self.app.world, scene, alpha)
-        fps = self.runner.fps if self.runner is not None else 0.0
-        draw_overlay(scene, self.app.world, self.game, self.hub, fps, self.app.clock.paused, self.overlay, size)
-
-    def on_event(self, event: Any, runner: Runner) -> bool:
-        """Mouse to the mouse source, right-drag orbits, R / F5 / F9 become recorded commands."""
-        import pygame
-
-        commands = {pygame.K_r: RESET, pygame.K_F5: SAVE, pygame.K_F9: RESTORE}
-        if event.type == pygame.KEYDOWN and event.key in commands:
-            self.hub.command(commands[event.key])
-            return True
-        if event.type == pygame.KEYDOWN and event.key in (pygame.K_h, pygame.K_F1):
-            self.overlay.toggle_help()
-            return True
-        if event.type == pygame.KEYDOWN and event.key == pygame.K_v:
-            if self.view == "orbit" and self.hub.replay is None and source_kinds(self.hub) <= {"mouse"}:
-                self.overlay.tell(NO_VIEW, self.app.world.frame)
-                return True
-            self.view = "orbit" if self.view == "phone" else "phone"
-            return True
-        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 3:
-            self._orbiting = True
-        elif event.type == pygame.MOUSEBUTTONUP and event.button == 3:
-            self._orbiting = False
-        elif event.type == pygame.MOUSEMOTION and self._orbiting:
-            self.orbit.orbit(-0.005 * event.rel[0], -0.005 * event.rel[1])
-        for source in self.hub.sources:
-            handle = getattr(source, "handle_event", None)
-            if handle is not None:
-                handle(event, self.camera, runner.size)
-        return False
+        draw_overlay(scene, self.app.world, self.game, self.hub, self.fps(), self.app.clock.paused, self.overlay, size)
 
     def close(self) -> None:
-        """Stop the devices, let the game release what it holds, close the recording (already flushed)."""
-        self.hub.close()
+        """Let the game release what it holds."""
         self.game.close(self.app.world)
-        if self.recorder is not None:
-            self.recorder.close()
 
 
 def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str, Any] | None = None,
                    options: dict[str, str] | None = None, record: Path | None = None, source_label: str = "",
                    verify: Recording | None = None, clips: dict[str, Any] | None = None,
-                   view: str = "orbit") -> GameActivity:
+                   view: str = "orbit") -> Session:
     """The session of ``game_name``.
 
     Args:
@@ -142,26 +151,24 @@ def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str,
         setup = game.prepare(dict(game.options) if options is None else options)
     if clips is not None:
         setup = {**setup, "clips": clips}
-    app = make_app(game_name, seed, hub, setup)
-    recorder = None
+    handed = _Handed()
+    app = make_app(game_name, seed, InputHub(replay=handed), setup)
+    simulation = GameSimulation(game, app, handed, hub, game.camera(), view)
+    session = Session(simulation, hub, pointer_acts=False)
     if record is not None:
-        header = RecordingHeader(game=game_name, seed=seed, dt=app.world.dt, sources=[source_label], setup=setup)
-        recorder = Recorder(record, header).attach(app)
-    check = None
+        session.record(record, game_name, seed, setup, source_label)
     if verify is not None:
-        check = HashCheck(verify)
-        app.on_step_end.append(check)
-    activity = GameActivity(game, app, hub, game.camera(), recorder, check, view=view)
-    _stream_to_phones(activity)
-    return activity
+        session.verify(verify)
+    _stream_to_phones(session, simulation)
+    return session
 
 
-def _stream_to_phones(activity: GameActivity) -> None:
+def _stream_to_phones(session: Session, simulation: GameSimulation) -> None:
     """With a web source, every step's scene goes to the connected pages too (output only)."""
     from input.web.server import WebSource
     from input.web.viewport import PhoneViewport
 
-    for source in activity.hub.sources:
+    for source in session.hub.sources:
         if isinstance(source, WebSource):
-            draw = activity.game.draw_state or activity.game.draw
-            activity.app.on_step_end.append(PhoneViewport(source, draw, lambda: activity.orbit))
+            draw = simulation.game.draw_state or simulation.game.draw
+            simulation.app.on_step_end.append(PhoneViewport(source, draw, lambda: simulation.orbit))

@@ -33,7 +33,8 @@ from games.snowman.game import GAME
 from input.hub import InputHub
 from input.recording import read_recording
 from input.replay import ReplaySource
-from puppetphone.session import GameActivity, build_activity
+from authoring.session import Session
+from puppetphone.session import build_activity
 from tools import REPO
 from tools.snowman_demo import DEMO_PATH
 
@@ -84,8 +85,8 @@ class _DemoView:
     """The replayed demo as the runner's activity, drawn as the README shows it: the game's
     view and its first status line (the counter), without the overlay's help and sources."""
 
-    def __init__(self, activity: GameActivity) -> None:
-        self.activity, self.app = activity, activity.app
+    def __init__(self, activity: Session) -> None:
+        self.activity, self.app = activity, activity.simulation.app
         self.dt, self.camera = activity.dt, GAME.camera()
 
     def step(self) -> None:
@@ -125,7 +126,7 @@ def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> li
                 written.append(out / f"snowman_{name}.jpg")
                 _save_jpeg(runner, view, written[-1])
 
-    activity.app.on_step_end.append(watch)
+    activity.simulation.app.on_step_end.append(watch)
     try:
         runner.run(view)
         written.append(out / "snowman_second.jpg")

@@ -69,7 +69,7 @@ def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(tmp_
         for i, (frame, digest, parts) in enumerate(zip(rec.frames, rec.hashes, rec.parts, strict=True)):
             out.write(InputFrame(frame=frame.frame, events=((TOOL, '["press"]'),)) if i == 3 else frame, digest, parts)
     done = puppetphone("replay", "short.rec", "--headless", cwd=tmp_path)
-    assert done.returncode == 2 and done.stderr.strip().endswith("does not fit the record scene")
+    assert done.returncode == 2 and done.stderr.strip().endswith("is not one a session knows (press, move, release, orbit, zoom, key, size with their arguments)")
 
 
 def test_a_scripted_pose_take_of_a_foot_records_and_replays(tmp_path: Path) -> None:
@@ -103,7 +103,8 @@ def test_a_six_dof_device_drives_position_and_rotation_together() -> None:
     from input.hub import InputHub
     from input.sample import PoseSample
     from input.source import PoseSource
-    from puppetphone.cmd_author import RecordActivity
+    from authoring.record_tool import RecordTool
+    from authoring.session import Session
 
     class Phone(PoseSource):
         threaded = False
@@ -114,7 +115,7 @@ def test_a_six_dof_device_drives_position_and_rotation_together() -> None:
 
     phone = Phone()
     scene = RecordScene(humanoid_skeleton(), "r_hand", "pose", countdown=0.1, take_seconds=30.0)
-    activity = RecordActivity(scene, InputHub([phone]))
+    activity = Session(RecordTool(scene), InputHub([phone]))
     rest = scene.rest_value()
     start = np.array([0.3, 1.2, 0.4])  # where the phone happens to be: only its motion counts
     scene.key("r")

@@ -8,13 +8,32 @@ import pytest
 
 from authoring.mocurves import EditSession, save_session
 from engine.clips import default_clips
-from puppetphone.cmd_author_edit import configure_edit, run_edit
+from puppetphone.cmd_author import configure_edit
+from puppetphone.cmd_author import run as run_author
 
 
 def parse(*argv: str) -> argparse.Namespace:
     p = argparse.ArgumentParser()
     configure_edit(p)
+    p.set_defaults(scene="edit")
     return p.parse_args(list(argv))
+
+
+def run_edit(args: argparse.Namespace) -> int:
+    return run_author(args)
+
+
+def build_edit(spec, size, output, *, record=None):
+    """A live edit session as ``author edit`` opens it (the tool's simulation in the one session class)."""
+    from authoring.edit_tool import TOOL
+    from authoring.session import Session
+    from input.hub import InputHub
+
+    opened = TOOL.open({"clip": spec, "output": output}, size)
+    session = Session(opened.simulation, InputHub())
+    if record is not None:
+        session.record(record, TOOL.name, 0, opened.setup, "mouse")
+    return session
 
 
 def test_headless_run_screenshots_and_exports(tmp_path):
@@ -48,11 +67,14 @@ def test_an_edit_session_records_and_replays_to_the_same_saved_clip(tmp_path):
     from authoring.mocurves import save_session
     from engine.runner import RunOptions, Runner
     from input.recording import read_recording
-    from puppetphone.cmd_author_edit import build_edit, replay_edit
+    from authoring.edit_tool import reopen_edit
+    from authoring.session import Session
+    from input.hub import InputHub
+    from input.replay import ReplaySource
 
     out, rec = tmp_path / "walk_edited.ppclip", tmp_path / "edit.rec"
     act = build_edit("walk", (640, 360), out, record=rec)
-    before = act.session.clip.rotations.copy()
+    before = act.simulation.session.clip.rotations.copy()
 
     def send(kind, **fields):
         assert act.on_event(pygame.event.Event(kind, **fields), None)
@@ -65,7 +87,7 @@ def test_an_edit_session_records_and_replays_to_the_same_saved_clip(tmp_path):
     send(pygame.KEYDOWN, key=pygame.K_2, mod=0)  # arrows mode: drag rotates the item around the view axis
     send(pygame.KEYDOWN, key=pygame.K_SPACE, mod=0)  # pause the loop so the keypoint stays put
     steps(2)
-    edit = act.edit
+    edit = act.simulation.edit
     screen = edit.camera.project(edit.session.curves()[edit.item].positions, *edit.size)
     k = int(np.nanargmin(np.linalg.norm(screen - np.array([320.0, 180.0]), axis=1)))
     x, y = (int(round(v)) for v in screen[k])
@@ -87,11 +109,12 @@ def test_an_edit_session_records_and_replays_to_the_same_saved_clip(tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"replayed {act.frame} frames, all {act.frame} state hashes match" in done.stdout
 
-    replayed = replay_edit(read_recording(rec))
+    recording = read_recording(rec)
+    replayed = Session(reopen_edit(recording.header.setup), InputHub(replay=ReplaySource(recording)))
     runner = Runner(RunOptions(headless=True))
     runner.run(replayed)
     again = tmp_path / "again.ppclip"
-    save_session(replayed.session, again)
+    save_session(replayed.simulation.session, again)
     assert again.read_bytes() == out.read_bytes()
 
 
@@ -121,7 +144,6 @@ def test_a_take_opens_as_the_loop_of_the_part_picked(tmp_path, mocap_dir):
 def test_a_failed_ctrl_s_says_so_and_the_session_goes_on(tmp_path, capsys, blocker):
     """A folder in the way or a full disk: one line, the edit stays open, a later Ctrl+S elsewhere works."""
     from tests.faults import full_disk
-    from puppetphone.cmd_author_edit import build_edit
 
     def ctrl_s(act):
         act.hub.tool("key", "s", True, False)
@@ -138,10 +160,10 @@ def test_a_failed_ctrl_s_says_so_and_the_session_goes_on(tmp_path, capsys, block
             act = build_edit("walk", (320, 180), out)
             ctrl_s(act)
             assert not out.exists()
-    assert act.edit.message.startswith("NOT saved") and "cannot save" in act.edit.message
+    assert act.simulation.edit.message.startswith("NOT saved") and "cannot save" in act.simulation.edit.message
     err = capsys.readouterr().err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     act.step()
-    act.output = tmp_path / "elsewhere.ppclip"
+    act.simulation.output = tmp_path / "elsewhere.ppclip"
     ctrl_s(act)
-    assert act.edit.message == f"saved {act.output}" and act.output.stat().st_size > 0
+    assert act.simulation.edit.message == f"saved {act.simulation.output}" and act.simulation.output.stat().st_size > 0

@@ -134,17 +134,19 @@ AUTHOR_SAVE = """
 import sys
 from pathlib import Path
 import numpy as np
-from puppetphone.cmd_author_edit import build_edit
-act = build_edit("walk", (160, 90), Path(sys.argv[1]))
+from authoring.edit_tool import TOOL
+from authoring.session import Session
+from input.hub import InputHub
+act = Session(TOOL.open({"clip": "walk", "output": Path(sys.argv[1])}, (160, 90)).simulation, InputHub())
 def ctrl_s():
     act.hub.tool("key", "s", True, False)
     act.step()
-    assert act.edit.message.startswith("saved"), act.edit.message
+    assert act.simulation.edit.message.startswith("saved"), act.simulation.edit.message
 ctrl_s()
 print("go", flush=True)
 for i in range(10**6):
-    session = act.edit.session  # what a drag of a control point does on release, a little each time
-    session.move_control_point(act.edit.item, i % 4, np.array([0.0, 0.004 * (-1) ** i, 0.0]))
+    session = act.simulation.edit.session  # what a drag of a control point does on release, a little each time
+    session.move_control_point(act.simulation.edit.item, i % 4, np.array([0.0, 0.004 * (-1) ** i, 0.0]))
     ctrl_s()
 """
 

@@ -20,12 +20,12 @@ def test_the_help_in_stage_two_ends_above_the_pose_pickers_title(size: tuple[int
     hub = InputHub([MouseSource()])
     session = build_activity("tasbada", 0, hub, setup={"pose_note": "pose: off (tasbada pose=off); drag the "
                                                                       "avatar's hands and feet to pose it"})
-    world = session.app.world
+    world = session.simulation.app.world
     q = world.resource(Quest)
     q.stage = PROPS_ALIVE
     assert q.pose_picker  # no pose in the setup: the person poses the stick figure
     scene = RenderScene()
-    draw_overlay(scene, world, session.game, hub, 60.0, False, session.overlay, size)
+    draw_overlay(scene, world, session.simulation.game, hub, 60.0, False, session.simulation.overlay, size)
     shown = [t.text for t in scene.texts]
     assert CONTROLS[1] in shown and CONTROLS[0] not in shown and CONTROLS[2] not in shown
     cache = TextCache(None)
@@ -38,7 +38,7 @@ def test_the_help_in_stage_two_ends_above_the_pose_pickers_title(size: tuple[int
 def test_the_menu_shows_no_help_over_its_title() -> None:
     hub = InputHub([MouseSource()])
     session = build_activity("tasbada", 0, hub, setup={})
-    session.app.world.resource(Quest).stage = MENU
+    session.simulation.app.world.resource(Quest).stage = MENU
     scene = RenderScene()
-    draw_overlay(scene, session.app.world, session.game, hub, 60.0, False, session.overlay)
+    draw_overlay(scene, session.simulation.app.world, session.simulation.game, hub, 60.0, False, session.simulation.overlay)
     assert not any(t.text in CONTROLS or "hides this help" in t.text for t in scene.texts)

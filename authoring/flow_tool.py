@@ -1,63 +1,41 @@
-"""``puppetphone author flow [snowman|FILE]``: bend a scene's flow with sketched strokes (thesis ch. 3).
+"""The ``author flow`` tool: bend a scene's flow with sketched strokes (thesis ch. 3), as a session's simulation.
 
-The scene opens from its camera; its SEcurves (blue) are computed once (a few seconds:
-one contour search per group). Then:
-
-- **left-drag**: sketch a flow curve — the objects nearby bend so their SEcurves follow
-  it (their contacts kept: trees stay planted, parts stay together);
-- **sketch a circle**: a centre-point; a network of flow curves converges on it;
-  **drag the centre-point** (press on it) and the scene re-bends live;
-- **Shift+left-drag**: draw an SEcurve of your own over objects;
-- ``[`` / ``]``: narrower / wider grouping radius d_Max of the centre-point's network;
-- ``Tab`` shows or hides the SEcurves; ``Ctrl+Z`` / ``Ctrl+Y`` undo / redo;
-  ``Ctrl+S`` saves (``-o``, default ``<scene>.flow.json``); Esc quits.
-
-A saved file reopens here (``author flow FILE``) and bends the game:
-``puppetphone play snowman --flow FILE``. ``--script row|centre|demo`` performs the
-thesis' kinds of edit with a scripted pointer (tests, screenshots, ``bench flow``'s
-operations per edit: it prints the clicks and solve times) and saves at the end. ``--record FILE``
-records the session (pointer and keys as tool operations, every step's state hash: the edits
-and the bent scenery); ``puppetphone replay FILE --verify`` rebuilds the scene from the
-recording and repeats the edits.
+Beside :mod:`authoring.flowcurves` (the solver and its scenes). The scene opens from its
+camera; its SEcurves are found once (a few seconds; on a thread while a window shows the
+rest scene). Left-drag sketches a flow curve, a sketched circle is a centre-point (a press
+on it drags it), Shift+left-drag draws an SEcurve; ``[`` ``]`` the grouping radius, Tab
+the SEcurves, Ctrl+Z/Y undo/redo, Ctrl+S saves. ``script`` performs the thesis' kinds of
+edit with a scripted pointer and saves at the end. A recording keeps the scene's name or
+the flow file's bytes; a replay rebuilds the scene and repeats the edits.
 """
 
 from __future__ import annotations
 
-import argparse
 import base64
 import hashlib
 import math
-import sys
 import tempfile
 import time
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-__all__ = ["configure_flow", "run_flow", "FlowActivity", "open_flow", "script_events", "SCRIPTS", "FLOW_GAME",
-           "replay_flow", "flow_digest"]
+from authoring.bindings import orbit_camera
+from authoring.operations import Key, Move, Operation, Orbit, Press, Release, Zoom
+from authoring.session import Ending, Opened, Script, ToolKind, ToolSimulation
+from engine.camera import Camera
+from input.sample import InputFrame
+
+__all__ = ["FlowTool", "TOOL", "open_flow", "script_events", "SCRIPTS", "FLOW_GAME", "flow_digest", "open_live",
+           "reopen_flow"]
 
 #: The name a flow session's recording gives as its game.
 FLOW_GAME = "author-flow"
 
 SCRIPTS = ("row", "centre", "demo")
 _CENTRE_GRAB = 18.0  # pixels: a press this close to the centre-point drags it
-
-
-def configure_flow(parser: argparse.ArgumentParser) -> None:
-    """Add the ``author flow`` arguments."""
-    from puppetphone.argtypes import output_file
-    from puppetphone.runargs import add_run_arguments
-
-    parser.add_argument("flow_scene", nargs="?", default="snowman", metavar="SCENE",
-                        help="snowman (default), or a saved .flow.json file to go on editing")
-    parser.add_argument("-o", "--output", type=output_file, default=None, help="where Ctrl+S saves (.json)")
-    parser.add_argument("--script", choices=SCRIPTS, default=None,
-                        help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "
-                             "sketched then dragged; demo: both) and the result is saved")
-    parser.add_argument("--record", type=output_file, default=None,
-                        help="record the session (pointer, keys, every step's state) to replay it later")
-    add_run_arguments(parser, screenshot_at=True)
 
 
 def flow_setup(spec: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
@@ -146,28 +124,21 @@ def flow_digest(activity) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-un
     return combine_parts([("edits", edits), ("bent", bent), ("editor", ui)])
 
 
-class FlowActivity:
-    """The flow editor as the runner's activity: pointer and keys reach it as tool operations through the hub.
+class FlowTool(ToolSimulation):
+    """The flow editor as a session's simulation; a replay saves nothing.
 
-    Operations (a hand's or a script's) are queued with the hub and applied at the next step,
-    so a session records like a game and replays to the same bent scene. A replay saves nothing.
+    ``script`` names a scripted edit (:func:`script_events`): its operations are the
+    session's script (:meth:`script_steps`), and the result is saved after its last step.
     """
 
-    dt = 1.0 / 60.0
-
-    def __init__(self, session, output: Path | None, script: str | None = None, *, hub=None,  # type: ignore[no-untyped-def]
-                 recorder=None, check=None) -> None:  # fmt: skip
-        from input.hub import InputHub
-
+    def __init__(self, session: Any, output: Path | None, script: str | None = None) -> None:
         from authoring.flowcurves.background import BackgroundSession
 
         # ``session`` may still be building on a thread: no input is applied and no step counted until it is whole.
         self.building = session if isinstance(session, BackgroundSession) else None
         self.session = None if self.building is not None else session
         self.output = output
-        self.hub = hub if hub is not None else InputHub()
-        self.recorder, self.check = recorder, check
-        self.camera = session.scene.camera
+        self._camera = session.scene.camera
         self.frame = 0
         self.script = script_events(script) if script else {}
         self.script_end = max(self.script) + 1 if self.script else 0
@@ -179,29 +150,24 @@ class FlowActivity:
         self.solve_ms: list[float] = []
         self.message = ""
 
-    def finished(self) -> bool:
-        if self.check is not None and not self.check.ok:
-            return True
+    @property
+    def camera(self) -> Camera:
+        """The scene's camera."""
+        return self._camera  # type: ignore[no-any-return]  # the flow scene's OrbitCamera
+
+    def ready(self) -> bool:
+        """Whole once its SEcurves are found (in a window they are found on a thread)."""
         if self.session is None and self.building is not None and self.building.done():
             self._take_built()
-            return self.session is None  # the build failed: its error is the message
-        return self.hub.replay is not None and self.frame > self.hub.replay.last_frame
+        return self.session is not None
 
-    def on_event(self, ev, runner) -> bool:  # type: ignore[no-untyped-def]
-        """Pointer and keys become queued operations (Esc and P stay the runner's)."""
-        import pygame
+    def ended(self) -> bool:
+        """The SEcurves could not be found: the build's error is the message."""
+        return self.session is None and self.building is not None and self.building.done()
 
-        if ev.type == pygame.MOUSEBUTTONDOWN and ev.button == 1:
-            self.hub.tool("press", float(ev.pos[0]), float(ev.pos[1]), bool(pygame.key.get_mods() & pygame.KMOD_SHIFT))
-        elif ev.type == pygame.MOUSEMOTION and ev.buttons[0]:
-            self.hub.tool("move", float(ev.pos[0]), float(ev.pos[1]))
-        elif ev.type == pygame.MOUSEBUTTONUP and ev.button == 1:
-            self.hub.tool("release", float(ev.pos[0]), float(ev.pos[1]))
-        elif ev.type == pygame.KEYDOWN and ev.key not in (pygame.K_ESCAPE, pygame.K_p):
-            self.hub.tool("key", pygame.key.name(ev.key), bool(ev.mod & pygame.KMOD_CTRL))
-        else:
-            return False
-        return True
+    def script_steps(self) -> Script:
+        """The scripted edit's operations, step by step."""
+        return ([list(op) for op in self.script.get(k, [])] for k in range(self.script_end))
 
     # -- operations ---------------------------------------------------------------------
     def _centre(self) -> np.ndarray | None:
@@ -234,26 +200,29 @@ class FlowActivity:
         else:
             self._timed(self.session.add, "stroke", pts)
 
-    def apply(self, op: tuple) -> None:  # type: ignore[type-arg]
-        """One operation: press / move / release of the pointer, or a key."""
-        kind = op[0]
-        if kind == "press":
+    def apply(self, op: Operation) -> None:
+        """One operation: press / move / release of the pointer (Shift: an SEcurve), the camera, or a key."""
+        if isinstance(op, Press):
             self.clicks += 1
             centre = self._centre()
-            self.dragging_centre = centre is not None and math.dist(centre, op[1:3]) < _CENTRE_GRAB
-            self.drawing_securve = bool(op[3])
-            self.stroke = None if self.dragging_centre else [(op[1], op[2])]
-        elif kind == "move" and self.dragging_centre:
-            self._timed(self.session.move_centre, [op[1], op[2]])
-        elif kind == "move" and self.stroke is not None:
-            self.stroke.append((op[1], op[2]))
-        elif kind == "release":
-            if self.stroke is not None:
-                self.stroke.append((op[1], op[2]))
+            self.dragging_centre = centre is not None and math.dist(centre, (op.x, op.y)) < _CENTRE_GRAB
+            self.drawing_securve = op.shift
+            self.stroke = None if self.dragging_centre else [(op.x, op.y)]
+        elif isinstance(op, Move) and self.dragging_centre:
+            self._timed(self.session.move_centre, [op.x, op.y])
+        elif isinstance(op, Move) and self.stroke is not None:
+            self.stroke.append((op.x, op.y))
+        elif isinstance(op, Release):
+            if self.stroke is not None and op.x is not None and op.y is not None:
+                self.stroke.append((op.x, op.y))
                 self._release()
-            self.dragging_centre = False
-        elif kind == "key":
-            self._key(op[1], op[2])
+            self.stroke, self.dragging_centre = None, False
+        elif isinstance(op, Orbit):
+            orbit_camera(self._camera, op)
+        elif isinstance(op, Zoom):
+            self._camera.zoom(op.factor)
+        elif isinstance(op, Key):
+            self._key(op.name, op.ctrl)
 
     def _key(self, name: str, ctrl: bool) -> None:
         s = self.session
@@ -262,8 +231,7 @@ class FlowActivity:
         elif ctrl and name == "y":
             self.message = "redone" if s.redo() else "nothing to redo"
         elif ctrl and name == "s":
-            if self.check is None:  # a replay saves nothing
-                self.save()
+            self.save()  # (a replay has no output: it saves nothing)
         elif name == "tab":
             self.show_securves = not self.show_securves
         elif name in ("[", "]"):
@@ -276,8 +244,7 @@ class FlowActivity:
     def save(self) -> None:
         """Write the flow file (edits and deformed scenery) atomically."""
         from authoring.flowcurves.storage import save_flow
-
-        from puppetphone.saving import save_or_say
+        from authoring.saving import save_or_say
 
         if self.output is not None:
             self.message = save_or_say(lambda path: save_flow(self.session, path), self.output)
@@ -288,29 +255,25 @@ class FlowActivity:
         except Exception as exc:  # noqa: BLE001 - the build's error, said once
             self.message = f"cannot find the SEcurves: {exc}"
 
-    def step(self) -> None:
-        if self.session is None:
-            if self.building is None or not self.building.done():
-                return  # still building: the hub keeps what was typed for the first real step
-            self._take_built()
-            if self.session is None:
-                return
-        for op in self.script.get(self.frame, []):
-            self.hub.tool(*op)
-        frame = self.hub.drain(self.frame)
-        for op in frame.tool_operations():
-            try:
-                self.apply(tuple(op))
-            except (IndexError, TypeError):
-                raise ValueError(f"tool operation {list(op)} does not fit the flow editor") from None
-        if self.script and self.frame + 1 == self.script_end:
+    def advance(self, frame: InputFrame) -> None:
+        """The edits are made by the operations; a scripted edit is saved after its last step."""
+        if self.script and frame.frame + 1 == self.script_end:
             self.save()
-        digest, parts = flow_digest(self)
-        if self.recorder is not None:
-            self.recorder.write(frame, digest, parts)
-        if self.check is not None:
-            self.check.check(self.frame, digest, parts)
-        self.frame += 1
+        self.frame = frame.frame + 1
+
+    def digest(self) -> tuple[str, dict[str, bytes]]:
+        """:func:`flow_digest`."""
+        return flow_digest(self)
+
+    def close(self) -> None:
+        """Stop a build still running."""
+        if self.building is not None:
+            self.building.stop()
+
+    def conclude(self) -> Ending:
+        """The figures and the last message; exit 2 when the SEcurves could not be found."""
+        lines = [self.figures()] + ([self.message] if self.message else [])
+        return Ending(lines, 2 if self.ended() else 0)
 
     def figures(self) -> str:
         """Clicks, strokes and solve times so far (operations of this session; no human study is compared)."""
@@ -336,62 +299,6 @@ class FlowActivity:
             scene.add_text(self.message, size=16, color=(1.0, 0.9, 0.5))
 
 
-def run_flow(args: argparse.Namespace) -> int:
-    """Open the scene, run the editor until the window closes (or ``--frames``)."""
-    from authoring.flowcurves.storage import FlowFileError
-    from engine.render.window import NoDisplayError
-    from engine.runner import Runner
-    from puppetphone.runargs import run_options
-
-    runner = Runner(run_options(args, "PuppetPhone — Flow Curves"))
-    try:
-        runner.open()
-    except NoDisplayError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-
-    def progress(k: int, n: int, name: str) -> None:
-        print(f"SEcurves: {k + 1}/{n} {name}", file=sys.stderr, flush=True)
-
-    try:
-        scene, default_out, edits = flow_setup(args.flow_scene, runner.size)
-        if args.headless:  # no window to keep alive: build it here
-            session = build_session(scene, edits, progress)
-        else:  # the window opens on the rest scene and shows the progress while the SEcurves are found
-            from authoring.flowcurves.background import BackgroundSession
-
-            session = BackgroundSession(scene, lambda found: build_session(scene, edits, securves=found))
-    except (ValueError, OSError, FlowFileError) as exc:
-        runner.close()
-        print(f"author flow: {exc}", file=sys.stderr)
-        return 2
-    recorder = None
-    if args.record is not None:
-        from input.recording import Recorder, RecordingHeader
-
-        recorder = Recorder(args.record, RecordingHeader(game=FLOW_GAME, seed=0, dt=FlowActivity.dt, sources=["mouse"],
-                                                         setup=_setup(args.flow_scene, runner.size)))  # fmt: skip
-    activity = FlowActivity(session, args.output or default_out, args.script, recorder=recorder)
-    runner.push_handlers(activity)
-    try:
-        result = runner.run(activity)
-        if result.screenshot is not None:
-            print(f"screenshot: {result.screenshot}")
-        print(activity.figures())
-        if activity.message:
-            print(activity.message)
-        if activity.session is None and activity.building is not None and activity.building.done():
-            return 2  # the SEcurves could not be found: said above
-    finally:
-        runner.close()
-        if activity.building is not None:
-            activity.building.stop()
-        if recorder is not None:
-            recorder.close()
-            print(f"recorded {recorder.frames} steps to {recorder.path}", file=sys.stderr)
-    return 0
-
-
 def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
     """What a recording needs to rebuild the scene: a scene's name, or a flow file's bytes (never its path)."""
     setup: dict[str, object] = {"scene": spec, "size": list(size), "file": ""}
@@ -400,14 +307,26 @@ def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
     return setup
 
 
-def replay_flow(recording, verify: bool = True) -> FlowActivity:  # type: ignore[no-untyped-def]
-    """The recorded flow session, rebuilt from the recording alone, checking every step."""
-    from input.hub import InputHub
-    from input.replay import HashCheck, ReplaySource
+def open_live(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
+    """A live session: ``flow_scene``, ``output``, ``script``; ``headless`` builds the SEcurves here
+    (``progress`` is told each group), a window builds them on a thread while it shows the rest scene."""
+    spec = str(options.get("flow_scene", "snowman"))
+    scene, default_out, edits = flow_setup(spec, size)
+    if options.get("headless"):
+        session = build_session(scene, edits, options.get("progress"))
+    else:
+        from authoring.flowcurves.background import BackgroundSession
 
-    setup = recording.header.setup
+        session = BackgroundSession(scene, lambda found: build_session(scene, edits, securves=found))
+    output = options.get("output")
+    tool = FlowTool(session, Path(output) if output else default_out, options.get("script"))
+    return Opened(tool, _setup(spec, size), tool.script_steps() if tool.script else None, tool.conclude)
+
+
+def reopen_flow(setup: object) -> FlowTool:
+    """The recorded flow session, rebuilt from its set-up alone (a flow file's bytes, never its path)."""
     size = setup.get("size") if isinstance(setup, dict) else None
-    if not (isinstance(size, list) and len(size) == 2
+    if not (isinstance(setup, dict) and isinstance(size, list) and len(size) == 2
             and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)):
         raise ValueError("the recorded window size is not two whole numbers in 1..16384")
     if not isinstance(setup.get("scene"), str) or not isinstance(setup.get("file", ""), str):
@@ -421,5 +340,7 @@ def replay_flow(recording, verify: bool = True) -> FlowActivity:  # type: ignore
         session, _ = open_flow("snowman", (int(size[0]), int(size[1])))
     else:
         raise ValueError(f"the recording names the scene {str(setup['scene'])[:60]!r} without carrying it")
-    return FlowActivity(session, None, hub=InputHub(replay=ReplaySource(recording)),
-                        check=HashCheck(recording) if verify else None)  # fmt: skip
+    return FlowTool(session, None)
+
+
+TOOL = ToolKind(FLOW_GAME, "PuppetPhone — Flow Curves", open_live, reopen_flow)
