@@ -14,7 +14,11 @@ into deformed objects:
    (:class:`~authoring.flowcurves.arap.ArapSystem`), the contacts kept exactly; the
    factorisation is reused while the constraint rows stay the same (a dragged
    centre-point usually moves targets, not rows);
-4. Eq. 3.9 lifts the deformed grids back to 3D primitives.
+4. no planted object may topple: when following the strokes all the way would turn a
+   planted object's base past :data:`~authoring.flowcurves.tilt.MAX_BASE_TILT_DEG`, the
+   targets are followed the largest part of the way that keeps every base within it
+   (``Solve.reach`` < 1, found by bisection over the prefactored system);
+5. Eq. 3.9 lifts the deformed grids back to 3D primitives and mesh vertices.
 
 Every solve starts from the rest pose, so the same edits give the same scene whatever
 was tried in between (undo, redo, a drag that came back).
@@ -35,13 +39,18 @@ from authoring.flowcurves.correspondence import Segment, correspond
 from authoring.flowcurves.grid import GRID_SPACING, Embedding
 from authoring.flowcurves.scene import FlowObject, FlowScene, Raster, rasterize
 from authoring.flowcurves.securves import SECurve
+from authoring.flowcurves.tilt import MAX_BASE_TILT_DEG, base_tilt_deg
 
-__all__ = ["SceneDeformer", "Solve", "ITERATIONS"]
+__all__ = ["SceneDeformer", "Solve", "ITERATIONS", "REACH_STEPS"]
 
 F = NDArray[np.float64]
 
 #: Local/global iterations per solve (from the rest pose; see tests for the energy they reach).
 ITERATIONS = 8
+#: Bisection steps for the part of the way a stroke is followed when a base would tilt too far
+#: (2⁻⁸ of the way: under a pixel for strokes that move objects less than 256 px).
+REACH_STEPS = 8
+_SCREEN_UP = np.array([0.0, -1.0])
 
 
 @dataclass
@@ -54,6 +63,10 @@ class Solve:
     solve_ms: float
     system: ArapSystem | None = None
     offsets: dict[int, int] | None = None
+    reach: float = 1.0
+    """The part of the way the targets were followed (1: all of it; less: a base reached the tilt limit)."""
+    tilt_deg: float = 0.0
+    """The largest base rotation of a planted object, on screen, in degrees."""
 
 
 class SceneDeformer:
@@ -77,6 +90,7 @@ class SceneDeformer:
             if c.b is not None:
                 parent[root(c.b)] = root(c.a)
         self.component = [root(i) for i in range(len(scene.objects))]
+        self.planted = sorted({c.a for c in self.contacts if c.b is None})
         self._cache: tuple[object, ArapSystem] | None = None
         self._hard: tuple[tuple[int, ...], sp.csr_matrix] | None = None
 
@@ -174,10 +188,43 @@ class SceneDeformer:
                 targets.append(tgt[m])
         system, offsets, factor_ms = self._system(active, soft)
         t0 = time.perf_counter()
-        x = system.solve(self.hard_targets(offsets), np.vstack(targets), iterations)
+        hard, goal = self.hard_targets(offsets), np.vstack(targets)
+        x = system.solve(hard, goal, iterations)
+        reach, tilt = 1.0, self.max_tilt(x, offsets)
+        if tilt > MAX_BASE_TILT_DEG:  # follow the stroke only as far as every base allows
+            start = np.vstack([xy for _, xy in soft])
+            lo, hi, x_lo, tilt_lo = 0.0, 1.0, system.rest.copy(), 0.0
+            for _ in range(REACH_STEPS):
+                mid = 0.5 * (lo + hi)
+                x_mid = system.solve(hard, start + mid * (goal - start), iterations)
+                t_mid = self.max_tilt(x_mid, offsets)
+                if t_mid <= MAX_BASE_TILT_DEG:
+                    lo, x_lo, tilt_lo = mid, x_mid, t_mid
+                else:
+                    hi = mid
+            reach, x, tilt = lo, x_lo, tilt_lo
         solve_ms = (time.perf_counter() - t0) * 1e3
         verts = {o: x[offsets[o]:offsets[o] + len(self.embeddings[o].grid.vertices)] for o in active}
-        return Solve(verts, [s for s, _, _ in taken], factor_ms, solve_ms, system, offsets)
+        return Solve(verts, [s for s, _, _ in taken], factor_ms, solve_ms, system, offsets, reach, tilt)
+
+    def max_tilt(self, x: F, offsets: dict[int, int]) -> float:
+        """The largest screen rotation (degrees) of a planted object's base in the stacked grids ``x``."""
+        tilts = [base_tilt_deg(self.embeddings[o].grid.vertices,
+                               x[offsets[o]:offsets[o] + len(self.embeddings[o].grid.vertices)], _SCREEN_UP)
+                 for o in self.planted if o in offsets]
+        return max(tilts, default=0.0)
+
+    def follow(self, xy: F, objects: list[int], result: Solve) -> F:
+        """Screen points ``xy`` on ``objects`` carried by the solve's grids (each by the object seen there)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        out = xy.copy()
+        if not result.vertices or not len(xy):
+            return out
+        owners = self.owners(xy, objects)
+        for o in sorted(set(owners.tolist()) & set(result.vertices)):
+            m = owners == o
+            out[m] = self.embeddings[o].grid.rows(xy[m]) @ result.vertices[o]
+        return out
 
     def deformed_objects(self, result: Solve) -> list[FlowObject]:
         """Every object, moved by Eq. 3.9 where the solve changed its grid."""
