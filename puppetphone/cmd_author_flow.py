@@ -1,4 +1,4 @@
-"""``puppetphone author flow [snowman|FILE]``: bend a scene's flow with sketched strokes (thesis ch. 3).
+"""``puppetphone author flow [snowman|tasbada|FILE]``: bend a scene's flow with sketched strokes (thesis ch. 3).
 
 The scene opens from its camera; its SEcurves (blue) are computed once (a few seconds:
 one contour search per group). Then:
@@ -50,7 +50,7 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("flow_scene", nargs="?", default="snowman", metavar="SCENE",
-                        help="snowman (default), or a saved .flow.json file to go on editing")
+                        help="snowman (default), tasbada, or a saved .flow.json file to go on editing")
     parser.add_argument("-o", "--output", type=output_file, default=None, help="where Ctrl+S saves (.json)")
     parser.add_argument("--script", choices=SCRIPTS, default=None,
                         help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "
@@ -60,26 +60,34 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     add_run_arguments(parser, screenshot_at=True)
 
 
+def _scene(name: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
+    """A named flow scene: the snowman field, or tasbada's crystal forest."""
+    if name == "tasbada":
+        from games.tasbada.flow_scene import flow_scene as tasbada_scene
+
+        return tasbada_scene(size)
+    from games.snowman.bent_scenery import flow_scene
+
+    return flow_scene(size)
+
+
 def flow_setup(spec: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
     """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet)."""
     from authoring.flowcurves.storage import load_flow
     from engine.camera import OrbitCamera
-    from games.snowman.bent_scenery import flow_scene
 
     path = Path(spec)
     if spec not in ("snowman", "tasbada") and (path.exists() or path.suffix == ".json"):
         doc = load_flow(path)
-        if doc["scene"] != "snowman":
-            raise ValueError(f"{path} bends the scene {doc['scene']!r}; this version opens the snowman field")
-        scene = flow_scene(tuple(doc["size"]))
+        if doc["scene"] not in ("snowman", "tasbada"):
+            raise ValueError(f"{path} bends the scene {doc['scene']!r}; this version opens snowman and tasbada")
+        scene = _scene(doc["scene"], tuple(doc["size"]))
         cam = doc["camera"]
         scene.camera = OrbitCamera(target=cam["target"], yaw=cam["yaw"], pitch=cam["pitch"], distance=cam["distance"])
         return scene, path, doc["edits"]
-    if spec == "tasbada":
-        raise ValueError("tasbada has no flow scene yet: its props are drawn by the quest, not as static scenery")
-    if spec != "snowman":
-        raise ValueError(f"{spec!r} is neither a scene (snowman) nor a flow file")
-    return flow_scene(size), Path("snowman.flow.json"), []
+    if spec not in ("snowman", "tasbada"):
+        raise ValueError(f"{spec!r} is neither a scene (snowman, tasbada) nor a flow file")
+    return _scene(spec, size), Path(f"{spec}.flow.json"), []
 
 
 def build_session(scene, edits, progress=None, securves=None):  # type: ignore[no-untyped-def]
@@ -417,8 +425,8 @@ def replay_flow(recording, verify: bool = True) -> FlowActivity:  # type: ignore
             path = Path(tmp) / "recorded.flow.json"
             path.write_bytes(base64.b64decode(str(setup["file"])))
             session, _ = open_flow(str(path), (int(size[0]), int(size[1])))
-    elif setup["scene"] == "snowman":
-        session, _ = open_flow("snowman", (int(size[0]), int(size[1])))
+    elif setup["scene"] in ("snowman", "tasbada"):
+        session, _ = open_flow(str(setup["scene"]), (int(size[0]), int(size[1])))
     else:
         raise ValueError(f"the recording names the scene {str(setup['scene'])[:60]!r} without carrying it")
     return FlowActivity(session, None, hub=InputHub(replay=ReplaySource(recording)),

@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from authoring.flowcurves.arap import ArapSystem
+from authoring.flowcurves.arap import W_SHAPE, ArapSystem
 from authoring.flowcurves.contacts import Contact, find_contacts
 from authoring.flowcurves.correspondence import Segment, correspond
 from authoring.flowcurves.grid import GRID_SPACING, Embedding
@@ -91,6 +91,7 @@ class SceneDeformer:
                 parent[root(c.b)] = root(c.a)
         self.component = [root(i) for i in range(len(scene.objects))]
         self.planted = sorted({c.a for c in self.contacts if c.b is None})
+        self.shape_weight = W_SHAPE  # Eq. 3.12's shape constraints' weight (see arap's docstring for why soft)
         self._cache: tuple[object, ArapSystem] | None = None
         self._hard: tuple[tuple[int, ...], sp.csr_matrix] | None = None
 
@@ -130,7 +131,7 @@ class SceneDeformer:
 
     # -- solving ------------------------------------------------------------------------
     def _system(self, active: list[int], soft: list[tuple[int, F]]) -> tuple[ArapSystem, dict[int, int], float]:
-        key = (tuple(active), tuple((o, xy.tobytes()) for o, xy in soft))
+        key = (tuple(active), tuple((o, xy.tobytes()) for o, xy in soft), self.shape_weight)
         offsets, n = {}, 0
         for o in active:
             offsets[o] = n
@@ -144,7 +145,8 @@ class SceneDeformer:
             self._hard = (key[0], self._rows(blocks, offsets, n))
         rest = np.vstack([self.embeddings[o].grid.vertices for o in active])
         tris = np.vstack([self.embeddings[o].grid.triangles + offsets[o] for o in active])
-        system = ArapSystem(rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n))
+        system = ArapSystem(rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n),
+                            self.shape_weight)
         self._cache = (key, system)
         return system, offsets, (time.perf_counter() - t0) * 1e3
 
