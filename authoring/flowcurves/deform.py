@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from authoring.flowcurves.arap import W_SHAPE, ArapSystem
 from authoring.flowcurves.contacts import Contact, find_contacts
 from authoring.flowcurves.correspondence import Segment, correspond
-from authoring.flowcurves.grid import GRID_SPACING, Embedding
+from authoring.flowcurves.grid import GRID_SPACING, Embedding, lift
 from authoring.flowcurves.scene import FlowObject, FlowScene, Raster, rasterize
 from authoring.flowcurves.securves import SECurve
 from authoring.flowcurves.tilt import MAX_BASE_TILT_DEG, base_tilt_deg
@@ -51,6 +51,7 @@ ITERATIONS = 8
 #: (2⁻⁸ of the way: under a pixel for strokes that move objects less than 256 px).
 REACH_STEPS = 8
 _SCREEN_UP = np.array([0.0, -1.0])
+_WORLD_UP = np.array([0.0, 1.0, 0.0])
 
 
 @dataclass
@@ -210,10 +211,19 @@ class SceneDeformer:
         return Solve(verts, [s for s, _, _ in taken], factor_ms, solve_ms, system, offsets, reach, tilt)
 
     def max_tilt(self, x: F, offsets: dict[int, int]) -> float:
-        """The largest screen rotation (degrees) of a planted object's base in the stacked grids ``x``."""
-        tilts = [base_tilt_deg(self.embeddings[o].grid.vertices,
-                               x[offsets[o]:offsets[o] + len(self.embeddings[o].grid.vertices)], _SCREEN_UP)
-                 for o in self.planted if o in offsets]
+        """The largest base rotation (degrees) of a planted object in the stacked grids ``x``: on screen
+        (its grid's), and in 3D where Eq. 3.9 lifts enough of its points (a mesh) to fit one."""
+        tilts = []
+        for o in self.planted:
+            if o not in offsets:
+                continue
+            emb = self.embeddings[o]
+            v = x[offsets[o]:offsets[o] + len(emb.grid.vertices)]
+            tilts.append(base_tilt_deg(emb.grid.vertices, v, _SCREEN_UP))
+            if emb.obj.mesh is not None:
+                rest = emb.obj.points()
+                bent = lift(emb.point_rows @ v, emb.distances, self.scene.camera, self.scene.size)
+                tilts.append(base_tilt_deg(rest, bent, _WORLD_UP))
         return max(tilts, default=0.0)
 
     def follow(self, xy: F, objects: list[int], result: Solve) -> F:

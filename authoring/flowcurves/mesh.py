@@ -7,7 +7,7 @@ one of its vertices through the object's deformed grid, so one mesh bends along 
 
 Its footprint and depth map (what §3.3.1 samples and the grid is laid over) come from a
 small software z-buffer: each triangle, projected, covers the stride-spaced pixel centres
-inside it, at the eye distance interpolated from its corners. :func:`read_glb_mesh` is the
+inside it, at the distance along each pixel's ray (view depth interpolated perspective-correctly). :func:`read_glb_mesh` is the
 one validation boundary for a mesh read from a file (a ``.glb`` prop).
 """
 
@@ -77,11 +77,13 @@ class TriMesh:
 def rasterize_mesh(mesh: TriMesh, camera: Camera, size: tuple[int, int], x0: int, y0: int, stride: int,
                    shape: tuple[int, int]) -> F:
     """Eye distance ``[ny, nx]`` of the mesh at pixel centres ``(x0 + i·stride, y0 + j·stride)`` (inf: uncovered)."""
+    from authoring.flowcurves.scene import pixel_rays
+
     ny, nx = shape
     depth = np.full(shape, np.inf)
     xy = camera.project(mesh.vertices, size[0], size[1])
-    dist = np.linalg.norm(mesh.vertices - camera.eye, axis=1)
-    ahead = (mesh.vertices - camera.eye) @ camera.forward > 1e-3
+    z = (mesh.vertices - camera.eye) @ camera.forward  # view depth: its inverse is linear on screen
+    ahead = z > 1e-3
     for a, b, c in mesh.faces:
         if not (ahead[a] and ahead[b] and ahead[c]):
             continue
@@ -104,9 +106,11 @@ def rasterize_mesh(mesh: TriMesh, camera: Camera, size: tuple[int, int], x0: int
         inside = (l1 >= -1e-9) & (l2 >= -1e-9) & (l1 + l2 <= 1 + 1e-9)
         if not inside.any():
             continue
-        z = (1 - l1 - l2) * dist[a] + l1 * dist[b] + l2 * dist[c]
+        l1, l2 = l1[inside], l2[inside]
+        zp = 1.0 / ((1 - l1 - l2) / z[a] + l1 / z[b] + l2 / z[c])  # perspective-correct view depth
+        hit = zp / (pixel_rays(camera, px[inside], size) @ camera.forward)  # the distance along the pixel's ray
         jj, ii = gj.ravel()[inside], gi.ravel()[inside]
-        np.minimum.at(depth, (jj, ii), z[inside])
+        np.minimum.at(depth, (jj, ii), hit)
     return depth
 
 
