@@ -153,7 +153,7 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
     tree, tree_securves = mesh_tree_problem()
     stroke = FlowActivity(FlowSession(tree, securves=tree_securves), None)
     ops = perform(stroke, _drag([(float(x), float(y)) for x, y in lean_stroke(tree_securves[0].points)]))
-    assert stroke.session.result.vertices, "the scripted stroke bent nothing"
+    assert stroke.session is not None and stroke.session.result.vertices, "the scripted stroke bent nothing"
     out.append(Figure("flow", "flow_ops_fig3_7_one_stroke", ops, "operations per edit"))
     return out + drag_figures(flow_scene(), securves)
 

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from bench.figures import Figure
 
-__all__ = ["mesh_tree_problem", "lean_stroke", "run", "bend", "HARD_WEIGHT"]
+__all__ = ["HARD_WEIGHT", "bend", "lean_stroke", "mesh_tree_problem", "run"]
 
 F = NDArray[np.float64]
 
@@ -43,7 +43,7 @@ def mesh_tree_problem(size: tuple[int, int] = (640, 480)):  # type: ignore[no-un
     from games.tasbada.flow_scene import crystal_tree
 
     data = [{"name": "tree", "group": "tree", "primitives": [], "mesh": crystal_tree([0.0, 0.0, 0.0], 2.2, 0.4, 0)}]
-    scene = scene_from_data("mesh-tree", data, OrbitCamera(target=[0.0, 1.25, 0.0], yaw=0.0, pitch=0.05,
+    scene = scene_from_data("mesh-tree", data, OrbitCamera(target=np.array([0.0, 1.25, 0.0]), yaw=0.0, pitch=0.05,
                                                             distance=4.2), size)
     spine = principal_curve(rasterize(scene.objects[0], scene.camera, scene.size).pixels()).sample(48)
     return scene, [SECurve(spine, False, "principal", [0], spine)]

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from engine.camera import Camera
 
-__all__ = ["TriMesh", "MeshError", "rasterize_mesh", "read_glb_mesh", "MAX_MESH_VERTICES", "MAX_MESH_TRIANGLES"]
+__all__ = ["MAX_MESH_TRIANGLES", "MAX_MESH_VERTICES", "MeshError", "TriMesh", "rasterize_mesh", "read_glb_mesh"]
 
 F = NDArray[np.float64]
 I = NDArray[np.int64]

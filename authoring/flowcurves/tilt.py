@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["base_tilt_deg", "MAX_BASE_TILT_DEG", "BASE_FRACTION"]
+__all__ = ["BASE_FRACTION", "MAX_BASE_TILT_DEG", "base_tilt_deg"]
 
 F = NDArray[np.float64]
 

@@ -28,9 +28,9 @@ _MESHES = MeshDrawer()
 def draw_objects(scene: RenderScene, objects: list[FlowObject], rest: list[FlowObject] | None = None) -> None:
     """Spheres, capsules and meshes of every object; ``rest`` (same order, default ``objects``) are
     the undeformed objects whose meshes the bent ones are drawn as."""
-    for o, r in zip(objects, rest if rest is not None else objects):
-        if o.mesh is not None and r.mesh is not None:
-            scene.skinned.append(_MESHES.instance(r.mesh, o.mesh))
+    for bent, still in zip(objects, rest if rest is not None else objects):
+        if bent.mesh is not None and still.mesh is not None:
+            scene.skinned.append(_MESHES.instance(still.mesh, bent.mesh))
     caps = [(p.a, p.b, p.radius, p.color) for o in objects for p in o.primitives if not p.is_sphere]
     balls = [(p.a, p.radius, p.color) for o in objects for p in o.primitives if p.is_sphere]
     if caps:

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["crystal_tree", "island", "flow_objects", "flow_camera", "SCENE"]
+__all__ = ["SCENE", "crystal_tree", "flow_camera", "flow_objects", "island"]
 
 F = NDArray[np.float64]
 

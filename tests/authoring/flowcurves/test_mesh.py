@@ -19,6 +19,11 @@ from engine.camera import OrbitCamera
 UP = np.array([0.0, 1.0, 0.0])
 
 
+def _mesh(obj: FlowObject) -> TriMesh:
+    assert obj.mesh is not None
+    return obj.mesh
+
+
 @pytest.fixture(scope="module")
 def bent():  # type: ignore[no-untyped-def]
     return bend()
@@ -65,7 +70,7 @@ def test_a_long_sideways_stroke_cannot_topple_the_tree() -> None:
     session.add("stroke", stroke)
     assert session.result.reach < 1.0
     assert session.result.tilt_deg <= MAX_BASE_TILT_DEG
-    assert base_tilt_deg(scene.objects[0].mesh.vertices, session.objects[0].mesh.vertices, UP) <= MAX_BASE_TILT_DEG
+    assert base_tilt_deg(_mesh(scene.objects[0]).vertices, _mesh(session.objects[0]).vertices, UP) <= MAX_BASE_TILT_DEG
     assert contact_error_px(scene, session.objects) < 1.0
 
 
@@ -86,7 +91,7 @@ def test_highlighted_securves_stay_on_the_bent_object(bent) -> None:  # type: ig
 
 
 def test_the_footprint_of_a_square_facing_the_camera() -> None:
-    cam = OrbitCamera(target=[0.0, 0.0, 0.0], yaw=0.0, pitch=0.0, distance=5.0)
+    cam = OrbitCamera(target=np.zeros(3), yaw=0.0, pitch=0.0, distance=5.0)
     quad = TriMesh(np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float), np.array([[0, 1, 2], [0, 2, 3]]))
     corners = cam.project(quad.vertices, 320, 240)
     lo, hi = corners.min(0), corners.max(0)
@@ -127,7 +132,7 @@ def test_a_glb_prop_is_read_at_its_node_and_bends_like_any_mesh(tmp_path: Path) 
     assert np.allclose(mesh.vertices[:, 0], [2, 3, 2, 3])
     obj = FlowObject("prop", "prop", [], mesh)
     moved = obj.with_points(obj.points() + 1.0)
-    assert np.allclose(moved.mesh.vertices, mesh.vertices + 1.0) and np.array_equal(moved.mesh.faces, mesh.faces)
+    assert np.allclose(_mesh(moved).vertices, mesh.vertices + 1.0) and np.array_equal(_mesh(moved).faces, mesh.faces)
 
 
 @pytest.mark.parametrize("bad", [b"", b"glTF\x02\0\0\0", b"not a glb file at all........"])
@@ -151,8 +156,8 @@ def test_a_flow_file_keeps_a_bent_mesh(bent, tmp_path: Path) -> None:  # type: i
     save_flow(session, tmp_path / "tree.flow.json")
     doc = load_flow(tmp_path / "tree.flow.json")
     back = objects_from_data(doc["objects"])[0]
-    assert np.allclose(back.mesh.vertices, session.objects[0].mesh.vertices, atol=1e-6)
-    assert np.array_equal(back.mesh.colors(), session.objects[0].mesh.colors())
+    assert np.allclose(_mesh(back).vertices, _mesh(session.objects[0]).vertices, atol=1e-6)
+    assert np.array_equal(_mesh(back).colors(), _mesh(session.objects[0]).colors())
     broken = json.loads(json.dumps(doc["objects"]))
     broken[0]["mesh"]["faces"][0] = [0, 1, 10**6]
     with pytest.raises(FlowFileError, match="triangle corner"):
