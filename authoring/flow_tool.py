@@ -1,4 +1,5 @@
-"""The ``author flow`` tool: bend a scene's flow with sketched strokes (thesis ch. 3), as a session's simulation.
+"""The ``author flow [snowman|tasbada|FILE]`` tool: bend a scene's flow with sketched strokes (thesis ch. 3),
+as a session's simulation.
 
 Beside :mod:`authoring.flowcurves` (the solver and its scenes). The scene opens from its
 camera; its SEcurves are found once (a few seconds; on a thread while a window shows the
@@ -18,7 +19,7 @@ import tempfile
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +27,9 @@ from authoring.bindings import orbit_camera
 from authoring.operations import Key, Move, Operation, Orbit, Press, Release, Zoom
 from authoring.session import Ending, Opened, Script, ToolKind, ToolSimulation
 from engine.camera import Camera
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.scene import FlowScene
 from input.sample import InputFrame
 
 __all__ = ["FlowTool", "TOOL", "open_flow", "script_events", "SCRIPTS", "FLOW_GAME", "flow_digest", "open_live",
@@ -38,26 +42,34 @@ SCRIPTS = ("row", "centre", "demo")
 _CENTRE_GRAB = 18.0  # pixels: a press this close to the centre-point drags it
 
 
+def _scene(name: str, size: tuple[int, int]) -> FlowScene:
+    """A named flow scene: the snowman field, or tasbada's crystal forest."""
+    if name == "tasbada":
+        from games.tasbada.flow_scene import flow_scene as tasbada_scene
+
+        return tasbada_scene(size)
+    from games.snowman.bent_scenery import flow_scene
+
+    return flow_scene(size)
+
+
 def flow_setup(spec: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
     """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet)."""
     from authoring.flowcurves.storage import load_flow
     from engine.camera import OrbitCamera
-    from games.snowman.bent_scenery import flow_scene
 
     path = Path(spec)
     if spec not in ("snowman", "tasbada") and (path.exists() or path.suffix == ".json"):
         doc = load_flow(path)
-        if doc["scene"] != "snowman":
-            raise ValueError(f"{path} bends the scene {doc['scene']!r}; this version opens the snowman field")
-        scene = flow_scene(tuple(doc["size"]))
+        if doc["scene"] not in ("snowman", "tasbada"):
+            raise ValueError(f"{path} bends the scene {doc['scene']!r}; this version opens snowman and tasbada")
+        scene = _scene(doc["scene"], tuple(doc["size"]))
         cam = doc["camera"]
         scene.camera = OrbitCamera(target=cam["target"], yaw=cam["yaw"], pitch=cam["pitch"], distance=cam["distance"])
         return scene, path, doc["edits"]
-    if spec == "tasbada":
-        raise ValueError("tasbada has no flow scene yet: its props are drawn by the quest, not as static scenery")
-    if spec != "snowman":
-        raise ValueError(f"{spec!r} is neither a scene (snowman) nor a flow file")
-    return flow_scene(size), Path("snowman.flow.json"), []
+    if spec not in ("snowman", "tasbada"):
+        raise ValueError(f"{spec!r} is neither a scene (snowman, tasbada) nor a flow file")
+    return _scene(spec, size), Path(f"{spec}.flow.json"), []
 
 
 def build_session(scene, edits, progress=None, securves=None):  # type: ignore[no-untyped-def]
@@ -336,8 +348,8 @@ def reopen_flow(setup: object) -> FlowTool:
             path = Path(tmp) / "recorded.flow.json"
             path.write_bytes(base64.b64decode(str(setup["file"])))
             session, _ = open_flow(str(path), (int(size[0]), int(size[1])))
-    elif setup["scene"] == "snowman":
-        session, _ = open_flow("snowman", (int(size[0]), int(size[1])))
+    elif setup["scene"] in ("snowman", "tasbada"):
+        session, _ = open_flow(str(setup["scene"]), (int(size[0]), int(size[1])))
     else:
         raise ValueError(f"the recording names the scene {str(setup['scene'])[:60]!r} without carrying it")
     return FlowTool(session, None)

@@ -11,15 +11,25 @@ solve is single-threaded, so CPU time is what it costs). ``flow_factor_ms_40_obj
 constraint rows change (a new stroke: building the rows from the grids, then the LU),
 against the solve it enables.
 
-``flow_ops_row_of_trees`` and ``flow_ops_centre_point`` count the operations (pointer
-presses: each stroke, circle or drag is one) of the editor's scripted reproduction of the
-thesis' two kinds of edit (``author flow --script row|centre``: trees bent along one stroke;
-the field converging on a centre-point sketched as a circle, then dragged). They are stated
-alone, with no baseline: Table 3.1 counts what artists did to match target scenes, and no
-person and no comparable task is involved here, so it is not a comparison.
+``flow_ops_*`` count the operations (pointer presses — each stroke, circle or drag is one —
+and keys) of the thesis' edits reproduced as scripts in the editor (:data:`THESIS_EDITS`):
+
+- ``flow_ops_fig3_6_grouping`` — Fig. 3.6: a centre-point sketched as a circle over the field,
+  then its grouping radius d_Max widened twice (``]``), so the network groups more SEcurves;
+- ``flow_ops_fig3_7_one_stroke`` — Fig. 3.7: one stroke up a crystal tree's SEcurve, and the
+  tree (one mesh) bends along it (:mod:`bench.flow_mesh`);
+- ``flow_ops_centre_point`` — Fig. 3.8: a centre-point sketched, then dragged, the field
+  re-bending live (``author flow --script centre``);
+- ``flow_ops_row_of_trees`` — Fig. 3.9's kind of edit: a row of trees bent along one stroke
+  (``author flow --script row``).
+
+They are stated alone, with no baseline: Table 3.1 counts the clicks of two artists matching
+target scenes of their own design, in Maya and in the thesis' tool; no person and no
+comparable task is involved here, so these are not compared with it.
 ``flow_update_ms_*`` is the editor's wall time for that edit's updates (correspondence,
 network, factorisation when the rows change, solve), median, against one 60 Hz frame.
-``flow_drag_*``: see :mod:`bench.flow_drag`.
+``flow_drag_*``: see :mod:`bench.flow_drag`; ``flow_mesh_*`` and ``flow_shape_residual_p90_px``:
+see :mod:`bench.flow_mesh`.
 
 Every object gets a flow curve: each group's principal curve, bent, so all 45 objects
 and their 81 contacts are in the system; the repeats move the targets a little (a drag).
@@ -36,9 +46,29 @@ from authoring.flowcurves.principal import principal_curve
 from authoring.flowcurves.securves import SECurve
 from bench.figures import Figure, median_time
 from bench.flow_drag import drag_figures
+from bench.flow_mesh import lean_stroke, mesh_tree_problem
+from bench.flow_mesh import run as mesh_figures
 from games.snowman.bent_scenery import flow_scene
 
-__all__ = ["run", "field_problem"]
+__all__ = ["run", "field_problem", "THESIS_EDITS", "perform"]
+
+Op = tuple  # type: ignore[type-arg]  # a tool operation: ("press", x, y, shift) / ("move", x, y) / ("release", x, y) / ("key", name, ctrl)
+
+
+def _drag(points: list[tuple[float, float]]) -> list[list[Op]]:
+    """A press, moves and a release, one a step."""
+    return [[("press", *points[0], False)], *[[("move", *p)] for p in points[1:]], [("release", *points[-1])]]
+
+
+def _circle(cx: float, cy: float, r: float) -> list[tuple[float, float]]:
+    return [(cx + r * float(np.cos(a)), cy + r * float(np.sin(a))) for a in np.linspace(0.0, 2.0 * np.pi, 24)]
+
+
+#: The thesis' edits as scripts of tool operations, one list per step (Fig. 3.6 and 3.8 on the snowman
+#: field; Fig. 3.7 on the crystal tree, where the stroke is laid along its SEcurve when performed).
+THESIS_EDITS: dict[str, list[list[Op]]] = {
+    "fig3_6_grouping": _drag(_circle(640.0, 120.0, 22.0)) + [[("key", "]", False)], [("key", "]", False)]],
+}
 
 
 def field_problem():  # type: ignore[no-untyped-def]
@@ -88,7 +118,7 @@ def run() -> list[Figure]:
     return [Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system", dense),
             Figure("flow", "flow_solve_cpu_ms_40_objects", cpu, "ms", "its wall time (shared cores)", solve),
             Figure("flow", "flow_factor_ms_40_objects", factor, "ms", "one prefactored solve", solve),
-            *_scripted_edits(scene)]
+            *_scripted_edits(scene), *mesh_figures()]
 
 
 def _cpu_median(fn, repeats: int = 15) -> float:  # type: ignore[no-untyped-def]
@@ -120,4 +150,21 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
         out.append(Figure("flow", f"flow_ops_{label}", activity.clicks, "operations per edit"))  # no human baseline
         out.append(Figure("flow", f"flow_update_ms_{label}", float(np.median(activity.solve_ms)), "ms",
                           "one frame at 60 Hz", 1000.0 / 60.0))
+    grouping = FlowActivity(FlowSession(flow_scene(), securves=securves), None)
+    out.append(Figure("flow", "flow_ops_fig3_6_grouping", perform(grouping, THESIS_EDITS["fig3_6_grouping"]),
+                      "operations per edit"))
+    tree, tree_securves = mesh_tree_problem()
+    stroke = FlowActivity(FlowSession(tree, securves=tree_securves), None)
+    ops = perform(stroke, _drag([(float(x), float(y)) for x, y in lean_stroke(tree_securves[0].points)]))
+    assert stroke.session is not None and stroke.session.result.vertices, "the scripted stroke bent nothing"
+    out.append(Figure("flow", "flow_ops_fig3_7_one_stroke", ops, "operations per edit"))
     return out + drag_figures(flow_scene(), securves)
+
+
+def perform(activity, steps: list[list[Op]]) -> int:  # type: ignore[no-untyped-def]
+    """Apply a scripted edit through the editor's hub, a step at a time; its operations (presses and keys)."""
+    for ops in steps:
+        for op in ops:
+            activity.hub.tool(*op)
+        activity.step()
+    return sum(op[0] in ("press", "key") for ops in steps for op in ops)

@@ -110,7 +110,7 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("flow_scene", nargs="?", default="snowman", metavar="SCENE",
-                        help="snowman (default), or a saved .flow.json file to go on editing")
+                        help="snowman (default), tasbada, or a saved .flow.json file to go on editing")
     parser.add_argument("-o", "--output", type=output_file, default=None, help="where Ctrl+S saves (.json)")
     parser.add_argument("--script", choices=FLOW_SCRIPTS, default=None,
                         help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "

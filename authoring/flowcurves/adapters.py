@@ -1,8 +1,9 @@
 """Flow scenes from plain data: the objects a game describes, seen from a camera.
 
 A game that wants its static scenery bent describes it as plain dicts (``{"name",
-"group", "primitives": [{"a", "b", "radius", "color"}]}``, the same shape a flow file
-stores), so authoring never imports a game: the launcher hands the data over.
+"group", "primitives": [{"a", "b", "radius", "color"}], "mesh": {"vertices", "faces",
+"color", "face_colors"}}`` — the mesh optional, the same shape a flow file stores), so
+authoring never imports a game: the launcher hands the data over.
 """
 
 from __future__ import annotations
@@ -11,10 +12,28 @@ from typing import Any
 
 import numpy as np
 
+from authoring.flowcurves.mesh import TriMesh
 from authoring.flowcurves.scene import FlowObject, FlowScene, Primitive
 from engine.camera import Camera
 
-__all__ = ["objects_from_data", "scene_from_data"]
+__all__ = ["objects_from_data", "scene_from_data", "mesh_from_data", "mesh_data"]
+
+
+def mesh_from_data(m: dict[str, Any]) -> TriMesh:
+    """A triangle mesh from its plain description."""
+    colors = m.get("face_colors")
+    return TriMesh(np.array(m["vertices"], dtype=np.float64), np.array(m["faces"], dtype=np.int64),
+                   tuple(float(c) for c in m.get("color", (0.6, 0.6, 0.6))),  # type: ignore[arg-type]
+                   None if colors is None else np.array(colors, dtype=np.float64))
+
+
+def mesh_data(mesh: TriMesh) -> dict[str, Any]:
+    """The plain description of a mesh (vertices rounded to a micrometre, as flow files keep them)."""
+    out: dict[str, Any] = {"vertices": np.round(mesh.vertices, 6).tolist(), "faces": mesh.faces.tolist(),
+                           "color": [float(c) for c in mesh.color]}
+    if mesh.face_colors is not None:
+        out["face_colors"] = mesh.face_colors.tolist()
+    return out
 
 
 def objects_from_data(objects: list[dict[str, Any]]) -> list[FlowObject]:
@@ -22,7 +41,8 @@ def objects_from_data(objects: list[dict[str, Any]]) -> list[FlowObject]:
     return [FlowObject(str(o["name"]), str(o["group"]),
                        [Primitive(np.array(p["a"], dtype=np.float64), np.array(p["b"], dtype=np.float64),
                                   float(p["radius"]), tuple(float(c) for c in p["color"]))  # type: ignore[arg-type]
-                        for p in o["primitives"]]) for o in objects]
+                        for p in o.get("primitives", [])],
+                       mesh_from_data(o["mesh"]) if o.get("mesh") is not None else None) for o in objects]
 
 
 def scene_from_data(name: str, objects: list[dict[str, Any]], camera: Camera, size: tuple[int, int]) -> FlowScene:

@@ -4,7 +4,9 @@ Two kinds of contact, found in 3D from the primitives and carried to the screen:
 
 - **ground**: a primitive that reaches y ≤ 0 rests on the ground, which never deforms;
   its footprint's two screen-side extremes become fixed points (two, so a tree stays
-  planted in place *and* upright at its base);
+  planted in place *and* upright at its base); a mesh's vertices at the ground
+  (y ≤ :data:`GROUND_TOLERANCE`) are all fixed where they are seen (up to
+  :data:`MESH_FEET`, spread across its foot), so a bent mesh keeps its whole foot;
 - **touch**: primitives of two objects that overlap (a tier on its trunk, a snow cap on
   its tier, a snowman's stacked balls); the middle of the overlap and a point either side
   of it on screen must stay one point for both objects.
@@ -19,12 +21,14 @@ from numpy.typing import NDArray
 
 from authoring.flowcurves.scene import FlowScene, Primitive
 
-__all__ = ["Contact", "find_contacts", "GROUND_TOLERANCE"]
+__all__ = ["Contact", "find_contacts", "mesh_feet", "GROUND_TOLERANCE", "MESH_FEET"]
 
 F = NDArray[np.float64]
 
 #: A primitive whose lowest point is this close above the ground (metres) still rests on it.
 GROUND_TOLERANCE = 0.02
+#: At most this many of a mesh's ground vertices become fixed points (spread evenly along screen x).
+MESH_FEET = 12
 
 
 @dataclass
@@ -70,6 +74,19 @@ def _pixels_per_metre(scene: FlowScene, point: F) -> float:
     return float(focal / max(np.linalg.norm(point - scene.camera.eye), 1e-6))
 
 
+def mesh_feet(scene: FlowScene, index: int) -> F:
+    """Screen points ``[K, 2]`` of an object's mesh vertices at the ground (none: ``[0, 2]``)."""
+    mesh = scene.objects[index].mesh
+    if mesh is None:
+        return np.zeros((0, 2))
+    low = mesh.vertices[mesh.vertices[:, 1] <= GROUND_TOLERANCE]
+    if not len(low):
+        return np.zeros((0, 2))
+    xy = np.unique(np.round(scene.camera.project(low, scene.size[0], scene.size[1]), 6), axis=0)
+    xy = xy[np.argsort(xy[:, 0], kind="stable")]
+    return xy[np.unique(np.linspace(0, len(xy) - 1, min(MESH_FEET, len(xy))).round().astype(np.int64))]
+
+
 def find_contacts(scene: FlowScene) -> list[Contact]:
     """Every ground contact and every touching pair of objects, in object order (repeatable)."""
     out: list[Contact] = []
@@ -77,6 +94,10 @@ def find_contacts(scene: FlowScene) -> list[Contact]:
     for i, obj in enumerate(scene.objects):
         if not scene.ground:
             break
+        on_ground = mesh_feet(scene, i)
+        if len(on_ground) >= 2:
+            out.append(Contact(i, None, on_ground))
+            continue
         feet = []
         for p in obj.primitives:
             low = p.a if p.a[1] <= p.b[1] else p.b

@@ -12,11 +12,19 @@ the circle inscribed in the box (``∫‖c''‖² ds / ((2π)⁴ a0 / 4)``), so 
 1 and the three weights compare as the thesis' numbers suggest: area dominates,
 curvature lets the curve into cavities only a little. Search runs in box-normalised
 coordinates with a fixed seed (repeatable), stopping on a small relative improvement.
+
+``cma`` imports ``matplotlib.pyplot`` when it is imported, for plots we never draw: the
+first time on a machine that costs ~20 s building matplotlib's font cache (with a
+"Matplotlib is building the font cache" line on stderr), and without matplotlib cma warns
+instead. :func:`_cma` imports it with matplotlib hidden and that one warning silenced.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import warnings
+from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -73,10 +81,27 @@ def _box_curve(lo: F, hi: F, n: int) -> Hermite:
     return Hermite(np.vstack([pts, tang / 2.0 * n]), closed=True)
 
 
+def _cma() -> ModuleType:
+    """The ``cma`` package, imported without its plotting (see the module docstring)."""
+    if "cma" in sys.modules:
+        return sys.modules["cma"]
+    hide = "matplotlib" not in sys.modules
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Could not import matplotlib")
+        if hide:
+            sys.modules["matplotlib"] = None  # type: ignore[assignment]  # None makes `import matplotlib` fail
+        try:
+            import cma
+        finally:
+            if hide and sys.modules.get("matplotlib", 0) is None:
+                del sys.modules["matplotlib"]
+    return cma
+
+
 def abstract_contour(outline: ArrayLike, n: int = CONTROL_POINTS, max_evaluations: int = 1500,
                      seed: int = 1) -> Hermite:
     """The abstract contour around outline pixels ``[N, 2]`` (an object's or a group's)."""
-    import cma
+    cma = _cma()
 
     pts = np.asarray(outline, dtype=np.float64)
     if len(pts) < 3:

@@ -14,7 +14,11 @@ into deformed objects:
    (:class:`~authoring.flowcurves.arap.ArapSystem`), the contacts kept exactly; the
    factorisation is reused while the constraint rows stay the same (a dragged
    centre-point usually moves targets, not rows);
-4. Eq. 3.9 lifts the deformed grids back to 3D primitives.
+4. no planted object may topple: when following the strokes all the way would turn a
+   planted object's base past :data:`~authoring.flowcurves.tilt.MAX_BASE_TILT_DEG`, the
+   targets are followed the largest part of the way that keeps every base within it
+   (``Solve.reach`` < 1, found by bisection over the prefactored system);
+5. Eq. 3.9 lifts the deformed grids back to 3D primitives and mesh vertices.
 
 Every solve starts from the rest pose, so the same edits give the same scene whatever
 was tried in between (undo, redo, a drag that came back).
@@ -29,19 +33,25 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from authoring.flowcurves.arap import ArapSystem
+from authoring.flowcurves.arap import W_SHAPE, ArapSystem
 from authoring.flowcurves.contacts import Contact, find_contacts
 from authoring.flowcurves.correspondence import Segment, correspond
-from authoring.flowcurves.grid import GRID_SPACING, Embedding
+from authoring.flowcurves.grid import GRID_SPACING, Embedding, lift
 from authoring.flowcurves.scene import FlowObject, FlowScene, Raster, rasterize
 from authoring.flowcurves.securves import SECurve
+from authoring.flowcurves.tilt import MAX_BASE_TILT_DEG, base_tilt_deg
 
-__all__ = ["SceneDeformer", "Solve", "ITERATIONS"]
+__all__ = ["SceneDeformer", "Solve", "ITERATIONS", "REACH_STEPS"]
 
 F = NDArray[np.float64]
 
 #: Local/global iterations per solve (from the rest pose; see tests for the energy they reach).
 ITERATIONS = 8
+#: Bisection steps for the part of the way a stroke is followed when a base would tilt too far
+#: (2⁻⁸ of the way: under a pixel for strokes that move objects less than 256 px).
+REACH_STEPS = 8
+_SCREEN_UP = np.array([0.0, -1.0])
+_WORLD_UP = np.array([0.0, 1.0, 0.0])
 
 
 @dataclass
@@ -54,6 +64,10 @@ class Solve:
     solve_ms: float
     system: ArapSystem | None = None
     offsets: dict[int, int] | None = None
+    reach: float = 1.0
+    """The part of the way the targets were followed (1: all of it; less: a base reached the tilt limit)."""
+    tilt_deg: float = 0.0
+    """The largest base rotation of a planted object, on screen, in degrees."""
 
 
 class SceneDeformer:
@@ -77,6 +91,8 @@ class SceneDeformer:
             if c.b is not None:
                 parent[root(c.b)] = root(c.a)
         self.component = [root(i) for i in range(len(scene.objects))]
+        self.planted = sorted({c.a for c in self.contacts if c.b is None})
+        self.shape_weight = W_SHAPE  # Eq. 3.12's shape constraints' weight (see arap's docstring for why soft)
         self._cache: tuple[object, ArapSystem] | None = None
         self._hard: tuple[tuple[int, ...], sp.csr_matrix] | None = None
 
@@ -116,7 +132,7 @@ class SceneDeformer:
 
     # -- solving ------------------------------------------------------------------------
     def _system(self, active: list[int], soft: list[tuple[int, F]]) -> tuple[ArapSystem, dict[int, int], float]:
-        key = (tuple(active), tuple((o, xy.tobytes()) for o, xy in soft))
+        key = (tuple(active), tuple((o, xy.tobytes()) for o, xy in soft), self.shape_weight)
         offsets, n = {}, 0
         for o in active:
             offsets[o] = n
@@ -130,7 +146,8 @@ class SceneDeformer:
             self._hard = (key[0], self._rows(blocks, offsets, n))
         rest = np.vstack([self.embeddings[o].grid.vertices for o in active])
         tris = np.vstack([self.embeddings[o].grid.triangles + offsets[o] for o in active])
-        system = ArapSystem(rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n))
+        system = ArapSystem(rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n),
+                            self.shape_weight)
         self._cache = (key, system)
         return system, offsets, (time.perf_counter() - t0) * 1e3
 
@@ -174,10 +191,52 @@ class SceneDeformer:
                 targets.append(tgt[m])
         system, offsets, factor_ms = self._system(active, soft)
         t0 = time.perf_counter()
-        x = system.solve(self.hard_targets(offsets), np.vstack(targets), iterations)
+        hard, goal = self.hard_targets(offsets), np.vstack(targets)
+        x = system.solve(hard, goal, iterations)
+        reach, tilt = 1.0, self.max_tilt(x, offsets)
+        if tilt > MAX_BASE_TILT_DEG:  # follow the stroke only as far as every base allows
+            start = np.vstack([xy for _, xy in soft])
+            lo, hi, x_lo, tilt_lo = 0.0, 1.0, system.rest.copy(), 0.0
+            for _ in range(REACH_STEPS):
+                mid = 0.5 * (lo + hi)
+                x_mid = system.solve(hard, start + mid * (goal - start), iterations)
+                t_mid = self.max_tilt(x_mid, offsets)
+                if t_mid <= MAX_BASE_TILT_DEG:
+                    lo, x_lo, tilt_lo = mid, x_mid, t_mid
+                else:
+                    hi = mid
+            reach, x, tilt = lo, x_lo, tilt_lo
         solve_ms = (time.perf_counter() - t0) * 1e3
         verts = {o: x[offsets[o]:offsets[o] + len(self.embeddings[o].grid.vertices)] for o in active}
-        return Solve(verts, [s for s, _, _ in taken], factor_ms, solve_ms, system, offsets)
+        return Solve(verts, [s for s, _, _ in taken], factor_ms, solve_ms, system, offsets, reach, tilt)
+
+    def max_tilt(self, x: F, offsets: dict[int, int]) -> float:
+        """The largest base rotation (degrees) of a planted object in the stacked grids ``x``: on screen
+        (its grid's), and in 3D where Eq. 3.9 lifts enough of its points (a mesh) to fit one."""
+        tilts = []
+        for o in self.planted:
+            if o not in offsets:
+                continue
+            emb = self.embeddings[o]
+            v = x[offsets[o]:offsets[o] + len(emb.grid.vertices)]
+            tilts.append(base_tilt_deg(emb.grid.vertices, v, _SCREEN_UP))
+            if emb.obj.mesh is not None:
+                rest = emb.obj.points()
+                bent = lift(emb.point_rows @ v, emb.distances, self.scene.camera, self.scene.size)
+                tilts.append(base_tilt_deg(rest, bent, _WORLD_UP))
+        return max(tilts, default=0.0)
+
+    def follow(self, xy: F, objects: list[int], result: Solve) -> F:
+        """Screen points ``xy`` on ``objects`` carried by the solve's grids (each by the object seen there)."""
+        xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+        out = xy.copy()
+        if not result.vertices or not len(xy):
+            return out
+        owners = self.owners(xy, objects)
+        for o in sorted(set(owners.tolist()) & set(result.vertices)):
+            m = owners == o
+            out[m] = self.embeddings[o].grid.rows(xy[m]) @ result.vertices[o]
+        return out
 
     def deformed_objects(self, result: Solve) -> list[FlowObject]:
         """Every object, moved by Eq. 3.9 where the solve changed its grid."""

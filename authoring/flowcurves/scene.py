@@ -1,10 +1,11 @@
-"""A flow scene: static objects made of spheres and capsules, seen from one camera.
+"""A flow scene: static objects made of spheres, capsules and triangle meshes, seen from one camera.
 
-Chapter 3 works on raw geometry seen from a viewpoint. Our scenery is drawn from
-spheres and capsules (trees, rocks, props), so an object here is a list of those
-primitives; its screen footprint and depth map come from casting one ray per pixel
-(at a stride) against them — the "depth map pixels whose depth is lower than 1" that
-§3.3.1 samples. The ground (y = 0) is not an object: it never deforms, so what rests
+Chapter 3 works on raw geometry seen from a viewpoint. Much of our scenery is drawn from
+spheres and capsules (trees, rocks), so an object here is a list of those primitives and,
+optionally, one triangle mesh (:class:`~authoring.flowcurves.mesh.TriMesh`: a crystal tree,
+an island, a glTF prop); its screen footprint and depth map come from casting one ray per
+pixel (at a stride) against the primitives and z-buffering the mesh's triangles — the
+"depth map pixels whose depth is lower than 1" that §3.3.1 samples. The ground (y = 0) is not an object: it never deforms, so what rests
 on it stays planted (§3.5.3's layout constraints).
 """
 
@@ -15,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from authoring.flowcurves.mesh import TriMesh, rasterize_mesh
 from engine.camera import Camera
 
 __all__ = ["Primitive", "FlowObject", "FlowScene", "Raster", "rasterize", "pixel_rays", "project"]
@@ -39,21 +41,31 @@ class Primitive:
 
 @dataclass
 class FlowObject:
-    """One deformable object; ``group`` names the assembly it belongs to (a tree's parts)."""
+    """One deformable object; ``group`` names the assembly it belongs to (a tree's parts).
+
+    Its primitives and its mesh (either may be absent, not both) are what Eq. 3.9 lifts.
+    """
 
     name: str
     group: str
     primitives: list[Primitive]
+    mesh: TriMesh | None = None
+
+    def __post_init__(self) -> None:
+        if not self.primitives and self.mesh is None:
+            raise ValueError(f"object {self.name!r} has neither primitives nor a mesh")
 
     def points(self) -> F:
-        """``[2P, 3]`` the primitives' end points (the "vertices" Eq. 3.9 moves)."""
-        return np.array([p for prim in self.primitives for p in (prim.a, prim.b)], dtype=np.float64)
+        """``[2P + V, 3]`` the primitives' end points, then the mesh's vertices (the "vertices" Eq. 3.9 moves)."""
+        ends = np.array([p for prim in self.primitives for p in (prim.a, prim.b)], dtype=np.float64).reshape(-1, 3)
+        return ends if self.mesh is None else np.vstack([ends, self.mesh.vertices])
 
     def with_points(self, pts: F) -> FlowObject:
-        """A copy whose primitive end points are ``pts`` (radii and colours kept)."""
+        """A copy whose primitive end points and mesh vertices are ``pts`` (radii, triangles, colours kept)."""
         prims = [Primitive(np.array(pts[2 * i]), np.array(pts[2 * i + 1]), p.radius, p.color)
                  for i, p in enumerate(self.primitives)]
-        return FlowObject(self.name, self.group, prims)
+        mesh = None if self.mesh is None else self.mesh.with_vertices(pts[2 * len(self.primitives):])
+        return FlowObject(self.name, self.group, prims, mesh)
 
 
 @dataclass
@@ -151,9 +163,10 @@ def hit_distance(prims: list[Primitive], ro: F, rd: F) -> F:
 
 
 def screen_bounds(obj: FlowObject, camera: Camera, size: tuple[int, int]) -> tuple[F, F]:
-    """Pixel bounding box (lo, hi) of an object: its primitives' ends padded by their projected radii."""
+    """Pixel bounding box (lo, hi) of an object: its primitives' ends padded by their projected radii,
+    its mesh vertices by two pixels."""
     pts = obj.points()
-    radii = np.repeat([p.radius for p in obj.primitives], 2)
+    radii = np.r_[np.repeat([p.radius for p in obj.primitives], 2), np.zeros(len(pts) - 2 * len(obj.primitives))]
     xy = project(camera, pts, size)
     dist = np.linalg.norm(pts - camera.eye, axis=1)
     focal = size[1] / (2.0 * np.tan(np.radians(camera.fov_y) / 2.0))
@@ -162,7 +175,7 @@ def screen_bounds(obj: FlowObject, camera: Camera, size: tuple[int, int]) -> tup
 
 
 def rasterize(obj: FlowObject, camera: Camera, size: tuple[int, int], stride: int = 2) -> Raster:
-    """Cast rays through the object's screen box; the hits are its footprint and depth map."""
+    """Cast rays through the object's screen box (and z-buffer its mesh); the hits are its footprint and depth map."""
     lo, hi = screen_bounds(obj, camera, size)
     x0, y0 = int(np.floor(lo[0])), int(np.floor(lo[1]))
     nx = max(1, int(np.ceil((hi[0] - x0) / stride)) + 1)
@@ -170,4 +183,6 @@ def rasterize(obj: FlowObject, camera: Camera, size: tuple[int, int], stride: in
     gx, gy = np.meshgrid(x0 + stride * np.arange(nx), y0 + stride * np.arange(ny))
     xy = np.c_[gx.ravel(), gy.ravel()].astype(np.float64)
     t = hit_distance(obj.primitives, camera.eye, pixel_rays(camera, xy, size)).reshape(ny, nx)
+    if obj.mesh is not None:
+        t = np.minimum(t, rasterize_mesh(obj.mesh, camera, size, x0, y0, stride, (ny, nx)))
     return Raster(x0, y0, stride, np.isfinite(t), t)

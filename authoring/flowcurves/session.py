@@ -64,6 +64,7 @@ class FlowSession:
         self.result = Solve({}, [], 0.0, 0.0)
         self.objects: list[FlowObject] = list(self.scene.objects)
         self.flows: list[Hermite] = []
+        self._bent: tuple[Solve, list[F], list[F]] | None = None
 
     # -- edits --------------------------------------------------------------------------
     def all_securves(self) -> list[SECurve]:
@@ -113,6 +114,16 @@ class FlowSession:
         self.edits.append(self.redo_stack.pop())
         self.update()
         return True
+
+    def bent_curves(self) -> tuple[list[F], list[F]]:
+        """Every SEcurve and every taken segment as the bent objects carry them (§3.5.1: they are
+        embedded in the same grids), so what is highlighted stays on the objects; kept per solve."""
+        if self._bent is None or self._bent[0] is not self.result:
+            moved = sorted(self.result.vertices)
+            curves = [self.deformer.follow(c.points, c.objects, self.result) for c in self.all_securves()]
+            segments = [self.deformer.follow(seg.c, moved, self.result) for seg in self.result.segments]
+            self._bent = (self.result, curves, segments)
+        return self._bent[1], self._bent[2]
 
     # -- solving ------------------------------------------------------------------------
     def _centre_curves(self, edit: Edit, warm: bool) -> list[Hermite]:

@@ -6,7 +6,11 @@
      "camera": {"target": [x, y, z], "yaw": .., "pitch": .., "distance": ..},
      "edits": [{"kind": "stroke" | "centre" | "securve", "points": [[x, y], ...], "d_max": 60}],
      "objects": [{"name": "tree0.trunk", "group": "tree0",
-                  "primitives": [{"a": [x, y, z], "b": [x, y, z], "radius": r, "color": [r, g, b]}]}]}
+                  "primitives": [{"a": [x, y, z], "b": [x, y, z], "radius": r, "color": [r, g, b]}],
+                  "mesh": {"vertices": [[x, y, z], ...], "faces": [[i, j, k], ...], "color": [r, g, b],
+                           "face_colors": [[r, g, b], ...]}}]}
+
+An object has primitives, a mesh, or both (``mesh`` and ``face_colors`` may be left out).
 
 The edits reopen the session in the editor; ``objects`` is the deformed static scenery a
 game starts in (``puppetphone play snowman --flow FILE``), so a game needs no solver.
@@ -31,6 +35,7 @@ FORMAT, VERSION = "puppetphone-flow", 1
 MAX_FILE = 8 * 1024 * 1024
 MAX_EDITS, MAX_POINTS, MAX_OBJECTS, MAX_PRIMITIVES = 1000, 20000, 5000, 64
 MAX_COORD = 1e6
+MAX_TOTAL_VERTICES = 200000
 KINDS = ("stroke", "centre", "securve")
 
 
@@ -69,6 +74,7 @@ def parse_objects(value: Any) -> list[dict[str, Any]]:
     """Validate the deformed objects of a flow document (also as a recording's set-up carries them)."""
     objects = []
     names = set()
+    budget = [MAX_TOTAL_VERTICES]
     for o in _list({"objects": value}, "objects", MAX_OBJECTS, "objects"):
         o = _dict(o, "an object")
         name, group = o.get("name"), o.get("group")
@@ -78,15 +84,51 @@ def parse_objects(value: Any) -> list[dict[str, Any]]:
             raise FlowFileError(f"object {name!r} appears twice"[:200])
         names.add(name)
         prims = []
-        for p in _list(o, "primitives", MAX_PRIMITIVES, f"primitives of {name!r}"[:200]):
+        for p in _list({"primitives": o.get("primitives", [])}, "primitives", MAX_PRIMITIVES,
+                       f"primitives of {name!r}"[:200]):
             p = _dict(p, "a primitive")
             prims.append({"a": _vec(p.get("a"), 3, "a primitive end"), "b": _vec(p.get("b"), 3, "a primitive end"),
                           "radius": _num(p.get("radius"), "a primitive radius", 1e-4, 1e3),
                           "color": _vec(p.get("color"), 3, "a primitive colour", 0.0, 1.0)})
-        if not prims:
-            raise FlowFileError(f"object {name!r} has no primitives"[:200])
-        objects.append({"name": name, "group": group, "primitives": prims})
+        entry: dict[str, Any] = {"name": name, "group": group, "primitives": prims}
+        if o.get("mesh") is not None:
+            entry["mesh"] = _mesh(o["mesh"], f"the mesh of {name!r}"[:200], budget)
+        if not prims and "mesh" not in entry:
+            raise FlowFileError(f"object {name!r} has no primitives and no mesh"[:200])
+        objects.append(entry)
     return objects
+
+
+def _mesh(value: Any, what: str, budget: list[int]) -> dict[str, Any]:
+    """A mesh's vertices, triangles and colours, bounded (``budget``: vertices left for the whole file)."""
+    from authoring.flowcurves.mesh import MAX_MESH_TRIANGLES, MAX_MESH_VERTICES
+
+    m = _dict(value, what)
+    verts = _list(m, "vertices", MAX_MESH_VERTICES, f"{what}: vertices")
+    budget[0] -= len(verts)
+    if budget[0] < 0:
+        raise FlowFileError(f"more than {MAX_TOTAL_VERTICES} mesh vertices in all")
+    if len(verts) < 3:
+        raise FlowFileError(f"{what} needs at least 3 vertices")
+    faces = _list(m, "faces", MAX_MESH_TRIANGLES, f"{what}: faces")
+    if not faces:
+        raise FlowFileError(f"{what} has no triangle")
+    out: dict[str, Any] = {"vertices": [_vec(v, 3, "a mesh vertex") for v in verts],
+                           "faces": [[int(_num(i, "a triangle corner", 0, len(verts) - 1)) for i in _ints(f)]
+                                     for f in faces],
+                           "color": _vec(m.get("color", [0.6, 0.6, 0.6]), 3, "a mesh colour", 0.0, 1.0)}
+    if m.get("face_colors") is not None:
+        colors = _list(m, "face_colors", MAX_MESH_TRIANGLES, f"{what}: face colours")
+        if len(colors) != len(faces):
+            raise FlowFileError(f"{what}: one face colour per triangle")
+        out["face_colors"] = [_vec(c, 3, "a face colour", 0.0, 1.0) for c in colors]
+    return out
+
+
+def _ints(v: Any) -> list[Any]:
+    if not isinstance(v, list) or len(v) != 3 or not all(isinstance(i, int) and not isinstance(i, bool) for i in v):
+        raise FlowFileError("a triangle must be three whole vertex indices")
+    return v
 
 
 def parse_flow(doc: Any) -> dict[str, Any]:
@@ -139,10 +181,13 @@ def load_flow(path: Path) -> dict[str, Any]:
 def flow_document(session) -> dict[str, Any]:  # type: ignore[no-untyped-def]
     """A session's edits and deformed objects as a flow document."""
     cam = session.scene.camera
+    from authoring.flowcurves.adapters import mesh_data
+
     objects = [{"name": o.name, "group": o.group,
                 "primitives": [{"a": [round(float(v), 6) for v in p.a], "b": [round(float(v), 6) for v in p.b],
                                 "radius": float(p.radius), "color": [float(c) for c in p.color]}
-                               for p in o.primitives]} for o in session.objects]
+                               for p in o.primitives],
+                **({"mesh": mesh_data(o.mesh)} if o.mesh is not None else {})} for o in session.objects]
     return {"format": FORMAT, "version": VERSION, "scene": session.scene.name, "size": list(session.scene.size),
             "camera": {"target": [float(v) for v in cam.target], "yaw": float(cam.yaw), "pitch": float(cam.pitch),
                        "distance": float(cam.distance)},

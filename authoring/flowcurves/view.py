@@ -2,7 +2,9 @@
 
 Curves live on the screen; to draw them with the scene's line renderer they are put on
 a plane just in front of the camera (their pixels unchanged), so they show over the
-objects they belong to.
+objects they belong to. SEcurves are drawn where the bent objects carry them. Meshes go
+through :class:`~authoring.flowcurves.meshdraw.MeshDrawer`, one per process: the renderer
+keeps a GPU copy per mesh object it is given, so the rest meshes are given, once each.
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from authoring.flowcurves.meshdraw import MeshDrawer
 from authoring.flowcurves.scene import FlowObject, FlowScene, pixel_rays
 from engine.render.scene import RenderScene
 
@@ -19,10 +22,15 @@ SECURVE_COLOR = (0.15, 0.45, 1.0)
 FLOW_COLOR = (0.75, 0.2, 0.85)
 CENTRE_COLOR = (1.0, 0.85, 0.1)
 _NEAR = 0.5  # metres in front of the eye where screen curves are drawn
+_MESHES = MeshDrawer()
 
 
-def draw_objects(scene: RenderScene, objects: list[FlowObject]) -> None:
-    """Spheres and capsules of every object."""
+def draw_objects(scene: RenderScene, objects: list[FlowObject], rest: list[FlowObject] | None = None) -> None:
+    """Spheres, capsules and meshes of every object; ``rest`` (same order, default ``objects``) are
+    the undeformed objects whose meshes the bent ones are drawn as."""
+    for bent, still in zip(objects, rest if rest is not None else objects):
+        if bent.mesh is not None and still.mesh is not None:
+            scene.skinned.append(_MESHES.instance(still.mesh, bent.mesh))
     caps = [(p.a, p.b, p.radius, p.color) for o in objects for p in o.primitives if not p.is_sphere]
     balls = [(p.a, p.radius, p.color) for o in objects for p in o.primitives if p.is_sphere]
     if caps:
@@ -48,12 +56,13 @@ def draw_session(scene: RenderScene, session, show_securves: bool = True, pendin
     from authoring.flowcurves.session import dense
 
     flow = session.scene
-    draw_objects(scene, session.objects)
+    draw_objects(scene, session.objects, flow.objects)
     if show_securves:
-        for s in session.all_securves():
-            draw_screen_polyline(scene, flow, s.points, SECURVE_COLOR, 2.0, s.closed)
-        for seg in session.result.segments:
-            draw_screen_polyline(scene, flow, seg.c, (0.1, 0.9, 0.9), 4.0)
+        curves, segments = session.bent_curves()
+        for s, pts in zip(session.all_securves(), curves):
+            draw_screen_polyline(scene, flow, pts, SECURVE_COLOR, 2.0, s.closed)
+        for pts in segments:
+            draw_screen_polyline(scene, flow, pts, (0.1, 0.9, 0.9), 4.0)
     for f in session.flows:
         draw_screen_polyline(scene, flow, dense(f), FLOW_COLOR, 4.0)
     for e in session.edits:
