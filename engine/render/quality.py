@@ -42,10 +42,12 @@ class Quality:
     max_casters: int | None = None
     """Capsules and spheres drawn into the shadow map, nearest the camera first (``None``: all).
     A crowd is vertex-bound on a software rasteriser, and the shadow map draws it a second time."""
+    impostors: bool = False
+    """Capsules and spheres ray-cast on their bounding boxes (:mod:`engine.render.impostors`), not meshed."""
 
 
 QUALITIES = {
-    "low": Quality("low", 0.5, 512, 128, 2.0, False, max_casters=600),
+    "low": Quality("low", 0.5, 512, 128, 2.0, False, max_casters=600, impostors=True),
     "medium": Quality("medium", 0.75, 1024, 256, 1.0, False),
     "high": Quality("high", 1.0, 1024, 256, 1.0, True),
 }

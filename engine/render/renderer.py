@@ -42,6 +42,7 @@ from engine.render import shaders_env as E
 from engine.render.env_meshes import cone_mesh
 from engine.render.environment import Environment
 from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
+from engine.render.impostors import Impostors
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.quality import QUALITIES, Quality
@@ -148,6 +149,7 @@ class Renderer:
         for name in ("sky_photo", "upscale"):
             self._vaos[name] = ctx.vertex_array(p[name], [])
         self.env = Environment(ctx)
+        self.impostors = Impostors(ctx)
         self.quality = quality
         self.shadows = Shadows(ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask, self._inst["cones"])
         self._scaled: tuple[moderngl.Framebuffer, moderngl.Texture] | None = None
@@ -163,11 +165,21 @@ class Renderer:
         self.timings: dict[str, float] = {}
         self._mark_t = 0.0
 
-    def _skinned_casters(self, scene: RenderScene) -> Callable[[NDArray[np.float64]], None] | None:
-        """The skinned characters' draw into the shadow map, when the scene has any."""
-        if not scene.skinned:
+    def _more_casters(self, scene: RenderScene, impostors: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+                      ) -> Callable[[NDArray[np.float64]], None] | None:
+        """What the shadow map draws besides its meshes: skinned characters, and the round solids
+        ``impostors`` holds (by kind: rows, levels) when they are drawn as impostors."""
+        if not scene.skinned and not impostors:
             return None
-        return lambda light_vp: self.skinned.draw_depth(scene.skinned, light_vp)
+        look = -np.asarray(scene.sun.direction, dtype=np.float64)
+        look /= np.linalg.norm(look)
+
+        def draw(light_vp: NDArray[np.float64]) -> None:
+            if impostors:
+                self.impostors.draw_depth(np.concatenate([rows for rows, _ in impostors.values()]), light_vp, look)
+            if scene.skinned:
+                self.skinned.draw_depth(scene.skinned, light_vp)
+        return draw
 
     def _keep(self, bufs: tuple[moderngl.Buffer, ...]) -> tuple[moderngl.Buffer, ...]:
         self._buffers += list(bufs)
@@ -228,8 +240,9 @@ class Renderer:
         # Coarser meshes where fewer pixels are drawn, or where the level allows a larger outline error.
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0)) / self.quality.silhouette_px
         levels = {kind: choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind]) for kind in self._lod}
+        impostors = self.quality.impostors
         for kind, batches in self._lod.items():
-            batches.upload(rows[kind], levels[kind])
+            batches.upload(rows[kind][:0] if impostors else rows[kind], levels[kind][:0] if impostors else levels[kind])
         outlined = {}
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data
@@ -238,8 +251,9 @@ class Renderer:
         rect = ground_rect(scene) if light_vp is not None else None
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
-            self.shadows.render(scene, {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}, light_vp, rect,
-                                more_casters=self._skinned_casters(scene))
+            casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
+            self.shadows.render(scene, {} if impostors else casters, light_vp, rect,
+                                more_casters=self._more_casters(scene, casters if impostors else {}))
         self._mark("shadows")
 
         target.use()
@@ -261,6 +275,8 @@ class Renderer:
         ctx.cull_face = "back"
         for batches in self._lod.values():
             batches.render()
+        if impostors:
+            self.impostors.draw(_nearest_first(np.concatenate([rows["capsules"], rows["spheres"]]), eye), eye)
         for kind in ("boxes", "cones"):
             if counts[kind]:
                 self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
@@ -363,7 +379,7 @@ class Renderer:
             "u_fade": 1.0 if bg is None else float(scene.background_fade), "u_bg_scale": bg_scale,
             "u_inv_view_proj": np.linalg.inv(vp), "u_inflate_px": 0.0,
         }
-        for prog in self._programs.values():
+        for prog in (*self._programs.values(), self.impostors.lit):
             for name, value in common.items():
                 set_uniform(prog, name, value)
         self.env.set_common(common)
@@ -432,6 +448,7 @@ class Renderer:
         self.shadows.release()
         self.skinned.release()
         self.env.release()
+        self.impostors.release()
         self._release_scaled()
         for batches in self._lod.values():
             batches.release()
