@@ -112,14 +112,19 @@ def scene_from_world(world: World, alpha: float, scene: RenderScene | None = Non
     if not 0.0 <= alpha <= 1.0:
         raise ValueError(f"alpha must be in [0, 1], got {alpha}")
     scene = RenderScene() if scene is None else scene
-    # Runs of consecutive puppets with one skeleton are drawn together (the order of the rows is kept).
+    # Runs of consecutive puppets whose skeletons have the same bones and radii (each puppet may hold
+    # its own copy) are drawn together; the order of the rows is kept.
     runs: list[tuple[Skeleton, list[WorldPose], list[Appearance]]] = []
+    run_key = b""
     for e, puppet, wpose in world.query(Puppet, WorldPose):
         look = world.try_get(e, Appearance) or _DEFAULT_PUPPET
         if not look.visible:
             continue
-        if not runs or runs[-1][0] is not puppet.skeleton:
-            runs.append((puppet.skeleton, [], []))
+        sk = puppet.skeleton
+        key = b"|".join((sk.parents.tobytes(), sk.tips.tobytes(), sk.radii.tobytes()))
+        if not runs or key != run_key:
+            runs.append((sk, [], []))
+            run_key = key
         runs[-1][1].append(wpose)
         runs[-1][2].append(look)
     for skeleton, poses, looks in runs:
