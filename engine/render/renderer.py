@@ -26,6 +26,7 @@ The renderer owns GPU objects only; it never writes the scene or the simulation.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 from collections.abc import Callable
@@ -82,6 +83,29 @@ def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArr
         return rows
     centre = 0.5 * (rows[:, 0:3] + rows[:, 3:6]) if rows.shape[1] != BOX_STRIDE else rows[:, 0:3]  # cones too
     return rows[np.argsort(np.sum((centre - eye) ** 2, axis=1), kind="stable")]
+
+
+def _shadow_key(scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+                rows: dict[str, NDArray[np.float32]], light_vp: NDArray[np.float64],
+                rect: tuple[float, float, float, float], how: tuple[object, bool]) -> bytes | None:
+    """A digest of everything the shadow map and the ground mask are drawn from, ``None`` if that
+    cannot be told (skinned characters: their poses live in textures).
+
+    When the sun and every caster stand still (an idle scene, a paused game) the key repeats
+    and the frame reuses last frame's map and mask instead of drawing the casters again.
+    ``how``: the shadow buffers in use and whether the casters are impostors.
+    """
+    if scene.skinned:
+        return None
+    h = hashlib.blake2b(digest_size=16)
+    h.update(f"{id(how[0])} {how[1]} {scene.sun.softness!r} {scene.ground.height!r} {rect!r}".encode())
+    h.update(np.ascontiguousarray(light_vp).tobytes())
+    for kind in sorted(casters):
+        for part in casters[kind]:
+            h.update(np.ascontiguousarray(part).tobytes())
+    for kind in ("boxes", "cones"):
+        h.update(np.ascontiguousarray(rows[kind]).tobytes())
+    return h.digest()
 
 
 def _linear(c: Any) -> tuple[float, float, float]:
@@ -166,6 +190,8 @@ class Renderer:
         """When true, each pass waits for the GPU and its time lands in :attr:`timings` (slow; benches only)."""
         self.timings: dict[str, float] = {}
         self._mark_t = 0.0
+        self._shadow_key: bytes | None = None
+        """What the shadow map and mask now hold (:func:`_shadow_key`); ``None``: nothing reusable."""
 
     def _more_casters(self, scene: RenderScene, impostors: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
                       ) -> Callable[[NDArray[np.float64]], None] | None:
@@ -203,6 +229,7 @@ class Renderer:
             self.shadows.release()
             self.shadows = Shadows(self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask,
                                    self._inst["cones"])
+            self._shadow_key = None
         self.quality = quality
 
     def _scene_target(self, framebuffer: moderngl.Framebuffer) -> tuple[moderngl.Framebuffer, tuple[int, int]]:
@@ -254,8 +281,11 @@ class Renderer:
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
             casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
-            self.shadows.render(scene, {} if impostors else casters, light_vp, rect,
-                                more_casters=self._more_casters(scene, casters if impostors else {}))
+            key = _shadow_key(scene, casters, rows, light_vp, rect, (self.shadows, impostors))
+            if key is None or key != self._shadow_key:
+                self.shadows.render(scene, {} if impostors else casters, light_vp, rect,
+                                    more_casters=self._more_casters(scene, casters if impostors else {}))
+            self._shadow_key = key
         self._mark("shadows")
 
         target.use()
