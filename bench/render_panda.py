@@ -25,9 +25,9 @@ __all__ = ["measure"]
 
 def measure(actors: int = 100, frames: int = 5, repeats: int = 3) -> tuple[float, int]:
     """``(process CPU seconds per frame, triangles per frame)`` of ``actors`` walking pandas."""
-    from direct.actor.Actor import Actor
-    from direct.showbase.ShowBase import ShowBase
-    from panda3d.core import loadPrcFileData
+    from direct.actor.Actor import Actor  # type: ignore[import-untyped]  # Panda3D ships no type stubs
+    from direct.showbase.ShowBase import ShowBase  # type: ignore[import-untyped]  # (same)
+    from panda3d.core import loadPrcFileData  # type: ignore[import-untyped]  # (same)
 
     loadPrcFileData("", "window-type offscreen\nwin-size 1280 720\nload-display p3headlessgl\n"
                         "audio-library-name null\ngl-finish true\nsync-video false\nnotify-level error\n")

@@ -189,6 +189,9 @@ class Impostors:
 
     def release(self) -> None:
         """Free the GPU objects."""
-        for obj in (*self._vaos.values(), self._vbo, self._ibo, self._inst.buf, self._shadow_inst.buf,
-                    self.lit, self.depth):
-            obj.release()
+        for vao in self._vaos.values():
+            vao.release()
+        for buf in (self._vbo, self._ibo, self._inst.buf, self._shadow_inst.buf):
+            buf.release()
+        self.lit.release()
+        self.depth.release()

@@ -192,6 +192,10 @@ class Renderer:
         self._mark_t = 0.0
         self._shadow_key: bytes | None = None
         """What the shadow map and mask now hold (:func:`_shadow_key`); ``None``: nothing reusable."""
+        self.reuse_shadows = False
+        """Reuse last frame's shadows when nothing they are drawn from changed. Off by default, so a
+        bench drawing one still frame again and again times the shadows a moving scene pays; the
+        runner turns it on for play."""
 
     def _more_casters(self, scene: RenderScene, impostors: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
                       ) -> Callable[[NDArray[np.float64]], None] | None:
@@ -282,7 +286,7 @@ class Renderer:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
             casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
             key = _shadow_key(scene, casters, rows, light_vp, rect, (self.shadows, impostors))
-            if key is None or key != self._shadow_key:
+            if key is None or key != self._shadow_key or not self.reuse_shadows:
                 self.shadows.render(scene, {} if impostors else casters, light_vp, rect,
                                     more_casters=self._more_casters(scene, casters if impostors else {}))
             self._shadow_key = key

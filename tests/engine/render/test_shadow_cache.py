@@ -1,6 +1,7 @@
 """The shadow map and ground mask are reused while the sun and every caster stand still.
 
-Broken once to see it fail: with the key check removed (``Shadows.render`` called every
+Off by default (benches time a moving scene); the runner turns it on. Broken once to see it
+fail: with the key check removed (``Shadows.render`` called every
 frame) the first test counts two draws where one is expected.
 """
 
@@ -35,6 +36,7 @@ def test_a_still_scene_draws_its_shadows_once_and_a_moved_caster_draws_them_agai
     try:
         with viewer.target.ctx:
             viewer.renderer.set_quality(QUALITIES[level])
+        viewer.renderer.reuse_shadows = True  # as the runner sets it
         viewer.camera = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), pitch=0.4, distance=5.0)
         still = _scene(0.0)
         viewer.draw(still)
