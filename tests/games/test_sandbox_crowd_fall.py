@@ -31,6 +31,7 @@ _reason = egl_available()
 
 
 @pytest.mark.soak
+@pytest.mark.timeout(3600)  # the long run: 240 steps of a thousand puppets on a shared machine
 def test_a_hundred_of_a_thousand_go_limp_at_once_in_the_game(request: pytest.FixtureRequest) -> None:
     long = "soak" in (request.config.option.markexpr or "")
     steps = 240 if long else 4
