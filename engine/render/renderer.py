@@ -85,6 +85,25 @@ def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArr
     return rows[np.argsort(np.sum((centre - eye) ** 2, axis=1), kind="stable")]
 
 
+def _in_view(rows: NDArray[np.float32], vp: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Indices of the capsule rows (ends in columns 0-5, radius in 6) whose bounding sphere meets
+    the view frustum of ``vp``, in order.
+
+    A crowd seen from within draws a tenth of its puppets or less: on a software rasteriser
+    every instance drawn costs vertex work on the main thread, on screen or not.
+    """
+    if len(rows) == 0:
+        return np.arange(0)
+    a, b = rows[:, 0:3].astype(np.float64), rows[:, 3:6].astype(np.float64)
+    centre = 0.5 * (a + b)
+    radius = 0.5 * np.linalg.norm(b - a, axis=1) + rows[:, 6]
+    m = np.asarray(vp, dtype=np.float64)
+    planes = np.array([m[3] + m[0], m[3] - m[0], m[3] + m[1], m[3] - m[1], m[3] + m[2], m[3] - m[2]])
+    planes /= np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+    distance = centre @ planes[:, :3].T + planes[:, 3]
+    return np.nonzero(np.all(distance >= -radius[:, None], axis=1))[0]
+
+
 def _shadow_key(scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
                 rows: dict[str, NDArray[np.float32]], light_vp: NDArray[np.float64],
                 rect: tuple[float, float, float, float], how: tuple[object, bool]) -> bytes | None:
@@ -274,8 +293,12 @@ class Renderer:
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0)) / self.quality.silhouette_px
         levels = {kind: choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind]) for kind in self._lod}
         impostors = self.quality.impostors
+        # The camera pass draws only what the view can see; the shadow map takes every caster (an
+        # off-screen one may shade the ground in view).
+        seen = {kind: _in_view(rows[kind], vp) for kind in self._lod}
         for kind, batches in self._lod.items():
-            batches.upload(rows[kind][:0] if impostors else rows[kind], levels[kind][:0] if impostors else levels[kind])
+            keep = seen[kind][:0] if impostors else seen[kind]
+            batches.upload(rows[kind][keep], levels[kind][keep])
         outlined = {}
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data
@@ -312,7 +335,8 @@ class Renderer:
         for batches in self._lod.values():
             batches.render()
         if impostors:
-            self.impostors.draw(_nearest_first(np.concatenate([rows["capsules"], rows["spheres"]]), eye), eye)
+            solids = np.concatenate([rows["capsules"][seen["capsules"]], rows["spheres"][seen["spheres"]]])
+            self.impostors.draw(_nearest_first(solids, eye), eye)
         for kind in ("boxes", "cones"):
             if counts[kind]:
                 self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
