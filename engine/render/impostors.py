@@ -22,11 +22,9 @@ from numpy.typing import NDArray
 from engine.render import shaders as S
 from engine.render.gpu import Instances, mesh_buffers, set_uniform
 from engine.render.scene import CAPSULE_STRIDE
+from engine.render.shadows import CAPSULE_FMT
 
 __all__ = ["IMPOSTOR_VS", "IMPOSTOR_FS", "IMPOSTOR_DEPTH_FS", "box_corners", "Impostors"]
-
-_CAPSULE_FMT = ("3f 3f 1f 3f 1f/i", "i_a", "i_b", "i_r", "i_color", "i_outline")
-
 
 def box_corners() -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """The cube ``[-1, 1]³``: eight corners and twelve triangles, counter-clockwise seen from outside."""
@@ -157,7 +155,7 @@ class Impostors:
         self._inst = Instances(ctx, 4 * CAPSULE_STRIDE)
         self._shadow_inst = Instances(ctx, 4 * CAPSULE_STRIDE)
         self._vaos = {
-            name: ctx.vertex_array(prog, [(self._vbo, "3f", "in_corner"), (inst.buf, *_CAPSULE_FMT)], self._ibo, 4,
+            name: ctx.vertex_array(prog, [(self._vbo, "3f", "in_corner"), (inst.buf, *CAPSULE_FMT)], self._ibo, 4,
                                    skip_errors=True)
             for name, prog, inst in (("lit", self.lit, self._inst), ("depth", self.depth, self._shadow_inst))}
 
