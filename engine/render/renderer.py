@@ -3,11 +3,14 @@
 Passes, in order (each kind of primitive is one instanced draw call):
 
 1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
-   (:mod:`engine.render.shadows`), both fitted around the casters each frame.
+   (:mod:`engine.render.shadows`), both fitted around the casters each frame, and kept from the
+   last frame when nothing they are drawn from changed (``reuse_shadows``).
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.
 3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
-   and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`).
+   and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`),
+   or ray-cast on their bounding boxes where the level says so (:mod:`engine.render.impostors`),
+   and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
    and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
    ground over the rectangles they cover: soft shadow, snow track, footprints.
