@@ -249,6 +249,7 @@ class Runner:
         o = self.options
         self.viewer = Viewer.create(headless=o.headless, width=o.width, height=o.height,
                                     **({} if o.headless else {"title": o.title}))
+        self.viewer.renderer.reuse_shadows = True  # a still scene (paused, idle) skips its shadow pass
         self._apply_quality()
 
     def cycle_quality(self) -> None:

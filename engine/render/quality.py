@@ -7,7 +7,8 @@ drawn at full size afterwards, so it stays sharp). Each level also bounds the sh
 work (map and mask sizes) and how coarse a round solid may be drawn (silhouette error).
 ``high`` adds the per-pixel snow detail near the camera; ``low`` lets only the solids
 nearest the camera cast shadows (600 of them: a crowd's near rows), bounding the shadow
-work whatever the crowd's size.
+work whatever the crowd's size, and draws capsules and spheres as ray-cast impostors
+(8 vertices each: a crowd is vertex-bound on a software rasteriser).
 
 ``auto`` is :class:`QualityGovernor`: it starts at ``medium``, steps down as soon as the
 median of the last frames misses the 30 fps budget, and steps up only when a level's
@@ -42,10 +43,12 @@ class Quality:
     max_casters: int | None = None
     """Capsules and spheres drawn into the shadow map, nearest the camera first (``None``: all).
     A crowd is vertex-bound on a software rasteriser, and the shadow map draws it a second time."""
+    impostors: bool = False
+    """Capsules and spheres ray-cast on their bounding boxes (:mod:`engine.render.impostors`), not meshed."""
 
 
 QUALITIES = {
-    "low": Quality("low", 0.5, 512, 128, 2.0, False, max_casters=600),
+    "low": Quality("low", 0.5, 512, 128, 2.0, False, max_casters=600, impostors=True),
     "medium": Quality("medium", 0.75, 1024, 256, 1.0, False),
     "high": Quality("high", 1.0, 1024, 256, 1.0, True),
 }

@@ -3,11 +3,14 @@
 Passes, in order (each kind of primitive is one instanced draw call):
 
 1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
-   (:mod:`engine.render.shadows`), both fitted around the casters each frame.
+   (:mod:`engine.render.shadows`), both fitted around the casters each frame, and kept from the
+   last frame when nothing they are drawn from changed (``reuse_shadows``).
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.
 3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
-   and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`).
+   and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`),
+   or ray-cast on their bounding boxes where the level says so (:mod:`engine.render.impostors`),
+   and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
    and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
    ground over the rectangles they cover: soft shadow, snow track, footprints.
@@ -26,6 +29,7 @@ The renderer owns GPU objects only; it never writes the scene or the simulation.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 from collections.abc import Callable
@@ -42,6 +46,7 @@ from engine.render import shaders_env as E
 from engine.render.env_meshes import cone_mesh
 from engine.render.environment import Environment
 from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
+from engine.render.impostors import Impostors
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
 from engine.render.quality import QUALITIES, Quality
@@ -56,13 +61,15 @@ _LINE_FMT = ("3f 3f 3f 1f/i", "i_p0", "i_p1", "i_color", "i_width")
 _POINT_FMT = ("3f 1f 3f 1f", "i_pos", "i_size", "i_color", "i_pixels")
 _SOLIDS = ("capsules", "spheres", "boxes")
 _KINDS = (*_SOLIDS, "cones", "lines", "points")
-# Nearest texel, fetched by integer address: on llvmpipe a filtered full-screen fetch cost
-# 6.5 ms a frame at 1280x720, more than the pixels the smaller buffer saved.
+# Nearest texel at the interpolated uv of the full-screen triangle. On llvmpipe a filtered
+# full-screen fetch cost 6.5 ms a frame at 1280x720, more than the pixels the smaller buffer
+# saved; a nearest fetch by integer address (texelFetch of gl_FragCoord) cost 9.5 ms against
+# 7.0 ms for this one in the same run (median of 12 × 8 frames, process CPU), same pixels.
 _UPSCALE_FS = """
 uniform sampler2D u_tex;
-uniform vec2 u_ratio;           // source texels per target pixel
+in vec2 v_uv;
 out vec4 f_color;
-void main() { f_color = texelFetch(u_tex, ivec2(gl_FragCoord.xy * u_ratio), 0); }
+void main() { f_color = texture(u_tex, v_uv); }
 """
 
 
@@ -79,6 +86,48 @@ def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArr
         return rows
     centre = 0.5 * (rows[:, 0:3] + rows[:, 3:6]) if rows.shape[1] != BOX_STRIDE else rows[:, 0:3]  # cones too
     return rows[np.argsort(np.sum((centre - eye) ** 2, axis=1), kind="stable")]
+
+
+def _in_view(rows: NDArray[np.float32], vp: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Indices of the capsule rows (ends in columns 0-5, radius in 6) whose bounding sphere meets
+    the view frustum of ``vp``, in order.
+
+    A crowd seen from within draws a tenth of its puppets or less: on a software rasteriser
+    every instance drawn costs vertex work on the main thread, on screen or not.
+    """
+    if len(rows) == 0:
+        return np.arange(0)
+    a, b = rows[:, 0:3].astype(np.float64), rows[:, 3:6].astype(np.float64)
+    centre = 0.5 * (a + b)
+    radius = 0.5 * np.linalg.norm(b - a, axis=1) + rows[:, 6]
+    m = np.asarray(vp, dtype=np.float64)
+    planes = np.array([m[3] + m[0], m[3] - m[0], m[3] + m[1], m[3] - m[1], m[3] + m[2], m[3] - m[2]])
+    planes /= np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+    distance = centre @ planes[:, :3].T + planes[:, 3]
+    return np.nonzero(np.all(distance >= -radius[:, None], axis=1))[0]
+
+
+def _shadow_key(scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+                rows: dict[str, NDArray[np.float32]], light_vp: NDArray[np.float64],
+                rect: tuple[float, float, float, float], how: tuple[object, bool]) -> bytes | None:
+    """A digest of everything the shadow map and the ground mask are drawn from, ``None`` if that
+    cannot be told (skinned characters: their poses live in textures).
+
+    When the sun and every caster stand still (an idle scene, a paused game) the key repeats
+    and the frame reuses last frame's map and mask instead of drawing the casters again.
+    ``how``: the shadow buffers in use and whether the casters are impostors.
+    """
+    if scene.skinned:
+        return None
+    h = hashlib.blake2b(digest_size=16)
+    h.update(f"{id(how[0])} {how[1]} {scene.sun.softness!r} {scene.ground.height!r} {rect!r}".encode())
+    h.update(np.ascontiguousarray(light_vp).tobytes())
+    for kind in sorted(casters):
+        for part in casters[kind]:
+            h.update(np.ascontiguousarray(part).tobytes())
+    for kind in ("boxes", "cones"):
+        h.update(np.ascontiguousarray(rows[kind]).tobytes())
+    return h.digest()
 
 
 def _linear(c: Any) -> tuple[float, float, float]:
@@ -148,6 +197,7 @@ class Renderer:
         for name in ("sky_photo", "upscale"):
             self._vaos[name] = ctx.vertex_array(p[name], [])
         self.env = Environment(ctx)
+        self.impostors = Impostors(ctx)
         self.quality = quality
         self.shadows = Shadows(ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask, self._inst["cones"])
         self._scaled: tuple[moderngl.Framebuffer, moderngl.Texture] | None = None
@@ -162,12 +212,28 @@ class Renderer:
         """When true, each pass waits for the GPU and its time lands in :attr:`timings` (slow; benches only)."""
         self.timings: dict[str, float] = {}
         self._mark_t = 0.0
+        self._shadow_key: bytes | None = None
+        """What the shadow map and mask now hold (:func:`_shadow_key`); ``None``: nothing reusable."""
+        self.reuse_shadows = False
+        """Reuse last frame's shadows when nothing they are drawn from changed. Off by default, so a
+        bench drawing one still frame again and again times the shadows a moving scene pays; the
+        runner turns it on for play."""
 
-    def _skinned_casters(self, scene: RenderScene) -> Callable[[NDArray[np.float64]], None] | None:
-        """The skinned characters' draw into the shadow map, when the scene has any."""
-        if not scene.skinned:
+    def _more_casters(self, scene: RenderScene, impostors: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+                      ) -> Callable[[NDArray[np.float64]], None] | None:
+        """What the shadow map draws besides its meshes: skinned characters, and the round solids
+        ``impostors`` holds (by kind: rows, levels) when they are drawn as impostors."""
+        if not scene.skinned and not impostors:
             return None
-        return lambda light_vp: self.skinned.draw_depth(scene.skinned, light_vp)
+        look = -np.asarray(scene.sun.direction, dtype=np.float64)
+        look /= np.linalg.norm(look)
+
+        def draw(light_vp: NDArray[np.float64]) -> None:
+            if impostors:
+                self.impostors.draw_depth(np.concatenate([rows for rows, _ in impostors.values()]), light_vp, look)
+            if scene.skinned:
+                self.skinned.draw_depth(scene.skinned, light_vp)
+        return draw
 
     def _keep(self, bufs: tuple[moderngl.Buffer, ...]) -> tuple[moderngl.Buffer, ...]:
         self._buffers += list(bufs)
@@ -189,6 +255,7 @@ class Renderer:
             self.shadows.release()
             self.shadows = Shadows(self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask,
                                    self._inst["cones"])
+            self._shadow_key = None
         self.quality = quality
 
     def _scene_target(self, framebuffer: moderngl.Framebuffer) -> tuple[moderngl.Framebuffer, tuple[int, int]]:
@@ -201,7 +268,7 @@ class Renderer:
         if self._scaled is None or self._scaled[1].size != size:
             self._release_scaled()
             tex = self.ctx.texture(size, 4)
-            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)  # the scale-up's fetch (see _UPSCALE_FS)
             tex.repeat_x = tex.repeat_y = False
             self._scaled = (self.ctx.framebuffer([tex], self.ctx.depth_renderbuffer(size)), tex)
         return self._scaled[0], size
@@ -228,8 +295,13 @@ class Renderer:
         # Coarser meshes where fewer pixels are drawn, or where the level allows a larger outline error.
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0)) / self.quality.silhouette_px
         levels = {kind: choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind]) for kind in self._lod}
+        impostors = self.quality.impostors
+        # The camera pass draws only what the view can see; the shadow map takes every caster (an
+        # off-screen one may shade the ground in view).
+        seen = {kind: _in_view(rows[kind], vp) for kind in self._lod}
         for kind, batches in self._lod.items():
-            batches.upload(rows[kind], levels[kind])
+            keep = seen[kind][:0] if impostors else seen[kind]
+            batches.upload(rows[kind][keep], levels[kind][keep])
         outlined = {}
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data
@@ -238,8 +310,12 @@ class Renderer:
         rect = ground_rect(scene) if light_vp is not None else None
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
-            self.shadows.render(scene, {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}, light_vp, rect,
-                                more_casters=self._skinned_casters(scene))
+            casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
+            key = _shadow_key(scene, casters, rows, light_vp, rect, (self.shadows, impostors))
+            if key is None or key != self._shadow_key or not self.reuse_shadows:
+                self.shadows.render(scene, {} if impostors else casters, light_vp, rect,
+                                    more_casters=self._more_casters(scene, casters if impostors else {}))
+            self._shadow_key = key
         self._mark("shadows")
 
         target.use()
@@ -261,6 +337,9 @@ class Renderer:
         ctx.cull_face = "back"
         for batches in self._lod.values():
             batches.render()
+        if impostors:
+            solids = np.concatenate([rows["capsules"][seen["capsules"]], rows["spheres"][seen["spheres"]]])
+            self.impostors.draw(_nearest_first(solids, eye), eye)
         for kind in ("boxes", "cones"):
             if counts[kind]:
                 self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
@@ -326,8 +405,6 @@ class Renderer:
         self.ctx.enable_only(moderngl.NOTHING)
         self._scaled[1].use(location=0)
         set_uniform(self._programs["upscale"], "u_tex", 0)
-        (sw, sh), (w, h) = self._scaled[1].size, framebuffer.size
-        set_uniform(self._programs["upscale"], "u_ratio", (sw / w, sh / h))
         self._vaos["upscale"].render(moderngl.TRIANGLES, vertices=3)
 
     def _set_frame_uniforms(self, scene: RenderScene, camera: Camera, vp: NDArray[np.float64],
@@ -363,7 +440,7 @@ class Renderer:
             "u_fade": 1.0 if bg is None else float(scene.background_fade), "u_bg_scale": bg_scale,
             "u_inv_view_proj": np.linalg.inv(vp), "u_inflate_px": 0.0,
         }
-        for prog in self._programs.values():
+        for prog in (*self._programs.values(), self.impostors.lit):
             for name, value in common.items():
                 set_uniform(prog, name, value)
         self.env.set_common(common)
@@ -432,6 +509,7 @@ class Renderer:
         self.shadows.release()
         self.skinned.release()
         self.env.release()
+        self.impostors.release()
         self._release_scaled()
         for batches in self._lod.values():
             batches.release()

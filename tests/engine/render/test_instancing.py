@@ -42,18 +42,19 @@ def test_draw_calls_do_not_grow_with_the_number_of_puppets(monkeypatch):
 
 
 def test_at_low_quality_only_the_nearest_solids_cast_shadows(monkeypatch):
+    """At ``low`` the round solids cast as impostors: the nearest ``max_casters`` of them, no more."""
     from engine.render import Viewer, make_target
+    from engine.render.impostors import Impostors
     from engine.render.quality import QUALITIES
-    from engine.render.shadows import Shadows
 
-    seen = {}
-    original = Shadows.render
+    seen = []
+    original = Impostors.draw_depth
 
-    def recording(self, scene, casters, light_vp, rect, **more):
-        seen.update({kind: rows for kind, (rows, _) in casters.items()})
-        return original(self, scene, casters, light_vp, rect, **more)
+    def recording(self, rows, light_vp, look):
+        seen.append(np.array(rows))
+        return original(self, rows, light_vp, look)
 
-    monkeypatch.setattr(Shadows, "render", recording)
+    monkeypatch.setattr(Impostors, "draw_depth", recording)
     viewer = Viewer(make_target(True, 160, 90, samples=0))
     try:
         scene, camera = demo_scene(puppets=100, snowballs=0)
@@ -62,7 +63,8 @@ def test_at_low_quality_only_the_nearest_solids_cast_shadows(monkeypatch):
             viewer.renderer.set_quality(QUALITIES["low"])
         viewer.draw(scene)
         limit = QUALITIES["low"].max_casters
-        casters = seen["capsules"]
+        assert limit is not None and len(seen) == 1
+        casters = seen[0]
         assert len(casters) == limit < len(scene.capsules)
         eye = camera.eye
         near = lambda rows: np.linalg.norm(0.5 * (rows[:, 0:3] + rows[:, 3:6]) - eye, axis=1)  # noqa: E731

@@ -65,9 +65,11 @@ def test_low_shades_a_quarter_of_the_pixels_and_keeps_the_text_sharp():
         assert not np.array_equal(high[60:][0::2], high[60:][1::2])
         # The text is drawn at full size after the scale-up: its pixels are those of high.
         assert np.abs(low[4:22, 4:60] - high[4:22, 4:60]).max() < 40
-        # The capsule is in the same place at both levels (about as big: low may draw it with fewer facets).
+        # The capsule is in the same place at both levels (about as big: low ray-casts its true outline,
+        # high draws an inscribed mesh; the shading differs, so compare the outlines' extents).
         spots = [np.argwhere((im[..., 0] - im[..., 2]) > 80) for im in (low, high)]
-        assert np.abs(spots[0].mean(axis=0) - spots[1].mean(axis=0)).max() < 2.0
+        assert np.abs(spots[0].min(axis=0) - spots[1].min(axis=0)).max() <= 2
+        assert np.abs(spots[0].max(axis=0) - spots[1].max(axis=0)).max() <= 2
         assert abs(len(spots[0]) - len(spots[1])) < 0.2 * len(spots[1])
     finally:
         viewer.close()
