@@ -102,17 +102,18 @@ def page_latency(steps: int = 600) -> dict[str, object]:
                     if i > 120 and i % 60 == 0:
                         fps.append(float(browser.evaluate("ppView.fps")))
                 time.sleep(0.3)
-                received = browser.evaluate("ppView.stream.log")
-                drawn = browser.evaluate("ppView.drawLog")
-                resolution = float(browser.evaluate("ppView.resolution || 1"))
-                frames = browser.evaluate("ppView.stream.frames")
+                report = browser.evaluate("ppView.report()")
+                received, drawn, frames = report["log"], report["drawLog"], report["frames"]
+                resolution = float(browser.evaluate("ppView.resolution"))
+                where = browser.evaluate("ppView.where")
         finally:
             activity.close()
-    published = {int(s): p for s, p, _ in received}
-    recv = np.array([r - p for s, p, r in received if s > 120])
+    published = {int(row[0]): row[1] for row in received}
+    late = np.array([row for row in received if row[0] > 120])
     draw = np.array([t - published[s] for s, t in drawn if s in published and s > 120])
-    return {"received_ms": recv, "drawn_ms": draw, "fps": float(np.median(fps[-3:])), "frames": frames,
-            "steps": steps, "resolution": resolution}
+    return {"received_ms": late[:, 2] - late[:, 1], "decoded_ms": late[:, 3] - late[:, 1],
+            "available_ms": late[:, 4] - late[:, 1], "drawn_ms": draw, "fps": float(np.median(fps[-3:])),
+            "frames": frames, "steps": steps, "resolution": resolution, "where": where}
 
 
 def client_latency(steps: int = 600) -> np.ndarray:

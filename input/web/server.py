@@ -62,7 +62,9 @@ DEFAULT_WEB_PORT = 8443
 _JS = "text/javascript; charset=utf-8"
 #: The page's files and their content types (served from the package, no build step).
 PAGE_FILES = {"/": ("index.html", "text/html; charset=utf-8"), "/index.html": ("index.html", "text/html; charset=utf-8"),
-              "/app.js": ("app.js", _JS), "/stream.js": ("stream.js", _JS), "/render.js": ("render.js", _JS),
+              "/app.js": ("app.js", _JS), "/stream.js": ("stream.js", _JS),
+              "/stream_worker.js": ("stream_worker.js", _JS), "/render_worker.js": ("render_worker.js", _JS),
+              "/render.js": ("render.js", _JS),
               "/placement.js": ("placement.js", _JS), "/style.css": ("style.css", "text/css; charset=utf-8")}
 #: Scene frames a connection may have sent and not yet had acknowledged.
 FRAMES_IN_FLIGHT = 2

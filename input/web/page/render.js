@@ -294,4 +294,25 @@ class PageRenderer {
   }
 }
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, perspective, viewMatrix, quatToMat3, mul4, roundRows };
+// Frames drawn, the step on screen and when each step was first drawn, frames per second, and the
+// resolution scale: a phone (or a software renderer) that cannot keep 40 fps draws fewer pixels,
+// stretched, rather than fewer frames. Used by whichever thread draws (the stream worker, or the main
+// thread in AR and where a worker cannot draw).
+class FrameCounter {
+  constructor() { this.drawn = 0; this.step = -1; this.fps = 0; this.resolution = 1; this.drawLog = []; this.ticks = 0; this.since = null; }
+
+  // One frame drawn at ``now`` (ms, performance.now()) showing ``step``; true when ``fps`` was renewed.
+  count(step, now) {
+    if (step !== this.step) { this.drawLog.push([step, performance.timeOrigin + now]); if (this.drawLog.length > 4000) this.drawLog.shift(); }
+    this.drawn += 1; this.step = step; this.ticks += 1;
+    if (this.since === null) this.since = now;
+    if (now - this.since < 1000) return false;
+    this.fps = (1000 * this.ticks) / (now - this.since); this.ticks = 0; this.since = now;
+    if (this.fps < 40 && this.resolution > MIN_RESOLUTION) this.resolution = Math.max(MIN_RESOLUTION, this.resolution * 0.85);
+    else if (this.fps > 55 && this.resolution < 1) this.resolution = Math.min(1, this.resolution / 0.85);
+    return true;
+  }
+}
+const MIN_RESOLUTION = 0.5;
+
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows };

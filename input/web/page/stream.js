@@ -1,6 +1,7 @@
 // PuppetPhone scene stream: the GLB a page gets once, then delta-coded frames (input/web/scene_stream.py).
-// The reader mirrors scene_stream.decode_frame; interpolation runs one frame behind the newest so a late
-// frame never stalls the picture (the last one simply holds).
+// The reader mirrors scene_stream.decode_frame. StreamDecoder runs in the stream worker (stream_worker.js),
+// off the main thread that renders; SceneStream, on the main thread, keeps the newest two decoded frames
+// and interpolates one frame behind the newest, so a late frame never stalls the picture (the last holds).
 "use strict";
 
 const KINDS = ["capsules", "spheres", "boxes", "lines", "points"];
@@ -80,30 +81,54 @@ function nlerpQuat(a, b, t) {
   return q.map((v) => v / n);
 }
 
-// Holds the newest two frames and blends between them by arrival time.
-class SceneStream {
-  constructor() { this.scales = null; this.extras = null; this.state = null; this.prev = null; this.cur = null; this.log = []; this.frames = 0; this.bytes = 0; }
+// The worker's half (stream_worker.js): the quantised state a page holds, and each message as a
+// frame of float rows ready to draw. ``receive`` returns that frame; ``extras`` only with a GLB.
+class StreamDecoder {
+  constructor() { this.scales = null; this.extras = null; this.state = null; this.received = 0; this.bytes = 0; }
 
-  // One binary WebSocket message: the GLB or a frame. Returns the step the page now has.
-  receive(buffer, now) {
-    let state;
+  receive(buffer) {
+    let state, extras = null;
     if (new DataView(buffer).getUint32(0, true) === 0x46546c67) {
       const glb = readSceneGlb(buffer);
-      this.scales = glb.scales; this.extras = glb.extras; state = glb.state;
+      this.scales = glb.scales; this.extras = extras = glb.extras; state = glb.state;
     } else {
+      if (!this.state) throw new Error("a frame before the scene");
       state = decodeFrame(this.state, this.scales, buffer);
     }
     this.state = state;
-    const rows = toFloat(state.rows, this.scales);
+    this.received += 1; this.bytes += buffer.byteLength;
+    return { extras, step: state.step, published: state.published * 1000, camera: state.camera,
+      rows: toFloat(state.rows, this.scales), received: this.received, bytes: this.bytes };
+  }
+}
+
+// The main thread's half: the newest two frames, blended by arrival time at each drawing.
+class SceneStream {
+  constructor() { this.extras = null; this.prev = null; this.cur = null; this.log = []; this.frames = 0; this.bytes = 0; }
+
+  // Forget the scene (a new connection starts from a new GLB).
+  reset() { this.extras = null; this.prev = null; this.cur = null; }
+
+  // One decoded frame, given to the page at ``now`` (ms, performance.now()).
+  accept(frame, now) {
+    if (frame.extras) { this.extras = frame.extras; this.prev = null; this.cur = null; }
+    if (!this.extras) return;
     const interval = this.cur ? Math.min(Math.max(now - this.cur.arrived, 1000 / 60), 100) : 1000 / 60;
     this.prev = this.cur;
-    this.cur = { rows, camera: state.camera, arrived: now, interval, step: state.step };
-    this.frames += 1; this.bytes += buffer.byteLength;
-    if (state.published) this.log.push([state.step, state.published * 1000, performance.timeOrigin + now]);
+    this.cur = { rows: frame.rows, camera: frame.camera, arrived: now, interval, step: frame.step };
+    this.frames = frame.received; this.bytes = frame.bytes;
+    // [step, published, reached the worker, decoded in the worker, available here]: ms since the epoch.
+    if (frame.published) this.log.push([frame.step, frame.published, frame.arrived, frame.decoded, performance.timeOrigin + now]);
     if (this.log.length > 4000) this.log.shift();
-    return state.step;
   }
 
+  // One binary message decoded here, on the calling thread (node tests, a page without workers).
+  receive(decoder, buffer, now) {
+    const frame = decoder.receive(buffer);
+    frame.arrived = frame.decoded = performance.timeOrigin + now;
+    this.accept(frame, now);
+    return frame.step;
+  }
   // The rows and camera to draw at ``now`` (ms): prev → cur over the arrival interval.
   sample(now) {
     const cur = this.cur, prev = this.prev;
@@ -123,4 +148,4 @@ class SceneStream {
   }
 }
 
-if (typeof module !== "undefined") module.exports = { SceneStream, decodeFrame, readSceneGlb, toFloat, KINDS };
+if (typeof module !== "undefined") module.exports = { SceneStream, StreamDecoder, decodeFrame, readSceneGlb, toFloat, KINDS };

@@ -137,10 +137,10 @@ def test_the_page_blends_between_frames_and_holds_the_last_one_when_the_next_is_
     (tmp_path / "0.bin").write_bytes(scene_glb(first, scene))
     (tmp_path / "1.bin").write_bytes(encode_frame(first, moved))
     script = f"""
-const fs = require("fs"); const {{ SceneStream }} = require({json.dumps(str(PAGE / "stream.js"))});
+const fs = require("fs"); const {{ SceneStream, StreamDecoder }} = require({json.dumps(str(PAGE / "stream.js"))});
 globalThis.performance = {{ timeOrigin: 0 }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const s = new SceneStream(); s.receive(buf(0), 1000); s.receive(buf(1), 1020);
+const s = new SceneStream(), d = new StreamDecoder(); s.receive(d, buf(0), 1000); s.receive(d, buf(1), 1020);
 const x = (t) => s.sample(t).rows.capsules[0];
 console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
 """
