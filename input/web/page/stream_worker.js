@@ -15,7 +15,8 @@
 importScripts("stream.js");
 
 const IN_FLIGHT = 2;
-let ws = null, decoder = null, inFlight = 0, held = null, drawer = null, resend = false;
+const NOT_SENT = {};
+let ws = null, decoder = null, inFlight = 0, held = null, drawer = null, resend = false, sentMarks = NOT_SENT;
 const clock = () => performance.timeOrigin + performance.now();
 
 function took() { inFlight = Math.max(0, inFlight - 1); flush(); }
@@ -25,12 +26,14 @@ function flush() {
   const frame = held;
   held = null;
   inFlight += 1;
+  // The tracks' grid goes only when it changed since the last frame the drawer got (a copy each time).
+  if (frame.marks === sentMarks) frame.marks = undefined; else sentMarks = frame.marks;
   const buffers = Object.values(frame.rows).map((a) => a.buffer);
   if (drawer) drawer.postMessage({ frame }, buffers); else postMessage({ frame }, buffers);
 }
 
 function open(url) {
-  decoder = new StreamDecoder(); inFlight = 0; held = null;
+  decoder = new StreamDecoder(); inFlight = 0; held = null; sentMarks = NOT_SENT;
   const sock = new WebSocket(url);
   sock.binaryType = "arraybuffer";
   ws = sock;
@@ -59,6 +62,6 @@ onmessage = (e) => {
   else if (m.drawer !== undefined) {
     drawer = m.drawer;
     if (drawer) drawer.onmessage = (ev) => { if (ev.data.got !== undefined) took(); };
-    inFlight = 0; held = null; resend = true;
+    inFlight = 0; held = null; resend = true; sentMarks = NOT_SENT;
   }
 };
