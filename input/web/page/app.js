@@ -20,6 +20,7 @@ const state = {
 // handles the sensors and the controls, and draws only in AR (the XR session is here) or where a
 // worker cannot draw: then the stream worker sends its frames here.
 const worker = new Worker("stream_worker.js");
+worker.onerror = (e) => { $("status").textContent = "stream: " + e.message; };
 const stream = new SceneStream(), counter = new FrameCounter();
 let renderer = null, drawsHere = false, painter = null;
 // What the bench and the tests read: frames drawn, the step on screen, frames per second, who draws;
@@ -65,6 +66,7 @@ function onPainter(e) {
     canvas.dataset.transferred = "1";
     painter = new Worker("render_worker.js");
     painter.onmessage = onPainter;
+    painter.onerror = (e) => { $("status").textContent = "view: " + e.message; };
     painter.postMessage({ canvas: off, size: canvasSize(), port: link.port2 }, [off, link.port2]);
     worker.postMessage({ drawer: link.port1 }, [link.port1]);
     window.addEventListener("resize", () => painter.postMessage({ size: canvasSize() }));

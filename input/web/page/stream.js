@@ -175,7 +175,8 @@ class SceneStream {
   sample(now) {
     const cur = this.cur, prev = this.prev;
     if (!cur) return null;
-    if (!prev) return { rows: cur.rows, camera: cur.camera, step: cur.step };
+    const marks = this.marks, marksVersion = this.marksVersion;
+    if (!prev) return { rows: cur.rows, camera: cur.camera, step: cur.step, marks, marksVersion };
     const t = Math.min(Math.max((now - cur.arrived) / cur.interval, 0), 1);
     const rows = {};
     for (const kind of KINDS) {
@@ -186,7 +187,7 @@ class SceneStream {
       rows[kind] = out;
     }
     const p = [0, 1, 2].map((i) => prev.camera.p[i] + (cur.camera.p[i] - prev.camera.p[i]) * t);
-    return { rows, camera: { p, q: nlerpQuat(prev.camera.q, cur.camera.q, t), fov: cur.camera.fov }, step: cur.step };
+    return { rows, camera: { p, q: nlerpQuat(prev.camera.q, cur.camera.q, t), fov: cur.camera.fov }, step: cur.step, marks, marksVersion };
   }
 }
 
