@@ -1,11 +1,12 @@
 """The phone as viewport: what the scene stream costs on the wire, how late it arrives, how fast the page draws.
 
 - **Bytes per second** (no browser): the snowman demo (the shipped recording: a puppet
-  rolling, stacking and carrying balls until two snowmen stand) and the sandbox with
+  rolling, stacking and carrying balls until two snowmen stand; its tracks in the snow
+  and footprints included, each snowman is a puppet too) and the sandbox with
   50 wandering puppets are stepped; after every step the game's state drawing is
   quantised and delta-coded against the previous step exactly as a phone that keeps up
-  gets it (:mod:`input.web.scene_stream`). Baseline: the same rows sent whole as float32
-  each step (a straw man: what streaming the render rows without the codec costs).
+  gets it (:mod:`input.web.scene_stream`). Baseline: the same rows and the track grid
+  sent whole as float32 each step (a straw man: streaming them without the codec).
 - **Step → page latency** on loopback: a snowman session paced to real time streams to
   headless Chromium at 390×844; the page notes, per frame, the engine's publication
   time (end of the step) and when it received the frame, and when it first drew that
@@ -50,6 +51,7 @@ def _stream_cost(app, draw, steps: int) -> tuple[float, float, int]:  # type: ig
         if i > 0:  # the first is the GLB a phone gets once
             coded += len(encode_frame(prev, state))
             raw += sum(getattr(scene, k).data.nbytes for k in KINDS) + 32
+            raw += scene.marks.amount.nbytes if scene.marks is not None else 0
         prev = state
     return coded / (steps - 1), raw / (steps - 1), len(app.world.query(Puppet))
 
@@ -66,11 +68,11 @@ def stream_bytes(demo_steps: int = 1800, crowd_steps: int = 600) -> dict[str, fl
     demo = Path(__import__("games.snowman", fromlist=["x"]).__file__).parent / "demo.rec"
     rec = read_recording(demo)
     app = make_app("snowman", rec.header.seed, replay_hub(rec), load_game("snowman").replay_setup(rec.header.setup))
-    s_coded, s_raw, _ = _stream_cost(app, draw_snowman_state, min(demo_steps, len(rec.frames)))
+    s_coded, s_raw, s_puppets = _stream_cost(app, draw_snowman_state, min(demo_steps, len(rec.frames)))
     crowd = make_app("sandbox", 1, InputHub(), {"puppets": 50})
     c_coded, c_raw, puppets = _stream_cost(crowd, draw_world, crowd_steps)
-    return {"snowman_coded": s_coded, "snowman_raw": s_raw, "crowd_coded": c_coded, "crowd_raw": c_raw,
-            "crowd_puppets": float(puppets)}
+    return {"snowman_coded": s_coded, "snowman_raw": s_raw, "snowman_puppets": float(s_puppets),
+            "crowd_coded": c_coded, "crowd_raw": c_raw, "crowd_puppets": float(puppets)}
 
 
 def page_latency(steps: int = 600) -> dict[str, object]:
@@ -179,6 +181,8 @@ def run() -> list[Figure]:
     figures = [
         Figure("phone-view", "snowman_stream_kb_per_s", b["snowman_coded"] * per_s / 1000, "KB/s",
                "raw float32 rows (straw man)", b["snowman_raw"] * per_s / 1000),
+        Figure("phone-view", "snowman_bytes_per_puppet_step", b["snowman_coded"] / b["snowman_puppets"], "B",
+               "raw float32 rows (straw man)", b["snowman_raw"] / b["snowman_puppets"]),
         Figure("phone-view", "crowd50_stream_kb_per_s", b["crowd_coded"] * per_s / 1000, "KB/s",
                "raw float32 rows (straw man)", b["crowd_raw"] * per_s / 1000),
         Figure("phone-view", "crowd50_bytes_per_puppet_step", b["crowd_coded"] / b["crowd_puppets"], "B",

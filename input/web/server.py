@@ -27,7 +27,10 @@ sends its page the scene as a GLB once (:mod:`input.web.scene_glb`), then a fram
 delta-coded against what *that* page last got (:mod:`input.web.scene_stream`). A
 connection never queues: it holds only the newest state, and sends while fewer than
 :data:`FRAMES_IN_FLIGHT` frames wait for the page's ``{"ack": step}``, so a slow phone
-(or Wi-Fi) gets fewer frames, each the latest, rather than a growing backlog.
+(or Wi-Fi) gets fewer frames, each the latest, rather than a growing backlog. The page
+reads the socket in a worker of its own (``page/stream_worker.js``) and acknowledges a
+frame as soon as it is decoded there, so the acknowledgements pace the network and the
+phone, not the page's drawing.
 
 :attr:`WebSource.page_times` remembers, for the latest readings, the page's clock at
 the sensor event, keyed by the sample's receive time: the latency bench reads it.
