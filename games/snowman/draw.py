@@ -15,10 +15,10 @@ from engine.components import Puppet, WorldPose
 from engine.ecs import World
 from engine.render.scene import GroundMarks, RenderScene
 from games.common import draw_world
+from games.snowman.bent_scenery import BentScenery
 from games.snowman.components import Snowman
 from games.snowman.footprints import Footprints
 from games.snowman.rig import bezier_spine, middle_ball_parameter
-from games.snowman.bent_scenery import BentScenery
 from games.snowman.scenery import draw_snowfall, draw_trees
 from games.snowman.snow import SnowField
 

@@ -17,8 +17,7 @@ import pytest
 import input.web
 from engine.render.scene import GroundMarks, RenderScene
 from input.web.scene_glb import read_scene_glb, scene_glb
-from input.web.scene_stream import (KINDS, CameraPose, FrameError, SceneState, decode_frame, encode_frame,
-                                    quantise)
+from input.web.scene_stream import KINDS, CameraPose, FrameError, SceneState, decode_frame, encode_frame, quantise
 
 CAM = CameraPose((0.0, 1.5, 4.0), (1.0, 0.0, 0.0, 0.0), 60.0)
 PAGE = Path(input.web.__file__).parent / "page"
