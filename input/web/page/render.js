@@ -130,18 +130,14 @@ precision highp float;
 in vec3 vP; in vec2 vUV;
 uniform sampler2D marks; uniform vec2 texel; uniform vec4 uvRect; uniform vec3 sunDir; uniform vec3 eye;
 out vec4 frag;
-// Four bilinear taps half a texel off the diagonals: the [1 2 1] blur the desktop applies on upload.
-float soft(vec2 uv) {
-  vec2 h = 0.5 * texel;
-  return 0.25 * (texture(marks, uv + h).r + texture(marks, uv - h).r + texture(marks, uv + vec2(h.x, -h.y)).r
-    + texture(marks, uv + vec2(-h.x, h.y)).r);
-}
+// The grid comes softened (stream.js softenMarks): one read per pixel, four more for the slope.
 void main() {
   vec2 uv = uvRect.xy + vUV * uvRect.zw;
-  float m = soft(uv);
+  float m = texture(marks, uv).r;
   if (m < 0.01) discard;
   vec2 dx = vec2(texel.x, 0.0), dz = vec2(0.0, texel.y);
-  vec3 n = normalize(vec3((soft(uv + dx) - soft(uv - dx)) * 1.6, 1.0, (soft(uv + dz) - soft(uv - dz)) * 1.6));
+  vec3 n = normalize(vec3((texture(marks, uv + dx).r - texture(marks, uv - dx).r) * 1.6, 1.0,
+    (texture(marks, uv + dz).r - texture(marks, uv - dz).r) * 1.6));
   float light = clamp(max(dot(n, sunDir), 0.0) / max(sunDir.y, 0.2), 0.72, 1.12);
   vec3 k = mix(vec3(1.0), vec3(0.76, 0.82, 0.92), smoothstep(0.0, 1.0, m)) * mix(1.0, light, smoothstep(0.0, 0.4, m));
   float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);

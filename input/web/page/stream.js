@@ -103,6 +103,26 @@ function decodeMarks(base, dv, at) {
   return [{ nx, nz, x0, z0, cell, cells }, at];
 }
 
+// The tracks blurred by one cell ([1 2 1] both ways, edges repeated), as the desktop does before it
+// uploads them (engine/render/environment.py soften_marks): with bilinear filtering, a soft groove
+// with no cell corners, for one texture read per pixel. Done once per change, off the drawing thread.
+function softenMarks(marks) {
+  if (!marks) return marks;
+  const { nx, nz, cells } = marks, rows = new Float32Array(nx * nz), out = new Uint8Array(nx * nz);
+  for (let r = 0; r < nz; r++) {
+    const up = Math.max(r - 1, 0) * nx, me = r * nx, down = Math.min(r + 1, nz - 1) * nx;
+    for (let c = 0; c < nx; c++) rows[me + c] = 0.25 * cells[up + c] + 0.5 * cells[me + c] + 0.25 * cells[down + c];
+  }
+  for (let r = 0; r < nz; r++) {
+    const me = r * nx;
+    for (let c = 0; c < nx; c++) {
+      const v = 0.25 * rows[me + Math.max(c - 1, 0)] + 0.5 * rows[me + c] + 0.25 * rows[me + Math.min(c + 1, nx - 1)];
+      out[me + c] = Math.min(255, Math.floor(v + 0.5));
+    }
+  }
+  return { ...marks, cells: out };
+}
+
 // Quantised rows to float rows (metres, colours in [0, 1]).
 function toFloat(rows, scales) {
   const out = {};
@@ -168,6 +188,7 @@ class SceneStream {
   receive(decoder, buffer, now) {
     const frame = decoder.receive(buffer);
     frame.arrived = frame.decoded = performance.timeOrigin + now;
+    if (frame.marks !== this.rawMarks) { this.rawMarks = frame.marks; frame.marks = softenMarks(frame.marks); } else frame.marks = undefined;
     this.accept(frame, now);
     return frame.step;
   }
@@ -191,4 +212,4 @@ class SceneStream {
   }
 }
 
-if (typeof module !== "undefined") module.exports = { SceneStream, StreamDecoder, decodeFrame, decodeMarks, readSceneGlb, toFloat, KINDS };
+if (typeof module !== "undefined") module.exports = { SceneStream, StreamDecoder, decodeFrame, decodeMarks, softenMarks, readSceneGlb, toFloat, KINDS };

@@ -26,8 +26,8 @@ function flush() {
   const frame = held;
   held = null;
   inFlight += 1;
-  // The tracks' grid goes only when it changed since the last frame the drawer got (a copy each time).
-  if (frame.marks === sentMarks) frame.marks = undefined; else sentMarks = frame.marks;
+  // The tracks' grid goes only when it changed since the last frame the drawer got, softened (a copy).
+  if (frame.marks === sentMarks) frame.marks = undefined; else { sentMarks = frame.marks; frame.marks = softenMarks(frame.marks); }
   const buffers = Object.values(frame.rows).map((a) => a.buffer);
   if (drawer) drawer.postMessage({ frame }, buffers); else postMessage({ frame }, buffers);
 }

@@ -193,3 +193,23 @@ console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
     assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
     assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
     assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), "a late frame must hold, not run on"
+
+
+@needs_node
+def test_the_page_softens_the_tracks_as_the_desktop_does_before_drawing_them(tmp_path):
+    """The page blurs the grid once per change (so its shader reads one texel a pixel); the result is the
+    desktop's ``soften_marks`` to within rounding. (A page that skipped the blur differs by up to 128.)"""
+    from engine.render.environment import soften_marks
+
+    cells = np.random.default_rng(5).integers(0, 256, (7, 11)).astype(np.uint8)
+    cells[2:4] = 0
+    script = f"""
+const {{ softenMarks }} = require({json.dumps(str(PAGE / "stream.js"))});
+const m = softenMarks({{ nx: 11, nz: 7, cells: Uint8Array.from({json.dumps(cells.reshape(-1).tolist())}) }});
+console.log(JSON.stringify(Array.from(m.cells)));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    page = np.array(json.loads(res.stdout)).reshape(7, 11)
+    desktop = soften_marks(cells.astype(np.float32) / 255.0).astype(int)
+    assert np.abs(page - desktop).max() <= 1
