@@ -1,7 +1,7 @@
 // PuppetPhone web controller: the phone's browser becomes the MotionStick, and the viewport.
 // Streams one JSON reading per sensor event over a WebSocket (format: input/web/protocol.py) and draws
-// the scene the engine streams back (stream_worker.js receives it, stream.js, render.js): the phone is the camera, the stick hangs
-// from it. Modes: WebXR immersive-ar (the field placed on the floor by a hit test, the camera image
+// the scene the engine streams back (stream_worker.js, render_worker.js, stream.js, render.js): the
+// phone is the camera, the stick hangs from it. Modes: WebXR immersive-ar (the field placed on the floor by a hit test, the camera image
 // behind it), else a "magic window" (device orientation turns the view over a plain sky).
 // Plain scripts, no build step; served by the engine over HTTPS (sensors need a secure context).
 "use strict";
@@ -104,8 +104,8 @@ function sendReading(t) {
   state.cal = false;
 }
 
-// The WebSocket lives in the stream worker (stream_worker.js): scene frames are read and decoded
-// there while this thread draws, and come here decoded; readings and pings go out through it.
+// The WebSocket lives in the stream worker (stream_worker.js): readings and pings go out through it,
+// the engine's JSON comes back here, and scene frames come here only when this thread draws.
 worker.onmessage = (e) => {
   const m = e.data;
   if (m.frame) {
