@@ -213,3 +213,50 @@ console.log(JSON.stringify(Array.from(m.cells)));
     page = np.array(json.loads(res.stdout)).reshape(7, 11)
     desktop = soften_marks(cells.astype(np.float32) / 255.0).astype(int)
     assert np.abs(page - desktop).max() <= 1
+
+
+@needs_node
+def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
+    """``stream_worker.js`` under node with a fake WebSocket and drawer port: every frame is acknowledged to the
+    engine as soon as it is decoded; the drawer gets at most two frames it has not taken, then, once it
+    takes one, the newest frame (not the next in a queue), and the tracks only when they changed.
+    (A worker that posts every frame fails the count; one that keeps a queue fails the newest step.)"""
+    scene = tracked(scene_with(4), [(10, 10, 3, 3)])
+    states = [quantise(scene, 1, 0.0, CAM)]
+    for i in range(2, 8):
+        strips = [(10, 10, 3, 3)] + ([(50, 50, 2, 2)] if i >= 6 else [])
+        states.append(quantise(tracked(scene_with(4, 0.01 * i, 2), strips), i, 0.0, CAM))
+    blobs = [scene_glb(states[0], scene)] + [encode_frame(a, b) for a, b in zip(states, states[1:], strict=False)]
+    for i, blob in enumerate(blobs):
+        (tmp_path / f"{i}.bin").write_bytes(blob)
+    script = f"""
+const fs = require("fs"), page = {json.dumps(str(PAGE))};
+globalThis.importScripts = (...names) => {{ for (const n of names) Object.assign(globalThis, require(page + "/" + n)); }};
+const toMain = [], sent = [], drawn = [];
+globalThis.postMessage = (m) => toMain.push(m);
+globalThis.onmessage = null;
+class FakeSocket {{ constructor(url) {{ this.url = url; this.readyState = 1; FakeSocket.last = this; }} send(x) {{ sent.push(JSON.parse(x)); }} }}
+FakeSocket.OPEN = 1;
+globalThis.WebSocket = FakeSocket;
+require(page + "/stream_worker.js");
+const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
+const port = {{ postMessage: (m) => drawn.push({{ step: m.frame.step, extras: !!m.frame.extras, marks: m.frame.marks === undefined ? "same" : "grid" }}) }};
+onmessage({{ data: {{ connect: "wss://x/ws" }} }});
+onmessage({{ data: {{ drawer: port }} }});
+for (let i = 0; i < {len(blobs)}; i++) FakeSocket.last.onmessage({{ data: buf(i) }});
+const before = drawn.length;
+port.onmessage({{ data: {{ got: 1 }} }});
+const after = drawn.length;
+port.onmessage({{ data: {{ got: 2 }} }});
+console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length }}));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout)
+    assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
+    assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
+    assert out["after"] == 3 and out["end"] == 3
+    first, second, newest = out["drawn"]
+    assert first == {"step": 1, "extras": True, "marks": "grid"}
+    assert second == {"step": 2, "extras": False, "marks": "same"}
+    assert newest == {"step": 7, "extras": False, "marks": "grid"}, "after a take: the newest frame, tracks changed"
