@@ -1,15 +1,20 @@
 """The phone as viewport: what the scene stream costs on the wire, how late it arrives, how fast the page draws.
 
 - **Bytes per second** (no browser): the snowman demo (the shipped recording: a puppet
-  rolling, stacking and carrying balls until two snowmen stand) and the sandbox with
+  rolling, stacking and carrying balls until two snowmen stand; its tracks in the snow
+  and footprints included, each snowman is a puppet too) and the sandbox with
   50 wandering puppets are stepped; after every step the game's state drawing is
   quantised and delta-coded against the previous step exactly as a phone that keeps up
-  gets it (:mod:`input.web.scene_stream`). Baseline: the same rows sent whole as float32
-  each step (a straw man: what streaming the render rows without the codec costs).
+  gets it (:mod:`input.web.scene_stream`). Baseline: the same rows and the track grid
+  sent whole as float32 each step (a straw man: streaming them without the codec).
 - **Step → page latency** on loopback: a snowman session paced to real time streams to
-  headless Chromium at 390×844; the page notes, per frame, the engine's publication
-  time (end of the step) and when it received the frame, and when it first drew that
-  step. Both clocks are this machine's system clock.
+  headless Chromium at 390×844. A *page frame* is counted two ways: **available** — the
+  frame is decoded (in the page's stream worker) and has reached the thread that draws
+  (the render worker), so the next animation frame can show it; and **drawn** — the
+  draw calls of the first animation frame that shows that step have returned. The
+  page also notes when the frame reached its stream worker and when it was decoded
+  there. All are against the engine's publication time (end of the step); every clock
+  is this machine's system clock.
 - **Step → client latency** on loopback, the same session with a Python WebSocket client
   in place of the browser (it decodes and acknowledges at once): the engine's and the
   network's part of the latency, without the page's main thread.
@@ -21,13 +26,14 @@ from __future__ import annotations
 
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from bench.figures import Figure
 
-__all__ = ["run", "stream_bytes", "page_latency", "client_latency"]
+__all__ = ["PageLatency", "client_latency", "page_latency", "run", "stream_bytes"]
 
 STEP_MS = 1000.0 / 60.0
 PHONE = (390, 844)
@@ -50,31 +56,50 @@ def _stream_cost(app, draw, steps: int) -> tuple[float, float, int]:  # type: ig
         if i > 0:  # the first is the GLB a phone gets once
             coded += len(encode_frame(prev, state))
             raw += sum(getattr(scene, k).data.nbytes for k in KINDS) + 32
+            raw += scene.marks.amount.nbytes if scene.marks is not None else 0
         prev = state
     return coded / (steps - 1), raw / (steps - 1), len(app.world.query(Puppet))
 
 
 def stream_bytes(demo_steps: int = 1800, crowd_steps: int = 600) -> dict[str, float]:
     """Coded and raw bytes per step for the snowman demo and a 50-puppet crowd."""
-    from games.snowman.draw import draw_snowman_state
+    import games.snowman
     from games.common import draw_world
+    from games.snowman.draw import draw_snowman_state
     from input.hub import InputHub
     from input.recording import read_recording
     from input.replay import replay_hub
     from puppetphone.games import load_game, make_app
 
-    demo = Path(__import__("games.snowman", fromlist=["x"]).__file__).parent / "demo.rec"
+    demo = Path(games.snowman.__path__[0]) / "demo.rec"
     rec = read_recording(demo)
     app = make_app("snowman", rec.header.seed, replay_hub(rec), load_game("snowman").replay_setup(rec.header.setup))
-    s_coded, s_raw, _ = _stream_cost(app, draw_snowman_state, min(demo_steps, len(rec.frames)))
+    s_coded, s_raw, s_puppets = _stream_cost(app, draw_snowman_state, min(demo_steps, len(rec.frames)))
     crowd = make_app("sandbox", 1, InputHub(), {"puppets": 50})
     c_coded, c_raw, puppets = _stream_cost(crowd, draw_world, crowd_steps)
-    return {"snowman_coded": s_coded, "snowman_raw": s_raw, "crowd_coded": c_coded, "crowd_raw": c_raw,
-            "crowd_puppets": float(puppets)}
+    return {"snowman_coded": s_coded, "snowman_raw": s_raw, "snowman_puppets": float(s_puppets),
+            "crowd_coded": c_coded, "crowd_raw": c_raw, "crowd_puppets": float(puppets)}
 
 
-def page_latency(steps: int = 600) -> dict[str, object]:
-    """Publication → receipt and → first drawing of each step on the page (ms), and the page's fps."""
+@dataclass(frozen=True)
+class PageLatency:
+    """Per step after the first two seconds, ms from the engine's publication (end of the step) to: the frame
+    reaching the page's stream worker, decoded there, available to the thread that draws, and first drawn
+    (the draw calls of the first animation frame showing it have returned); and the page's drawing."""
+
+    received_ms: np.ndarray
+    decoded_ms: np.ndarray
+    available_ms: np.ndarray
+    drawn_ms: np.ndarray
+    fps: float
+    resolution: float
+    frames: int
+    steps: int
+    where: str
+
+
+def page_latency(steps: int = 600) -> PageLatency:
+    """Publication → receipt, decoding, availability and first drawing of each step on the page, and its fps."""
     from bench.chromium import Chromium
     from engine.pacing import RealTimePacer
     from input.hub import InputHub
@@ -102,17 +127,17 @@ def page_latency(steps: int = 600) -> dict[str, object]:
                     if i > 120 and i % 60 == 0:
                         fps.append(float(browser.evaluate("ppView.fps")))
                 time.sleep(0.3)
-                received = browser.evaluate("ppView.stream.log")
-                drawn = browser.evaluate("ppView.drawLog")
-                resolution = float(browser.evaluate("ppView.resolution || 1"))
-                frames = browser.evaluate("ppView.stream.frames")
+                report = browser.evaluate("ppView.report()")
+                received, drawn, frames = report["log"], report["drawLog"], report["frames"]
+                resolution = float(browser.evaluate("ppView.resolution"))
+                where = browser.evaluate("ppView.where")
         finally:
             activity.close()
-    published = {int(s): p for s, p, _ in received}
-    recv = np.array([r - p for s, p, r in received if s > 120])
+    published = {int(row[0]): row[1] for row in received}
+    late = np.array([row for row in received if row[0] > 120])
     draw = np.array([t - published[s] for s, t in drawn if s in published and s > 120])
-    return {"received_ms": recv, "drawn_ms": draw, "fps": float(np.median(fps[-3:])), "frames": frames,
-            "steps": steps, "resolution": resolution}
+    return PageLatency(late[:, 2] - late[:, 1], late[:, 3] - late[:, 1], late[:, 4] - late[:, 1], draw,
+                       float(np.median(fps[-3:])), resolution, int(frames), steps, str(where))
 
 
 def client_latency(steps: int = 600) -> np.ndarray:
@@ -150,6 +175,7 @@ def client_latency(steps: int = 600) -> np.ndarray:
                     except TimeoutError:
                         continue
                     now = time.time()
+                    assert isinstance(data, bytes), "the engine sends scene frames as binary messages"
                     state = read_scene_glb(data)[1] if state is None else decode_frame(state, data)
                     ws.send(json.dumps({"ack": state.step}))
                     if state.published and state.step > 120:
@@ -178,6 +204,8 @@ def run() -> list[Figure]:
     figures = [
         Figure("phone-view", "snowman_stream_kb_per_s", b["snowman_coded"] * per_s / 1000, "KB/s",
                "raw float32 rows (straw man)", b["snowman_raw"] * per_s / 1000),
+        Figure("phone-view", "snowman_bytes_per_puppet_step", b["snowman_coded"] / b["snowman_puppets"], "B",
+               "raw float32 rows (straw man)", b["snowman_raw"] / b["snowman_puppets"]),
         Figure("phone-view", "crowd50_stream_kb_per_s", b["crowd_coded"] * per_s / 1000, "KB/s",
                "raw float32 rows (straw man)", b["crowd_raw"] * per_s / 1000),
         Figure("phone-view", "crowd50_bytes_per_puppet_step", b["crowd_coded"] / b["crowd_puppets"], "B",
@@ -192,14 +220,14 @@ def run() -> list[Figure]:
         print("phone-view: no chromium (apt-get install chromium): the page figures are left out")
         return figures
     lat = page_latency()
-    rec, drawn = lat["received_ms"], lat["drawn_ms"]
-    return figures + [
-        Figure("phone-view", "step_to_page_p50_ms", float(np.percentile(rec, 50)), "ms", "two steps", 2 * STEP_MS),
-        Figure("phone-view", "step_to_page_p99_ms", float(np.percentile(rec, 99)), "ms", "two steps", 2 * STEP_MS),
-        Figure("phone-view", "step_to_drawn_p50_ms", float(np.percentile(drawn, 50)), "ms", "two steps", 2 * STEP_MS),
-        Figure("phone-view", "step_to_drawn_p99_ms", float(np.percentile(drawn, 99)), "ms", "two steps", 2 * STEP_MS),
-        Figure("phone-view", "page_fps_390x844", lat["fps"], "fps", "goal", 30.0),
-        Figure("phone-view", "page_resolution_scale", lat["resolution"], "ratio", "full resolution", 1.0),
-        Figure("phone-view", "frames_sent_per_step", float(lat["frames"]) / float(lat["steps"]), "ratio",
-               "one per step", 1.0),
+    out = []
+    for name, values in (("page_decoded", lat.decoded_ms), ("page_available", lat.available_ms),
+                         ("page_drawn", lat.drawn_ms)):
+        for q in (50, 99):
+            out.append(Figure("phone-view", f"step_to_{name}_p{q}_ms", float(np.percentile(values, q)), "ms",
+                              "two steps", 2 * STEP_MS))
+    return figures + out + [
+        Figure("phone-view", "page_fps_390x844", lat.fps, "fps", "goal", 30.0),
+        Figure("phone-view", "page_resolution_scale", lat.resolution, "ratio", "full resolution", 1.0),
+        Figure("phone-view", "frames_sent_per_step", lat.frames / lat.steps, "ratio", "one per step", 1.0),
     ]

@@ -15,10 +15,10 @@ from engine.components import Puppet, WorldPose
 from engine.ecs import World
 from engine.render.scene import GroundMarks, RenderScene
 from games.common import draw_world
-from games.snowman.components import Snowman
-from games.snowman.footprints import draw_footprints
-from games.snowman.rig import bezier_spine, middle_ball_parameter
 from games.snowman.bent_scenery import BentScenery
+from games.snowman.components import Snowman
+from games.snowman.footprints import Footprints
+from games.snowman.rig import bezier_spine, middle_ball_parameter
 from games.snowman.scenery import draw_snowfall, draw_trees
 from games.snowman.snow import SnowField
 
@@ -111,7 +111,8 @@ def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[i
 
 
 def draw_snowman_state(world: World, scene: RenderScene, alpha: float) -> None:
-    """Puppets, snowballs, snowmen, sticks and trees: what the phone is streamed (no tracks, no falling snow)."""
+    """Puppets, snowballs, snowmen, sticks, trees and the tracks and footprints in the snow: what the phone is
+    streamed (everything but the falling snow, which each side draws from its own clock)."""
     from engine.components import Stick
 
     draw_world(world, scene, alpha)
@@ -120,14 +121,33 @@ def draw_snowman_state(world: World, scene: RenderScene, alpha: float) -> None:
     draw_snowmen(world, scene, alpha, outlined)
     draw_trees(scene, world.try_resource(BentScenery))
     scene.ground.grid = False  # a field of snow, not a floor
-
-
-def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
-    """The whole game view: the state, the tracks in the snow, falling snow."""
-    draw_snowman_state(world, scene, alpha)
     field = world.try_resource(SnowField)
     if field is not None:
         taken = 1.0 - field.depth / field.initial_depth  # [x, z] → the marks' [z, x]
         scene.marks = GroundMarks(taken.T.astype(np.float32), -field.size / 2, -field.size / 2, field.cell)
-    draw_footprints(world, scene)
+    _draw_prints_in_place(world, scene)
+
+
+def _draw_prints_in_place(world: World, scene: RenderScene) -> None:
+    """Every footprint ever stamped, in its ring slot, a filled one at zero size.
+
+    The same prints as :func:`~games.snowman.footprints.draw_footprints` draws, but rows
+    that keep their place: when the oldest print fills, the phone's stream would
+    otherwise see every later row move up one and resend them all.
+    """
+    prints = world.try_resource(Footprints)
+    if prints is None or prints.count == 0:
+        return
+    used = np.nonzero(prints.frame >= 0)[0]
+    age = (world.frame - prints.frame[used]) * world.dt
+    strength = np.clip(1.0 - (age - prints.fade_start) / prints.fade_time, 0.0, 1.0)
+    size = (strength > 0.0).astype(np.float64)
+    start = len(scene.prints)
+    scene.add_prints(prints.xz[used], prints.heading[used], strength=strength)
+    scene.prints.data[start:, 4:6] *= size[:, None]
+
+
+def draw_snowman_game(world: World, scene: RenderScene, alpha: float) -> None:
+    """The whole game view: the state (tracks and footprints included), falling snow."""
+    draw_snowman_state(world, scene, alpha)
     draw_snowfall(scene, (world.frame + alpha) * world.dt)

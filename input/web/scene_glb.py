@@ -19,7 +19,7 @@ import numpy as np
 
 from engine.io.gltf_write import container_bytes
 from engine.render.scene import RenderScene
-from input.web.scene_stream import FRAME_VERSION, KINDS, SCALES, SceneState
+from input.web.scene_stream import FRAME_VERSION, KINDS, SCALES, MarksGrid, SceneState
 
 __all__ = ["scene_glb", "read_scene_glb", "FIELD_HALF_SIZE"]
 
@@ -59,13 +59,19 @@ def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
         rows[kind] = {"accessor": add(data.astype("<i2").tobytes(), 5122, int(data.size) or 1, "SCALAR")
                       if data.size else None, "rows": int(len(data)), "columns": len(SCALES[kind]),
                       "scales": list(SCALES[kind])}
+    marks = None
+    if state.marks is not None:
+        m = state.marks
+        nz, nx = m.cells.shape
+        marks = {"accessor": add(m.cells.tobytes(), 5121, int(m.cells.size), "SCALAR"), "nx": nx, "nz": nz,
+                 "x0": m.x0, "z0": m.z0, "cell": m.cell}
     blob = b"".join(chunks)
     cam = state.camera
     doc = {
         "asset": {"version": "2.0", "generator": "PuppetPhone scene stream"},
         "scene": 0,
         "scenes": [{"name": "field", "nodes": [0], "extras": {"puppetphone": {
-            "version": FRAME_VERSION, "step": state.step, "rows": rows, "ground": asdict(g), "sun": asdict(scene.sun),
+            "version": FRAME_VERSION, "step": state.step, "rows": rows, "marks": marks, "ground": asdict(g), "sun": asdict(scene.sun),
             "sky": list(scene.sky_color), "horizon": list(scene.horizon_color),
             "outline": list(scene.outline_color),
             "camera": {"position": list(cam.position), "rotation": list(cam.rotation), "fov_y": cam.fov_y}}}}],
@@ -101,7 +107,13 @@ def read_scene_glb(data: bytes) -> tuple[dict, SceneState]:  # type: ignore[type
         view = doc["bufferViews"][doc["accessors"][info["accessor"]]["bufferView"]]
         raw = np.frombuffer(blob, "<i2", view["byteLength"] // 2, view["byteOffset"])
         rows[kind] = raw.reshape(info["rows"], info["columns"]).astype(np.int16)
+    marks = None
+    if extras["marks"] is not None:
+        info = extras["marks"]
+        view = doc["bufferViews"][doc["accessors"][info["accessor"]]["bufferView"]]
+        cells = np.frombuffer(blob, np.uint8, view["byteLength"], view["byteOffset"]).reshape(info["nz"], info["nx"])
+        marks = MarksGrid(cells.copy(), info["x0"], info["z0"], info["cell"])
     cam = extras["camera"]
     state = SceneState(extras["step"], 0.0, CameraPose(tuple(cam["position"]), tuple(cam["rotation"]), cam["fov_y"]),
-                       rows)
+                       rows, marks)
     return extras, state

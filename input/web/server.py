@@ -27,7 +27,10 @@ sends its page the scene as a GLB once (:mod:`input.web.scene_glb`), then a fram
 delta-coded against what *that* page last got (:mod:`input.web.scene_stream`). A
 connection never queues: it holds only the newest state, and sends while fewer than
 :data:`FRAMES_IN_FLIGHT` frames wait for the page's ``{"ack": step}``, so a slow phone
-(or Wi-Fi) gets fewer frames, each the latest, rather than a growing backlog.
+(or Wi-Fi) gets fewer frames, each the latest, rather than a growing backlog. The page
+reads the socket in a worker of its own (``page/stream_worker.js``) and acknowledges a
+frame as soon as it is decoded there, so the acknowledgements pace the network and the
+phone, not the page's drawing.
 
 :attr:`WebSource.page_times` remembers, for the latest readings, the page's clock at
 the sensor event, keyed by the sample's receive time: the latency bench reads it.
@@ -62,7 +65,9 @@ DEFAULT_WEB_PORT = 8443
 _JS = "text/javascript; charset=utf-8"
 #: The page's files and their content types (served from the package, no build step).
 PAGE_FILES = {"/": ("index.html", "text/html; charset=utf-8"), "/index.html": ("index.html", "text/html; charset=utf-8"),
-              "/app.js": ("app.js", _JS), "/stream.js": ("stream.js", _JS), "/render.js": ("render.js", _JS),
+              "/app.js": ("app.js", _JS), "/stream.js": ("stream.js", _JS),
+              "/stream_worker.js": ("stream_worker.js", _JS), "/render_worker.js": ("render_worker.js", _JS),
+              "/render.js": ("render.js", _JS),
               "/placement.js": ("placement.js", _JS), "/style.css": ("style.css", "text/css; charset=utf-8")}
 #: Scene frames a connection may have sent and not yet had acknowledged.
 FRAMES_IN_FLIGHT = 2

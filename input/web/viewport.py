@@ -2,8 +2,8 @@
 
 :class:`PhoneViewport` hangs on ``App.on_step_end``. When at least one page is
 connected it draws the world once into a scratch :class:`RenderScene` (the game's own
-state drawing: puppets, props, snowmen, sticks, scenery; the falling snow and the
-tracks in the snow are left out, see :attr:`games.base.Game.draw_state`),
+state drawing: puppets, props, snowmen, sticks, scenery, the snowman's tracks and
+footprints; the falling snow is left out, see :attr:`games.base.Game.draw_state`),
 quantises it (:func:`input.web.scene_stream.quantise`) with the camera the phone is
 (the held controller's view, :func:`input.controller_view.controller_camera`, or the
 game's starting camera before the first reading) and hands it to the

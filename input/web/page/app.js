@@ -1,7 +1,7 @@
 // PuppetPhone web controller: the phone's browser becomes the MotionStick, and the viewport.
 // Streams one JSON reading per sensor event over a WebSocket (format: input/web/protocol.py) and draws
-// the scene the engine streams back (stream.js, render.js): the phone is the camera, the stick hangs
-// from it. Modes: WebXR immersive-ar (the field placed on the floor by a hit test, the camera image
+// the scene the engine streams back (stream_worker.js, render_worker.js, stream.js, render.js): the
+// phone is the camera, the stick hangs from it. Modes: WebXR immersive-ar (the field placed on the floor by a hit test, the camera image
 // behind it), else a "magic window" (device orientation turns the view over a plain sky).
 // Plain scripts, no build step; served by the engine over HTTPS (sensors need a secure context).
 "use strict";
@@ -11,15 +11,69 @@ const token = new URLSearchParams(location.search).get("t") || "";
 const clock = () => performance.timeOrigin + performance.now();
 
 const state = {
-  ws: null, seq: 0, touch: false, jump: false, cal: false, crouch: 0,
+  open: false, seq: 0, touch: false, jump: false, cal: false, crouch: 0,
   o: [0, 0, 0], acc: null, rot: null, kind: "orientation", q: null, p: null,
   sensor: "none", lastSent: 0, taken: false, rtt: null, xrNote: "", placement: null,
 };
-const stream = new SceneStream();
-let renderer = null;
-try { renderer = new PageRenderer($("view"), { xrCompatible: true }); } catch (err) { $("fps").textContent = "view: " + err.message; }
-// What the bench and the tests read: frames drawn, the step on screen, frames per second.
-window.ppView = { drawn: 0, step: -1, fps: 0, stream, drawLog: [] };
+// Threads: the stream worker (stream_worker.js) holds the WebSocket and decodes; the render worker
+// (render_worker.js) draws the magic window into the page's canvas, transferred to it. This thread
+// handles the sensors and the controls, and draws only in AR (the XR session is here) or where a
+// worker cannot draw: then the stream worker sends its frames here.
+const worker = new Worker("stream_worker.js");
+worker.onerror = (e) => { $("status").textContent = "stream: " + e.message; };
+const stream = new SceneStream(), counter = new FrameCounter();
+let renderer = null, drawsHere = false, painter = null;
+// What the bench and the tests read: frames drawn, the step on screen, frames per second, who draws;
+// report() gives the logs (per step: published, reached the stream worker, decoded, available to the
+// drawer; and when each step was first drawn), all in ms since the epoch.
+const reportWaiters = [];
+window.ppView = { drawn: 0, step: -1, fps: 0, resolution: 1, frames: 0, bytes: 0, where: "render worker",
+  report: () => (drawsHere || state.kind === "xr"
+    ? Promise.resolve({ log: stream.log, drawLog: counter.drawLog, frames: stream.frames, bytes: stream.bytes })
+    : new Promise((resolve) => { reportWaiters.push(resolve); painter.postMessage({ report: true }); })) };
+
+function canvasSize() {
+  const canvas = $("view"), px = Math.min(devicePixelRatio, 2);
+  return [Math.max(1, Math.round(canvas.clientWidth * px)), Math.max(1, Math.round(canvas.clientHeight * px))];
+}
+
+// Draw on this thread from now on (on a fresh canvas if the old one went to the render worker).
+function drawHere(reason) {
+  let canvas = $("view");
+  if (canvas.dataset.transferred) {
+    const fresh = document.createElement("canvas");
+    fresh.id = "view";
+    canvas.replaceWith(fresh);
+    canvas = fresh;
+  }
+  drawsHere = true; window.ppView.where = "main thread";
+  worker.postMessage({ drawer: null });
+  try { renderer = new PageRenderer(canvas, { xrCompatible: true }); } catch (err) { $("fps").textContent = "view: " + err.message; }
+  if (reason) $("status").textContent = "view: " + reason;
+}
+
+function onPainter(e) {
+  const m = e.data;
+  if (m.status) { Object.assign(window.ppView, m.status); showFps(m.status); }
+  else if (m.report) reportWaiters.splice(0).forEach((resolve) => resolve(m.report));
+  else if (m.cannotDraw !== undefined) drawHere(m.cannotDraw);
+}
+
+{
+  const canvas = $("view");
+  if (typeof canvas.transferControlToOffscreen === "function") {
+    const off = canvas.transferControlToOffscreen(), link = new MessageChannel();
+    canvas.dataset.transferred = "1";
+    painter = new Worker("render_worker.js");
+    painter.onmessage = onPainter;
+    painter.onerror = (e) => { $("status").textContent = "view: " + e.message; };
+    painter.postMessage({ canvas: off, size: canvasSize(), port: link.port2 }, [off, link.port2]);
+    worker.postMessage({ drawer: link.port1 }, [link.port1]);
+    window.addEventListener("resize", () => painter.postMessage({ size: canvasSize() }));
+  } else {
+    drawHere("");
+  }
+}
 
 function setState(text, cls) { const el = $("state"); el.textContent = text; el.className = "state " + cls; }
 function setMode() {
@@ -29,9 +83,8 @@ function setMode() {
 }
 
 function send(reading) {
-  const ws = state.ws;
-  if (!ws || ws.readyState !== WebSocket.OPEN) return;
-  ws.send(JSON.stringify(reading));
+  if (!state.open) return;
+  worker.postMessage({ send: JSON.stringify(reading) });
   state.lastSent = performance.now();
 }
 
@@ -51,39 +104,48 @@ function sendReading(t) {
   state.cal = false;
 }
 
-function connect() {
-  const url = (location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws?t=" + encodeURIComponent(token);
-  setState("connecting…", "wait");
-  const ws = new WebSocket(url);
-  ws.binaryType = "arraybuffer";
-  state.ws = ws;
-  ws.onopen = () => setState("connected", "on");
-  ws.onmessage = (ev) => {
-    if (ev.data instanceof ArrayBuffer) {
-      try { send({ ack: stream.receive(ev.data, performance.now()) }); } catch (err) { $("status").textContent = "view: " + err.message; }
-      return;
-    }
-    let msg;
-    try { msg = JSON.parse(ev.data); } catch (e) { return; }
-    if (msg.pong !== undefined) {
-      state.rtt = clock() - msg.pong;
-      $("latency").textContent = "latency: " + (state.rtt / 2).toFixed(1) + " ms (round trip " + state.rtt.toFixed(1) + ")";
-    } else if (msg.hello) {
-      setState("connected: " + msg.hello + " drives the puppet", "on");
-    } else if (msg.taken) {
-      state.taken = true;
-      $("start").hidden = true;
-      $("taken").hidden = false;
-      setState("every puppet is taken", "off");
-    }
-  };
-  ws.onclose = () => {
-    state.ws = null;
-    stream.state = null;  // a new connection starts from a new scene GLB
+// The WebSocket lives in the stream worker (stream_worker.js): readings and pings go out through it,
+// the engine's JSON comes back here, and scene frames come here only when this thread draws.
+worker.onmessage = (e) => {
+  const m = e.data;
+  if (m.frame) {
+    stream.accept(m.frame, performance.now());
+    worker.postMessage({ got: m.frame.step });
+  } else if (m.text !== undefined) {
+    onText(m.text);
+  } else if (m.open) {
+    state.open = true;
+    setState("connected", "on");
+  } else if (m.close) {
+    state.open = false;
+    stream.reset();  // a new connection starts from a new scene GLB
     if (state.taken) return;
     setState("disconnected: retrying", "off");
     setTimeout(connect, 1000);
-  };
+  } else if (m.error !== undefined) {
+    $("status").textContent = "view: " + m.error;
+  }
+};
+
+function onText(text) {
+  let msg;
+  try { msg = JSON.parse(text); } catch (e) { return; }
+  if (msg.pong !== undefined) {
+    state.rtt = clock() - msg.pong;
+    $("latency").textContent = "latency: " + (state.rtt / 2).toFixed(1) + " ms (round trip " + state.rtt.toFixed(1) + ")";
+  } else if (msg.hello) {
+    setState("connected: " + msg.hello + " drives the puppet", "on");
+  } else if (msg.taken) {
+    state.taken = true;
+    $("start").hidden = true;
+    $("taken").hidden = false;
+    setState("every puppet is taken", "off");
+  }
+}
+
+function connect() {
+  setState("connecting…", "wait");
+  worker.postMessage({ connect: (location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws?t=" + encodeURIComponent(token) });
 }
 
 function onOrientation(e) {
@@ -132,15 +194,12 @@ function confirmCalibration() {
   setTimeout(() => { $("calibrated").hidden = true; }, 1500);
 }
 
-// The magic window: draw the newest frames, interpolated, at the display's rate. A phone (or a
-// software renderer) that cannot keep 30 fps draws fewer pixels, stretched, rather than fewer frames.
-let fpsCount = 0, fpsStart = performance.now(), resolution = 1;
-const MIN_RESOLUTION = 0.5;
+// The magic window on this thread (where the worker cannot draw): the newest frames, interpolated.
 function drawFrame(now) {
   if (state.kind !== "xr") requestAnimationFrame(drawFrame);
-  if (!renderer || !stream.extras) return;
-  const canvas = $("view"), px = Math.min(devicePixelRatio, 2) * resolution;
-  const w = Math.round(canvas.clientWidth * px), h = Math.round(canvas.clientHeight * px);
+  if (!drawsHere || !renderer || !stream.extras) return;
+  const canvas = $("view"), [cw, ch] = canvasSize();
+  const w = Math.max(1, Math.round(cw * counter.resolution)), h = Math.max(1, Math.round(ch * counter.resolution));
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
   const frame = stream.sample(now);
   if (!frame) return;
@@ -149,21 +208,26 @@ function drawFrame(now) {
 }
 
 function countFrame(step, now) {
-  const view = window.ppView;
-  if (step !== view.step) { view.drawLog.push([step, performance.timeOrigin + now]); if (view.drawLog.length > 4000) view.drawLog.shift(); }
-  view.drawn += 1; view.step = step; fpsCount += 1;
-  if (now - fpsStart >= 1000) {
-    view.fps = (1000 * fpsCount) / (now - fpsStart); fpsCount = 0; fpsStart = now;
-    if (view.fps < 40 && resolution > MIN_RESOLUTION) resolution = Math.max(MIN_RESOLUTION, resolution * 0.85);
-    else if (view.fps > 55 && resolution < 1) resolution = Math.min(1, resolution / 0.85);
-    view.resolution = resolution;
-    $("fps").textContent = "view: " + view.fps.toFixed(0) + " fps, step " + step + (resolution < 1 ? ", " + Math.round(100 * resolution) + " % resolution" : "");
-  }
+  const renewed = counter.count(step, now), view = window.ppView;
+  Object.assign(view, { drawn: counter.drawn, step: counter.step, fps: counter.fps, resolution: counter.resolution,
+    frames: stream.frames, bytes: stream.bytes });
+  if (renewed) showFps(view);
+}
+
+let fpsShown = 0;
+function showFps(v) {
+  if (performance.now() - fpsShown < 1000) return;
+  fpsShown = performance.now();
+  $("fps").textContent = "view: " + v.fps.toFixed(0) + " fps, step " + v.step + (v.resolution < 1 ? ", " + Math.round(100 * v.resolution) + " % resolution" : "")
+    + " (" + window.ppView.where + ")";
 }
 
 async function startXR() {
   const session = await navigator.xr.requestSession("immersive-ar", { requiredFeatures: ["local"],
     optionalFeatures: ["hit-test", "dom-overlay"], domOverlay: { root: document.body } });
+  // The XR session draws on this thread: the worker forwards its frames here meanwhile.
+  if (!renderer) renderer = new PageRenderer(document.createElement("canvas"), { xrCompatible: true });
+  if (painter && !drawsHere) { painter.postMessage({ pause: true }); worker.postMessage({ drawer: null }); }
   const gl = renderer.gl;
   await gl.makeXRCompatible();
   session.updateRenderState({ baseLayer: new XRWebGLLayer(session, gl) });
@@ -200,6 +264,7 @@ async function startXR() {
   };
   session.addEventListener("end", () => {
     state.kind = "orientation"; state.sensor = "orientation"; state.placement = null; document.body.classList.remove("ar");
+    if (painter && !drawsHere) { const link = new MessageChannel(); painter.postMessage({ pause: false, port: link.port2 }, [link.port2]); worker.postMessage({ drawer: link.port1 }, [link.port1]); }
     setMode(); requestAnimationFrame(drawFrame);
   });
   session.requestAnimationFrame(frame);

@@ -60,12 +60,15 @@ const GROUND_FS = `#version 300 es
 precision highp float;
 in vec3 vP; uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
 uniform vec3 eye; uniform vec3 horizon; uniform float alpha;
+uniform sampler2D shadowMask; uniform vec4 shadowRect; uniform vec3 shadowTint;
 out vec4 frag;
 void main() {
   vec2 g = abs(fract(vP.xz / spacing + 0.5) - 0.5) / fwidth(vP.xz / spacing);
   float line = 1.0 - min(min(g.x, g.y), 1.0);
   float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
   vec3 c = mix(color, gridColor, line * gridStrength * (1.0 - fade));
+  vec2 muv = (vP.xz - shadowRect.xy) / shadowRect.zw;
+  if (all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) c *= mix(vec3(1.0), shadowTint, texture(shadowMask, muv).r);
   c = mix(c, horizon, fade * fade);
   frag = vec4(c, alpha);
 }`;
@@ -82,6 +85,98 @@ void main() {
   vec3 d = normalize(basis * vec3(ndc * tanHalf, -1.0));
   frag = vec4(mix(horizon, sky, pow(clamp(d.y, 0.0, 1.0), 0.45)), 1.0);
 }`;
+
+// Blob shadows: each round thing (capsule, sphere; a box as its footprint's circle) cast along the sun
+// onto the ground as a soft stadium, drawn into a small mask over the rectangle the casters cover (MAX
+// blending: overlapping limbs do not darken twice). The ground reads the mask: its blue-tinted shade.
+const BLOB_VS = `#version 300 es
+layout(location=0) in vec2 corner;
+layout(location=1) in vec3 a; layout(location=2) in vec3 b; layout(location=3) in float r;
+uniform vec3 sunDir; uniform float height; uniform vec4 rect;
+out vec2 vXZ; flat out vec2 vA; flat out vec2 vB; flat out float vR; flat out float vSoft; flat out float vStrength;
+vec2 onGround(vec3 p) { return p.xz - sunDir.xz * (max(p.y - height, 0.0) / sunDir.y); }
+void main() {
+  vec2 pa = onGround(a), pb = onGround(b);
+  float lift = max(min(a.y, b.y) - r - height, 0.0);
+  vSoft = 0.35 * r + 0.25 * lift; vR = r; vA = pa; vB = pb;
+  vStrength = clamp(1.0 - lift / 3.0, 0.25, 1.0);
+  vec2 ax = pb - pa; float len = length(ax);
+  vec2 u = len > 1e-5 ? ax / len : vec2(1.0, 0.0), v = vec2(-u.y, u.x);
+  float e = r + vSoft;
+  vXZ = mix(pa, pb, 0.5 + 0.5 * corner.x) + u * corner.x * e + v * corner.y * e;
+  gl_Position = vec4((vXZ - rect.xy) / rect.zw * 2.0 - 1.0, 0.0, 1.0);
+}`;
+
+const BLOB_FS = `#version 300 es
+precision highp float;
+in vec2 vXZ; flat in vec2 vA; flat in vec2 vB; flat in float vR; flat in float vSoft; flat in float vStrength;
+out vec4 frag;
+void main() {
+  vec2 ab = vB - vA; float t = clamp(dot(vXZ - vA, ab) / max(dot(ab, ab), 1e-8), 0.0, 1.0);
+  float d = length(vXZ - vA - ab * t);
+  frag = vec4(vStrength * (1.0 - smoothstep(vR - vSoft, vR + vSoft, d)), 0.0, 0.0, 1.0);
+}`;
+
+// Decals over the ground (multiplied in: blend dst·src·2, so 0.5 keeps the colour), as on the desktop:
+// the tracks in the snow and the footprints (engine/render/shaders_ground.py's MARKS_FS and PRINT_FS).
+const DECAL_VS = `#version 300 es
+layout(location=0) in vec2 corner;
+uniform mat4 viewProj; uniform vec4 rect; uniform float height;
+out vec3 vP; out vec2 vUV;
+void main() { vUV = corner; vP = vec3(rect.x + corner.x * rect.z, height, rect.y + corner.y * rect.w); gl_Position = viewProj * vec4(vP, 1.0); }`;
+
+const MARKS_FS = `#version 300 es
+precision highp float;
+in vec3 vP; in vec2 vUV;
+uniform sampler2D marks; uniform vec2 texel; uniform vec4 uvRect; uniform vec3 sunDir; uniform vec3 eye;
+out vec4 frag;
+// The grid comes softened (stream.js softenMarks): one read per pixel, four more for the slope.
+void main() {
+  vec2 uv = uvRect.xy + vUV * uvRect.zw;
+  float m = texture(marks, uv).r;
+  if (m < 0.01) discard;
+  vec2 dx = vec2(texel.x, 0.0), dz = vec2(0.0, texel.y);
+  vec3 n = normalize(vec3((texture(marks, uv + dx).r - texture(marks, uv - dx).r) * 1.6, 1.0,
+    (texture(marks, uv + dz).r - texture(marks, uv - dz).r) * 1.6));
+  float light = clamp(max(dot(n, sunDir), 0.0) / max(sunDir.y, 0.2), 0.72, 1.12);
+  vec3 k = mix(vec3(1.0), vec3(0.76, 0.82, 0.92), smoothstep(0.0, 1.0, m)) * mix(1.0, light, smoothstep(0.0, 0.4, m));
+  float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
+  frag = vec4(0.5 * mix(k, vec3(1.0), fade * fade), 1.0);
+}`;
+
+const PRINT_VS = `#version 300 es
+layout(location=0) in vec2 corner;
+layout(location=1) in vec2 xz; layout(location=2) in vec2 dir; layout(location=3) in vec2 half_; layout(location=4) in float strength;
+uniform mat4 viewProj; uniform float height;
+out vec3 vP; out vec2 vLocal; out float vStrength; out vec2 vDir;
+void main() {
+  vec2 side = vec2(-dir.y, dir.x);
+  vec2 p = xz + dir * (corner.x * half_.x) + side * (corner.y * half_.y);
+  vP = vec3(p.x, height, p.y); vLocal = corner; vStrength = strength; vDir = dir;
+  gl_Position = viewProj * vec4(vP, 1.0);
+}`;
+
+const PRINT_FS = `#version 300 es
+precision highp float;
+in vec3 vP; in vec2 vLocal; in float vStrength; in vec2 vDir;
+uniform vec3 sunDir; uniform vec3 eye;
+out vec4 frag;
+void main() {
+  vec2 ball = (vLocal - vec2(0.38, 0.0)) / vec2(0.58, 0.95);
+  vec2 heel = (vLocal - vec2(-0.55, 0.0)) / vec2(0.42, 0.72);
+  float f = max(1.0 - dot(ball, ball), 1.0 - dot(heel, heel));
+  if (f <= 0.0) discard;
+  float m = smoothstep(0.0, 0.45, f);
+  vec2 g = dot(ball, ball) < dot(heel, heel) ? -ball / vec2(0.58, 0.95) : -heel / vec2(0.42, 0.72);
+  vec2 gw = vDir * g.x + vec2(-vDir.y, vDir.x) * g.y;
+  float wall = m * (1.0 - m) * 4.0;
+  float k = 1.0 - 0.12 * m + 0.25 * wall * dot(normalize(gw + 1e-5), normalize(sunDir.xz + 1e-5));
+  float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
+  k = mix(1.0, k, vStrength * (1.0 - fade * fade));
+  frag = vec4(vec3(0.5 * k) * vec3(0.97, 0.985, 1.0), 1.0);
+}`;
+
+const SHADOW_SIZE = 256;
 
 function compile(gl, vs, fs) {
   const prog = gl.createProgram();
@@ -153,6 +248,16 @@ function mul4(a, b) {
   return m;
 }
 
+// What a full shadow leaves of the snow's colour, per channel: the sun's share of its light goes, the blue
+// sky's stays (as the desktop's ground shadow; colours squared and rooted for gamma 2).
+function shadowTint(look) {
+  const s = look.sun, d = s.direction, up = Math.max(d[1] / Math.hypot(d[0], d[1], d[2]), 0);
+  return [0, 1, 2].map((i) => {
+    const sun = s.color[i] * s.intensity * up, sky = look.sky[i] * look.sky[i] * s.ambient * 1.6;
+    return Math.sqrt(1 - 0.9 * sun / (sun + sky));
+  });
+}
+
 // Every round thing as one capsule row a[3] b[3] r colour[3] outline: capsules, spheres, lines, points.
 function roundRows(rows) {
   const caps = rows.capsules, sph = rows.spheres, lines = rows.lines, pts = rows.points;
@@ -196,7 +301,120 @@ class PageRenderer {
     this.groundBuf = this.buffer(new Float32Array(8));
     gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     this.skyVao = gl.createVertexArray();
+    this.blob = compile(gl, BLOB_VS, BLOB_FS);
+    this.marksProg = compile(gl, DECAL_VS, MARKS_FS);
+    this.printProg = compile(gl, PRINT_VS, PRINT_FS);
+    const square = new Float32Array([-1, -1, 1, -1, -1, 1, 1, 1]);
+    this.blobVao = gl.createVertexArray(); gl.bindVertexArray(this.blobVao);
+    this.buffer(square); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    this.blobInst = this.instances([3, 3, 1, 3, 1]);
+    this.printVao = gl.createVertexArray(); gl.bindVertexArray(this.printVao);
+    this.buffer(square); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    this.printInst = this.instances([2, 2, 2, 1]);
+    this.decalVao = gl.createVertexArray(); gl.bindVertexArray(this.decalVao);
+    this.buffer(new Float32Array([0, 0, 1, 0, 0, 1, 1, 1])); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     gl.bindVertexArray(null);
+    this.shadowTex = this.texture(SHADOW_SIZE, SHADOW_SIZE, null);
+    this.shadowFbo = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.shadowTex, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.shadowRect = null;
+    this.marksTex = null; this.marksVersion = -1; this.marksRect = null;
+  }
+
+  // A one-channel texture, linearly filtered, clamped at its edges.
+  texture(w, h, data) {
+    const gl = this.gl, tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.R8, w, h, 0, gl.RED, gl.UNSIGNED_BYTE, data);
+    for (const [k, v] of [[gl.TEXTURE_MIN_FILTER, gl.LINEAR], [gl.TEXTURE_MAG_FILTER, gl.LINEAR],
+      [gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE], [gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE]]) gl.texParameteri(gl.TEXTURE_2D, k, v);
+    return tex;
+  }
+
+  // The blob shadows of ``round`` rows (capsule layout) into the mask; its rectangle on the ground, or null.
+  drawShadows(round, look) {
+    const gl = this.gl, n = round.length / 11, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]);
+    const sx = d[0] / len, sy = Math.max(d[1] / len, 0.2), sz = d[2] / len, g = look.ground.height;
+    let x0 = Infinity, z0 = Infinity, x1 = -Infinity, z1 = -Infinity;
+    for (let i = 0; i < n; i++) {
+      const o = i * 11, r = round[o + 6];
+      for (const e of [o, o + 3]) {
+        const lift = Math.max(round[e + 1] - g, 0) / sy, x = round[e] - sx * lift, z = round[e + 2] - sz * lift;
+        const m = 1.35 * r + 0.25 * Math.max(round[e + 1] - g, 0) + 0.05;
+        x0 = Math.min(x0, x - m); x1 = Math.max(x1, x + m); z0 = Math.min(z0, z - m); z1 = Math.max(z1, z + m);
+      }
+    }
+    if (!(x1 > x0)) return null;
+    const size = Math.min(Math.max(x1 - x0, z1 - z0), 48), cx = Math.min(Math.max((x0 + x1) / 2, -60), 60), cz = Math.min(Math.max((z0 + z1) / 2, -60), 60);
+    const rect = [cx - size / 2, cz - size / 2, size, size];
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
+    gl.viewport(0, 0, SHADOW_SIZE, SHADOW_SIZE);
+    gl.disable(gl.DEPTH_TEST);
+    gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT);
+    gl.enable(gl.BLEND); gl.blendEquation(gl.MAX);
+    gl.useProgram(this.blob.prog);
+    const u = this.blob.u;
+    gl.uniform3f(u.sunDir, sx, sy, sz); gl.uniform1f(u.height, g); gl.uniform4fv(u.rect, rect);
+    gl.bindVertexArray(this.blobVao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.blobInst); gl.bufferData(gl.ARRAY_BUFFER, round, gl.DYNAMIC_DRAW);
+    gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, n);
+    gl.blendEquation(gl.FUNC_ADD); gl.disable(gl.BLEND);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    return rect;
+  }
+
+  // The tracks' texture, uploaded when the stream brought a new grid, and the rectangle of marked cells.
+  updateMarks(marks, version) {
+    if (version === this.marksVersion) return;
+    this.marksVersion = version;
+    const gl = this.gl;
+    if (this.marksTex) gl.deleteTexture(this.marksTex);
+    this.marksTex = null; this.marksRect = null;
+    if (!marks) return;
+    let r0 = marks.nz, r1 = -1, c0 = marks.nx, c1 = -1;
+    for (let r = 0; r < marks.nz; r++) {
+      const row = marks.cells.subarray(r * marks.nx, (r + 1) * marks.nx);
+      for (let c = 0; c < marks.nx; c++) if (row[c] > 5) { if (r < r0) r0 = r; if (r > r1) r1 = r; if (c < c0) c0 = c; if (c > c1) c1 = c; }
+    }
+    if (r1 < 0) return;
+    this.marksTex = this.texture(marks.nx, marks.nz, marks.cells);
+    const cell = marks.cell;
+    this.marksRect = { marks, rect: [marks.x0 + (c0 - 1) * cell, marks.z0 + (r0 - 1) * cell, (c1 - c0 + 3) * cell, (r1 - r0 + 3) * cell] };
+  }
+
+  // Tracks and footprints over the ground just drawn (objects in front keep their pixels: depth test).
+  drawDecals(frame, look, viewProj, eye) {
+    const gl = this.gl, g = look.ground.height, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]);
+    const prints = frame.rows.prints || new Float32Array(0);
+    if (!this.marksRect && !prints.length) return;
+    gl.enable(gl.BLEND); gl.blendFunc(gl.DST_COLOR, gl.SRC_COLOR);
+    gl.depthFunc(gl.LEQUAL); gl.depthMask(false);
+    gl.enable(gl.POLYGON_OFFSET_FILL); gl.polygonOffset(-2, -8);
+    if (this.marksRect) {
+      const { marks, rect } = this.marksRect, p = this.marksProg, u = p.u, w = marks.cell * marks.nx, h = marks.cell * marks.nz;
+      gl.useProgram(p.prog);
+      gl.activeTexture(gl.TEXTURE1); gl.bindTexture(gl.TEXTURE_2D, this.marksTex); gl.uniform1i(u.marks, 1);
+      gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform4fv(u.rect, rect); gl.uniform1f(u.height, g);
+      gl.uniform2f(u.texel, 1 / marks.nx, 1 / marks.nz);
+      gl.uniform4f(u.uvRect, (rect[0] - marks.x0) / w, (rect[1] - marks.z0) / h, rect[2] / w, rect[3] / h);
+      gl.uniform3f(u.sunDir, d[0] / len, d[1] / len, d[2] / len); gl.uniform3fv(u.eye, eye);
+      gl.bindVertexArray(this.decalVao); gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
+      gl.activeTexture(gl.TEXTURE0);
+    }
+    if (prints.length) {
+      const p = this.printProg, u = p.u;
+      gl.useProgram(p.prog);
+      gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g);
+      gl.uniform3f(u.sunDir, d[0] / len, d[1] / len, d[2] / len); gl.uniform3fv(u.eye, eye);
+      gl.bindVertexArray(this.printVao);
+      gl.bindBuffer(gl.ARRAY_BUFFER, this.printInst); gl.bufferData(gl.ARRAY_BUFFER, prints, gl.DYNAMIC_DRAW);
+      gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, prints.length / 7);
+    }
+    gl.disable(gl.POLYGON_OFFSET_FILL); gl.disable(gl.BLEND);
+    gl.depthMask(true); gl.depthFunc(gl.LESS);
   }
 
   buffer(data) {
@@ -232,6 +450,20 @@ class PageRenderer {
   draw(frame, look, xr = null) {
     const gl = this.gl;
     let proj, view, eye, basis;
+    const round = roundRows(frame.rows);
+    if (!xr) {
+      // Boxes cast as the circle round their footprint.
+      const boxes = frame.rows.boxes, nb = boxes.length / 14, casters = new Float32Array(round.length + 11 * nb);
+      casters.set(round);
+      for (let i = 0, at = round.length; i < nb; i++, at += 11) {
+        const o = i * 14;
+        casters.set(boxes.subarray(o, o + 3), at); casters.set(boxes.subarray(o, o + 3), at + 3);
+        casters[at + 1] = casters[at + 4] = boxes[o + 1] - boxes[o + 4] + Math.hypot(boxes[o + 3], boxes[o + 5]);
+        casters[at + 6] = Math.hypot(boxes[o + 3], boxes[o + 5]);
+      }
+      this.shadowRect = this.drawShadows(casters, look);
+      this.updateMarks(frame.marks, frame.marksVersion);
+    }
     if (xr) {
       ({ proj, view, eye } = xr);
       gl.viewport(...xr.viewport);
@@ -245,7 +477,6 @@ class PageRenderer {
     const viewProj = mul4(proj, view);
     gl.enable(gl.DEPTH_TEST); gl.disable(gl.CULL_FACE);
     if (!xr || xr.first) { gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT); }
-    const round = roundRows(frame.rows);
     if (round.length) {
       gl.useProgram(this.capsule.prog);
       gl.uniformMatrix4fv(this.capsule.u.viewProj, false, viewProj);
@@ -281,8 +512,12 @@ class PageRenderer {
       gl.uniform3fv(u.color, g.color); gl.uniform3fv(u.gridColor, g.grid_color);
       gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0); gl.uniform1f(u.spacing, g.grid_spacing);
       gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform1f(u.alpha, 1);
+      gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, this.shadowTex); gl.uniform1i(u.shadowMask, 0);
+      gl.uniform4fv(u.shadowRect, this.shadowRect || [0, 0, 0, 0]);
+      gl.uniform3fv(u.shadowTint, shadowTint(look));
       gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
     }
+    this.drawDecals(frame, look, viewProj, eye);
     const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
     gl.useProgram(this.sky.prog);
     gl.uniformMatrix3fv(this.sky.u.basis, false, new Float32Array([0, 1, 2].flatMap((c) => [basis[0][c], basis[1][c], basis[2][c]])));
@@ -294,4 +529,25 @@ class PageRenderer {
   }
 }
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, perspective, viewMatrix, quatToMat3, mul4, roundRows };
+// Frames drawn, the step on screen and when each step was first drawn, frames per second, and the
+// resolution scale: a phone (or a software renderer) that cannot keep 40 fps draws fewer pixels,
+// stretched, rather than fewer frames. Used by whichever thread draws (the stream worker, or the main
+// thread in AR and where a worker cannot draw).
+class FrameCounter {
+  constructor() { this.drawn = 0; this.step = -1; this.fps = 0; this.resolution = 1; this.drawLog = []; this.ticks = 0; this.since = null; }
+
+  // One frame drawn at ``now`` (ms, performance.now()) showing ``step``; true when ``fps`` was renewed.
+  count(step, now) {
+    if (step !== this.step) { this.drawLog.push([step, performance.timeOrigin + now]); if (this.drawLog.length > 4000) this.drawLog.shift(); }
+    this.drawn += 1; this.step = step; this.ticks += 1;
+    if (this.since === null) this.since = now;
+    if (now - this.since < 1000) return false;
+    this.fps = (1000 * this.ticks) / (now - this.since); this.ticks = 0; this.since = now;
+    if (this.fps < 40 && this.resolution > MIN_RESOLUTION) this.resolution = Math.max(MIN_RESOLUTION, this.resolution * 0.85);
+    else if (this.fps > 55 && this.resolution < 1) this.resolution = Math.min(1, this.resolution / 0.85);
+    return true;
+  }
+}
+const MIN_RESOLUTION = 0.5;
+
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows };

@@ -70,3 +70,28 @@ def test_trees_are_a_trunk_and_three_overlapping_cone_tiers_each():
     # Narrower going up, each tier's skirt below the apex of the one beneath (whorls, not a stack).
     assert np.all(np.diff(radius, axis=1) < 0) and np.all(base_y[:, 1:] < apex_y[:, :-1])
     assert np.all(base_y[:, 0] < trunks[:, 4])  # the lowest skirt hides the top of the trunk
+
+
+def test_the_streamed_drawing_keeps_each_footprint_in_its_slot_and_a_filled_one_at_no_size():
+    """The phone's stream sends rows that changed; a print that fills must not move every later row
+    (``draw_footprints``' visible list would). The desktop sees the same prints: a filled one has no area.
+    (Dropping the filled rows, as ``visible`` does, fails the slot check.)"""
+    from games.snowman.draw import draw_snowman_state
+    from games.snowman.footprints import Footprints, draw_footprints
+
+    world = World()
+    prints = Footprints()
+    world.insert_resource(prints)
+    for k in range(5):
+        prints.stamp(np.array([0.3 * k, 0.0]), 0.1 * k, frame=k * 1500)  # 25 s apart: the oldest fill first
+    world.frame = 4 * 1500 + 60
+    now = RenderScene()
+    draw_snowman_state(world, now, 1.0)
+    shown = RenderScene()
+    draw_footprints(world, shown)
+    rows = now.prints.data
+    assert len(rows) == 5 and np.allclose(rows[:, 0], [0.0, 0.3, 0.6, 0.9, 1.2]), "a print left its slot"
+    sized = rows[:, 4] > 0
+    assert sized.sum() == len(shown.prints) < 5, "the filled prints should be there at no size"
+    assert np.allclose(rows[sized], shown.prints.data)
+    assert np.all(rows[~sized, 4:6] == 0.0)

@@ -86,7 +86,7 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
             assert play.returncode == 0, err
             time.sleep(0.3)
             last = bare_shot(browser, tmp_path / "last.png")
-            stats = browser.evaluate("({frames: ppView.stream.frames, bytes: ppView.stream.bytes, step: ppView.step})")
+            stats = browser.evaluate("({frames: ppView.frames, bytes: ppView.bytes, step: ppView.step, where: ppView.where})")
     finally:
         if play.poll() is None:
             play.kill()

@@ -15,14 +15,24 @@ import numpy as np
 import pytest
 
 import input.web
-from engine.render.scene import RenderScene
+from engine.render.scene import GroundMarks, RenderScene
 from input.web.scene_glb import read_scene_glb, scene_glb
-from input.web.scene_stream import (KINDS, CameraPose, FrameError, SceneState, decode_frame, encode_frame,
-                                    quantise)
+from input.web.scene_stream import KINDS, CameraPose, FrameError, SceneState, decode_frame, encode_frame, quantise
 
 CAM = CameraPose((0.0, 1.5, 4.0), (1.0, 0.0, 0.0, 0.0), 60.0)
 PAGE = Path(input.web.__file__).parent / "page"
 needs_node = pytest.mark.skipif(shutil.which("node") is None, reason="no node executable: apt-get install nodejs")
+
+
+def tracked(scene: RenderScene, rolled: list[tuple[int, int, int, int]]) -> RenderScene:
+    """``scene`` with a 240 × 240 snow track grid (10 cm cells) cleared over each ``(row0, col0, rows, cols)``,
+    and two footprints."""
+    amount = np.zeros((240, 240), dtype=np.float32)
+    for r0, c0, h, w in rolled:
+        amount[r0:r0 + h, c0:c0 + w] = np.linspace(0.2, 1.0, w)
+    scene.marks = GroundMarks(amount, -12.0, -12.0, 0.1)
+    scene.add_prints(np.array([[0.5, 1.0], [0.8, 1.3]]), np.array([0.0, 1.2]), strength=np.array([1.0, 0.4]))
+    return scene
 
 
 def scene_with(n_capsules: int, shift: float = 0.0, moved: int | None = None) -> RenderScene:
@@ -42,7 +52,33 @@ def scene_with(n_capsules: int, shift: float = 0.0, moved: int | None = None) ->
 
 
 def same(x: SceneState, y: SceneState) -> bool:
-    return all(np.array_equal(x.rows[k], y.rows[k]) for k in KINDS)
+    rows = all(np.array_equal(x.rows[k], y.rows[k]) for k in KINDS)
+    if x.marks is None or y.marks is None:
+        return rows and x.marks is y.marks
+    return rows and np.array_equal(x.marks.cells, y.marks.cells) and x.marks.same_grid(y.marks)
+
+
+def test_the_tracks_go_once_whole_then_as_the_cells_a_ball_cleared():
+    """A rolled strip costs its rectangle; two strips far apart cost a list of cells, not the rectangle
+    between them; an unchanged grid costs one byte. (Sending the whole grid each time fails the sizes;
+    a decoder that drops the base grid fails ``same``.)"""
+    base = quantise(tracked(scene_with(3), [(100, 100, 4, 6)]), 1, 0.0, CAM)
+    plain = encode_frame(base, quantise(scene_with(3), 2, 0.0, CAM))  # the tracks gone: one byte
+    still = encode_frame(base, quantise(tracked(scene_with(3), [(100, 100, 4, 6)]), 2, 0.0, CAM))
+    assert len(still) == len(plain)
+    rolled = quantise(tracked(scene_with(3), [(100, 100, 4, 6), (104, 103, 3, 5)]), 3, 0.0, CAM)
+    frame = encode_frame(base, rolled)
+    assert same(decode_frame(base, frame), rolled)
+    assert 3 * 5 <= len(frame) - len(still) <= 3 * 5 + 8 + 14 + 2
+    apart = quantise(tracked(scene_with(3), [(100, 100, 4, 6), (5, 5, 2, 2), (230, 230, 2, 2)]), 4, 0.0, CAM)
+    frame = encode_frame(base, apart)
+    assert same(decode_frame(base, frame), apart)
+    assert len(frame) - len(still) <= 8 * 5 + 4 + 16, "two small strips far apart sent as the rectangle between them"
+    whole = encode_frame(SceneState.empty(), apart)
+    assert same(decode_frame(SceneState.empty(), whole), apart) and len(whole) > 240 * 240 / 5
+    glb_state = read_scene_glb(scene_glb(apart, scene_with(3)))[1]
+    assert same(glb_state, apart)
+    assert same(decode_frame(glb_state, encode_frame(glb_state, rolled)), rolled)
 
 
 def test_a_frame_takes_the_phone_exactly_to_the_new_state_and_sends_only_what_moved():
@@ -102,10 +138,10 @@ def test_the_glb_is_a_gltf_with_a_ground_mesh_and_the_rows_the_first_frame_build
 
 @needs_node
 def test_the_pages_reader_decodes_the_engines_frames_to_the_same_rows(tmp_path):
-    scene = scene_with(15)
+    scene = tracked(scene_with(15), [(10, 10, 3, 3)])
     first = quantise(scene, 1, 0.0, CAM)
-    states = [quantise(scene_with(15, 0.02 * i, 8), 1 + i, 0.0, CAM) for i in range(1, 4)]
-    states.append(quantise(scene_with(3, 2.0, 3), 9, 0.0, CAM))  # int16 values, fewer rows
+    states = [quantise(tracked(scene_with(15, 0.02 * i, 8), [(10, 10, 3, 3 + i)]), 1 + i, 0.0, CAM) for i in range(1, 4)]
+    states.append(quantise(tracked(scene_with(3, 2.0, 3), [(10, 10, 3, 6), (200, 3, 1, 1)]), 9, 0.0, CAM))  # int16, fewer rows
     blobs = [scene_glb(first, scene)]
     prev = first
     for s in states:
@@ -119,7 +155,9 @@ const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/
 const glb = readSceneGlb(buf(0)); let state = glb.state;
 for (let i = 1; i < {len(blobs)}; i++) state = decodeFrame(state, glb.scales, buf(i));
 const out = {{}}; for (const k of KINDS) out[k] = Array.from(state.rows[k]);
-console.log(JSON.stringify({{ step: state.step, rows: out }}));
+const m = state.marks, on = [];
+m.cells.forEach((v, i) => {{ if (v) on.push([i, v]); }});
+console.log(JSON.stringify({{ step: state.step, rows: out, marks: [m.nx, m.nz, m.x0, m.z0, m.cell, on] }}));
 """
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stderr
@@ -127,6 +165,10 @@ console.log(JSON.stringify({{ step: state.step, rows: out }}));
     assert page["step"] == 9
     for kind in KINDS:
         assert page["rows"][kind] == states[-1].rows[kind].reshape(-1).tolist(), kind
+    want = states[-1].marks
+    flat = want.cells.reshape(-1)
+    assert page["marks"][:5] == [240, 240, want.x0, want.z0, want.cell]
+    assert page["marks"][5] == [[int(i), int(flat[i])] for i in np.flatnonzero(flat)]
 
 
 @needs_node
@@ -137,10 +179,10 @@ def test_the_page_blends_between_frames_and_holds_the_last_one_when_the_next_is_
     (tmp_path / "0.bin").write_bytes(scene_glb(first, scene))
     (tmp_path / "1.bin").write_bytes(encode_frame(first, moved))
     script = f"""
-const fs = require("fs"); const {{ SceneStream }} = require({json.dumps(str(PAGE / "stream.js"))});
+const fs = require("fs"); const {{ SceneStream, StreamDecoder }} = require({json.dumps(str(PAGE / "stream.js"))});
 globalThis.performance = {{ timeOrigin: 0 }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const s = new SceneStream(); s.receive(buf(0), 1000); s.receive(buf(1), 1020);
+const s = new SceneStream(), d = new StreamDecoder(); s.receive(d, buf(0), 1000); s.receive(d, buf(1), 1020);
 const x = (t) => s.sample(t).rows.capsules[0];
 console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
 """
@@ -151,3 +193,70 @@ console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
     assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
     assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
     assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), "a late frame must hold, not run on"
+
+
+@needs_node
+def test_the_page_softens_the_tracks_as_the_desktop_does_before_drawing_them(tmp_path):
+    """The page blurs the grid once per change (so its shader reads one texel a pixel); the result is the
+    desktop's ``soften_marks`` to within rounding. (A page that skipped the blur differs by up to 128.)"""
+    from engine.render.environment import soften_marks
+
+    cells = np.random.default_rng(5).integers(0, 256, (7, 11)).astype(np.uint8)
+    cells[2:4] = 0
+    script = f"""
+const {{ softenMarks }} = require({json.dumps(str(PAGE / "stream.js"))});
+const m = softenMarks({{ nx: 11, nz: 7, cells: Uint8Array.from({json.dumps(cells.reshape(-1).tolist())}) }});
+console.log(JSON.stringify(Array.from(m.cells)));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    page = np.array(json.loads(res.stdout)).reshape(7, 11)
+    desktop = soften_marks(cells.astype(np.float32) / 255.0).astype(int)
+    assert np.abs(page - desktop).max() <= 1
+
+
+@needs_node
+def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
+    """``stream_worker.js`` under node with a fake WebSocket and drawer port: every frame is acknowledged to the
+    engine as soon as it is decoded; the drawer gets at most two frames it has not taken, then, once it
+    takes one, the newest frame (not the next in a queue), and the tracks only when they changed.
+    (A worker that posts every frame fails the count; one that keeps a queue fails the newest step.)"""
+    scene = tracked(scene_with(4), [(10, 10, 3, 3)])
+    states = [quantise(scene, 1, 0.0, CAM)]
+    for i in range(2, 8):
+        strips = [(10, 10, 3, 3)] + ([(50, 50, 2, 2)] if i >= 6 else [])
+        states.append(quantise(tracked(scene_with(4, 0.01 * i, 2), strips), i, 0.0, CAM))
+    blobs = [scene_glb(states[0], scene)] + [encode_frame(a, b) for a, b in zip(states, states[1:], strict=False)]
+    for i, blob in enumerate(blobs):
+        (tmp_path / f"{i}.bin").write_bytes(blob)
+    script = f"""
+const fs = require("fs"), page = {json.dumps(str(PAGE))};
+globalThis.importScripts = (...names) => {{ for (const n of names) Object.assign(globalThis, require(page + "/" + n)); }};
+const toMain = [], sent = [], drawn = [];
+globalThis.postMessage = (m) => toMain.push(m);
+globalThis.onmessage = null;
+class FakeSocket {{ constructor(url) {{ this.url = url; this.readyState = 1; FakeSocket.last = this; }} send(x) {{ sent.push(JSON.parse(x)); }} }}
+FakeSocket.OPEN = 1;
+globalThis.WebSocket = FakeSocket;
+require(page + "/stream_worker.js");
+const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
+const port = {{ postMessage: (m) => drawn.push({{ step: m.frame.step, extras: !!m.frame.extras, marks: m.frame.marks === undefined ? "same" : "grid" }}) }};
+onmessage({{ data: {{ connect: "wss://x/ws" }} }});
+onmessage({{ data: {{ drawer: port }} }});
+for (let i = 0; i < {len(blobs)}; i++) FakeSocket.last.onmessage({{ data: buf(i) }});
+const before = drawn.length;
+port.onmessage({{ data: {{ got: 1 }} }});
+const after = drawn.length;
+port.onmessage({{ data: {{ got: 2 }} }});
+console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length }}));
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout)
+    assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
+    assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
+    assert out["after"] == 3 and out["end"] == 3
+    first, second, newest = out["drawn"]
+    assert first == {"step": 1, "extras": True, "marks": "grid"}
+    assert second == {"step": 2, "extras": False, "marks": "same"}
+    assert newest == {"step": 7, "extras": False, "marks": "grid"}, "after a take: the newest frame, tracks changed"
