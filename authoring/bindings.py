@@ -19,10 +19,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from engine.camera import OrbitCamera
 from authoring.operations import Key, Move, Operation, Orbit, Press, Release, Resize, Zoom
+from engine.camera import OrbitCamera
 
-__all__ = ["Bindings", "orbit_camera", "ORBIT_RADIANS_PER_PIXEL", "ZOOM_STEP", "ACT", "ORBIT_BUTTON"]
+__all__ = ["ACT", "ORBIT_BUTTON", "ORBIT_RADIANS_PER_PIXEL", "ZOOM_STEP", "Bindings", "orbit_camera"]
 
 #: Radians the camera turns per pixel of right-drag, in yaw and pitch.
 ORBIT_RADIANS_PER_PIXEL = 0.005

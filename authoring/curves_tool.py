@@ -25,7 +25,7 @@ from engine.render.scene import RenderScene
 from input.hub import InputHub
 from input.sample import InputFrame
 
-__all__ = ["CurvesTool", "TOOL", "curves_digest", "CURVES_GAME", "SCRIPTS", "open_curves", "reopen_curves"]
+__all__ = ["CURVES_GAME", "SCRIPTS", "TOOL", "CurvesTool", "curves_digest", "open_curves", "reopen_curves"]
 
 #: The name a curves session's recording gives as its game.
 CURVES_GAME = "author-curves"

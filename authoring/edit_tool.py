@@ -25,7 +25,7 @@ from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.sample import InputFrame
 
-__all__ = ["EditTool", "TOOL", "edit_digest", "EDIT_GAME", "open_edit", "reopen_edit"]
+__all__ = ["EDIT_GAME", "TOOL", "EditTool", "edit_digest", "open_edit", "reopen_edit"]
 
 #: The name an edit session's recording gives as its game.
 EDIT_GAME = "author-edit"

@@ -1,5 +1,4 @@
-"""The ``author flow [snowman|tasbada|FILE]`` tool: bend a scene's flow with sketched strokes (thesis ch. 3),
-as a session's simulation.
+"""The ``author flow [SCENE|FILE]`` tool: bend a scene's flow with sketched strokes (thesis ch. 3), as a session's simulation.
 
 Beside :mod:`authoring.flowcurves` (the solver and its scenes). The scene opens from its
 camera; its SEcurves are found once (a few seconds; on a thread while a window shows the
@@ -17,9 +16,10 @@ import hashlib
 import math
 import tempfile
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -27,49 +27,49 @@ from authoring.bindings import orbit_camera
 from authoring.operations import Key, Move, Operation, Orbit, Press, Release, Zoom
 from authoring.session import Ending, Opened, Script, ToolKind, ToolSimulation
 from engine.camera import Camera
-
-if TYPE_CHECKING:
-    from authoring.flowcurves.scene import FlowScene
 from input.sample import InputFrame
 
-__all__ = ["FlowTool", "TOOL", "open_flow", "script_events", "SCRIPTS", "FLOW_GAME", "flow_digest", "open_live",
-           "reopen_flow"]
+__all__ = [
+    "FLOW_GAME",
+    "SCRIPTS",
+    "FlowTool",
+    "Scenes",
+    "flow_digest",
+    "flow_tool",
+    "open_flow",
+    "open_live",
+    "reopen_flow",
+    "script_events",
+]
 
 #: The name a flow session's recording gives as its game.
 FLOW_GAME = "author-flow"
 
 SCRIPTS = ("row", "centre", "demo")
+#: The scenes the tool can open, by name: each builds its scene for a window size.
+Scenes = Mapping[str, Callable[[tuple[int, int]], Any]]
 _CENTRE_GRAB = 18.0  # pixels: a press this close to the centre-point drags it
 
 
-def _scene(name: str, size: tuple[int, int]) -> FlowScene:
-    """A named flow scene: the snowman field, or tasbada's crystal forest."""
-    if name == "tasbada":
-        from games.tasbada.flow_scene import flow_scene as tasbada_scene
+def flow_setup(spec: str, size: tuple[int, int], scenes: Scenes):  # type: ignore[no-untyped-def]
+    """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet).
 
-        return tasbada_scene(size)
-    from games.snowman.bent_scenery import flow_scene
-
-    return flow_scene(size)
-
-
-def flow_setup(spec: str, size: tuple[int, int]):  # type: ignore[no-untyped-def]
-    """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet)."""
+    ``scenes`` are the scenes a game offers by name (the launcher wires them: a tool never imports a game)."""
     from authoring.flowcurves.storage import load_flow
     from engine.camera import OrbitCamera
 
     path = Path(spec)
-    if spec not in ("snowman", "tasbada") and (path.exists() or path.suffix == ".json"):
+    if spec not in scenes and (path.exists() or path.suffix == ".json"):
         doc = load_flow(path)
-        if doc["scene"] not in ("snowman", "tasbada"):
-            raise ValueError(f"{path} bends the scene {doc['scene']!r}; this version opens snowman and tasbada")
-        scene = _scene(doc["scene"], tuple(doc["size"]))
+        if doc["scene"] not in scenes:
+            raise ValueError(f"{path} bends the scene {doc['scene']!r}; this version opens {', '.join(scenes)}")
+        scene = scenes[doc["scene"]](tuple(doc["size"]))
         cam = doc["camera"]
         scene.camera = OrbitCamera(target=cam["target"], yaw=cam["yaw"], pitch=cam["pitch"], distance=cam["distance"])
         return scene, path, doc["edits"]
-    if spec not in ("snowman", "tasbada"):
-        raise ValueError(f"{spec!r} is neither a scene (snowman, tasbada) nor a flow file")
-    return _scene(spec, size), Path(f"{spec}.flow.json"), []
+    if spec not in scenes:
+        raise ValueError(f"{spec!r} is neither a scene ({', '.join(scenes)}) nor a flow file")
+    return scenes[spec](size), Path(f"{spec}.flow.json"), []
 
 
 def build_session(scene, edits, progress=None, securves=None):  # type: ignore[no-untyped-def]
@@ -82,9 +82,9 @@ def build_session(scene, edits, progress=None, securves=None):  # type: ignore[n
     return session
 
 
-def open_flow(spec: str, size: tuple[int, int], progress=None):  # type: ignore[no-untyped-def]
+def open_flow(spec: str, size: tuple[int, int], scenes: Scenes, progress=None):  # type: ignore[no-untyped-def]
     """A session of a named scene or of a saved flow file (its edits re-applied), and its default output."""
-    scene, out, edits = flow_setup(spec, size)
+    scene, out, edits = flow_setup(spec, size, scenes)
     return build_session(scene, edits, progress), out
 
 
@@ -148,7 +148,7 @@ class FlowTool(ToolSimulation):
 
         # ``session`` may still be building on a thread: no input is applied and no step counted until it is whole.
         self.building = session if isinstance(session, BackgroundSession) else None
-        self.session = None if self.building is not None else session
+        self.session: Any = None if self.building is not None else session
         self.output = output
         self._camera = session.scene.camera
         self.frame = 0
@@ -311,19 +311,19 @@ class FlowTool(ToolSimulation):
             scene.add_text(self.message, size=16, color=(1.0, 0.9, 0.5))
 
 
-def _setup(spec: str, size: tuple[int, int]) -> dict[str, object]:
+def _setup(spec: str, size: tuple[int, int], scenes: Scenes) -> dict[str, object]:
     """What a recording needs to rebuild the scene: a scene's name, or a flow file's bytes (never its path)."""
     setup: dict[str, object] = {"scene": spec, "size": list(size), "file": ""}
-    if spec not in ("snowman", "tasbada"):
+    if spec not in scenes:
         setup["file"] = base64.b64encode(Path(spec).read_bytes()).decode()
     return setup
 
 
-def open_live(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
+def open_live(options: Mapping[str, Any], size: tuple[int, int], scenes: Scenes) -> Opened:
     """A live session: ``flow_scene``, ``output``, ``script``; ``headless`` builds the SEcurves here
     (``progress`` is told each group), a window builds them on a thread while it shows the rest scene."""
     spec = str(options.get("flow_scene", "snowman"))
-    scene, default_out, edits = flow_setup(spec, size)
+    scene, default_out, edits = flow_setup(spec, size, scenes)
     if options.get("headless"):
         session = build_session(scene, edits, options.get("progress"))
     else:
@@ -332,10 +332,10 @@ def open_live(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
         session = BackgroundSession(scene, lambda found: build_session(scene, edits, securves=found))
     output = options.get("output")
     tool = FlowTool(session, Path(output) if output else default_out, options.get("script"))
-    return Opened(tool, _setup(spec, size), tool.script_steps() if tool.script else None, tool.conclude)
+    return Opened(tool, _setup(spec, size, scenes), tool.script_steps() if tool.script else None, tool.conclude)
 
 
-def reopen_flow(setup: object) -> FlowTool:
+def reopen_flow(setup: object, scenes: Scenes) -> FlowTool:
     """The recorded flow session, rebuilt from its set-up alone (a flow file's bytes, never its path)."""
     size = setup.get("size") if isinstance(setup, dict) else None
     if not (isinstance(setup, dict) and isinstance(size, list) and len(size) == 2
@@ -347,12 +347,15 @@ def reopen_flow(setup: object) -> FlowTool:
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "recorded.flow.json"
             path.write_bytes(base64.b64decode(str(setup["file"])))
-            session, _ = open_flow(str(path), (int(size[0]), int(size[1])))
-    elif setup["scene"] in ("snowman", "tasbada"):
-        session, _ = open_flow(str(setup["scene"]), (int(size[0]), int(size[1])))
+            session, _ = open_flow(str(path), (int(size[0]), int(size[1])), scenes)
+    elif setup["scene"] in scenes:
+        session, _ = open_flow(str(setup["scene"]), (int(size[0]), int(size[1])), scenes)
     else:
         raise ValueError(f"the recording names the scene {str(setup['scene'])[:60]!r} without carrying it")
     return FlowTool(session, None)
 
 
-TOOL = ToolKind(FLOW_GAME, "PuppetPhone — Flow Curves", open_live, reopen_flow)
+def flow_tool(scenes: Scenes) -> ToolKind:
+    """The flow tool over the scenes a game offers by name (``puppetphone.flow_scenes`` wires the snowman field)."""
+    return ToolKind(FLOW_GAME, "PuppetPhone — Flow Curves", partial(open_live, scenes=scenes),
+                    partial(reopen_flow, scenes=scenes))

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import astuple, dataclass
 
-__all__ = ["Operation", "Press", "Move", "Release", "Orbit", "Zoom", "Key", "Resize", "decode", "encode", "OPERATIONS"]
+__all__ = ["OPERATIONS", "Key", "Move", "Operation", "Orbit", "Press", "Release", "Resize", "Zoom", "decode", "encode"]
 
 Raw = tuple[str | int | float | bool, ...]
 

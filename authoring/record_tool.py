@@ -22,7 +22,7 @@ from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.sample import InputFrame
 
-__all__ = ["RecordTool", "TOOL", "record_digest", "RECORD_GAME", "open_record", "reopen_record"]
+__all__ = ["RECORD_GAME", "TOOL", "RecordTool", "open_record", "record_digest", "reopen_record"]
 
 #: The name a take's recording gives as its game.
 RECORD_GAME = "author-record"
@@ -86,7 +86,7 @@ class RecordTool(ToolSimulation):
         self.scene, self.script, self.output = scene, script, output
         self.size = (int(size[0]), int(size[1]))
         self.frame, self.previewing = 0, 0
-        self.press: tuple[float, float, object] | None = None
+        self.press: tuple[float, float, Any] | None = None
         self.pointer: tuple[float, float] | None = None
         self.phase_acc = [0.0]
         self.reference: Any = None
@@ -188,9 +188,9 @@ class RecordTool(ToolSimulation):
         scene.feed(self._value(frame))
         scene.step(self.dt)
         self.previewing = self.previewing + 1 if scene.phase == "preview" else 0
-        if self.script and self.previewing == int(2 / self.dt) and scene.accept() is not None:
-            if self._save("saved {output}"):
-                self.saved.append(f"saved {self.output}")
+        accepted = self.script and self.previewing == int(2 / self.dt) and scene.accept() is not None
+        if accepted and self._save("saved {output}"):
+            self.saved.append(f"saved {self.output}")
         self.frame += 1
 
     def digest(self) -> tuple[str, dict[str, bytes]]:
@@ -241,12 +241,13 @@ def _check_record_setup(setup: object) -> dict[str, object]:
     import math
 
     def number(key: str, lo: float, hi: float) -> None:
-        v = setup.get(key)  # type: ignore[union-attr]
+        v = checked.get(key)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not lo <= v <= hi:
             raise ValueError(f"the recorded {key} {repr(v)[:30]} is not a number in [{lo:g}, {hi:g}]")
 
     if not isinstance(setup, dict):
         raise ValueError("the recorded take's set-up is not an object")
+    checked: dict[str, object] = setup
     if not isinstance(setup.get("item"), str) or not isinstance(setup.get("base", ""), str):
         raise ValueError("the recorded item and base must be text")
     if setup.get("drive") not in ("rotation", "translation", "pose", "scale"):
@@ -264,7 +265,8 @@ def _check_record_setup(setup: object) -> dict[str, object]:
     return setup
 
 
-def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
+def _record_scene(setup: dict[str, Any]) -> Any:
+    """The record scene of a checked set-up (its base clip decoded from the bytes it carries)."""
     import base64
 
     import numpy as np
@@ -282,8 +284,8 @@ def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
             path.write_bytes(base64.b64decode(str(setup["base"])))
             base, curve = load_clip_curve(path)
     skeleton = base.skeleton if base is not None else humanoid_skeleton()
-    return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),  # type: ignore[arg-type]
-                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve)  # type: ignore[arg-type]
+    return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),
+                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve)
 
 
 TOOL = ToolKind(RECORD_GAME, "PuppetPhone — record a cycle", open_record, reopen_record)

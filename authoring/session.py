@@ -33,7 +33,7 @@ from input.recording import Recorder, Recording, RecordingHeader
 from input.replay import HashCheck
 from input.sample import InputFrame
 
-__all__ = ["Simulation", "Session", "ToolKind", "Opened", "Ending", "Script", "KeyUse", "ToolSimulation", "tool_session"]
+__all__ = ["Ending", "KeyUse", "Opened", "Script", "Session", "Simulation", "ToolKind", "ToolSimulation", "tool_session"]
 
 #: What a simulation does with a key (:meth:`Simulation.on_key`).
 KeyUse = Literal["queue", "done", "pass"]
@@ -201,8 +201,8 @@ class Session:
         if not sim.ready():
             return  # still building: what was typed stays queued for the first real step
         if self.script is not None:
-            for raw in next(self.script, []):
-                self.bindings.queue(decode(raw))  # type: ignore[arg-type]  # a script's own tuples, checked here
+            for scripted in next(self.script, []):
+                self.bindings.queue(decode(scripted))
         for op in self.bindings.take():
             self.hub.tool(*encode(op))
         frame = self.hub.drain(self.frame)

@@ -41,6 +41,7 @@ import time
 
 import numpy as np
 
+from authoring.flow_tool import FlowTool
 from authoring.flowcurves.deform import ITERATIONS, SceneDeformer
 from authoring.flowcurves.principal import principal_curve
 from authoring.flowcurves.securves import SECurve
@@ -136,7 +137,6 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
     """Operations and update times of the editor's scripted row and centre-point edits."""
     from authoring.flowcurves.securves import compute_securves
     from authoring.flowcurves.session import FlowSession
-    from authoring.flow_tool import FlowTool
     from authoring.session import Session
     from input.hub import InputHub
 
@@ -150,21 +150,26 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
         out.append(Figure("flow", f"flow_ops_{label}", activity.clicks, "operations per edit"))  # no human baseline
         out.append(Figure("flow", f"flow_update_ms_{label}", float(np.median(activity.solve_ms)), "ms",
                           "one frame at 60 Hz", 1000.0 / 60.0))
-    grouping = FlowActivity(FlowSession(flow_scene(), securves=securves), None)
+    grouping = FlowTool(FlowSession(flow_scene(), securves=securves), None)
     out.append(Figure("flow", "flow_ops_fig3_6_grouping", perform(grouping, THESIS_EDITS["fig3_6_grouping"]),
                       "operations per edit"))
     tree, tree_securves = mesh_tree_problem()
-    stroke = FlowActivity(FlowSession(tree, securves=tree_securves), None)
+    stroke = FlowTool(FlowSession(tree, securves=tree_securves), None)
     ops = perform(stroke, _drag([(float(x), float(y)) for x, y in lean_stroke(tree_securves[0].points)]))
     assert stroke.session is not None and stroke.session.result.vertices, "the scripted stroke bent nothing"
     out.append(Figure("flow", "flow_ops_fig3_7_one_stroke", ops, "operations per edit"))
     return out + drag_figures(flow_scene(), securves)
 
 
-def perform(activity, steps: list[list[Op]]) -> int:  # type: ignore[no-untyped-def]
-    """Apply a scripted edit through the editor's hub, a step at a time; its operations (presses and keys)."""
+def perform(tool: FlowTool, steps: list[list[Op]]) -> int:
+    """Apply a scripted edit through the one session's hub, a step at a time, as a user's pointer would;
+    the edit's operations (presses and keys)."""
+    from authoring.session import Session
+    from input.hub import InputHub
+
+    session = Session(tool, InputHub())
     for ops in steps:
         for op in ops:
-            activity.hub.tool(*op)
-        activity.step()
+            session.hub.tool(*op)
+        session.step()
     return sum(op[0] in ("press", "key") for ops in steps for op in ops)

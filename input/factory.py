@@ -30,13 +30,13 @@ __all__ = [
     "DEFAULT_HOST",
     "DEFAULT_SILENT_AFTER",
     "SILENT_AFTER_RANGE",
+    "SOURCES",
     "SOURCE_KINDS",
+    "SourceOptions",
     "add_source_arguments",
     "make_hub",
     "open_hub",
     "silent_after",
-    "SourceOptions",
-    "SOURCES",
 ]
 
 #: The OSC and web defaults, repeated here so parsing ``--help`` imports neither server (a test checks they agree).

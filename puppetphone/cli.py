@@ -11,7 +11,7 @@ import importlib
 import os
 import sys
 
-__all__ = ["main", "COMMANDS"]
+__all__ = ["COMMANDS", "main"]
 
 COMMANDS: dict[str, tuple[str, str]] = {
     "play": ("puppetphone.cmd_play", "play a game (snowman, tasbada or sandbox)"),

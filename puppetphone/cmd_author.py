@@ -123,8 +123,8 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
 _PARSERS = {
     "record": (configure_record, "act a cycle out with the mouse or a device; layers stack into a clip"),
     "edit": (configure_edit, "refine a cycle with MoCurves while it plays"),
-    "curves": (configure_curves, "author a keyframed clip: pose its keys, shape its motion curves and their timing "
-                                 "(thesis ch. 4)"),
+    "curves": (configure_curves, ("author a keyframed clip: pose its keys, shape its motion curves and their timing "
+                                  "(thesis ch. 4)")),
     "flow": (configure_flow, "bend a scene's flow with sketched strokes and centre-points (Flow Curves)"),
 }
 
@@ -210,7 +210,7 @@ def run(args: argparse.Namespace) -> int:
     _announce(hub)
     runner.push_handlers(session)
     try:
-        result = runner.run(session)
+        result = runner.run(session)  # type: ignore[arg-type]  # Session.camera is read-only: the runner only reads it
         if result.screenshot is not None:
             print(f"screenshot: {result.screenshot}")
         ending = opened.conclude()

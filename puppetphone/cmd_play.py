@@ -83,7 +83,7 @@ def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-un
     activity.simulation.fps = lambda: runner.fps
     activity.hub.start()
     try:
-        result = runner.run(activity)
+        result = runner.run(activity)  # (a Session: its camera is read-only, the runner only reads it)
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2, None

@@ -106,7 +106,7 @@ def _replay_tool(entry, rec, args: argparse.Namespace, cut_short: bool) -> int: 
         return 2
     runner = Runner(run_options(args, f"PuppetPhone — replay of {args.file}"))
     try:
-        result = runner.run(session)
+        result = runner.run(session)  # type: ignore[arg-type]  # Session.camera is read-only: the runner only reads it
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

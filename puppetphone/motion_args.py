@@ -13,8 +13,15 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-__all__ = ["add_motion_options", "add_export_options", "motion_options", "export_options", "about", "UNIT_NAMES",
-           "UP_AXES"]
+__all__ = [
+    "UNIT_NAMES",
+    "UP_AXES",
+    "about",
+    "add_export_options",
+    "add_motion_options",
+    "export_options",
+    "motion_options",
+]
 
 # The choices of ``--units`` and ``--up``, spelled here so parsing imports neither numpy nor the readers
 # (a test checks them against ``engine.io.units.UNITS`` and ``engine.io.up_axis.AXES``).

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from authoring.session import ToolKind
     from games.base import Game
 
-__all__ = ["Entry", "GAMES", "TOOLS", "lookup", "load_game", "load_tool"]
+__all__ = ["GAMES", "TOOLS", "Entry", "load_game", "load_tool", "lookup"]
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ TOOLS: dict[str, Entry] = {
     "record": Entry("tool", "authoring.record_tool", "author-record"),
     "edit": Entry("tool", "authoring.edit_tool", "author-edit"),
     "curves": Entry("tool", "authoring.curves_tool", "author-curves"),
-    "flow": Entry("tool", "authoring.flow_tool", "author-flow"),
+    "flow": Entry("tool", "puppetphone.flow_scenes", "author-flow"),
 }
 
 

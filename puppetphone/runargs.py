@@ -16,7 +16,7 @@ from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
 if TYPE_CHECKING:  # the engine's modules load numpy and GL: imported when a session starts, not to parse
     from engine.runner import RunOptions
 
-__all__ = ["add_run_arguments", "run_options", "steps", "image_path", "HUD_DUMP_ENV", "quality_name"]
+__all__ = ["HUD_DUMP_ENV", "add_run_arguments", "image_path", "quality_name", "run_options", "steps"]
 
 #: Steps: zero or more.
 steps = int_range(0)

@@ -21,10 +21,10 @@ def test_the_mesh_figures_meet_their_goals() -> None:
 
 def test_the_fig_3_7_script_is_one_operation_that_bends_the_tree() -> None:
     from authoring.flowcurves.session import FlowSession
-    from puppetphone.cmd_author_flow import FlowActivity
+    from authoring.flow_tool import FlowTool
 
     scene, securves = mesh_tree_problem()
-    activity = FlowActivity(FlowSession(scene, securves=securves), None)
+    activity = FlowTool(FlowSession(scene, securves=securves), None)
     pts = [(float(x), float(y)) for x, y in lean_stroke(securves[0].points)]
     steps = [[("press", *pts[0], False)], *[[("move", *p)] for p in pts[1:]], [("release", *pts[-1])]]
     assert perform(activity, steps) == 1

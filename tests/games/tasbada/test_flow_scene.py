@@ -37,20 +37,22 @@ def test_a_crystal_tree_is_a_closed_trunk_of_rings_under_its_crystal() -> None:
 
 
 def test_author_flow_opens_tasbada() -> None:
-    from puppetphone.cmd_author_flow import flow_setup
+    from authoring.flow_tool import flow_setup
+    from puppetphone.flow_scenes import SCENES
 
-    scene, out, edits = flow_setup("tasbada", (640, 360))
+    scene, out, edits = flow_setup("tasbada", (640, 360), SCENES)
     assert scene.name == "tasbada" and str(out) == "tasbada.flow.json" and edits == []
 
 
 def test_a_saved_tasbada_flow_file_reopens_on_the_forest(tmp_path) -> None:  # type: ignore[no-untyped-def]
     from authoring.flowcurves.session import FlowSession
     from authoring.flowcurves.storage import save_flow
-    from puppetphone.cmd_author_flow import flow_setup
+    from authoring.flow_tool import flow_setup
+    from puppetphone.flow_scenes import SCENES
 
     session = FlowSession(flow_scene((640, 360)), securves=[])
     session.add("stroke", [[300.0, 300.0], [320.0, 200.0]])
     save_flow(session, tmp_path / "forest.flow.json")
-    scene, out, edits = flow_setup(str(tmp_path / "forest.flow.json"), (1280, 720))
+    scene, out, edits = flow_setup(str(tmp_path / "forest.flow.json"), (1280, 720), SCENES)
     assert scene.name == "tasbada" and scene.size == (640, 360) and len(edits) == 1
     assert [o.name for o in scene.objects] == [o.name for o in session.scene.objects]
