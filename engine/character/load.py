@@ -38,8 +38,8 @@ F64 = NDArray[np.float64]
 MAX_CHARACTER = 8 << 20
 """Bytes of a character file a recording carries (CesiumMan is 0.5 MB; its header's limit is 16 MB)."""
 
-_HOW = ("give them in a JSON joint map {\"file joint\": \"puppet role\", …} with --joint-map FILE "
-        f"(roles: {', '.join(JOINTS)})")
+_HOW = ("map its joints to the puppet's roles in a JSON file {\"file joint\": \"puppet role\", …} and pass "
+        f"--joint-map FILE (roles: {', '.join(JOINTS)})")
 
 
 class CharacterError(ValueError):
@@ -135,13 +135,20 @@ def _roles(asset: GltfAsset, names: list[str], parents: NDArray[np.int64], rest:
             except ValueError as by_shape:
                 best = max((resolve_joint_map(c, names) for c in JOINT_MAPS.values()), key=len)
                 missing = [r for r in JOINTS if r not in best]
+                shown = ", ".join(names[:4]) + (", …" if len(names) > 4 else "")
                 raise CharacterError(
-                    f"{name}: not a humanoid the puppet can be: no joint-name family fits (missing "
-                    f"{', '.join(missing)}) and by its shape {by_shape}; if it is one, {_HOW}") from None
+                    f"{name}: not a humanoid the puppet can be: its joint names ({shown}) follow none of the "
+                    f"known families ({', '.join(JOINT_MAPS)}), leaving {_count(missing)} without a joint, and by "
+                    f"its shape {by_shape}; if it is a humanoid, {_HOW}") from None
     missing = [r for r in JOINTS if r not in roles]
     if missing:
-        raise CharacterError(f"{name}: no joint found for the roles {', '.join(missing)}; {_HOW}")
+        raise CharacterError(f"{name}: {_count(missing)} without a joint; {_HOW}")
     return roles
+
+
+def _count(missing: list[str]) -> str:
+    """``"all 17 roles"`` or ``"the roles neck, head"``."""
+    return f"all {len(JOINTS)} roles" if len(missing) == len(JOINTS) else f"the roles {', '.join(missing)}"
 
 
 def _skin_tree(asset: GltfAsset, nodes: list[int]) -> NDArray[np.int64]:
