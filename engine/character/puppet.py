@@ -17,6 +17,7 @@ the capsules: :func:`skinned_instances`.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -26,6 +27,8 @@ from numpy.typing import ArrayLike
 from engine.blend.locomotion import BlendLibrary
 from engine.character.load import Character
 from engine.character.locomotion import character_locomotion
+from engine.clip import Clip
+from engine.clips.contacts import foot_contacts
 from engine.components import WorldPose
 from engine.ecs import Entity, World
 from engine.humanoid import humanoid_skeleton
@@ -54,7 +57,7 @@ def standing_height(sk: Skeleton) -> float:
     """Floor to the top of the head (the head joint's height plus its tip) in the rest pose."""
     from engine.fk import forward_kinematics
 
-    pos, rot = forward_kinematics(sk, sk.offsets[0], np.tile([1.0, 0.0, 0.0, 0.0], (sk.num_joints, 1)))
+    pos, _ = forward_kinematics(sk, sk.offsets[0], np.tile([1.0, 0.0, 0.0, 0.0], (sk.num_joints, 1)))
     return float(max(pos[:, 1].max(), (pos[:, 1] + sk.tips[:, 1]).max()))
 
 
@@ -64,7 +67,7 @@ def character_profile(sk: Skeleton) -> RagdollProfile:
     return default_profile(sk, total_mass=MANNEQUIN_MASS * ratio**3)
 
 
-def spawn_character(world: World, character: Character, clips: dict[str, object], position: ArrayLike = (0.0, 0.0, 0.0),
+def spawn_character(world: World, character: Character, clips: Mapping[str, Clip], position: ArrayLike = (0.0, 0.0, 0.0),
                     heading: float = 0.0, *, name: str = "puppet", extra: tuple[object, ...] = ()) -> Entity:
     """A puppet that is ``character``: its set built (or found) from ``clips``, its ragdoll, its skin.
 
@@ -76,7 +79,12 @@ def spawn_character(world: World, character: Character, clips: dict[str, object]
     library = world.resource(BlendLibrary)
     key = character.library_key
     if key not in library:
-        library.add(key, character_locomotion(character, clips))  # type: ignore[arg-type]  # clips are Clip values
+        library.add(key, character_locomotion(character, clips))
+        # A retargeted clip plants its feet when its source does (same phases): its source's contact
+        # labels, not ones re-read from the character's soles against the mannequin's heel and
+        # clearance (a long, high-ankled foot reads as down late and up early, unlocked in between).
+        by_name = {c.name: c for c in clips.values()}
+        library.contact_tracks[key] = [foot_contacts(by_name[c.name]) for c in library[key].space.clips]
     sk = character.rig.skeleton
     e = spawn_puppet(world, position, heading, skeleton=sk, library_key=key, name=name,
                      extra=(*extra, CharacterSkin(character.binding)))

@@ -258,8 +258,8 @@ def retarget_proportions(clip: Clip, target: Skeleton, name: str | None = None) 
     src = clip.skeleton
     if src.names != target.names or not np.array_equal(src.parents, target.parents):
         raise ValueError(f"clip {clip.name!r}: the target must have the same joints and hierarchy as its skeleton")
-    legs = [(f"{s}_upper_leg", f"{s}_foot") for s in ("l", "r")]
-    ratios = [leg_length(target, *leg) / leg_length(src, *leg) for leg in legs
+    ends = [(f"{s}_upper_leg", f"{s}_foot") for s in ("l", "r")]
+    ratios = [leg_length(target, *leg) / leg_length(src, *leg) for leg in ends
               if all(n in src.names for n in leg) and leg_length(src, *leg) > 1e-9]
     k = float(np.mean(ratios)) if ratios else float(target.offsets[0, 1] / max(src.offsets[0, 1], 1e-9))
     root = k * np.asarray(clip.root, dtype=np.float64)
