@@ -47,6 +47,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     rec.add_argument("-o", "--output", type=Path, default=Path("performed_cycle.ppclip"), help="where accepted cycles are saved")
     rec.add_argument("--countdown", type=float, default=3.0, help="seconds of countdown (default 3)")
     rec.add_argument("--seconds", type=float, default=8.0, help="length of a take (default 8)")
+    rec.add_argument("--character", default=None, metavar="FILE.glb",
+                     help="draw this rigged humanoid (.glb) acting the take instead of the mannequin")
     rec.add_argument("--script", choices=("loops",), default=None, help="a scripted performer instead of a hand")
     add_run_arguments(rec)
     rec.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points")
@@ -315,12 +317,15 @@ class RecordActivity:
 
 
 def _record_setup(args: argparse.Namespace, size: tuple[int, int]) -> dict[str, object]:
-    """Everything the take depends on, the base clip's bytes included."""
+    """Everything the take depends on, the base clip's bytes (and a ``--character``'s) included."""
     import base64
+
+    from engine.character.setup import character_setup
 
     return {"item": args.item, "drive": args.drive, "countdown": args.countdown, "seconds": args.seconds,
             "seed": args.seed, "script": args.script, "size": list(size),
-            "base": base64.b64encode(args.base.read_bytes()).decode() if args.base is not None else ""}
+            "base": base64.b64encode(args.base.read_bytes()).decode() if args.base is not None else "",
+            **({"character": character_setup(args.character)} if getattr(args, "character", None) else {})}
 
 
 def _check_record_setup(setup: object) -> dict[str, object]:
@@ -369,8 +374,12 @@ def _record_scene(setup: dict[str, object]):  # type: ignore[no-untyped-def]
             path.write_bytes(base64.b64decode(str(setup["base"])))
             base, curve = load_clip_curve(path)
     skeleton = base.skeleton if base is not None else humanoid_skeleton()
+    from engine.character.setup import decode
+
+    character = decode(setup["character"]) if setup.get("character") is not None else None
     return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),  # type: ignore[arg-type]
-                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve)  # type: ignore[arg-type]
+                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve,  # type: ignore[arg-type]
+                       character=character)
 
 
 def replay_record(recording):  # type: ignore[no-untyped-def]

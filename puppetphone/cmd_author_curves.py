@@ -46,6 +46,8 @@ def configure_curves(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--every", type=int, default=None, help="key a clip without keys every N frames (N ≥ 3)")
     parser.add_argument("--duration", type=float, default=1.0, help="rest: the new clip's length in seconds")
     parser.add_argument("--script", choices=("drag", "walk"), default=None, help="a scripted animator instead of a hand")
+    parser.add_argument("--character", default=None, metavar="FILE.glb",
+                        help="draw this rigged humanoid (.glb) in the clip's poses instead of the mannequin")
     parser.add_argument("--record", type=output_file, default=None,
                         help="record the session (pointer, keys, every step's state) to replay it later")
     add_run_arguments(parser)
@@ -206,12 +208,15 @@ class CurvesActivity:
         self.scene.draw(scene)
 
 
-def _setup(args: argparse.Namespace, size: tuple[int, int]) -> dict[str, object]:
+def _setup(args: argparse.Namespace, size: tuple[int, int], character: dict[str, object] | None = None
+           ) -> dict[str, object]:
     """What a recording needs to reopen the same session: the clip's bytes (and keys), never its path."""
     from authoring.keyframe_curves.session import keys_path
 
     setup: dict[str, object] = {"clip": args.clip, "size": list(size), "joint": args.joint,
                                 "every": args.every or 0, "duration": float(args.duration)}  # fmt: skip
+    if character is not None:  # the --character file's bytes, as play carries them
+        setup["character"] = character
     path = Path(args.clip)
     if path.suffix.lower() == ".ppclip":
         setup["name"] = path.name
@@ -257,8 +262,18 @@ def replay_curves(recording, verify: bool = True) -> CurvesActivity:  # type: ig
     from input.replay import HashCheck, ReplaySource
 
     session, size, joint = _reopen(recording.header.setup)
-    return CurvesActivity(CurvesScene(session, size, joint), None, InputHub(replay=ReplaySource(recording)),
+    scene = CurvesScene(session, size, joint)
+    scene.character = _character(recording.header.setup)
+    return CurvesActivity(scene, None, InputHub(replay=ReplaySource(recording)),
                           check=HashCheck(recording) if verify else None)  # fmt: skip
+
+
+def _character(setup: object):  # type: ignore[no-untyped-def]
+    """The set-up's ``--character``, rebuilt from its bytes (``None`` without one; one-line ``ValueError``)."""
+    from engine.character.setup import decode
+
+    value = setup.get("character") if isinstance(setup, dict) else None
+    return None if value is None else decode(value)
 
 
 def run_curves(args: argparse.Namespace) -> int:
@@ -281,6 +296,12 @@ def run_curves(args: argparse.Namespace) -> int:
             return 2
     try:
         session = CurveSession.from_spec(args.clip, args.every, args.duration)
+        if args.character:
+            from engine.character.setup import character_setup
+
+            character = character_setup(args.character)
+        else:
+            character = None
     except (ValueError, OSError) as exc:
         print(f"cannot open {args.clip!r}: {exc}", file=sys.stderr)
         return 2
@@ -294,8 +315,9 @@ def run_curves(args: argparse.Namespace) -> int:
     recorder = None
     if args.record is not None:
         recorder = Recorder(args.record, RecordingHeader(game=CURVES_GAME, seed=0, dt=CurvesActivity.dt,
-                                                         sources=["mouse"], setup=_setup(args, runner.size)))  # fmt: skip
+                                                         sources=["mouse"], setup=_setup(args, runner.size, character)))  # fmt: skip
     scene = CurvesScene(session, runner.size, args.joint)
+    scene.character = _character({"character": character})
     activity = CurvesActivity(scene, output, InputHub(), args.script, recorder=recorder)
     runner.push_handlers(activity)
     try:
