@@ -170,10 +170,15 @@ def run(args: argparse.Namespace) -> int:
         from puppetphone.cmd_clips import library_setup
 
         clips = library_setup(args.clips, replay=hub.replay is not None)
-        if args.character is not None and hub.replay is None:
+        if hub.replay is None:  # --character, else the clip library's character (engine.cliplib.character)
             from engine.character.setup import character_setup
+            from engine.cliplib.character import library_character
+            from engine.cliplib.library import ClipLibrary, default_library_dir
 
-            setup = {**game.prepare(options), "character": character_setup(args.character, args.joint_map)}
+            character = (character_setup(args.character, args.joint_map) if args.character is not None
+                         else library_character(ClipLibrary(args.clips or default_library_dir())))
+            if character is not None:
+                setup = {**game.prepare(options), "character": character}
         activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
                                   source_label=source, clips=clips, view=args.view)
     except (GameOptionError, OSError, ValueError) as exc:
