@@ -6,6 +6,8 @@ toe tips) run on it unchanged. Two things are the character's own:
 
 - its **locomotion set** (:mod:`engine.character.locomotion`), registered in the
   :class:`~engine.blend.locomotion.BlendLibrary` under :attr:`Character.library_key`;
+- its **behaviour thresholds** (:func:`character_tuning`): crouch and stand heights, lift, reach,
+  scaled to its hips height as a snowman's are;
 - its **ragdoll**: capsules as thick as its mesh (the rig's radii), its body mass the
   mannequin's 70 kg scaled by the cube of their standing heights (a figure of the same
   build), spread over the bones by capsule volume — a stocky character's trunk weighs more
@@ -18,7 +20,7 @@ the capsules: :func:`skinned_instances`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
@@ -37,8 +39,9 @@ from engine.ragdoll.profile import RagdollProfile, default_profile
 from engine.render.scene import SkinnedInstance
 from engine.skeleton import Skeleton
 from engine.skinning import SkinBinding
+from engine.statemachine.puppet.body import PuppetTuning
 
-__all__ = ["CharacterSkin", "spawn_character", "character_profile", "skinned_instances", "standing_height", "MANNEQUIN_MASS"]
+__all__ = ["CharacterSkin", "spawn_character", "character_profile", "skinned_instances", "standing_height", "character_tuning", "MANNEQUIN_MASS"]
 
 MANNEQUIN_MASS = 70.0
 """kg: the mannequin's body mass (``default_profile``'s), the reference a character's is scaled from."""
@@ -67,6 +70,21 @@ def character_profile(sk: Skeleton) -> RagdollProfile:
     return default_profile(sk, total_mass=MANNEQUIN_MASS * ratio**3)
 
 
+def character_tuning(sk: Skeleton) -> PuppetTuning:
+    """The puppet's behaviour thresholds scaled to the character's hips height (as a snowman's are).
+
+    The thresholds are hips heights in metres: unscaled, a character whose hips stand at 0.68 m
+    would be below the mannequin's crouch threshold (0.80 m) while standing, and crouch-walk at
+    every drag."""
+    s = float(sk.offsets[0, 1]) / humanoid_skeleton().offsets[0, 1]
+    base = PuppetTuning()
+    return replace(base, stand_height=float(sk.offsets[0, 1]), crouch_height=base.crouch_height * s,
+                   crouch_enter=base.crouch_enter * s, crouch_exit=base.crouch_exit * s,
+                   lift_limit=base.lift_limit * max(s, 0.5), max_speed=base.max_speed * s,
+                   flick_launch_speed=base.flick_launch_speed * float(np.sqrt(s)), reach=base.reach * s,
+                   front=base.front * s)
+
+
 def spawn_character(world: World, character: Character, clips: Mapping[str, Clip], position: ArrayLike = (0.0, 0.0, 0.0),
                     heading: float = 0.0, *, name: str = "puppet", extra: tuple[object, ...] = ()) -> Entity:
     """A puppet that is ``character``: its set built (or found) from ``clips``, its ragdoll, its skin.
@@ -86,7 +104,7 @@ def spawn_character(world: World, character: Character, clips: Mapping[str, Clip
         by_name = {c.name: c for c in clips.values()}
         library.contact_tracks[key] = [foot_contacts(by_name[c.name]) for c in library[key].space.clips]
     sk = character.rig.skeleton
-    e = spawn_puppet(world, position, heading, skeleton=sk, library_key=key, name=name,
+    e = spawn_puppet(world, position, heading, skeleton=sk, library_key=key, tuning=character_tuning(sk), name=name,
                      extra=(*extra, CharacterSkin(character.binding)))
     world.get(e, Ragdoll).profile = character_profile(sk)  # before any physics step builds the body
     return e
