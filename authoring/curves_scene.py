@@ -45,9 +45,9 @@ from authoring.curves_view import framing_camera, panel_layout
 from authoring.keyframe_curves.session import CurveSession
 from authoring.screen_pick import pick_point, point_on_view_plane
 from engine import quat
-from engine.fk import forward_kinematics
 from engine.character.load import Character
 from engine.character.view import character_instance
+from engine.fk import forward_kinematics
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
 

@@ -43,12 +43,12 @@ from authoring.joint_pick import joint_at
 from authoring.mocurves.curves import item_chain
 from engine import quat
 from engine.camera import OrbitCamera
+from engine.character.load import Character
+from engine.character.view import character_instance
 from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.ik import two_bone_ik
 from engine.pose import Pose
-from engine.character.load import Character
-from engine.character.view import character_instance
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
 from engine.root_curve import RootCurve
