@@ -53,7 +53,7 @@ def test_the_rest_pose_puts_the_roles_where_the_file_has_its_joints(cesium) -> N
 
 
 def test_at_rest_the_skin_lands_where_the_files_own_skinning_puts_it(cesium) -> None:  # type: ignore[no-untyped-def]
-    """Broken by binding without ``to_engine``: off by the hips' placement and the floor (~2 cm)."""
+    """Broken by binding without ``to_engine``: off by the hips' placement over the origin (5 mm)."""
     path, ch = cesium
     asset = read_gltf(path)
     mats = skin_matrices(asset, node_world_matrices(asset))
@@ -69,7 +69,7 @@ def test_at_rest_the_skin_lands_where_the_files_own_skinning_puts_it(cesium) -> 
 def test_a_bent_knee_carries_the_foot_rigidly_with_the_puppets_shin(cesium) -> None:  # type: ignore[no-untyped-def]
     """Vertices weighted wholly to the foot keep their place in the engine foot's frame.
 
-    Broken by driving every skin joint from the hips: the foot vertices stay behind (error ~0.3 m)."""
+    Broken by driving every skin joint from the hips: no vertex follows the foot any more (the count fails)."""
     _, ch = cesium
     sk = ch.rig.skeleton
     local = np.array(ch.rig.rest_local)
