@@ -52,7 +52,7 @@ def _record(glb: Path, path: Path) -> list[str]:
 
 def test_a_character_session_replays_after_its_file_is_moved_away(mocap_dir: Path, tmp_path: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
-    """Broken by keeping only the file's path in the set-up: the replay cannot open it and exits 2."""
+    """The set-up carries the file's bytes, not its path: the replay builds the same puppet without the file."""
     glb = tmp_path / "hero.glb"
     shutil.copy(mocap_dir / "CesiumMan.glb", glb)
     rec = tmp_path / "hero.rec"
