@@ -45,6 +45,8 @@ from authoring.curves_view import framing_camera, panel_layout
 from authoring.keyframe_curves.session import CurveSession
 from authoring.screen_pick import pick_point, point_on_view_plane
 from engine import quat
+from engine.character.load import Character
+from engine.character.view import character_instance
 from engine.fk import forward_kinematics
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
@@ -86,6 +88,7 @@ class CurvesScene:
         self.message = ""
         self._turn_from: tuple[F, F] = (quat.identity(), np.zeros(3))  # an orient gesture's start: rotation, base
         self.camera = framing_camera(self._all_joint_positions(), size)
+        self.character: Character | None = None  # drawn instead of the mannequin (``author curves --character``)
 
     def _all_joint_positions(self) -> F:
         """``[N,3]`` the puppet's surface extremes over the clip (capsule ends ± radius): what the framing must show."""
@@ -147,8 +150,11 @@ class CurvesScene:
         c = clip.coordinates([self.frame_times()[self.frame]])
         root, rot = clip.pose_arrays(c)
         pos, wrot = forward_kinematics(clip.skeleton, root[0], rot[0])
-        a, b, r, _ = puppet_capsules(clip.skeleton, pos, wrot)
-        scene.add_capsules(a, b, r, color=(0.86, 0.86, 0.9))
+        if self.character is not None:
+            scene.skinned.append(character_instance(self.character, clip.skeleton, root[0], rot[0]))
+        else:
+            a, b, r, _ = puppet_capsules(clip.skeleton, pos, wrot)
+            scene.add_capsules(a, b, r, color=(0.86, 0.86, 0.9))
         traj = self.trajectory()
         scene.add_polyline(traj, ORANGE, 3.0, closed=clip.loop)
         col = np.tile(np.array([0.2, 0.2, 0.25]), (len(traj), 1))

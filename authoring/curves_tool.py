@@ -156,12 +156,14 @@ def open_curves(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
     clip = str(options["clip"])
     session = CurveSession.from_spec(clip, options.get("every"), float(options.get("duration", 1.0)))
     scene = CurvesScene(session, size, str(options.get("joint", "l_hand")))
+    setup = _setup(options, size)
+    scene.character = _character(setup)
     output = options.get("output")
     tool = CurvesTool(scene, Path(output) if output else Path(f"{Path(clip).stem}_curves.ppclip"), exports,
                       save_at_end=output is not None)
     script = options.get("script")
     steps = None if script is None else (walk_script(scene) if script == "walk" else _drag_script(scene))
-    return Opened(tool, _setup(options, size), steps, tool.conclude)
+    return Opened(tool, setup, steps, tool.conclude)
 
 
 def reopen_curves(setup: object) -> CurvesTool:
@@ -169,7 +171,17 @@ def reopen_curves(setup: object) -> CurvesTool:
     from authoring.curves_scene import CurvesScene
 
     session, size, joint = _reopen(setup)
-    return CurvesTool(CurvesScene(session, size, joint))
+    scene = CurvesScene(session, size, joint)
+    scene.character = _character(setup)
+    return CurvesTool(scene)
+
+
+def _character(setup: object) -> Any:
+    """The set-up's ``--character``, rebuilt from its bytes (``None`` without one; one-line ``ValueError``)."""
+    from engine.character.setup import decode
+
+    value = setup.get("character") if isinstance(setup, dict) else None
+    return None if value is None else decode(value)
 
 
 def _setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str, object]:
@@ -178,6 +190,10 @@ def _setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str, objec
 
     setup: dict[str, object] = {"clip": options["clip"], "size": list(size), "joint": options.get("joint", "l_hand"),
                                 "every": options.get("every") or 0, "duration": float(options.get("duration", 1.0))}  # fmt: skip
+    if options.get("character"):  # the --character file's bytes, as play carries them
+        from engine.character.setup import character_setup
+
+        setup["character"] = character_setup(str(options["character"]))
     path = Path(str(options["clip"]))
     if path.suffix.lower() == ".ppclip":
         setup["name"] = path.name

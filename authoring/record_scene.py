@@ -43,6 +43,8 @@ from authoring.joint_pick import joint_at
 from authoring.mocurves.curves import item_chain
 from engine import quat
 from engine.camera import OrbitCamera
+from engine.character.load import Character
+from engine.character.view import character_instance
 from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.ik import two_bone_ik
@@ -100,17 +102,19 @@ class RecordScene:
         take_seconds: the take stops by itself after this long (or on :meth:`stop`).
         rng: seeded generator for the extractor's probe points.
         root_curve: the base clip's root curve (from its ``.ppclip``), kept while no layer moves the root.
+        character: a skinned character drawn in the puppet's pose instead of the mannequin.
     """
 
     def __init__(self, skeleton: Skeleton, item: str, drive: str = "rotation", base: Clip | None = None,
                  countdown: float = 3.0, take_seconds: float = 8.0, rng: np.random.Generator | None = None,
-                 root_curve: RootCurve | None = None) -> None:
+                 root_curve: RootCurve | None = None, character: Character | None = None) -> None:
         if drive not in DRIVES:
             raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
         joint, self.chain = _drivable(skeleton, item, drive)
         if base is not None and (base.skeleton.names != skeleton.names or not base.loop):
             raise ValueError("the base clip must be a looping clip of the same skeleton")
         self.skeleton = skeleton
+        self.character = character  # drawn instead of the mannequin (``author record --character``)
         self.joint = joint
         self.drive = drive
         self.clip = base
@@ -397,10 +401,13 @@ class RecordScene:
                 roots, rots = self._driven(root[None], rot[None], self._value[None])
                 root, rot = roots[0], rots[0]
         wpos, wrot = forward_kinematics(self.skeleton, root, rot, scales=scales)
-        a, b, r, owner = puppet_capsules(self.skeleton, wpos, wrot)
-        colors = np.tile(np.array([0.82, 0.8, 0.76]), (len(a), 1))
-        colors[owner == self.joint] = PERFORMANCE
-        scene.add_capsules(a, b, r, colors)
+        if self.character is not None:
+            scene.skinned.append(character_instance(self.character, self.skeleton, root, rot))
+        else:
+            a, b, r, owner = puppet_capsules(self.skeleton, wpos, wrot)
+            colors = np.tile(np.array([0.82, 0.8, 0.76]), (len(a), 1))
+            colors[owner == self.joint] = PERFORMANCE
+            scene.add_capsules(a, b, r, colors)
         rotation = self.drive in ("rotation", "scale")  # both show the driven bone's end
         if self._take is not None and len(self._take.values) > 1:
             scene.add_polyline(self._joint_path(np.asarray(self._take.values), rotation), PERFORMANCE, 2.0)

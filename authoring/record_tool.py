@@ -226,14 +226,17 @@ def reopen_record(setup: object) -> RecordTool:
 
 
 def _record_setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str, object]:
-    """Everything the take depends on, the base clip's bytes included."""
+    """Everything the take depends on, the base clip's bytes (and a ``--character``'s) included."""
     import base64
 
-    base = options.get("base")
+    from engine.character.setup import character_setup
+
+    base, character = options.get("base"), options.get("character")
     return {"item": options.get("item", "r_upper_arm"), "drive": options.get("drive", "rotation"),
             "countdown": float(options.get("countdown", 3.0)), "seconds": float(options.get("seconds", 8.0)),
             "seed": int(options.get("seed", 0)), "script": options.get("script"), "size": list(size),
-            "base": base64.b64encode(Path(base).read_bytes()).decode() if base is not None else ""}
+            "base": base64.b64encode(Path(base).read_bytes()).decode() if base is not None else "",
+            **({"character": character_setup(character)} if character else {})}
 
 
 def _check_record_setup(setup: object) -> dict[str, object]:
@@ -284,8 +287,12 @@ def _record_scene(setup: dict[str, Any]) -> Any:
             path.write_bytes(base64.b64decode(str(setup["base"])))
             base, curve = load_clip_curve(path)
     skeleton = base.skeleton if base is not None else humanoid_skeleton()
+    from engine.character.setup import decode
+
+    character = decode(setup["character"]) if setup.get("character") is not None else None
     return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),
-                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve)
+                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve,
+                       character=character)
 
 
 TOOL = ToolKind(RECORD_GAME, "PuppetPhone — record a cycle", open_record, reopen_record)

@@ -12,7 +12,12 @@ Per case and device it prints:
 - ``_lowest_sole`` (m), ``_time_to_90`` (s, straight drags), ``_time_to_rest`` (s),
   ``_fell`` (1 when the puppet dropped into the ragdoll);
 
-and over the jump sweep (valid flicks at 0–4 m/s, both devices) ``<device>_jump_landed_pct``
+and, with CesiumMan (``shared/data/mocap``) as the player's puppet (``play --character``),
+``character_<device>_<case>_slide_mean`` / ``_slide_p95`` / ``_lowest_sole`` against the mannequin's of the
+same run: a character must keep its feet as planted as the mannequin (the bound ``tests/bench``
+holds both to: mean ≤ 0.02 m/s, p95 ≤ 0.05 m/s).
+
+Over the jump sweep (valid flicks at 0–4 m/s, both devices) it prints ``<device>_jump_landed_pct``
 against the legacy controller, ``_jump_apex_error`` (m) and ``_jump_takeoff_s``.
 ``puppetphone bench motion --plot FILE [--case NAME]`` draws foot height and speed over
 time for one case (:func:`plot_case`). Simulation only: no timing figures, so the machine's load does not matter.
@@ -34,6 +39,7 @@ JUMP_SPEEDS = (0.0, 1.0, 2.0, 3.0, 4.0)
 def run() -> list[Figure]:
     """Every case with both devices and both controllers, then the jump sweep."""
     figs: list[Figure] = []
+    character = _character()
     for case in CASES:
         alone = blend_alone_slide(case.speed) if case.speed is not None else None
         if alone is not None:
@@ -53,6 +59,14 @@ def run() -> list[Figure]:
                                    old.time_to_90))
             if new.time_to_rest is not None:
                 figs.append(Figure(BENCH, f"{key}_time_to_rest", new.time_to_rest, "s"))
+            if character is not None:
+                ch = motion_figures(case, drive(case, device, "spring", character=character))
+                figs += [
+                    Figure(BENCH, f"character_{key}_slide_mean", ch.slide_mean, "m/s", "mannequin", new.slide_mean),
+                    Figure(BENCH, f"character_{key}_slide_p95", ch.slide_p95, "m/s", "mannequin", new.slide_p95),
+                    Figure(BENCH, f"character_{key}_lowest_sole", ch.lowest_sole, "m", "mannequin", new.lowest_sole),
+                    Figure(BENCH, f"character_{key}_fell", float(ch.fell), "", "mannequin", float(new.fell)),
+                ]
     for device in ("phone", "mouse"):
         new = [jump(v, device, "spring") for v in JUMP_SPEEDS]
         old = [jump(v, device, "legacy") for v in JUMP_SPEEDS]
@@ -65,6 +79,20 @@ def run() -> list[Figure]:
             Figure(BENCH, f"{device}_jump_takeoff_s", float(np.median(delay)) if delay else float("nan"), "s"),
         ]
     return figs
+
+
+def _character() -> dict[str, object] | None:
+    """CesiumMan as a ``play --character`` set-up value, or ``None`` (said in one line) without the data."""
+    import sys
+
+    from bench.render_skinned import character_file
+    from engine.character.setup import character_setup
+
+    path = character_file()
+    if path is None:
+        print("motion: CesiumMan.glb not found (set PUPPETPHONE_DATA): no character figures", file=sys.stderr)
+        return None
+    return character_setup(str(path))
 
 
 def plot_case(case: Case, path: str, device: str = "mouse") -> None:

@@ -135,7 +135,8 @@ class _Phone(PoseSource):
 class _Driver:
     """The sandbox with one puppet and one scripted device, stepping and recording."""
 
-    def __init__(self, device: str, controller: str, seed: int = 0, fps: float = 60.0) -> None:
+    def __init__(self, device: str, controller: str, seed: int = 0, fps: float = 60.0,
+                 character: dict[str, object] | None = None) -> None:
         from puppetphone.games import load_game, make_app
 
         if device not in DEVICES or controller not in CONTROLLERS:
@@ -146,7 +147,10 @@ class _Driver:
         self._pending: list[pygame.event.Event] = []
         self._steps = 0
         self.source: PoseSource = _Phone() if device == "phone" else MouseSource()
-        self.app: App = make_app("sandbox", seed, InputHub([self.source]), {"scene": "empty", "puppets": 1})
+        setup: dict[str, object] = {"scene": "empty", "puppets": 1}
+        if character is not None:  # the player's puppet is a character (engine.character.setup value)
+            setup["character"] = character
+        self.app: App = make_app("sandbox", seed, InputHub([self.source]), setup)
         self.world = self.app.world
         self.puppet = next(e for e, _ in self.world.query(Brain))
         body = self.world.get(self.puppet, PuppetBody)
@@ -270,9 +274,11 @@ class _Driver:
                    np.array([r[2] for r in rows]), [r[3] for r in rows], [r[4] for r in rows])
 
 
-def drive(case: Case, device: str = "phone", controller: str = "spring", settle: float = 1.0) -> Run:
-    """Play ``case`` with ``device`` and the given locomotion ``controller``; keep ``settle`` s after it."""
-    d = _Driver(device, controller)
+def drive(case: Case, device: str = "phone", controller: str = "spring", settle: float = 1.0,
+          character: dict[str, object] | None = None) -> Run:
+    """Play ``case`` with ``device`` and the given locomotion ``controller``; keep ``settle`` s after it.
+    ``character`` (an :mod:`engine.character.setup` value) plays it with that character as the puppet."""
+    d = _Driver(device, controller, character=character)
     d.grab()
     for _ in range(int(round((case.moving + settle) / d.world.dt))):
         d.step(lambda t: (case.path(t), 0.0))

@@ -20,14 +20,15 @@ import numpy as np
 
 from bench.figures import Figure
 
-__all__ = ["run", "COUNTS"]
+__all__ = ["run", "COUNTS", "character_file"]
 
 COUNTS = (1, 10, 100)
 _ROW, _SPACING = 10, 1.0
 WIDTH, HEIGHT = 1280, 720
 
 
-def _character_file() -> Path | None:
+def character_file() -> Path | None:
+    """CesiumMan.glb in ``$PUPPETPHONE_DATA/mocap`` or ``shared/data/mocap`` beside the project, if there."""
     here = Path(__file__).resolve().parent.parent
     roots = [Path(os.environ["PUPPETPHONE_DATA"])] if os.environ.get("PUPPETPHONE_DATA") else []
     roots.append(here.parent / "shared" / "data")
@@ -36,7 +37,7 @@ def _character_file() -> Path | None:
 
 def run() -> list[Figure]:
     """The three figures, or none (with a line) without the character file."""
-    path = _character_file()
+    path = character_file()
     if path is None:
         print("render_skinned: CesiumMan.glb not found (set PUPPETPHONE_DATA): no skinned figures", file=sys.stderr)
         return []

@@ -7,14 +7,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from engine.components import Puppet, Stick, Transform, WorldPose
-from engine.ecs import World
+from engine.ecs import Entity, World
 from engine.ragdoll.components import Prop
 from engine.render.components import Appearance
 from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
-__all__ = ["draw_world", "draw_sticks", "draw_height_cues", "draw_walk_target", "height_cues", "CUE_COLOR",
+__all__ = ["draw_world", "spawn_player", "player_character", "PlayerCharacter", "draw_sticks", "draw_height_cues", "draw_walk_target", "height_cues", "CUE_COLOR",
            "Notice", "post_notice", "NOTICE_SECONDS"]
 
 NOTICE_SECONDS = 2.0
@@ -47,6 +47,60 @@ class Notice:
 def post_notice(world: World, text: str) -> None:
     """Show ``text`` to the player from this frame on (a newer notice replaces an older one)."""
     world.insert_resource(Notice(text, world.frame))
+
+
+@dataclass
+class PlayerCharacter:
+    """Resource: the character the set-up's ``"character"`` value (``play --character``) was decoded into.
+
+    An asset kept so the set-up's file is read and checked once per world; not simulation state."""
+
+    SIM_STATE = False
+
+    value: object
+    character: object
+
+
+def player_character(world: World):  # type: ignore[no-untyped-def]  # -> engine.character.load.Character | None
+    """The player's character of the game's set-up, or ``None`` for the mannequin.
+
+    Raises:
+        engine.character.load.CharacterError: the set-up's character is unusable (one line why).
+    """
+    from games.base import GameSetup
+
+    setup = world.try_resource(GameSetup)
+    value = setup.get("character") if setup is not None else None
+    if value is None:
+        return None
+    held = world.try_resource(PlayerCharacter)
+    if held is None or held.value is not value:
+        from engine.character.setup import decode
+
+        held = PlayerCharacter(value, decode(value))
+        world.insert_resource(held)
+    return held.character
+
+
+def spawn_player(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
+                 heading: float = 0.0, *, name: str = "puppet",
+                 color: tuple[float, float, float] = (0.85, 0.35, 0.25)) -> Entity:
+    """The player's puppet: the set-up's character (``play --character``) when it has one, else the mannequin
+    in ``color``. A character plays the clips the mannequin would (the library's authored ones over
+    the built-in ones), retargeted to it."""
+    from engine.statemachine.puppet import spawn_puppet
+
+    character = player_character(world)
+    if character is None:
+        return spawn_puppet(world, position, heading, name=name, extra=(Appearance(color=color),))
+    from engine.character.puppet import spawn_character
+    from engine.cliplib.authored import AuthoredClips, merged_clips
+    from engine.clips import default_clips
+
+    authored = world.try_resource(AuthoredClips)
+    clips = merged_clips(authored.clips) if authored is not None and authored.clips else default_clips()
+    return spawn_character(world, character, clips, position, heading, name=name,
+                           extra=(Appearance(color=color, visible=False),))
 
 
 def draw_sticks(world: World, scene: RenderScene) -> None:
@@ -139,12 +193,15 @@ def draw_walk_target(world: World, scene: RenderScene, alpha: float) -> None:
 
 
 def draw_world(world: World, scene: RenderScene, alpha: float) -> None:
-    """Puppets as capsules, snowballs as spheres, the focused thing outlined, the stick, height cues."""
+    """Puppets as capsules (characters as their skinned mesh), snowballs as spheres, the focused thing outlined, the stick, height cues."""
     focus = {s.focus for _, s in world.query(Stick) if s.focus is not None and s.grabbed is None}
     held = {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None}
     for e, app in world.query(Appearance):
         app.outline = e in focus or e in held
     scene_from_world(world, alpha, scene)
+    from engine.character.puppet import skinned_instances
+
+    scene.skinned.extend(skinned_instances(world, alpha, focus | held))
     rows = [(prop.radius, tr.position, world.try_get(e, Appearance)) for e, prop, tr in world.query(Prop, Transform)]
     if rows:
         centers = np.array([r[1] for r in rows])

@@ -27,7 +27,7 @@ from engine.ragdoll.system import spawn_snowball
 from engine.render.components import Appearance
 from engine.statemachine.puppet import install_puppets, spawn_puppet
 from games.base import Game, GameOptionError, GameSetup
-from games.common import draw_world
+from games.common import draw_world, spawn_player
 from games.wander import Wanderer, install_wander
 
 __all__ = ["GAME", "SCENES", "SMALL_BALL", "BIG_BALL", "SPACING", "PACES", "MAX_PUPPETS"]
@@ -78,7 +78,7 @@ def install(app: App) -> None:
         raise GameOptionError(f"sandbox puppets must be from 1 to {MAX_PUPPETS}, not {puppets}")
     app.add_plugin(install_puppets)
     world = app.world
-    spawn_puppet(world, (0.0, 0.0, 0.0), 0.0, extra=(Appearance(color=(0.85, 0.35, 0.25)),))
+    spawn_player(world, (0.0, 0.0, 0.0), 0.0, color=(0.85, 0.35, 0.25))
     if puppets > 1:
         app.add_plugin(install_wander)
         _spawn_crowd(world, puppets - 1)

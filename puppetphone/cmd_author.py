@@ -54,6 +54,8 @@ def configure_record(rec: argparse.ArgumentParser) -> None:
     rec.add_argument("-o", "--output", type=Path, default=Path("performed_cycle.ppclip"), help="where accepted cycles are saved")
     rec.add_argument("--countdown", type=float, default=3.0, help="seconds of countdown (default 3)")
     rec.add_argument("--seconds", type=float, default=8.0, help="length of a take (default 8)")
+    rec.add_argument("--character", default=None, metavar="FILE.glb",
+                     help="draw this rigged humanoid (.glb) acting the take instead of the mannequin")
     rec.add_argument("--script", choices=RECORD_SCRIPTS, default=None, help="a scripted performer instead of a hand")
     add_run_arguments(rec)
     rec.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points")
@@ -99,6 +101,8 @@ def configure_curves(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--every", type=int, default=None, help="key a clip without keys every N frames (N ≥ 3)")
     parser.add_argument("--duration", type=float, default=1.0, help="rest: the new clip's length in seconds")
     parser.add_argument("--script", choices=CURVES_SCRIPTS, default=None, help="a scripted animator instead of a hand")
+    parser.add_argument("--character", default=None, metavar="FILE.glb",
+                        help="draw this rigged humanoid (.glb) in the clip's poses instead of the mannequin")
     parser.add_argument("--record", type=output_file, default=None,
                         help="record the session (pointer, keys, every step's state) to replay it later")
     add_run_arguments(parser)

@@ -36,7 +36,8 @@ def configure(parser: argparse.ArgumentParser) -> None:
     add = sub.add_parser("add", help="add a clip (.ppclip, .bvh, .glb/.gltf) in a role, retargeted to the puppet")
     add.add_argument("file", type=Path, metavar="FILE")
     add.add_argument("--role", required=True,
-                     help="idle, walk, run, crouch_idle, crouch_walk, get_up, mid_jump, or a new name")
+                     help="idle, walk, run, crouch_idle, crouch_walk, get_up, mid_jump, a new name, or character "
+                          "(a rigged humanoid .glb that plays the library's clips)")
     add.add_argument("--clips", type=Path, default=argparse.SUPPRESS, metavar="DIR", help="the library folder")
     add_motion_options(add)
     ls = sub.add_parser("list", help="the library's roles: clip, frames, speed, hips height, source")
@@ -97,10 +98,22 @@ def run(args: argparse.Namespace) -> int:
 
     library = ClipLibrary(args.clips or default_library_dir())
     try:
+        from engine.cliplib import character as lib_character
+
+        if args.action == "add" and args.role == lib_character.CHARACTER_ROLE:
+            from engine.io.motion_file import load_joint_map
+
+            chosen = lib_character.set_character(library, args.file,
+                                                 load_joint_map(args.joint_map) if args.joint_map else None)
+            print(f"{chosen.name} is the library's character: play without --character plays it")
+            return 0
         if args.action == "add":
             return _add(library, args)
         if args.action == "list":
             return _list(library)
+        if args.role == lib_character.CHARACTER_ROLE and lib_character.remove_character(library):
+            print("removed the library's character; the mannequin plays again")
+            return 0
         entry = library.remove(args.role)
         print(f"removed the {entry.role} ({entry.file}); the built-in {entry.role} plays it")
         return 0

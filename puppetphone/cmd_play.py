@@ -40,6 +40,10 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--flow", default=None, metavar="FILE",
                         help="snowman: start in the field as a flow file bent it (puppetphone author flow; "
                              "same as --set flow=FILE)")
+    parser.add_argument("--character", default=None, metavar="FILE.glb",
+                        help="the player's puppet is this rigged humanoid (.glb), the puppet's clips retargeted to it")
+    parser.add_argument("--joint-map", default=None, metavar="FILE",
+                        help="with --character: JSON {\"file joint\": \"puppet role\"} when its names and shape do not tell")
     parser.epilog = ("exit codes: 0 the session ran; 2 a bad option value, no display for a window, an input "
                      "that cannot be opened, or a recording of another game")
 
@@ -166,6 +170,15 @@ def run(args: argparse.Namespace) -> int:
         from puppetphone.cmd_clips import library_setup
 
         clips = library_setup(args.clips, replay=hub.replay is not None)
+        if hub.replay is None:  # --character, else the clip library's character (engine.cliplib.character)
+            from engine.character.setup import character_setup
+            from engine.cliplib.character import library_character
+            from engine.cliplib.library import ClipLibrary, default_library_dir
+
+            character = (character_setup(args.character, args.joint_map) if args.character is not None
+                         else library_character(ClipLibrary(args.clips or default_library_dir())))
+            if character is not None:
+                setup = {**game.prepare(options), "character": character}
         activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
                                   source_label=source, clips=clips, view=args.view)
     except (GameOptionError, OSError, ValueError) as exc:

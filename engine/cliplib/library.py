@@ -153,9 +153,22 @@ class ClipLibrary:
             out[role] = clip
         return out
 
-    def _write_manifest(self, entries: Mapping[str, Entry]) -> None:
+    def raw_manifest(self) -> dict[str, object]:
+        """The manifest as JSON (empty without one): what the entries and the ``character`` entry are read from."""
+        if not self.manifest_path.exists():
+            return {}
+        self.entries()  # the checks: size, JSON, format
+        raw = json.loads(self.manifest_path.read_bytes().decode())
+        return raw if isinstance(raw, dict) else {}
+
+    def _write_manifest(self, entries: Mapping[str, Entry], character: object = None, keep: bool = True) -> None:
+        """Write the entries; the ``character`` entry (:mod:`engine.cliplib.character`) is kept unless given or dropped."""
         clips = {r: {"file": e.file, "sha256": e.sha256, "source": e.source} for r, e in sorted(entries.items())}
-        body = {"format": FORMAT, "version": VERSION, "clips": clips}
+        body: dict[str, object] = {"format": FORMAT, "version": VERSION, "clips": clips}
+        if character is None and keep:
+            character = self.raw_manifest().get("character")
+        if character is not None:
+            body["character"] = character
         atomic_write_bytes(self.manifest_path, (json.dumps(body, indent=2) + "\n").encode())
 
     def add(self, clip: Clip, role: str, skeleton: Skeleton, defaults: Mapping[str, Clip], source: str = "") -> Entry:

@@ -27,12 +27,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
-from engine.clip import Clip
+from engine.clip import Clip, RootMotion
 from engine.fk import forward_kinematics
 from engine.io.joint_shape import guess_clip_joint_map
 from engine.skeleton import Skeleton
 
-__all__ = ["retarget", "leg_length", "RetargetWarning", "LARGE_TRANSLATION"]
+__all__ = ["retarget", "retarget_proportions", "leg_length", "RetargetWarning", "LARGE_TRANSLATION"]
 
 LARGE_TRANSLATION = 0.02  # share of the source leg length
 
@@ -239,3 +239,95 @@ def retarget(
     if floor:
         root[:, 1] -= _floor_level(target, root, local)
     return Clip(name or clip.name, target, clip.fps, root, local, loop=clip.loop, markers=dict(clip.markers))
+
+
+def retarget_proportions(clip: Clip, target: Skeleton, name: str | None = None) -> Clip:
+    """``clip`` played by a skeleton of the same joints and rest convention with other bone lengths.
+
+    A character built on the puppet's roles (:mod:`engine.character.rig`) stands like the puppet
+    when every rotation is the identity, so the puppet's clips need no direction alignment: the
+    local rotations carry over as they are. What changes is size: the root's travel, height and
+    root motion scale by the ratio of leg lengths (so a stride fits the legs and a planted foot
+    stays planted when the proportions match), and the motion is lifted or lowered so the lowest
+    foot point sits as high above the floor as it did on the source (:func:`_floor_level`).
+    Markers, loop and frame rate are kept.
+
+    Raises:
+        ValueError: the skeletons differ in joints or hierarchy.
+    """
+    src = clip.skeleton
+    if src.names != target.names or not np.array_equal(src.parents, target.parents):
+        raise ValueError(f"clip {clip.name!r}: the target must have the same joints and hierarchy as its skeleton")
+    ends = [(f"{s}_upper_leg", f"{s}_foot") for s in ("l", "r")]
+    ratios = [leg_length(target, *leg) / leg_length(src, *leg) for leg in ends
+              if all(n in src.names for n in leg) and leg_length(src, *leg) > 1e-9]
+    k = float(np.mean(ratios)) if ratios else float(target.offsets[0, 1] / max(src.offsets[0, 1], 1e-9))
+    root = k * np.asarray(clip.root, dtype=np.float64)
+    floor = _floor_level(src, clip.root, clip.rotations)
+    root[:, 1] += floor - _floor_level(target, root, clip.rotations)
+    rotations = np.array(clip.rotations)
+    legs = [[target.index(n) for n in leg] for leg in _LEGS if all(n in target.names for n in leg)]
+    goals = [_ankle_goal(clip, target, leg, k) for leg in legs]
+    if legs:
+        root[:, 1] -= _reach_drop(target, root, rotations, legs, goals)
+    for leg, goal in zip(legs, goals):
+        _plant_leg(clip, target, root, rotations, leg, goal)
+    motion = clip.root_motion
+    if motion is not None:
+        motion = RootMotion(k * np.asarray(motion.translation, dtype=np.float64), np.array(motion.heading))
+    return Clip(name or clip.name, target, clip.fps, root, rotations, loop=clip.loop, root_motion=motion,
+                markers=dict(clip.markers))
+
+
+_LEGS = (("l_upper_leg", "l_lower_leg", "l_foot"), ("r_upper_leg", "r_lower_leg", "r_foot"))
+
+
+def _ankle_goal(clip: Clip, target: Skeleton, leg: list[int], k: float) -> F64:
+    """``[F,3]`` where the target's ankle goes so its toe tip follows the source's: scaled by ``k`` across the
+    floor, at the source's height above it."""
+    src = clip.skeleton
+    foot = leg[2]
+    s_pos, s_rot = forward_kinematics(src, clip.root, clip.rotations)
+    toe = s_pos[:, foot] + quat.rotate(s_rot[:, foot], src.tips[foot])
+    goal = k * toe
+    goal[:, 1] = toe[:, 1]  # the source's clearance, not scaled: a smaller character's toes still clear the floor
+    return goal - quat.rotate(s_rot[:, foot], target.tips[foot])
+
+
+def _reach_drop(target: Skeleton, root: F64, rotations: F64, legs: list[list[int]], goals: list[F64],
+                most: float = 0.995) -> float:
+    """How far to lower the whole clip so every ankle goal is within ``most`` of its leg's length.
+
+    The character's ankle may sit higher over its sole than the source's, scaled: standing the
+    hips as high as the source's, scaled, would leave its legs a few centimetres short."""
+    pos, _ = forward_kinematics(target, root, rotations)
+    drop = 0.0
+    for leg, goal in zip(legs, goals):
+        reach = most * float(np.linalg.norm(target.offsets[leg[1]]) + np.linalg.norm(target.offsets[leg[2]]))
+        d = pos[:, leg[0]] - goal
+        across = np.minimum(d[:, 0] ** 2 + d[:, 2] ** 2, reach**2)
+        drop = max(drop, float(np.max(d[:, 1] - np.sqrt(reach**2 - across))))
+    return max(drop, 0.0)
+
+
+def _plant_leg(clip: Clip, target: Skeleton, root: F64, rotations: F64, leg: list[int], ankle: F64) -> None:
+    """Re-solve one leg of :func:`retarget_proportions` so its ankle reaches ``ankle`` (:func:`_ankle_goal`).
+
+    Copied rotations keep a foot planted only when every leg bone scales alike; a character's
+    foot is rarely the puppet's foot scaled (CesiumMan's ankle is high, its toes long), so a
+    heel-off rolling over the puppet's toe would roll the character's toe forward. The foot
+    keeps the source's world rotation and the two-bone leg solve (knee towards where the
+    source's knee points) reaches the ankle that puts the toe on its goal. ``rotations`` is
+    changed in place.
+    """
+    from engine.clips._legik import solve_leg
+
+    upper, lower, foot = leg
+    _, s_rot = forward_kinematics(clip.skeleton, clip.root, clip.rotations)
+    t_pos, t_rot = forward_kinematics(target, root, rotations)
+    pole = quat.rotate(s_rot[:, upper], np.array([0.0, 0.0, 1.0]))
+    parent = int(target.parents[upper])
+    thigh = float(np.linalg.norm(target.offsets[lower]))
+    shin = float(np.linalg.norm(target.offsets[foot]))
+    sol = solve_leg(t_pos[:, upper], t_rot[:, parent], ankle, pole, s_rot[:, foot], thigh, shin)
+    rotations[:, upper], rotations[:, lower], rotations[:, foot] = sol.upper, sol.knee, sol.foot

@@ -34,20 +34,19 @@ import numpy as np
 
 from engine.app import App
 from engine.atomic import WriteError, atomic_write_bytes, set_aside
-from engine.npz_safe import read_bounded
 from engine.components import Transform
 from engine.ecs import World
+from engine.npz_safe import read_bounded
 from engine.ragdoll.components import Prop
 from engine.recovery import Rescue
-from engine.render.components import Appearance
-from engine.statemachine.puppet import PuppetBody, spawn_puppet
+from engine.statemachine.puppet import PuppetBody
 from games.common import post_notice
 from games.snowman.alive import bring_to_life
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
 from games.snowman.rig import SnowmanShape
 from games.snowman.rules import spawn_ball
 from games.snowman.snow import SnowField
-from input.sample import InputFrame, RESET, RESTORE, SAVE
+from input.sample import RESET, RESTORE, SAVE, InputFrame
 
 __all__ = ["FIELD_VERSION", "FieldError", "FieldSlot", "snapshot", "restore", "spawn_first_puppet", "field_commands",
            "default_field_path", "load_field", "install_field_slot", "prepare", "replay_setup"]
@@ -84,7 +83,9 @@ class FieldSlot:
 def spawn_first_puppet(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
                        heading: float = 0.0) -> int:
     """The player's puppet (red), as at the start of a game."""
-    return spawn_puppet(world, position, heading, name="puppet", extra=(Appearance(color=PUPPET_COLOR),))
+    from games.common import spawn_player
+
+    return spawn_player(world, position, heading, name="puppet", color=PUPPET_COLOR)
 
 
 def _encode_depth(depth: np.ndarray) -> dict[str, Any]:
