@@ -113,3 +113,42 @@ def test_brain_is_hashable_state():
     h0 = state_hash(w)
     step_machine(w, e, w.get(e, type(m.new_brain())))
     assert state_hash(w) != h0
+
+
+def test_step_machines_steps_quiet_entities_over_arrays_and_the_rest_alone() -> None:
+    """Entities an array guard flags, and those with events, take their transitions as alone; the
+    others get the array update once, together. Fails if flagged rows were array-updated, if the
+    event were missed, or if the array update ran per entity."""
+    import numpy as np
+
+    from engine.statemachine import step_machines
+
+    calls: list[list[int]] = []
+
+    def fast(w, cols, rows):  # type: ignore[no-untyped-def]
+        return cols[rows] > 2.0  # over-approximates high_speed: it is only a filter
+
+    states = [
+        State("ragdoll"),
+        State("idle", batch_update=lambda w, cols, rows: calls.append([int(r) for r in rows])),
+        State("run"),
+        State("jump"),
+    ]
+    transitions = [
+        Transition("idle", "run", guard=lambda w, e, b: w.get(e, Speed).value > 2.0, batch_guard=fast),
+        Transition("idle", "jump", event="flick"),
+    ]
+    m = StateMachine("arrays", states, transitions, default="ragdoll", initial="idle")
+    assert m.batchable("idle") and not m.batchable("run")
+    w = World()
+    speeds = [0.0, 3.0, 1.0, 0.5]
+    es = [w.spawn(Speed(v)) for v in speeds]
+    bs = [m.new_brain() for _ in es]
+    cols = np.array(speeds)
+    step_machines(w, es, bs, cols)  # the first step enters the initial state, one by one
+    assert [b.active for b in bs] == ["idle"] * 4 and calls == []
+    bs[3].raise_event("flick")
+    step_machines(w, es, bs, cols)
+    assert [b.active for b in bs] == ["idle", "run", "idle", "jump"]
+    assert calls == [[0, 2]]
+    assert bs[0].time_in_state == pytest.approx(2 * w.dt) and bs[1].time_in_state == pytest.approx(w.dt)
