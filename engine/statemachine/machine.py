@@ -41,8 +41,18 @@ from numpy.typing import NDArray
 
 from engine.ecs import Entity, World
 
-__all__ = ["State", "Transition", "StateMachine", "Brain", "TraceEntry", "step_machine", "step_machines", "ANY",
-           "BatchGuard", "BatchUpdate"]
+__all__ = [
+    "ANY",
+    "BatchGuard",
+    "BatchUpdate",
+    "Brain",
+    "State",
+    "StateMachine",
+    "TraceEntry",
+    "Transition",
+    "step_machine",
+    "step_machines",
+]
 
 ANY = "*"
 C = TypeVar("C")

@@ -21,7 +21,23 @@ from engine.statemachine.puppet.plugin import PuppetMachine, brain_system, insta
 from engine.statemachine.puppet.spec import PuppetColumns, StateSpec
 
 __all__ = [
-    "PoseOverride", "PuppetBody", "PuppetTuning", "Jumping", "JumpPhase", "Landing", "GettingUp", "Handling",
-    "STATE_NAMES", "BUILT_IN", "puppet_machine", "PuppetState", "PuppetEvent", "PuppetColumns", "StateSpec",
-    "PuppetMachine", "brain_system", "install_puppets", "spawn_puppet",
+    "BUILT_IN",
+    "STATE_NAMES",
+    "GettingUp",
+    "Handling",
+    "JumpPhase",
+    "Jumping",
+    "Landing",
+    "PoseOverride",
+    "PuppetBody",
+    "PuppetColumns",
+    "PuppetEvent",
+    "PuppetMachine",
+    "PuppetState",
+    "PuppetTuning",
+    "StateSpec",
+    "brain_system",
+    "install_puppets",
+    "puppet_machine",
+    "spawn_puppet",
 ]

@@ -26,10 +26,26 @@ from engine.statemachine.puppet.body import Handling, PuppetBody
 from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity
 from engine.statemachine.puppet.follow_legacy import follow_stick_legacy
 from engine.statemachine.puppet.names import PuppetState
-from engine.statemachine.puppet.spec import PuppetColumns, PuppetStateDef, PuppetTransition, StateSpec, free_rows, held_rows
+from engine.statemachine.puppet.spec import (
+    PuppetColumns,
+    PuppetStateDef,
+    PuppetTransition,
+    StateSpec,
+    free_rows,
+    held_rows,
+)
 
-__all__ = ["follow_stick", "update_locomotion", "update_locomotion_batch", "update_crouch", "locomotion_fits",
-           "wants_crouch", "wants_stand", "lifted", "SPEC"]
+__all__ = [
+    "SPEC",
+    "follow_stick",
+    "lifted",
+    "locomotion_fits",
+    "update_crouch",
+    "update_locomotion",
+    "update_locomotion_batch",
+    "wants_crouch",
+    "wants_stand",
+]
 
 
 def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0,

@@ -76,7 +76,7 @@ def _take_off(world: World, entity: Entity, body: PuppetBody, jump: Jumping, sti
     start = tr.position + np.array([0.0, t.stand_height, 0.0])
     rising = stick is not None and float(wanted_anchor(stick)[1]) > t.stand_height + 0.1 and stick.velocity[1] > 0.5
     jump.from_stick = bool(rising)
-    if rising:
+    if rising and stick is not None:
         velocity = stick.velocity.copy()
     else:
         horizontal = np.array([jump.air_velocity[0], 0.0, jump.air_velocity[2]])

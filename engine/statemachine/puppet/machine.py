@@ -16,7 +16,7 @@ from engine.statemachine.puppet import fall_states, ground_states, jump_state, o
 from engine.statemachine.puppet.names import PuppetState
 from engine.statemachine.puppet.spec import PuppetColumns, StateSpec
 
-__all__ = ["puppet_machine", "STATE_NAMES", "BUILT_IN"]
+__all__ = ["BUILT_IN", "STATE_NAMES", "puppet_machine"]
 
 BUILT_IN: tuple[StateSpec, ...] = (ground_states.SPEC, jump_state.SPEC, fall_states.SPEC, object_states.SPEC)
 """The state modules every puppet runs, in the order their transitions are declared."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from enum import StrEnum
 
-__all__ = ["PuppetState", "PuppetEvent"]
+__all__ = ["PuppetEvent", "PuppetState"]
 
 
 class PuppetState(StrEnum):

@@ -22,7 +22,7 @@ from engine.ecs import Entity, World
 from engine.statemachine.machine import Rows, State, Transition
 from engine.statemachine.puppet.body import PuppetBody
 
-__all__ = ["PuppetColumns", "StateSpec", "PuppetStateDef", "PuppetTransition", "held_rows", "free_rows"]
+__all__ = ["PuppetColumns", "PuppetStateDef", "PuppetTransition", "StateSpec", "free_rows", "held_rows"]
 
 
 @dataclass

@@ -21,7 +21,7 @@ __all__ = ["describe_puppet", "RUN_FRACTION"]
 RUN_FRACTION = 0.55
 """Ground speed, as a fraction of the puppet's top speed, from which it reads as running."""
 
-_FIXED = {
+_FIXED: dict[str, str] = {
     PuppetState.LAND: "landing",
     PuppetState.GET_UP: "getting up",
     PuppetState.PICK_UP: "picking up a ball",
