@@ -40,6 +40,7 @@ from engine.clips.contacts import HEEL_OFFSET
 from engine.components import Grabbable, Puppet, Stick, Transform, WorldPose
 from engine.statemachine import Brain
 from engine.statemachine.puppet.body import Jumping, PuppetBody
+from engine.statemachine.puppet.names import PuppetState
 from input.hub import InputHub
 from input.motionstick import StickConfig
 from input.mouse import MouseSource
@@ -321,7 +322,7 @@ def motion_figures(case: Case, run: Run) -> MotionFigures:
         lowest_sole=float(np.nanmin(soles)),
         time_to_90=t90,
         time_to_rest=rest,
-        fell="Ragdoll" in run.states,
+        fell=PuppetState.RAGDOLL in run.states,
     )
 
 
@@ -399,10 +400,10 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
         d.step(hand)
     run = d.result()
     states = run.states
-    fell = "Ragdoll" in states
+    fell = PuppetState.RAGDOLL in states
     reason = next((j.invalid.value for j in run.jumps if j.invalid is not None), None)
-    jumped = [i for i, s in enumerate(states) if s == "Jump"]
-    landed = bool(jumped) and "Land" in states[jumped[0]:] and not fell
+    jumped = [i for i, s in enumerate(states) if s == PuppetState.JUMP]
+    landed = bool(jumped) and PuppetState.LAND in states[jumped[0]:] and not fell
     apex_error = delay = None
     if jumped:
         air = [i for i in jumped if run.jumps[i].progress is not None]
@@ -411,7 +412,7 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
             top = max(float(run.position[i][1]) for i in air) + d.world.get(d.puppet, PuppetBody).tuning.stand_height
             apex_error = None if predicted is None else abs(top - predicted)
             delay = (air[0] - start) * dt
-    land = [i for i, s in enumerate(states) if s == "Land"]
+    land = [i for i, s in enumerate(states) if s == PuppetState.LAND]
     landing_speed = None
     if len(land) > 1:
         span = run.position[land[-1]] - run.position[land[0]]
