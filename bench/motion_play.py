@@ -39,7 +39,8 @@ from engine.blend.locomotion import LocomotionPlayer
 from engine.clips.contacts import HEEL_OFFSET
 from engine.components import Grabbable, Puppet, Stick, Transform, WorldPose
 from engine.statemachine import Brain
-from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.body import Jumping, PuppetBody
+from engine.statemachine.puppet.names import PuppetState
 from input.hub import InputHub
 from input.motionstick import StickConfig
 from input.mouse import MouseSource
@@ -119,7 +120,7 @@ class Run:
     heels: F  # [T, 2, 3]
     position: F  # [T, 3]
     states: list[str]
-    brains: list[dict]
+    jumps: list[Jumping]
 
 
 class _Phone(PoseSource):
@@ -168,7 +169,7 @@ class _Driver:
         self.orientation = quat.identity()
         self.lift = 0.0  # phone height offset / mouse cursor rise in pixels (flicks)
         self.run = Run(self.world.dt, np.zeros((0, 2, 3)), np.zeros((0, 2, 3)), np.zeros((0, 3)), [], [])
-        self._rows: list[tuple[F, F, F, str, dict]] = []
+        self._rows: list[tuple[F, F, F, str, Jumping]] = []
         self.airborne: list[float | None] = []  # per step: the airborne clip's time, while it plays
 
     # -- devices ------------------------------------------------------------------
@@ -230,7 +231,7 @@ class _Driver:
         pos = self.world.get(self.puppet, Transform).position.copy()
         player = self.world.get(self.puppet, LocomotionPlayer)
         self.airborne.append(player.override_time if player.override == "mid_jump" else None)
-        self._rows.append((toes, heels, pos, brain.active, dict(brain.memory)))
+        self._rows.append((toes, heels, pos, brain.active, replace(self.world.get(self.puppet, Jumping))))
 
     def grab(self) -> None:
         """Settle, point at the puppet's hips and press (a phone calibrates first)."""
@@ -327,7 +328,7 @@ def motion_figures(case: Case, run: Run) -> MotionFigures:
         lowest_sole=float(np.nanmin(soles)),
         time_to_90=t90,
         time_to_rest=rest,
-        fell="Ragdoll" in run.states,
+        fell=PuppetState.RAGDOLL in run.states,
     )
 
 
@@ -405,19 +406,19 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
         d.step(hand)
     run = d.result()
     states = run.states
-    fell = "Ragdoll" in states
-    reason = next((m.get("jump_invalid") for m in run.brains if m.get("jump_invalid")), None)
-    jumped = [i for i, s in enumerate(states) if s == "Jump"]
-    landed = bool(jumped) and "Land" in states[jumped[0]:] and not fell
+    fell = PuppetState.RAGDOLL in states
+    reason = next((j.invalid.value for j in run.jumps if j.invalid is not None), None)
+    jumped = [i for i, s in enumerate(states) if s == PuppetState.JUMP]
+    landed = bool(jumped) and PuppetState.LAND in states[jumped[0]:] and not fell
     apex_error = delay = None
     if jumped:
-        air = [i for i in jumped if run.brains[i].get("jump_progress") is not None]
+        air = [i for i in jumped if run.jumps[i].progress is not None]
         if air:
-            predicted = run.brains[air[0]].get("jump_apex_height")
+            predicted = run.jumps[air[0]].apex_height
             top = max(float(run.position[i][1]) for i in air) + d.world.get(d.puppet, PuppetBody).tuning.stand_height
             apex_error = None if predicted is None else abs(top - predicted)
             delay = (air[0] - start) * dt
-    land = [i for i, s in enumerate(states) if s == "Land"]
+    land = [i for i, s in enumerate(states) if s == PuppetState.LAND]
     landing_speed = None
     if len(land) > 1:
         span = run.position[land[-1]] - run.position[land[0]]

@@ -20,7 +20,7 @@ from engine.blend.locomotion import LocomotionPlayer
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
-from engine.statemachine.puppet import PuppetBody
+from engine.statemachine.puppet import Jumping, PuppetBody
 from engine.statemachine.puppet.senses import yaw_rotation
 
 __all__ = ["Wanderer", "wander_system", "install_wander"]
@@ -41,7 +41,7 @@ class Wanderer:
 def wander_system(world: World) -> None:
     """Steer every free wanderer toward its goal; pick a new goal when one is reached."""
     rows = [(w, body, tr, player) for e, w, body in world.query(Wanderer, PuppetBody)
-            if body.held_by is None and body.air == 0.0
+            if body.held_by is None and ((jump := world.try_get(e, Jumping)) is None or jump.air == 0.0)
             and (rd := world.try_get(e, Ragdoll)) is not None and rd.mode is RagdollMode.ANIMATED
             and (tr := world.try_get(e, Transform)) is not None
             and (player := world.try_get(e, LocomotionPlayer)) is not None]

@@ -28,6 +28,7 @@ from engine.render.scene import RenderScene
 from engine.render.target import save_image
 from engine.runner import RunOptions, Runner
 from engine.statemachine import Brain
+from engine.statemachine.puppet import PuppetState
 from games.snowman.components import Snowman
 from games.snowman.game import GAME
 from input.hub import InputHub
@@ -47,7 +48,7 @@ FIELD_CAMERA = OrbitCamera(target=[0.0, 0.9, 0.0], yaw=0.15, pitch=0.15, distanc
 
 
 def _rolling_big(world: World) -> bool:
-    return any(brain.active == "RollSnowball" and not world.has(e, Snowman) and _rolled_radius(world) > 0.3
+    return any(brain.active == PuppetState.ROLL_SNOWBALL and not world.has(e, Snowman) and _rolled_radius(world) > 0.3
                for e, brain in world.query(Brain))
 
 
@@ -61,7 +62,7 @@ def _lifted_high(world: World) -> bool:
 
 
 def _carrying(world: World) -> bool:
-    return any(brain.active == "Carry" for _, brain in world.query(Brain))
+    return any(brain.active == PuppetState.CARRY for _, brain in world.query(Brain))
 
 
 def _alive(world: World) -> bool:
@@ -69,7 +70,7 @@ def _alive(world: World) -> bool:
 
 
 def _snowman_rolling(world: World) -> bool:
-    return any(brain.active == "RollSnowball" and world.has(e, Snowman) for e, brain in world.query(Brain))
+    return any(brain.active == PuppetState.ROLL_SNOWBALL and world.has(e, Snowman) for e, brain in world.query(Brain))
 
 
 STAGES: dict[str, Callable[[World], bool]] = {

@@ -2,7 +2,8 @@
 
 The definition (:class:`StateMachine`) is an immutable asset shared by every puppet
 that uses it; what changes per step lives in the :class:`Brain` component (active
-state, time in it, the cross-fade in progress, the trace of transitions).
+state, time in it, the cross-fade in progress, the trace of transitions). Per-state
+data belongs in the entity's own typed components, not in the brain.
 
 Each step :func:`step_machine`:
 
@@ -17,21 +18,51 @@ Each step :func:`step_machine`:
 
 Guards and callbacks take ``(world, entity, brain)``; they read the context
 (stick, ground, nearby objects) from the world and write the animation request.
+
+:func:`step_machines` steps many entities at once. A crowd is mostly entities in a
+common state with nothing happening, so a state may give its guards an *array* form
+(``Transition.batch_guard``, ``State.batch_fits``) and its update one
+(``State.batch_update``): these run once over every entity in the state, on columns
+the caller gathered (the context ``C``), and only the entities an array guard flags,
+those with events, and those in states without array forms go through
+:func:`step_machine` one by one. An array guard may over-approximate (``True`` means
+"evaluate this one in Python"), ``batch_fits`` may under-approximate; so a flagged
+entity is simply evaluated exactly, and the result is the same as stepping each alone.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Generic, TypeVar
+
+import numpy as np
+from numpy.typing import NDArray
 
 from engine.ecs import Entity, World
 
-__all__ = ["State", "Transition", "StateMachine", "Brain", "TraceEntry", "step_machine", "ANY"]
+__all__ = [
+    "ANY",
+    "BatchGuard",
+    "BatchUpdate",
+    "Brain",
+    "State",
+    "StateMachine",
+    "TraceEntry",
+    "Transition",
+    "step_machine",
+    "step_machines",
+]
 
 ANY = "*"
+C = TypeVar("C")
 Callback = Callable[[World, Entity, "Brain"], None]
 Guard = Callable[[World, Entity, "Brain"], bool]
+Rows = NDArray[np.intp]
+BatchGuard = Callable[[World, C, Rows], NDArray[np.bool_]]
+"""``(world, columns, rows) -> mask``: the array form of a guard over the entities ``rows`` of the columns."""
+BatchUpdate = Callable[[World, C, Rows], None]
+"""``(world, columns, rows)``: the array form of a state's update, for entities no transition left."""
 
 
 def _nothing(world: World, entity: Entity, brain: Brain) -> None:
@@ -43,8 +74,8 @@ def _always(world: World, entity: Entity, brain: Brain) -> bool:
 
 
 @dataclass(frozen=True)
-class State:
-    """A state's behaviour: ``enter``/``update``/``exit`` callbacks and a ``fits`` guard."""
+class State(Generic[C]):
+    """A state's behaviour: ``enter``/``update``/``exit`` callbacks, a ``fits`` guard, and their array forms."""
 
     name: str
     enter: Callback = _nothing
@@ -52,11 +83,15 @@ class State:
     exit: Callback = _nothing
     fits: Guard = _always
     description: str = ""
+    batch_update: BatchUpdate[C] | None = None
+    batch_fits: BatchGuard[C] | None = None
 
 
 @dataclass(frozen=True)
-class Transition:
-    """An edge: from ``source`` (or ``ANY``) to ``target`` on ``event`` and/or when ``guard`` holds."""
+class Transition(Generic[C]):
+    """An edge: from ``source`` (or ``ANY``) to ``target`` on ``event`` and/or when ``guard`` holds.
+
+    ``batch_guard`` is the guard over arrays (see :func:`step_machines`)."""
 
     source: str
     target: str
@@ -65,6 +100,7 @@ class Transition:
     priority: int = 0
     crossfade: float = 0.2
     label: str = ""
+    batch_guard: BatchGuard[C] | None = None
 
     def fires(self, world: World, entity: Entity, brain: Brain, events: Sequence[str]) -> bool:
         """Whether this transition should be taken now."""
@@ -89,7 +125,7 @@ class TraceEntry:
 class Brain:
     """Per-entity runtime state of a state machine (a component)."""
 
-    machine: StateMachine = field(metadata={"hash": False})
+    machine: StateMachine[Any] = field(metadata={"hash": False})
     active: str = ""
     time_in_state: float = 0.0
     crossfade: float = 0.0
@@ -98,7 +134,6 @@ class Brain:
     pending_events: list[str] = field(default_factory=list)
     last_events: list[str] = field(default_factory=list)
     trace: list[TraceEntry] = field(default_factory=list)
-    memory: dict[str, Any] = field(default_factory=dict)
     max_trace: int = 256
 
     def raise_event(self, name: str) -> None:
@@ -113,10 +148,11 @@ class Brain:
         return 1.0 - self.crossfade / self.crossfade_total
 
 
-class StateMachine:
+class StateMachine(Generic[C]):
     """An immutable graph of states and transitions with a default state."""
 
-    def __init__(self, name: str, states: Sequence[State], transitions: Sequence[Transition], default: str, initial: str | None = None) -> None:
+    def __init__(self, name: str, states: Sequence[State[C]], transitions: Sequence[Transition[C]], default: str,
+                 initial: str | None = None) -> None:
         self.name = name
         self.states = {s.name: s for s in states}
         if len(self.states) != len(states):
@@ -134,20 +170,30 @@ class StateMachine:
         if self.initial not in self.states:
             raise ValueError(f"{name}: initial state {self.initial!r} is not a state")
         self.transitions = tuple(transitions)
-        self._outgoing: dict[str, list[Transition]] = {}
-        for s in self.states:
+        self._outgoing: dict[str, list[Transition[C]]] = {}
+        self._batchable: dict[str, bool] = {}
+        for s, state in self.states.items():
             out = [t for t in transitions if t.source in (s, ANY) and t.target != s]
             # Highest priority first; among equals, specific before ANY, then declaration order.
             out.sort(key=lambda t: (-t.priority, t.source == ANY))
             self._outgoing[s] = out
+            # A state is stepped over arrays only if every way out of it has an array guard
+            # (event transitions need no guard: an entity with events is stepped alone).
+            self._batchable[s] = state.batch_update is not None and (
+                state.fits is _always or state.batch_fits is not None) and all(
+                t.batch_guard is not None or t.guard is None for t in out)
 
     def new_brain(self) -> Brain:
         """A component starting in the initial state (``enter`` runs on the first step)."""
         return Brain(machine=self, active="")
 
-    def outgoing(self, state: str) -> list[Transition]:
+    def outgoing(self, state: str) -> list[Transition[C]]:
         """Transitions leaving ``state``, in evaluation order."""
         return self._outgoing[state]
+
+    def batchable(self, state: str) -> bool:
+        """Whether entities in ``state`` can be stepped over arrays (see :func:`step_machines`)."""
+        return self._batchable[state]
 
     def to_dot(self) -> str:
         """The graph in Graphviz DOT: the default state double-circled, edges labelled."""
@@ -173,7 +219,7 @@ def _switch(world: World, entity: Entity, brain: Brain, target: str, reason: str
     brain.trace.append(TraceEntry(world.frame, brain.active or "-", target, reason))
     if len(brain.trace) > brain.max_trace:
         del brain.trace[: len(brain.trace) - brain.max_trace]
-    brain.previous, brain.active = brain.active, target
+    brain.previous, brain.active = brain.active, machine.states[target].name
     brain.time_in_state = 0.0
     brain.crossfade = brain.crossfade_total = crossfade
     machine.states[target].enter(world, entity, brain)
@@ -198,3 +244,50 @@ def step_machine(world: World, entity: Entity, brain: Brain) -> None:
     machine.states[brain.active].update(world, entity, brain)
     brain.time_in_state += world.dt
     brain.crossfade = max(0.0, brain.crossfade - world.dt)
+
+
+def _quiet_rows(world: World, machine: StateMachine[C], state: str, columns: C, rows: Rows) -> NDArray[np.bool_]:
+    """Which of ``rows`` (all in ``state``, without events) certainly stay in it: no array guard flags them."""
+    stay = np.ones(len(rows), dtype=bool)
+    for t in machine.outgoing(state):
+        if t.batch_guard is not None:
+            stay &= ~t.batch_guard(world, columns, rows)
+    fits = machine.states[state].batch_fits
+    if fits is not None:
+        stay &= fits(world, columns, rows)
+    return stay
+
+
+def step_machines(world: World, entities: Sequence[Entity], brains: Sequence[Brain], columns: C) -> None:
+    """Advance many entities' machines by one step: over arrays where nothing happens, one by one elsewhere.
+
+    ``columns`` is what the array guards and updates of the machine read (gathered by the
+    caller, row ``i`` for ``entities[i]``). The entities stepped one by one go in entity
+    order, after the array updates; an array guard or update must therefore read and
+    write only its own entities' components (what :func:`step_machine` of another
+    entity changes cannot decide it).
+    """
+    groups: dict[tuple[int, str], list[int]] = {}
+    single: list[int] = []
+    for i, brain in enumerate(brains):
+        if brain.active and not brain.pending_events and brain.machine.batchable(brain.active):
+            groups.setdefault((id(brain.machine), brain.active), []).append(i)
+        else:
+            single.append(i)
+    dt = world.dt
+    for (_, state), members in groups.items():
+        rows = np.array(members, dtype=np.intp)
+        machine = brains[members[0]].machine
+        stay = _quiet_rows(world, machine, state, columns, rows)
+        quiet = rows[stay]
+        single.extend(int(i) for i in rows[~stay])
+        if len(quiet):
+            update = machine.states[state].batch_update
+            assert update is not None  # batchable() checked it
+            update(world, columns, quiet)
+            for i in quiet:
+                brain = brains[i]
+                brain.time_in_state += dt
+                brain.crossfade = max(0.0, brain.crossfade - dt)
+    for i in sorted(single):
+        step_machine(world, entities[i], brains[i])

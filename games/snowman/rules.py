@@ -21,7 +21,7 @@ from engine.components import Grabbable, Stick, Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
 from engine.statemachine import Brain
-from engine.statemachine.puppet import PuppetBody
+from engine.statemachine.puppet import Handling, PuppetBody, PuppetState
 from engine.statemachine.puppet.senses import heading_vector, prop_in_front
 from games.snowman.alive import bring_to_life
 from games.snowman.assembly import Ball, find_snowmen, resting_matrix
@@ -50,7 +50,7 @@ def spawn_ball(world: World, position: np.ndarray, radius: float) -> int:
 
 def _held(world: World) -> set[int]:
     return {s.grabbed for _, s in world.query(Stick) if s.grabbed is not None} | {
-        b.object for _, b in world.query(PuppetBody) if b.object is not None
+        h.object for _, h in world.query(Handling) if h.object is not None
     }
 
 
@@ -129,21 +129,21 @@ def snow_drag(world: World) -> None:
 def aim_putdown_on_stacks(world: World) -> None:
     """A puppet putting a ball down onto a stack puts it on the stack's top ball.
 
-    The brain aims at the first free ball in front (``putdown_on``); balls already
+    The brain aims at the first free ball in front (``Handling.onto``); balls already
     packed on it are ``carried`` and invisible to it, so it would press the new ball
     into them. This rule climbs the stack to its top and aims there while the top ball
     is still the bigger one.
     """
     on = {s.on: e for e, s in world.query(Stacked)}
-    for _, body, brain in world.query(PuppetBody, Brain):
-        base = brain.memory.get("putdown_on")
-        if brain.active != "PutDown" or base not in on or body.object is None or not world.alive(body.object):
+    for _, hand, brain in world.query(Handling, Brain):
+        base, ball = hand.onto, hand.object
+        if brain.active != PuppetState.PUT_DOWN or base not in on or ball is None or not world.alive(ball):
             continue
         top = base
-        while top in on and on[top] != body.object:
+        while top in on and on[top] != ball:
             top = on[top]
-        if world.get(top, Prop).radius > world.get(body.object, Prop).radius:
-            brain.memory["putdown_on"] = top
+        if world.get(top, Prop).radius > world.get(ball, Prop).radius:
+            hand.onto = top
 
 
 def start_snowballs(world: World) -> None:
@@ -154,7 +154,7 @@ def start_snowballs(world: World) -> None:
     for e, body, brain, tr, player in world.query(PuppetBody, Brain, Transform, LocomotionPlayer):
         # The puppet itself must be under way (not only the stick): a ball packed at the
         # feet of a puppet still crouching in place lands in its hands' collision shapes.
-        if brain.active != "Crouch" or body.held_by is None or body.speed < 0.3 or player.speed < 0.3 or brain.time_in_state < 0.4:
+        if brain.active != PuppetState.CROUCH or body.held_by is None or body.speed < 0.3 or player.speed < 0.3 or brain.time_in_state < 0.4:
             continue
         if count >= MAX_BALLS or prop_in_front(world, e, body, 1.0) is not None:
             continue
@@ -202,4 +202,4 @@ def assemble_snowmen(world: World) -> None:
 
 def snowmen_standing(world: World) -> int:
     """How many snowmen are alive and on their feet (not a ragdoll)."""
-    return sum(1 for _, _, brain in world.query(Snowman, Brain) if brain.active not in ("Ragdoll", "GetUp"))
+    return sum(1 for _, _, brain in world.query(Snowman, Brain) if brain.active not in (PuppetState.RAGDOLL, PuppetState.GET_UP))

@@ -1,22 +1,30 @@
 """What a puppet's brain keeps between steps, and the tuning it reads.
 
-:class:`PuppetBody` is the per-puppet component (hashed: it is simulation state);
-:class:`PuppetTuning` holds the thresholds of the behaviour — immutable data a game
-may replace (a snowman jumps lower, its crouch is shallower).
+:class:`PuppetBody` is what every state reads: the stick as the puppet senses it and
+the locomotion control (hashed: it is simulation state). What only some states use
+lives in a small component of its own, present on every puppet and reset by the
+state that owns it: :class:`Jumping` (Jump), :class:`Landing` (Land),
+:class:`GettingUp` (GetUp) and :class:`Handling` (PickUp, Carry, PutDown,
+RollSnowball) — so a game rule reads or steers a puppet through typed fields, never
+through string keys. :class:`PuppetTuning` holds the thresholds of the behaviour —
+immutable data a game may replace (a snowman jumps lower, its crouch is shallower).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from enum import Enum
 
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.ecs import Entity
 from engine.pose import Pose
-from engine.statemachine.jump_arc import JumpTracker
+from engine.ragdoll.getup import GetUpBlend, LyingOrientation
+from engine.statemachine.jump_arc import JumpStatus, JumpTracker
 
-__all__ = ["PuppetBody", "PuppetTuning", "PoseOverride"]
+__all__ = ["PuppetBody", "PuppetTuning", "PoseOverride", "Jumping", "JumpPhase", "Landing", "GettingUp", "Handling",
+           "PUPPET_COMPONENTS"]
 
 F = NDArray[np.float64]
 
@@ -75,7 +83,7 @@ class PoseOverride:
 
 @dataclass
 class PuppetBody:
-    """Per-puppet brain state.
+    """What every state of a puppet reads: the stick as sensed, the facing and the locomotion control.
 
     Attributes:
         tuning: behaviour thresholds (an asset).
@@ -91,17 +99,8 @@ class PuppetBody:
             spring's ``walk_velocity``), oldest first: a jump goes where the hand was leading
             just before the flick (a puppet still turning round after a reversal jumps the way
             it is led), not where a stroke's burst of mouse events jerked the request.
-        air: height of the root above the ground during a jump.
-        air_velocity: the puppet's velocity while airborne (ballistic jumps).
         ground_velocity: the puppet's measured ground velocity over the last step (its momentum).
         last_position: where it stood a step ago (for ``ground_velocity``).
-        jump: the arc tracker of the current jump.
-        land_depth: how deep the landing crouch goes (0..1 of a full crouch), from the landing speed.
-        jump_from_stick: whether the stick's own path drives the arc (phones) or a flick launched it (mouse).
-        object: the prop carried or rolled.
-        timer: seconds in the current phase of a multi-phase state.
-        phase: the phase name within a state (``"anticipation"``, ``"air"``…).
-        getup: the get-up blend in progress (an object; its frame is hashed through ``timer``).
     """
 
     tuning: PuppetTuning = field(default_factory=PuppetTuning, metadata={"hash": False})
@@ -114,14 +113,81 @@ class PuppetBody:
     walk_velocity: F = field(default_factory=lambda: np.zeros(3))
     walk_rate: F = field(default_factory=lambda: np.zeros(3))
     recent: F = field(default_factory=lambda: np.zeros((12, 3)))
-    air: float = 0.0
-    air_velocity: F = field(default_factory=lambda: np.zeros(3))
     ground_velocity: F = field(default_factory=lambda: np.zeros(3))
     last_position: F | None = None
-    jump: JumpTracker | None = None
-    land_depth: float = 0.7
-    jump_from_stick: bool = False
-    object: int | None = None
+
+
+class JumpPhase(Enum):
+    """The two parts of a jump: the squat before take-off, then the arc."""
+
+    ANTICIPATION = "anticipation"
+    AIR = "air"
+
+
+@dataclass
+class Jumping:
+    """The Jump state's data (:mod:`~engine.statemachine.puppet.jump_state`).
+
+    Attributes:
+        phase: anticipation or airborne.
+        timer: seconds in the current phase.
+        air: height of the root above the ground (0 on the ground).
+        air_velocity: the puppet's velocity while airborne (ballistic jumps).
+        tracker: the arc tracker of the current jump (``None`` before take-off).
+        from_stick: whether the stick's own path drives the arc (phones) or a flick launched it (mouse).
+        apex_height: the predicted apex height of the last jump (0 until it is known; ``None`` before any jump).
+        progress: where the last jump is on its arc (0 take-off, 0.5 apex, 1 down; ``None`` before any).
+        invalid: why the last jump was invalid, if it was (cleared when the next one starts).
+    """
+
+    phase: JumpPhase = JumpPhase.ANTICIPATION
     timer: float = 0.0
-    phase: str = ""
-    getup: Any = field(default=None, metadata={"hash": False})
+    air: float = 0.0
+    air_velocity: F = field(default_factory=lambda: np.zeros(3))
+    tracker: JumpTracker | None = None
+    from_stick: bool = False
+    apex_height: float | None = None
+    progress: float | None = None
+    invalid: JumpStatus | None = None
+
+
+@dataclass
+class Landing:
+    """The Land state's data: seconds into the absorbing crouch and how deep it goes (0..1 of a full crouch)."""
+
+    timer: float = 0.0
+    depth: float = 0.7
+
+
+@dataclass
+class GettingUp:
+    """The GetUp state's data: the blend in progress (its frame is hashed as ``frame``) and how the body lay."""
+
+    blend: GetUpBlend | None = field(default=None, metadata={"hash": False})
+    frame: float = 0.0
+    lying: LyingOrientation | None = None
+
+
+@dataclass
+class Handling:
+    """The data of the states that handle a ball: PickUp, Carry, PutDown and RollSnowball.
+
+    Attributes:
+        object: the prop being picked up, carried, put down or rolled.
+        timer: seconds into reaching (PickUp) or lowering (PutDown).
+        raised: the stick was raised while carrying (only a lowering after that puts the ball down).
+        spot: where a put-down ball goes on the ground.
+        onto: the bigger ball a put-down ball goes on top of (a game may re-aim it to a stack's top).
+        left: the ball just put down, left alone until the puppet stands up again.
+    """
+
+    object: Entity | None = None
+    timer: float = 0.0
+    raised: bool = False
+    spot: F | None = None
+    onto: Entity | None = None
+    left: Entity | None = None
+
+
+PUPPET_COMPONENTS = (Jumping, Landing, GettingUp, Handling)
+"""The per-state components every puppet carries (a spawned puppet gets one fresh instance of each)."""

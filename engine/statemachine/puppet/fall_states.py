@@ -22,10 +22,13 @@ from engine.pose import Pose
 from engine.ragdoll.components import Ragdoll, RagdollMode
 from engine.ragdoll.getup import GetUpBlend, lying_orientation, pick_get_up_clip
 from engine.statemachine.machine import Brain
-from engine.statemachine.puppet.body import PoseOverride, PuppetBody
+from engine.statemachine.puppet.body import GettingUp, PoseOverride, PuppetBody
+from engine.statemachine.puppet.names import PuppetState
 from engine.statemachine.puppet.senses import holder
+from engine.statemachine.puppet.spec import PuppetStateDef, PuppetTransition, StateSpec
 
-__all__ = ["enter_ragdoll", "update_ragdoll", "ragdoll_settled", "enter_getup", "update_getup", "exit_getup", "getup_done"]
+__all__ = ["enter_ragdoll", "update_ragdoll", "ragdoll_settled", "enter_getup", "update_getup", "exit_getup", "getup_done",
+           "SPEC"]
 
 _HELD_JOINT = "chest"
 
@@ -67,38 +70,37 @@ def enter_getup(world: World, entity: Entity, brain: Brain) -> None:
     rd = world.get(entity, Ragdoll)
     rd.release()
     lp = world.get(entity, LocalPose)
-    body = world.get(entity, PuppetBody)
+    up = world.get(entity, GettingUp)
     player = world.get(entity, LocomotionPlayer)
     start = Pose(np.array(lp.root), np.array(lp.rotations))
     lying = lying_orientation(start.rotations[0])
     clips = world.resource(BlendLibrary)[player.library_key].clips
-    body.getup = GetUpBlend(start, pick_get_up_clip(clips, lying), world.dt)
-    body.phase, body.timer = lying.value, 0.0
-    brain.memory["lying"] = lying.value
+    up.blend = GetUpBlend(start, pick_get_up_clip(clips, lying), world.dt)
+    up.lying, up.frame = lying, 0.0
     rd.set_mode(RagdollMode.ANIMATED, immediate=True)
     world.get(entity, PoseOverride).weight = 1.0
-    _write_getup_pose(world, entity, body)
+    _write_getup_pose(world, entity, up, up.blend)
 
 
-def _write_getup_pose(world: World, entity: Entity, body: PuppetBody) -> None:
+def _write_getup_pose(world: World, entity: Entity, up: GettingUp, blend: GetUpBlend) -> None:
     override = world.get(entity, PoseOverride)
-    override.pose = body.getup.advance()
-    body.timer = float(body.getup.frame)
+    override.pose = blend.advance()
+    up.frame = float(blend.frame)
 
 
 def update_getup(world: World, entity: Entity, brain: Brain) -> None:
     """One frame of the get-up blend."""
-    body = world.get(entity, PuppetBody)
+    up = world.get(entity, GettingUp)
     player = world.get(entity, LocomotionPlayer)
     player.speed, player.height = 0.0, None
-    if not body.getup.done:
-        _write_getup_pose(world, entity, body)
+    if up.blend is not None and not up.blend.done:
+        _write_getup_pose(world, entity, up, up.blend)
 
 
 def getup_done(world: World, entity: Entity, brain: Brain) -> bool:
     """The get-up clip has played to its end."""
-    body = world.get(entity, PuppetBody)
-    return body.getup is not None and body.getup.done
+    blend = world.get(entity, GettingUp).blend
+    return blend is not None and blend.done
 
 
 def exit_getup(world: World, entity: Entity, brain: Brain) -> None:
@@ -113,5 +115,22 @@ def exit_getup(world: World, entity: Entity, brain: Brain) -> None:
         tr.position = np.array([root[0], 0.0, root[2]])
         tr.rotation = quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), body.heading)
     override.weight, override.pose = 0.0, None
-    body.getup = None
+    world.get(entity, GettingUp).blend = None
     world.get(entity, LocomotionPlayer).point = None
+
+
+_RAGDOLL: PuppetStateDef = PuppetStateDef(
+    PuppetState.RAGDOLL, enter=enter_ragdoll, update=update_ragdoll,
+    description="default state: limp physics, hangs from the stick when held")
+_GET_UP: PuppetStateDef = PuppetStateDef(
+    PuppetState.GET_UP, enter=enter_getup, update=update_getup, exit=exit_getup,
+    description="blend from the lying pose into the get-up clip")
+
+SPEC = StateSpec(
+    states=(_RAGDOLL, _GET_UP),
+    transitions=(
+        PuppetTransition(PuppetState.RAGDOLL, PuppetState.GET_UP, guard=ragdoll_settled, crossfade=0.0, label="settled"),
+        PuppetTransition(PuppetState.GET_UP, PuppetState.LOCOMOTION, guard=getup_done, crossfade=0.2, label="standing"),
+    ),
+)
+"""Ragdoll and GetUp (the ways into the ragdoll are the other states' and the machine's default)."""

@@ -18,8 +18,9 @@ walks only as fast as its facing allows, so a reversal turns it around. The drag
 limit grows with the puppet's own speed (a running puppet reaches further), never with
 the stick's (a yank stays a yank).
 
-Everything is arrays over the ground plane, one puppet at a time (the crowd batches
-the same functions); time is ``world.dt``.
+Everything is arrays over the ground plane, one puppet at a time; a crowd's released
+puppets (no stick, the spring settling to rest) go through :func:`follow_released` in one
+pass, with the same numbers. Time is ``world.dt``.
 """
 
 from __future__ import annotations
@@ -33,17 +34,18 @@ from engine.ecs import Entity, World
 from engine.statemachine.puppet.body import PuppetBody, PuppetTuning
 from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
 
-__all__ = ["spring_step", "wanted_velocity", "follow_velocity", "drag_reach"]
+__all__ = ["spring_step", "wanted_velocity", "follow_velocity", "follow_released", "drag_reach"]
 
 F = NDArray[np.float64]
 _TURN_FROM = 0.1  # m/s: a request slower than this turns nothing; twice this turns at the full rate
 
 
-def spring_step(value: F, rate: F, goal: F, omega: float, dt: float) -> tuple[F, F]:
+def spring_step(value: F, rate: F, goal: F, omega: float | F, dt: float) -> tuple[F, F]:
     """One exact step of a critically damped spring pulling ``value`` toward ``goal``.
 
     The closed form of ``x'' = -2ωx' - ω²x`` (``x = value - goal``) over ``dt``, so it is
     stable for any step and does not overshoot a step change. Returns ``(value, rate)``.
+    ``omega`` may be a column (``[n, 1]``) for ``n`` springs at once.
     """
     x = value - goal
     decay = np.exp(-omega * dt)
@@ -101,7 +103,15 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
     omega = t.follow_omega * (2.0 if braking else 1.0)
     body.walk_velocity, body.walk_rate = spring_step(body.walk_velocity, body.walk_rate, goal, omega, world.dt)
     v = body.walk_velocity
-    speed = float(np.hypot(v[0], v[2]))
+    _face(tr, body, player, float(np.hypot(v[0], v[2])), world.dt, speed_scale)
+    body.recent = np.vstack([body.recent[1:], body.walk_velocity])
+
+
+def _face(tr: Transform, body: PuppetBody, player: LocomotionPlayer, speed: float, dt: float,
+          speed_scale: float) -> None:
+    """Turn toward the smoothed velocity at a bounded rate; ask the clip for the speed the facing allows."""
+    t = body.tuning
+    v = body.walk_velocity
     facing = 1.0
     if speed > 1e-3:
         turn = _wrap(float(np.arctan2(v[0], v[2])) - body.heading)
@@ -109,8 +119,40 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
         # coming to rest stops turning (the fading request's direction is noise, and a few
         # centimetres past the hand are not worth turning round for).
         rate = t.turn_rate * (1.0 + 1.0 / (1.0 + speed)) * float(np.clip((speed - _TURN_FROM) / _TURN_FROM, 0.0, 1.0))
-        body.heading = _wrap(body.heading + float(np.clip(turn, -rate * world.dt, rate * world.dt)))
+        body.heading = _wrap(body.heading + float(np.clip(turn, -rate * dt, rate * dt)))
         facing = max(float(heading_vector(body.heading) @ (v / speed)), 0.0)
     tr.rotation = yaw_rotation(body.heading)
     player.speed = speed * facing * speed_scale
-    body.recent = np.vstack([body.recent[1:], body.walk_velocity])
+
+
+def follow_released(dt: float, bodies: list[PuppetBody], transforms: list[Transform],
+                    players: list[LocomotionPlayer]) -> None:
+    """:func:`follow_velocity` (``speed_scale`` 1) for puppets no stick holds, over arrays.
+
+    Unheld, the spring pulls the request to rest; the spring step, the speed and the
+    facing rotation are computed for all at once with the very operations of the
+    single-puppet path (elementwise, so the numbers are the same), and only a puppet
+    still moving fast enough to turn is turned one by one."""
+    n = len(bodies)
+    if n == 0:
+        return
+    value = np.array([b.walk_velocity for b in bodies], dtype=np.float64).reshape(n, 3)
+    rate = np.array([b.walk_rate for b in bodies], dtype=np.float64).reshape(n, 3)
+    goal = np.zeros((n, 3))
+    # The single path brakes when |goal| = 0 < |v|, i.e. when v·v > 0 (a sum of squares is
+    # positive exactly when one of them is).
+    braking = (value * value).sum(axis=1) > 0.0
+    omega = (np.array([b.tuning.follow_omega for b in bodies]) * np.where(braking, 2.0, 1.0))[:, None]
+    value, rate = spring_step(value, rate, goal, omega, dt)
+    speed = np.hypot(value[:, 0], value[:, 2])
+    heading = np.array([b.heading for b in bodies])
+    rotation = yaw_rotation(heading)
+    recent = np.array([b.recent for b in bodies], dtype=np.float64).reshape(n, -1, 3)
+    recent = np.concatenate([recent[:, 1:], value[:, None]], axis=1)
+    for i, (body, tr, player) in enumerate(zip(bodies, transforms, players, strict=True)):
+        body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
+        if speed[i] > 1e-3:
+            _face(tr, body, player, float(speed[i]), dt, 1.0)
+        else:
+            tr.rotation = rotation[i]
+            player.speed = float(speed[i])

@@ -7,6 +7,10 @@ ground point through the locomotion control (:mod:`~engine.statemachine.puppet.f
 the stick's velocity plus a smooth catch-up, through a critically damped spring),
 turning toward where it is led at a bounded rate, so the clip's root motion — not a
 teleport — carries it and its feet do not slide.
+
+A crowd is mostly puppets walking in Locomotion with no stick: their guards are
+decided over arrays (a guard of a ground state can only fire for a held puppet) and
+:func:`update_locomotion_batch` updates them in one pass.
 """
 
 from __future__ import annotations
@@ -17,12 +21,31 @@ from engine.blend.locomotion import LocomotionPlayer
 from engine.components import Transform
 from engine.ecs import Entity, World
 from engine.ik.system import IKRequest
-from engine.statemachine.machine import Brain
-from engine.statemachine.puppet.body import PuppetBody
-from engine.statemachine.puppet.follow import drag_reach, follow_velocity
+from engine.statemachine.machine import Brain, Rows
+from engine.statemachine.puppet.body import Handling, PuppetBody
+from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity
 from engine.statemachine.puppet.follow_legacy import follow_stick_legacy
+from engine.statemachine.puppet.names import PuppetState
+from engine.statemachine.puppet.spec import (
+    PuppetColumns,
+    PuppetStateDef,
+    PuppetTransition,
+    StateSpec,
+    free_rows,
+    held_rows,
+)
 
-__all__ = ["follow_stick", "update_locomotion", "update_crouch", "locomotion_fits", "wants_crouch", "wants_stand", "lifted"]
+__all__ = [
+    "SPEC",
+    "follow_stick",
+    "lifted",
+    "locomotion_fits",
+    "update_crouch",
+    "update_locomotion",
+    "update_locomotion_batch",
+    "wants_crouch",
+    "wants_stand",
+]
 
 
 def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0,
@@ -81,7 +104,7 @@ def update_locomotion(world: World, entity: Entity, brain: Brain) -> None:
     t = body.tuning
     standing = body.held_by is None or body.target_height >= t.crouch_exit
     if standing:  # standing up ends the "leave it there" of a put-down (object_states)
-        brain.memory.pop("put_down", None)
+        world.get(entity, Handling).left = None
     player.height = None if standing else float(np.clip(body.target_height, t.crouch_enter, t.stand_height))
     follow_stick(world, entity, body, player)
     _ground_ik(world, entity)
@@ -97,3 +120,47 @@ def update_crouch(world: World, entity: Entity, brain: Brain) -> None:
     # point out along the cursor's ray and back: it must lead by the dead band to make a stride.
     follow_stick(world, entity, body, player, lead_band=t.follow_deadband)
     _ground_ik(world, entity)
+
+
+def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) -> None:
+    """:func:`update_locomotion` for many puppets: those no stick holds, with the spring control, in one pass."""
+    fast: list[int] = []
+    for i in rows:
+        body = columns.bodies[i]
+        if body.held_by is None and body.tuning.controller != "legacy":
+            fast.append(int(i))
+        else:
+            update_locomotion(world, columns.entities[i], world.get(columns.entities[i], Brain))
+    transforms, players = [], []
+    for i in fast:
+        e = columns.entities[i]
+        world.get(e, Handling).left = None  # standing
+        player = world.get(e, LocomotionPlayer)
+        player.height = None
+        ik = world.try_get(e, IKRequest)
+        if ik is not None:
+            ik.foot_lock.enabled = True
+            ik.grounding = True
+            ik.sphere_centre, ik.sphere_radius = None, 0.0
+        transforms.append(world.get(e, Transform))
+        players.append(player)
+    follow_released(world.dt, [columns.bodies[i] for i in fast], transforms, players)
+
+
+_LOCOMOTION: PuppetStateDef = PuppetStateDef(
+    PuppetState.LOCOMOTION, update=update_locomotion, fits=locomotion_fits, batch_update=update_locomotion_batch,
+    batch_fits=free_rows, description="idle / walk / run from the blend space; follows the stick")
+_CROUCH: PuppetStateDef = PuppetStateDef(
+    PuppetState.CROUCH, update=update_crouch, fits=locomotion_fits,
+    description="crouch idle / crouch walk; hips as low as the stick holds them")
+
+SPEC = StateSpec(
+    states=(_LOCOMOTION, _CROUCH),
+    transitions=(
+        PuppetTransition(PuppetState.LOCOMOTION, PuppetState.CROUCH, guard=wants_crouch, batch_guard=held_rows,
+                         priority=5, crossfade=0.25, label="lowered"),
+        PuppetTransition(PuppetState.CROUCH, PuppetState.LOCOMOTION, guard=wants_stand, priority=5, crossfade=0.25,
+                         label="raised"),
+    ),
+)
+"""Locomotion and Crouch, and the ways between them."""

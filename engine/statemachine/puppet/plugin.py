@@ -23,29 +23,36 @@ from engine.ragdoll.components import Ragdoll, RagdollMode
 from engine.ragdoll.profile import RagdollProfile, default_profile
 from engine.ragdoll.system import install_physics
 from engine.skeleton import Skeleton
-from engine.statemachine.machine import Brain, StateMachine, step_machine
-from engine.statemachine.puppet.body import PoseOverride, PuppetBody, PuppetTuning
+from engine.statemachine.machine import Brain, StateMachine, step_machines
+from engine.statemachine.puppet.body import PUPPET_COMPONENTS, PoseOverride, PuppetBody, PuppetTuning
 from engine.statemachine.puppet.machine import puppet_machine
 from engine.statemachine.puppet.props import held_props_system
-from engine.statemachine.puppet.senses import sense, yaw_rotation
+from engine.statemachine.puppet.senses import sense_all, yaw_rotation
+from engine.statemachine.puppet.spec import PuppetColumns
 
 __all__ = ["PuppetMachine", "apply_pose_overrides", "brain_system", "install_puppets", "spawn_puppet"]
 
 
 class PuppetMachine:
-    """Resource: the one state-machine asset all puppets share."""
+    """Resource: the one state-machine asset all puppets share (insert one built with
+    ``puppet_machine(extra=...)`` before installing the puppets to add a state)."""
 
     SIM_STATE = False
 
-    def __init__(self, machine: StateMachine | None = None) -> None:
+    def __init__(self, machine: StateMachine[PuppetColumns] | None = None) -> None:
         self.machine = machine or puppet_machine()
 
 
 def brain_system(world: World) -> None:
-    """The ``statemachine`` stage: sense the stick, then step each puppet's machine (entity order)."""
-    for e, body, brain in world.query(PuppetBody, Brain):
-        sense(world, e, body)
-        step_machine(world, e, brain)
+    """The ``statemachine`` stage: sense the sticks, then step every puppet's machine.
+
+    Sensing is one pass over all puppets; the machines are stepped by
+    :func:`~engine.statemachine.machine.step_machines`: the puppets walking free in
+    Locomotion over arrays, the others (held, jumping, fallen…) one by one in entity order."""
+    rows = world.query(PuppetBody, Brain)
+    entities = [r[0] for r in rows]
+    columns = sense_all(world, entities, [r[1] for r in rows])
+    step_machines(world, entities, [r[2] for r in rows], columns)
 
 
 def apply_pose_overrides(world: World) -> None:
@@ -117,6 +124,7 @@ def spawn_puppet(
         Ragdoll(_profile(sk), mode=RagdollMode.ANIMATED),
         PoseOverride(),
         PuppetBody(tuning=tuning, heading=float(heading), target=pos.copy(), target_height=tuning.stand_height),
+        *(component() for component in PUPPET_COMPONENTS),
         Grabbable(radius=0.45 * tuning.stand_height, kind="puppet", offset=np.array([0.0, tuning.stand_height, 0.0])),
         machine.new_brain(),
         *extra,

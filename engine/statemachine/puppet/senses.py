@@ -6,6 +6,9 @@ by its anchor (the hips, ``Grabbable.offset``); the anchor the stick asks for is
 ``tip + R_stick · grab_offset``. Its ground projection is where the puppet should
 stand, its height is the hips height asked for (lower: crouch; much higher: the
 puppet is held in the air).
+
+:func:`sense_all` does it for every puppet at once: the momentum over arrays, the
+holders from one pass over the sticks, and only the held puppets one by one.
 """
 
 from __future__ import annotations
@@ -18,8 +21,9 @@ from engine.components import Stick, Transform
 from engine.ecs import Entity, World
 from engine.ragdoll.components import Prop
 from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.spec import PuppetColumns
 
-__all__ = ["holder", "wanted_anchor", "sense", "heading_vector", "prop_in_front", "yaw_rotation"]
+__all__ = ["holder", "wanted_anchor", "sense", "heading_vector", "prop_in_front", "yaw_rotation", "sense_all"]
 
 F = NDArray[np.float64]
 _UP = np.array([0.0, 1.0, 0.0])
@@ -43,8 +47,8 @@ def heading_vector(heading: float) -> F:
     return np.array([np.sin(heading), 0.0, np.cos(heading)])
 
 
-def yaw_rotation(heading: float) -> F:
-    """The rotation about +Y of a heading angle."""
+def yaw_rotation(heading: float | F) -> F:
+    """The rotation about +Y of a heading angle (``[4]``), or of an array of them (``[n, 4]``)."""
     return quat.from_axis_angle(_UP, heading)
 
 
@@ -60,13 +64,47 @@ def sense(world: World, entity: Entity, body: PuppetBody) -> Stick | None:
         body.speed = 0.0
         body.lead = np.zeros(3)
         return None
-    body.held_by, stick = held
+    return _sense_stick(body, *held)
+
+
+def _sense_stick(body: PuppetBody, controller: Entity, stick: Stick) -> Stick:
+    body.held_by = controller
     anchor = wanted_anchor(stick)
     body.target = np.array([anchor[0], 0.0, anchor[2]])
     body.target_height = float(anchor[1])
     body.speed = float(np.hypot(stick.velocity[0], stick.velocity[2]))
     body.lead = np.array([stick.velocity[0], 0.0, stick.velocity[2]])
     return stick
+
+
+def sense_all(world: World, entities: list[Entity], bodies: list[PuppetBody]) -> PuppetColumns:
+    """:func:`sense` for every puppet at once (the same numbers); the columns the array guards read.
+
+    The rows' new ``ground_velocity``, ``last_position`` and ``lead`` are views into one
+    array per step each (fresh every step, never written in place)."""
+    n = len(entities)
+    sticks: dict[Entity, tuple[Entity, Stick]] = {}
+    for e, stick in world.query(Stick):  # entity order: the lowest id holds, as in holder()
+        if stick.grabbed is not None:
+            sticks.setdefault(stick.grabbed, (e, stick))
+    pos = np.array([world.get(e, Transform).position for e in entities], dtype=np.float64).reshape(n, 3)
+    known = [i for i, b in enumerate(bodies) if b.last_position is not None]
+    if known:
+        last = np.array([bodies[i].last_position for i in known], dtype=np.float64)
+        velocity = (pos[known] - last) * np.array([1.0, 0.0, 1.0]) / world.dt
+        for j, i in enumerate(known):
+            bodies[i].ground_velocity = velocity[j]
+    zeros = np.zeros((n, 3))
+    held = np.zeros(n, dtype=bool)
+    for i, (e, body) in enumerate(zip(entities, bodies, strict=True)):
+        body.last_position = pos[i]
+        by = sticks.get(e)
+        if by is None:
+            body.held_by, body.speed, body.lead = None, 0.0, zeros[i]
+        else:
+            held[i] = True
+            _sense_stick(body, *by)
+    return PuppetColumns(entities, bodies, held)
 
 
 def prop_in_front(world: World, entity: Entity, body: PuppetBody, reach: float, max_radius: float | None = None,

@@ -13,20 +13,21 @@ import numpy as np
 
 from engine.ecs import Entity, World
 from engine.statemachine.machine import Brain
-from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.body import Jumping, JumpPhase, PuppetBody
+from engine.statemachine.puppet.names import PuppetEvent, PuppetState
 
 __all__ = ["describe_puppet", "RUN_FRACTION"]
 
 RUN_FRACTION = 0.55
 """Ground speed, as a fraction of the puppet's top speed, from which it reads as running."""
 
-_FIXED = {
-    "Land": "landing",
-    "GetUp": "getting up",
-    "PickUp": "picking up a ball",
-    "Carry": "carrying a ball",
-    "PutDown": "putting a ball down",
-    "RollSnowball": "rolling a snowball",
+_FIXED: dict[str, str] = {
+    PuppetState.LAND: "landing",
+    PuppetState.GET_UP: "getting up",
+    PuppetState.PICK_UP: "picking up a ball",
+    PuppetState.CARRY: "carrying a ball",
+    PuppetState.PUT_DOWN: "putting a ball down",
+    PuppetState.ROLL_SNOWBALL: "rolling a snowball",
 }
 
 
@@ -39,12 +40,12 @@ def _gait(body: PuppetBody, crouched: bool) -> str:
     return "running" if speed >= RUN_FRACTION * body.tuning.max_speed else "walking"
 
 
-def _fall(brain: Brain, body: PuppetBody) -> str:
+def _fall(brain: Brain, body: PuppetBody, jump: Jumping | None) -> str:
     """Why the puppet is limp: the reason of the transition into the ragdoll, if it says one,
     else whether the stick holds it up."""
     entered = next((t for t in reversed(brain.trace) if t.target == brain.active), None)
-    if entered is not None and entered.reason == "jump_invalid":
-        why = brain.memory.get("jump_invalid")
+    if entered is not None and entered.reason == PuppetEvent.JUMP_INVALID:
+        why = None if jump is None or jump.invalid is None else jump.invalid.value
         return "fell: invalid jump" + (f" ({why})" if why else "")
     return "hanging from the stick" if body.held_by is not None else "fell over"
 
@@ -55,10 +56,11 @@ def describe_puppet(world: World, entity: Entity, brain: Brain) -> str:
     body = world.try_get(entity, PuppetBody)
     if state in _FIXED or body is None:
         return _FIXED.get(state, state.lower() or "starting")
-    if state in ("Locomotion", "Crouch"):
-        return _gait(body, crouched=state == "Crouch")
-    if state == "Jump":
-        return "getting ready to jump" if body.phase == "anticipation" else "in the air"
-    if state == "Ragdoll":
-        return _fall(brain, body)
+    if state in (PuppetState.LOCOMOTION, PuppetState.CROUCH):
+        return _gait(body, crouched=state == PuppetState.CROUCH)
+    jump = world.try_get(entity, Jumping)
+    if state == PuppetState.JUMP:
+        return "getting ready to jump" if jump is not None and jump.phase is JumpPhase.ANTICIPATION else "in the air"
+    if state == PuppetState.RAGDOLL:
+        return _fall(brain, body, jump)
     return state.lower()

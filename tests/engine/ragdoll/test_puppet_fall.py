@@ -18,7 +18,7 @@ puppet = pytest.importorskip("engine.statemachine.puppet.plugin")
 
 def test_let_go_in_mid_air_falls_settles_and_gets_up() -> None:
     from engine.statemachine.machine import Brain
-    from engine.statemachine.puppet.body import PuppetBody
+    from engine.statemachine.puppet.body import GettingUp
 
     app = App(seed=0, plugins=[puppet.install_puppets])
     w = app.world
@@ -46,7 +46,7 @@ def test_let_go_in_mid_air_falls_settles_and_gets_up() -> None:
             if not getup_rot:
                 getup_rot.append(before)  # the last limp frame: the blend must start from it
             getup_rot.append(w.get(e, LocalPose).rotations.copy())
-            blend = w.get(e, PuppetBody).getup or blend
+            blend = w.get(e, GettingUp).blend or blend
         before = w.get(e, LocalPose).rotations.copy()
         if 90 <= i and active == "Ragdoll":
             lowest = min(lowest, float(pw.body_positions(e)[:, 1].min()))

@@ -18,7 +18,7 @@ from engine.ecs import World
 from engine.ik.system import IKRequest
 from engine.statemachine.machine import Brain
 from engine.statemachine.puppet import ground_states
-from engine.statemachine.puppet.body import PuppetBody, PuppetTuning
+from engine.statemachine.puppet.body import Handling, PuppetBody, PuppetTuning
 from engine.statemachine.puppet.ground_states import (
     follow_stick,
     lifted,
@@ -39,7 +39,7 @@ def _puppet(tuning: PuppetTuning = T, held: bool = True, height: float = 0.95,
     player, ik = LocomotionPlayer(), IKRequest()
     ik.grounding, ik.sphere_centre, ik.sphere_radius = False, np.array([0.0, 1.0, 0.0]), 0.3
     brain = Brain(machine=None)  # type: ignore[arg-type]
-    entity = world.spawn(Transform(position=np.array(_AT)), body, player, ik, brain)
+    entity = world.spawn(Transform(position=np.array(_AT)), body, player, ik, brain, Handling())
     return world, entity, body, player, ik, brain
 
 
@@ -109,10 +109,11 @@ def test_a_lifted_puppet_leaves_the_ground_states_even_at_its_stick() -> None:
 ])
 def test_locomotion_stands_tall_or_dips_with_the_stick(held: bool, height: float, asked: float | None) -> None:
     world, e, _body, player, ik, brain = _puppet(held=held, height=height)
-    brain.memory["put_down"] = True
+    hand = world.get(e, Handling)
+    hand.left = 42
     update_locomotion(world, e, brain)
     assert player.height == (None if asked is None else pytest.approx(asked))
-    assert ("put_down" in brain.memory) == (asked is not None)  # standing up ends a put-down's "leave it"
+    assert (hand.left == 42) == (asked is not None)  # standing up ends a put-down's "leave it"
     assert ik.grounding is True and ik.sphere_centre is None and ik.sphere_radius == 0.0
 
 

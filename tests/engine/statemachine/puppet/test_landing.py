@@ -6,7 +6,7 @@ import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
 from engine.statemachine import Brain
-from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.body import Jumping, Landing, PuppetBody
 from engine.statemachine.puppet.jump_state import enter_land, update_land
 from input.hub import InputHub
 from puppetphone.games import make_app
@@ -17,11 +17,11 @@ def _lowest_hips(fall_speed: float) -> float:
     world = app.world
     entity, brain = next(iter(world.query(Brain)))
     body = world.get(entity, PuppetBody)
-    body.air_velocity = np.array([0.0, -fall_speed, 0.0])
+    world.get(entity, Jumping).air_velocity = np.array([0.0, -fall_speed, 0.0])
     enter_land(world, entity, brain)
     lowest = np.inf
     player = world.get(entity, LocomotionPlayer)
-    while body.timer < body.tuning.landing:
+    while world.get(entity, Landing).timer < body.tuning.landing:
         update_land(world, entity, brain)
         lowest = min(lowest, float(player.height))
     return lowest

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import importlib.util
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import groupby
 from pathlib import Path
 
@@ -26,7 +26,7 @@ import pytest
 from engine.components import LocalPose, Stick, Transform
 from engine.ragdoll.components import Prop, Ragdoll
 from engine.statemachine import Brain
-from engine.statemachine.puppet import PuppetBody
+from engine.statemachine.puppet import Jumping, PuppetBody
 from engine.statemachine.puppet.words import describe_puppet
 from games.sandbox import GAME
 from input.hub import InputHub
@@ -63,7 +63,7 @@ class Watch:
     ball_rot: list[np.ndarray] = field(default_factory=list)
     words: list[str] = field(default_factory=list)
     trace: list = field(default_factory=list)  # type: ignore[type-arg]
-    memory: dict = field(default_factory=dict)  # type: ignore[type-arg]
+    jump: Jumping = field(default_factory=Jumping)
     frames: int = 0
 
     def arr(self, name: str) -> np.ndarray:
@@ -94,7 +94,7 @@ def replay(name: str) -> Watch:
         brain, body = world.get(p, Brain), world.get(p, PuppetBody)
         stick = next(s for _, s in world.query(Stick))
         w.state.append(brain.active)
-        w.phase.append(body.phase)
+        w.phase.append(world.get(p, Jumping).phase.value)
         w.pos.append(world.get(p, Transform).position.copy())
         w.hips.append(float(world.get(p, LocalPose).root[1]))
         w.stick_speed.append(float(np.hypot(stick.velocity[0], stick.velocity[2])))
@@ -107,7 +107,7 @@ def replay(name: str) -> Watch:
             w.ball.append(balls[0][2].position.copy())
             w.ball_rot.append(balls[0][2].rotation.copy())
         w.words.append(describe_puppet(world, p, brain))
-        w.trace, w.memory = list(brain.trace), dict(brain.memory)
+        w.trace, w.jump = list(brain.trace), replace(world.get(p, Jumping))
 
     result = verify(lambda hub: S.make_app(session.scene, hub), rec, on_step=on_step)
     assert result.ok, result.message()
@@ -183,7 +183,7 @@ def test_valid_jump_anticipates_reaches_its_apex_and_lands() -> None:
     assert np.all(pos[:take_off, 1] == 0.0)
     # Ballistic launch at 3.4 m/s: apex 3.4² / 2g above standing.
     expected_apex = STAND + 3.4**2 / (2 * 9.81)
-    assert w.memory["jump_apex_height"] == pytest.approx(expected_apex, abs=0.03)
+    assert w.jump.apex_height == pytest.approx(expected_apex, abs=0.03)
     assert pos[:, 1].max() + STAND == pytest.approx(expected_apex, abs=0.05)
     # It carried its walking momentum forward (+Z), not the flick's stroke.
     land = w.first("state", "Land")
@@ -207,7 +207,7 @@ def test_invalid_jump_ends_in_ragdoll(name: str, reason: str) -> None:
     w = replay(name)
     assert transitions(w) == [("-", "Locomotion", "start"), ("Locomotion", "Jump", "flick"),
                               ("Jump", "Ragdoll", "jump_invalid")]
-    assert w.memory["jump_invalid"] == reason
+    assert w.jump.invalid is not None and w.jump.invalid.value == reason
     take_off = w.first("phase", "air")
     fell = w.first("state", "Ragdoll")
     assert take_off < fell  # invalid in the air, not on the ground

@@ -1,0 +1,88 @@
+"""Adding a state is one module plus its registration, and the crowd's array path changes nothing.
+
+``wave_state.py`` is a state the engine does not know; registering it with
+``puppet_machine(extra=...)`` is all it takes for a puppet to enter it on its event,
+run it, and leave it by its own guard, while the other puppets walk on.
+
+The array path (:func:`~engine.statemachine.machine.step_machines`) is compared with
+stepping every puppet alone (``sense`` + ``step_machine``, the path before it) on the
+same crowd, state hash by state hash. Shown to fail when broken: ``follow_released``
+without the braking stiffness, or the batched puppets' ``time_in_state`` not advanced.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from engine.ecs import World
+from engine.hashing import state_hash
+from engine.statemachine import Brain, step_machine
+from engine.statemachine.puppet import PuppetBody, PuppetMachine, PuppetState, puppet_machine, spawn_puppet
+from engine.statemachine.puppet import plugin as puppet_plugin
+from engine.statemachine.puppet.senses import sense
+from input.hub import InputHub
+from puppetphone.games import make_app
+
+_spec = importlib.util.spec_from_file_location("wave_state", Path(__file__).with_name("wave_state.py"))
+assert _spec is not None and _spec.loader is not None
+wave = importlib.util.module_from_spec(_spec)
+sys.modules[_spec.name] = wave  # a dataclass looks its module up while it is defined
+_spec.loader.exec_module(wave)
+
+
+def test_a_registered_state_is_entered_run_and_left() -> None:
+    app = make_app("sandbox", 3, InputHub([]), {"scene": "empty", "puppets": 1})
+    world = app.world
+    assert wave.WAVE not in world.resource(PuppetMachine).machine.states  # not built in
+    world.insert_resource(PuppetMachine(puppet_machine(extra=(wave.SPEC,))))
+    e = spawn_puppet(world, (2.0, 0.0, 0.0), extra=(wave.Waving(),))
+    app.run_steps(10)
+    brain = world.get(e, Brain)
+    assert brain.active == PuppetState.LOCOMOTION
+    brain.raise_event(wave.WAVE_EVENT)
+    app.step()
+    assert brain.active == wave.WAVE
+    steps = 0
+    while brain.active == wave.WAVE:
+        app.step()
+        steps += 1
+    assert steps == pytest.approx(wave.WAVE_TIME / world.dt, abs=1)
+    assert [(t.source, t.target, t.reason) for t in brain.trace[-2:]] == [
+        (PuppetState.LOCOMOTION, wave.WAVE, wave.WAVE_EVENT), (wave.WAVE, PuppetState.LOCOMOTION, "waved")]
+
+
+def _one_by_one(world: World) -> None:
+    """The brain stage as it was before the array path: sense and step each puppet in turn."""
+    for e, body, brain in world.query(PuppetBody, Brain):
+        sense(world, e, body)
+        step_machine(world, e, brain)
+
+
+def _crowd(seed: int):  # type: ignore[no-untyped-def]
+    app = make_app("sandbox", seed, InputHub([]), {"puppets": 8})
+    app.run_steps(5)
+    # Some puppets just let go while moving: the spring brakes them and they turn as they stop.
+    rng = np.random.default_rng(seed)
+    for i, (_, body) in enumerate(app.world.query(PuppetBody)):
+        if i % 3 == 0:
+            body.walk_velocity = rng.normal(size=3) * np.array([1.5, 0.0, 1.5])
+            body.walk_rate = rng.normal(size=3) * np.array([4.0, 0.0, 4.0])
+    return app
+
+
+def test_the_array_path_steps_a_crowd_exactly_as_one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    batched = _crowd(4)
+    monkeypatch.setattr(puppet_plugin, "brain_system", _one_by_one)  # what install_puppets registers
+    single = _crowd(4)
+    assert _one_by_one in single.systems("statemachine") and _one_by_one not in batched.systems("statemachine")
+    for step in range(60):
+        batched.step()
+        single.step()
+        assert state_hash(batched.world) == state_hash(single.world), f"differs at step {step}"
+    moved = [b.heading for _, b in batched.world.query(PuppetBody)]
+    assert len(set(moved)) > 5  # the crowd did walk and turn
