@@ -33,7 +33,7 @@ _PASS_R = {"r_foot": (-0.09, 0.22, -0.12), "l_foot": (0.09, 0.06, 0.0), "pin": (
            "unpin": (), "l_hand": (0.24, 0.82, 0.02), "r_hand": (-0.24, 0.82, 0.02)}  # fmt: skip
 
 
-def _mirror(pose: dict) -> dict:  # type: ignore[type-arg]
+def _mirror(pose: dict) -> dict:
     swap = {"l_foot": "r_foot", "r_foot": "l_foot", "l_hand": "r_hand", "r_hand": "l_hand"}
     out = {}
     for name, target in pose.items():

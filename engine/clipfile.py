@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from engine.atomic import atomic_write
+from engine.atomic import atomic_write_bytes
 from engine.clip import Clip, RootMotion
 from engine.npz_safe import read_bounded, read_npz
 from engine.root_curve import RootCurve
@@ -95,8 +95,9 @@ def save_clip(clip: Clip, path: str | Path, root_curve: RootCurve | None = None)
         "sha256": _digest(arrays),
     }
     buf = io.BytesIO()
-    np.savez_compressed(buf, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8), **arrays)
-    return atomic_write(path, lambda f: f.write(buf.getvalue()))
+    np.savez_compressed(buf, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8),
+                        **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as the allow_pickle flag
+    return atomic_write_bytes(path, buf.getvalue())
 
 
 def _finite(name: str, a: np.ndarray, shape_tail: tuple[int, ...] = ()) -> np.ndarray:

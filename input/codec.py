@@ -21,6 +21,7 @@ about 138 bytes.
 from __future__ import annotations
 
 import struct
+from typing import Any
 
 import numpy as np
 
@@ -84,7 +85,7 @@ class _Reader:
         self.pos += n
         return chunk
 
-    def unpack(self, st: struct.Struct) -> tuple:  # type: ignore[type-arg]
+    def unpack(self, st: struct.Struct) -> tuple[Any, ...]:
         return st.unpack(self.take(st.size))
 
     def string(self) -> str:
@@ -99,7 +100,7 @@ def decode_frame(data: bytes) -> InputFrame:
     """The frame encoded in ``data``; :class:`CodecError` if it is truncated or corrupt."""
     r = _Reader(data)
     index, n = r.unpack(_HEAD)
-    samples = []
+    samples: list[PoseSample] = []
     for _ in range(n):
         source = r.string()
         t, flags, *q = r.unpack(_SAMPLE_HEAD)

@@ -164,7 +164,7 @@ class RecordActivity:
     dt = 1.0 / 60.0
 
     def __init__(self, scene, hub, *, script: str | None = None, output: Path | None = None, size=(1280, 720),
-                 recorder=None, check=None) -> None:  # type: ignore[no-untyped-def]
+                 recorder=None, check=None) -> None:
         self.scene, self.hub, self.script, self.output = scene, hub, script, output
         self.recorder, self.check = recorder, check
         self.camera = scene.camera
@@ -217,7 +217,7 @@ class RecordActivity:
         self.scene.message = message.format(output=self.output) if saved else said
         return saved
 
-    def _apply(self, op: tuple) -> object:  # type: ignore[type-arg]
+    def _apply(self, op: tuple) -> object:
         """One tool operation; returns a pointer position when the operation is one."""
         scene, kind = self.scene, op[0]
         if kind == "press" and scene.choose(float(op[1]), float(op[2]), self.size):
@@ -328,7 +328,7 @@ def _check_record_setup(setup: object) -> dict[str, object]:
     import math
 
     def number(key: str, lo: float, hi: float) -> None:
-        v = setup.get(key)  # type: ignore[union-attr]
+        v = setup.get(key)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not lo <= v <= hi:
             raise ValueError(f"the recorded {key} {repr(v)[:30]} is not a number in [{lo:g}, {hi:g}]")
 

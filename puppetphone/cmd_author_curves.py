@@ -162,7 +162,7 @@ class CurvesActivity:
             return False
         return True
 
-    def _apply(self, op: tuple) -> None:  # type: ignore[type-arg]
+    def _apply(self, op: tuple) -> None:
         from authoring.keyframe_curves.session import save_curves
         from puppetphone.saving import save_or_say
 

@@ -276,7 +276,7 @@ class EditActivity:
             return False
         return True
 
-    def _apply(self, op: tuple) -> None:  # type: ignore[type-arg]
+    def _apply(self, op: tuple) -> None:
         from authoring.mocurves import save_session
         from puppetphone.saving import save_or_say
 

@@ -103,9 +103,9 @@ def _circle(centre: tuple[float, float], radius: float, n: int = 24) -> list[tup
     return [(centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a)) for a in t]
 
 
-def script_events(name: str) -> dict[int, list[tuple]]:  # type: ignore[type-arg]
+def script_events(name: str) -> dict[int, list[tuple]]:
     """Pointer operations per step of a scripted edit (press, move, release), as a user would make them."""
-    ops: dict[int, list[tuple]] = {}  # type: ignore[type-arg]
+    ops: dict[int, list[tuple]] = {}
 
     def drag(start: int, points: list[tuple[float, float]], shift: bool = False) -> int:
         ops.setdefault(start, []).append(("press", *points[0], shift))
@@ -234,7 +234,7 @@ class FlowActivity:
         else:
             self._timed(self.session.add, "stroke", pts)
 
-    def apply(self, op: tuple) -> None:  # type: ignore[type-arg]
+    def apply(self, op: tuple) -> None:
         """One operation: press / move / release of the pointer, or a key."""
         kind = op[0]
         if kind == "press":

@@ -29,7 +29,7 @@ def load_game(name: str) -> Game:
     """The game object of a registered game; ``ValueError`` lists the known ones."""
     if name not in GAMES:
         raise ValueError(f"unknown game {name!r}; games are {', '.join(GAMES)}")
-    return importlib.import_module(GAMES[name]).GAME  # type: ignore[no-any-return]
+    return importlib.import_module(GAMES[name]).GAME
 
 
 def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None = None) -> App:

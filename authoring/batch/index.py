@@ -279,9 +279,9 @@ def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
     return takes, clips
 
 
-def _checked_rows(con: sqlite3.Connection, table: str, order: str, path: Path) -> list[dict[str, object]]:
+def _checked_rows(con: sqlite3.Connection, table: str, order: str, path: Path) -> list[dict[str, Any]]:
     """Every row of ``table`` as a dict of its columns, each checked against its ``row_sum``
-    (an index of schema 1 has none to check).
+    (an index of schema 1 has none to check). Values are SQLite's, untyped until the entry classes read them.
 
     Raises:
         LibraryIndexError: a row whose values are not what was written.

@@ -358,7 +358,7 @@ class RenderScene:
             if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
                 raise ValueError(f"background must be uint8 [H,W,3], got {img.dtype} {img.shape}")
             image = np.ascontiguousarray(img)
-        self.background = image  # type: ignore[assignment]
+        self.background = image
         if fade is not None:
             if not 0.0 <= fade <= 1.0:
                 raise ValueError(f"background fade must be in [0, 1], got {fade}")

@@ -168,5 +168,5 @@ def decode_frame(base: SceneState, data: bytes) -> SceneState:
         rows[kind] = new
     if at != len(data):
         raise FrameError("bytes after the last kind")
-    pose = CameraPose(tuple(cam[0:3]), tuple(cam[3:7]), cam[7])  # type: ignore[arg-type]  # lengths are fixed above
+    pose = CameraPose(tuple(cam[0:3]), tuple(cam[3:7]), cam[7])  # lengths are fixed above
     return SceneState(step, published, pose, rows)
