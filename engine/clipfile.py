@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip, RootMotion
 from engine.npz_safe import read_bounded, read_npz
@@ -49,7 +50,7 @@ MAX_FPS = 1000.0
 MAX_COORDINATE = 1e6  # metres (and radians of heading)
 
 
-class ClipFileError(ValueError):
+class ClipFileError(FormatError):
     """A clip file that cannot be read: corrupt, truncated, not a clip, or a newer version."""
 
 

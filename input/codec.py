@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from engine.errors import FormatError
 from input.sample import EVENT_KINDS, InputFrame, PoseSample, check_sample_ranges
 
 __all__ = ["encode_frame", "decode_frame", "CodecError"]
@@ -37,7 +38,7 @@ _V3 = struct.Struct("<3d")
 _D = struct.Struct("<d")
 
 
-class CodecError(ValueError):
+class CodecError(FormatError):
     """A frame's bytes do not decode (truncated, corrupt, or a sample out of range)."""
 
 

@@ -38,7 +38,9 @@ import sqlite3
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from engine.errors import FormatError
 from authoring.batch.row_sums import COLUMNS, intact, row_sum, typed
 from authoring.batch.worker import TakeOutcome
 
@@ -89,7 +91,7 @@ def _add_row_sums(con: sqlite3.Connection) -> None:
         _insert(con, "meta", ("schema", str(SCHEMA_VERSION)))
 
 
-class LibraryIndexError(ValueError):
+class LibraryIndexError(FormatError):
     """An index that cannot be used: not an index, a newer schema, or built with other options."""
 
 

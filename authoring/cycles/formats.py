@@ -116,7 +116,7 @@ def seamless_repeats(clip: Clip) -> Clip:
 
 def _load_skeletal(path: Path, items: list[str] | None, options: dict[str, object]) -> Performance:
     try:
-        motion = load_motion(path, **options)  # type: ignore[arg-type]
+        motion = load_motion(path, **options)  # type: ignore[arg-type]  # the options are load_motion's own names
     except MotionFileError as exc:
         raise TrajectoryError(str(exc)) from None
     return performance_from_motion(motion, items)
@@ -412,7 +412,7 @@ def save_loop(
 
         clip = loop_clip(result, perf)
         travel, turn = loop_travel(result, perf)
-        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]
+        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]  # skeletal: has a clip
         if fmt.name != "bvh":
             return write_gltf(path, clip)
         return write_bvh(path, clip_to_bvh(closed(clip, travel, turn) if closing_frame is not False else clip))

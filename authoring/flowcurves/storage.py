@@ -22,6 +22,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded
 
@@ -34,7 +35,7 @@ MAX_COORD = 1e6
 KINDS = ("stroke", "centre", "securve")
 
 
-class FlowFileError(ValueError):
+class FlowFileError(FormatError):
     """A flow file that cannot be used (one line says why)."""
 
 

@@ -91,8 +91,8 @@ def matte(photo: NDArray[np.uint8], mark: Mark) -> Matte:
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(12345)
     if (mask == cv2.GC_PR_FGD).any() and (mask == cv2.GC_BGD).any():
-        # OpenCV's stub wants a rect; with GC_INIT_WITH_MASK it is unused, and None is what its docs pass.
-        cv2.grabCut(patch, mask, None, bgd, fgd, _ITERATIONS, cv2.GC_INIT_WITH_MASK)  # type: ignore[call-overload]
+        cv2.grabCut(patch, mask, None, bgd, fgd, _ITERATIONS,  # type: ignore[call-overload]  # rect unused with a mask
+                    cv2.GC_INIT_WITH_MASK)
     hard = np.isin(mask, (cv2.GC_FGD, cv2.GC_PR_FGD)).astype(np.uint8)
     # Slivers of the room along the prop (a strip of skirting board) are thinner than any part of it.
     hard = np.asarray(cv2.morphologyEx(hard, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))), np.uint8)

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.errors import FormatError
 from engine.render.scene import RenderScene
 
 __all__ = ["SceneState", "CameraPose", "KINDS", "SCALES", "quantise", "encode_frame", "decode_frame",
@@ -54,7 +55,7 @@ _KIND = struct.Struct("<HB")
 _COLUMNS = struct.Struct("<H")
 
 
-class FrameError(ValueError):
+class FrameError(FormatError):
     """Bytes that are not a scene frame of this version."""
 
 

@@ -8,6 +8,8 @@ leads where, with which priority and cross-fade.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from engine.statemachine.machine import State, StateMachine, Transition
 from engine.statemachine.puppet import fall_states as fall
 from engine.statemachine.puppet import ground_states as ground
@@ -19,7 +21,12 @@ __all__ = ["puppet_machine", "STATE_NAMES"]
 STATE_NAMES = ("Locomotion", "Crouch", "Jump", "Land", "Ragdoll", "GetUp", "PickUp", "Carry", "PutDown", "RollSnowball")
 
 
-def _always(world, entity, brain) -> bool:  # type: ignore[no-untyped-def]
+if TYPE_CHECKING:
+    from engine.ecs import Entity, World
+    from engine.statemachine.machine import Brain
+
+
+def _always(world: World, entity: Entity, brain: Brain) -> bool:
     return True
 
 
