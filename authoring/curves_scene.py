@@ -359,7 +359,7 @@ class CurvesScene:
         else:
             self.session.commit_preview(f"drag {self.joint}@{g.frame}")
 
-    def apply(self, op: list | tuple) -> None:  # type: ignore[type-arg]
+    def apply(self, op: list | tuple) -> None:
         """One recorded tool operation: ``press x y shift``, ``move x y``, ``release x y``, ``key name ctrl shift``,
         ``orbit dx dy`` (pixels) or ``zoom factor``."""
         kind = op[0]

@@ -15,14 +15,19 @@ whole cycle and the left hand's path is pulled up at frame 22 with one drag.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    from authoring.curves_scene import CurvesScene
 
 from authoring.bindings import ORBIT_RADIANS_PER_PIXEL
 
 __all__ = ["walk_script", "goto_frame", "WALK_KEYS", "HAND_DRAG_FRAME", "Op"]
 
-Op = list  # ["press", x, y, shift] | ["move", x, y] | ["release", x, y] | ["key", name, ctrl, shift]
+Op = list[Any]  # ["press", x, y, shift] | ["move", x, y] | ["release", x, y] | ["key", name, ctrl, shift]
 
 WALK_KEYS = (0, 15, 30, 45)
 HAND_DRAG_FRAME = 22
@@ -35,7 +40,7 @@ _PASS_R = {"r_foot": (-0.09, 0.22, -0.12), "l_foot": (0.09, 0.06, 0.0), "pin": (
            "unpin": (), "l_hand": (0.24, 0.82, 0.02), "r_hand": (-0.24, 0.82, 0.02)}  # fmt: skip
 
 
-def _mirror(pose: dict) -> dict:  # type: ignore[type-arg]
+def _mirror(pose: dict) -> dict:
     swap = {"l_foot": "r_foot", "r_foot": "l_foot", "l_hand": "r_hand", "r_hand": "l_hand"}
     out = {}
     for name, target in pose.items():
@@ -46,12 +51,12 @@ def _mirror(pose: dict) -> dict:  # type: ignore[type-arg]
 WALK_POSES = (_CONTACT_L, _PASS_R, _mirror(_CONTACT_L), _mirror(_PASS_R))
 
 
-def _screen(scene, point) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+def _screen(scene: CurvesScene, point: ArrayLike) -> tuple[float, float]:
     x, y = scene.camera.project(np.asarray(point, dtype=np.float64)[None], *scene.size)[0]
     return round(float(x), 2), round(float(y), 2)
 
 
-def _drag(scene, start, end) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+def _drag(scene: CurvesScene, start: tuple[float, float], end: tuple[float, float]) -> Iterator[list[Op]]:
     yield [["press", *start, False]]
     for i in range(1, DRAG_MOVES + 1):
         a = i / DRAG_MOVES
@@ -59,7 +64,7 @@ def _drag(scene, start, end) -> Iterator[list[Op]]:  # type: ignore[no-untyped-d
     yield [["release", *end]]
 
 
-def goto_frame(scene, frame: int) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+def goto_frame(scene: CurvesScene, frame: int) -> Iterator[list[Op]]:
     """A click on the timeline at ``frame``."""
     line = scene.timeline()
     x, y = round(line.x_of(frame), 2), round(line.top + line.height / 2, 2)
@@ -67,20 +72,20 @@ def goto_frame(scene, frame: int) -> Iterator[list[Op]]:  # type: ignore[no-unty
     yield [["release", x, y]]
 
 
-def _select(scene, joint: str) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+def _select(scene: CurvesScene, joint: str) -> Iterator[list[Op]]:
     """Click a joint of the key pose shown (a click without a move poses nothing)."""
     at = _screen(scene, scene.joint_positions()[scene.session.clip.skeleton.index(joint)])
     yield [["press", *at, False]]
     yield [["release", *at]]
 
 
-def _pin_feet(scene, whole: bool) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+def _pin_feet(scene: CurvesScene, whole: bool) -> Iterator[list[Op]]:
     for foot in ("l_foot", "r_foot"):
         yield from _select(scene, foot)
         yield [["key", "p", False, whole]]
 
 
-def walk_script(scene) -> Iterator[list[Op]]:  # type: ignore[no-untyped-def]
+def walk_script(scene: CurvesScene) -> Iterator[list[Op]]:
     """The operations of each step, computed from the scene as it is when their turn comes."""
     for frame in WALK_KEYS[1:]:
         yield from goto_frame(scene, frame)

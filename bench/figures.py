@@ -28,7 +28,7 @@ class Figure:
         """``value / baseline_value`` when both exist."""
         if self.baseline_value in (None, 0) or self.value is None:
             return None
-        return float(self.value) / float(self.baseline_value)  # type: ignore[arg-type]
+        return float(self.value) / float(self.baseline_value)
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON object of ``bench --json``."""

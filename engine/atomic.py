@@ -159,7 +159,7 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, expect_head
     return target
 
 
-def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], None]) -> Path:
+def atomic_write(path: str | os.PathLike[str], write: Callable[[BinaryIO], object]) -> Path:
     """Call ``write(f)`` on an in-memory file, then :func:`atomic_write_bytes` its bytes to ``path``."""
     buf = io.BytesIO()
     write(buf)

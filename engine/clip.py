@@ -144,8 +144,8 @@ class Clip:
         rm = self.root_motion
         if rm is None:
             return np.zeros(3), 0.0
-        i0, i1, a = self.frame_pair(t)
-        i0, i1, a = int(i0), int(i1), float(a)
+        f0, f1, fa = self.frame_pair(t)
+        i0, i1, a = int(f0), int(f1), float(fa)
         n = self.num_frames
         # The loop's closing segment runs from the last frame to the first frame of the
         # next cycle, whose travel is the per-cycle travel plus the first frame's.
@@ -263,7 +263,8 @@ class Clip:
             return None if a is None else np.concatenate([a, a[:1]])
 
         root = np.concatenate([self.root, self.root[:1] + self.root_travel()])
-        return replace(self, loop=False, root=root, rotations=more(self.rotations), root_motion=None,
+        rotations = np.concatenate([self.rotations, self.rotations[:1]])
+        return replace(self, loop=False, root=root, rotations=rotations, root_motion=None,
                        translations=more(self.translations), scales=more(self.scales))
 
     def offsets(self) -> NDArray[np.float64]:

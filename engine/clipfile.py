@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from engine.atomic import atomic_write
+from engine.errors import FormatError
+from engine.atomic import atomic_write_bytes
 from engine.clip import Clip, RootMotion
 from engine.npz_safe import read_bounded, read_npz
 from engine.root_curve import RootCurve
@@ -49,7 +50,7 @@ MAX_FPS = 1000.0
 MAX_COORDINATE = 1e6  # metres (and radians of heading)
 
 
-class ClipFileError(ValueError):
+class ClipFileError(FormatError):
     """A clip file that cannot be read: corrupt, truncated, not a clip, or a newer version."""
 
 
@@ -95,8 +96,9 @@ def save_clip(clip: Clip, path: str | Path, root_curve: RootCurve | None = None)
         "sha256": _digest(arrays),
     }
     buf = io.BytesIO()
-    np.savez_compressed(buf, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8), **arrays)
-    return atomic_write(path, lambda f: f.write(buf.getvalue()))
+    np.savez_compressed(buf, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8),
+                        **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as the allow_pickle flag
+    return atomic_write_bytes(path, buf.getvalue())
 
 
 def _finite(name: str, a: np.ndarray, shape_tail: tuple[int, ...] = ()) -> np.ndarray:

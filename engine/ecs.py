@@ -107,7 +107,7 @@ class World:
     def get(self, entity: Entity, ctype: type[T]) -> T:
         """The entity's component of that type; ``KeyError`` names what is missing."""
         try:
-            return self._components[ctype][entity]  # type: ignore[no-any-return]
+            return self._components[ctype][entity]
         except KeyError:
             raise KeyError(f"entity {entity} has no {ctype.__name__}") from None
 
@@ -199,7 +199,7 @@ class World:
     def resource(self, rtype: type[T]) -> T:
         """The resource of that type; ``KeyError`` says which plugin should have added it."""
         try:
-            return self._resources[rtype]  # type: ignore[no-any-return]
+            return self._resources[rtype]
         except KeyError:
             raise KeyError(f"no resource {rtype.__name__}: is its plugin installed?") from None
 

@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 from numpy.lib import format as npy
 
+from engine.errors import FormatError
+
 __all__ = ["NpzError", "read_npz", "read_bounded", "MAX_NPZ_BYTES", "MAX_MEMBERS"]
 
 MAX_NPZ_BYTES = 256 << 20  # uncompressed, all members together
@@ -34,7 +36,7 @@ _ARCHIVE_ERRORS = (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError
                    struct.error, KeyError, IndexError, OverflowError, TypeError, SyntaxError, tokenize.TokenError)
 
 
-class NpzError(ValueError):
+class NpzError(FormatError):
     """An archive that is damaged, too big, or holds something other than plain arrays."""
 
 

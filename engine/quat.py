@@ -149,7 +149,7 @@ def slerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F:
     """Spherical interpolation from ``a`` to ``b`` along the shorter arc; ``t`` broadcasts."""
     a = np.asarray(a, dtype=np.float64)
     b = align_hemisphere(b, a)
-    t = np.asarray(t, dtype=np.float64)[..., None] if np.ndim(t) else np.float64(t)
+    t = np.asarray(t, dtype=np.float64)[..., None] if np.ndim(t) else np.asarray(t, dtype=np.float64)
     d = np.clip(np.sum(a * b, axis=-1, keepdims=True), -1.0, 1.0)
     theta = np.arccos(d)
     s = np.sin(theta)
@@ -164,7 +164,7 @@ def nlerp(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> F:
     """Normalised linear interpolation: cheaper than slerp, same endpoints and path."""
     a = np.asarray(a, dtype=np.float64)
     b = align_hemisphere(b, a)
-    t = np.asarray(t, dtype=np.float64)[..., None] if np.ndim(t) else np.float64(t)
+    t = np.asarray(t, dtype=np.float64)[..., None] if np.ndim(t) else np.asarray(t, dtype=np.float64)
     return normalize((1.0 - t) * a + t * b)
 
 
@@ -213,12 +213,12 @@ def from_euler(order: str, angles: ArrayLike, degrees: bool = False) -> F:
     ``angles[..., k]`` is the rotation about ``order[k]``; the composed rotation is
     ``R = R[order[0]] · R[order[1]] · R[order[2]]``, the BVH convention.
     """
-    angles = np.asarray(angles, dtype=np.float64)
+    rad = np.asarray(angles, dtype=np.float64)
     if degrees:
-        angles = np.radians(angles)
-    q = identity(*angles.shape[:-1])
+        rad = np.radians(rad)
+    q = identity(*rad.shape[:-1])
     for k, axis in enumerate(order.lower()):
-        q = mul(q, from_axis_angle(_AXES[axis], angles[..., k]))
+        q = mul(q, from_axis_angle(_AXES[axis], rad[..., k]))
     return q
 
 
@@ -234,19 +234,19 @@ def to_euler(order: str, q: ArrayLike, degrees: bool = False) -> F:
 
 def between(u: ArrayLike, v: ArrayLike) -> F:
     """Shortest-arc rotation taking direction ``u`` to direction ``v``."""
-    u = np.asarray(u, dtype=np.float64)
-    v = np.asarray(v, dtype=np.float64)
-    u = u / np.linalg.norm(u, axis=-1, keepdims=True)
-    v = v / np.linalg.norm(v, axis=-1, keepdims=True)
-    d = np.sum(u * v, axis=-1, keepdims=True)
-    c = np.cross(u, v)
+    ua = np.asarray(u, dtype=np.float64)
+    va = np.asarray(v, dtype=np.float64)
+    un = ua / np.linalg.norm(ua, axis=-1, keepdims=True)
+    vn = va / np.linalg.norm(va, axis=-1, keepdims=True)
+    d = np.sum(un * vn, axis=-1, keepdims=True)
+    c = np.cross(un, vn)
     q = np.concatenate([1.0 + d, c], axis=-1)
     # Opposite vectors: any axis perpendicular to u works.
     opposite = (1.0 + d[..., 0]) < 1e-9
     if np.any(opposite):
-        perp = np.cross(u, [1.0, 0.0, 0.0])
+        perp = np.cross(un, [1.0, 0.0, 0.0])
         weak = np.linalg.norm(perp, axis=-1, keepdims=True) < 1e-6
-        perp = np.where(weak, np.cross(u, [0.0, 1.0, 0.0]), perp)
+        perp = np.where(weak, np.cross(un, [0.0, 1.0, 0.0]), perp)
         q = np.where(opposite[..., None], np.concatenate([np.zeros_like(d), perp], axis=-1), q)
     return normalize(q)
 

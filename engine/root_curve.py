@@ -91,4 +91,5 @@ class RootCurve:
         """Least-squares control points (same ``K`` and travel) for new keypoint ``positions [n,3]``."""
         p = np.asarray(positions, dtype=np.float64)
         b = closed_basis(len(p), self.count)
-        return RootCurve(np.linalg.solve(b.T @ b, b.T @ (p - self.ramp(len(p)))), self.travel)
+        control = np.asarray(np.linalg.solve(b.T @ b, b.T @ (p - self.ramp(len(p)))), dtype=np.float64)
+        return RootCurve(control, self.travel)

@@ -32,8 +32,9 @@ class Skeleton:
     names: tuple[str, ...]
     parents: NDArray[np.int64]
     offsets: NDArray[np.float64]
-    tips: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
-    radii: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
+    # None means "derive": __post_init__ always replaces it with an array, so readers see one.
+    tips: NDArray[np.float64] = field(default=None)  # type: ignore[arg-type]  # filled in __post_init__
+    radii: NDArray[np.float64] = field(default=None)  # type: ignore[arg-type]  # filled in __post_init__
 
     def __post_init__(self) -> None:
         parents = np.asarray(self.parents, dtype=np.int64)
@@ -103,4 +104,5 @@ class Skeleton:
 
     def with_offsets(self, offsets: ArrayLike, tips: ArrayLike | None = None) -> Skeleton:
         """The same hierarchy with other bone lengths (snowmen, retargeting)."""
-        return Skeleton(self.names, self.parents, np.asarray(offsets), self.tips if tips is None else tips, self.radii)
+        return Skeleton(self.names, self.parents, np.asarray(offsets),
+                        self.tips if tips is None else np.asarray(tips, dtype=np.float64), self.radii)

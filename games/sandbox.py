@@ -102,7 +102,7 @@ def _spawn_crowd(world: World, n: int) -> None:
 
 def camera() -> OrbitCamera:
     """A three-quarter view of the field."""
-    return OrbitCamera(target=[0.0, 0.8, 0.0], yaw=0.5, pitch=0.35, distance=6.0)
+    return OrbitCamera(target=np.array([0.0, 0.8, 0.0]), yaw=0.5, pitch=0.35, distance=6.0)
 
 
 def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:

@@ -21,9 +21,11 @@ about 138 bytes.
 from __future__ import annotations
 
 import struct
+from typing import Any
 
 import numpy as np
 
+from engine.errors import FormatError
 from input.sample import EVENT_KINDS, InputFrame, PoseSample, check_sample_ranges
 
 __all__ = ["encode_frame", "decode_frame", "CodecError"]
@@ -36,7 +38,7 @@ _V3 = struct.Struct("<3d")
 _D = struct.Struct("<d")
 
 
-class CodecError(ValueError):
+class CodecError(FormatError):
     """A frame's bytes do not decode (truncated, corrupt, or a sample out of range)."""
 
 
@@ -84,7 +86,7 @@ class _Reader:
         self.pos += n
         return chunk
 
-    def unpack(self, st: struct.Struct) -> tuple:  # type: ignore[type-arg]
+    def unpack(self, st: struct.Struct) -> tuple[Any, ...]:
         return st.unpack(self.take(st.size))
 
     def string(self) -> str:
@@ -99,7 +101,7 @@ def decode_frame(data: bytes) -> InputFrame:
     """The frame encoded in ``data``; :class:`CodecError` if it is truncated or corrupt."""
     r = _Reader(data)
     index, n = r.unpack(_HEAD)
-    samples = []
+    samples: list[PoseSample] = []
     for _ in range(n):
         source = r.string()
         t, flags, *q = r.unpack(_SAMPLE_HEAD)

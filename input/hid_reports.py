@@ -24,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.errors import FormatError
+
 __all__ = ["SPACEMOUSE_IDS", "SPACEMOUSE_COMBINED", "SONY_VID", "DS4_PIDS", "DUALSENSE_PIDS", "AXIS_SCALE",
            "SpaceMouseReport", "parse_spacemouse", "ImuReport", "ImuCalibration", "parse_ds4", "parse_dualsense",
            "ds4_calibration", "dualsense_calibration", "DS4_DEFAULT", "DUALSENSE_DEFAULT", "HidFormatError",
@@ -48,7 +50,7 @@ DS4_PIDS = {0x05C4: "DualShock 4", 0x09CC: "DualShock 4 (v2)", 0x0BA0: "DualShoc
 DUALSENSE_PIDS = {0x0CE6: "DualSense", 0x0DF2: "DualSense Edge"}
 
 
-class HidFormatError(ValueError):
+class HidFormatError(FormatError):
     """A report too short or of an unexpected ID for the parser it was given."""
 
 

@@ -248,7 +248,7 @@ def _filter_velocity(st: StickState, stick: Stick, tips: list[tuple[F, float]], 
     backwards) gets the step shared evenly between its samples, so a burst never blows the
     rate up. A step without samples holds the tip still for ``dt``: a mouse that stops
     sends nothing."""
-    steps = tips or [(stick.tip.copy(), None)]
+    steps: list[tuple[F, float | None]] = list(tips) or [(stick.tip.copy(), None)]
     share = dt / len(steps)
     for tip, stamp in steps:
         if st.filt_x is None:

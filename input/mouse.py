@@ -48,7 +48,8 @@ MOUSEMOTION, MOUSEBUTTONDOWN, MOUSEBUTTONUP, MOUSEWHEEL = 1024, 1025, 1026, 1027
 class RayCamera(Protocol):
     """What the mouse needs from a camera."""
 
-    forward: Any
+    @property
+    def forward(self) -> Any: ...
 
     def ray(self, px: float, py: float, width: int, height: int) -> tuple[Any, Any]: ...
 

@@ -39,7 +39,7 @@ class MouseBot:
         return self.app.world.frame * self.app.world.dt
 
     def _send(self, kind: int, **attrs: object) -> None:
-        self.mouse.handle_event(pygame.event.Event(kind, **attrs), self.camera, self.size, now=self.now)
+        self.mouse.handle_event(pygame.event.Event(kind, attrs), self.camera, self.size, now=self.now)
 
     def step(self, n: int = 1) -> None:
         """Run ``n`` fixed steps."""

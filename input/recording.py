@@ -64,6 +64,7 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any, BinaryIO
 
+from engine.errors import FormatError
 from engine.app import App
 from engine.ecs import World
 from engine.hashing import PART_DIGEST_SIZE, part_digests
@@ -90,7 +91,7 @@ FSYNC_EVERY = 60
 _LEN = struct.Struct("<II")
 
 
-class RecordingError(ValueError):
+class RecordingError(FormatError):
     """The file is not a recording, or its header is damaged (nothing can be replayed)."""
 
 

@@ -126,7 +126,7 @@ class PoseSource:
         never an exception that ends the thread.
         """
         try:
-            sample = PoseSample(**fields)  # type: ignore[arg-type]
+            sample = PoseSample(**fields)  # type: ignore[arg-type]  # PoseSample checks them: a bad one is dropped
         except ValueError as exc:
             self.drop("invalid sample", str(exc)[:200])
             return None

@@ -54,7 +54,8 @@ def resolve_source(source: str, game: str) -> str:
     if kind == "replay" and arg == "demo":
         from puppetphone.games import load_game
 
-        demo = Path(__import__(f"games.{load_game(game).name}", fromlist=["x"]).__file__).parent / "demo.rec"
+        module_file = __import__(f"games.{load_game(game).name}", fromlist=["x"]).__file__
+        demo = Path(str(module_file)).parent / "demo.rec"
         return f"replay:{demo}"
     return source
 

@@ -20,6 +20,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from engine.camera import OrbitCamera
 from engine.components import Stick, Transform
 from engine.ecs import World
@@ -43,7 +45,7 @@ __all__ = ["STAGES", "take_screenshots"]
 
 OUT = REPO / "docs" / "screenshots"
 DELAY = 45  # frames after a stage is first seen: let it show
-FIELD_CAMERA = OrbitCamera(target=[0.0, 0.9, 0.0], yaw=0.15, pitch=0.15, distance=10.5)
+FIELD_CAMERA = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), yaw=0.15, pitch=0.15, distance=10.5)
 """Low over the field, so the far ridge and the sky show above the snow."""
 
 

@@ -38,7 +38,9 @@ import sqlite3
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from engine.errors import FormatError
 from authoring.batch.row_sums import COLUMNS, intact, row_sum, typed
 from authoring.batch.worker import TakeOutcome
 
@@ -89,7 +91,7 @@ def _add_row_sums(con: sqlite3.Connection) -> None:
         _insert(con, "meta", ("schema", str(SCHEMA_VERSION)))
 
 
-class LibraryIndexError(ValueError):
+class LibraryIndexError(FormatError):
     """An index that cannot be used: not an index, a newer schema, or built with other options."""
 
 
@@ -279,9 +281,9 @@ def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
     return takes, clips
 
 
-def _checked_rows(con: sqlite3.Connection, table: str, order: str, path: Path) -> list[dict[str, object]]:
+def _checked_rows(con: sqlite3.Connection, table: str, order: str, path: Path) -> list[dict[str, Any]]:
     """Every row of ``table`` as a dict of its columns, each checked against its ``row_sum``
-    (an index of schema 1 has none to check).
+    (an index of schema 1 has none to check). Values are SQLite's, untyped until the entry classes read them.
 
     Raises:
         LibraryIndexError: a row whose values are not what was written.

@@ -27,6 +27,7 @@ with ``‖a − b‖² = ‖a‖² + ‖b‖² − 2a·b``. Three exact strategi
 from __future__ import annotations
 
 from collections.abc import Iterator
+from functools import reduce
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -76,7 +77,7 @@ class _GramRows:
         self.table[1:, 1:] = padded.cumsum(axis=0).cumsum(axis=1)
         i = np.arange(n)
         self.bounds = [(i + k_max - k, i + k_max + k + 1) for k in range(k_max + 1)]
-        self.own = sum(self._box(a, b, a, b, diagonal=True) for a, b in self.bounds)
+        self.own = reduce(np.add, (self._box(a, b, a, b, diagonal=True) for a, b in self.bounds))
 
     def _box(self, a: NDArray[np.int64], b: NDArray[np.int64], c: NDArray[np.int64], d: NDArray[np.int64], diagonal: bool = False) -> NDArray[np.float64]:
         s = self.table
@@ -85,7 +86,7 @@ class _GramRows:
         return s[np.ix_(b, d)] - s[np.ix_(a, d)] - s[np.ix_(b, c)] + s[np.ix_(a, c)]
 
     def sq_distances(self, q: NDArray[np.int64]) -> NDArray[np.float64]:
-        cross = sum(self._box(a[q], b[q], a, b) for a, b in self.bounds)
+        cross = reduce(np.add, (self._box(a[q], b[q], a, b) for a, b in self.bounds))
         return np.maximum(self.own[q][:, None] + self.own[None, :] - 2.0 * cross, 0.0)
 
 

@@ -273,7 +273,7 @@ def _extract(traj: Trajectory, rng: np.random.Generator, opt: CycleOptions, repo
     closed, d_ex = stitch(traj, average, aligned.phases, travel)
     gaps = {it.name: float(np.linalg.norm(d_ex[it.columns])) for it in traj.items}
     loop = closed[:-1]
-    loop_times = np.arange(samples) * (period / samples)
+    loop_times = np.arange(samples, dtype=np.float64) * (period / samples)
     curves: dict[str, BezierLoop] = {}
     report("spline fit", 0.9)
     if opt.fit:

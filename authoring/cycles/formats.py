@@ -116,7 +116,7 @@ def seamless_repeats(clip: Clip) -> Clip:
 
 def _load_skeletal(path: Path, items: list[str] | None, options: dict[str, object]) -> Performance:
     try:
-        motion = load_motion(path, **options)  # type: ignore[arg-type]
+        motion = load_motion(path, **options)  # type: ignore[arg-type]  # the options are load_motion's own names
     except MotionFileError as exc:
         raise TrajectoryError(str(exc)) from None
     return performance_from_motion(motion, items)
@@ -137,7 +137,7 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
     cols = [local]
     names = [f"{sk.names[0]}.x", f"{sk.names[0]}.y", f"{sk.names[0]}.z"]
     its = [Item(f"{sk.names[0]}.position", "position", 0, 3, travel=True)]
-    joints = []
+    joints: list[int] = []
     for name in chosen:
         j = sk.index(name)
         start = 3 + 4 * len(joints)
@@ -145,16 +145,16 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
         names += [f"{name}.qw", f"{name}.qx", f"{name}.qy", f"{name}.qz"]
         its.append(Item(f"{name}.rotation", "rotation", start, start + 4))
         joints.append(j)
-    translated = []
+    translated: list[int] = []
     if clip.translations is not None:
         # Joints whose bones stretch or slide loop too: their local translation is a position item.
         moving = np.ptp(clip.translations, axis=0).max(axis=1) > 1e-9
-        for j in np.flatnonzero(moving[1:]) + 1:
+        for j in (int(k) for k in np.flatnonzero(moving[1:]) + 1):
             start = 3 + 4 * len(joints) + 3 * len(translated)
             cols.append(clip.translations[:, j])
             names += [f"{sk.names[j]}.tx", f"{sk.names[j]}.ty", f"{sk.names[j]}.tz"]
             its.append(Item(f"{sk.names[j]}.translation", "position", start, start + 3))
-            translated.append(int(j))
+            translated.append(j)
     column = 3 + 4 * len(joints) + 3 * len(translated)
     cols.append(heading[:, None])
     names.append(f"{sk.names[0]}.heading")
@@ -270,12 +270,12 @@ def _load_recording(path: Path, items: list[str] | None) -> Performance:
     src = chosen[0]
     t, pos, ori = [], [], []
     for fr in rec.frames:
-        s = fr.latest(src)
-        if s is None:
+        sample = fr.latest(src)
+        if sample is None:
             continue
         t.append(fr.frame * rec.header.dt)
-        ori.append(s.orientation)
-        pos.append(s.position if s.position is not None else np.full(3, np.nan))
+        ori.append(sample.orientation)
+        pos.append(sample.position if sample.position is not None else np.full(3, np.nan))
     if len(t) < 3:
         raise TrajectoryError(f"{path}: source {src!r} has only {len(t)} samples")
     p = np.asarray(pos)
@@ -412,7 +412,7 @@ def save_loop(
 
         clip = loop_clip(result, perf)
         travel, turn = loop_travel(result, perf)
-        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]
+        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]  # skeletal: has a clip
         if fmt.name != "bvh":
             return write_gltf(path, clip)
         return write_bvh(path, clip_to_bvh(closed(clip, travel, turn) if closing_frame is not False else clip))

@@ -98,7 +98,7 @@ def _fit(values: NDArray[np.float64], segments: int) -> tuple[NDArray[np.float64
     b = _basis(len(values), segments)
     # Normal equations: B is tiny (segments ≤ samples) and well conditioned for a uniform
     # periodic basis, and solving K×K beats an SVD of the data by far when d is large.
-    ctrl = np.linalg.solve(b.T @ b, b.T @ values)
+    ctrl = np.asarray(np.linalg.solve(b.T @ b, b.T @ values), dtype=np.float64)
     idx = (np.arange(segments)[:, None] + np.arange(4)[None, :]) % segments
     bez = np.einsum("ij,kjd->kid", _TO_BEZIER, ctrl[idx])
     return ctrl, bez

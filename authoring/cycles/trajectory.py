@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from engine.errors import FormatError
 from engine import quat
 
 __all__ = ["KINDS", "Item", "Trajectory", "TrajectoryError", "continuous_quaternions"]
@@ -31,7 +32,7 @@ _WIDTH = {"position": 3, "rotation": 4, "scale": 3}
 MAX_MAGNITUDE = 1e7
 
 
-class TrajectoryError(ValueError):
+class TrajectoryError(FormatError):
     """A performed trajectory that cannot be analysed (bad shape, NaN, times not increasing…)."""
 
 

@@ -26,6 +26,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded
 
@@ -39,7 +40,7 @@ MAX_TOTAL_VERTICES = 200000
 KINDS = ("stroke", "centre", "securve")
 
 
-class FlowFileError(ValueError):
+class FlowFileError(FormatError):
     """A flow file that cannot be used (one line says why)."""
 
 

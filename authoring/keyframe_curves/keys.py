@@ -20,6 +20,7 @@ edits, as pure functions from one :class:`~engine.keyframes.KeyframedClip` to an
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -95,7 +96,7 @@ def insert_key(clip: KeyframedClip, time: float) -> KeyframedClip:
     x0, x1, x2, x3 = 0.0, c.out_x[k], (t1 - t0) - c.in_x[k + 1], t1 - t0
     y0, y1, y2, y3 = c.values[k], c.values[k] + c.out_y[k], c.values[k + 1] - c.in_y[k + 1], c.values[k + 1]
 
-    def lerp(a, b):  # type: ignore[no-untyped-def]
+    def lerp(a: Any, b: Any) -> Any:  # scalars or arrays alike (de Casteljau on values and on times)
         return a + (b - a) * lam
 
     x01, x12, x23 = lerp(x0, x1), lerp(x1, x2), lerp(x2, x3)

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from engine.errors import FormatError
 from authoring.keyframe_curves import keys as key_ops
 from authoring.keyframe_curves.limits import retime_segment
 from authoring.keyframe_curves.posing import KeyPose, pose_key
@@ -29,6 +30,7 @@ from engine.clipfile import MAX_FILE as MAX_CLIP_FILE
 from engine.ik import humanoid_rig
 from engine.keyframes import BezierCurves, KeyframedClip, keyframe_clip
 from engine.npz_safe import read_bounded
+from engine.skeleton import Skeleton
 
 __all__ = ["CurveSession", "CurveFileError", "save_curves", "load_curves", "keys_path"]
 
@@ -42,7 +44,7 @@ REST = "rest"  # the spec of a new clip holding the rest pose
 CLOSEST_HALVINGS = 4  # a drag out of reach keeps the farthest reachable point within 1/16 of the way
 
 
-def standing_root(skeleton) -> np.ndarray:  # type: ignore[no-untyped-def]
+def standing_root(skeleton: Skeleton) -> np.ndarray:
     """Where the root stands so the rest pose's lowest joint touches the ground."""
     from engine import quat
     from engine.fk import forward_kinematics
@@ -51,7 +53,7 @@ def standing_root(skeleton) -> np.ndarray:  # type: ignore[no-untyped-def]
     return np.array([0.0, -float(pos[:, 1].min()), 0.0])
 
 
-class CurveFileError(ValueError):
+class CurveFileError(FormatError):
     """A ``.ppkeys`` side file that cannot be read or does not match its clip."""
 
 

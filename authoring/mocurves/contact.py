@@ -65,8 +65,8 @@ def plane_from_stroke(a: ArrayLike, b: ArrayLike, view_dir: ArrayLike, allowed: 
     """
     a, b, v = (np.asarray(x, dtype=np.float64) for x in (a, b, view_dir))
     n = np.cross(b - a, v)
-    length = np.linalg.norm(n)
-    if not np.isfinite(length) or length < 1e-9 * max(np.linalg.norm(b - a) * np.linalg.norm(v), 1e-12) or length == 0:
+    length = float(np.linalg.norm(n))
+    if not np.isfinite(length) or length < 1e-9 * max(float(np.linalg.norm(b - a) * np.linalg.norm(v)), 1e-12) or length == 0:
         raise ValueError("contact stroke is too short or parallel to the view: draw a line across the curves")
     n = n / length
     if np.dot(np.asarray(allowed, dtype=np.float64) - a, n) < 0:

@@ -101,7 +101,7 @@ def control_points(positions: ArrayLike, k: int) -> F:
     """``[k,3]`` least-squares control points of the closed B-spline through the keypoints."""
     p = np.asarray(positions, dtype=np.float64)
     b = control_basis(len(p), k)
-    return np.linalg.solve(b.T @ b, b.T @ p)
+    return np.asarray(np.linalg.solve(b.T @ b, b.T @ p), dtype=np.float64)
 
 
 def set_positions(clip: Clip, joint: int, positions: ArrayLike) -> Clip:

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from engine.errors import FormatError
 from authoring.mocurves.session import EditSession
 from authoring.paired_save import entry_for, write_pair
 from engine import quat
@@ -46,7 +47,7 @@ EXPORT_SUFFIXES = suffixes(skeletal=True, writable=True)
 _UP = np.array([0.0, 1.0, 0.0])
 
 
-class SessionFileError(ValueError):
+class SessionFileError(FormatError):
     """A session side file that is unreadable, of a newer version, or not of this clip."""
 
 

@@ -81,7 +81,7 @@ class TimeWarp:
             raise TimeWarpError(f"period must be positive and finite, got {period}")
         self.n, self.period = int(n), float(period)
         self.w_strong, self.w_soft = float(w_strong), float(w_soft)
-        self.times = np.arange(n + 1) * (self.period / n)
+        self.times = np.arange(n + 1, dtype=np.float64) * (self.period / n)
         """Original keypoint times ``t_0 … t_N`` (``t_N = T`` is the seam)."""
         period_rows, vel, speed = _energy_rows(self.n)
         gaps = np.diff(self.times)

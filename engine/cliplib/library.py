@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
 from engine.clipfile import ClipFileError, load_clip, save_clip
@@ -44,7 +45,7 @@ VERSION = 1
 _MAX_MANIFEST = 1 << 20
 
 
-class ClipLibraryError(ValueError):
+class ClipLibraryError(FormatError):
     """A library that cannot be used: a damaged manifest, a missing or altered clip, a refused role."""
 
 

@@ -16,7 +16,7 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 __all__ = ["Keys", "periodic", "one_shot", "smoothstep"]
 
-Keys = Sequence[tuple[float, float | Sequence[float]]]
+Keys = Sequence[tuple[float, float | Sequence[float] | NDArray[np.float64]]]
 
 
 def _split(keys: Keys) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

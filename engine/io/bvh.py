@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded
 
@@ -41,7 +42,7 @@ MAX_FRAME_TIME = 10.0
 _CANON = {c.lower(): c for c in CHANNEL_NAMES}
 
 
-class BvhError(ValueError):
+class BvhError(FormatError):
     """A BVH file that cannot be read; the message names the file and line."""
 
 
@@ -244,11 +245,11 @@ def parse_bvh(text: str, source: str = "<string>") -> BvhMotion:
     while i < n_lines and len(header) < 2:
         s = lines[i].strip()
         if s:
-            key, sep, value = s.partition(":")
+            key, sep, text = s.partition(":")
             key = " ".join(key.split()).lower()
             if not sep or key not in ("frames", "frame time"):
                 raise BvhError(f"{where(i)}: expected 'Frames:' and 'Frame Time:' after MOTION")
-            header[key] = value.strip()
+            header[key] = text.strip()
         i += 1
     if len(header) < 2:
         raise BvhError(f"{where(motion_line)}: MOTION without 'Frames:' and 'Frame Time:'")

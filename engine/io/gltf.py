@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.errors import FormatError
 from engine import quat
 from engine.npz_safe import read_bounded
 
@@ -41,7 +42,7 @@ MAX_TIME = 1e5  # seconds of animation
 _MALFORMED = (KeyError, TypeError, IndexError, AttributeError, ValueError, OverflowError)
 
 
-class GltfError(ValueError):
+class GltfError(FormatError):
     """A glTF file that cannot be read; the message names the file and the broken part."""
 
 

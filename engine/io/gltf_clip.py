@@ -181,7 +181,7 @@ def _build(
         names = [f"{nm}#{k}" if names.count(nm) > 1 else nm for k, nm in enumerate(names)]
     radii = radii[len(radii) - len(names):]
     r = np.array(radii, dtype=np.float64) * scale if all(isinstance(x, (int, float)) for x in radii) else None
-    skeleton = Skeleton(tuple(names), parents, trans[0] * scale, tips * scale, r)
+    skeleton = Skeleton(tuple(names), parents, trans[0] * scale, tips * scale, r)  # type: ignore[arg-type]  # None: derived
     own_moves = own_moves[folded:]
     translations = trans * scale if own_moves[1:].any() else None
     return skeleton, trans[:, 0] * scale, rots, translations, scales

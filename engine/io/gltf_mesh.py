@@ -112,10 +112,9 @@ def _primitive(doc: dict[str, Any], buffers: list[bytes], prim: dict[str, Any], 
             raise GltfError(f"{source}: {name} has shape {a.shape}, not ({v}, {width})")
         return a
 
-    jw = per_vertex("JOINTS_0", 4), per_vertex("WEIGHTS_0", 4)
-    if jw[0] is None or jw[1] is None:
+    joint_idx, weights = per_vertex("JOINTS_0", 4), per_vertex("WEIGHTS_0", 4)
+    if joint_idx is None or weights is None:
         raise GltfError(f"{source}: a skinned primitive has no JOINTS_0/WEIGHTS_0")
-    joint_idx, weights = jw
     if (joint_idx < 0).any() or (joint_idx >= joints).any() or (joint_idx != np.round(joint_idx)).any():
         raise GltfError(f"{source}: JOINTS_0 names joints outside the skin's 0..{joints - 1}")
     weights = np.where(weights > 0.0, weights, 0.0)

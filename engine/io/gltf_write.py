@@ -130,7 +130,7 @@ def gltf_bytes(clip: Clip, binary: bool = True) -> bytes:
     return container_bytes(doc, blob, binary)
 
 
-def container_bytes(doc: dict, blob: bytes, binary: bool) -> bytes:  # type: ignore[type-arg]
+def container_bytes(doc: dict, blob: bytes, binary: bool) -> bytes:
     """A glTF document and its buffer as a file: a GLB container, or JSON with the buffer as a data URI."""
     if not binary:
         doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")

@@ -82,7 +82,7 @@ def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None,
     shift = np.zeros(3) if travel is None else np.asarray(travel, dtype=np.float64)[:3]
     whole = closed(clip, shift, turn)
     n = max(int(round(clip.duration * rate)), 2)
-    t = np.arange(n) * (whole.duration / n)
+    t = np.arange(n, dtype=np.float64) * (whole.duration / n)
     pose = whole.sample(t)
     stretch = n / rate / clip.duration - 1.0
     root = pose.root + np.outer(np.arange(n) / n, stretch * shift)

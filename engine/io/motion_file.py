@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from engine.errors import FormatError
 from engine.clip import Clip
 from engine.io.bvh import BvhError, BvhWarning, read_bvh
 from engine.io.formats import motion_format, suffixes
@@ -37,7 +38,7 @@ _CONVENTION = UpAxis("y", "the format's convention")
 MAX_MAP_FILE = 1 << 20
 
 
-class MotionFileError(ValueError):
+class MotionFileError(FormatError):
     """A motion file, option or joint map that cannot be used; the message says which and why."""
 
 

@@ -113,7 +113,7 @@ def _rule(name: str) -> tuple[str, tuple[float, float, float], tuple[float, floa
     for keys, kind, axis, rng, cone, twist in _RULES:
         if any(k in low for k in keys):
             return kind, axis, rng, cone, twist
-    return _GENERIC  # type: ignore[return-value]
+    return _GENERIC
 
 
 def bone_segments(

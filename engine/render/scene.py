@@ -358,7 +358,7 @@ class RenderScene:
             if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
                 raise ValueError(f"background must be uint8 [H,W,3], got {img.dtype} {img.shape}")
             image = np.ascontiguousarray(img)
-        self.background = image  # type: ignore[assignment]
+        self.background = image
         if fade is not None:
             if not 0.0 <= fade <= 1.0:
                 raise ValueError(f"background fade must be in [0, 1], got {fade}")
@@ -371,10 +371,11 @@ class RenderScene:
         if img.ndim != 3 or img.shape[2] != 4 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
             raise ValueError(f"overlay must be uint8 [H,W,4], got {img.dtype} {img.shape}")
         at = None if depth_at is None else tuple(float(x) for x in np.asarray(depth_at, dtype=np.float64).reshape(3))
-        r = tuple(float(x) for x in rect)
+        r0, r1, r2, r3 = (float(x) for x in rect)
+        r = (r0, r1, r2, r3)
         if not (r[0] < r[2] and r[1] < r[3]):
             raise ValueError(f"overlay rect must be (u0, v0, u1, v1) with u0 < u1 and v0 < v1, got {rect}")
-        self.overlays.append(Overlay(np.ascontiguousarray(img), r, at, bool(photo),  # type: ignore[arg-type]
+        self.overlays.append(Overlay(np.ascontiguousarray(img), r, at, bool(photo),
                                      float(np.clip(alpha, 0.0, 1.0))))
 
     # -- views ------------------------------------------------------------------------

@@ -23,8 +23,12 @@ import re
 from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import moderngl
+
+if TYPE_CHECKING:
+    import pygame.font
 
 from engine.render.scene import TextLine
 
@@ -79,7 +83,7 @@ class TextCache:
     def __len__(self) -> int:
         return len(self._tex)
 
-    def _font(self, size: int):  # type: ignore[no-untyped-def]
+    def _font(self, size: int) -> pygame.font.Font:
         f = self._fonts.get(size)
         if f is None:
             f = self._pgfont.Font(None, size)  # pygame's bundled default font

@@ -56,7 +56,7 @@ def find_snowmen(balls: list[Ball], on_ground: float = 0.1) -> list[list[Ball]]:
             continue
         stack = [base]
         while len(stack) < 3:
-            above = [i for i in np.nonzero(on[:, stack[-1]])[0] if i not in used and i not in stack]
+            above = [int(i) for i in np.nonzero(on[:, stack[-1]])[0] if i not in used and i not in stack]
             if not above:
                 break
             stack.append(min(above, key=lambda i: balls[i].entity))

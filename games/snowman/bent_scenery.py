@@ -15,9 +15,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.scene import FlowScene
+    from engine.camera import OrbitCamera
 
 __all__ = ["scenery_objects", "prepare_flow", "recorded_flow", "BentScenery", "bent_scenery", "TRUNK_COLOR", "SNOW_COLOR"]
 
@@ -127,14 +131,14 @@ def bent_scenery(objects: list[dict[str, Any]]) -> tuple[BentScenery, list[np.nd
     return BentScenery((a, b, r, col), (centre, radius)), trunks, rocks
 
 
-def flow_camera():  # type: ignore[no-untyped-def]
+def flow_camera() -> OrbitCamera:
     """The camera the field is bent from: over the field from the south-east, every tree in view."""
     from engine.camera import OrbitCamera
 
-    return OrbitCamera(target=[0.0, 0.8, 0.0], yaw=0.35, pitch=0.42, distance=17.0)
+    return OrbitCamera(target=np.array([0.0, 0.8, 0.0]), yaw=0.35, pitch=0.42, distance=17.0)
 
 
-def flow_scene(size: tuple[int, int] = (1280, 720)):  # type: ignore[no-untyped-def]
+def flow_scene(size: tuple[int, int] = (1280, 720)) -> FlowScene:
     """The field's static scenery as a flow scene (6 trees × 7 parts + 3 rocks = 45 objects)."""
     from authoring.flowcurves.adapters import scene_from_data
 

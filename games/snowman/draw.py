@@ -14,6 +14,7 @@ from engine import quat
 from engine.components import Puppet, WorldPose
 from engine.ecs import World
 from engine.render.scene import GroundMarks, RenderScene
+from engine.skeleton import Skeleton
 from games.common import draw_world
 from games.snowman.bent_scenery import BentScenery
 from games.snowman.components import Snowman
@@ -40,7 +41,7 @@ _NOSE = np.array([[0.0, 0.0, 0.9], [0.0, -0.05, 1.6]])
 _BUTTONS = np.array([[0.0, 0.45 * k, 0.95] for k in (-0.6, 0.0, 0.6)])
 
 
-def _joint_indices(sk) -> dict[str, list[int]]:  # type: ignore[no-untyped-def]
+def _joint_indices(sk: Skeleton) -> dict[str, list[int]]:
     """The joints a snowman is drawn from, looked up once per rig."""
     j = sk.index
     return {"legs": [j(f"{side}_{bone}") for side in "lr" for bone in _LEG],
@@ -48,7 +49,7 @@ def _joint_indices(sk) -> dict[str, list[int]]:  # type: ignore[no-untyped-def]
             "body": [j("hips"), j("spine"), j("chest"), j("head")]}
 
 
-def _snowman_rows(snowman: Snowman, sk, pos: np.ndarray, rot: np.ndarray,  # type: ignore[no-untyped-def]
+def _snowman_rows(snowman: Snowman, sk: Skeleton, pos: np.ndarray, rot: np.ndarray,
                   joints: dict[str, list[int]]) -> tuple[np.ndarray, ...]:
     """One snowman's capsules (a, b, radius) and spheres (centre, radius, is-a-ball)."""
     shape = snowman.shape

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from engine.errors import FormatError
 from engine.app import App
 from engine.atomic import WriteError, atomic_write_bytes, set_aside
 from engine.components import Transform
@@ -67,7 +68,7 @@ FIELD_HEADS = (b'{"version": 1, "balls": ',)
 PUPPET_COLOR = (0.85, 0.32, 0.24)
 
 
-class FieldError(ValueError):
+class FieldError(FormatError):
     """A saved field that cannot be read back."""
 
 
@@ -360,7 +361,11 @@ def field_commands(world: World) -> None:
                 continue
             data = json.dumps(slot.saved).encode("utf-8")
             slot.rescue = slot.rescue or Rescue(slot.path)
-            saved = slot.rescue.save(lambda path, data=data: atomic_write_bytes(path, data, expect_head=FIELD_HEADS))
+
+            def write(path: Path, data: bytes = data) -> Path:
+                return atomic_write_bytes(path, data, expect_head=FIELD_HEADS)
+
+            saved = slot.rescue.save(write)
             if saved.recovered:  # the game goes on; the field is on disk all the same, and in the slot for F9
                 _tell(world, f"field NOT saved to its file: kept in {saved.path}",
                       f" ({saved.why}; play it with --set field={saved.path})")

@@ -42,9 +42,9 @@ class Footprints:
     fade_start: float = 40.0
     """Seconds a print stays sharp before it starts to fill with snow."""
     fade_time: float = 30.0
-    xz: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
-    heading: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
-    frame: NDArray[np.int64] = field(default=None)  # type: ignore[assignment]
+    xz: NDArray[np.float64] = field(default=None)
+    heading: NDArray[np.float64] = field(default=None)
+    frame: NDArray[np.int64] = field(default=None)
     count: int = 0
     down: dict[tuple[int, int], bool] = field(default_factory=dict)
     last: dict[tuple[int, int], NDArray[np.float64]] = field(default_factory=dict)

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from engine.app import App
 from engine.camera import OrbitCamera
 from engine.ecs import World
@@ -67,7 +69,7 @@ def install(app: App) -> None:
 
 def camera() -> OrbitCamera:
     """Looking over the field from the south-east."""
-    return OrbitCamera(target=[0.0, 0.6, 0.0], yaw=0.35, pitch=0.5, distance=9.0)
+    return OrbitCamera(target=np.array([0.0, 0.6, 0.0]), yaw=0.35, pitch=0.5, distance=9.0)
 
 
 def status(world: World) -> list[str]:

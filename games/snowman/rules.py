@@ -64,12 +64,13 @@ def stick_stacked_balls(world: World) -> None:
     held = _held(world)
     balls = {e: (prop, tr) for e, _, prop, tr in world.query(Snowball, Prop, Transform)}
     for e, stacked in list(world.query(Stacked)):
-        prop, tr = balls.get(e, (None, None))
-        if prop is None or e in held or stacked.on not in balls:
+        pair = balls.get(e)
+        if pair is None or e in held or stacked.on not in balls:
             world.remove(e, Stacked)
-            if prop is not None and e not in held:
-                prop.carried, prop.placed, prop.velocity = False, True, np.zeros(6)
+            if pair is not None and e not in held:
+                pair[0].carried, pair[0].placed, pair[0].velocity = False, True, np.zeros(6)
             continue
+        prop, tr = pair
         lower_prop, lower_tr = balls[stacked.on]
         tr.position = lower_tr.position + np.array([0.0, lower_prop.radius + prop.radius, 0.0])
         prop.carried, prop.velocity = True, np.zeros(6)

@@ -7,12 +7,17 @@ and fall with the frame time — so it never touches the simulation.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from engine.components import Obstacle, Transform
 from engine.ecs import World
 from engine.render.components import Appearance, Shape
 from engine.render.scene import RenderScene
+
+if TYPE_CHECKING:
+    from games.snowman.bent_scenery import BentScenery
 
 __all__ = ["build_scenery", "draw_snowfall", "draw_trees", "conifer_tiers", "TREES", "ROCKS"]
 
@@ -57,9 +62,9 @@ def _tree_primitives() -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
             c = base + [0, h * s, 0]
             caps.append((c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, (0.16, 0.36 - 0.03 * k, 0.24)))
             snow.append((c + [0, 0.45 * s, 0], 0.35 * r * s))
-    a, b, r, col = (np.array(v) for v in zip(*caps))
-    centre, radius = (np.array(v) for v in zip(*snow))
-    return (a, b, r, col), (centre, radius)
+    ends_a, ends_b, radii, colours = (np.array(v) for v in zip(*caps, strict=True))
+    centre, radius = (np.array(v) for v in zip(*snow, strict=True))
+    return (ends_a, ends_b, radii, colours), (centre, radius)
 
 
 _TREE_CAPSULES, _TREE_SNOW = _tree_primitives()
@@ -78,7 +83,7 @@ def conifer_tiers(a: np.ndarray, b: np.ndarray, r: np.ndarray) -> tuple[np.ndarr
     return a - 0.25 * r[:, None] * up, b + 1.6 * r[:, None] * up, 1.15 * r
 
 
-def draw_trees(scene: RenderScene, bent=None) -> None:  # type: ignore[no-untyped-def]
+def draw_trees(scene: RenderScene, bent: BentScenery | None = None) -> None:
     """Conifers: a trunk and three snowy tiers each (``bent``: as a flow file deformed them).
 
     The rows come four to a tree, trunk first (:func:`_tree_primitives`, and a bent

@@ -46,7 +46,7 @@ class SnowField:
     size: float = 24.0
     cell: float = 0.1
     initial_depth: float = 0.04
-    depth: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
+    depth: NDArray[np.float64] = field(default=None)  # type: ignore[arg-type]  # made in __post_init__
 
     SIM_STATE = True
 

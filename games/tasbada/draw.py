@@ -47,7 +47,9 @@ def dissolve(q: Quest, now: float) -> float:
 
 
 def _lerp(a: tuple[float, ...], b: tuple[float, ...], t: float) -> tuple[float, float, float]:
-    return tuple(float(x + (y - x) * t) for x, y in zip(a, b, strict=True))  # type: ignore[return-value]
+    if len(a) != 3 or len(b) != 3:
+        raise ValueError(f"colours have three channels, got {len(a)} and {len(b)}")
+    return (float(a[0] + (b[0] - a[0]) * t), float(a[1] + (b[1] - a[1]) * t), float(a[2] + (b[2] - a[2]) * t))
 
 
 def _cage(scene: RenderScene, home: np.ndarray, sink: float) -> None:

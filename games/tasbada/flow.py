@@ -20,6 +20,7 @@ instead, with one line naming it (:mod:`engine.recovery`); the journey goes on e
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -46,7 +47,7 @@ class SaveSlot:
 
     SIM_STATE = False
 
-    def __init__(self, path: object = None, photo: str = "") -> None:
+    def __init__(self, path: str | os.PathLike[str] | None = None, photo: str = "") -> None:
         self.path = path
         self.photo = photo
         self.dirty = False
@@ -287,7 +288,7 @@ def save_system(world: World) -> None:
     from games.tasbada.save import progress_of, save_progress
 
     slot.dirty = False
-    slot.rescue = slot.rescue or Rescue(Path(slot.path))  # type: ignore[arg-type]
+    slot.rescue = slot.rescue or Rescue(Path(slot.path))
     progress = progress_of(world.resource(Quest), slot.photo)
     saved = slot.rescue.save(lambda path: save_progress(path, progress))
     if saved.why and saved.why != slot.error:  # one line per new trouble; the journey goes on either way

@@ -19,6 +19,8 @@ import numpy as np
 from numpy.typing import NDArray
 from PIL import Image
 
+from engine.errors import FormatError
+
 __all__ = ["PHOTO_SIZE", "PhotoError", "load_image", "fit_photo", "clothes_color", "TORSO"]
 
 PHOTO_SIZE = (960, 540)
@@ -28,7 +30,7 @@ TORSO = (0.3, 0.62, 0.7, 0.98)
 U8 = NDArray[np.uint8]
 
 
-class PhotoError(ValueError):
+class PhotoError(FormatError):
     """The picture cannot be used (missing, not an image, too small)."""
 
 

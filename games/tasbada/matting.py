@@ -91,10 +91,11 @@ def matte(photo: NDArray[np.uint8], mark: Mark) -> Matte:
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(12345)
     if (mask == cv2.GC_PR_FGD).any() and (mask == cv2.GC_BGD).any():
-        cv2.grabCut(patch, mask, None, bgd, fgd, _ITERATIONS, cv2.GC_INIT_WITH_MASK)
+        cv2.grabCut(patch, mask, None, bgd, fgd, _ITERATIONS,  # type: ignore[call-overload]  # rect unused with a mask
+                    cv2.GC_INIT_WITH_MASK)
     hard = np.isin(mask, (cv2.GC_FGD, cv2.GC_PR_FGD)).astype(np.uint8)
     # Slivers of the room along the prop (a strip of skirting board) are thinner than any part of it.
-    hard = cv2.morphologyEx(hard, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5)))
+    hard = np.asarray(cv2.morphologyEx(hard, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))), np.uint8)
     hard = _largest_parts(hard)
     if hard.mean() < 0.02:  # nothing stood out: keep the marked region itself
         hard = (_seed((h, w), mark, crop) == cv2.GC_PR_FGD).astype(np.uint8)
@@ -141,6 +142,6 @@ def inpaint_hole(photo: NDArray[np.uint8], hole: NDArray[np.float32], grow: int 
     mask = (hole > 0.02).astype(np.uint8)
     if not mask.any():
         return photo.copy()
-    mask = cv2.dilate(mask, np.ones((2 * grow + 1, 2 * grow + 1), np.uint8))
+    mask = np.asarray(cv2.dilate(mask, np.ones((2 * grow + 1, 2 * grow + 1), np.uint8)), np.uint8)
     out = cv2.inpaint(np.ascontiguousarray(photo[..., ::-1]), mask * 255, 5, cv2.INPAINT_TELEA)
     return np.ascontiguousarray(out[..., ::-1])

@@ -118,9 +118,10 @@ def deform(tex: PropTexture, d: Deform) -> tuple[NDArray[np.uint8], tuple[int, i
         Y = np.where(up, Yu, Y)
     mapx = (bx + X - x0).astype(np.float32)
     mapy = (by - Y - y0).astype(np.float32)
-    out = cv2.remap(tex.rgba, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    if inside_mouth.any():
-        lip_y = (by - tex.mouth_y - y0).astype(np.float32) if np.ndim(by) else np.float32(by - tex.mouth_y - y0)
+    out = np.asarray(cv2.remap(tex.rgba, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0),
+                     np.uint8)
+    if gap is not None and inside_mouth.any():
+        lip_y = np.asarray(by - tex.mouth_y - y0, dtype=np.float32)
         a = cv2.remap(tex.rgba[..., 3], mapx, np.full_like(mapy, lip_y), cv2.INTER_LINEAR,
                       borderMode=cv2.BORDER_CONSTANT, borderValue=0)
         shade = np.clip((Ya - tex.mouth_y) / np.maximum(gap, 1.0), 0.0, 1.0)

@@ -92,7 +92,7 @@ class Quest:
     gesture: str = ""
     """What the current press does: ``draw`` a mark, drag the ``ground`` line, a ``button``."""
     path: list[tuple[float, float]] = field(default_factory=list)
-    undo: list[list[object]] = field(default_factory=list)
+    undo: list[list[str | float]] = field(default_factory=list)
     """Set-up actions to take back, last first: ``["mark", count after]`` or ``["ground", previous v]``."""
     alive_t: float = -1.0
     """When the props came alive (the narrator's clock), -1 before."""

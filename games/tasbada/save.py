@@ -24,6 +24,7 @@ from pathlib import Path
 
 from typing import Any
 
+from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded
 from games.tasbada.quest import STAGES, Mark, Quest
@@ -41,7 +42,7 @@ MAX_PATH = 4096
 SAVE_HEADS = (b'{\n "format": "tasbada-progress"',)
 
 
-class SaveError(ValueError):
+class SaveError(FormatError):
     """The save file exists but cannot be read as Tasbada progress."""
 
 

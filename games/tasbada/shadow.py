@@ -126,13 +126,13 @@ def _ratio(photo: NDArray[np.uint8], blocked: NDArray[np.bool_], height: float,
     small = cv2.resize(np.ascontiguousarray(crop), (sw, sh), interpolation=cv2.INTER_AREA)
     small_hole = cv2.dilate(cv2.resize(hole, (sw, sh), interpolation=cv2.INTER_NEAREST), np.ones((3, 3), np.uint8))
     small = cv2.inpaint(small, small_hole * 255, 2, cv2.INPAINT_TELEA)
-    lum_small = _luma(small)
+    lum_small = _luma(np.asarray(small, np.uint8))
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (max(kx // k, 1) | 1, max(ky // k, 1) | 1))
     env = cv2.morphologyEx(lum_small, cv2.MORPH_CLOSE, kernel)
     env = cv2.resize(cv2.GaussianBlur(env, (0, 0), 0.75), (x1 - x0, y1 - y0), interpolation=cv2.INTER_LINEAR)
     props = cv2.inpaint(np.ascontiguousarray(crop), cv2.dilate(hole, np.ones((3, 3), np.uint8)) * 255, 3,
                         cv2.INPAINT_TELEA)
-    lum = cv2.GaussianBlur(_luma(props), (0, 0), 1.5)
+    lum = cv2.GaussianBlur(_luma(np.asarray(props, np.uint8)), (0, 0), 1.5)
     out = np.ones((h, w), dtype=np.float32)
     out[y0:y1, x0:x1] = np.minimum(lum / np.maximum(env, 1.0), 1.5)
     return out

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.errors import FormatError
 from engine import quat
 from input.phone_frames import arkit_to_stick, phone_to_stick
 
@@ -57,7 +58,7 @@ _DEG = math.pi / 180.0
 F = NDArray[np.float64]
 
 
-class WebMessageError(ValueError):
+class WebMessageError(FormatError):
     """A message from a controller page that is not a valid reading (the reason, one line)."""
 
 

@@ -37,8 +37,8 @@ def _ground_mesh(half: float, height: float) -> tuple[bytes, bytes]:
 def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
     """The GLB a phone starts from: ground mesh, ``state``'s rows, lighting in the scene's extras."""
     chunks: list[bytes] = []
-    views: list[dict] = []  # type: ignore[type-arg]
-    accessors: list[dict] = []  # type: ignore[type-arg]
+    views: list[dict] = []
+    accessors: list[dict] = []
 
     def add(raw: bytes, component: int, count: int, kind: str, **extra: object) -> int:
         offset = sum(len(c) for c in chunks)
@@ -87,7 +87,7 @@ def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
     return container_bytes(doc, blob, binary=True)
 
 
-def read_scene_glb(data: bytes) -> tuple[dict, SceneState]:  # type: ignore[type-arg]
+def read_scene_glb(data: bytes) -> tuple[dict, SceneState]:
     """The scene extras and the starting :class:`SceneState` of a GLB from :func:`scene_glb` (tests, bench)."""
     from input.web.scene_stream import CameraPose
 

@@ -23,7 +23,7 @@ __all__ = ["held_props_system"]
 CLEARANCE = 0.03
 
 
-def _clear_of_others(point: np.ndarray, entity: int, radius: float, props: list) -> np.ndarray:  # type: ignore[type-arg]
+def _clear_of_others(point: np.ndarray, entity: int, radius: float, props: list) -> np.ndarray:
     """Keep a held ball out of the ground and out of every other ball: it passes over them.
 
     A held ball is moved kinematically; letting it sink into another would hand the
