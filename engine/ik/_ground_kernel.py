@@ -203,3 +203,89 @@ def legs_solve(parents: I, roots: F, rots: F, offs: F, legs: I, knees: F, target
             pole = (pos[lo, 0] + pk[0], pos[lo, 1] + pk[1], pos[lo, 2] + pk[2])
             end = qnormalize(_q(new_rot[p], k))
             _solve_limb(parents, pos, wrot, rots[p], u, lo, f, _v(targets[p], k), pole, end)
+
+
+@njit
+def _smooth(w: float) -> float:
+    return w * w * (3.0 - 2.0 * w)
+
+
+@njit
+def lock_group(idx: I, targets: F, new_rot: F, floor: F, tips: F, dt: float, settings: F, points: F, weights: F,
+               planted: NDArray[np.bool_], stepping: NDArray[np.bool_], yaw: F, animated: F, contacts: F,
+               settle: NDArray[np.bool_]) -> None:
+    """:func:`engine.ik.grounding._lock_group` and :func:`engine.ik.foot_lock.lock_feet` for puppets ``idx``
+    (lock state ``[G, L, …]`` advanced in place; their ``targets``/``new_rot`` rows moved to the locks).
+
+    ``settings`` is :meth:`FootLock.settings`: release time, max stretch, release height, settle gap,
+    max twist, settle twist, step time, step height."""
+    release_time, max_stretch, release_height, settle_gap = settings[0], settings[1], settings[2], settings[3]
+    max_twist, settle_twist, step_time, step_height = settings[4], settings[5], settings[6], settings[7]
+    legs = targets.shape[1]
+    toe = np.empty((legs, 3))
+    twist, gap = np.empty(legs), np.empty(legs)
+    start, still, misplaced = np.empty(legs, np.bool_), np.empty(legs, np.bool_), np.empty(legs, np.bool_)
+    for g in range(idx.shape[0]):
+        i = idx[g]
+        st = settle[g]
+        for k in range(legs):
+            r = _q(new_rot[i], k)
+            fwd = qrot(r, (0.0, 0.0, 1.0))
+            y = math.atan2(fwd[0], fwd[2])
+            held = yaw[g, k] if weights[g, k] > 0.0 else y
+            tw = (held - y + math.pi) % (2 * math.pi) - math.pi
+            r = qmul(qaxis_angle((0.0, 1.0, 0.0), tw * _smooth(weights[g, k])), r)
+            new_rot[i, k, 0], new_rot[i, k, 1], new_rot[i, k, 2], new_rot[i, k, 3] = r
+            yaw[g, k] = held
+            twist[k] = abs(tw)
+            tp = qrot(r, _v(tips, k))
+            for c in range(3):
+                toe[k, c] = targets[i, k, c] + tp[c]
+            dx, dz = toe[k, 0] - animated[g, k, 0], toe[k, 2] - animated[g, k, 2]
+            still[k] = math.sqrt(dx * dx + dz * dz) <= 0.1 * max(dt, 1e-9)
+        any_stepping = False
+        for k in range(legs):  # lock_feet, first pass: new locks, gaps, who must step
+            w = weights[g, k]
+            stepping[g, k] = stepping[g, k] and w > 0.0 and st
+            any_stepping = any_stepping or stepping[g, k]
+            down = contacts[g, k] > 0.5
+            start[k] = down and not planted[g, k] and not stepping[g, k]
+            if start[k]:
+                sw = _smooth(w)
+                points[g, k, 0] = toe[k, 0] + sw * (points[g, k, 0] - toe[k, 0])
+                points[g, k, 1] = toe[k, 1]
+                points[g, k, 2] = toe[k, 2] + sw * (points[g, k, 2] - toe[k, 2])
+                weights[g, k] = 1.0
+            dx, dz = points[g, k, 0] - toe[k, 0], points[g, k, 2] - toe[k, 2]
+            gap[k] = math.sqrt(dx * dx + dz * dz) + 0.15 * (0.0 if start[k] else twist[k])
+            misplaced[k] = ((planted[g, k] or start[k]) and st and still[k]
+                            and (gap[k] > settle_gap or twist[k] > settle_twist))
+        far = 0.0
+        for k in range(legs):
+            far = max(far, gap[k] if misplaced[k] else 0.0)
+        for k in range(legs):
+            held = planted[g, k] or start[k]
+            stretched = (gap[k] > max_stretch or twist[k] > max_twist) and not start[k] and not st
+            if misplaced[k] and gap[k] >= far and not any_stepping:
+                stepping[g, k] = True
+            down = contacts[g, k] > 0.5
+            holding = down or (planted[g, k] and toe[k, 1] - floor[i, k, 1] < release_height)
+            planted[g, k] = holding and not stretched and held and not stepping[g, k]
+            w = weights[g, k]
+            if not planted[g, k]:
+                w = max(w - (dt / step_time if stepping[g, k] else dt / release_time), 0.0)
+                weights[g, k] = w
+            progress = 1.0 - w
+            if stepping[g, k]:
+                along = 1.0 - _smooth(min(max((progress - 0.25) / 0.5, 0.0), 1.0))
+                lift = math.sin(math.pi * progress) * min(0.5 * gap[k] + 0.04, step_height)
+            else:
+                along = _smooth(w)
+                lift = 4.0 * w * (1.0 - w) * min(0.5 * gap[k], step_height) if not planted[g, k] else 0.0
+            placed_x = toe[k, 0] + along * (points[g, k, 0] - toe[k, 0])
+            placed_z = toe[k, 2] + along * (points[g, k, 2] - toe[k, 2])
+            targets[i, k, 0] += placed_x - toe[k, 0]
+            targets[i, k, 1] += toe[k, 1] + lift - toe[k, 1]
+            targets[i, k, 2] += placed_z - toe[k, 2]
+            for c in range(3):
+                animated[g, k, c] = toe[k, c]

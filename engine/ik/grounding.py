@@ -153,6 +153,9 @@ def _fit_lock(lock: FootLock, toes: F) -> None:
 def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, toes: F, floor: F, tips: F,
                 dt: float) -> None:
     """Lock the feet of puppets ``idx`` (their ``group`` of locks, one setting) in place, as arrays ``[G, L]``."""
+    if jit.enabled():
+        _lock_group_compiled(idx, group, targets, new_rot, floor, tips, dt)
+        return
     weights = np.stack([g.weights for g in group])
     # A planted foot keeps the heading it landed with while the body turns above it
     # (a foot that turned with the hips would sweep its toe or heel over the ground).
@@ -173,6 +176,30 @@ def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_r
         g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
         g.yaw, g.animated = held_yaw[k], toe[k].copy()
     targets[idx] += placed - toe
+
+
+def _lock_group_compiled(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, floor: F, tips: F,
+                         dt: float) -> None:
+    """:func:`_lock_group` on the compiled kernel: the locks' state gathered into ``[G, L]`` arrays, one pass,
+    each lock given its rows back."""
+    legs = tips.shape[0]
+    try:
+        contacts = np.array([g.contacts for g in group], dtype=np.float64)
+    except ValueError:  # ragged: some puppet's vote is one number for every leg
+        contacts = np.zeros(0)
+    if contacts.shape != (len(group), legs):
+        contacts = np.stack([np.broadcast_to(np.asarray(g.contacts, dtype=np.float64), (legs,)) for g in group])
+    points, weights = np.array([g.points for g in group]), np.array([g.weights for g in group])
+    planted = np.array([g.planted for g in group], dtype=bool)
+    stepping = np.array([g.stepping for g in group], dtype=bool)
+    yaw, animated = np.array([g.yaw for g in group]), np.array([g.animated for g in group])
+    settle = np.array([g.settle for g in group], dtype=bool)
+    _kernel.lock_group(np.asarray(idx, dtype=np.int64), targets, new_rot, np.ascontiguousarray(floor),
+                       np.ascontiguousarray(tips, dtype=np.float64), dt, np.array(group[0].settings()), points,
+                       weights, planted, stepping, yaw, animated, contacts, settle)
+    for k, g in enumerate(group):
+        g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
+        g.yaw, g.animated = yaw[k], animated[k]
 
 
 def _reach_shift(hips: F, targets: F, lengths: F, shift: F, max_pelvis_shift: float) -> F:
