@@ -19,7 +19,7 @@ from engine import jit, quat
 from engine.jit import qmul, qrot
 from engine.skeleton import Skeleton
 
-__all__ = ["forward_kinematics", "world_points", "levels", "fk_kernel"]
+__all__ = ["fk_kernel", "forward_kinematics", "levels", "world_points"]
 
 
 @lru_cache(maxsize=64)

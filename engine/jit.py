@@ -25,11 +25,12 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any, TypeVar
 
-__all__ = ["AVAILABLE", "enabled", "use", "njit", "qmul", "qrot", "qnormalize", "qconj", "qslerp", "qbetween",
-           "qaxis_angle", "vcross", "vdot", "vnorm", "vunit"]
+__all__ = ["AVAILABLE", "enabled", "njit", "qaxis_angle", "qbetween", "qconj", "qmul", "qnormalize", "qrot", "qslerp",
+           "use", "vcross", "vdot", "vnorm", "vunit"]
 
 T = TypeVar("T", bound=Callable[..., Any])
 
+_numba: Any
 try:
     import numba as _numba
 except ImportError:  # the numpy path runs everywhere then
@@ -62,7 +63,7 @@ def njit(fn: T) -> T:
     the plain function otherwise (never called then)."""
     if _numba is None:
         return fn
-    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)  # type: ignore[no-any-return]  # numba is untyped
+    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)  # type: ignore[no-any-return,return-value]  # a Dispatcher is called like fn
 
 
 @njit

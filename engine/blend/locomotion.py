@@ -17,7 +17,9 @@ machine: requested root speed in m/s and hips height in m):
 
 Puppets sharing a locomotion set are evaluated together, batched over puppets:
 one inside test and one k-d tree query for all their requests, one sample per
-active clip for all their phases. Answers are memoised per request (a puppet held
+active clip for all their phases; with numba (:mod:`engine.jit`) steps 3–5's blend
+(weights, phase, root motion, pose, votes) is one compiled pass over the group
+(:mod:`engine.blend._kernel`). Answers are memoised per request (a puppet held
 still, or an idle crowd, asks the same thing every step).
 Assets (spaces, tables, clips) live in the :class:`BlendLibrary` resource; the
 component holds only what changes per frame. Time is ``world.dt`` steps only.
@@ -30,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from engine import quat
+from engine import jit, quat
 from engine.app import App
+from engine.blend import _kernel
 from engine.blend.lookup import LookupTable, Resolution
 from engine.blend.measure import contact_votes
 from engine.blend.pose_blend import crossfade, fade_weight
@@ -240,6 +243,19 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
     return out  # type: ignore[return-value]
 
 
+def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F,
+                   dt: float) -> tuple[F, F, F, F, F, F | None]:
+    """:meth:`BlendSpace.advance`, :meth:`~BlendSpace.sample` and :func:`contact_votes` of a group in one
+    compiled pass: (root, rotations, new phase, travel, turn, votes or ``None``)."""
+    count, joints, legs = len(points), pk.rotations.shape[1], pk.contacts.shape[1]
+    w, new_phase, travel, turn = np.empty((count, len(pk.points))), np.empty(count), np.empty((count, 3)), np.empty(count)
+    root, rots, votes = np.empty((count, 3)), np.empty((count, joints, 4)), np.empty((count, legs))
+    _kernel.play(pk.points, pk.durations, pk.fps, pk.frames, pk.start, pk.knot_x, pk.knot_y, pk.roots, pk.rotations,
+                 pk.tables, pk.cycles, pk.contacts, np.ascontiguousarray(points, dtype=np.float64), phase,
+                 np.ascontiguousarray(rates, dtype=np.float64), dt, w, new_phase, travel, turn, root, rots, votes)
+    return root, rots, new_phase, travel, turn, (votes if legs else None)
+
+
 def animate(world: World) -> None:
     """The animation-stage system: resolve, advance and pose every locomotion puppet (batched per set)."""
     library = world.try_resource(BlendLibrary)
@@ -260,17 +276,23 @@ def animate(world: World) -> None:
             player.point, player.feasible, player.inside, player.rate = p, res.feasible * player.scale, res.inside, res.rate
             points.append(p)
             rates.append(res.rate)
-        w = space.weights(np.array(points))
         phase = np.array([m[3].phase for m in members])
-        new_phase, travel, turn = space.advance(phase, w, dt, np.array(rates))
-        # Scaling the phase step by the rate already scales the root travel: feet keep pace with the ground.
-        pose = space.sample(w, new_phase)
+        tracks = library.tracks(key)
+        packed = _kernel.packed(space, tracks) if jit.enabled() else None
+        if packed is None:
+            w = space.weights(np.array(points))
+            # Scaling the phase step by the rate already scales the root travel: feet keep pace with the ground.
+            new_phase, travel, turn = space.advance(phase, w, dt, np.array(rates))
+            pose = space.sample(w, new_phase)
+            blended, rots = pose.root, pose.rotations.copy()
+            votes = None if tracks is None else contact_votes(space, w, new_phase, tracks)
+        else:
+            blended, rots, new_phase, travel, turn, votes = _play_compiled(packed, np.array(points), phase,
+                                                                            np.array(rates), dt)
         scale = np.array([m[3].scale for m in members])
-        roots, rots = pose.root * scale[:, None], pose.rotations.copy()
+        roots = blended * scale[:, None]
         travel = travel * scale[:, None]
         keep_turn = np.ones(len(members))
-        tracks = library.tracks(key)
-        votes = None if tracks is None else contact_votes(space, w, new_phase, tracks)
         for i, (e, _tr, _pup, player) in enumerate(members):
             player.phase = float(new_phase[i] % 1.0)
             clip, weight, clip_travel = _override(player, loco, dt)

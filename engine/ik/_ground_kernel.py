@@ -25,10 +25,10 @@ from numpy.typing import NDArray
 
 from engine.jit import njit, qaxis_angle, qbetween, qconj, qmul, qnormalize, qrot, qslerp, vcross, vdot, vnorm, vunit
 
-__all__ = ["legs_fk", "legs_targets", "legs_solve"]
+__all__ = ["legs_fk", "legs_solve", "legs_targets", "lock_group"]
 
 F = NDArray[np.float64]
-I = NDArray[np.int64]  # noqa: E741  # an index array, as F is a float one
+I = NDArray[np.int64]  # an index array, as F is a float one
 _EPS = 1e-9
 
 
