@@ -371,8 +371,9 @@ def _ground_compiled(skeleton: Skeleton, roots: F, rotations: F, ground: GroundQ
                      max_pelvis_shift: float, w: F, locks: Sequence[FootLock | None] | None, dt: float) -> F:
     """:func:`ground_feet_batch` on the compiled kernels (:mod:`engine.ik._ground_kernel`); the locks in numpy."""
     p, n = rotations.shape[0], len(legs)
-    if not (roots.flags.c_contiguous and rotations.flags.c_contiguous):
-        raise ValueError("compiled grounding needs C-contiguous roots and rotations (it writes them in place)")
+    given_roots, given_rotations = roots, rotations  # the kernels write C-contiguous doubles; copied back below
+    roots = np.ascontiguousarray(roots, dtype=np.float64)
+    rotations = np.ascontiguousarray(rotations, dtype=np.float64)
     offs = np.ascontiguousarray(np.broadcast_to(off, rotations.shape[:-1] + (3,)))
     leg_idx = np.array(idx, dtype=np.int64).reshape(n, 3)
     soles = np.array([leg.sole for leg in legs], dtype=np.float64).reshape(n, 3)
@@ -394,6 +395,10 @@ def _ground_compiled(skeleton: Skeleton, roots: F, rotations: F, ground: GroundQ
     shift = np.empty(p)
     _kernel.legs_solve(skeleton.parents, roots, rotations, offs, leg_idx, knees, targets, new_rot, ankles, hips,
                        max_pelvis_shift, shift)
+    if roots is not given_roots:
+        given_roots[...] = roots
+    if rotations is not given_rotations:
+        given_rotations[...] = rotations
     return shift
 
 

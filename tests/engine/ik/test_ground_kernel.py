@@ -76,3 +76,18 @@ def test_compiled_grounding_plants_the_soles_and_rejects_bad_ground() -> None:
         assert np.all(sole[:, 1] >= 0.1 - 1e-6)
     with jit.use(True), pytest.raises(ValueError, match="non-finite"):
         ground_feet_batch(sk, roots.copy(), rots.copy(), lambda x, z: (np.full_like(x, np.nan), np.zeros(x.shape + (3,))))
+
+
+def test_compiled_grounding_writes_back_into_strided_inputs() -> None:
+    """Views (every other puppet of a bigger array) are grounded in place as the numpy path does them."""
+    sk, _rng, rots, roots, offsets = _crowd(6, 20)
+    ground = PlaneGround(point=(0.0, 0.05, 0.0))
+    results = []
+    for compiled in (False, True):
+        r, q = roots.copy(), rots.copy()
+        with jit.use(compiled):
+            ground_feet_batch(sk, r[::2], q[::2], ground, offsets=offsets[::2])
+        results.append((r, q))
+    np.testing.assert_allclose(results[1][0], results[0][0], atol=1e-9)
+    np.testing.assert_allclose(results[1][1], results[0][1], atol=1e-9)
+    assert not np.allclose(results[1][0][::2], roots[::2])  # something was written
