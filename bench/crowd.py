@@ -10,7 +10,10 @@ same crowd on the path from before animated puppets left the dynamics
 (:attr:`PhysicsWorld.simulate_animated`) and before crowds were grounded in one batch
 (:attr:`IKRigCache.batch_from`), measured in the same run so the ratio is fair; the other
 batching (animated drive, locomotion write-back) has no switch and is in both.
-``crowd_system_ms_<stage>_100`` splits the 100-puppet step by schedule stage.
+``crowd_system_ms_<stage>_100`` splits the 100-puppet step by schedule stage; the animation,
+ik and fk stages, and the whole step (``crowd_step_ms_100_numpy``), are set against the same
+crowd on the pure-numpy path of the same kernels (:mod:`engine.jit` switched off), measured in
+the same run: what compiling the per-puppet loops with numba buys.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import time
 import numpy as np
 
 from bench.figures import Figure
+from engine import jit
 from engine.app import STAGES, App
 from engine.ik.system import IKRigCache
 from engine.ragdoll.physics import PhysicsWorld
@@ -68,6 +72,9 @@ def timed_steps(app: App, steps: int = STEPS) -> tuple[np.ndarray, dict[str, np.
     return total, per_stage
 
 
+_KERNEL_STAGES = ("animation", "ik", "fk")
+
+
 def run() -> list[Figure]:
     """Median step time for 1, 10 and 100 walking puppets, the old path at 100, and the stages at 100."""
     figures = []
@@ -76,8 +83,17 @@ def run() -> list[Figure]:
         total, stages = timed_steps(crowd_app(n))
         figures.append(Figure(_BENCH, f"crowd_step_ms_{n}", float(np.median(total)) * 1e3, "ms",
                               "60 Hz budget", BUDGET_MS))
+    with jit.use(False):
+        numpy_total, numpy_stages = timed_steps(crowd_app(100))
     for stage, t in stages.items():
-        figures.append(Figure(_BENCH, f"crowd_system_ms_{stage}_100", float(np.median(t)) * 1e3, "ms"))
+        if stage in _KERNEL_STAGES and jit.enabled():
+            figures.append(Figure(_BENCH, f"crowd_system_ms_{stage}_100", float(np.median(t)) * 1e3, "ms",
+                                  "numpy path, same run", float(np.median(numpy_stages[stage])) * 1e3))
+        else:
+            figures.append(Figure(_BENCH, f"crowd_system_ms_{stage}_100", float(np.median(t)) * 1e3, "ms"))
+    if jit.enabled():
+        figures.append(Figure(_BENCH, "crowd_step_ms_100_numpy", float(np.median(numpy_total)) * 1e3, "ms",
+                              "this run's crowd_step_ms_100 (compiled)", figures[2].value))
     old, _ = timed_steps(crowd_app(100, old=True))
     new = figures[2].value
     figures.append(Figure(_BENCH, "crowd_step_ms_100_old", float(np.median(old)) * 1e3, "ms",

@@ -3,11 +3,12 @@
 - ``peer_fk_100_puppets_us``: batched FK of 100 humanoids (17 joints) against pinocchio's
   ``forwardKinematics`` on the same skeleton (a free-flyer root and spherical joints), one call per
   puppet since pinocchio has no batch call. Skipped with a line when pinocchio (the ``[peers]``
-  extra) is absent.
+  extra) is absent. Ours is the compiled kernel when numba is installed (:mod:`engine.jit`);
+  ``peer_fk_100_puppets_us_numpy`` is its pure-numpy twin against the same peer.
 - ``peer_lookup_1_us`` / ``peer_lookup_100_us``: the puppet's IDW lookup (k-d tree + probe slopes),
   one request and a crowd's 100, against SciPy's ``cKDTree`` query plus textbook IDW (weights
   ``1/dᵖ`` over the same k neighbours) — the peer does less (no slopes, no exact-hit guard), so
-  this is generous to it.
+  this is generous to it. Ours weights the neighbours in one compiled loop when numba is installed.
 
 Every figure is the median of :data:`REPEATS` samples, each sample the mean of enough calls to
 run :data:`SAMPLE_S` seconds of thread CPU time.
@@ -24,7 +25,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from bench.figures import Figure, median_time
-from engine import quat
+from engine import jit, quat
 from engine.blend.puppet import puppet_locomotion
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
@@ -87,8 +88,14 @@ def run() -> list[Figure]:
             for q in qs:
                 pin.forwardKinematics(model, data, q)
 
+        theirs_us = cpu_time(pin_fk) * 1e6
         figures.append(Figure(_BENCH, "peer_fk_100_puppets_us", ours * 1e6, "us", "pinocchio forwardKinematics x100",
-                              cpu_time(pin_fk) * 1e6))
+                              theirs_us))
+        if jit.enabled():  # the pure-numpy twin of our kernel beside the same peer
+            with jit.use(False):
+                ours_numpy = cpu_time(lambda: forward_kinematics(sk, roots, rots))
+            figures.append(Figure(_BENCH, "peer_fk_100_puppets_us_numpy", ours_numpy * 1e6, "us",
+                                  "pinocchio forwardKinematics x100", theirs_us))
     table = puppet_locomotion().table
     tree = cKDTree(table._scaled_values)
     k, power = min(table.neighbours, len(table.probes)), table.power

@@ -25,9 +25,9 @@ def fk_system(world: World) -> None:
         groups.setdefault(puppet.skeleton.parents.tobytes(), []).append((e, puppet, local))
     for members in groups.values():
         skeleton = members[0][1].skeleton
-        roots = np.stack([m[2].root for m in members])
-        rots = np.stack([m[2].rotations for m in members])
-        offsets = np.stack([m[1].joint_offsets() for m in members])
+        roots = np.array([m[2].root for m in members], dtype=np.float64)
+        rots = np.array([m[2].rotations for m in members], dtype=np.float64)
+        offsets = np.array([m[1].joint_offsets() for m in members], dtype=np.float64)
         pos, rot = forward_kinematics(skeleton, roots, rots, offsets)
         for k, (e, _, _) in enumerate(members):
             wp = world.try_get(e, WorldPose)

@@ -17,7 +17,9 @@ machine: requested root speed in m/s and hips height in m):
 
 Puppets sharing a locomotion set are evaluated together, batched over puppets:
 one inside test and one k-d tree query for all their requests, one sample per
-active clip for all their phases. Answers are memoised per request (a puppet held
+active clip for all their phases; with numba (:mod:`engine.jit`) steps 3–5's blend
+(weights, phase, root motion, pose, votes) is one compiled pass over the group
+(:mod:`engine.blend._kernel`). Answers are memoised per request (a puppet held
 still, or an idle crowd, asks the same thing every step).
 Assets (spaces, tables, clips) live in the :class:`BlendLibrary` resource; the
 component holds only what changes per frame. Time is ``world.dt`` steps only.
@@ -25,13 +27,15 @@ component holds only what changes per frame. Time is ``world.dt`` steps only.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from engine import quat
+from engine import jit, quat
 from engine.app import App
+from engine.blend import _kernel
 from engine.blend.lookup import LookupTable, Resolution
 from engine.blend.measure import contact_votes
 from engine.blend.pose_blend import crossfade, fade_weight
@@ -214,9 +218,9 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
     missed: list[tuple[float, float | None]] = []  # their requests in the set's units
     for i, (e, _tr, _pup, player) in enumerate(members):
         speed, height = player.speed, player.height
-        if not (np.isfinite(speed) and speed >= 0.0 and (height is None or np.isfinite(height))):
+        if not (math.isfinite(speed) and speed >= 0.0 and (height is None or math.isfinite(height))):
             raise ValueError(f"entity {e}: locomotion request speed={speed!r}, height={height!r} is invalid")
-        if not (np.isfinite(player.scale) and player.scale > 0.0):
+        if not (math.isfinite(player.scale) and player.scale > 0.0):
             raise ValueError(f"entity {e}: locomotion scale {player.scale!r} must be positive")
         request = (float(speed / player.scale), None if height is None else float(height / player.scale))
         res = library.memo.get((key, *request))
@@ -240,6 +244,19 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
     return out  # type: ignore[return-value]
 
 
+def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F,
+                   dt: float) -> tuple[F, F, F, F, F, F | None]:
+    """:meth:`BlendSpace.advance`, :meth:`~BlendSpace.sample` and :func:`contact_votes` of a group in one
+    compiled pass: (root, rotations, new phase, travel, turn, votes or ``None``)."""
+    count, joints, legs = len(points), pk.rotations.shape[1], pk.contacts.shape[1]
+    w, new_phase, travel, turn = np.empty((count, len(pk.points))), np.empty(count), np.empty((count, 3)), np.empty(count)
+    root, rots, votes = np.empty((count, 3)), np.empty((count, joints, 4)), np.empty((count, legs))
+    _kernel.play(pk.points, pk.durations, pk.fps, pk.frames, pk.start, pk.knot_x, pk.knot_y, pk.roots, pk.rotations,
+                 pk.tables, pk.cycles, pk.contacts, np.ascontiguousarray(points, dtype=np.float64), phase,
+                 np.ascontiguousarray(rates, dtype=np.float64), dt, w, new_phase, travel, turn, root, rots, votes)
+    return root, rots, new_phase, travel, turn, (votes if legs else None)
+
+
 def animate(world: World) -> None:
     """The animation-stage system: resolve, advance and pose every locomotion puppet (batched per set)."""
     library = world.try_resource(BlendLibrary)
@@ -250,29 +267,53 @@ def animate(world: World) -> None:
         groups.setdefault(player.library_key, []).append((e, tr, pup, player))
     dt = world.dt
     for key, members in groups.items():
-        loco = library[key]
-        space = loco.space
-        alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
-        points, rates = [], []
-        for (_e, _, _, player), res in zip(members, _resolve_group(library, key, loco, members), strict=True):
-            player.finished = None
-            p = res.point if player.point is None else player.point + alpha * (res.point - player.point)
-            player.point, player.feasible, player.inside, player.rate = p, res.feasible * player.scale, res.inside, res.rate
-            points.append(p)
-            rates.append(res.rate)
-        w = space.weights(np.array(points))
-        phase = np.array([m[3].phase for m in members])
-        new_phase, travel, turn = space.advance(phase, w, dt, np.array(rates))
+        _animate_group(world, library, key, members, dt)
+
+
+def _animate_group(world: World, library: BlendLibrary, key: str, members: list[_Row], dt: float) -> None:
+    """One locomotion set's puppets: array passes, and per-puppet Python only to read and write
+    components and for a puppet playing an override clip."""
+    loco = library[key]
+    space = loco.space
+    players = [m[3] for m in members]
+    alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
+    resolved = _resolve_group(library, key, loco, members)
+    target = np.array([res.point for res in resolved])
+    previous = [player.point for player in players]
+    if any(p is None for p in previous):
+        previous = [res.point if p is None else p for p, res in zip(previous, resolved, strict=True)]
+        eased = np.array(previous)
+        fresh = np.array([player.point is None for player in players])
+        points = np.where(fresh[:, None], target, eased + alpha * (target - eased))
+    else:
+        eased = np.array(previous)
+        points = eased + alpha * (target - eased)
+    scale = np.array([player.scale for player in players])
+    rates = np.array([res.rate for res in resolved])
+    feasible = np.array([res.feasible for res in resolved]) * scale[:, None]
+    for i, (player, res) in enumerate(zip(players, resolved, strict=True)):
+        player.finished = None
+        player.point, player.feasible, player.inside, player.rate = points[i], feasible[i], res.inside, res.rate
+    phase = np.array([player.phase for player in players])
+    tracks = library.tracks(key)
+    packed = _kernel.packed(space, tracks) if jit.enabled() else None
+    if packed is None:
+        w = space.weights(points)
         # Scaling the phase step by the rate already scales the root travel: feet keep pace with the ground.
+        new_phase, travel, turn = space.advance(phase, w, dt, rates)
         pose = space.sample(w, new_phase)
-        scale = np.array([m[3].scale for m in members])
-        roots, rots = pose.root * scale[:, None], pose.rotations.copy()
-        travel = travel * scale[:, None]
-        keep_turn = np.ones(len(members))
-        tracks = library.tracks(key)
+        blended, rots = pose.root, pose.rotations.copy()
         votes = None if tracks is None else contact_votes(space, w, new_phase, tracks)
-        for i, (e, _tr, _pup, player) in enumerate(members):
-            player.phase = float(new_phase[i] % 1.0)
+    else:
+        blended, rots, new_phase, travel, turn, votes = _play_compiled(packed, points, phase, rates, dt)
+    roots = blended * scale[:, None]
+    travel = travel * scale[:, None]
+    keep_turn = np.ones(len(members))
+    wrapped = (new_phase % 1.0).tolist()
+    for i, (e, _tr, _pup, player) in enumerate(members):
+        player.phase = wrapped[i]
+        clip, weight = None, 0.0
+        if player.override is not None:  # the unusual puppet: a one-shot or a held pose over its blend
             clip, weight, clip_travel = _override(player, loco, dt)
             if clip is not None:
                 over = clip.sample(player.override_time)
@@ -280,28 +321,29 @@ def animate(world: World) -> None:
                 roots[i], rots[i] = local.root, local.rotations
                 travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
                 keep_turn[i] = 1.0 - weight
-            ik = world.try_get(e, IKRequest)
-            if ik is not None:
-                ik.foot_lock.contacts = None if votes is None else votes[i] * (1.0 - (weight if clip is not None else 0.0))
-                ik.foot_lock.settle = player.speed < _SETTLE_SPEED
-        # Heading, travel and the world root for the whole group at once.
-        yaw = _yaw(np.array([m[1].rotation for m in members]))
-        hq = quat.from_axis_angle(_UP, yaw)
-        step = quat.rotate(hq, travel)
-        turn_q = quat.from_axis_angle(_UP, turn * keep_turn)
-        hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
-        rots[:, 0] = quat.mul(hq_new, rots[:, 0])
-        offsets = quat.rotate(hq_new, roots)
-        positions = np.array([m[1].position for m in members]) + step
-        headings = quat.normalize(quat.mul(turn_q, np.array([m[1].rotation for m in members])))
-        world_roots = positions + offsets
-        for i, (e, tr, _pup, _player) in enumerate(members):
-            tr.position, tr.rotation, root = positions[i], headings[i], world_roots[i]
-            existing = world.try_get(e, LocalPose)
-            if existing is None:
-                world.queue_add(e, LocalPose(root, rots[i]))
-            else:
-                existing.root, existing.rotations = root, rots[i]
+        ik = world.try_get(e, IKRequest)
+        if ik is not None:
+            ik.foot_lock.contacts = None if votes is None else votes[i] * (1.0 - (weight if clip is not None else 0.0))
+            ik.foot_lock.settle = player.speed < _SETTLE_SPEED
+    # Heading, travel and the world root for the whole group at once.
+    rotation = np.array([m[1].rotation for m in members])
+    yaw = _yaw(rotation)
+    hq = quat.from_axis_angle(_UP, yaw)
+    step = quat.rotate(hq, travel)
+    turn_q = quat.from_axis_angle(_UP, turn * keep_turn)
+    hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
+    rots[:, 0] = quat.mul(hq_new, rots[:, 0])
+    offsets = quat.rotate(hq_new, roots)
+    positions = np.array([m[1].position for m in members]) + step
+    headings = quat.normalize(quat.mul(turn_q, rotation))
+    world_roots = positions + offsets
+    for i, (e, tr, _pup, _player) in enumerate(members):
+        tr.position, tr.rotation, root = positions[i], headings[i], world_roots[i]
+        existing = world.try_get(e, LocalPose)
+        if existing is None:
+            world.queue_add(e, LocalPose(root, rots[i]))
+        else:
+            existing.root, existing.rotations = root, rots[i]
 
 
 def install_blend(app: App) -> None:

@@ -11,7 +11,8 @@ rather than over-stretching a leg, and the other knee bends instead.
 One puppet's legs are a few dozen 3-vector operations, so they run on floats
 (:mod:`engine.ik._scalar`, :mod:`engine.ik._limb`); only the ground query sees numpy.
 A crowd of one skeleton goes through :func:`ground_feet_batch` instead: the same steps
-as arrays over the puppets.
+as arrays over the puppets, or, with numba (:mod:`engine.jit`), as compiled loops over
+them (:mod:`engine.ik._ground_kernel`; only the ground query and the foot locks stay numpy).
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from engine import quat
+from engine import jit, quat
+from engine.ik import _ground_kernel as _kernel
 from engine.ik._limb import solve_limb
 from engine.ik.foot_lock import FootLock, floor_lift, lock_feet, smoothstep
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
@@ -121,8 +123,14 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
     targets = targets.copy()
     targets[..., 1] += lift
     toes[..., 1] += lift
-    if locks is None:
-        return targets
+    if locks is not None:
+        _apply_locks(locks, targets, new_rot, toes, floor, tips, dt)
+    return targets
+
+
+def _apply_locks(locks: Sequence[FootLock | None], targets: F, new_rot: F, toes: F, floor: F, tips: F,
+                 dt: float) -> None:
+    """Hold planted toes where they landed: ``targets`` and ``new_rot`` changed in place, the locks advanced."""
     groups: dict[tuple[float, ...], list[int]] = {}
     for p, lock in enumerate(locks):
         if lock is not None and lock.contacts is not None and lock.enabled:
@@ -130,7 +138,6 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
             groups.setdefault(lock.settings(), []).append(p)
     for members in groups.values():  # puppets whose locks share settings: one array pass
         _lock_group(np.array(members), [locks[p] for p in members], targets, new_rot, toes, floor, tips, dt)
-    return targets
 
 
 def _fit_lock(lock: FootLock, toes: F) -> None:
@@ -146,6 +153,9 @@ def _fit_lock(lock: FootLock, toes: F) -> None:
 def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, toes: F, floor: F, tips: F,
                 dt: float) -> None:
     """Lock the feet of puppets ``idx`` (their ``group`` of locks, one setting) in place, as arrays ``[G, L]``."""
+    if jit.enabled():
+        _lock_group_compiled(idx, group, targets, new_rot, floor, tips, dt)
+        return
     weights = np.stack([g.weights for g in group])
     # A planted foot keeps the heading it landed with while the body turns above it
     # (a foot that turned with the hips would sweep its toe or heel over the ground).
@@ -166,6 +176,30 @@ def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_r
         g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
         g.yaw, g.animated = held_yaw[k], toe[k].copy()
     targets[idx] += placed - toe
+
+
+def _lock_group_compiled(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, floor: F, tips: F,
+                         dt: float) -> None:
+    """:func:`_lock_group` on the compiled kernel: the locks' state gathered into ``[G, L]`` arrays, one pass,
+    each lock given its rows back."""
+    legs = tips.shape[0]
+    try:
+        contacts = np.array([g.contacts for g in group], dtype=np.float64)
+    except ValueError:  # ragged: some puppet's vote is one number for every leg
+        contacts = np.zeros(0)
+    if contacts.shape != (len(group), legs):
+        contacts = np.stack([np.broadcast_to(np.asarray(g.contacts, dtype=np.float64), (legs,)) for g in group])
+    points, weights = np.array([g.points for g in group]), np.array([g.weights for g in group])
+    planted = np.array([g.planted for g in group], dtype=bool)
+    stepping = np.array([g.stepping for g in group], dtype=bool)
+    yaw, animated = np.array([g.yaw for g in group]), np.array([g.animated for g in group])
+    settle = np.array([g.settle for g in group], dtype=bool)
+    _kernel.lock_group(np.asarray(idx, dtype=np.int64), targets, new_rot, np.ascontiguousarray(floor),
+                       np.ascontiguousarray(tips, dtype=np.float64), dt, np.array(group[0].settings()), points,
+                       weights, planted, stepping, yaw, animated, contacts, settle)
+    for k, g in enumerate(group):
+        g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
+        g.yaw, g.animated = yaw[k], animated[k]
 
 
 def _reach_shift(hips: F, targets: F, lengths: F, shift: F, max_pelvis_shift: float) -> F:
@@ -292,6 +326,9 @@ def ground_feet_batch(
         raise ValueError("weight must lie in 0..1")
     off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
     idx = [(skeleton.index(leg.upper), skeleton.index(leg.lower), skeleton.index(leg.foot)) for leg in legs]
+    if jit.enabled():
+        return _ground_compiled(skeleton, roots, rotations, ground, legs, off, idx, align_height, contact_height,
+                                max_pelvis_shift, w, locks, dt)
     soles = np.array([leg.sole for leg in legs])
     ankle, qfoot, hip = [], [], []
     for u, _, f in idx:
@@ -326,6 +363,42 @@ def ground_feet_batch(
             two_bone_ik(skeleton, pose, (u, lo, f), targets[:, k], pole, end_rotation=new_rot[:, k], offsets=off)
         return shift
     _solve_legs(skeleton, roots, rotations, off, hips.pop(), idx, legs, targets, new_rot)
+    return shift
+
+
+def _ground_compiled(skeleton: Skeleton, roots: F, rotations: F, ground: GroundQuery, legs: tuple[Leg, ...], off: F,
+                     idx: list[tuple[int, int, int]], align_height: float, contact_height: float,
+                     max_pelvis_shift: float, w: F, locks: Sequence[FootLock | None] | None, dt: float) -> F:
+    """:func:`ground_feet_batch` on the compiled kernels (:mod:`engine.ik._ground_kernel`); the locks in numpy."""
+    p, n = rotations.shape[0], len(legs)
+    given_roots, given_rotations = roots, rotations  # the kernels write C-contiguous doubles; copied back below
+    roots = np.ascontiguousarray(roots, dtype=np.float64)
+    rotations = np.ascontiguousarray(rotations, dtype=np.float64)
+    offs = np.ascontiguousarray(np.broadcast_to(off, rotations.shape[:-1] + (3,)))
+    leg_idx = np.array(idx, dtype=np.int64).reshape(n, 3)
+    soles = np.array([leg.sole for leg in legs], dtype=np.float64).reshape(n, 3)
+    tips = np.array([skeleton.tips[f] for _, _, f in idx], dtype=np.float64).reshape(n, 3)
+    heels = np.array([leg.heel for leg in legs], dtype=np.float64).reshape(n, 3)
+    knees = np.array([leg.knee_forward for leg in legs], dtype=np.float64).reshape(n, 3)
+    ankles, hips, sole, qfeet = np.empty((p, n, 3)), np.empty((p, n, 3)), np.empty((p, n, 3)), np.empty((p, n, 4))
+    _kernel.legs_fk(skeleton.parents, roots, rotations, offs, leg_idx, soles, ankles, qfeet, hips, sole)
+    height, normal = ground(sole[..., 0], sole[..., 2])
+    height = np.ascontiguousarray(np.broadcast_to(np.asarray(height, dtype=np.float64), (p, n)))
+    normal = np.ascontiguousarray(np.broadcast_to(np.asarray(normal, dtype=np.float64), (p, n, 3)))
+    if not (np.all(np.isfinite(height)) and np.all(np.isfinite(normal))):
+        raise ValueError("ground query returned non-finite values")
+    targets, new_rot, floor = np.empty((p, n, 3)), np.empty((p, n, 4)), np.empty((p, n, 3))
+    _kernel.legs_targets(sole, qfeet, height, normal, np.ascontiguousarray(w), soles, tips, heels, align_height,
+                         contact_height, targets, new_rot, floor)
+    if locks is not None:
+        _apply_locks(locks, targets, new_rot, targets + quat.rotate(new_rot, tips), floor, tips, dt)
+    shift = np.empty(p)
+    _kernel.legs_solve(skeleton.parents, roots, rotations, offs, leg_idx, knees, targets, new_rot, ankles, hips,
+                       max_pelvis_shift, shift)
+    if roots is not given_roots:
+        given_roots[...] = roots
+    if rotations is not given_rotations:
+        given_rotations[...] = rotations
     return shift
 
 

@@ -1,0 +1,217 @@
+"""Compiled blend-space playback for a crowd: weights, phase, root motion, pose and contact votes in one pass.
+
+:func:`engine.blend.locomotion.animate` plays every puppet of a locomotion set through
+:meth:`BlendSpace.weights`, :meth:`~BlendSpace.advance`, :meth:`~BlendSpace.sample` and
+:func:`~engine.blend.measure.contact_votes`: some sixty numpy calls over ``[P, K, J, 4]``
+arrays. With numba (:mod:`engine.jit`) the same formulas run as one loop over puppets
+(:func:`play`), each skipping the clips it gives no weight, on the space's assets packed
+once into flat arrays (:func:`packed`). The numpy methods stay as the twin and reference;
+``tests/engine/blend/test_kernel.py`` plays a crowd on both and compares.
+
+Spaces whose clips animate translations or scales take the numpy path (:func:`packed`
+returns ``None``): their channels are blended there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from engine.blend.space import BlendSpace
+from engine.jit import njit, qnormalize, qslerp
+
+__all__ = ["Packed", "packed", "play"]
+
+F = NDArray[np.float64]
+I = NDArray[np.int64]  # an index array, as F is a float one
+
+
+@dataclass(frozen=True)
+class Packed:
+    """A blend space's assets as flat arrays for :func:`play` (clip ``k``'s frames start at ``start[k]``)."""
+
+    points: F  # [K, N]
+    durations: F  # [K]
+    fps: F  # [K]
+    frames: I  # [K]
+    start: I  # [K] first row of clip k in roots/rotations/votes; its root table starts at start[k] + k
+    knot_x: F  # [K, M] phase knots
+    knot_y: F  # [K, M] clip normalised times
+    roots: F  # [ΣF, 3]
+    rotations: F  # [ΣF, J, 4]
+    tables: F  # [ΣF + K, 4] root motion tables (closing row appended)
+    cycles: F  # [K, 4]
+    contacts: F  # [ΣF, L] contact labels (0/1), L = 0 without feet
+
+
+_CACHE: dict[int, tuple[BlendSpace, Packed | None]] = {}
+
+
+def packed(space: BlendSpace, tracks: list[NDArray[np.bool_]] | None) -> Packed | None:
+    """The space's packed assets (cached per space and tracks), ``None`` when its clips have channels."""
+    key = id(space)
+    hit = _CACHE.get(key)
+    if hit is not None and hit[0] is space and (hit[1] is None or (tracks is None) == (hit[1].contacts.shape[1] == 0)):
+        return hit[1]
+    clips = space.clips
+    if any(c.translations is not None or c.scales is not None for c in clips):
+        _CACHE[key] = (space, None)
+        return None
+    knots = space.sync._knots
+    frames = np.array([c.num_frames for c in clips], dtype=np.int64)
+    start = np.concatenate([[0], np.cumsum(frames)[:-1]]).astype(np.int64)
+    result = Packed(
+        points=np.ascontiguousarray(space.points, dtype=np.float64),
+        durations=np.ascontiguousarray(space.sync.durations, dtype=np.float64),
+        fps=np.array([c.fps for c in clips], dtype=np.float64),
+        frames=frames,
+        start=start,
+        knot_x=np.stack([x for x, _ in knots]).astype(np.float64),
+        knot_y=np.stack([y for _, y in knots]).astype(np.float64),
+        roots=np.ascontiguousarray(np.concatenate([c.root for c in clips]), dtype=np.float64),
+        rotations=np.ascontiguousarray(np.concatenate([c.rotations for c in clips]), dtype=np.float64),
+        tables=np.ascontiguousarray(np.concatenate([t for t, _ in space.sync._root_tables]), dtype=np.float64),
+        cycles=np.stack([c for _, c in space.sync._root_tables]).astype(np.float64),
+        contacts=(np.zeros((int(frames.sum()), 0)) if tracks is None
+                  else np.concatenate([np.asarray(t, dtype=np.float64) for t in tracks])),
+    )
+    _CACHE[key] = (space, result)
+    return result
+
+
+@njit
+def _weights(points: F, q: F, out: F) -> None:
+    """Gradient-band weights of one point (:func:`engine.blend.space.gradient_band_weights`)."""
+    k, n = points.shape
+    if k == 1:
+        out[0] = 1.0
+        return
+    total = 0.0
+    for i in range(k):
+        h = math.inf
+        for j in range(k):
+            if j == i:
+                continue
+            dot, len2 = 0.0, 0.0
+            for c in range(n):
+                d = points[j, c] - points[i, c]
+                dot += (q[c] - points[i, c]) * d
+                len2 += d * d
+            h = min(h, 1.0 - dot * (1.0 / len2))
+        h = min(max(h, 0.0), 1.0)
+        out[i] = h
+        total += h
+    for i in range(k):
+        out[i] = out[i] / total
+
+
+@njit
+def _clip_time(pk_x: F, pk_y: F, duration: float, phase: float) -> float:
+    """A clip's unwrapped time (s) at group ``phase`` (:meth:`SyncGroup.clip_times`)."""
+    cycles = math.floor(phase)
+    return (cycles + np.interp(phase - cycles, pk_x, pk_y)) * duration
+
+
+@njit
+def _root_row(tables: F, cycles: F, base: int, n: int, k: int, time: float, fps: float, out: F) -> None:
+    """Accumulated root travel and heading ``out [4]`` at a clip time (:meth:`SyncGroup.root_motion`)."""
+    f = time * fps
+    cyc = math.floor(f / n)
+    local = f - cyc * n
+    i0 = min(math.floor(local), n - 1)
+    a = local - i0
+    for c in range(4):
+        t0 = tables[base + i0, c]
+        out[c] = t0 + a * (tables[base + i0 + 1, c] - t0) + cyc * cycles[k, c]
+
+
+@njit
+def play(pk_points: F, durations: F, fps: F, frames: I, start: I, knot_x: F, knot_y: F, roots: F, rotations: F,
+         tables: F, cycles: F, contacts: F, points: F, phase: F, rate: F, dt: float,
+         w_out: F, phase_out: F, travel: F, turn: F, root_out: F, rot_out: F, votes: F) -> None:
+    """Play ``dt`` seconds of every puppet (blend ``points [P,N]``, ``phase``, ``rate [P]``): weights, new
+    phase, root travel (clip frame) and turn, the blended pose at the new phase and the feet's votes."""
+    k_all = pk_points.shape[0]
+    joints = rotations.shape[1]
+    legs = contacts.shape[1]
+    row0, row1 = np.empty(4), np.empty(4)
+    ref_rot = np.empty((joints, 4))
+    for p in range(points.shape[0]):
+        w = w_out[p]
+        _weights(pk_points, points[p], w)
+        period = 0.0
+        for k in range(k_all):
+            period += w[k] * durations[k]
+        ph0 = phase[p]
+        ph1 = ph0 + dt * rate[p] / period
+        phase_out[p] = ph1
+        total, ref, best = 0.0, 0, -1.0
+        for k in range(k_all):
+            total += w[k]
+            if w[k] > best:
+                ref, best = k, w[k]
+        for c in range(3):
+            travel[p, c] = 0.0
+            root_out[p, c] = 0.0
+        turn[p] = 0.0
+        for c in range(legs):
+            votes[p, c] = 0.0
+        for j in range(joints):
+            for c in range(4):
+                rot_out[p, j, c] = 0.0
+        # every clip's joints are turned into the hemisphere of the heaviest clip's (blend_quaternions)
+        _frame_rotations(rotations, start[ref], frames[ref],
+                         _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1) * fps[ref], ref_rot, ref_rot, False)
+        for k in range(k_all):
+            n = frames[k]
+            t1 = _clip_time(knot_x[k], knot_y[k], durations[k], ph1)
+            if legs > 0:
+                fr = int(np.rint(t1 * fps[k])) % n
+                for c in range(legs):
+                    votes[p, c] = votes[p, c] + w[k] * contacts[start[k] + fr, c]
+            if w[k] <= 0.0:
+                continue
+            t0 = _clip_time(knot_x[k], knot_y[k], durations[k], ph0)
+            _root_row(tables, cycles, start[k] + k, n, k, t0, fps[k], row0)
+            _root_row(tables, cycles, start[k] + k, n, k, t1, fps[k], row1)
+            for c in range(3):
+                travel[p, c] += w[k] * (row1[c] - row0[c])
+            turn[p] += w[k] * (row1[3] - row0[3])
+            f = t1 * fps[k] % n
+            i0 = math.floor(f) % n
+            i1 = (i0 + 1) % n
+            a = f - math.floor(f)
+            wn = w[k] / total
+            r0, r1 = start[k] + i0, start[k] + i1
+            for c in range(3):
+                root_out[p, c] += wn * (roots[r0, c] + a * (roots[r1, c] - roots[r0, c]))
+            _frame_rotations(rotations, start[k], n, t1 * fps[k], ref_rot, rot_out[p], True, wn)
+        for j in range(joints):
+            m = qnormalize((rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3]))
+            rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3] = m
+
+
+@njit
+def _frame_rotations(rotations: F, first: int, n: int, frame: float, ref: F, out: F, accumulate: bool,
+                     wn: float = 1.0) -> None:
+    """A loop's joint rotations at fractional ``frame`` (slerp between its frames, :meth:`Clip.frame_pair`):
+    stored in ``out``, or (``accumulate``) turned into ``ref``'s hemisphere and added with weight ``wn``."""
+    f = frame % n
+    i0 = math.floor(f) % n
+    i1 = (i0 + 1) % n
+    a = f - math.floor(f)
+    r0, r1 = first + i0, first + i1
+    for j in range(rotations.shape[1]):
+        q = qslerp((rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
+                   (rotations[r1, j, 0], rotations[r1, j, 1], rotations[r1, j, 2], rotations[r1, j, 3]), a)
+        if not accumulate:
+            for c in range(4):
+                out[j, c] = q[c]
+            continue
+        if q[0] * ref[j, 0] + q[1] * ref[j, 1] + q[2] * ref[j, 2] + q[3] * ref[j, 3] < 0.0:
+            q = (-q[0], -q[1], -q[2], -q[3])
+        for c in range(4):
+            out[j, c] += wn * q[c]

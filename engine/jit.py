@@ -1,0 +1,171 @@
+"""The numba switch for the crowd kernels, and the scalar quaternion maths they share.
+
+A crowd's animation, leg IK and FK are loops over puppets and joints of a few float
+operations each. Written as numpy calls over ``[P, …]`` arrays they cost a microsecond
+of dispatch per call for nanoseconds of arithmetic; compiled by numba as plain loops
+they cost the arithmetic. Every kernel keeps its pure-numpy twin (the code it replaced):
+that path runs when numba is absent or switched off, and the tests run both on the same
+input and compare them (see ``tests/engine/test_jit.py`` and the kernels' own tests).
+
+:func:`enabled` says which path runs; ``PUPPETPHONE_NUMPY=1`` in the environment or
+:func:`use` (a context manager, for tests and benches) selects the numpy one. Kernels are
+compiled on first use and cached on disk (``cache=True``), so a process pays numba's
+compile time once per machine, not per start.
+
+The helpers below work on tuples, ``(x, y, z)`` vectors and ``(w, x, y, z)`` quaternions,
+with the operation order of :mod:`engine.quat` (a compiled kernel agrees with the numpy
+path to rounding, not always bit for bit: numpy's ``norm``/``sum`` may pair terms differently).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any, TypeVar
+
+__all__ = ["AVAILABLE", "enabled", "njit", "qaxis_angle", "qbetween", "qconj", "qmul", "qnormalize", "qrot", "qslerp",
+           "use", "vcross", "vdot", "vnorm", "vunit"]
+
+T = TypeVar("T", bound=Callable[..., Any])
+
+_numba: Any
+try:
+    import numba as _numba
+except ImportError:  # the numpy path runs everywhere then
+    _numba = None
+
+AVAILABLE: bool = _numba is not None
+_state = {"on": AVAILABLE and os.environ.get("PUPPETPHONE_NUMPY", "") not in ("1", "true", "yes")}
+
+
+def enabled() -> bool:
+    """Whether the compiled kernels run (numba installed and not switched off)."""
+    return _state["on"]
+
+
+@contextmanager
+def use(compiled: bool) -> Iterator[None]:
+    """Run the block on the compiled kernels (``True``, needs numba) or the numpy path (``False``)."""
+    if compiled and not AVAILABLE:
+        raise RuntimeError("numba is not installed: the compiled kernels cannot run")
+    before = _state["on"]
+    _state["on"] = compiled
+    try:
+        yield
+    finally:
+        _state["on"] = before
+
+
+def njit(fn: T) -> T:
+    """``numba.njit`` (cached; division by zero gives inf/NaN as numpy does) when numba is installed;
+    the plain function otherwise (never called then)."""
+    if _numba is None:
+        return fn
+    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)  # type: ignore[no-any-return,return-value]  # a Dispatcher is called like fn
+
+
+@njit
+def vdot(a: tuple[float, float, float], b: tuple[float, float, float]) -> float:
+    """``a · b``."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit
+def vcross(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float, float]:
+    """``a × b``."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit
+def vnorm(a: tuple[float, float, float]) -> float:
+    """``|a|``."""
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@njit
+def vunit(a: tuple[float, float, float], eps: float) -> tuple[float, float, float]:
+    """``a / max(|a|, eps)``."""
+    n = max(vnorm(a), eps)
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+@njit
+def qmul(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    """Hamilton product ``a * b`` (:func:`engine.quat.mul`)."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw)
+
+
+@njit
+def qconj(q: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    """Conjugate: the inverse of a unit quaternion."""
+    return (q[0], -q[1], -q[2], -q[3])
+
+
+@njit
+def qnormalize(q: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    """Unit quaternion; a zero one becomes the identity (:func:`engine.quat.normalize`)."""
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    if n > 1e-12:
+        return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
+    return (1.0, 0.0, 0.0, 0.0)
+
+
+@njit
+def qrot(q: tuple[float, float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Rotate ``v`` by the unit quaternion ``q``: ``v + w·t + u×t`` with ``t = 2u×v`` (:func:`engine.quat.rotate`)."""
+    w, x, y, z = q
+    vx, vy, vz = v
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx))
+
+
+@njit
+def qaxis_angle(axis: tuple[float, float, float], angle: float) -> tuple[float, float, float, float]:
+    """Rotation of ``angle`` about ``axis`` (normalised here; a zero axis is left as is)."""
+    n = vnorm(axis)
+    if not n > 1e-12:
+        n = 1.0
+    half = 0.5 * angle
+    s = math.sin(half)
+    return (math.cos(half), s * (axis[0] / n), s * (axis[1] / n), s * (axis[2] / n))
+
+
+@njit
+def qslerp(a: tuple[float, float, float, float], b: tuple[float, float, float, float],
+           t: float) -> tuple[float, float, float, float]:
+    """Spherical interpolation along the shorter arc (:func:`engine.quat.slerp`)."""
+    if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0:
+        b = (-b[0], -b[1], -b[2], -b[3])
+    d = min(max(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], -1.0), 1.0)
+    theta = math.acos(d)
+    s = math.sin(theta)
+    if s < 1e-6:
+        wa, wb = 1.0 - t, t
+    else:
+        wa, wb = math.sin((1.0 - t) * theta) / s, math.sin(t * theta) / s
+    return qnormalize((wa * a[0] + wb * b[0], wa * a[1] + wb * b[1], wa * a[2] + wb * b[2], wa * a[3] + wb * b[3]))
+
+
+@njit
+def qbetween(u: tuple[float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float, float]:
+    """Shortest-arc rotation taking direction ``u`` to ``v`` (:func:`engine.quat.between`)."""
+    nu, nv = vnorm(u), vnorm(v)
+    u = (u[0] / nu, u[1] / nu, u[2] / nu)
+    v = (v[0] / nv, v[1] / nv, v[2] / nv)
+    d = vdot(u, v)
+    if 1.0 + d < 1e-9:  # opposite: any axis perpendicular to u
+        perp = vcross(u, (1.0, 0.0, 0.0))
+        if vnorm(perp) < 1e-6:
+            perp = vcross(u, (0.0, 1.0, 0.0))
+        return qnormalize((0.0, perp[0], perp[1], perp[2]))
+    c = vcross(u, v)
+    return qnormalize((1.0 + d, c[0], c[1], c[2]))
