@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
 
@@ -97,7 +98,7 @@ def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Co
     # ragdoll) touches only the ground and props until it is out (mjcf.GHOST_BITS).
     kind = np.where(kin, 1, np.where(ghost, 2, 0))[L.geom_owner]
     bits = np.array([SIMULATED_BITS, ANIMATED_BITS, GHOST_BITS])[kind]
-    m.geom_contype[L.geom], m.geom_conaffinity[L.geom] = bits[:, 0], bits[:, 1]
+    set_contact_bits(m, L.geom, bits[:, 0], bits[:, 1])
     for p, c in enumerate(cmds):
         for name, eq in L.hold_eq[p].items():
             d.eq_active[eq] = name == c.hold

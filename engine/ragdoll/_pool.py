@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, ragdoll_fragment, rd_name
 
@@ -150,8 +151,7 @@ def park(m: mujoco.MjModel, d: mujoco.MjData, pool: Layout, slot: int) -> None:
     b0, nb = int(m.tree_bodyadr[tree]), int(m.tree_bodynum[tree])
     v0, nv = int(m.tree_dofadr[tree]), int(m.tree_dofnum[tree])
     geoms = np.nonzero((m.geom_bodyid >= b0) & (m.geom_bodyid < b0 + nb))[0]
-    m.geom_contype[geoms] = 0
-    m.geom_conaffinity[geoms] = 0
+    set_contact_bits(m, geoms, 0, 0)
     m.actuator_gainprm[acts, 0] = 0.0
     m.actuator_biasprm[acts, :3] = 0.0
     d.eq_active[eqs] = 0

@@ -121,3 +121,34 @@ def test_a_crowd_standing_steps_no_mujoco_at_all(skeleton: Skeleton) -> None:
     _drive(pw, skeleton, {2})
     pw.step()
     assert pw.data.time == pytest.approx(t + pw.dt)
+
+
+
+
+def test_a_ragdoll_that_falls_again_lands_on_the_ground(skeleton: Skeleton) -> None:
+    """MuJoCo's broad phase filters on ``body_contype``/``body_conaffinity`` (the OR of a body's
+    geoms' bits), which it recomputes from the geoms only at some steps. In a recorded snowman
+    session (a snowball in the field, the puppet lifted, put down, lifted again) it had recomputed
+    them while the slot was parked, so they were zero when the slot joined again with only its geom
+    bits rewritten, and the ragdoll fell through the ground (y = -30 m two seconds after the release).
+    Here the parked slot's body bits are zeroed as that session had them; joining must restore them
+    (:func:`~engine.ragdoll._contact_bits.set_contact_bits`). Broken once by writing the geom bits
+    alone: the hips ended 19 m under the field."""
+    pw = _crowd(skeleton, 2)
+    for falling, steps in (({1}, 60), (set(), 10)):  # a fall, then parked again
+        for _ in range(steps):
+            _drive(pw, skeleton, falling)
+            pw.step()
+    m = pw.model
+    assert m is not None and pw._pool_layout is not None
+    pool = pw._pool_layout
+    slot = pool.body[pool.body_owner == 0]
+    m.body_contype[slot] = 0  # what MuJoCo's own recomputation left on the parked slot
+    m.body_conaffinity[slot] = 0
+    for _ in range(120):  # two seconds limp
+        _drive(pw, skeleton, {1})
+        pw.step()
+    hips = pw.pose(1).root
+    assert hips[1] > 0.0, f"the ragdoll fell through the ground: hips at y = {hips[1]:.2f} m"
+    body = m.body(pw.mujoco_name(1, "hips")).id
+    assert m.body_contype[body] != 0 and m.body_conaffinity[body] != 0
