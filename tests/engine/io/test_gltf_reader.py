@@ -173,7 +173,7 @@ def test_accessor_types_strides_offsets_and_normalisation() -> None:
     plain_u8 = d.add([[200], [3], [0], [0]], "SCALAR", ctype=5121)
     doc = d.finish()
     buffers = [bytes(d.blob)]
-    np.testing.assert_allclose(accessor(doc, buffers, u8), [[0, 1], [0.2, 0.4]])
+    np.testing.assert_allclose(accessor(doc, buffers, u8), np.array([[0.0, 1.0], [0.2, 0.4]]))
     np.testing.assert_allclose(accessor(doc, buffers, i8)[:2, 0], [-1.0, 1.0])
     np.testing.assert_allclose(accessor(doc, buffers, i16)[:, 0], [-1.0, 1.0])
     np.testing.assert_allclose(accessor(doc, buffers, u16)[:, 0], [1.0, 0.0])
