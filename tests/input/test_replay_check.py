@@ -52,6 +52,12 @@ def test_the_first_mismatch_is_kept_and_nothing_after_it_is_checked() -> None:
     assert check.message() == (f"state hash differs at frame 1 in A (after 1 matching): expected {H1}, got {H2}")
 
 
+def test_a_mismatch_names_every_differing_part() -> None:
+    check = HashCheck(recording([H0], parts=[{"A": b"a", "B": b"b"}]))
+    check.check(0, H1, {"A": b"x", "B": b"y"})
+    assert check.message() == f"state hash differs at frame 0 in A, B (after 0 matching): expected {H0}, got {H1}"
+
+
 def test_a_mismatch_without_recorded_parts_names_no_part() -> None:
     check = HashCheck(recording([H0, H1], parts=[{"A": b"a"}]))
     check.check(0, H0, {"A": b"a"})
@@ -90,8 +96,9 @@ def test_replay_source_serves_each_recorded_frame_and_counts_only_hits() -> None
     assert src.frame_at(3) is None and src.served == 0
     f = src.frame_at(5)
     assert f is not None and f.frame == 5 and src.served == 1
+    assert src.frame_at(6) is not None and src.served == 2
     status = src.status()
-    assert status.name == "replay" and status.connected and status.packets == 1
+    assert status.name == "replay" and status.connected and status.packets == 2
     assert ReplaySource(recording([])).last_frame == -1
     hub = replay_hub(recording([H0]))
     assert isinstance(hub.replay, ReplaySource) and hub.replay.recording.hashes == [H0]
@@ -105,9 +112,9 @@ def test_verify_replays_a_recording_and_names_a_frame_out_of_step(tmp_path: Path
     app.run_steps(4)
     rec.close()
     r = read_recording(tmp_path / "s.rec")
-    seen: list[int] = []
-    check = verify(make_app, r, on_step=lambda a, i: seen.append(i))
-    assert check.ok and check.frames == 4 and seen == [0, 1, 2, 3]
+    seen: list[tuple[int, int]] = []
+    check = verify(make_app, r, on_step=lambda a, i: seen.append((a.world.frame, i)))
+    assert check.ok and check.frames == 4 and seen == [(1, 0), (2, 1), (3, 2), (4, 3)]
     late = recording(r.hashes, first=2)
     check = verify(make_app, late)
     assert not check.ok and check.first_mismatch == 2 and check.expected == r.hashes[0]
