@@ -221,3 +221,19 @@ def test_format_refuses_two_roots_or_joints_out_of_order() -> None:
     swapped = BvhMotion(m3.names, np.array([-1, 2, 0]), m3.offsets, {}, m3.channels, 1.0, m3.data)
     with pytest.raises(BvhError, match="^BVH: joints must be in depth-first file order"):
         format_bvh(swapped)
+
+
+def test_to_clip_hands_every_option_to_the_converter() -> None:
+    """``to_clip`` passes scale, skipped frames, name and the position rule through (the converter's own tests
+    cover what it does with them)."""
+    from engine.io.bvh_convert import bvh_to_clip
+
+    m = parse_bvh(one_joint("MOTION\nFrames: 3\nFrame Time: 0.25\n1 2 30\n4 5 60\n7 8 90\n"), "f.bvh")
+    for kw in ({}, {"scale": 0.5, "skip_frames": 1, "name": "walk", "positions": "add"},
+               {"scale": 2.0, "positions": "replace"}):
+        got, want = m.to_clip(**kw), bvh_to_clip(m, **kw)  # type: ignore[arg-type]  # options vary per case
+        assert got.name == want.name and got.num_frames == want.num_frames
+        np.testing.assert_array_equal(got.root, want.root)
+        np.testing.assert_array_equal(got.skeleton.offsets, want.skeleton.offsets)
+    assert m.to_clip(name="walk", skip_frames=1).name == "walk" and m.to_clip(skip_frames=1).num_frames == 2
+    np.testing.assert_allclose(m.to_clip(scale=0.5, positions="replace").root[0], [0.5, 1.0, 1.5])
