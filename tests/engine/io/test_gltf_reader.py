@@ -354,3 +354,37 @@ def test_file_level_refusals(tmp_path: Path) -> None:
     path.write_text(json.dumps(doc))
     with pytest.raises(GltfError, match="is not a file beside the glTF"):
         read_gltf(path)
+
+
+@pytest.mark.parametrize("uri,says", [
+    ("../b.bin", "is not a file beside the glTF"), ("%2e%2e/b.bin", "is not a file beside the glTF"),
+    ("file:b.bin", "is not a file beside the glTF"), ("http://host/b.bin", "is not a file beside the glTF"),
+    ("sub\\b.bin", "is not a file beside the glTF"), ("", "is not a file beside the glTF"),
+    ("/b.bin", "is not a file beside the glTF"), ("link/b.bin", "leads out of the glTF's folder"),
+])
+def test_a_buffer_uri_must_name_a_file_beside_the_gltf(tmp_path: Path, uri: str, says: str) -> None:
+    folder, outside = tmp_path / "model", tmp_path / "elsewhere"
+    folder.mkdir()
+    outside.mkdir()
+    d = arm(tmp_path)
+    (outside / "b.bin").write_bytes(bytes(d.blob))
+    (folder / "link").symlink_to(outside)
+    doc = d.finish()
+    doc["buffers"][0]["uri"] = uri
+    path = folder / "a.gltf"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError) as err:
+        read_gltf(path)
+    assert str(err.value) == f"{path}: buffer 0: uri {uri!r} {says}" + (
+        " (no absolute paths, schemes or ..)" if "beside" in says else "")
+
+
+def test_a_buffer_beside_the_gltf_or_in_a_subfolder_reads(tmp_path: Path) -> None:
+    d = arm(tmp_path)
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "my buffer.bin").write_bytes(bytes(d.blob))
+    doc = d.finish()
+    doc["buffers"][0]["uri"] = "sub/my%20buffer.bin"
+    path = tmp_path / "a.gltf"
+    path.write_text(json.dumps(doc))
+    assert read_gltf(path).names == ("root", "node1", "node2")
