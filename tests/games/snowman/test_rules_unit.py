@@ -213,10 +213,19 @@ def test_an_unplaced_ball_starts_tracking_without_growing() -> None:
 
 def test_a_still_ball_does_not_grow() -> None:
     w = world()
-    e = rules.spawn_ball(w, np.zeros(3), 0.2)
-    w.get(e, Transform).position = np.array([0.00005, 0.2, 0.0])
+    e = rules.spawn_ball(w, np.array([1.0, 0.0, 1.0]), 0.2)
+    w.get(e, Transform).position = np.array([1.00005, 0.2, 1.0])
     rules.grow_snowballs(w)
     assert w.get(e, Snowball).snow == 0.2
+
+
+def test_a_full_size_ball_leaves_the_snow_alone() -> None:
+    w = world()
+    before = w.resource(SnowField).depth.copy()
+    e = rules.spawn_ball(w, np.zeros(3), rules.MAX_RADIUS)
+    w.get(e, Transform).position = np.array([2.0, rules.MAX_RADIUS, 0.0])
+    rules.grow_snowballs(w)
+    np.testing.assert_array_equal(w.resource(SnowField).depth, before)
 
 
 def test_snow_drag_slows_a_free_ball_to_a_stop_and_no_further() -> None:
@@ -231,6 +240,17 @@ def test_snow_drag_slows_a_free_ball_to_a_stop_and_no_further() -> None:
     prop.velocity = np.array([0.01, 0.0, 0.0, 0.0, 0.0, 0.0])
     rules.snow_drag(w)
     np.testing.assert_array_equal(prop.velocity, np.zeros(6))
+
+
+def test_snow_drag_slows_every_free_ball_whatever_comes_before_it() -> None:
+    w = world()
+    rest = rules.spawn_ball(w, np.array([4.0, 0.0, 0.0]), 0.2)
+    carried = rules.spawn_ball(w, np.array([2.0, 0.0, 0.0]), 0.2)
+    w.get(carried, Prop).carried = True
+    moving = rules.spawn_ball(w, np.zeros(3), 0.2)
+    w.get(moving, Prop).velocity = np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    rules.snow_drag(w)
+    assert w.get(moving, Prop).velocity[0] < 1.0 and not w.get(rest, Prop).placed
 
 
 def test_snow_drag_spares_carried_held_airborne_and_resting_balls() -> None:
@@ -254,6 +274,18 @@ def test_snow_drag_spares_carried_held_airborne_and_resting_balls() -> None:
         assert not w.get(e, Prop).placed
     assert w.get(low, Prop).velocity[0] < 1.0 and w.get(low, Prop).placed
     assert w.get(rest, Prop).velocity[3] == 5.0 and not w.get(rest, Prop).placed
+
+
+def test_every_puppet_putting_down_is_aimed() -> None:
+    w = world()
+    bottom = rules.spawn_ball(w, np.zeros(3), 0.5)
+    middle = on_top(w, bottom, 0.35)
+    rules.stick_stacked_balls(w)
+    w.spawn(PuppetBody(), brain("Walk", putdown_on=bottom))
+    held = rules.spawn_ball(w, np.array([3.0, 0.0, 0.0]), 0.2)
+    puppet = w.spawn(PuppetBody(object=held), brain("PutDown", putdown_on=bottom))
+    rules.aim_putdown_on_stacks(w)
+    assert w.get(puppet, Brain).memory["putdown_on"] == middle
 
 
 def test_putting_a_ball_down_on_a_stack_aims_at_its_top() -> None:
@@ -348,19 +380,48 @@ def test_no_ball_is_started_unless_every_condition_holds(change: str) -> None:
     assert len(w.query(Snowball)) == before and w.resource(SnowmanStats).balls_started == 0
 
 
-def test_the_thresholds_of_starting_a_ball_are_inclusive() -> None:
+@pytest.mark.parametrize("which", ["body", "player", "time"])
+def test_the_thresholds_of_starting_a_ball_are_inclusive(which: str) -> None:
     w = world()
     p = crouch_walker(w)
-    w.get(p, PuppetBody).speed = 0.3
-    w.get(p, LocomotionPlayer).speed = 0.3
-    w.get(p, Brain).time_in_state = 0.4
-    for i in range(rules.MAX_BALLS - 1):
-        rules.spawn_ball(w, np.array([-3.0, 0.0, -3.0 + 0.25 * i]), 0.1)
-    q = crouch_walker(w)
-    w.get(q, Transform).position = np.array([2.0, 0.0, 0.0])
+    if which == "body":
+        w.get(p, PuppetBody).speed = 0.3
+    elif which == "player":
+        w.get(p, LocomotionPlayer).speed = 0.3
+    else:
+        w.get(p, Brain).time_in_state = 0.4
     rules.start_snowballs(w)
-    assert len(w.query(Snowball)) == rules.MAX_BALLS  # the 24th ball, and no 25th for the second puppet
-    assert w.resource(SnowmanStats).balls_started == 1
+    assert len(w.query(Snowball)) == 1
+
+
+def test_each_puppet_may_start_a_ball_up_to_the_most_balls() -> None:
+    w = world()
+    for i in range(rules.MAX_BALLS - 3):
+        rules.spawn_ball(w, np.array([-3.0, 0.0, -3.0 + 0.25 * i]), 0.1)
+    idle = crouch_walker(w)
+    w.get(idle, Brain).active = "Other"  # skipped: the others still get their turn
+    w.get(idle, Transform).position = np.array([3.0, 0.0, -2.0])
+    blocked = crouch_walker(w)
+    w.get(blocked, Transform).position = np.array([2.0, 0.0, -2.0])
+    rules.spawn_ball(w, np.array([2.0, 0.0, -2.0 + 0.6]), 0.1)  # a ball half a metre ahead: in its way
+    bare = crouch_walker(w)
+    w.get(bare, Transform).position = np.array([-3.5, 0.0, 3.0])
+    w.resource(SnowField).depth[:, :] = np.where(np.arange(80)[:, None] < 10, 0.0, 0.04)  # x < -3 m is bare
+    for x in (0.0, 1.0, -1.0):
+        q = crouch_walker(w)
+        w.get(q, Transform).position = np.array([x, 0.0, 0.0])
+    rules.start_snowballs(w)
+    assert len(w.query(Snowball)) == rules.MAX_BALLS  # two started (22 → 24), not three
+    assert w.resource(SnowmanStats).balls_started == 2
+
+
+@pytest.mark.parametrize("gap,starts", [(0.9, False), (1.5, True)])
+def test_a_ball_within_a_metre_ahead_stops_a_new_one(gap: float, starts: bool) -> None:
+    w = world()
+    p = crouch_walker(w)
+    rules.spawn_ball(w, np.array([0.0, 0.0, gap + 0.1]), 0.1)
+    rules.start_snowballs(w)
+    assert (w.resource(SnowmanStats).balls_started == 1) is starts and w.alive(p)
 
 
 def stack(w: World, radii: list[float], x: float = 0.0, z: float = 0.0) -> list[int]:
