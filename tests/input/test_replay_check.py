@@ -10,15 +10,23 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from engine import quat
 from engine.app import App
 from engine.ecs import World
 from engine.hashing import part_digests
 from input.hub import InputHub
 from input.recording import Recorder, Recording, RecordingHeader, read_recording
 from input.replay import HashCheck, ReplaySource, differing_parts, replay_hub, verify
-from input.sample import InputFrame
+from input.sample import InputFrame, PoseSample
+from input.source import PoseSource
 
 H0, H1, H2 = "0" * 32, "1" * 32, "2" * 32
+
+
+class Fed(PoseSource):
+    """A source the test pushes samples into (no thread)."""
+
+    threaded = False
 
 
 def recording(hashes: list[str], parts: list[dict[str, bytes]] | None = None, first: int = 0) -> Recording:
@@ -107,11 +115,16 @@ def test_replay_source_serves_each_recorded_frame_and_counts_only_hits() -> None
 def test_verify_replays_a_recording_and_names_a_frame_out_of_step(tmp_path: Path,
                                                                   make_app: Callable[[InputHub], App]) -> None:
     """A real (tiny) session verifies; a recording that starts at another frame than the app stops at once."""
-    app = make_app(InputHub([]))
+    src = Fed("phone")
+    app = make_app(InputHub([src]))
     rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
-    app.run_steps(4)
+    for i in range(4):  # the stick grabs and moves: the replay must feed the same input to match
+        src.push(PoseSample(time=i / 60, source="osc:1", orientation=quat.from_axis_angle([1.0, 0.0, 0.0], -0.3 + 0.1 * i),
+                            touch=True))
+        app.step()
     rec.close()
     r = read_recording(tmp_path / "s.rec")
+    assert len(r.parts) == 4 and r.parts[-1] == part_digests(app.world)[1]  # attach() records the part digests
     seen: list[tuple[int, int]] = []
     check = verify(make_app, r, on_step=lambda a, i: seen.append((a.world.frame, i)))
     assert check.ok and check.frames == 4 and seen == [(1, 0), (2, 1), (3, 2), (4, 3)]
