@@ -13,7 +13,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from engine.io.bvh import MAX_FRAME_TIME, MAX_VALUE, BvhError, BvhMotion, BvhWarning, format_bvh, parse_bvh, read_bvh
+from engine.io.bvh import (
+    MAX_FRAME_TIME,
+    MAX_VALUE,
+    BvhError,
+    BvhMotion,
+    BvhWarning,
+    format_bvh,
+    parse_bvh,
+    read_bvh,
+    write_bvh,
+)
 
 FRAMES = f"frame count must be >= 0 and frame time in (0, {MAX_FRAME_TIME:g}] s"
 HEAD = "HIERARCHY\nROOT hips\n{\n  OFFSET 1 2 3\n  CHANNELS 3 Xposition Yposition Zrotation\n"
@@ -186,7 +196,7 @@ def test_the_motion_object_checks_its_shapes() -> None:
 
 
 def test_unwrapping_and_frame_selection() -> None:
-    m = parse_bvh(one_joint("MOTION\nFrames: 3\nFrame Time: 0.25\n100 0 170\n200 0 -170\n300 0 -175\n"))
+    m = parse_bvh(one_joint("MOTION\nFrames: 3\nFrame Time: 0.25\n0 0 170\n300 0 -170\n600 0 -175\n"))
     u = m.unwrapped()
     np.testing.assert_allclose(u.data[:, 2], [170, 190, 185])
     np.testing.assert_array_equal(u.data[:, :2], m.data[:, :2])  # positions are not unwrapped
@@ -237,3 +247,17 @@ def test_to_clip_hands_every_option_to_the_converter() -> None:
         np.testing.assert_array_equal(got.skeleton.offsets, want.skeleton.offsets)
     assert m.to_clip(name="walk", skip_frames=1).name == "walk" and m.to_clip(skip_frames=1).num_frames == 2
     np.testing.assert_allclose(m.to_clip(scale=0.5, positions="replace").root[0], [0.5, 1.0, 1.5])
+
+
+def test_format_and_write_refuse_a_hierarchy_out_of_order(tmp_path: Path) -> None:
+    m = parse_bvh(one_joint(body="  JOINT b\n  {\n    OFFSET 0 0 0\n    CHANNELS 0\n  }\n"))
+    rootless = BvhMotion(m.names, np.array([1, 0]), m.offsets, {}, m.channels, 1.0, m.data)
+    with pytest.raises(BvhError, match="^BVH: need exactly one root joint, found 0$"):
+        format_bvh(rootless)
+    for source, says in (("", "BVH"), ("w.bvh", "w.bvh")):
+        own = BvhMotion(m.names, np.array([-1, 1]), m.offsets, {}, m.channels, 1.0, m.data, source)  # its own parent
+        with pytest.raises(BvhError) as err:
+            write_bvh(tmp_path / "o.bvh", own)
+        assert str(err.value) == f"{says}: joints must be in file order (parents first)"
+    assert not (tmp_path / "o.bvh").exists()
+    assert read_bvh(write_bvh(tmp_path / "ok.bvh", m)).names == m.names
