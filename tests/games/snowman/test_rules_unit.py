@@ -499,3 +499,64 @@ def test_a_carried_ball_counts_only_when_packed_on_the_stack() -> None:
     w.add(ids[1], Stacked(on=ids[0]))  # packed on by the stacking rule
     rules.assemble_snowmen(w)
     assert w.resource(StackWatch).frames == {tuple(ids): 1}
+
+
+def test_packed_balls_stay_packed_and_follow_step_after_step() -> None:
+    w = world()
+    gone = rules.spawn_ball(w, np.array([-2.0, 0.0, 0.0]), 0.4)
+    loose = on_top(w, gone, 0.2)
+    base = rules.spawn_ball(w, np.zeros(3), 0.4)
+    top = on_top(w, base, 0.2)
+    rules.stick_stacked_balls(w)
+    assert w.get(loose, Stacked).on == gone and w.get(top, Stacked).on == base  # two stacks in one step
+    w.despawn(gone)  # the first packed ball comes loose: the second is still carried along
+    w.get(base, Transform).position = np.array([1.0, 0.4, 0.0])
+    rules.stick_stacked_balls(w)
+    prop = w.get(top, Prop)
+    assert not w.has(loose, Stacked) and prop.carried and prop.velocity.shape == (6,) and not prop.velocity.any()
+    np.testing.assert_allclose(w.get(top, Transform).position, [1.0, 1.0, 0.0])
+
+
+def test_how_far_from_touching_and_off_axis_a_ball_may_rest() -> None:
+    w = world()
+    near = rules.spawn_ball(w, np.array([-3.0, 0.0, 0.0]), 0.4)
+    pressed = _ball_at(w, np.array([-3.0, 0.4 + 0.6 * 1.08, 0.0]), 0.2)  # 8 % further than touching
+    side = rules.spawn_ball(w, np.array([3.0, 0.0, 0.0]), 0.4)
+    off = 0.8 * 0.4  # beyond 0.6 of the lower radius to the side
+    askew = _ball_at(w, np.array([3.0 + off, 0.4 + float(np.sqrt(0.6**2 - off**2)), 0.0]), 0.2)
+    rules.stick_stacked_balls(w)
+    assert w.get(pressed, Stacked).on == near and not w.has(askew, Stacked) and side != near
+
+
+def test_only_free_balls_pack_on_and_the_others_do_not_stop_them() -> None:
+    w = world()
+    held_base = rules.spawn_ball(w, np.array([-0.21, 0.0, 0.0]), 0.4)
+    free_base = rules.spawn_ball(w, np.array([0.21, 0.0, 0.0]), 0.4)
+    w.get(w.spawn(Stick()), Stick).grabbed = held_base
+    top = _ball_at(w, np.array([0.0, 0.4 + float(np.sqrt(0.6**2 - 0.21**2)), 0.0]), 0.2)
+    carried_base = rules.spawn_ball(w, np.array([3.0, 0.0, 0.0]), 0.4)
+    carried = on_top(w, carried_base, 0.2)
+    w.get(carried, Prop).carried = True  # carried by something else: not packed on
+    rules.stick_stacked_balls(w)
+    assert w.get(top, Stacked).on == free_base and not w.has(carried, Stacked)
+
+
+def test_headless_stacks_are_all_counted() -> None:
+    w = world()
+    stack(w, [0.5, 0.4])
+    stack(w, [0.5, 0.45], x=3.0)
+    rules.assemble_snowmen(w)
+    assert w.resource(StackWatch).headless == 2
+
+
+def test_snowmen_are_numbered_and_stand_where_their_bottom_ball_was(capsys: pytest.CaptureFixture[str]) -> None:
+    w = world()
+    for x in (-2.0, 2.0):
+        bottom = rules.spawn_ball(w, np.array([x, 0.0, 1.0]), 0.5)
+        _ball_at(w, np.array([x + 0.15, 0.5 + float(np.sqrt(0.8**2 - 0.15**2)), 1.0]), 0.3)  # a little askew
+        for _ in range(rules.STILL_FRAMES):
+            rules.assemble_snowmen(w)
+        assert not w.alive(bottom)
+    men = sorted((man.number, tr.position[0], tr.position[2]) for _, man, tr in w.query(Snowman, Transform))
+    assert men == [(1, -2.0, 1.0), (2, 2.0, 1.0)] and w.resource(SnowmanStats).built == 2
+    assert capsys.readouterr().out.splitlines()[1] == "snowman 2 came alive (2 balls: 0.50, 0.30 m)"
