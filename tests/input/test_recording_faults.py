@@ -116,3 +116,24 @@ def test_a_failing_sync_at_the_close_says_the_recording_may_be_incomplete(tmp_pa
     assert read_recording(path).complete  # the closing record was written; only its sync failed
     rec.close()  # closed: nothing more happens
     assert capsys.readouterr().err == ""
+
+
+def test_a_failure_without_an_error_code_is_still_named(tmp_path: Path, recovered: Path,
+                                                        monkeypatch: pytest.MonkeyPatch,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=1, dt=0.02))
+    for i in range(FSYNC_EVERY - 1):
+        rec.write(frame(i), HASH)
+    real = os.fsync
+    calls: list[int] = []
+
+    def fsync(fd: int) -> None:
+        calls.append(fd)
+        if len(calls) == 1:
+            raise OSError("the device went away")
+        real(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    rec.write(frame(FSYNC_EVERY - 1), HASH)
+    assert ": the device went away after 59 frames; it goes on in" in capsys.readouterr().err
+    rec.close()

@@ -75,7 +75,7 @@ def test_a_recording_reads_back_exactly_what_was_written(tmp_path: Path) -> None
     parts = [{"A": b"\x01\x02", "B": b"\x03\x04"}, {"A": b"\x05\x06", "B": b"\x07\x08"}, {"C": b"\x09\x0a"}]
     with write(tmp_path / "s.rec", parts) as rec:
         pass
-    assert rec.frames == 3 and rec.bytes + _LEN.size == (tmp_path / "s.rec").stat().st_size
+    assert rec.frames == 3 and rec.bytes + _LEN.size == (tmp_path / "s.rec").stat().st_size and rec.failed == ""
     r = read_recording(tmp_path / "s.rec")
     assert r.complete and not r.cut and r.problem == "" and len(r) == 3
     h = r.header
@@ -203,6 +203,7 @@ def _one_record_file(path: Path, payload: bytes) -> Path:
 
 
 @pytest.mark.parametrize("parts,says", [
+    (b"", "record too short for its parts"),
     (b"\x00", "record too short for its parts"),
     (b"\x00\x01", "1 part digests for 0 part names"),
     (b"\x01\x05\x00AB", "part names cut short"),
@@ -310,3 +311,11 @@ def test_the_recorder_writes_the_header_as_sorted_json(tmp_path: Path) -> None:
     assert data.startswith(MAGIC) and zlib.crc32(head) == crc
     assert head == json.dumps(_asdict(rec.header), sort_keys=True).encode()
     assert data[len(MAGIC) + _LEN.size + n :] == _LEN.pack(0, 0)
+
+
+def test_long_part_names_fit_the_names_block(tmp_path: Path) -> None:
+    """The names block's length is unsigned 16-bit: 36 KB of names (past a signed length) read back."""
+    parts = {name * 12_000: b"\x01\x02" for name in "abc"}
+    with write(tmp_path / "s.rec", [parts, parts]):
+        pass
+    assert read_recording(tmp_path / "s.rec").parts == [parts, parts]
