@@ -261,3 +261,22 @@ def test_format_and_write_refuse_a_hierarchy_out_of_order(tmp_path: Path) -> Non
         assert str(err.value) == f"{says}: joints must be in file order (parents first)"
     assert not (tmp_path / "o.bvh").exists()
     assert read_bvh(write_bvh(tmp_path / "ok.bvh", m)).names == m.names
+
+
+def test_a_motion_without_a_source_is_called_bvh_in_messages() -> None:
+    m = parse_bvh(one_joint())
+    with pytest.raises(BvhError, match=r"^BVH: names, parents, offsets and channels disagree in length$"):
+        BvhMotion(m.names, np.array([-1, 0]), m.offsets, {}, m.channels, 1.0, m.data)
+    with pytest.raises(BvhError, match=r"^BVH: data must be \[F,3\], got \(1, 2\)$"):
+        BvhMotion(m.names, m.parents, m.offsets, {}, m.channels, 1.0, np.zeros((1, 2)))
+
+
+def test_a_single_value_motion_keeps_its_value() -> None:
+    text = "HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 1 Yrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n42\n"
+    assert parse_bvh(text).data.tolist() == [[42.0]]
+
+
+def test_the_frame_count_warning_points_at_the_caller() -> None:
+    with pytest.warns(BvhWarning) as caught:
+        parse_bvh(one_joint("MOTION\nFrames: 3\nFrame Time: 0.25\n1 2 3\n"))
+    assert caught[0].filename == __file__
