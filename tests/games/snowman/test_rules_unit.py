@@ -560,3 +560,12 @@ def test_snowmen_are_numbered_and_stand_where_their_bottom_ball_was(capsys: pyte
     men = sorted((man.number, tr.position[0], tr.position[2]) for _, man, tr in w.query(Snowman, Transform))
     assert men == [(1, -2.0, 1.0), (2, 2.0, 1.0)] and w.resource(SnowmanStats).built == 2
     assert capsys.readouterr().out.splitlines()[1] == "snowman 2 came alive (2 balls: 0.50, 0.30 m)"
+
+
+def test_a_snowman_a_metre_from_the_middle_faces_it() -> None:
+    w = world()
+    stack(w, [0.5, 0.3], x=0.6, z=0.8)
+    for _ in range(rules.STILL_FRAMES):
+        rules.assemble_snowmen(w)
+    (_, body), = w.query(PuppetBody)
+    assert body.heading == pytest.approx(float(np.arctan2(-0.6, -0.8)))
