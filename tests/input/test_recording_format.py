@@ -41,7 +41,7 @@ def frame(i: int) -> InputFrame:
     return InputFrame(frame=i, samples=(PoseSample(time=i / 60, source="osc:10.0.0.2", orientation=q, touch=i % 2 == 0),))
 
 
-def header_bytes(d: dict[str, object]) -> bytes:
+def header_bytes(d: object) -> bytes:
     head = json.dumps(d).encode()
     return MAGIC + _LEN.pack(len(head), zlib.crc32(head)) + head
 
@@ -263,10 +263,11 @@ def test_header_limits_are_inclusive(tmp_path: Path, d: dict[str, object]) -> No
     (base(libraries=[]), "bad header: libraries must be an object"),
     (base(setup=[]), "bad header: setup must be an object"),
     (base(zz=1, aa=2), "bad header: unknown fields 'aa', 'zz'"),
+    ([1, 2], "bad header: not a JSON object$"),
     ({"game": "g"}, "bad header: missing dt, seed"),
     (base(format=FORMAT_VERSION + 1), f"is format {FORMAT_VERSION + 1}; this build reads up to {FORMAT_VERSION}"),
 ])
-def test_a_bad_header_is_refused_with_one_line(tmp_path: Path, d: dict[str, object], says: str) -> None:
+def test_a_bad_header_is_refused_with_one_line(tmp_path: Path, d: object, says: str) -> None:
     path = tmp_path / "h.rec"
     path.write_bytes(header_bytes(d) + _LEN.pack(0, 0))
     with pytest.raises(RecordingError, match=says):
@@ -319,3 +320,9 @@ def test_long_part_names_fit_the_names_block(tmp_path: Path) -> None:
     with write(tmp_path / "s.rec", [parts, parts]):
         pass
     assert read_recording(tmp_path / "s.rec").parts == [parts, parts]
+
+
+def test_parts_that_end_the_record_leave_an_empty_frame(tmp_path: Path) -> None:
+    """Digests that fill the record exactly are fine; the frame after them is what is missing."""
+    r = read_recording(_one_record_file(tmp_path / "p.rec", bytes.fromhex(HASH) + b"\x01\x01\x00A\x01\x00\x00"))
+    assert r.problem.startswith("undecodable record at frame 0: ") and "part digests" not in r.problem
