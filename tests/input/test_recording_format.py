@@ -326,3 +326,15 @@ def test_parts_that_end_the_record_leave_an_empty_frame(tmp_path: Path) -> None:
     """Digests that fill the record exactly are fine; the frame after them is what is missing."""
     r = read_recording(_one_record_file(tmp_path / "p.rec", bytes.fromhex(HASH) + b"\x01\x01\x00A\x01\x00\x00"))
     assert r.problem.startswith("undecodable record at frame 0: ") and "part digests" not in r.problem
+
+
+def test_the_header_names_the_engine_version_or_says_unknown(monkeypatch: pytest.MonkeyPatch) -> None:
+    import importlib.metadata
+
+    assert RecordingHeader(game="g", seed=0, dt=0.02).engine_version == importlib.metadata.version("puppetphone")
+
+    def missing(name: str) -> str:
+        raise importlib.metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(importlib.metadata, "version", missing)
+    assert RecordingHeader(game="g", seed=0, dt=0.02).engine_version == "unknown"  # a bare checkout
