@@ -280,3 +280,17 @@ def test_the_frame_count_warning_points_at_the_caller() -> None:
     with pytest.warns(BvhWarning) as caught:
         parse_bvh(one_joint("MOTION\nFrames: 3\nFrame Time: 0.25\n1 2 3\n"))
     assert caught[0].filename == __file__
+
+
+def test_blank_lines_and_a_bare_joint_in_the_hierarchy() -> None:
+    """Blank lines anywhere in the hierarchy are skipped; a joint with no OFFSET or CHANNELS has zeros and none."""
+    text = ("HIERARCHY\n\nROOT a\n\n{\n  OFFSET 1 2 3\n\n  CHANNELS 1 Xrotation\n  JOINT b\n  {\n  }\n\n}\n\n"
+            "MOTION\nFrames: 1\nFrame Time: 0.1\n5\n")
+    m = parse_bvh(text)
+    assert m.names == ("a", "b") and m.channels == (("Xrotation",), ()) and m.data.tolist() == [[5.0]]
+    np.testing.assert_array_equal(m.offsets, [[1, 2, 3], [0, 0, 0]])
+
+
+def test_text_without_a_source_is_named_string_in_errors() -> None:
+    with pytest.raises(BvhError, match=r"^<string>:1: not a BVH file"):
+        parse_bvh("nope\n")
