@@ -294,3 +294,8 @@ def test_blank_lines_and_a_bare_joint_in_the_hierarchy() -> None:
 def test_text_without_a_source_is_named_string_in_errors() -> None:
     with pytest.raises(BvhError, match=r"^<string>:1: not a BVH file"):
         parse_bvh("nope\n")
+
+
+def test_a_hash_in_a_motion_row_is_not_a_comment() -> None:
+    with pytest.raises(BvhError, match="frame 0 has 5 values, expected 3"):
+        parse_bvh(one_joint("MOTION\nFrames: 1\nFrame Time: 0.25\n1 2 3 # note\n"))
