@@ -20,7 +20,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
     from puppetphone.argtypes import int_range, output_file
     from puppetphone.runargs import add_run_arguments
 
-    parser.add_argument("game", help="snowman, tasbada or sandbox")
+    from puppetphone.registry import GAMES
+
+    parser.add_argument("game", help=", ".join(GAMES))
     add_source_arguments(parser)
     add_run_arguments(parser)
     parser.add_argument("--view", choices=("orbit", "phone", "none"), default="orbit",
@@ -52,7 +54,7 @@ def resolve_source(source: str, game: str) -> str:
     """``replay:demo`` means the demo recording shipped with the game."""
     kind, _, arg = source.partition(":")
     if kind == "replay" and arg == "demo":
-        from puppetphone.games import load_game
+        from puppetphone.registry import load_game
 
         module_file = __import__(f"games.{load_game(game).name}", fromlist=["x"]).__file__
         demo = Path(str(module_file)).parent / "demo.rec"
@@ -105,7 +107,7 @@ def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-un
 def print_option_help() -> None:
     """``--set help``: every game's options with their types, ranges and defaults."""
     from games.base import describe_options
-    from puppetphone.games import GAMES, load_game
+    from puppetphone.registry import GAMES, load_game
 
     print("game options (--set KEY=VALUE, repeatable):")
     for name in GAMES:
@@ -120,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
     from games.base import GameOptionError, parse_settings
     from input.factory import make_hub
     from input.recording import RecordingError
-    from puppetphone.games import load_game
+    from puppetphone.registry import load_game
     from puppetphone.runargs import run_options
     from puppetphone.session import build_activity
 

@@ -20,7 +20,9 @@ __all__ = ["configure", "run", "schedule_lines"]
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the schedule arguments."""
-    parser.add_argument("game", help="the game whose schedule to print (snowman, tasbada, sandbox)")
+    from puppetphone.registry import GAMES
+
+    parser.add_argument("game", help=f"the game whose schedule to print: {', '.join(GAMES)}")
     parser.add_argument("--seed", type=int, default=0, help="world seed of the assembled app (default 0)")
 
 
@@ -43,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from input.hub import InputHub
-    from puppetphone.games import load_game, make_app
+    from puppetphone.games import make_app
+    from puppetphone.registry import load_game
 
     try:
         load_game(args.game)

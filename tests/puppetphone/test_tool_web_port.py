@@ -6,6 +6,7 @@ in ``puppetphone.cmd_author.run`` (no link), or pass only the OSC options to ``m
 """
 
 import os
+import select
 import socket
 import subprocess
 import sys
@@ -29,9 +30,10 @@ def test_author_record_listens_on_the_given_web_port_and_prints_the_link(tmp_pat
         lines = []
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
-            line = proc.stderr.readline()
+            ready, _, _ = select.select([proc.stderr], [], [], max(0.0, deadline - time.monotonic()))
+            line = proc.stderr.readline() if ready else ""
             if not line:
-                break
+                break  # silent for the whole minute, or ended
             lines.append(line)
             if "█" in line or "▀" in line or "▄" in line:  # the QR code follows the link
                 break
