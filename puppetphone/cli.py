@@ -23,7 +23,6 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "devices": ("puppetphone.cmd_devices", "list input devices and where a phone should send"),
     "bench": ("puppetphone.cmd_bench", "run benchmarks and print figures against baselines"),
     "blendspace": ("puppetphone.cmd_blendspace", "inspect the puppet's blend space and IDW lookup"),
-    "regen": ("puppetphone.cmd_regen", "developers: regenerate shipped recordings, screenshots and assets"),
     "schedule": ("puppetphone.cmd_schedule", "print a game's frame schedule: stages, systems, plugins"),
 }
 

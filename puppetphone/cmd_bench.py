@@ -21,7 +21,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the chosen benches in order and report every figure."""
-    from bench import BENCHES
+    from puppetphone.bench import BENCHES
 
     names = args.names or list(BENCHES)
     unknown = [n for n in names if n not in BENCHES]
@@ -42,8 +42,8 @@ def run(args: argparse.Namespace) -> int:
             print(fig.line(), flush=True)
             figures.append(fig)
     if args.plot and "motion" in names:
-        from bench.motion import plot_case
-        from bench.motion_play import CASES
+        from puppetphone.bench.motion import plot_case
+        from puppetphone.bench.motion_play import CASES
 
         case = next((c for c in CASES if c.name == args.case), None)
         if case is None:

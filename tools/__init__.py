@@ -1,6 +1,6 @@
 """Developer tooling: regenerate the shipped recordings, screenshots and picture assets.
 
-``puppetphone regen [demos|recordings|screenshots|assets|all]`` runs these. Nothing of the
+``python -m tools.regen [demos|recordings|screenshots|assets|all]`` runs these. Nothing of the
 runtime (engine, input, authoring, games) imports this package; a layering test keeps it so.
 """
 

@@ -1,4 +1,4 @@
-"""Regenerate the puppet-brain recordings in ``tests/data``: ``puppetphone regen recordings``.
+"""Regenerate the puppet-brain recordings in ``tests/data``: ``python -m tools.regen recordings``.
 
 Each recording is a short scripted session of the sandbox puppet driven through the
 real input path (see ``tests/engine/statemachine/puppet/sessions.py``); engine changes

@@ -1,4 +1,4 @@
-"""What ``puppetphone regen`` regenerates, and in which order.
+"""``python -m tools.regen TARGET...`` (from the repository checkout): what it regenerates, and in which order.
 
 After a change to the simulation the shipped recordings' state hashes no longer match;
 after a change to the look the screenshots are stale. Each target rebuilds one kind of
@@ -10,9 +10,11 @@ order: assets first (the demo plays over them), screenshots last (they replay th
 
 from __future__ import annotations
 
+import argparse
+import sys
 from collections.abc import Callable
 
-__all__ = ["TARGETS", "ORDER", "regenerate"]
+__all__ = ["TARGETS", "ORDER", "main", "regenerate"]
 
 
 def _assets() -> None:
@@ -58,3 +60,22 @@ def regenerate(names: list[str]) -> None:
         if name in wanted:
             print(f"== regen {name}")
             TARGETS[name]()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The developer command: parse the targets and regenerate them (exit 2 on an unknown one).
+
+    It lives in the repository, not in the installed package: it writes ``tests/data`` and
+    ``docs/``, which only a checkout has.
+    """
+    parser = argparse.ArgumentParser(prog="python -m tools.regen",
+                                     description="rebuild the shipped recordings, demos, screenshots and assets")
+    parser.add_argument("targets", nargs="+", metavar="TARGET", choices=(*ORDER, "all"),
+                        help=f"{', '.join(ORDER)} or all")
+    args = parser.parse_args(argv)
+    regenerate(args.targets)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -3,7 +3,7 @@
 Roll three balls, lift the middle one onto the biggest with the stick, let the
 puppet carry the head on top: the first snowman comes alive. Then the snowman
 itself rolls two balls and lifts the smaller onto the bigger with the stick, and a
-second snowman comes alive. ``puppetphone regen demos`` rewrites
+second snowman comes alive. ``python -m tools.regen demos`` rewrites
 ``games/snowman/demo.rec``; ``puppetphone play snowman --source replay:demo``
 plays it.
 

@@ -1,6 +1,6 @@
 """Screenshots of each stage of the shipped demo, for the README.
 
-``puppetphone regen screenshots`` replays ``demo.rec`` once and writes a
+``python -m tools.regen screenshots`` replays ``demo.rec`` once and writes a
 JPEG the moment each stage is first seen in the world (not at fixed frame numbers,
 so a re-recorded demo still gives the right pictures):
 

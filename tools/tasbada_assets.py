@@ -3,7 +3,7 @@
 ``room.jpg`` stands in for the camera in the demo and when no webcam is present: a
 living-room corner (back wall, window, picture, wooden floor, rug) with three things
 worth marking — an orange clay pot, a potted plant and a floor lamp — drawn with a fixed
-seed, so running ``puppetphone regen assets`` again rebuilds the very same file.
+seed, so running ``python -m tools.regen assets`` again rebuilds the very same file.
 :func:`draw_selfie` draws a person in a sweater for the clothes-colour test; the shipped
 ``selfie.jpg`` is a real photo (a pose estimator needs one; origin and licence in
 ``assets/README.md``).

@@ -1,6 +1,6 @@
 """Rebuild ``games/tasbada/demo.rec``: the whole journey, played through the real input path.
 
-Run ``puppetphone regen demos`` (or ``python -m tools.tasbada_demo [--screenshots DIR]``). Mouse events are
+Run ``python -m tools.regen demos`` (or ``python -m tools.tasbada_demo [--screenshots DIR]``). Mouse events are
 synthesised as pygame would deliver them for a 1280x720 window, handed to
 :class:`input.mouse.MouseSource` with the game's camera, and each step is recorded by
 :class:`input.recording.Recorder` — exactly what ``puppetphone play tasbada --record``

@@ -19,7 +19,7 @@ Modules, each one job:
 - :mod:`~games.tasbada.compositor`, :mod:`~games.tasbada.reality`, :mod:`~games.tasbada.draw` — the view;
 - :mod:`~games.tasbada.webcam` — the optional live camera;
 - :mod:`~games.tasbada.save` — atomic progress files;
-- ``puppetphone regen demos`` (:mod:`tools.tasbada_demo`) rebuilds ``demo.rec``.
+- ``python -m tools.regen demos`` (:mod:`tools.tasbada_demo`) rebuilds ``demo.rec``.
 """
 
 from games.tasbada.quest import MIXED, PROPS_ALIVE, REAL, STAGES, VIRTUAL, Mark, Quest

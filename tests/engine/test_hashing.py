@@ -106,7 +106,7 @@ def _nudged(value):
 
 @pytest.fixture(scope="module")
 def crowd():
-    from bench.state_hash import crowd_app
+    from puppetphone.bench.state_hash import crowd_app
 
     return crowd_app(puppets=3, steps=30).world
 
@@ -114,7 +114,7 @@ def crowd():
 def test_packed_hash_sees_every_change_the_field_by_field_one_sees(crowd):
     """Every hashed scalar or float-array field of every component, nudged by one ulp (or one),
     changes both hashes; put back, both return to what they were."""
-    from bench.state_hash import field_by_field_hash
+    from puppetphone.bench.state_hash import field_by_field_hash
 
     w = crowd
     h0, r0 = state_hash(w), field_by_field_hash(w)

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from authoring.batch.index import read_index
-from bench.cycles_batch import write_takes
+from puppetphone.bench.cycles_batch import write_takes
 
 CLI = [sys.executable, "-m", "puppetphone", "cycles"]
 SUMMARY = re.compile(r"^cycles: (\d+) looped \((\d+) clips\), (\d+) refused, (\d+) failed, (\d+) already done, in [\d.]+ s")

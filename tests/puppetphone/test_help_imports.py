@@ -8,7 +8,7 @@ import subprocess
 import sys
 
 HEAVY = ("numpy", "pygame", "moderngl", "scipy", "mujoco", "engine.runner", "engine.render", "input.hub",
-         "input.osc", "input.web", "authoring", "games", "bench")
+         "input.osc", "input.web", "authoring", "games", "puppetphone.bench")
 
 
 def test_help_imports_no_heavy_module():

@@ -182,7 +182,7 @@ def _done_takes(lib: Path) -> set[str]:
 
 
 def _cycles(tmp_path: Path, points: list[float], count: int) -> None:
-    from bench.cycles_batch import write_takes
+    from puppetphone.bench.cycles_batch import write_takes
 
     write_takes(tmp_path / "takes", count=count)
     lib = tmp_path / "lib"

@@ -13,7 +13,7 @@ import pytest
 from authoring.flowcurves.mesh import MeshError, TriMesh, rasterize_mesh, read_glb_mesh
 from authoring.flowcurves.scene import FlowObject, FlowScene, rasterize
 from authoring.flowcurves.tilt import MAX_BASE_TILT_DEG, base_tilt_deg
-from bench.flow_mesh import bend, contact_error_px, mesh_tree_problem
+from puppetphone.bench.flow_mesh import bend, contact_error_px, mesh_tree_problem
 from engine.camera import OrbitCamera
 
 UP = np.array([0.0, 1.0, 0.0])

@@ -27,7 +27,7 @@ def _render(viewer, objects, rest) -> np.ndarray:  # type: ignore[no-untyped-def
 
 
 def test_the_bent_crystal_is_drawn_where_the_bend_put_it() -> None:
-    from bench.flow_mesh import bend
+    from puppetphone.bench.flow_mesh import bend
     from engine.render import Viewer, make_target
 
     scene, session = bend()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bench.ik import TIP, chain_skeleton, chain_targets, pin_joints
+from puppetphone.bench.ik import TIP, chain_skeleton, chain_targets, pin_joints
 from engine import quat
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton

@@ -4,7 +4,7 @@ import moderngl
 import numpy as np
 import pytest
 
-from bench.render import demo_scene
+from puppetphone.bench.render import demo_scene
 from engine.render.headless import egl_available
 
 _reason = egl_available()

@@ -1,6 +1,6 @@
 """The shipped snowman demo replays headless to the end of the arc with every hash matching.
 
-The recording (``games/snowman/demo.rec``, rewritten by ``puppetphone regen demos``)
+The recording (``games/snowman/demo.rec``, rewritten by ``python -m tools.regen demos``)
 holds only mouse input: three balls rolled, the middle lifted onto the bottom with the
 stick, the head carried up and put on top; the snowman comes alive and itself rolls
 two balls and stacks them into a second snowman.

@@ -1,7 +1,7 @@
 """The web controller in a real browser: headless Chromium grabs and moves the puppet of a headless game.
 
 ``puppetphone play sandbox --source web --record`` runs as a user starts it; Chromium
-(DevTools protocol, :mod:`bench.chromium`) opens the printed HTTPS link, overrides the
+(DevTools protocol, :mod:`puppetphone.bench.chromium`) opens the printed HTTPS link, overrides the
 orientation and motion sensors, taps to calibrate, presses the touch area while
 pointing at the puppet and turns. The recording is then replayed in-process to check
 that the puppet was grabbed and moved, and ``puppetphone replay --verify`` reproduces it.
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bench.chromium import Chromium, find_chromium
+from puppetphone.bench.chromium import Chromium, find_chromium
 
 pytestmark = pytest.mark.skipif(find_chromium() is None,
                                 reason="no chromium executable: apt-get install chromium (.ci/run installs it)")

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from bench.chromium import Chromium, find_chromium
+from puppetphone.bench.chromium import Chromium, find_chromium
 from engine.render.scene import GroundMarks, RenderScene
 from input.web.cert import load_or_create
 from input.web.scene_stream import CameraPose, quantise

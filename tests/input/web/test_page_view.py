@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from bench.chromium import Chromium, find_chromium
+from puppetphone.bench.chromium import Chromium, find_chromium
 from tests.input.web.test_browser import calibrate, start_play
 
 pytestmark = pytest.mark.skipif(find_chromium() is None,

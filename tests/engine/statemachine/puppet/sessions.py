@@ -4,7 +4,7 @@ Each session is a short play of the sandbox puppet driven through the *real* inp
 path — pygame mouse events into :class:`input.mouse.MouseSource` (via
 :class:`input.mousebot.MouseBot`), or phone-style ``"device"`` pose samples pushed
 into a :class:`input.source.PoseSource` queue — with the hub, the MotionStick and
-the brain exactly as in a game. ``puppetphone regen recordings`` runs the scripts and
+the brain exactly as in a game. ``python -m tools.regen recordings`` runs the scripts and
 writes ``tests/data/<name>.rec``; the tests replay those files through
 :func:`make_app` (which must therefore rebuild the very same world) and assert what
 the brain did.

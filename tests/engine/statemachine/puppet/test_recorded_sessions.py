@@ -2,14 +2,14 @@
 
 Each ``tests/data/puppet_*.rec`` is a real session through the real input path
 (mouse events or phone samples → hub → MotionStick → brain), recorded by
-``puppetphone regen recordings``. Every test replays its file through
+``python -m tools.regen recordings``. Every test replays its file through
 :func:`input.replay.verify` — which rebuilds the world and checks every step's
 state hash — while watching the puppet, then asserts the state sequence from the
 brain's trace and the quantities that make each behaviour what it is, and what the
 overlay says the puppet is doing (:mod:`engine.statemachine.puppet.words`).
 
 When an engine change legitimately alters the simulation the hashes stop matching:
-re-record with ``puppetphone regen recordings`` and re-run.
+re-record with ``python -m tools.regen recordings`` and re-run.
 """
 
 from __future__ import annotations
@@ -82,7 +82,7 @@ def replay(name: str) -> Watch:
         return _CACHE[name]
     session = S.SESSIONS[name]
     if not session.path.exists():
-        pytest.fail(f"{session.path} is missing: run puppetphone regen recordings")
+        pytest.fail(f"{session.path} is missing: run python -m tools.regen recordings")
     rec = read_recording(session.path)
     assert rec.complete, rec.problem
     assert rec.header.extra["session"] == name and rec.header.sources == [session.source]

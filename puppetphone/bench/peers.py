@@ -1,0 +1,115 @@
+"""Our kernels beside the best PyPI peer for the same job, in thread CPU time, same run.
+
+- ``peer_fk_100_puppets_us``: batched FK of 100 humanoids (17 joints) against pinocchio's
+  ``forwardKinematics`` on the same skeleton (a free-flyer root and spherical joints), one call per
+  puppet since pinocchio has no batch call. Skipped with a line when pinocchio (the ``[peers]``
+  extra) is absent. Ours is the compiled kernel when numba is installed (:mod:`engine.jit`);
+  ``peer_fk_100_puppets_us_numpy`` is its pure-numpy twin against the same peer.
+- ``peer_lookup_1_us`` / ``peer_lookup_100_us``: the puppet's IDW lookup (k-d tree + probe slopes),
+  one request and a crowd's 100, against SciPy's ``cKDTree`` query plus textbook IDW (weights
+  ``1/dᵖ`` over the same k neighbours) — the peer does less (no slopes, no exact-hit guard), so
+  this is generous to it. Ours weights the neighbours in one compiled loop when numba is installed.
+
+Every figure is the median of :data:`REPEATS` samples, each sample the mean of enough calls to
+run :data:`SAMPLE_S` seconds of thread CPU time.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from puppetphone.bench.figures import Figure, median_time
+from engine import jit, quat
+from engine.blend.puppet import puppet_locomotion
+from engine.fk import forward_kinematics
+from engine.humanoid import humanoid_skeleton
+from engine.skeleton import Skeleton
+
+__all__ = ["run", "cpu_time", "pinocchio_model", "REPEATS"]
+
+REPEATS = 5
+SAMPLE_S = 0.05
+_BENCH = "peers"
+
+
+def cpu_time(fn: Callable[[], Any], repeats: int = REPEATS) -> float:
+    """Median thread CPU seconds per call of ``fn``."""
+    return median_time(fn, repeats=repeats, min_time=SAMPLE_S, clock=time.thread_time)
+
+
+def pinocchio_model(sk: Skeleton) -> Any:
+    """The skeleton as a pinocchio model: a free-flyer root, a spherical joint per other joint."""
+    import pinocchio as pin
+
+    model = pin.Model()
+    ids = [model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), sk.names[0])]
+    for j in range(1, sk.num_joints):
+        place = pin.SE3(np.eye(3), np.asarray(sk.offsets[j], dtype=np.float64))
+        ids.append(model.addJoint(ids[int(sk.parents[j])], pin.JointModelSpherical(), place, sk.names[j]))
+    return model
+
+
+def _pin_configs(rots: np.ndarray, roots: np.ndarray) -> list[np.ndarray]:
+    """Our ``[P,J,4]`` (w, x, y, z) poses as pinocchio configurations (x, y, z, w quaternions)."""
+    xyzw = np.concatenate([rots[..., 1:], rots[..., :1]], axis=-1)
+    return [np.concatenate([roots[i], xyzw[i].ravel()]) for i in range(len(roots))]
+
+
+def run() -> list[Figure]:
+    """The peer figures (see the module docstring)."""
+    sk = humanoid_skeleton()
+    rng = np.random.default_rng(0)
+    puppets = 100
+    rots = quat.exp(rng.normal(scale=0.3, size=(puppets, sk.num_joints, 3)))
+    roots = rng.normal(size=(puppets, 3))
+    ours = cpu_time(lambda: forward_kinematics(sk, roots, rots))
+    figures = []
+    try:
+        import pinocchio as pin
+    except ImportError:
+        print("peers: pinocchio not installed (pip install '.[peers]'): FK peer skipped", file=sys.stderr)
+    else:
+        model = pinocchio_model(sk)
+        data = model.createData()
+        qs = _pin_configs(rots, roots)
+        pos, _ = forward_kinematics(sk, roots, rots)
+        pin.forwardKinematics(model, data, qs[0])
+        theirs = np.array([data.oMi[j + 1].translation for j in range(sk.num_joints)])
+        if not np.allclose(theirs, pos[0], atol=1e-9):  # the same answer, or the race means nothing
+            raise RuntimeError("pinocchio's FK disagrees with ours on the same pose")
+
+        def pin_fk() -> None:
+            for q in qs:
+                pin.forwardKinematics(model, data, q)
+
+        theirs_us = cpu_time(pin_fk) * 1e6
+        figures.append(Figure(_BENCH, "peer_fk_100_puppets_us", ours * 1e6, "us", "pinocchio forwardKinematics x100",
+                              theirs_us))
+        if jit.enabled():  # the pure-numpy twin of our kernel beside the same peer
+            with jit.use(False):
+                ours_numpy = cpu_time(lambda: forward_kinematics(sk, roots, rots))
+            figures.append(Figure(_BENCH, "peer_fk_100_puppets_us_numpy", ours_numpy * 1e6, "us",
+                                  "pinocchio forwardKinematics x100", theirs_us))
+    table = puppet_locomotion().table
+    tree = cKDTree(table._scaled_values)
+    k, power = min(table.neighbours, len(table.probes)), table.power
+
+    def textbook(u: np.ndarray) -> np.ndarray:
+        x = (u - table.offset) / table.scale
+        dist, idx = tree.query(x, k=k)
+        w = 1.0 / np.maximum(dist, 1e-12) ** power
+        return np.einsum("...k,...kn->...n", w, table.probes[idx]) / w.sum(axis=-1, keepdims=True)
+
+    lo, hi = table.values.min(axis=0), table.values.max(axis=0)
+    many = lo + rng.random((puppets, len(lo))) * (hi - lo)
+    one = many[0]
+    for name, u in (("peer_lookup_1_us", one), ("peer_lookup_100_us", many)):
+        figures.append(Figure(_BENCH, name, cpu_time(lambda u=u: table.query(u)) * 1e6, "us",
+                              "SciPy cKDTree query + textbook IDW", cpu_time(lambda u=u: textbook(u)) * 1e6))
+    return figures

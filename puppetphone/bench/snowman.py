@@ -1,0 +1,126 @@
+"""The snowman game under load: a simulation step and a rendered frame.
+
+The loaded scene is the one the issue names: the game's own field (rocks, trees,
+snow), its puppet, six snowmen of different proportions (each with its own rig,
+playing the shared locomotion set at its leg scale) and twenty snowballs, some resting and some rolling
+through each other. The baseline is the same game with nothing in the field (no
+puppet, no snowman, no ball), measured in the same run: the fixed cost of the
+schedule, the snow and the scenery.
+
+The puppets stand idle (nobody holds a stick); their per-step work is the same as
+walking — every puppet samples its blend space, animates, solves its leg IK and
+drives its ragdoll every step — only the stick-following is skipped.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from puppetphone.bench.figures import Figure, median_time
+
+__all__ = ["run", "loaded_app", "SNOWMEN", "SNOWBALLS"]
+
+SNOWMEN = 6
+SNOWBALLS = 20
+WIDTH, HEIGHT = 1280, 720
+
+
+def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1):  # type: ignore[no-untyped-def]
+    """The snowman game with its puppet, ``snowmen`` snowmen and ``snowballs`` balls (0, 0 and
+    no puppet: the empty field), stepped for one second so every model is built."""
+    from engine.ragdoll.components import Prop
+    from engine.statemachine.puppet import PuppetBody
+    from games.snowman.alive import bring_to_life
+    from games.snowman.components import SnowmanStats
+    from games.snowman.rig import SnowmanShape
+    from games.snowman.rules import spawn_ball
+    from input.hub import InputHub
+    from puppetphone.games import make_app
+
+    app = make_app("snowman", seed, InputHub())
+    world = app.world
+    rng = np.random.default_rng(seed)
+    if snowmen == 0 and snowballs == 0:
+        for e, _ in world.query(PuppetBody):
+            world.despawn(e)
+    for i in range(snowmen):
+        bottom = float(rng.uniform(0.3, 0.5))
+        middle = float(rng.uniform(0.6, 0.8) * bottom) if i % 2 == 0 else None
+        head = float(rng.uniform(0.4, 0.55) * bottom)
+        angle = 2 * np.pi * i / max(snowmen, 1)
+        world.resource(SnowmanStats).built += 1
+        bring_to_life(world, SnowmanShape(bottom, middle, head), np.array([3.5 * np.cos(angle), 0.0, 3.5 * np.sin(angle)]),
+                      float(rng.uniform(-np.pi, np.pi)), i + 1)
+    for i in range(snowballs):
+        r = float(rng.uniform(0.12, 0.35))
+        ball = spawn_ball(world, np.array([rng.uniform(-6, 6), 0.0, rng.uniform(-5, 2)]), r)
+        if i % 2:  # half of them rolling, into each other and the snowmen
+            v = rng.normal(size=3) * [1.5, 0.0, 1.5]
+            world.get(ball, Prop).velocity = np.concatenate([v, np.cross([0.0, 1.0, 0.0], v) / r])
+    world.flush()
+    for _ in range(60):
+        app.step()
+    return app
+
+
+def _step_time(app, steps: int = 300) -> float:  # type: ignore[no-untyped-def]
+    """Median seconds of ``steps`` consecutive steps, each timed alone.
+
+    The scene moves on as it is stepped (balls roll and slow down), so every run times
+    the same deterministic stretch of simulation rather than a wall-clock-sized one.
+    """
+    times = np.empty(steps)
+    for i in range(steps):
+        t0 = time.perf_counter()
+        app.step()
+        times[i] = time.perf_counter() - t0
+    return float(np.median(times))
+
+
+def _render_fps(app) -> tuple[float, float | None]:  # type: ignore[no-untyped-def]
+    """Median frames per second of the game's full frame (world, scenery, snow, overlay) at
+    1280x720, and the rate the same frames would run at with the cores free (see
+    :mod:`puppetphone.bench.render`; ``None`` without ``/proc``)."""
+    from puppetphone.bench.render import unloaded_frame_time
+    from engine.render.renderer import Renderer
+    from engine.render.scene import RenderScene
+    from engine.render.target import make_target
+    from games.snowman.game import GAME
+    from input.hub import InputHub
+    from puppetphone.overlay import draw_overlay
+
+    target = make_target(True, WIDTH, HEIGHT)
+    renderer = Renderer(target.ctx)
+    scene, camera, hub = RenderScene(), GAME.camera(), InputHub()
+    try:
+        def frame() -> None:
+            scene.clear()
+            GAME.draw(app.world, scene, 1.0)
+            draw_overlay(scene, app.world, GAME, hub, 60.0, False)
+            renderer.render(scene, camera, target.begin())
+            target.end()
+            target.ctx.finish()
+
+        fps = 1.0 / median_time(frame, repeats=11, min_time=0.0)
+        free = unloaded_frame_time(frame, frames=20)
+        return fps, (1.0 / free if free else None)
+    finally:
+        target.close()
+
+
+def run() -> list[Figure]:
+    """Median step time and frame rate, loaded and empty, from the same run."""
+    loaded, empty = loaded_app(), loaded_app(0, 0)
+    t_loaded, t_empty = _step_time(loaded), _step_time(empty)
+    (fps_loaded, free_loaded), (fps_empty, free_empty) = _render_fps(loaded), _render_fps(empty)
+    figures = [
+        Figure("snowman", "sim_step_ms", t_loaded * 1e3, "ms", "empty field", t_empty * 1e3),
+        Figure("snowman", "sim_step_ms_vs_goal", t_loaded * 1e3, "ms", "goal", 8.0),
+        Figure("snowman", "render_fps", fps_loaded, "fps", "empty field", fps_empty),
+        Figure("snowman", "render_fps_vs_goal", fps_loaded, "fps", "goal", 30.0),
+    ]
+    if free_loaded is not None:
+        figures.append(Figure("snowman", "render_fps_unloaded", free_loaded, "fps", "empty field, unloaded", free_empty))
+    return figures
