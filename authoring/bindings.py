@@ -61,8 +61,12 @@ class Bindings:
             self.orbiting = False
         elif kind == pygame.MOUSEMOTION and self.orbiting:
             return Orbit(float(ev.rel[0]), float(ev.rel[1]))
-        elif not self.pointer_acts and kind in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEMOTION,
-                                                pygame.MOUSEWHEEL):
+        elif not self.pointer_acts and kind in (
+            pygame.MOUSEBUTTONDOWN,
+            pygame.MOUSEBUTTONUP,
+            pygame.MOUSEMOTION,
+            pygame.MOUSEWHEEL,
+        ):
             return None
         elif kind == pygame.MOUSEBUTTONDOWN and ev.button == ACT:
             return Press(float(ev.pos[0]), float(ev.pos[1]), _shift(ev))

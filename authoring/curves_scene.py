@@ -191,7 +191,9 @@ class CurvesScene:
         where = f"key {at}" if at is not None else "between keys"
         scene.add_text(f"Motion Curves — {clip.name}   {self.joint} [Tab]   frame {self.frame} ({where}) [, . [ ]]",
                        12, 10, font + 2)  # fmt: skip
-        holds = ", ".join(f"{'contact' if h.contact else 'pin'} {h.joint} {h.first}-{h.last}" for h in s.holds) or "none"
+        holds = (
+            ", ".join(f"{'contact' if h.contact else 'pin'} {h.joint} {h.first}-{h.last}" for h in s.holds) or "none"
+        )
         scene.add_text(f"{k} keys [K add, X delete]   holds: {holds} [P, C]", 12, 10 + step, font)
         tool = "drag a joint: pose the key" if at is not None else "drag the curve · Shift: re-time · arrows turn"
         scene.add_text(f"edits: {len(s.history)} ({s.history[-1] if s.history else 'none'})   {tool} · Ctrl+Z/Y/S",
@@ -220,7 +222,11 @@ class CurvesScene:
             return True
         if not shift and self._press_grip(p):
             return True
-        if not shift and self.key_index() is None and pick_point(self.camera, self.size, self.spacing_handle()[None], p) == 0:
+        if (
+            not shift
+            and self.key_index() is None
+            and pick_point(self.camera, self.size, self.spacing_handle()[None], p) == 0
+        ):
             self.gesture = _Gesture("space", self.frame, self.spacing_handle(), p)
             return True
         key = self.key_index()
@@ -271,7 +277,9 @@ class CurvesScene:
                             self.trajectory()[self.frame][None]])  # fmt: skip
         if np.nanmin(np.linalg.norm(self.camera.project(others, *self.size) - np.asarray(p), axis=1)) < d_grip:
             return False
-        self.gesture = _Gesture("orient", self.frame, tip[0], p, key=-1 if self.key_index() is None else int(self.key_index()))
+        self.gesture = _Gesture(
+            "orient", self.frame, tip[0], p, key=-1 if self.key_index() is None else int(self.key_index())
+        )
         self._turn_from = (rot[0], self.trajectory()[self.frame])
         return True
 
@@ -309,12 +317,20 @@ class CurvesScene:
         target = point_on_view_plane(self.camera, self.size, (float(px), float(py)), g.anchor)
         if g.kind == "pose":
             res = self.session.pose(g.key, self.joint, target, commit=False)
-            self.message = "" if res.reached else f"out of reach: closest pose kept (residual {res.residual * 1e3:.0f} mm)"
+            self.message = (
+                "" if res.reached else f"out of reach: closest pose kept (residual {res.residual * 1e3:.0f} mm)"
+            )
             return
         res = self.session.drag(self.joint, self.frame_times()[g.frame], position=target, commit=False)
-        self.message = "" if res.reached else (
-            f"out of reach: closest kept (residual {res.closest_error * 1e3:.0f} mm)"
-            if self.session.preview is not None else f"out of reach (miss {res.error * 1e3:.0f} mm): a pin would slip")
+        self.message = (
+            ""
+            if res.reached
+            else (
+                f"out of reach: closest kept (residual {res.closest_error * 1e3:.0f} mm)"
+                if self.session.preview is not None
+                else f"out of reach (miss {res.error * 1e3:.0f} mm): a pin would slip"
+            )
+        )
 
     def _move_key(self, g: _Gesture, px: float, commit: bool) -> None:
         frame = self.timeline().frame_at(px)
@@ -426,7 +442,9 @@ class CurvesScene:
         j = clip.skeleton.index(self.joint)
         root, rot = clip.pose_arrays(clip.coordinates([t]))
         _, wrot = forward_kinematics(clip.skeleton, root[0], rot[0])
-        axis = np.array([0.0, 1.0, 0.0]) if arrow in ("left", "right") else np.cross(self.camera.forward, [0.0, 1.0, 0.0])
+        axis = (
+            np.array([0.0, 1.0, 0.0]) if arrow in ("left", "right") else np.cross(self.camera.forward, [0.0, 1.0, 0.0])
+        )
         angle = TURN if arrow in ("right", "up") else -TURN
         goal = quat.mul(quat.from_axis_angle(axis / np.linalg.norm(axis), angle), wrot[j])
         try:

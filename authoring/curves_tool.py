@@ -72,15 +72,16 @@ def curves_digest(activity) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-
 class CurvesTool(ToolSimulation):
     """The curves scene as a session's simulation (a replay saves nothing)."""
 
-    def __init__(self, scene: Any, output: Path | None = None, exports: list[Path] | None = None,
-                 save_at_end: bool = False) -> None:
+    def __init__(
+        self, scene: Any, output: Path | None = None, exports: list[Path] | None = None, save_at_end: bool = False
+    ) -> None:
         self.scene, self.output = scene, output
         self.exports, self.save_at_end = list(exports or []), save_at_end
 
     @property
     def camera(self) -> Camera:
         """The scene's orbit camera."""
-        return self.scene.camera  # type: ignore[no-any-return]  # CurvesScene's OrbitCamera
+        return self.scene.camera
 
     def on_key(self, key: Key, hub: InputHub) -> str:  # type: ignore[override]  # the KeyUse literal
         """Every key is the scene's (P pins, . steps a frame) but Ctrl+P, the runner's pause."""
@@ -159,8 +160,12 @@ def open_curves(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
     setup = _setup(options, size)
     scene.character = _character(setup)
     output = options.get("output")
-    tool = CurvesTool(scene, Path(output) if output else Path(f"{Path(clip).stem}_curves.ppclip"), exports,
-                      save_at_end=output is not None)
+    tool = CurvesTool(
+        scene,
+        Path(output) if output else Path(f"{Path(clip).stem}_curves.ppclip"),
+        exports,
+        save_at_end=output is not None,
+    )
     script = options.get("script")
     steps = None if script is None else (walk_script(scene) if script == "walk" else _drag_script(scene))
     return Opened(tool, setup, steps, tool.conclude)
@@ -211,8 +216,11 @@ def _reopen(setup: object):  # type: ignore[no-untyped-def]
     if not isinstance(setup, dict):
         raise ValueError("the recorded curves set-up is not an object")
     size = setup.get("size")
-    if not (isinstance(size, list) and len(size) == 2
-            and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)):
+    if not (
+        isinstance(size, list)
+        and len(size) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)
+    ):
         raise ValueError("the recorded window size is not two whole numbers in 1..16384")
     for key, kind in (("clip", str), ("joint", str), ("every", int), ("duration", float)):
         if not isinstance(setup.get(key), kind) or isinstance(setup.get(key), bool):

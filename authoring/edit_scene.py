@@ -54,11 +54,16 @@ def speed_lines(clip: Clip, curve: MoCurve) -> list[str]:
     its period, the item's is along its curve in the character's frame (the body carried along).
     """
     travel = clip.average_speed()
-    root = (f"root: travels {travel:.2f} m/s (the cycle's travel ÷ its {clip.duration:.2f} s)" if travel > 1e-3
-            else "root: stays in place (no travel over the cycle)")
+    root = (
+        f"root: travels {travel:.2f} m/s (the cycle's travel ÷ its {clip.duration:.2f} s)"
+        if travel > 1e-3
+        else "root: stays in place (no travel over the cycle)"
+    )
     speeds = curve.speeds()
-    item = (f"{curve.item}: {speeds.min():.2f}–{speeds.max():.2f} m/s along its curve, relative to the body "
-            "(a planted foot slides back at about the root's speed; fastest mid-swing)")
+    item = (
+        f"{curve.item}: {speeds.min():.2f}–{speeds.max():.2f} m/s along its curve, relative to the body "
+        "(a planted foot slides back at about the root's speed; fastest mid-swing)"
+    )
     return [root, item]
 
 
@@ -154,9 +159,12 @@ class EditScene:
         s = self.session
         curve = s.curves()[self.item]
         scene.add_text(f"MoCurves — {s.clip.name}   mode: {self.mode.upper()}   [1-4]", 12, 10, 20)
-        scene.add_text(f"item: {self.item} [Tab]   layer: {self.layer} [L]   τ = {s.tau} [ ]   σ = {s.sigma:.3g} [- =]", 12, 36)
-        scene.add_text(f"t = {self.time:5.2f} / {s.clip.duration:.2f} s {'playing' if self.playing else 'paused'} "
-                       "[Space]", 12, 60)
+        scene.add_text(
+            f"item: {self.item} [Tab]   layer: {self.layer} [L]   τ = {s.tau} [ ]   σ = {s.sigma:.3g} [- =]", 12, 36
+        )
+        scene.add_text(
+            f"t = {self.time:5.2f} / {s.clip.duration:.2f} s {'playing' if self.playing else 'paused'} [Space]", 12, 60
+        )
         for k, line in enumerate(speed_lines(s.state.clip, curve)):
             scene.add_text(line, 12, 84 + 22 * k)
         hist = s.history[-3:]
@@ -228,7 +236,9 @@ class EditScene:
                 plane = plane_from_stroke(g.anchor, end, self.camera.forward, root)
                 result = s.add_contact(list(self.contact_items), plane)
                 travel = float(np.linalg.norm(result.clip.cycle_travel()[0]))
-                self.message = f"contact: {int(result.contacts.sum())} keypoints planted, root travels {travel:.2f} m per cycle"
+                self.message = (
+                    f"contact: {int(result.contacts.sum())} keypoints planted, root travels {travel:.2f} m per cycle"
+                )
         except ValueError as exc:
             if g.retime is not None:
                 g.retime.cancel()

@@ -44,8 +44,14 @@ def _motion_setup(path: Path, size: tuple[int, int], options: dict[str, object] 
     print(note, file=sys.stderr)
     with tempfile.TemporaryDirectory() as tmp:
         data = save_clip(clip, Path(tmp) / "clip.ppclip").read_bytes()
-    return {"clip": str(path), "size": list(size), "name": path.stem + ".ppclip",
-            "ppclip": base64.b64encode(data).decode(), "side": "", "character": _character_setup(path)}
+    return {
+        "clip": str(path),
+        "size": list(size),
+        "name": path.stem + ".ppclip",
+        "ppclip": base64.b64encode(data).decode(),
+        "side": "",
+        "character": _character_setup(path),
+    }
 
 
 def _character_setup(path: Path) -> str:
@@ -63,8 +69,11 @@ def _character_setup(path: Path) -> str:
         print(f"{path.name}: not drawn: {', '.join(meshes.ignored)}", file=sys.stderr)
     size = path.stat().st_size
     if size > MAX_CHARACTER:
-        print(f"{path.name}: the character ({size >> 20} MB) is over the {MAX_CHARACTER >> 20} MB a recording "
-              f"carries: drawn live, a replay draws the mannequin", file=sys.stderr)
+        print(
+            f"{path.name}: the character ({size >> 20} MB) is over the {MAX_CHARACTER >> 20} MB a recording "
+            f"carries: drawn live, a replay draws the mannequin",
+            file=sys.stderr,
+        )
         return ""
     return base64.b64encode(path.read_bytes()).decode()
 
@@ -83,7 +92,9 @@ def _character(setup: dict[str, object], skeleton):  # type: ignore[no-untyped-d
         try:
             return SkinBinding.bind(read_gltf(path), read_skinned_meshes(path), skeleton)
         except (GltfError, ValueError) as exc:
-            print(f"the character is drawn as the mannequin: {str(exc).replace(str(path), 'the file')}", file=sys.stderr)
+            print(
+                f"the character is drawn as the mannequin: {str(exc).replace(str(path), 'the file')}", file=sys.stderr
+            )
             return None
 
 
@@ -98,14 +109,18 @@ def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[
         setup = _motion_setup(path, (0, 0), options)
         return _reopen(setup), path.with_name(path.stem + "_edited.ppclip")
     if path.exists() and suffix != ".ppclip":
-        raise ValueError(f"{path} is not a clip file: author edit opens a .ppclip cycle, a motion file "
-                         f"({', '.join(MOTION_SUFFIXES)}) or a default clip ({', '.join(default_clips())})")
+        raise ValueError(
+            f"{path} is not a clip file: author edit opens a .ppclip cycle, a motion file "
+            f"({', '.join(MOTION_SUFFIXES)}) or a default clip ({', '.join(default_clips())})"
+        )
     if suffix == ".ppclip":
         return load_session(path), path.with_name(path.stem + "_edited.ppclip")
     clips = default_clips()
     if spec not in clips:
-        raise ValueError(f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)}) "
-                         f"nor a motion file ({', '.join(MOTION_SUFFIXES)})")
+        raise ValueError(
+            f"{spec!r} is neither a .ppclip file nor a default clip ({', '.join(clips)}) "
+            f"nor a motion file ({', '.join(MOTION_SUFFIXES)})"
+        )
     return EditSession(clips[spec]), Path(f"{spec}_edited.ppclip")
 
 
@@ -134,8 +149,11 @@ def _check_setup(setup: object) -> dict[str, object]:
     if not isinstance(setup, dict):
         raise ValueError("the recorded edit set-up is not an object")
     size = setup.get("size", [1280, 720])
-    if not (isinstance(size, list) and len(size) == 2
-            and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)):
+    if not (
+        isinstance(size, list)
+        and len(size) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)
+    ):
         raise ValueError("the recorded window size is not two whole numbers in 0..16384")
     for key in ("clip", "name", "ppclip", "side", "character"):
         if not isinstance(setup.get(key, ""), str):
@@ -143,8 +161,10 @@ def _check_setup(setup: object) -> dict[str, object]:
     if len(str(setup.get("character", ""))) > (MAX_CHARACTER * 4) // 3 + 4:
         raise ValueError(f"the recorded character is over {MAX_CHARACTER >> 20} MB")
     if not setup.get("ppclip") and setup.get("clip") not in default_clips():
-        raise ValueError(f"the recording names the clip {str(setup.get('clip'))[:80]!r} without carrying it; "
-                         f"a replay opens only a clip the recording holds or a default clip")
+        raise ValueError(
+            f"the recording names the clip {str(setup.get('clip'))[:80]!r} without carrying it; "
+            f"a replay opens only a clip the recording holds or a default clip"
+        )
     return setup
 
 
@@ -177,8 +197,22 @@ def edit_digest(edit) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untype
         parts.append((name, h))
     cam = edit.camera
     h = hashlib.blake2b(b"scene", digest_size=16)
-    h.update(np.array([edit.time, cam.yaw, cam.pitch, cam.distance, *np.asarray(cam.target, dtype=np.float64),
-                       edit.session.tau, edit.session.sigma, edit.focus, *edit.size], dtype=np.float64).tobytes())
+    h.update(
+        np.array(
+            [
+                edit.time,
+                cam.yaw,
+                cam.pitch,
+                cam.distance,
+                *np.asarray(cam.target, dtype=np.float64),
+                edit.session.tau,
+                edit.session.sigma,
+                edit.focus,
+                *edit.size,
+            ],
+            dtype=np.float64,
+        ).tobytes()
+    )
     h.update(f"{edit.item}|{edit.layer}|{edit.mode}|{edit.playing}|{edit.session.revision}".encode())
     parts.append(("scene", h))
     return combine_parts(parts)
@@ -194,7 +228,7 @@ class EditTool(ToolSimulation):
     @property
     def camera(self) -> Camera:
         """The scene's orbit camera."""
-        return self.edit.camera  # type: ignore[no-any-return]  # EditScene's OrbitCamera
+        return self.edit.camera
 
     def apply(self, op: Operation) -> None:
         """Pointer gestures, camera, window size and keys (Ctrl+S saves)."""

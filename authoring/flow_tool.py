@@ -93,9 +93,9 @@ def _circle(centre: tuple[float, float], radius: float, n: int = 24) -> list[tup
     return [(centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a)) for a in t]
 
 
-def script_events(name: str) -> dict[int, list[tuple]]:  # type: ignore[type-arg]
+def script_events(name: str) -> dict[int, list[tuple]]:
     """Pointer operations per step of a scripted edit (press, move, release), as a user would make them."""
-    ops: dict[int, list[tuple]] = {}  # type: ignore[type-arg]
+    ops: dict[int, list[tuple]] = {}
 
     def drag(start: int, points: list[tuple[float, float]], shift: bool = False) -> int:
         ops.setdefault(start, []).append(("press", *points[0], shift))
@@ -165,7 +165,7 @@ class FlowTool(ToolSimulation):
     @property
     def camera(self) -> Camera:
         """The scene's camera."""
-        return self._camera  # type: ignore[no-any-return]  # the flow scene's OrbitCamera
+        return self._camera
 
     def ready(self) -> bool:
         """Whole once its SEcurves are found (in a window they are found on a thread)."""
@@ -293,9 +293,11 @@ class FlowTool(ToolSimulation):
             return self.building.text if self.building is not None else ""
         r = self.session.result
         med = float(np.median(self.solve_ms)) if self.solve_ms else 0.0
-        return (f"{len(self.session.edits)} edits, {self.strokes} strokes, {self.clicks} clicks; "
-                f"update median {med:.0f} ms (last ARAP solve {r.solve_ms:.1f} ms after a {r.factor_ms:.0f} ms "
-                f"factorisation), {len(r.vertices)} objects moved")
+        return (
+            f"{len(self.session.edits)} edits, {self.strokes} strokes, {self.clicks} clicks; "
+            f"update median {med:.0f} ms (last ARAP solve {r.solve_ms:.1f} ms after a {r.factor_ms:.0f} ms "
+            f"factorisation), {len(r.vertices)} objects moved"
+        )
 
     def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
         from authoring.flowcurves.view import draw_objects, draw_session
@@ -304,8 +306,11 @@ class FlowTool(ToolSimulation):
             draw_objects(scene, self.building.scene.objects if self.building is not None else [])
         else:
             draw_session(scene, self.session, self.show_securves, self.stroke)
-        scene.add_text("Flow Curves — drag: stroke · circle: centre-point · Shift+drag: SEcurve · "
-                       "Ctrl+Z/Y undo/redo · Ctrl+S save · Tab SEcurves", size=16)
+        scene.add_text(
+            "Flow Curves — drag: stroke · circle: centre-point · Shift+drag: SEcurve · "
+            "Ctrl+Z/Y undo/redo · Ctrl+S save · Tab SEcurves",
+            size=16,
+        )
         scene.add_text(self.figures(), size=16)
         if self.message:
             scene.add_text(self.message, size=16, color=(1.0, 0.9, 0.5))
@@ -338,8 +343,12 @@ def open_live(options: Mapping[str, Any], size: tuple[int, int], scenes: Scenes)
 def reopen_flow(setup: object, scenes: Scenes) -> FlowTool:
     """The recorded flow session, rebuilt from its set-up alone (a flow file's bytes, never its path)."""
     size = setup.get("size") if isinstance(setup, dict) else None
-    if not (isinstance(setup, dict) and isinstance(size, list) and len(size) == 2
-            and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)):
+    if not (
+        isinstance(setup, dict)
+        and isinstance(size, list)
+        and len(size) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) and 0 < v <= 16384 for v in size)
+    ):
         raise ValueError("the recorded window size is not two whole numbers in 1..16384")
     if not isinstance(setup.get("scene"), str) or not isinstance(setup.get("file", ""), str):
         raise ValueError("the recorded flow scene is not text")
@@ -357,5 +366,6 @@ def reopen_flow(setup: object, scenes: Scenes) -> FlowTool:
 
 def flow_tool(scenes: Scenes) -> ToolKind:
     """The flow tool over the scenes a game offers by name (``puppetphone.flow_scenes`` wires the snowman field)."""
-    return ToolKind(FLOW_GAME, "PuppetPhone — Flow Curves", partial(open_live, scenes=scenes),
-                    partial(reopen_flow, scenes=scenes))
+    return ToolKind(
+        FLOW_GAME, "PuppetPhone — Flow Curves", partial(open_live, scenes=scenes), partial(reopen_flow, scenes=scenes)
+    )

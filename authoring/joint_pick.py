@@ -25,8 +25,14 @@ def _segment_distance(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray
     return np.asarray(np.linalg.norm(a + t[:, None] * ab - p, axis=1))
 
 
-def joint_at(camera: OrbitCamera, starts: NDArray[np.float64], ends: NDArray[np.float64], px: float, py: float,
-             size: tuple[int, int]) -> int | None:
+def joint_at(
+    camera: OrbitCamera,
+    starts: NDArray[np.float64],
+    ends: NDArray[np.float64],
+    px: float,
+    py: float,
+    size: tuple[int, int],
+) -> int | None:
     """The index of the bone (joint) nearest the cursor, or ``None`` when none is within reach.
 
     Args:

@@ -49,8 +49,9 @@ def open_loop(
     clip = motion.clip
     if start is not None or end is not None:
         # The part is cut from the take as stored (a closed loop keeps its closing frame).
-        motion = load_motion(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height,
-                             skip_tpose=not clip.loop)
+        motion = load_motion(
+            path, animation=animation, units=units, joint_map=joint_map, up=up, height=height, skip_tpose=not clip.loop
+        )
         loop, note = _loop_of_part(motion, start, end, items)
     elif clip.loop and not items:  # a loop our glTF writer marked as one, or a closed loop (its last pose is its first)
         loop, note = clip, f"{motion.source.name}: a {'seamless ' * motion.seamless}loop of {clip.num_frames} frames"
@@ -72,8 +73,12 @@ def open_loop(
     return loop.extract_root_motion(), note
 
 
-def _loop_of_part(motion, start: object, end: object,  # type: ignore[no-untyped-def]
-                  items: list[str] | None) -> tuple[Clip, str]:
+def _loop_of_part(
+    motion,
+    start: object,
+    end: object,  # type: ignore[no-untyped-def]
+    items: list[str] | None,
+) -> tuple[Clip, str]:
     """The loop extracted from the part ``[start, end)`` of a take (the refusal names the part that loops)."""
     from authoring.cycles.extract import CycleError, extract_cycle
     from authoring.cycles.formats import loop_clip, performance_from_motion
@@ -86,5 +91,7 @@ def _loop_of_part(motion, start: object, end: object,  # type: ignore[no-untyped
     except CycleError as exc:
         hint = refusal_hint(whole, perf, offset, 0)
         raise ValueError(f"{exc}" + (f"; {hint}" if hint else "")) from None
-    note = f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles of the part picked"
+    note = (
+        f"{motion.source.name}: extracted a {result.period:.3f} s loop from {result.cycles} cycles of the part picked"
+    )
     return loop_clip(result, perf, name=motion.clip.name), note

@@ -79,8 +79,15 @@ class Resize:
 Operation = Press | Move | Release | Orbit | Zoom | Key | Resize
 
 #: Recorded name → class.
-OPERATIONS: dict[str, type[Operation]] = {"press": Press, "move": Move, "release": Release, "orbit": Orbit,
-                                          "zoom": Zoom, "key": Key, "size": Resize}
+OPERATIONS: dict[str, type[Operation]] = {
+    "press": Press,
+    "move": Move,
+    "release": Release,
+    "orbit": Orbit,
+    "zoom": Zoom,
+    "key": Key,
+    "size": Resize,
+}
 _NAMES = {cls: name for name, cls in OPERATIONS.items()}
 
 
@@ -112,7 +119,9 @@ def decode(raw: Raw | list[object]) -> Operation:
     where = f"tool operation {list(raw)!r:.60}"
     try:
         if name == "press" and len(args) in (2, 3):
-            return Press(_number(args[0], where), _number(args[1], where), _flag(args[2], where) if len(args) == 3 else False)
+            return Press(
+                _number(args[0], where), _number(args[1], where), _flag(args[2], where) if len(args) == 3 else False
+            )
         if name == "move" and len(args) == 2:
             return Move(_number(args[0], where), _number(args[1], where))
         if name == "release" and len(args) in (0, 2):

@@ -28,8 +28,9 @@ def entry_for(side: Any, digest: str) -> dict[str, Any] | None:
     return None
 
 
-def write_pair(clip_path: Path, data: bytes, side_file: Path, side: dict[str, Any],
-               before: dict[str, Any] | None) -> Path:
+def write_pair(
+    clip_path: Path, data: bytes, side_file: Path, side: dict[str, Any], before: dict[str, Any] | None
+) -> Path:
     """Write ``side`` (carrying ``before``, the entry the clip on disk opens with, when it differs), then the clip."""
     if before is not None and before.get("clip_sha256") != side.get("clip_sha256"):
         side = {**side, "previous": before}

@@ -105,9 +105,18 @@ class RecordScene:
         character: a skinned character drawn in the puppet's pose instead of the mannequin.
     """
 
-    def __init__(self, skeleton: Skeleton, item: str, drive: str = "rotation", base: Clip | None = None,
-                 countdown: float = 3.0, take_seconds: float = 8.0, rng: np.random.Generator | None = None,
-                 root_curve: RootCurve | None = None, character: Character | None = None) -> None:
+    def __init__(
+        self,
+        skeleton: Skeleton,
+        item: str,
+        drive: str = "rotation",
+        base: Clip | None = None,
+        countdown: float = 3.0,
+        take_seconds: float = 8.0,
+        rng: np.random.Generator | None = None,
+        root_curve: RootCurve | None = None,
+        character: Character | None = None,
+    ) -> None:
         if drive not in DRIVES:
             raise ValueError(f"drive must be one of {DRIVES}, got {drive!r}")
         joint, self.chain = _drivable(skeleton, item, drive)
@@ -174,10 +183,16 @@ class RecordScene:
             return
         v = np.asarray(value, dtype=np.float64).reshape(-1)
         want = _WIDTH[self.drive]
-        if v.shape != (want,) or not np.isfinite(v).all() or (want > 3 and np.linalg.norm(v[-4:]) < 1e-9) \
-                or (self.drive == "scale" and v[0] <= 0):
-            raise ValueError(f"a {self.drive} performance value is {want} finite numbers"
-                             f"{' (positive)' * (self.drive == 'scale')}, got {v.tolist()}")
+        if (
+            v.shape != (want,)
+            or not np.isfinite(v).all()
+            or (want > 3 and np.linalg.norm(v[-4:]) < 1e-9)
+            or (self.drive == "scale" and v[0] <= 0)
+        ):
+            raise ValueError(
+                f"a {self.drive} performance value is {want} finite numbers"
+                f"{' (positive)' * (self.drive == 'scale')}, got {v.tolist()}"
+            )
         if want > 3:
             v = np.concatenate([v[:-4], quat.normalize(v[-4:])])
         self._value = v
@@ -188,8 +203,14 @@ class RecordScene:
             return False
         root, rot = self._pose(self.time, None)
         wpos, wrot = forward_kinematics(self.skeleton, root, rot, scales=self._scales(self.time, None))
-        ends = np.array([wpos[kids[0]] if (kids := self.skeleton.children(j))
-                         else wpos[j] + quat.rotate(wrot[j], self.skeleton.tips[j]) for j in range(len(wpos))])
+        ends = np.array(
+            [
+                wpos[kids[0]]
+                if (kids := self.skeleton.children(j))
+                else wpos[j] + quat.rotate(wrot[j], self.skeleton.tips[j])
+                for j in range(len(wpos))
+            ]
+        )
         picked = joint_at(self.camera, wpos, ends, px, py, size)
         if picked is None:
             return False
@@ -264,10 +285,12 @@ class RecordScene:
             self.message = f"the performance did not move: {PERFORM} while it records — R to retry"
             return
         item = self.skeleton.names[self.joint]
-        items = {"translation": (Item(f"{item}.translation", "position", 0, 3),),
-                 "rotation": (Item(f"{item}.rotation", "rotation", 0, 4),),
-                 "scale": (Item(f"{item}.scale", "scale", 0, 1),),
-                 "pose": (Item(f"{item}.translation", "position", 0, 3), Item(f"{item}.rotation", "rotation", 3, 7))}
+        items = {
+            "translation": (Item(f"{item}.translation", "position", 0, 3),),
+            "rotation": (Item(f"{item}.rotation", "rotation", 0, 4),),
+            "scale": (Item(f"{item}.scale", "scale", 0, 1),),
+            "pose": (Item(f"{item}.translation", "position", 0, 3), Item(f"{item}.rotation", "rotation", 3, 7)),
+        }
         try:
             traj = Trajectory(np.asarray(take.times), values, items[self.drive])
             self.result = extract_cycle(traj, self.rng)
@@ -278,8 +301,10 @@ class RecordScene:
         self.candidate = self._stack(self.result, take)
         self._candidate_curve = self._root_curve(self.result, self.candidate)
         self._performed = values
-        self.message = (f"loop of {self.result.period:.2f} s from {self.result.cycles} cycles "
-                        f"(spread {self.result.spread:.0%}) — Enter accepts, Backspace retries")
+        self.message = (
+            f"loop of {self.result.period:.2f} s from {self.result.cycles} cycles "
+            f"(spread {self.result.spread:.0%}) — Enter accepts, Backspace retries"
+        )
 
     # -- layering ----------------------------------------------------------------------
     def _stack(self, result: CycleResult, take: _Take) -> Clip:
@@ -288,7 +313,9 @@ class RecordScene:
         if self.clip is None:
             frames = len(result.loop)
             fps = frames / result.period
-            base_rot = np.broadcast_to(quat.identity(self.skeleton.num_joints), (frames, self.skeleton.num_joints, 4)).copy()
+            base_rot = np.broadcast_to(
+                quat.identity(self.skeleton.num_joints), (frames, self.skeleton.num_joints, 4)
+            ).copy()
             base_root = np.broadcast_to(self.skeleton.offsets[0], (frames, 3)).copy()
             base_scales = None
             shift = 0.0
@@ -414,9 +441,12 @@ class RecordScene:
         if self.phase == "preview" and self.result is not None:
             scene.add_polyline(self._joint_path(np.asarray(self._performed), rotation), PERFORMANCE, 1.5)
             scene.add_polyline(self._joint_path(self.result.loop, rotation), CYCLE, 4.0, closed=True)
-        title = {"ready": "ready", "countdown": f"get ready… {max(self.timer, 0.0):.0f} — then {PERFORM}",
-                 "recording": f"recording {self.timer:4.1f} s — {PERFORM}, several loops; Space stops",
-                 "preview": "preview"}[self.phase]
+        title = {
+            "ready": "ready",
+            "countdown": f"get ready… {max(self.timer, 0.0):.0f} — then {PERFORM}",
+            "recording": f"recording {self.timer:4.1f} s — {PERFORM}, several loops; Space stops",
+            "preview": "preview",
+        }[self.phase]
         scene.add_text(f"{self.skeleton.names[self.joint]} · {self.drive} · {title}", size=22)
         if self.message:
             scene.add_text(self.message, size=16)
@@ -429,8 +459,10 @@ def _drivable(skeleton: Skeleton, item: str, drive: str) -> tuple[int, object]:
     joint = skeleton.index(item)
     chain = item_chain(skeleton, joint)
     if drive in ("translation", "pose") and joint != 0 and chain is None:
-        raise ValueError(f"{item}'s position follows its parents: drive the root, a hand or a foot by "
-                         f"{drive}, or {item!r} by rotation")
+        raise ValueError(
+            f"{item}'s position follows its parents: drive the root, a hand or a foot by "
+            f"{drive}, or {item!r} by rotation"
+        )
     return joint, chain
 
 
@@ -447,4 +479,3 @@ def _sample_loop(loop: F, phase: F, drive: str) -> F:
     if drive in ("rotation", "pose"):
         out[:, -4:] = quat.nlerp(loop[i, -4:], loop[i + 1, -4:], w)
     return out
-

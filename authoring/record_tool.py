@@ -67,11 +67,21 @@ def record_digest(scene) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-unt
     h = hashlib.blake2b(b"take", digest_size=16)
     take = scene.take
     if take is not None and take.values:
-        h.update(np.asarray(take.times, dtype=np.float64).tobytes() + np.asarray(take.values, dtype=np.float64).tobytes())
+        h.update(
+            np.asarray(take.times, dtype=np.float64).tobytes() + np.asarray(take.values, dtype=np.float64).tobytes()
+        )
     parts.append(("take", h))
     h = hashlib.blake2b(b"scene", digest_size=16)
-    feed(h, [scene.phase, scene.time, scene.timer, scene.rng.bit_generator.state,
-             None if scene.value is None else np.asarray(scene.value, dtype=np.float64)])
+    feed(
+        h,
+        [
+            scene.phase,
+            scene.time,
+            scene.timer,
+            scene.rng.bit_generator.state,
+            None if scene.value is None else np.asarray(scene.value, dtype=np.float64),
+        ],
+    )
     cam = scene.camera
     h.update(np.array([cam.yaw, cam.pitch, cam.distance], dtype=np.float64).tobytes())
     parts.append(("scene", h))
@@ -81,8 +91,9 @@ def record_digest(scene) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-unt
 class RecordTool(ToolSimulation):
     """The record scene as a session's simulation (see the module docstring)."""
 
-    def __init__(self, scene: Any, *, script: str | None = None, output: Path | None = None,
-                 size: tuple[int, int] = (1280, 720)) -> None:
+    def __init__(
+        self, scene: Any, *, script: str | None = None, output: Path | None = None, size: tuple[int, int] = (1280, 720)
+    ) -> None:
         self.scene, self.script, self.output = scene, script, output
         self.size = (int(size[0]), int(size[1]))
         self.frame, self.previewing = 0, 0
@@ -99,7 +110,7 @@ class RecordTool(ToolSimulation):
     @property
     def camera(self) -> Camera:
         """The scene's orbit camera."""
-        return self.scene.camera  # type: ignore[no-any-return]  # RecordScene's OrbitCamera
+        return self.scene.camera
 
     def _save(self, message: str) -> bool:
         """Save the accepted cycle; whether it was written (a failure is shown, the take stays open)."""
@@ -210,8 +221,12 @@ def open_record(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
     """A live take: ``item``, ``drive``, ``base``, ``output``, ``countdown``, ``seconds``, ``seed``, ``script``."""
     setup = _record_setup(options, size)
     output = options.get("output")
-    tool = RecordTool(_record_scene(setup), script=setup["script"], output=Path(output) if output else None,  # type: ignore[arg-type]  # checked choice
-                      size=size)
+    tool = RecordTool(
+        _record_scene(setup),
+        script=setup["script"],
+        output=Path(output) if output else None,  # type: ignore[arg-type]  # checked choice
+        size=size,
+    )
     return Opened(tool, setup, conclude=tool.conclude)
 
 
@@ -219,10 +234,11 @@ def reopen_record(setup: object) -> RecordTool:
     """The recorded take, rebuilt from its set-up alone (saving nothing)."""
     checked = _check_record_setup(setup)
     size = checked.get("size", [1280, 720])
-    return RecordTool(_record_scene(checked), script=checked.get("script"),  # type: ignore[arg-type]  # checked choice
-                      size=(int(size[0]), int(size[1])))  # type: ignore[index]  # checked: two ints
-
-
+    return RecordTool(
+        _record_scene(checked),
+        script=checked.get("script"),  # type: ignore[arg-type]  # checked choice
+        size=(int(size[0]), int(size[1])),
+    )  # type: ignore[index]  # checked: two ints
 
 
 def _record_setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str, object]:
@@ -232,11 +248,17 @@ def _record_setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str
     from engine.character.setup import character_setup
 
     base, character = options.get("base"), options.get("character")
-    return {"item": options.get("item", "r_upper_arm"), "drive": options.get("drive", "rotation"),
-            "countdown": float(options.get("countdown", 3.0)), "seconds": float(options.get("seconds", 8.0)),
-            "seed": int(options.get("seed", 0)), "script": options.get("script"), "size": list(size),
-            "base": base64.b64encode(Path(base).read_bytes()).decode() if base is not None else "",
-            **({"character": character_setup(character)} if character else {})}
+    return {
+        "item": options.get("item", "r_upper_arm"),
+        "drive": options.get("drive", "rotation"),
+        "countdown": float(options.get("countdown", 3.0)),
+        "seconds": float(options.get("seconds", 8.0)),
+        "seed": int(options.get("seed", 0)),
+        "script": options.get("script"),
+        "size": list(size),
+        "base": base64.b64encode(Path(base).read_bytes()).decode() if base is not None else "",
+        **({"character": character_setup(character)} if character else {}),
+    }
 
 
 def _check_record_setup(setup: object) -> dict[str, object]:
@@ -262,8 +284,11 @@ def _check_record_setup(setup: object) -> dict[str, object]:
     seed, size = setup.get("seed"), setup.get("size", [1280, 720])
     if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
         raise ValueError("the recorded seed is not a whole number in 0..2**63-1")
-    if not (isinstance(size, list) and len(size) == 2
-            and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)):
+    if not (
+        isinstance(size, list)
+        and len(size) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 16384 for v in size)
+    ):
         raise ValueError("the recorded window size is not two whole numbers in 0..16384")
     return setup
 
@@ -290,9 +315,17 @@ def _record_scene(setup: dict[str, Any]) -> Any:
     from engine.character.setup import decode
 
     character = decode(setup["character"]) if setup.get("character") is not None else None
-    return RecordScene(skeleton, str(setup["item"]), str(setup["drive"]), base, float(setup["countdown"]),
-                       float(setup["seconds"]), np.random.default_rng(int(setup["seed"])), root_curve=curve,
-                       character=character)
+    return RecordScene(
+        skeleton,
+        str(setup["item"]),
+        str(setup["drive"]),
+        base,
+        float(setup["countdown"]),
+        float(setup["seconds"]),
+        np.random.default_rng(int(setup["seed"])),
+        root_curve=curve,
+        character=character,
+    )
 
 
 TOOL = ToolKind(RECORD_GAME, "PuppetPhone — record a cycle", open_record, reopen_record)

@@ -37,6 +37,8 @@ def save_or_say(save: Callable[[Path], object], target: Path) -> str:
     if saved.path is not None:
         line = f"NOT saved to {target}: {saved.why}; saved instead to {saved.path} (open that file to go on)"
     else:
-        line = f"NOT saved: {saved.why} (the work is still open: Ctrl+S again once fixed, or restart with -o OTHER_FILE)"
+        line = (
+            f"NOT saved: {saved.why} (the work is still open: Ctrl+S again once fixed, or restart with -o OTHER_FILE)"
+        )
     print(line, file=sys.stderr)
     return line

@@ -33,7 +33,17 @@ from input.recording import Recorder, Recording, RecordingHeader
 from input.replay import HashCheck
 from input.sample import InputFrame
 
-__all__ = ["Ending", "KeyUse", "Opened", "Script", "Session", "Simulation", "ToolKind", "ToolSimulation", "tool_session"]
+__all__ = [
+    "Ending",
+    "KeyUse",
+    "Opened",
+    "Script",
+    "Session",
+    "Simulation",
+    "ToolKind",
+    "ToolSimulation",
+    "tool_session",
+]
 
 #: What a simulation does with a key (:meth:`Simulation.on_key`).
 KeyUse = Literal["queue", "done", "pass"]
@@ -135,8 +145,16 @@ class Session:
         script: operations per step instead of a hand (the window's pointer and keys are then ignored).
     """
 
-    def __init__(self, simulation: Any, hub: InputHub, *, pointer_acts: bool = True, recorder: Recorder | None = None,
-                 check: HashCheck | None = None, script: Script | None = None) -> None:
+    def __init__(
+        self,
+        simulation: Any,
+        hub: InputHub,
+        *,
+        pointer_acts: bool = True,
+        recorder: Recorder | None = None,
+        check: HashCheck | None = None,
+        script: Script | None = None,
+    ) -> None:
         self.simulation = simulation
         self.hub = hub
         self.recorder = recorder
@@ -149,7 +167,7 @@ class Session:
     @property
     def camera(self) -> Camera:
         """The simulation's camera."""
-        return self.simulation.camera  # type: ignore[no-any-return]  # the Simulation protocol's
+        return self.simulation.camera
 
     @property
     def input_wake(self) -> threading.Event | None:
@@ -171,9 +189,12 @@ class Session:
         import pygame
 
         size = runner.size if runner is not None else (0, 0)
-        if self.script is not None and ev.type in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEMOTION,
-                                                   pygame.MOUSEWHEEL, pygame.KEYDOWN) \
-                and getattr(ev, "key", None) != pygame.K_ESCAPE:
+        if (
+            self.script is not None
+            and ev.type
+            in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEMOTION, pygame.MOUSEWHEEL, pygame.KEYDOWN)
+            and getattr(ev, "key", None) != pygame.K_ESCAPE
+        ):
             return True  # a script is the hand: the real pointer (a window opening under it) must not join in
         op = self.bindings.operation(ev, size)
         if op is None:

@@ -136,7 +136,9 @@ def _write_verified(target: Path, data: bytes) -> None:
     _fsync_folder(target.parent)
 
 
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, expect_head: Sequence[bytes] | None = None) -> Path:
+def atomic_write_bytes(
+    path: str | os.PathLike[str], data: bytes, *, expect_head: Sequence[bytes] | None = None
+) -> Path:
     """Atomically replace ``path`` with ``data``, verified by reading it back.
 
     Args:

@@ -257,5 +257,4 @@ class PhoneCamera(Camera):
     def looking_at(cls, position: ArrayLike, target: ArrayLike, **kw: float) -> PhoneCamera:
         """A phone camera at ``position`` pointing at ``target`` with world Y up."""
         view = look_at(position, target)
-        return cls(position=np.asarray(position, dtype=np.float64),
-                   orientation=quat.from_matrix(view[:3, :3].T), **kw)
+        return cls(position=np.asarray(position, dtype=np.float64), orientation=quat.from_matrix(view[:3, :3].T), **kw)

@@ -97,7 +97,9 @@ class Clip:
             if arr.shape != (len(root), *tail):
                 raise ValueError(f"clip {self.name!r}: {attr} must be [F,{','.join(map(str, tail))}], got {arr.shape}")
             if not np.isfinite(arr).all() or (attr == "scales" and (arr <= 0).any()):
-                raise ValueError(f"clip {self.name!r}: {attr} hold NaN, infinite{' or non-positive' * (attr == 'scales')} values")
+                raise ValueError(
+                    f"clip {self.name!r}: {attr} hold NaN, infinite{' or non-positive' * (attr == 'scales')} values"
+                )
             arr.setflags(write=False)
             object.__setattr__(self, attr, arr)
 
@@ -111,7 +113,9 @@ class Clip:
         """Length in seconds; a loop's last frame joins the first, so it spans ``F`` frames."""
         return (self.num_frames if self.loop else self.num_frames - 1) / self.fps
 
-    def frame_pair(self, t: float | NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+    def frame_pair(
+        self, t: float | NDArray[np.float64]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
         """The two frames around time ``t`` (wrapped for loops, clamped otherwise) and the fraction between them."""
         f = np.asarray(t, dtype=np.float64) * self.fps
         n = self.num_frames
@@ -254,18 +258,33 @@ class Clip:
         if self.root_motion is not None:
             samples = [self.sample_root_motion(float(x)) for x in t]
             rm = RootMotion(np.array([s[0] for s in samples]), np.array([s[1] for s in samples]))
-        return replace(self, fps=fps, root=pose.root, rotations=pose.rotations, root_motion=rm,
-                       translations=pose.offsets, scales=pose.scales)
+        return replace(
+            self,
+            fps=fps,
+            root=pose.root,
+            rotations=pose.rotations,
+            root_motion=rm,
+            translations=pose.offsets,
+            scales=pose.scales,
+        )
 
     def _closed(self) -> Clip:
         """A loop as a one-shot of ``F + 1`` frames: the first frame repeated, moved on by the cycle's travel."""
+
         def more(a: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
             return None if a is None else np.concatenate([a, a[:1]])
 
         root = np.concatenate([self.root, self.root[:1] + self.root_travel()])
         rotations = np.concatenate([self.rotations, self.rotations[:1]])
-        return replace(self, loop=False, root=root, rotations=rotations, root_motion=None,
-                       translations=more(self.translations), scales=more(self.scales))
+        return replace(
+            self,
+            loop=False,
+            root=root,
+            rotations=rotations,
+            root_motion=None,
+            translations=more(self.translations),
+            scales=more(self.scales),
+        )
 
     def offsets(self) -> NDArray[np.float64]:
         """``[F,J,3]`` local offsets per frame: the translation channel, or the skeleton's offsets."""

@@ -31,9 +31,9 @@ from typing import Any
 
 import numpy as np
 
-from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip, RootMotion
+from engine.errors import FormatError
 from engine.npz_safe import read_bounded, read_npz
 from engine.root_curve import RootCurve
 from engine.skeleton import Skeleton
@@ -96,8 +96,7 @@ def save_clip(clip: Clip, path: str | Path, root_curve: RootCurve | None = None)
         "sha256": _digest(arrays),
     }
     buf = io.BytesIO()
-    np.savez_compressed(buf, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8),
-                        **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as the allow_pickle flag
+    np.savez_compressed(buf, header=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8), **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as the allow_pickle flag
     return atomic_write_bytes(path, buf.getvalue())
 
 
@@ -142,7 +141,8 @@ def _check_header(header: dict[str, Any]) -> None:
         raise ClipFileError(f"joints must be a list of 1..{MAX_JOINTS} names")
     markers = header.get("markers", {})
     if not isinstance(markers, dict) or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in markers.values()):
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in markers.values()
+    ):
         raise ClipFileError("markers must map names to finite times")
 
 
@@ -156,7 +156,9 @@ def _root_curve(arrays: dict[str, np.ndarray], frames: int) -> RootCurve | None:
     control = _finite("root_curve_control", arrays["root_curve_control"], (3,))
     travel = _finite("root_curve_travel", arrays["root_curve_travel"])
     if control.ndim != 2 or not 4 <= control.shape[0] <= frames or travel.shape != (3,):
-        raise ClipFileError(f"root curve has shapes {control.shape} and {travel.shape}, expected [4..{frames},3] and [3]")
+        raise ClipFileError(
+            f"root curve has shapes {control.shape} and {travel.shape}, expected [4..{frames},3] and [3]"
+        )
     return RootCurve(control, travel)
 
 
@@ -197,13 +199,19 @@ def load_clip_curve(path: str | Path) -> tuple[Clip, RootCurve | None]:
         parents = arrays["parents"]
         if parents.dtype.kind not in "iu":
             raise ClipFileError("parents are not integers")
-        sk = Skeleton(tuple(header["joints"]), parents.astype(np.int64), _finite("offsets", arrays["offsets"]),
-                      _finite("tips", arrays["tips"]), radii)
+        sk = Skeleton(
+            tuple(header["joints"]),
+            parents.astype(np.int64),
+            _finite("offsets", arrays["offsets"]),
+            _finite("tips", arrays["tips"]),
+            radii,
+        )
         root = _finite("root", arrays["root"], (3,))
         rm = None
         if "rm_translation" in arrays:
-            rm = RootMotion(_finite("rm_translation", arrays["rm_translation"], (3,)),
-                            _finite("rm_heading", arrays["rm_heading"]))
+            rm = RootMotion(
+                _finite("rm_translation", arrays["rm_translation"], (3,)), _finite("rm_heading", arrays["rm_heading"])
+            )
             if rm.translation.shape != root.shape or rm.heading.shape != root.shape[:1]:
                 raise ClipFileError("root motion does not have one entry per frame")
         channels = {}

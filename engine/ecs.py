@@ -126,7 +126,9 @@ class World:
 
     def component_types(self) -> list[type]:
         """The component types at least one entity has, ordered by type name (stable for hashing)."""
-        return sorted((t for t, store in self._components.items() if store), key=lambda t: (t.__module__, t.__qualname__))
+        return sorted(
+            (t for t, store in self._components.items() if store), key=lambda t: (t.__module__, t.__qualname__)
+        )
 
     # -- queries ----------------------------------------------------------------------
     @overload

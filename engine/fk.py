@@ -65,7 +65,9 @@ def forward_kinematics(
         n = skeleton.num_joints
         flat_rot = np.ascontiguousarray(rot).reshape(-1, n, 4)
         count = len(flat_rot)
-        flat_root = np.ascontiguousarray(np.broadcast_to(np.asarray(root, dtype=np.float64), batch + (3,))).reshape(count, 3)
+        flat_root = np.ascontiguousarray(np.broadcast_to(np.asarray(root, dtype=np.float64), batch + (3,))).reshape(
+            count, 3
+        )
         flat_off = np.ascontiguousarray(np.broadcast_to(off, batch + (n, 3))).reshape(count, n, 3)
         out_pos, out_rot = np.empty((count, n, 3)), np.empty((count, n, 4))
         fk_kernel(skeleton.parents, flat_root, flat_rot, flat_off, out_pos, out_rot)
@@ -90,8 +92,14 @@ def forward_kinematics(
 
 
 @jit.njit
-def fk_kernel(parents: NDArray[np.int64], root: NDArray[np.float64], rot: NDArray[np.float64],
-              off: NDArray[np.float64], out_pos: NDArray[np.float64], out_rot: NDArray[np.float64]) -> None:
+def fk_kernel(
+    parents: NDArray[np.int64],
+    root: NDArray[np.float64],
+    rot: NDArray[np.float64],
+    off: NDArray[np.float64],
+    out_pos: NDArray[np.float64],
+    out_rot: NDArray[np.float64],
+) -> None:
     """FK of ``P`` puppets into ``out_pos [P,J,3]`` / ``out_rot [P,J,4]``: parents before children,
     each joint ``pos = parent_pos + parent_rot·offset``, ``rot = parent_rot·local`` as the numpy path."""
     for p in range(rot.shape[0]):

@@ -153,13 +153,25 @@ def _column(values: list[Any]) -> bytes:
         return b"L" + _lengths(values) + _column([item for v in values for item in v])
     if kind is dict:
         keys = [sorted(v, key=repr) for v in values]
-        return (b"M" + _lengths(values) + _column([k for ks in keys for k in ks])
-                + _column([v[k] for v, ks in zip(values, keys) for k in ks]))
+        return (
+            b"M"
+            + _lengths(values)
+            + _column([k for ks in keys for k in ks])
+            + _column([v[k] for v, ks in zip(values, keys) for k in ks])
+        )
     if issubclass(kind, enum.Enum):
         return b"E" + _column([str(v.value) for v in values])
     if dataclasses.is_dataclass(kind) and not hasattr(kind, "state_bytes"):
-        return b"D" + kind.__qualname__.encode() + b"\0" + b"".join(
-            _column([getattr(v, f.name) for v in values]) for f in dataclasses.fields(kind) if f.metadata.get("hash", True))
+        return (
+            b"D"
+            + kind.__qualname__.encode()
+            + b"\0"
+            + b"".join(
+                _column([getattr(v, f.name) for v in values])
+                for f in dataclasses.fields(kind)
+                if f.metadata.get("hash", True)
+            )
+        )
     return _fed(values)
 
 

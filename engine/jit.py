@@ -25,8 +25,23 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any, TypeVar
 
-__all__ = ["AVAILABLE", "enabled", "njit", "qaxis_angle", "qbetween", "qconj", "qmul", "qnormalize", "qrot", "qslerp",
-           "use", "vcross", "vdot", "vnorm", "vunit"]
+__all__ = [
+    "AVAILABLE",
+    "enabled",
+    "njit",
+    "qaxis_angle",
+    "qbetween",
+    "qconj",
+    "qmul",
+    "qnormalize",
+    "qrot",
+    "qslerp",
+    "use",
+    "vcross",
+    "vdot",
+    "vnorm",
+    "vunit",
+]
 
 T = TypeVar("T", bound=Callable[..., Any])
 
@@ -63,7 +78,7 @@ def njit(fn: T) -> T:
     the plain function otherwise (never called then)."""
     if _numba is None:
         return fn
-    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)  # type: ignore[no-any-return,return-value]  # a Dispatcher is called like fn
+    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
 
 
 @njit
@@ -92,14 +107,18 @@ def vunit(a: tuple[float, float, float], eps: float) -> tuple[float, float, floa
 
 
 @njit
-def qmul(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+def qmul(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
+) -> tuple[float, float, float, float]:
     """Hamilton product ``a * b`` (:func:`engine.quat.mul`)."""
     aw, ax, ay, az = a
     bw, bx, by, bz = b
-    return (aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw)
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
 
 
 @njit
@@ -140,8 +159,9 @@ def qaxis_angle(axis: tuple[float, float, float], angle: float) -> tuple[float, 
 
 
 @njit
-def qslerp(a: tuple[float, float, float, float], b: tuple[float, float, float, float],
-           t: float) -> tuple[float, float, float, float]:
+def qslerp(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float], t: float
+) -> tuple[float, float, float, float]:
     """Spherical interpolation along the shorter arc (:func:`engine.quat.slerp`)."""
     if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0:
         b = (-b[0], -b[1], -b[2], -b[3])

@@ -28,7 +28,14 @@ from engine import quat
 from engine.clip import Clip, RootMotion
 from engine.skeleton import Skeleton
 
-__all__ = ["BezierCurves", "KeyframedClip", "keyframe_clip", "default_keyframed_clips", "bezier_basis", "bezier_basis_slope"]
+__all__ = [
+    "BezierCurves",
+    "KeyframedClip",
+    "keyframe_clip",
+    "default_keyframed_clips",
+    "bezier_basis",
+    "bezier_basis_slope",
+]
 
 F = NDArray[np.float64]
 

@@ -32,8 +32,22 @@ MAX_NPZ_BYTES = 256 << 20  # uncompressed, all members together
 MAX_MEMBERS = 64
 # What a corrupt archive can make zipfile and numpy raise.
 # (numpy parses an array header with tokenize and ast.literal_eval: TokenError, SyntaxError.)
-_ARCHIVE_ERRORS = (zipfile.BadZipFile, zlib.error, OSError, EOFError, ValueError, NotImplementedError, RuntimeError,
-                   struct.error, KeyError, IndexError, OverflowError, TypeError, SyntaxError, tokenize.TokenError)
+_ARCHIVE_ERRORS = (
+    zipfile.BadZipFile,
+    zlib.error,
+    OSError,
+    EOFError,
+    ValueError,
+    NotImplementedError,
+    RuntimeError,
+    struct.error,
+    KeyError,
+    IndexError,
+    OverflowError,
+    TypeError,
+    SyntaxError,
+    tokenize.TokenError,
+)
 
 
 class NpzError(FormatError):

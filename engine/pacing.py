@@ -43,9 +43,15 @@ class RealTimePacer:
         early: how long before its slot a reading may start a step; default half a step.
     """
 
-    def __init__(self, dt: float, max_lag: float = 0.25, clock: Callable[[], float] = time.perf_counter,
-                 sleep: Callable[[float], None] = time.sleep, wake: threading.Event | None = None,
-                 early: float | None = None) -> None:
+    def __init__(
+        self,
+        dt: float,
+        max_lag: float = 0.25,
+        clock: Callable[[], float] = time.perf_counter,
+        sleep: Callable[[float], None] = time.sleep,
+        wake: threading.Event | None = None,
+        early: float | None = None,
+    ) -> None:
         if dt <= 0:
             raise ValueError("dt must be positive")
         self.dt, self.max_lag = dt, max_lag
@@ -137,8 +143,10 @@ class TimeKeeper:
             return None
         wall = sum(e for e, _ in self._frames)
         fps = len(self._frames) / wall if wall > 0 else 0.0
-        text = (f"too slow to keep time: the game runs at {kept:.2f}x real time ({fps:.1f} fps, "
-                f"frames over {self.max_frame * 1000:.0f} ms); G lowers the quality")
+        text = (
+            f"too slow to keep time: the game runs at {kept:.2f}x real time ({fps:.1f} fps, "
+            f"frames over {self.max_frame * 1000:.0f} ms); G lowers the quality"
+        )
         if not self._warned:
             self._warned = True
             print(f"puppetphone: {text}", file=sys.stderr)

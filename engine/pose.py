@@ -37,9 +37,12 @@ class Pose:
 
     def copy(self) -> Pose:
         """A deep copy, so systems can write without aliasing an asset."""
-        return Pose(self.root.copy(), self.rotations.copy(),
-                    None if self.offsets is None else self.offsets.copy(),
-                    None if self.scales is None else self.scales.copy())
+        return Pose(
+            self.root.copy(),
+            self.rotations.copy(),
+            None if self.offsets is None else self.offsets.copy(),
+            None if self.scales is None else self.scales.copy(),
+        )
 
     @property
     def num_joints(self) -> int:

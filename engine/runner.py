@@ -44,8 +44,16 @@ from engine.pacing import RealTimePacer, TimeKeeper
 from engine.render.scene import RenderScene
 from engine.render.window import INVISIBLE_DRIVERS, NoDisplayError
 
-__all__ = ["Activity", "EventHandler", "NoDisplayError", "RunOptions", "RunResult", "Runner", "check_display",
-           "MAX_FRAME_TIME"]
+__all__ = [
+    "Activity",
+    "EventHandler",
+    "NoDisplayError",
+    "RunOptions",
+    "RunResult",
+    "Runner",
+    "check_display",
+    "MAX_FRAME_TIME",
+]
 
 #: Real time a window frame may add at most (a stall drops time beyond this): 2.5 frames at 10 fps.
 MAX_FRAME_TIME = 0.25
@@ -89,11 +97,14 @@ def check_display() -> None:
     """
     driver = os.environ.get("SDL_VIDEODRIVER", "").lower()
     if driver in INVISIBLE_DRIVERS:
-        raise NoDisplayError(f"no display (SDL_VIDEODRIVER={driver}): a window cannot be shown here; "
-                             "use --headless to run without one")
+        raise NoDisplayError(
+            f"no display (SDL_VIDEODRIVER={driver}): a window cannot be shown here; use --headless to run without one"
+        )
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        raise NoDisplayError("no display (DISPLAY and WAYLAND_DISPLAY are unset): a window cannot be shown here; "
-                             "use --headless to run without one")
+        raise NoDisplayError(
+            "no display (DISPLAY and WAYLAND_DISPLAY are unset): a window cannot be shown here; "
+            "use --headless to run without one"
+        )
 
 
 @dataclass
@@ -198,8 +209,9 @@ class Runner:
         wall: the wall clock (injectable for tests of the tempo).
     """
 
-    def __init__(self, options: RunOptions, clock: FixedStepClock | None = None,
-                 wall: Callable[[], float] = time.perf_counter) -> None:
+    def __init__(
+        self, options: RunOptions, clock: FixedStepClock | None = None, wall: Callable[[], float] = time.perf_counter
+    ) -> None:
         self.options = options
         self.clock = clock
         self.handlers: list[EventHandler] = [_BaseKeys()]
@@ -247,8 +259,9 @@ class Runner:
         if not self.options.headless:
             check_display()
         o = self.options
-        self.viewer = Viewer.create(headless=o.headless, width=o.width, height=o.height,
-                                    **({} if o.headless else {"title": o.title}))
+        self.viewer = Viewer.create(
+            headless=o.headless, width=o.width, height=o.height, **({} if o.headless else {"title": o.title})
+        )
         self.viewer.renderer.reuse_shadows = True  # a still scene (paused, idle) skips its shadow pass
         self._apply_quality()
 

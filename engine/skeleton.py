@@ -104,5 +104,10 @@ class Skeleton:
 
     def with_offsets(self, offsets: ArrayLike, tips: ArrayLike | None = None) -> Skeleton:
         """The same hierarchy with other bone lengths (snowmen, retargeting)."""
-        return Skeleton(self.names, self.parents, np.asarray(offsets),
-                        self.tips if tips is None else np.asarray(tips, dtype=np.float64), self.radii)
+        return Skeleton(
+            self.names,
+            self.parents,
+            np.asarray(offsets),
+            self.tips if tips is None else np.asarray(tips, dtype=np.float64),
+            self.radii,
+        )

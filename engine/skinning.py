@@ -22,8 +22,16 @@ from engine.io.gltf_clip import sample_channel
 from engine.io.gltf_mesh import SkinnedMeshes
 from engine.skeleton import Skeleton
 
-__all__ = ["trs_matrices", "node_world_matrices", "skin_matrices", "blend_skin", "rigid_matrices",
-           "fit_similarity", "bind_from_engine", "SkinBinding"]
+__all__ = [
+    "trs_matrices",
+    "node_world_matrices",
+    "skin_matrices",
+    "blend_skin",
+    "rigid_matrices",
+    "fit_similarity",
+    "bind_from_engine",
+    "SkinBinding",
+]
 
 F64 = NDArray[np.float64]
 
@@ -75,8 +83,9 @@ def skin_matrices(asset: GltfAsset, world: F64, skin: int = 0) -> F64:
     return world[list(sk.joints)] @ sk.inverse_bind
 
 
-def blend_skin(positions: NDArray[np.floating], joints: NDArray[np.integer], weights: NDArray[np.floating],
-               matrices: F64) -> F64:
+def blend_skin(
+    positions: NDArray[np.floating], joints: NDArray[np.integer], weights: NDArray[np.floating], matrices: F64
+) -> F64:
     """Skinned positions ``[V,3]``: ``Σ_k w_k · M[j_k] · [p, 1]``, in double precision."""
     p = np.concatenate([np.asarray(positions, dtype=np.float64), np.ones((len(positions), 1))], axis=1)
     per_vertex = matrices[np.asarray(joints, dtype=np.int64)]
@@ -163,8 +172,10 @@ class SkinBinding:
         used = {nodes[int(j)] for p in meshes.primitives for j in np.unique(p.joints[p.weights > 0.0])}
         if 2 * len(used & set(engine)) < len(used):
             missing = sorted(asset.names[n] for n in used - set(engine))
-            raise ValueError(f"the skeleton shares too few joints with the skin to drive it (missing: "
-                             f"{', '.join(missing[:6])}{'…' if len(missing) > 6 else ''})")
+            raise ValueError(
+                f"the skeleton shares too few joints with the skin to drive it (missing: "
+                f"{', '.join(missing[:6])}{'…' if len(missing) > 6 else ''})"
+            )
         world = node_world_matrices(asset)
         rigid = world.copy()
         rigid[:, :3, :3] /= np.linalg.norm(world[:, :3, :3], axis=1, keepdims=True)

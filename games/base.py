@@ -76,7 +76,7 @@ def parse_settings(pairs: list[str], declared: dict[str, str], game: str) -> dic
     return options
 
 
-def describe_options(game: "Game") -> list[str]:
+def describe_options(game: Game) -> list[str]:
     """``--set help``: one line per option: its type or range, what it does, its default.
 
     An option whose default is empty says in its help what leaving it unset means.

@@ -14,8 +14,20 @@ from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
-__all__ = ["draw_world", "spawn_player", "player_character", "PlayerCharacter", "draw_sticks", "draw_height_cues", "draw_walk_target", "height_cues", "CUE_COLOR",
-           "Notice", "post_notice", "NOTICE_SECONDS"]
+__all__ = [
+    "draw_world",
+    "spawn_player",
+    "player_character",
+    "PlayerCharacter",
+    "draw_sticks",
+    "draw_height_cues",
+    "draw_walk_target",
+    "height_cues",
+    "CUE_COLOR",
+    "Notice",
+    "post_notice",
+    "NOTICE_SECONDS",
+]
 
 NOTICE_SECONDS = 2.0
 """How long a notice stays on screen (the last quarter of it fading out)."""
@@ -82,9 +94,14 @@ def player_character(world: World):  # type: ignore[no-untyped-def]  # -> engine
     return held.character
 
 
-def spawn_player(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
-                 heading: float = 0.0, *, name: str = "puppet",
-                 color: tuple[float, float, float] = (0.85, 0.35, 0.25)) -> Entity:
+def spawn_player(
+    world: World,
+    position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
+    heading: float = 0.0,
+    *,
+    name: str = "puppet",
+    color: tuple[float, float, float] = (0.85, 0.35, 0.25),
+) -> Entity:
     """The player's puppet: the set-up's character (``play --character``) when it has one, else the mannequin
     in ``color``. A character plays the clips the mannequin would (the library's authored ones over
     the built-in ones), retargeted to it."""
@@ -99,8 +116,9 @@ def spawn_player(world: World, position: np.ndarray | tuple[float, float, float]
 
     authored = world.try_resource(AuthoredClips)
     clips = merged_clips(authored.clips) if authored is not None and authored.clips else default_clips()
-    return spawn_character(world, character, clips, position, heading, name=name,
-                           extra=(Appearance(color=color, visible=False),))
+    return spawn_character(
+        world, character, clips, position, heading, name=name, extra=(Appearance(color=color, visible=False),)
+    )
 
 
 def draw_sticks(world: World, scene: RenderScene) -> None:
@@ -146,7 +164,7 @@ def height_cues(world: World, alpha: float) -> list[tuple[np.ndarray, float, flo
     cues = []
     for i, (centre, radius) in enumerate(props):
         bottom = centre - np.array([0.0, radius, 0.0])
-        surface = _surface_below(bottom[0], bottom[2], bottom[1], props[:i] + props[i + 1:])
+        surface = _surface_below(bottom[0], bottom[2], bottom[1], props[:i] + props[i + 1 :])
         if bottom[1] - surface > _PROP_LIFT:
             cues.append((bottom, surface, radius))
     for _, _puppet, wp in world.query(Puppet, WorldPose):
@@ -182,14 +200,15 @@ def draw_walk_target(world: World, scene: RenderScene, alpha: float) -> None:
     """
     from engine.statemachine.puppet.body import PuppetBody
 
-    for e, body, tr in world.query(PuppetBody, Transform):
+    for _e, body, tr in world.query(PuppetBody, Transform):
         if body.held_by is None:
             continue
         feet = np.array([tr.position[0], 0.015, tr.position[2]])
         goal = np.array([body.target[0], 0.015, body.target[2]])
         scene.add_line(feet, goal, CUE_COLOR, width=2.0)
-        scene.add_polyline(goal + np.c_[0.25 * np.cos(_RING), np.zeros_like(_RING), 0.25 * np.sin(_RING)], CUE_COLOR,
-                           width=3.0)
+        scene.add_polyline(
+            goal + np.c_[0.25 * np.cos(_RING), np.zeros_like(_RING), 0.25 * np.sin(_RING)], CUE_COLOR, width=3.0
+        )
 
 
 def draw_world(world: World, scene: RenderScene, alpha: float) -> None:

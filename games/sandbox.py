@@ -95,8 +95,13 @@ def _spawn_crowd(world: World, n: int) -> None:
         heading = float(world.rng.uniform(-np.pi, np.pi))
         goal = np.array([world.rng.uniform(-half, half), 0.0, world.rng.uniform(-half, half)])
         pace = float(world.rng.uniform(*PACES))
-        e = spawn_puppet(world, pos, heading, name=f"wanderer {k + 1}",
-                         extra=(Appearance(color=(0.3, 0.45, 0.8)), Wanderer(pace, goal, half)))
+        e = spawn_puppet(
+            world,
+            pos,
+            heading,
+            name=f"wanderer {k + 1}",
+            extra=(Appearance(color=(0.3, 0.45, 0.8)), Wanderer(pace, goal, half)),
+        )
         world.remove(e, Grabbable)
 
 
@@ -111,10 +116,19 @@ def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
     if not isinstance(scene, str) or scene not in SCENES:
         raise GameOptionError(f"the recorded sandbox scene {repr(scene)[:40]} is not one of {', '.join(SCENES)}")
     if not isinstance(puppets, int) or isinstance(puppets, bool) or not 1 <= puppets <= MAX_PUPPETS:
-        raise GameOptionError(f"the recorded sandbox puppets {repr(puppets)[:40]} is not a number from 1 to {MAX_PUPPETS}")
+        raise GameOptionError(
+            f"the recorded sandbox puppets {repr(puppets)[:40]} is not a number from 1 to {MAX_PUPPETS}"
+        )
     return dict(recorded)
 
 
-GAME = Game(name="sandbox", install=install, draw=draw_world, camera=camera,
-            options={"scene": "empty", "puppets": "1"}, option_help=OPTION_HELP, prepare=prepare,
-            replay_setup=replay_setup)
+GAME = Game(
+    name="sandbox",
+    install=install,
+    draw=draw_world,
+    camera=camera,
+    options={"scene": "empty", "puppets": "1"},
+    option_help=OPTION_HELP,
+    prepare=prepare,
+    replay_setup=replay_setup,
+)

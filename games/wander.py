@@ -40,11 +40,16 @@ class Wanderer:
 
 def wander_system(world: World) -> None:
     """Steer every free wanderer toward its goal; pick a new goal when one is reached."""
-    rows = [(w, body, tr, player) for e, w, body in world.query(Wanderer, PuppetBody)
-            if body.held_by is None and ((jump := world.try_get(e, Jumping)) is None or jump.air == 0.0)
-            and (rd := world.try_get(e, Ragdoll)) is not None and rd.mode is RagdollMode.ANIMATED
-            and (tr := world.try_get(e, Transform)) is not None
-            and (player := world.try_get(e, LocomotionPlayer)) is not None]
+    rows = [
+        (w, body, tr, player)
+        for e, w, body in world.query(Wanderer, PuppetBody)
+        if body.held_by is None
+        and ((jump := world.try_get(e, Jumping)) is None or jump.air == 0.0)
+        and (rd := world.try_get(e, Ragdoll)) is not None
+        and rd.mode is RagdollMode.ANIMATED
+        and (tr := world.try_get(e, Transform)) is not None
+        and (player := world.try_get(e, LocomotionPlayer)) is not None
+    ]
     if not rows:
         return
     pos = np.array([r[2].position for r in rows])
@@ -62,8 +67,13 @@ def wander_system(world: World) -> None:
         tr.rotation = rotation[i]
         player.speed = float(w.speed * facing[i])
         if dist[i] < _REACHED:
-            w.goal = np.array([*world.rng.uniform(-w.field_half, w.field_half, 1), 0.0,
-                               *world.rng.uniform(-w.field_half, w.field_half, 1)])
+            w.goal = np.array(
+                [
+                    *world.rng.uniform(-w.field_half, w.field_half, 1),
+                    0.0,
+                    *world.rng.uniform(-w.field_half, w.field_half, 1),
+                ]
+            )
 
 
 def install_wander(app: App) -> None:

@@ -18,13 +18,28 @@ from typing import Any
 # Each public name → its submodule, imported on first use (PEP 562): parsing ``puppetphone --help``
 # reads ``input.factory`` without loading the hub, numpy or the device servers.
 _WHERE = {
-    "add_source_arguments": "factory", "make_hub": "factory", "InputHub": "hub",
-    "StickConfig": "motionstick", "StickState": "motionstick", "motionstick_system": "motionstick",
-    "spawn_stick": "motionstick", "input_plugin": "plugin", "install_input": "plugin",
-    "Recorder": "recording", "Recording": "recording", "RecordingError": "recording",
-    "RecordingHeader": "recording", "read_recording": "recording", "HashCheck": "replay",
-    "ReplaySource": "replay", "replay_hub": "replay", "verify": "replay", "InputFrame": "sample",
-    "PoseSample": "sample", "SourceStatus": "sample", "PoseSource": "source",
+    "add_source_arguments": "factory",
+    "make_hub": "factory",
+    "InputHub": "hub",
+    "StickConfig": "motionstick",
+    "StickState": "motionstick",
+    "motionstick_system": "motionstick",
+    "spawn_stick": "motionstick",
+    "input_plugin": "plugin",
+    "install_input": "plugin",
+    "Recorder": "recording",
+    "Recording": "recording",
+    "RecordingError": "recording",
+    "RecordingHeader": "recording",
+    "read_recording": "recording",
+    "HashCheck": "replay",
+    "ReplaySource": "replay",
+    "replay_hub": "replay",
+    "verify": "replay",
+    "InputFrame": "sample",
+    "PoseSample": "sample",
+    "SourceStatus": "sample",
+    "PoseSource": "source",
 }
 
 

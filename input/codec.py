@@ -54,8 +54,12 @@ def encode_frame(frame: InputFrame) -> bytes:
     for s in frame.samples:
         flags = 0
         extra = bytearray()
-        for bit, v in ((_F_POS, s.position), (_F_GYR, s.angular_velocity), (_F_ACC, s.acceleration),
-                       (_F_PLANE, s.plane_normal)):
+        for bit, v in (
+            (_F_POS, s.position),
+            (_F_GYR, s.angular_velocity),
+            (_F_ACC, s.acceleration),
+            (_F_PLANE, s.plane_normal),
+        ):
             if v is not None:
                 flags |= bit
                 extra += _V3.pack(*v)
@@ -112,11 +116,18 @@ def decode_frame(data: bytes) -> InputFrame:
         sample = PoseSample.__new__(PoseSample)
         # Bypass __post_init__'s renormalisation: the bits must come back unchanged.
         sample.__dict__.update(
-            time=t, source=source, orientation=np.array(q), position=vecs[_F_POS],
-            angular_velocity=vecs[_F_GYR], acceleration=vecs[_F_ACC],
+            time=t,
+            source=source,
+            orientation=np.array(q),
+            position=vecs[_F_POS],
+            angular_velocity=vecs[_F_GYR],
+            acceleration=vecs[_F_ACC],
             touch=bool(flags & _F_TOUCH) if flags & _F_HAS_TOUCH else None,
-            mode="world" if flags & _F_WORLD else "device", plane_normal=vecs[_F_PLANE],
-            depth_delta=depth, flick=bool(flags & _F_FLICK), calibrate=bool(flags & _F_CAL),
+            mode="world" if flags & _F_WORLD else "device",
+            plane_normal=vecs[_F_PLANE],
+            depth_delta=depth,
+            flick=bool(flags & _F_FLICK),
+            calibrate=bool(flags & _F_CAL),
         )
         try:
             check_sample_ranges(sample)

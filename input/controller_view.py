@@ -30,6 +30,7 @@ def controller_camera(world: World) -> PhoneCamera | None:
     """The view from the first controller that drives a stick in device mode, or ``None``."""
     for _, stick, st in world.query(Stick, StickState):
         if st.source and stick.connected and not st.world_mode:
-            return PhoneCamera(position=stick.pivot.copy(), orientation=quat.mul(stick.orientation, _HALF_TURN_Y),
-                               fov_y=FOV_Y)
+            return PhoneCamera(
+                position=stick.pivot.copy(), orientation=quat.mul(stick.orientation, _HALF_TURN_Y), fov_y=FOV_Y
+            )
     return None

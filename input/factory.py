@@ -64,20 +64,33 @@ def silent_after(text: str) -> float:
 def add_source_arguments(parser: argparse.ArgumentParser) -> None:
     """Add ``--source`` and the device options to a sub-command's parser."""
     parser.add_argument("--source", default="mouse", help=f"input source: {'|'.join(SOURCE_KINDS)} (default mouse)")
-    parser.add_argument("--osc-host", default=DEFAULT_HOST,
-                        help="OSC bind address; phones on the LAN need 0.0.0.0 (default 127.0.0.1)")
+    parser.add_argument(
+        "--osc-host", default=DEFAULT_HOST, help="OSC bind address; phones on the LAN need 0.0.0.0 (default 127.0.0.1)"
+    )
     parser.add_argument("--osc-port", type=int, default=DEFAULT_PORT, help=f"OSC UDP port (default {DEFAULT_PORT})")
     parser.add_argument("--osc-senders", type=int, default=1, help="how many phones may drive sticks (default 1)")
     parser.add_argument("--serial-port", default=None, help="serial device or pyserial URL (or --source serial:PORT)")
     parser.add_argument("--baud", type=int, default=115200, help="serial baud rate (default 115200)")
-    parser.add_argument("--web-host", default=DEFAULT_HOST,
-                        help="web controller bind address; phones on the LAN need 0.0.0.0 (default 127.0.0.1)")
-    parser.add_argument("--web-port", type=int, default=DEFAULT_WEB_PORT,
-                        help=f"web controller HTTPS port, 0 for any free one (default {DEFAULT_WEB_PORT})")
+    parser.add_argument(
+        "--web-host",
+        default=DEFAULT_HOST,
+        help="web controller bind address; phones on the LAN need 0.0.0.0 (default 127.0.0.1)",
+    )
+    parser.add_argument(
+        "--web-port",
+        type=int,
+        default=DEFAULT_WEB_PORT,
+        help=f"web controller HTTPS port, 0 for any free one (default {DEFAULT_WEB_PORT})",
+    )
     lo, hi = SILENT_AFTER_RANGE
-    parser.add_argument("--silent-after", type=silent_after, default=DEFAULT_SILENT_AFTER, metavar="SECONDS",
-                        help="an OSC or web controller silent this long loses its puppet to the next phone "
-                             f"({lo}..{hi:g}, default {DEFAULT_SILENT_AFTER:g})")
+    parser.add_argument(
+        "--silent-after",
+        type=silent_after,
+        default=DEFAULT_SILENT_AFTER,
+        metavar="SECONDS",
+        help="an OSC or web controller silent this long loses its puppet to the next phone "
+        f"({lo}..{hi:g}, default {DEFAULT_SILENT_AFTER:g})",
+    )
 
 
 @dataclass(frozen=True)
@@ -104,8 +117,9 @@ def _mouse(o: SourceOptions) -> PoseSource:
 def _osc(o: SourceOptions) -> PoseSource:
     from input.osc import OscSource
 
-    return OscSource(host=o.osc_host, port=int(o.arg) if o.arg else o.osc_port, max_senders=o.osc_senders,
-                     timeout=o.silent_after)
+    return OscSource(
+        host=o.osc_host, port=int(o.arg) if o.arg else o.osc_port, max_senders=o.osc_senders, timeout=o.silent_after
+    )
 
 
 def _hid(o: SourceOptions) -> PoseSource:
@@ -131,21 +145,41 @@ def _web(o: SourceOptions) -> PoseSource:
 
 #: Every live source kind by its ``--source`` name: adding a device is a builder and one line here.
 SOURCES: dict[str, Callable[[SourceOptions], PoseSource]] = {
-    "mouse": _mouse, "osc": _osc, "hid": _hid, "serial": _serial, "web": _web,
+    "mouse": _mouse,
+    "osc": _osc,
+    "hid": _hid,
+    "serial": _serial,
+    "web": _web,
 }
 SOURCE_KINDS = (*SOURCES, "replay:FILE")
 
 
 def open_hub(args: argparse.Namespace) -> InputHub:
     """The hub of a parsed command line's ``--source`` and device options (not started): every option passed."""
-    return make_hub(args.source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
-                    args.web_host, args.web_port, args.silent_after)
+    return make_hub(
+        args.source,
+        args.osc_host,
+        args.osc_port,
+        args.osc_senders,
+        args.serial_port,
+        args.baud,
+        args.web_host,
+        args.web_port,
+        args.silent_after,
+    )
 
 
-def make_hub(source: str = "mouse", osc_host: str = DEFAULT_HOST, osc_port: int = DEFAULT_PORT,
-             osc_senders: int = 1, serial_port: str | None = None, baud: int = 115200,
-             web_host: str = DEFAULT_HOST, web_port: int = DEFAULT_WEB_PORT,
-             silent_after: float = DEFAULT_SILENT_AFTER) -> InputHub:
+def make_hub(
+    source: str = "mouse",
+    osc_host: str = DEFAULT_HOST,
+    osc_port: int = DEFAULT_PORT,
+    osc_senders: int = 1,
+    serial_port: str | None = None,
+    baud: int = 115200,
+    web_host: str = DEFAULT_HOST,
+    web_port: int = DEFAULT_WEB_PORT,
+    silent_after: float = DEFAULT_SILENT_AFTER,
+) -> InputHub:
     """The hub for one ``--source`` value (sources not yet started).
 
     Raises:

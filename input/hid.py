@@ -28,9 +28,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
-from input.hid_reports import (DS4_DEFAULT, DUALSENSE_DEFAULT, SPACEMOUSE_COMBINED, HidFormatError, ImuCalibration,
-                               ImuReport, ds4_calibration, dualsense_calibration, known_device, parse_ds4,
-                               parse_dualsense, parse_spacemouse)
+from input.hid_reports import (
+    DS4_DEFAULT,
+    DUALSENSE_DEFAULT,
+    SPACEMOUSE_COMBINED,
+    HidFormatError,
+    ImuCalibration,
+    ImuReport,
+    ds4_calibration,
+    dualsense_calibration,
+    known_device,
+    parse_ds4,
+    parse_dualsense,
+    parse_spacemouse,
+)
 from input.phone_frames import STICK_TO_ARKIT_CAMERA
 from input.sample import LIMITS
 from input.source import PoseSource
@@ -135,8 +146,14 @@ class HidSource(PoseSource):
             (tests pass a fake; default opens through hidapi).
     """
 
-    def __init__(self, vid: int | None = None, pid: int | None = None, retry: float = 1.0,
-                 opener: Callable[[], Any] | None = None, capacity: int = 256) -> None:
+    def __init__(
+        self,
+        vid: int | None = None,
+        pid: int | None = None,
+        retry: float = 1.0,
+        opener: Callable[[], Any] | None = None,
+        capacity: int = 256,
+    ) -> None:
         super().__init__("hid", capacity)
         self.vid, self.pid, self.retry = vid, pid, retry
         self._opener = opener
@@ -209,8 +226,13 @@ class HidSource(PoseSource):
                     continue
                 last = now
                 if data[0] == 1 or not combined:
-                    self.offer(time=now, source=self.source_id, orientation=sm.orientation,
-                               position=sm.position, touch=bool(sm.buttons & 1))
+                    self.offer(
+                        time=now,
+                        source=self.source_id,
+                        orientation=sm.orientation,
+                        position=sm.position,
+                        touch=bool(sm.buttons & 1),
+                    )
             return
         imu = ImuIntegrator(self._calibration(dev))
         parse, wrap = (parse_ds4, 65536 * 16 / 3 * 1e-6) if self.kind == "ds4" else (parse_dualsense, 2**32 / 3 * 1e-6)
@@ -224,5 +246,11 @@ class HidSource(PoseSource):
                 self.drop("bad report", str(exc))
                 continue
             imu.update(r, wrap)
-            self.offer(time=time.monotonic(), source=self.source_id, orientation=imu.stick_orientation(),
-                       angular_velocity=imu.gyro, acceleration=imu.accel * 9.80665, touch=r.cross)
+            self.offer(
+                time=time.monotonic(),
+                source=self.source_id,
+                orientation=imu.stick_orientation(),
+                angular_velocity=imu.gyro,
+                acceleration=imu.accel * 9.80665,
+                touch=r.cross,
+            )

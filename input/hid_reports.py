@@ -26,23 +26,47 @@ from numpy.typing import NDArray
 
 from engine.errors import FormatError
 
-__all__ = ["SPACEMOUSE_IDS", "SPACEMOUSE_COMBINED", "SONY_VID", "DS4_PIDS", "DUALSENSE_PIDS", "AXIS_SCALE",
-           "SpaceMouseReport", "parse_spacemouse", "ImuReport", "ImuCalibration", "parse_ds4", "parse_dualsense",
-           "ds4_calibration", "dualsense_calibration", "DS4_DEFAULT", "DUALSENSE_DEFAULT", "HidFormatError",
-           "known_device"]
+__all__ = [
+    "SPACEMOUSE_IDS",
+    "SPACEMOUSE_COMBINED",
+    "SONY_VID",
+    "DS4_PIDS",
+    "DUALSENSE_PIDS",
+    "AXIS_SCALE",
+    "SpaceMouseReport",
+    "parse_spacemouse",
+    "ImuReport",
+    "ImuCalibration",
+    "parse_ds4",
+    "parse_dualsense",
+    "ds4_calibration",
+    "dualsense_calibration",
+    "DS4_DEFAULT",
+    "DUALSENSE_DEFAULT",
+    "HidFormatError",
+    "known_device",
+]
 
 F = NDArray[np.float64]
 AXIS_SCALE = 350.0
 
 # (vid, pid) -> name; rotation in report 2 unless listed in SPACEMOUSE_COMBINED.
 SPACEMOUSE_IDS: dict[tuple[int, int], str] = {
-    (0x046D, 0xC626): "SpaceNavigator", (0x046D, 0xC628): "SpaceNavigator for Notebooks",
-    (0x046D, 0xC627): "SpaceExplorer", (0x046D, 0xC625): "SpacePilot", (0x046D, 0xC629): "SpacePilot Pro",
-    (0x046D, 0xC62B): "SpaceMouse Pro", (0x256F, 0xC635): "SpaceMouse Compact",
-    (0x256F, 0xC62E): "SpaceMouse Wireless (cable)", (0x256F, 0xC62F): "SpaceMouse Wireless (receiver)",
-    (0x256F, 0xC63A): "SpaceMouse Wireless (BT)", (0x256F, 0xC631): "SpaceMouse Pro Wireless (cable)",
-    (0x256F, 0xC632): "SpaceMouse Pro Wireless (receiver)", (0x256F, 0xC638): "SpaceMouse Pro Wireless (BT)",
-    (0x256F, 0xC633): "SpaceMouse Enterprise", (0x256F, 0xC652): "3Dconnexion Universal Receiver",
+    (0x046D, 0xC626): "SpaceNavigator",
+    (0x046D, 0xC628): "SpaceNavigator for Notebooks",
+    (0x046D, 0xC627): "SpaceExplorer",
+    (0x046D, 0xC625): "SpacePilot",
+    (0x046D, 0xC629): "SpacePilot Pro",
+    (0x046D, 0xC62B): "SpaceMouse Pro",
+    (0x256F, 0xC635): "SpaceMouse Compact",
+    (0x256F, 0xC62E): "SpaceMouse Wireless (cable)",
+    (0x256F, 0xC62F): "SpaceMouse Wireless (receiver)",
+    (0x256F, 0xC63A): "SpaceMouse Wireless (BT)",
+    (0x256F, 0xC631): "SpaceMouse Pro Wireless (cable)",
+    (0x256F, 0xC632): "SpaceMouse Pro Wireless (receiver)",
+    (0x256F, 0xC638): "SpaceMouse Pro Wireless (BT)",
+    (0x256F, 0xC633): "SpaceMouse Enterprise",
+    (0x256F, 0xC652): "3Dconnexion Universal Receiver",
 }
 SPACEMOUSE_COMBINED = frozenset({(0x256F, p) for p in (0xC62E, 0xC62F, 0xC63A, 0xC631, 0xC632, 0xC638, 0xC633, 0xC652)})
 SONY_VID = 0x054C
@@ -158,8 +182,25 @@ def parse_dualsense(report: bytes | list[int]) -> ImuReport:
 def _feature(data: bytes) -> dict[str, int]:
     if len(data) < 35:
         raise HidFormatError(f"calibration report too short ({len(data)} bytes)")
-    names = ["pb", "yb", "rb", "a7", "a9", "a11", "a13", "a15", "a17", "sp", "sm",
-             "axp", "axm", "ayp", "aym", "azp", "azm"]
+    names = [
+        "pb",
+        "yb",
+        "rb",
+        "a7",
+        "a9",
+        "a11",
+        "a13",
+        "a15",
+        "a17",
+        "sp",
+        "sm",
+        "axp",
+        "axm",
+        "ayp",
+        "aym",
+        "azp",
+        "azm",
+    ]
     return dict(zip(names, struct.unpack_from("<17h", data, 1), strict=True))
 
 

@@ -19,12 +19,12 @@ recorded frame for each index instead of draining live sources.
 from __future__ import annotations
 
 import threading
-from dataclasses import replace
 from collections.abc import Iterable
+from dataclasses import replace
 from typing import Protocol
 
 from input.codec import decode_frame, encode_frame
-from input.sample import LIMITS, COMMANDS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus, encode_tool
+from input.sample import COMMANDS, LIMITS, TOOL, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample, SourceStatus, encode_tool
 from input.source import PoseSource
 
 __all__ = ["InputHub", "FrameSource"]
@@ -49,8 +49,9 @@ class InputHub:
         max_samples: per source and step, how many pose samples are kept.
     """
 
-    def __init__(self, sources: Iterable[PoseSource] = (), replay: FrameSource | None = None,
-                 max_samples: int = 8) -> None:
+    def __init__(
+        self, sources: Iterable[PoseSource] = (), replay: FrameSource | None = None, max_samples: int = 8
+    ) -> None:
         self.sources: list[PoseSource] = list(sources)
         # Set whenever a live source queues a reading: a paced loop may start the step early for it.
         self.arrived = threading.Event()

@@ -15,8 +15,18 @@ from functools import lru_cache
 __all__ = ["NUMERIC_LIBRARIES", "libraries_problem", "running_versions", "version_difference"]
 
 #: The distributions whose version can change a state hash: exactly the ones constraints.txt pins.
-NUMERIC_LIBRARIES = ("numpy", "scipy", "mujoco", "mujoco-core", "mujoco-studio", "osqp", "daqp", "cma",
-                     "opencv-python-headless", "pillow")
+NUMERIC_LIBRARIES = (
+    "numpy",
+    "scipy",
+    "mujoco",
+    "mujoco-core",
+    "mujoco-studio",
+    "osqp",
+    "daqp",
+    "cma",
+    "opencv-python-headless",
+    "pillow",
+)
 _MAX_NAME = 64
 
 

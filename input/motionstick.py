@@ -146,8 +146,9 @@ def _release(stick: Stick) -> None:
         stick.grabbed, stick.released = None, stick.grabbed
 
 
-def _length(st: StickState, stick: Stick, depth_delta: float, cfg: StickConfig, focus_t: float | None,
-            holding: bool = False) -> float:
+def _length(
+    st: StickState, stick: Stick, depth_delta: float, cfg: StickConfig, focus_t: float | None, holding: bool = False
+) -> float:
     if stick.grabbed is None and not holding:
         return focus_t if focus_t is not None else cfg.idle_length
     if depth_delta:
@@ -227,7 +228,9 @@ def motionstick_system(world: World) -> None:
             shift = stick.direction * (wanted - before)
             st.filt_x, st.raw_x = st.filt_x + shift, st.raw_x + shift
         bases, radii_o, heights = _obstacles(world, stick.grabbed)
-        tips = [(pivot + d * shorten(pivot, d, wanted, cfg.ground_y, bases, radii_o, heights), t) for pivot, d, t in poses]
+        tips = [
+            (pivot + d * shorten(pivot, d, wanted, cfg.ground_y, bases, radii_o, heights), t) for pivot, d, t in poses
+        ]
         stick.length = shorten(stick.pivot, stick.direction, wanted, cfg.ground_y, bases, radii_o, heights)
         stick.tip = stick.pivot + stick.direction * stick.length
         stick.tip_rotation = stick.orientation.copy()
@@ -239,8 +242,9 @@ def motionstick_system(world: World) -> None:
         assert np.isfinite(stick.tip).all() and np.isfinite(stick.velocity).all(), f"stick {e} is not finite"
 
 
-def _filter_velocity(st: StickState, stick: Stick, tips: list[tuple[F, float]], flicked: bool, cfg: StickConfig,
-                     dt: float) -> None:
+def _filter_velocity(
+    st: StickState, stick: Stick, tips: list[tuple[F, float]], flicked: bool, cfg: StickConfig, dt: float
+) -> None:
     """Feed each sample's tip to the One Euro filter at its own time; detect a flick.
 
     The time between samples comes from their timestamps, at most 0.1 s (a long silence

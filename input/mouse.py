@@ -67,8 +67,9 @@ class MouseSource(PoseSource):
     threaded = False
     person = True
 
-    def __init__(self, wheel_step: float = 0.1, flick_rise: float = 0.08, flick_window: float = 0.15,
-                 plane: str = "ground") -> None:
+    def __init__(
+        self, wheel_step: float = 0.1, flick_rise: float = 0.08, flick_window: float = 0.15, plane: str = "ground"
+    ) -> None:
         super().__init__("mouse")
         if plane not in ("ground", "view"):
             raise ValueError(f"plane must be 'ground' or 'view', not {plane!r}")
@@ -144,11 +145,29 @@ class MouseSource(PoseSource):
             return np.array([0.0, -1.0, 0.0])
         return np.asarray(camera.forward, dtype=np.float64)
 
-    def _emit(self, camera: RayCamera, size: tuple[int, int], pos: Any, now: float, touch: bool | None = None,
-              depth_delta: float = 0.0, flick: bool = False) -> None:
+    def _emit(
+        self,
+        camera: RayCamera,
+        size: tuple[int, int],
+        pos: Any,
+        now: float,
+        touch: bool | None = None,
+        depth_delta: float = 0.0,
+        flick: bool = False,
+    ) -> None:
         origin, direction = camera.ray(float(pos[0]), float(pos[1]), int(size[0]), int(size[1]))
         d = np.asarray(direction, dtype=np.float64)
         orientation = quat.between([0.0, 0.0, 1.0], d / np.linalg.norm(d))
-        self.push(PoseSample(time=now, source="mouse", orientation=orientation, position=np.asarray(origin, float),
-                             touch=touch, mode="world", plane_normal=self._plane_normal(camera),
-                             depth_delta=depth_delta, flick=flick))
+        self.push(
+            PoseSample(
+                time=now,
+                source="mouse",
+                orientation=orientation,
+                position=np.asarray(origin, float),
+                touch=touch,
+                mode="world",
+                plane_normal=self._plane_normal(camera),
+                depth_delta=depth_delta,
+                flick=flick,
+            )
+        )

@@ -19,8 +19,8 @@ from engine.app import App
 from engine.camera import Camera
 from engine.components import Grabbable, Stick, Transform
 from engine.ecs import Entity
-from input.mouse import MouseSource
 from input.motionstick import StickState
+from input.mouse import MouseSource
 
 __all__ = ["MouseBot"]
 

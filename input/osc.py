@@ -48,8 +48,18 @@ from input.osc_profiles import OscDecoder
 from input.sample import PoseSample
 from input.source import PoseSource
 
-__all__ = ["OscSource", "DEFAULT_PORT", "ADMIT_AFTER", "MAX_CANDIDATES", "MAX_DATAGRAM", "MAX_BUNDLE_DEPTH",
-           "MAX_MESSAGES", "STEP_BUDGET", "CANDIDATE_BUDGET", "bundle_shape"]
+__all__ = [
+    "OscSource",
+    "DEFAULT_PORT",
+    "ADMIT_AFTER",
+    "MAX_CANDIDATES",
+    "MAX_DATAGRAM",
+    "MAX_BUNDLE_DEPTH",
+    "MAX_MESSAGES",
+    "STEP_BUDGET",
+    "CANDIDATE_BUDGET",
+    "bundle_shape",
+]
 
 DEFAULT_PORT = 9000
 ADMIT_AFTER = 3  # valid samples: 50 ms of a 60 Hz phone
@@ -78,14 +88,14 @@ def bundle_shape(data: bytes) -> tuple[int, str]:
     messages = 0
     while todo:
         start, end, depth = todo.pop()
-        if data[start:start + 8] != _BUNDLE:
+        if data[start : start + 8] != _BUNDLE:
             messages += 1
             continue
         if depth > MAX_BUNDLE_DEPTH:
             return messages, "bundle too deep"
         pos = start + 16  # past the tag and the time tag
         while pos + 4 <= end:
-            n = int.from_bytes(data[pos:pos + 4], "big")
+            n = int.from_bytes(data[pos : pos + 4], "big")
             pos += 4
             if n <= 0 or pos + n > end:
                 break
@@ -113,11 +123,21 @@ class OscSource(PoseSource):
         OSError: the port cannot be bound.
     """
 
-    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_senders: int = 1,
-                 max_rate: float = 400.0, timeout: float = 2.0, gyrosc_order: str = "wxyz",
-                 capacity: int = 256, admit_after: int = ADMIT_AFTER) -> None:
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = DEFAULT_PORT,
+        max_senders: int = 1,
+        max_rate: float = 400.0,
+        timeout: float = 2.0,
+        gyrosc_order: str = "wxyz",
+        capacity: int = 256,
+        admit_after: int = ADMIT_AFTER,
+    ) -> None:
         if max_senders < 1:
-            raise ValueError(f"the number of OSC senders must be at least 1 (0 would refuse every phone), not {max_senders}")
+            raise ValueError(
+                f"the number of OSC senders must be at least 1 (0 would refuse every phone), not {max_senders}"
+            )
         if admit_after < 1:
             raise ValueError(f"admit_after must be at least 1, not {admit_after}")
         if not 0 <= port <= 65535:

@@ -32,14 +32,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 import pythonosc
+from numpy.typing import NDArray
 from pythonosc import osc_packet
 from pythonosc.dispatcher import Dispatcher
 
 from engine import quat
-from input.phone_frames import (arkit_to_stick, phone_to_stick, reorder_quat, tilt_from_gravity,
-                                z_up_to_engine)
+from input.phone_frames import arkit_to_stick, phone_to_stick, reorder_quat, tilt_from_gravity, z_up_to_engine
 from input.sample import PoseSample
 
 __all__ = ["OscDecoder", "SenderState", "G"]
@@ -124,8 +123,9 @@ class OscDecoder:
             (iOS reports −1 g on Z lying flat, hence −1).
     """
 
-    def __init__(self, on_drop: Callable[[str, str], None], gyrosc_order: str = "wxyz",
-                 accxyz_up_sign: float = -1.0) -> None:
+    def __init__(
+        self, on_drop: Callable[[str, str], None], gyrosc_order: str = "wxyz", accxyz_up_sign: float = -1.0
+    ) -> None:
         reorder_quat(np.zeros(4), gyrosc_order)  # validates the order early
         _quiet_python_osc()
         self.on_drop = on_drop
@@ -135,21 +135,36 @@ class OscDecoder:
         self._state = SenderState()
         d = Dispatcher(strict_timing=False)
         for address, handler in (
-            ("/puppetphone/pose", self._pp_pose), ("/puppetphone/orientation", self._pp_orientation),
-            ("/puppetphone/touch", self._pp_touch), ("/puppetphone/calibrate", self._pp_calibrate),
-            ("/puppetphone/gyro", self._gyro_rad), ("/puppetphone/accel", self._accel_ms2),
+            ("/puppetphone/pose", self._pp_pose),
+            ("/puppetphone/orientation", self._pp_orientation),
+            ("/puppetphone/touch", self._pp_touch),
+            ("/puppetphone/calibrate", self._pp_calibrate),
+            ("/puppetphone/gyro", self._gyro_rad),
+            ("/puppetphone/accel", self._accel_ms2),
             # ZIG SIM: "/ZIGSIM/<uuid>/name" in its source, "/<uuid>/name" in its docs: match both.
-            ("/*/quaternion", self._zig_quaternion), ("/*/arkitposition", self._zig_arkit_position),
-            ("/*/arkitrotation", self._zig_arkit_rotation), ("/*/touch[0-9]*", self._zig_touch),
-            ("/*/touchradius*", self._zig_touch), ("/*/touchforce*", self._zig_touch),
-            ("/ZIGSIM/*/gyro", self._gyro_rad), ("/ZIGSIM/*/accel", self._accel_g), ("/*/deviceinfo", self._ignore),
+            ("/*/quaternion", self._zig_quaternion),
+            ("/*/arkitposition", self._zig_arkit_position),
+            ("/*/arkitrotation", self._zig_arkit_rotation),
+            ("/*/touch[0-9]*", self._zig_touch),
+            ("/*/touchradius*", self._zig_touch),
+            ("/*/touchforce*", self._zig_touch),
+            ("/ZIGSIM/*/gyro", self._gyro_rad),
+            ("/ZIGSIM/*/accel", self._accel_g),
+            ("/*/deviceinfo", self._ignore),
             ("/ZIGSIM/*/gravity", self._ignore),
-            ("/rotationvector", self._s2o_rotation), ("/gamerotationvector", self._s2o_rotation),
-            ("/georotationvector", self._s2o_rotation), ("/pose6dof", self._s2o_pose6dof),
-            ("/touch1", self._s2o_touch), ("/gyroscope", self._gyro_rad), ("/accelerometer", self._accel_ms2),
+            ("/rotationvector", self._s2o_rotation),
+            ("/gamerotationvector", self._s2o_rotation),
+            ("/georotationvector", self._s2o_rotation),
+            ("/pose6dof", self._s2o_pose6dof),
+            ("/touch1", self._s2o_touch),
+            ("/gyroscope", self._gyro_rad),
+            ("/accelerometer", self._accel_ms2),
             ("/accxyz", self._touchosc_accxyz),
-            ("/gyrosc/quat", self._gyrosc_quat), ("/gyrosc/gyro", self._gyrosc_euler),
-            ("/gyrosc/rrate", self._gyro_rad), ("/gyrosc/accel", self._accel_g), ("/gyrosc/button", self._gyrosc_button),
+            ("/gyrosc/quat", self._gyrosc_quat),
+            ("/gyrosc/gyro", self._gyrosc_euler),
+            ("/gyrosc/rrate", self._gyro_rad),
+            ("/gyrosc/accel", self._accel_g),
+            ("/gyrosc/button", self._gyrosc_button),
         ):
             d.map(address, handler)
         self.dispatcher = d
@@ -187,8 +202,16 @@ class OscDecoder:
         st.dirty = False
         cal, st.calibrate = st.calibrate, False
         try:
-            sample = PoseSample(time=now, source=sender, orientation=st.orientation, position=st.position,
-                                angular_velocity=st.gyro, acceleration=st.accel, touch=st.touch, calibrate=cal)
+            sample = PoseSample(
+                time=now,
+                source=sender,
+                orientation=st.orientation,
+                position=st.position,
+                angular_velocity=st.gyro,
+                acceleration=st.accel,
+                touch=st.touch,
+                calibrate=cal,
+            )
         except ValueError as exc:  # finite but out of range (a 1e308 position): forget the whole packet
             if before is not None:
                 self.senders[sender] = before

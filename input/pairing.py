@@ -41,8 +41,9 @@ class PairingInfo:
         """A warning when the bind address cannot be reached from a phone."""
         if self.bind_host in ("0.0.0.0", ""):
             return ""
-        return (f"OSC listens on {self.bind_host} only: a phone on the LAN cannot reach it; "
-                "start with --osc-host 0.0.0.0")
+        return (
+            f"OSC listens on {self.bind_host} only: a phone on the LAN cannot reach it; start with --osc-host 0.0.0.0"
+        )
 
     @property
     def play_command(self) -> str:
@@ -52,13 +53,16 @@ class PairingInfo:
     def lines(self) -> list[str]:
         """The human-readable listing (``puppetphone devices`` and the overlay)."""
         out = [f"Phone (OSC over UDP): send to port {self.port} at"]
-        out += [f"  {a}   ({u})" for a, u in zip(self.addresses, self.urls, strict=True)] or ["  (no LAN address found)"]
+        out += [f"  {a}   ({u})" for a, u in zip(self.addresses, self.urls, strict=True)] or [
+            "  (no LAN address found)"
+        ]
         out.append("  ZIG SIM: Settings > IP address / Port; Sensors2OSC: host and port in Settings")
         if self.note:
             out.append(f"  note: {self.note}")
         out.append("HID devices:")
-        out += [f"  {d['name']} [{d['vendor_id']:04x}:{d['product_id']:04x}] ({d['kind']})" for d in self.hid_devices] \
-            or ["  none recognised (SpaceMouse, DualShock 4, DualSense)"]
+        out += [
+            f"  {d['name']} [{d['vendor_id']:04x}:{d['product_id']:04x}] ({d['kind']})" for d in self.hid_devices
+        ] or ["  none recognised (SpaceMouse, DualShock 4, DualSense)"]
         out.append("Serial ports:")
         out += [f"  {p['device']}  {p['description']}" for p in self.serial_ports] or ["  none"]
         return out
@@ -96,8 +100,10 @@ def serial_ports() -> list[dict[str, Any]]:
     """Serial ports pyserial can see."""
     from serial.tools import list_ports
 
-    return [{"device": p.device, "description": p.description, "vid": p.vid, "pid": p.pid}
-            for p in sorted(list_ports.comports(), key=lambda p: p.device)]
+    return [
+        {"device": p.device, "description": p.description, "vid": p.vid, "pid": p.pid}
+        for p in sorted(list_ports.comports(), key=lambda p: p.device)
+    ]
 
 
 def qr_ascii(text: str) -> str:
@@ -129,5 +135,6 @@ def pairing_info(port: int = DEFAULT_PORT, bind_host: str = "0.0.0.0") -> Pairin
         hid_devices = enumerate_supported()
     except OSError:
         hid_devices = []
-    return PairingInfo(port=port, bind_host=bind_host, addresses=lan_addresses(), hid_devices=hid_devices,
-                       serial_ports=serial_ports())
+    return PairingInfo(
+        port=port, bind_host=bind_host, addresses=lan_addresses(), hid_devices=hid_devices, serial_ports=serial_ports()
+    )

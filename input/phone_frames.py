@@ -24,8 +24,17 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 
-__all__ = ["WORLD_Z_UP_TO_ENGINE", "STICK_TO_DEVICE", "STICK_TO_ARKIT_CAMERA", "phone_to_stick",
-           "arkit_to_stick", "z_up_to_engine", "tilt_from_gravity", "QUAT_ORDERS", "reorder_quat"]
+__all__ = [
+    "WORLD_Z_UP_TO_ENGINE",
+    "STICK_TO_DEVICE",
+    "STICK_TO_ARKIT_CAMERA",
+    "phone_to_stick",
+    "arkit_to_stick",
+    "z_up_to_engine",
+    "tilt_from_gravity",
+    "QUAT_ORDERS",
+    "reorder_quat",
+]
 
 F = NDArray[np.float64]
 

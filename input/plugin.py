@@ -38,8 +38,7 @@ def _drain_system(world: World) -> None:
     world.insert_resource(world.resource(HubResource).hub.drain(world.frame))
 
 
-def install_input(app: App, hub: InputHub, sticks: Sequence[str] = ("*",),
-                  config: StickConfig | None = None) -> None:
+def install_input(app: App, hub: InputHub, sticks: Sequence[str] = ("*",), config: StickConfig | None = None) -> None:
     """Add the hub drain, the MotionStick system, their resources and the stick entities."""
     world = app.world
     world.insert_resource(HubResource(hub))

@@ -64,17 +64,25 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any, BinaryIO
 
-from engine.errors import FormatError
 from engine.app import App
 from engine.ecs import World
+from engine.errors import FormatError
 from engine.hashing import PART_DIGEST_SIZE, part_digests
 from engine.npz_safe import read_bounded
 from input.codec import CodecError, decode_frame, encode_frame
 from input.library_versions import libraries_problem, running_versions
 from input.sample import InputFrame
 
-__all__ = ["FORMAT_VERSION", "MAGIC", "RecordingHeader", "Recording", "Recorder", "RecordingError", "read_recording",
-           "MAX_RECORDING"]
+__all__ = [
+    "FORMAT_VERSION",
+    "MAGIC",
+    "RecordingHeader",
+    "Recording",
+    "Recorder",
+    "RecordingError",
+    "read_recording",
+    "MAX_RECORDING",
+]
 
 FORMAT_VERSION = 4
 #: The first format whose records carry per-part digests.
@@ -219,12 +227,16 @@ class Recorder:
                 moved.close()
                 raise
         except OSError as exc:
-            self.failed = (f"recording {self.path} stopped after {self.frames} frames: {why} "
-                           f"(and not in {target.parent} either: {exc.strerror or exc})")
+            self.failed = (
+                f"recording {self.path} stopped after {self.frames} frames: {why} "
+                f"(and not in {target.parent} either: {exc.strerror or exc})"
+            )
             print(self.failed, file=sys.stderr)
             return False
-        print(f"recording {self.path}: {why} after {self.frames} frames; it goes on in {target} "
-              f"(replay that file)", file=sys.stderr)
+        print(
+            f"recording {self.path}: {why} after {self.frames} frames; it goes on in {target} (replay that file)",
+            file=sys.stderr,
+        )
         self.path, self._file = target, moved
         return True
 
@@ -378,8 +390,15 @@ def read_recording(path: str | Path) -> Recording:
     cut = problem.startswith("cut inside")
     if not problem and not closed:
         problem, cut = f"cut: ended without its closing record after {len(frames)} frames (killed mid-session?)", True
-    return Recording(header=header, frames=frames, hashes=hashes, complete=not problem, problem=problem,
-                     parts=parts[: len(frames)], cut=cut)
+    return Recording(
+        header=header,
+        frames=frames,
+        hashes=hashes,
+        complete=not problem,
+        problem=problem,
+        parts=parts[: len(frames)],
+        cut=cut,
+    )
 
 
 def _read_parts(payload: bytes, names: tuple[str, ...]) -> tuple[tuple[str, ...], dict[str, bytes], int]:
@@ -406,5 +425,7 @@ def _read_parts(payload: bytes, names: tuple[str, ...]) -> tuple[tuple[str, ...]
     end = pos + count * PART_DIGEST_SIZE
     if count != len(names) or end > len(payload):
         raise CodecError(f"{count} part digests for {len(names)} part names")
-    digests = {name: payload[pos + i * PART_DIGEST_SIZE : pos + (i + 1) * PART_DIGEST_SIZE] for i, name in enumerate(names)}
+    digests = {
+        name: payload[pos + i * PART_DIGEST_SIZE : pos + (i + 1) * PART_DIGEST_SIZE] for i, name in enumerate(names)
+    }
     return names, digests, end

@@ -104,12 +104,15 @@ class HashCheck:
         if self.ok:
             return f"replayed {self.frames} frames, all {self.matched} state hashes match"
         what = f" in {', '.join(self.differing)}" if self.differing else ""
-        return (f"state hash differs at frame {self.first_mismatch}{what} (after {self.matched} matching): "
-                f"expected {self.expected}, got {self.got}")
+        return (
+            f"state hash differs at frame {self.first_mismatch}{what} (after {self.matched} matching): "
+            f"expected {self.expected}, got {self.got}"
+        )
 
 
-def verify(make_app: Callable[[InputHub], App], recording: Recording,
-           on_step: Callable[[App, int], None] | None = None) -> HashCheck:
+def verify(
+    make_app: Callable[[InputHub], App], recording: Recording, on_step: Callable[[App, int], None] | None = None
+) -> HashCheck:
     """Rebuild the app with a replay hub, step it once per recorded frame, compare every hash.
 
     Args:

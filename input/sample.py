@@ -25,8 +25,25 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["PoseSample", "InputFrame", "SourceStatus", "CONNECT", "DISCONNECT", "TOUCH_DOWN", "TOUCH_UP", "EVENT_KINDS",
-           "RESET", "SAVE", "RESTORE", "COMMANDS", "TOOL", "encode_tool", "decode_tool", "LIMITS", "check_sample_ranges"]
+__all__ = [
+    "PoseSample",
+    "InputFrame",
+    "SourceStatus",
+    "CONNECT",
+    "DISCONNECT",
+    "TOUCH_DOWN",
+    "TOUCH_UP",
+    "EVENT_KINDS",
+    "RESET",
+    "SAVE",
+    "RESTORE",
+    "COMMANDS",
+    "TOOL",
+    "encode_tool",
+    "decode_tool",
+    "LIMITS",
+    "check_sample_ranges",
+]
 
 CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP = "connect", "disconnect", "touch_down", "touch_up"
 # Commands from the keyboard (the launcher's keys), recorded like any input so a
@@ -56,11 +73,15 @@ def decode_tool(text: str) -> tuple[str | int | float | bool, ...]:
         operation = json.loads(text)
     except ValueError:
         raise ValueError(f"malformed tool operation {text[:40]!r}") from None
-    if (not isinstance(operation, list) or not operation or not isinstance(operation[0], str)
-            or not all(isinstance(v, (str, bool)) or (isinstance(v, (int, float)) and math.isfinite(v))
-                       for v in operation)):
+    if (
+        not isinstance(operation, list)
+        or not operation
+        or not isinstance(operation[0], str)
+        or not all(isinstance(v, (str, bool)) or (isinstance(v, (int, float)) and math.isfinite(v)) for v in operation)
+    ):
         raise ValueError(f"malformed tool operation {text[:40]!r}")
     return tuple(operation)
+
 
 # Physical bounds of a sample (largest magnitude per component). A finite value can still
 # poison the simulation: 1e308 as a position makes the stick's velocity filter overflow to

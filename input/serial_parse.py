@@ -137,7 +137,7 @@ class SerialStreamParser:
             noise = _NOISE.search(raw)
             if noise is not None:  # line noise before the text (a cable plugged in mid-line): keep the tail
                 self._skip("binary garbage")
-                raw = raw[noise.end():]
+                raw = raw[noise.end() :]
             try:
                 out.append(parse_line(raw.decode("ascii")))
             except ParseSkip as exc:

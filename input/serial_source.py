@@ -36,8 +36,9 @@ class SerialSource(PoseSource):
         wake: send one byte after opening (i2cdevlib waits for it).
     """
 
-    def __init__(self, port: str, baudrate: int = 115200, retry: float = 0.5, wake: bool = True,
-                 capacity: int = 256) -> None:
+    def __init__(
+        self, port: str, baudrate: int = 115200, retry: float = 0.5, wake: bool = True, capacity: int = 256
+    ) -> None:
         super().__init__(f"serial {port}", capacity)
         self.port = port
         self.baudrate = baudrate
@@ -89,9 +90,13 @@ class SerialSource(PoseSource):
                 continue
             before = dict(self.parser.skipped)
             for r in self.parser.feed(chunk):
-                self.offer(time=time.monotonic(), source=self.source_id,
-                           orientation=phone_to_stick(np.array(r.quaternion)),
-                           position=None if r.position is None else z_up_to_engine(r.position), touch=r.touch)
+                self.offer(
+                    time=time.monotonic(),
+                    source=self.source_id,
+                    orientation=phone_to_stick(np.array(r.quaternion)),
+                    position=None if r.position is None else z_up_to_engine(r.position),
+                    touch=r.touch,
+                )
             for reason, n in self.parser.skipped.items():
                 for _ in range(n - before.get(reason, 0)):
                     self.drop(reason)

@@ -179,7 +179,12 @@ class PoseSource:
     def status(self) -> SourceStatus:
         """A snapshot of the status for display."""
         with self._lock:
-            s = SourceStatus(**{**self._status.__dict__, "drop_reasons": dict(self._status.drop_reasons),
-                                "locked_out": list(self._status.locked_out)})
+            s = SourceStatus(
+                **{
+                    **self._status.__dict__,
+                    "drop_reasons": dict(self._status.drop_reasons),
+                    "locked_out": list(self._status.locked_out),
+                }
+            )
         s.packets_per_s = self._meter.rate()
         return s

@@ -36,8 +36,15 @@ def pick(origin: F, direction: F, centers: F, radii: F, max_distance: float = 50
     return i, float(t[i])
 
 
-def shorten(pivot: F, direction: F, length: float, ground_y: float = 0.0,
-            bases: F | None = None, radii: F | None = None, heights: F | None = None) -> float:
+def shorten(
+    pivot: F,
+    direction: F,
+    length: float,
+    ground_y: float = 0.0,
+    bases: F | None = None,
+    radii: F | None = None,
+    heights: F | None = None,
+) -> float:
     """The stick length allowed before the tip would go below the ground or into an obstacle.
 
     Obstacles are vertical cylinders standing on ``bases [N,3]`` with ``radii`` and

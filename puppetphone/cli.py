@@ -48,8 +48,13 @@ def build_parser() -> argparse.ArgumentParser:
 class _VersionAction(argparse.Action):
     """``--version``: the installed distribution's version, looked up only when asked (importlib.metadata is slow)."""
 
-    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: object,
-                 option_string: str | None = None) -> None:
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: object,
+        option_string: str | None = None,
+    ) -> None:
         print(f"puppetphone {_version()}")
         parser.exit()
 

@@ -58,8 +58,14 @@ class _ScriptedPhone(PoseSource):
         self._status.connected = True
 
 
-def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 5.0, seed: int = 0,
-                      direction: tuple[float, float] = (0.6, -0.8), clips: dict | None = None) -> Path:
+def record_stick_walk(
+    path: str | Path,
+    speed: float = 1.1,
+    distance: float = 5.0,
+    seed: int = 0,
+    direction: tuple[float, float] = (0.6, -0.8),
+    clips: dict | None = None,
+) -> Path:
     """Record the sandbox puppet walked ``distance`` m along ground ``direction`` (x, z) at ``speed`` m/s by
     a phone, then let go. The default direction crosses the sandbox camera's view, so a screenshot shows
     the puppet side-on. ``clips`` (an :func:`engine.cliplib.embed.encode` value) plays authored clips.
@@ -79,16 +85,25 @@ def record_stick_walk(path: str | Path, speed: float = 1.1, distance: float = 5.
     setup = {"scene": "empty", "puppets": 1, **({"clips": clips} if clips is not None else {})}
     app = make_app("sandbox", seed, InputHub([phone]), setup)
     world = app.world
-    header = RecordingHeader(game="sandbox", seed=seed, dt=world.dt, sources=["phone"], setup=setup,
-                             extra={"session": "stick_walk"})
+    header = RecordingHeader(
+        game="sandbox", seed=seed, dt=world.dt, sources=["phone"], setup=setup, extra={"session": "stick_walk"}
+    )
     puppet = next(e for e, _ in world.query(Brain))
     pivot = np.array(world.resource(StickConfig).virtual_pivot, dtype=np.float64)
     state = {"position": np.zeros(3), "orientation": quat.identity()}
 
     def push(n: int = 1, touch: bool | None = None, calibrate: bool = False) -> None:
         for _ in range(n):
-            phone.push(PoseSample(time=world.frame * world.dt, source="phone", orientation=state["orientation"],
-                                  position=state["position"].copy(), touch=touch, calibrate=calibrate))
+            phone.push(
+                PoseSample(
+                    time=world.frame * world.dt,
+                    source="phone",
+                    orientation=state["orientation"],
+                    position=state["position"].copy(),
+                    touch=touch,
+                    calibrate=calibrate,
+                )
+            )
             app.step()
 
     with Recorder(path, header).attach(app):

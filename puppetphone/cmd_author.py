@@ -47,20 +47,36 @@ def configure_record(rec: argparse.ArgumentParser) -> None:
     from puppetphone.runargs import add_run_arguments
 
     rec.add_argument("--item", default="r_upper_arm", help="joint to drive (default r_upper_arm)")
-    rec.add_argument("--drive", default="rotation", choices=("rotation", "translation", "pose", "scale"),
-                     help="what to drive: a joint's rotation, the root's or a hand's/foot's translation (IK), "
-                          "or its pose (translation and rotation in one take, from a 6-DoF device)")
-    rec.add_argument("--base", type=Path, default=None, help="a looping .ppclip whose layers play back while performing")
-    rec.add_argument("-o", "--output", type=Path, default=Path("performed_cycle.ppclip"), help="where accepted cycles are saved")
+    rec.add_argument(
+        "--drive",
+        default="rotation",
+        choices=("rotation", "translation", "pose", "scale"),
+        help="what to drive: a joint's rotation, the root's or a hand's/foot's translation (IK), "
+        "or its pose (translation and rotation in one take, from a 6-DoF device)",
+    )
+    rec.add_argument(
+        "--base", type=Path, default=None, help="a looping .ppclip whose layers play back while performing"
+    )
+    rec.add_argument(
+        "-o", "--output", type=Path, default=Path("performed_cycle.ppclip"), help="where accepted cycles are saved"
+    )
     rec.add_argument("--countdown", type=float, default=3.0, help="seconds of countdown (default 3)")
     rec.add_argument("--seconds", type=float, default=8.0, help="length of a take (default 8)")
-    rec.add_argument("--character", default=None, metavar="FILE.glb",
-                     help="draw this rigged humanoid (.glb) acting the take instead of the mannequin")
+    rec.add_argument(
+        "--character",
+        default=None,
+        metavar="FILE.glb",
+        help="draw this rigged humanoid (.glb) acting the take instead of the mannequin",
+    )
     rec.add_argument("--script", choices=RECORD_SCRIPTS, default=None, help="a scripted performer instead of a hand")
     add_run_arguments(rec)
     rec.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points")
-    rec.add_argument("--record", type=output_file, default=None,
-                     help="record the take (pointer, keys or device, every step's state) to replay it later")
+    rec.add_argument(
+        "--record",
+        type=output_file,
+        default=None,
+        help="record the take (pointer, keys or device, every step's state) to replay it later",
+    )
     add_source_arguments(rec)
 
 
@@ -69,22 +85,38 @@ def configure_edit(parser: argparse.ArgumentParser) -> None:
     from puppetphone.argtypes import output_file, take_position
     from puppetphone.runargs import add_run_arguments
 
-    parser.add_argument("clip", help="a .ppclip cycle, a .bvh/.gltf/.glb motion (opened as its loop), "
-                                     "or a default clip name (walk, run, crouch_walk, idle…)")
+    parser.add_argument(
+        "clip",
+        help="a .ppclip cycle, a .bvh/.gltf/.glb motion (opened as its loop), "
+        "or a default clip name (walk, run, crouch_walk, idle…)",
+    )
     from puppetphone.motion_args import add_motion_options
 
     add_motion_options(parser)
     parser.add_argument("--retarget", action="store_true", help="a BVH/glTF motion: edit it on the puppet's skeleton")
-    parser.add_argument("--start", metavar="T0", type=take_position, help="a take: extract the loop from here "
-                        "(seconds, or a frame: 480f)")
+    parser.add_argument(
+        "--start",
+        metavar="T0",
+        type=take_position,
+        help="a take: extract the loop from here (seconds, or a frame: 480f)",
+    )
     parser.add_argument("--end", metavar="T1", type=take_position, help="a take: ...up to here (excluded)")
-    parser.add_argument("--items", metavar="JOINT", nargs="+", help="a take: extract the loop from these joints' "
-                        "motion only (the legs of a dance whose arms vary); the others keep their mean pose")
+    parser.add_argument(
+        "--items",
+        metavar="JOINT",
+        nargs="+",
+        help="a take: extract the loop from these joints' "
+        "motion only (the legs of a dance whose arms vary); the others keep their mean pose",
+    )
     parser.add_argument("-o", "--output", type=Path, default=None, help="where Ctrl+S saves (.ppclip)")
     parser.add_argument("--export", type=Path, action="append", default=[],
                         help="also write the edited cycle here on exit (.ppclip, .bvh, .glb, .gltf); repeatable")  # fmt: skip
-    parser.add_argument("--record", type=output_file, default=None,
-                        help="record the session (pointer, keys, every step's state) to replay it later")
+    parser.add_argument(
+        "--record",
+        type=output_file,
+        default=None,
+        help="record the session (pointer, keys, every step's state) to replay it later",
+    )
     add_run_arguments(parser)
 
 
@@ -101,10 +133,18 @@ def configure_curves(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--every", type=int, default=None, help="key a clip without keys every N frames (N ≥ 3)")
     parser.add_argument("--duration", type=float, default=1.0, help="rest: the new clip's length in seconds")
     parser.add_argument("--script", choices=CURVES_SCRIPTS, default=None, help="a scripted animator instead of a hand")
-    parser.add_argument("--character", default=None, metavar="FILE.glb",
-                        help="draw this rigged humanoid (.glb) in the clip's poses instead of the mannequin")
-    parser.add_argument("--record", type=output_file, default=None,
-                        help="record the session (pointer, keys, every step's state) to replay it later")
+    parser.add_argument(
+        "--character",
+        default=None,
+        metavar="FILE.glb",
+        help="draw this rigged humanoid (.glb) in the clip's poses instead of the mannequin",
+    )
+    parser.add_argument(
+        "--record",
+        type=output_file,
+        default=None,
+        help="record the session (pointer, keys, every step's state) to replay it later",
+    )
     add_run_arguments(parser)
 
 
@@ -113,22 +153,37 @@ def configure_flow(parser: argparse.ArgumentParser) -> None:
     from puppetphone.argtypes import output_file
     from puppetphone.runargs import add_run_arguments
 
-    parser.add_argument("flow_scene", nargs="?", default="snowman", metavar="SCENE",
-                        help="snowman (default), tasbada, or a saved .flow.json file to go on editing")
+    parser.add_argument(
+        "flow_scene",
+        nargs="?",
+        default="snowman",
+        metavar="SCENE",
+        help="snowman (default), tasbada, or a saved .flow.json file to go on editing",
+    )
     parser.add_argument("-o", "--output", type=output_file, default=None, help="where Ctrl+S saves (.json)")
-    parser.add_argument("--script", choices=FLOW_SCRIPTS, default=None,
-                        help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "
-                             "sketched then dragged; demo: both) and the result is saved")
-    parser.add_argument("--record", type=output_file, default=None,
-                        help="record the session (pointer, keys, every step's state) to replay it later")
+    parser.add_argument(
+        "--script",
+        choices=FLOW_SCRIPTS,
+        default=None,
+        help="a scripted pointer performs the edit (row: one stroke; centre: a centre-point "
+        "sketched then dragged; demo: both) and the result is saved",
+    )
+    parser.add_argument(
+        "--record",
+        type=output_file,
+        default=None,
+        help="record the session (pointer, keys, every step's state) to replay it later",
+    )
     add_run_arguments(parser, screenshot_at=True)
 
 
 _PARSERS = {
     "record": (configure_record, "act a cycle out with the mouse or a device; layers stack into a clip"),
     "edit": (configure_edit, "refine a cycle with MoCurves while it plays"),
-    "curves": (configure_curves, ("author a keyframed clip: pose its keys, shape its motion curves and their timing "
-                                  "(thesis ch. 4)")),
+    "curves": (
+        configure_curves,
+        ("author a keyframed clip: pose its keys, shape its motion curves and their timing (thesis ch. 4)"),
+    ),
     "flow": (configure_flow, "bend a scene's flow with sketched strokes and centre-points (Flow Curves)"),
 }
 
@@ -137,13 +192,20 @@ def _motion_options(args: argparse.Namespace) -> dict[str, object]:
     from engine.io.motion_file import MOTION_SUFFIXES
     from puppetphone.motion_args import motion_options
 
-    given = [f"--{k}" for k in ("animation", "units", "height", "joint_map", "retarget", "start", "end", "items")
-             if getattr(args, k, None) is not None and getattr(args, k, None) is not False]
+    given = [
+        f"--{k}"
+        for k in ("animation", "units", "height", "joint_map", "retarget", "start", "end", "items")
+        if getattr(args, k, None) is not None and getattr(args, k, None) is not False
+    ]
     if given and Path(args.clip).suffix.lower() not in MOTION_SUFFIXES:
         raise ValueError(f"{', '.join(g.replace('_', '-') for g in given)} only apply to a BVH/glTF/GLB file")
-    return {**motion_options(args), "retarget": bool(getattr(args, "retarget", False)),
-            "start": getattr(args, "start", None), "end": getattr(args, "end", None),
-            "items": getattr(args, "items", None)}
+    return {
+        **motion_options(args),
+        "retarget": bool(getattr(args, "retarget", False)),
+        "start": getattr(args, "start", None),
+        "end": getattr(args, "end", None),
+        "items": getattr(args, "items", None),
+    }
 
 
 def _options(args: argparse.Namespace) -> dict[str, Any]:

@@ -12,8 +12,9 @@ __all__ = ["configure", "run"]
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the bench arguments (the bench package loads numpy: its names are checked when the command runs)."""
-    parser.add_argument("names", nargs="*", metavar="NAME",
-                        help="benches to run (default all; an unknown name lists the known ones)")
+    parser.add_argument(
+        "names", nargs="*", metavar="NAME", help="benches to run (default all; an unknown name lists the known ones)"
+    )
     parser.add_argument("--json", metavar="FILE", help="write the figures as a JSON list")
     parser.add_argument("--plot", metavar="PNG", help="motion: draw foot height and speed over time for one case")
     parser.add_argument("--case", default="stop_and_go", help="motion: the case --plot draws (default stop_and_go)")

@@ -30,14 +30,22 @@ def configure(parser: argparse.ArgumentParser) -> None:
     """Add the clips sub-commands."""
     from puppetphone.motion_args import add_motion_options
 
-    parser.add_argument("--clips", type=Path, default=None, metavar="DIR",
-                        help="the library folder (default $XDG_DATA_HOME/puppetphone/clips)")
+    parser.add_argument(
+        "--clips",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="the library folder (default $XDG_DATA_HOME/puppetphone/clips)",
+    )
     sub = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
     add = sub.add_parser("add", help="add a clip (.ppclip, .bvh, .glb/.gltf) in a role, retargeted to the puppet")
     add.add_argument("file", type=Path, metavar="FILE")
-    add.add_argument("--role", required=True,
-                     help="idle, walk, run, crouch_idle, crouch_walk, get_up, mid_jump, a new name, or character "
-                          "(a rigged humanoid .glb that plays the library's clips)")
+    add.add_argument(
+        "--role",
+        required=True,
+        help="idle, walk, run, crouch_idle, crouch_walk, get_up, mid_jump, a new name, or character "
+        "(a rigged humanoid .glb that plays the library's clips)",
+    )
     add.add_argument("--clips", type=Path, default=argparse.SUPPRESS, metavar="DIR", help="the library folder")
     add_motion_options(add)
     ls = sub.add_parser("list", help="the library's roles: clip, frames, speed, hips height, source")
@@ -49,9 +57,9 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
 
 def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
-    from engine.clips import default_clips
     from engine.cliplib.roles import RoleError, check_role, conform, normalise_role
     from engine.cliplib.source import read_source, to_puppet
+    from engine.clips import default_clips
     from engine.humanoid import humanoid_skeleton
     from puppetphone.motion_args import motion_options
 
@@ -71,8 +79,10 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
         print(f"note: {args.file.name}: {size_note}")
     stored = library.load()[entry.role]
     how = f"retargeted to the puppet by the {joint_map} joint map, " if joint_map else ""
-    print(f"added {args.file.name} as the {entry.role} ({how}{stored.num_frames} frames at {stored.fps:g} fps, "
-          f"{stored.average_speed():.2f} m/s) -> {library.root / entry.file}")
+    print(
+        f"added {args.file.name} as the {entry.role} ({how}{stored.num_frames} frames at {stored.fps:g} fps, "
+        f"{stored.average_speed():.2f} m/s) -> {library.root / entry.file}"
+    )
     if before is not None:
         print(f"replaced the {entry.role} that came from {before.source or before.file}")
     return 0
@@ -87,8 +97,10 @@ def _list(library) -> int:  # type: ignore[no-untyped-def]
     print(f"{library.root}:")
     for role, clip in clips.items():
         kind = "loop" if clip.loop else "one-shot"
-        print(f"  {role:<12} {clip.num_frames:4d} frames {kind:<8} {clip.average_speed():5.2f} m/s  "
-              f"hips {float(clip.root[:, 1].mean()):.2f} m  from {entries[role].source or '?'}")
+        print(
+            f"  {role:<12} {clip.num_frames:4d} frames {kind:<8} {clip.average_speed():5.2f} m/s  "
+            f"hips {float(clip.root[:, 1].mean()):.2f} m  from {entries[role].source or '?'}"
+        )
     return 0
 
 
@@ -103,8 +115,9 @@ def run(args: argparse.Namespace) -> int:
         if args.action == "add" and args.role == lib_character.CHARACTER_ROLE:
             from engine.io.motion_file import load_joint_map
 
-            chosen = lib_character.set_character(library, args.file,
-                                                 load_joint_map(args.joint_map) if args.joint_map else None)
+            chosen = lib_character.set_character(
+                library, args.file, load_joint_map(args.joint_map) if args.joint_map else None
+            )
             print(f"{chosen.name} is the library's character: play without --character plays it")
             return 0
         if args.action == "add":

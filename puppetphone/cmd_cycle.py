@@ -31,8 +31,14 @@ _PROGRESS_SAMPLES = 200_000  # values (T·N) from which a progress bar is worth 
 
 def configure(parser: argparse.ArgumentParser) -> None:
     """Add the cycle arguments."""
-    parser.add_argument("input", metavar="INPUT", help="performance: .bvh, .gltf, .glb, .csv (time + columns), .npz or a recording (.rec)")
-    parser.add_argument("-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .glb, .gltf, .csv or .npz")
+    parser.add_argument(
+        "input",
+        metavar="INPUT",
+        help="performance: .bvh, .gltf, .glb, .csv (time + columns), .npz or a recording (.rec)",
+    )
+    parser.add_argument(
+        "-o", "--output", required=True, metavar="OUTPUT", help="loop file: .bvh, .ppclip, .glb, .gltf, .csv or .npz"
+    )
     from puppetphone.motion_args import add_export_options, add_motion_options
 
     add_motion_options(parser)
@@ -41,20 +47,38 @@ def configure(parser: argparse.ArgumentParser) -> None:
     from puppetphone.argtypes import take_position
     from puppetphone.runargs import image_path
 
-    parser.add_argument("--plot", metavar="IMAGE", type=image_path,
-                        help="draw the performance, cuts, aligned cycles and the loop (.png or .jpg; needs "
-                             "matplotlib: the 'plot' extra)")
-    parser.add_argument("--items", metavar="NAME", nargs="+", help="only these joints (BVH), items (CSV/npz) or sources (recording)")
+    parser.add_argument(
+        "--plot",
+        metavar="IMAGE",
+        type=image_path,
+        help="draw the performance, cuts, aligned cycles and the loop (.png or .jpg; needs "
+        "matplotlib: the 'plot' extra)",
+    )
+    parser.add_argument(
+        "--items", metavar="NAME", nargs="+", help="only these joints (BVH), items (CSV/npz) or sources (recording)"
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed of the random probe points (default 0)")
-    parser.add_argument("--samples", type=int, help="samples in the output loop (default: the period at the input rate)")
-    parser.add_argument("--retarget", choices=("puppet",), default=None,
-                        help="move a BVH performance onto the puppet's skeleton first (the loop is then the puppet's)")
+    parser.add_argument(
+        "--samples", type=int, help="samples in the output loop (default: the period at the input rate)"
+    )
+    parser.add_argument(
+        "--retarget",
+        choices=("puppet",),
+        default=None,
+        help="move a BVH performance onto the puppet's skeleton first (the loop is then the puppet's)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
-    parser.add_argument("--start", metavar="T0", type=take_position, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)")
-    parser.add_argument("--end", metavar="T1", type=take_position, help="analyse up to here (excluded): seconds or a frame")
-    parser.epilog = (f"exit codes: 0 the loop was written; {EXIT_BAD_INPUT} an unreadable input or output, or a bad "
-                     f"option; {EXIT_NO_CYCLE} no cycle in the take (why, and the part that loops if any, on "
-                     "standard error; nothing written)")
+    parser.add_argument(
+        "--start", metavar="T0", type=take_position, help="analyse from here: seconds (4.0, 4.0s) or a frame (480f)"
+    )
+    parser.add_argument(
+        "--end", metavar="T1", type=take_position, help="analyse up to here (excluded): seconds or a frame"
+    )
+    parser.epilog = (
+        f"exit codes: 0 the loop was written; {EXIT_BAD_INPUT} an unreadable input or output, or a bad "
+        f"option; {EXIT_NO_CYCLE} no cycle in the take (why, and the part that loops if any, on "
+        "standard error; nothing written)"
+    )
 
 
 class _Bar:
@@ -80,9 +104,9 @@ def run(args: argparse.Namespace) -> int:
 
     from authoring.cycles.extract import CycleError, CycleOptions, extract_cycle
     from authoring.cycles.formats import OUTPUT_SUFFIXES, load_performance, save_loop
-    from engine.io.formats import suffixes
     from authoring.cycles.take_range import refusal_hint, select
     from authoring.cycles.trajectory import TrajectoryError
+    from engine.io.formats import suffixes
     from puppetphone.motion_args import about, export_options, motion_options
 
     def fail(code: int, message: str) -> int:
@@ -93,7 +117,10 @@ def run(args: argparse.Namespace) -> int:
 
     out_suffix = "." + args.output.rsplit(".", 1)[-1].lower() if "." in args.output else ""
     if out_suffix not in OUTPUT_SUFFIXES:
-        return fail(EXIT_BAD_INPUT, f"unknown output type {out_suffix or args.output!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
+        return fail(
+            EXIT_BAD_INPUT,
+            f"unknown output type {out_suffix or args.output!r}; use one of {', '.join(OUTPUT_SUFFIXES)}",
+        )
     if args.plot:
         import importlib.util
 
@@ -114,7 +141,9 @@ def run(args: argparse.Namespace) -> int:
     except (TrajectoryError, ValueError) as exc:
         return fail(EXIT_BAD_INPUT, f"cannot read {about(args.input, exc)}")
     if perf.clip is None and out_suffix in suffixes(skeletal=True):
-        return fail(EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH, glTF); write .csv or .npz for {args.input}")
+        return fail(
+            EXIT_BAD_INPUT, f"{out_suffix} output needs skeletal input (BVH, glTF); write .csv or .npz for {args.input}"
+        )
     for warning in perf.motion.warnings if perf.motion else ():
         print(f"cycle: warning: {warning}", file=sys.stderr)
     if perf.motion and perf.motion.unit_note:

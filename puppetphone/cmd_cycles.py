@@ -43,23 +43,42 @@ def configure(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("sources", nargs="+", metavar="SRC", help="takes: files, folders (recursive) or glob patterns")
     parser.add_argument("-o", "--output", required=True, metavar="LIBDIR", help="library folder (made if missing)")
-    parser.add_argument("--jobs", "-j", type=int_range(1, 1024), metavar="N",
-                        help="worker processes on this machine (default: every core)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run on a Dask cluster, e.g. tcp://host:8786 (needs the 'cluster' extra)")
-    parser.add_argument("--send-bytes", action="store_true",
-                        help="send each take's bytes to the workers (when they do not share this file system)")
+    parser.add_argument(
+        "--jobs",
+        "-j",
+        type=int_range(1, 1024),
+        metavar="N",
+        help="worker processes on this machine (default: every core)",
+    )
+    parser.add_argument(
+        "--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786 (needs the 'cluster' extra)"
+    )
+    parser.add_argument(
+        "--send-bytes",
+        action="store_true",
+        help="send each take's bytes to the workers (when they do not share this file system)",
+    )
     parser.add_argument("--retarget", choices=["puppet"], help="retarget skeletal loops to the puppet's skeleton")
-    parser.add_argument("--licence", metavar="TEXT", help="licence recorded for every take (default: known sets "
-                        "by file name, else 'unknown')")
-    parser.add_argument("--no-segments", action="store_true", help="one loop per take: do not look for several activities")
+    parser.add_argument(
+        "--licence",
+        metavar="TEXT",
+        help="licence recorded for every take (default: known sets by file name, else 'unknown')",
+    )
+    parser.add_argument(
+        "--no-segments", action="store_true", help="one loop per take: do not look for several activities"
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed of the extractor's probe points (default 0)")
     parser.add_argument("--no-progress", action="store_true", help="never show the progress bar")
-    parser.add_argument("--retry-failed", action="store_true",
-                        help="do again the takes a previous run recorded as failed (looped and refused ones stay)")
-    parser.epilog = (f"exit codes: 0 every take looped, refused or already done; {EXIT_SOME_FAILED} done, but some "
-                     f"takes could not be read or analysed (listed as failed); {EXIT_RUN_FAILED} the run failed "
-                     f"(run again to resume); {EXIT_BAD_INPUT} bad arguments")
+    parser.add_argument(
+        "--retry-failed",
+        action="store_true",
+        help="do again the takes a previous run recorded as failed (looped and refused ones stay)",
+    )
+    parser.epilog = (
+        f"exit codes: 0 every take looped, refused or already done; {EXIT_SOME_FAILED} done, but some "
+        f"takes could not be read or analysed (listed as failed); {EXIT_RUN_FAILED} the run failed "
+        f"(run again to resume); {EXIT_BAD_INPUT} bad arguments"
+    )
 
 
 def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
@@ -72,8 +91,10 @@ def _line(outcome: TakeOutcome, files: list[str]) -> list[str]:
         part = "" if len(outcome.clips) == 1 and clip.start_frame <= 5 else f" [{clip.start_s:.2f}–{clip.end_s:.2f} s]"
         part = f" [{clip.animation}]" if clip.animation is not None else part
         speed = "" if clip.speed is None else f", {clip.speed:.2f} m/s"
-        lines.append(f"looped   {name}{part}: {clip.kind}, period {clip.period:.3f} s, {clip.cycles} cycles, "
-                     f"closure error {clip.closure_error:.1e}{speed}, {clip.dims} dims -> {file}")
+        lines.append(
+            f"looped   {name}{part}: {clip.kind}, period {clip.period:.3f} s, {clip.cycles} cycles, "
+            f"closure error {clip.closure_error:.1e}{speed}, {clip.dims} dims -> {file}"
+        )
     return lines
 
 
@@ -89,8 +110,15 @@ def _progress(enabled: bool) -> Progress:
         TimeRemainingColumn,
     )
 
-    return Progress(TextColumn("[progress.description]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TimeElapsedColumn(), TimeRemainingColumn(), console=Console(stderr=True), disable=not enabled)
+    return Progress(
+        TextColumn("[progress.description]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        disable=not enabled,
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -128,9 +156,11 @@ def run(args: argparse.Namespace) -> int:
         for path, reason in plan.unreadable:
             print(f"failed   {Path(path).name}: cannot read: {reason}")
         if not plan.tasks:
-            print(f"cycles: nothing to do: {plan.already} take(s) already in {index.path}"
-                  + (f", {plan.duplicates} duplicate(s)" if plan.duplicates else "")
-                  + (f", {len(plan.unreadable)} unreadable" if plan.unreadable else ""))
+            print(
+                f"cycles: nothing to do: {plan.already} take(s) already in {index.path}"
+                + (f", {plan.duplicates} duplicate(s)" if plan.duplicates else "")
+                + (f", {len(plan.unreadable)} unreadable" if plan.unreadable else "")
+            )
             return EXIT_SOME_FAILED if plan.unreadable else 0
         library = Library(libdir, index, args.licence)
         counts = {"looped": 0, "refused": 0, "failed": len(plan.unreadable)}
@@ -143,8 +173,9 @@ def run(args: argparse.Namespace) -> int:
                 bar.update(task, description=f"cycles ({workers} worker{'s' if workers != 1 else ''})")
 
             jobs = args.jobs or default_jobs()
-            for outcome in run_tasks(plan.tasks, options, jobs=jobs, scheduler=args.scheduler, on_start=started,
-                                     send_bytes=args.send_bytes):
+            for outcome in run_tasks(
+                plan.tasks, options, jobs=jobs, scheduler=args.scheduler, on_start=started, send_bytes=args.send_bytes
+            ):
                 files = library.add(outcome)
                 counts[outcome.outcome] += 1
                 clips += len(files)
@@ -160,6 +191,8 @@ def run(args: argparse.Namespace) -> int:
     finally:
         index.close()
     skipped = f"{plan.already} already done" + (f", {plan.duplicates} duplicate(s)" if plan.duplicates else "")
-    print(f"cycles: {counts['looped']} looped ({clips} clips), {counts['refused']} refused, {counts['failed']} failed, "
-          f"{skipped}, in {time.perf_counter() - t0:.1f} s -> {libdir}")
+    print(
+        f"cycles: {counts['looped']} looped ({clips} clips), {counts['refused']} refused, {counts['failed']} failed, "
+        f"{skipped}, in {time.perf_counter() - t0:.1f} s -> {libdir}"
+    )
     return EXIT_SOME_FAILED if counts["failed"] else 0

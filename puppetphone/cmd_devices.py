@@ -28,8 +28,10 @@ def run(args: argparse.Namespace) -> int:
     info = pairing_info(port=args.osc_port or DEFAULT_PORT, bind_host=args.osc_host)
     print("\n".join(info.lines()))
     print(f"\nTo play with the phone, start:\n  {info.play_command}")
-    print(f"(by default play --source osc listens on {DEFAULT_HOST} only, this machine; a phone on the LAN "
-          "needs --osc-host 0.0.0.0 as above)")
+    print(
+        f"(by default play --source osc listens on {DEFAULT_HOST} only, this machine; a phone on the LAN "
+        "needs --osc-host 0.0.0.0 as above)"
+    )
     if info.urls and not args.no_qr:
         print(f"\nScan to pair ({info.urls[0]}):")
         print(qr_ascii(info.urls[0]))
@@ -44,9 +46,11 @@ def _web(no_qr: bool) -> None:
 
     link = running_session()
     if link is None:
-        print("\nPhone (web browser, no app): no session is running; start one with\n"
-              "  puppetphone play snowman --source web --web-host 0.0.0.0\n"
-              "(it prints the link, its QR code and the certificate fingerprint; run devices again to see them here)")
+        print(
+            "\nPhone (web browser, no app): no session is running; start one with\n"
+            "  puppetphone play snowman --source web --web-host 0.0.0.0\n"
+            "(it prints the link, its QR code and the certificate fingerprint; run devices again to see them here)"
+        )
         return
     print("\n" + "\n".join(link.lines()))
     if not no_qr:

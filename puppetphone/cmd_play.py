@@ -18,36 +18,71 @@ def configure(parser: argparse.ArgumentParser) -> None:
     """Add the play arguments."""
     from input.factory import add_source_arguments
     from puppetphone.argtypes import int_range, output_file
-    from puppetphone.runargs import add_run_arguments
-
     from puppetphone.registry import GAMES
+    from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("game", help=", ".join(GAMES))
     add_source_arguments(parser)
     add_run_arguments(parser)
-    parser.add_argument("--view", choices=("orbit", "phone", "none"), default="orbit",
-                        help="phone: see the scene from the held controller (web, OSC or SpaceMouse); V switches; "
-                             "none: no desktop window at all (with --source web the phones are the only views)")
-    parser.add_argument("--record", type=output_file, default=None,
-                        help="record the session's input and state hashes (an existing file is replaced)")
+    parser.add_argument(
+        "--view",
+        choices=("orbit", "phone", "none"),
+        default="orbit",
+        help="phone: see the scene from the held controller (web, OSC or SpaceMouse); V switches; "
+        "none: no desktop window at all (with --source web the phones are the only views)",
+    )
+    parser.add_argument(
+        "--record",
+        type=output_file,
+        default=None,
+        help="record the session's input and state hashes (an existing file is replaced)",
+    )
     parser.add_argument("--seed", type=int_range(0, 2**63 - 1), default=0, help="the world's random seed (default 0)")
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings",
-                        help="a game option, repeatable; --set help lists every game's options with their types, "
-                             "ranges and defaults")
-    parser.add_argument("--clips", type=Path, default=None, metavar="DIR",
-                        help="play the authored clips of this library (default: $XDG_DATA_HOME/puppetphone/clips "
-                             "when live; an empty or missing library means the built-in clips)")
-    parser.add_argument("--puppets", type=int, default=None, metavar="N",
-                        help="sandbox: a crowd of N puppets wandering the field (same as --set puppets=N)")
-    parser.add_argument("--flow", default=None, metavar="FILE",
-                        help="snowman: start in the field as a flow file bent it (puppetphone author flow; "
-                             "same as --set flow=FILE)")
-    parser.add_argument("--character", default=None, metavar="FILE.glb",
-                        help="the player's puppet is this rigged humanoid (.glb), the puppet's clips retargeted to it")
-    parser.add_argument("--joint-map", default=None, metavar="FILE",
-                        help="with --character: JSON {\"file joint\": \"puppet role\"} when its names and shape do not tell")
-    parser.epilog = ("exit codes: 0 the session ran; 2 a bad option value, no display for a window, an input "
-                     "that cannot be opened, or a recording of another game")
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        dest="settings",
+        help="a game option, repeatable; --set help lists every game's options with their types, ranges and defaults",
+    )
+    parser.add_argument(
+        "--clips",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="play the authored clips of this library (default: $XDG_DATA_HOME/puppetphone/clips "
+        "when live; an empty or missing library means the built-in clips)",
+    )
+    parser.add_argument(
+        "--puppets",
+        type=int,
+        default=None,
+        metavar="N",
+        help="sandbox: a crowd of N puppets wandering the field (same as --set puppets=N)",
+    )
+    parser.add_argument(
+        "--flow",
+        default=None,
+        metavar="FILE",
+        help="snowman: start in the field as a flow file bent it (puppetphone author flow; same as --set flow=FILE)",
+    )
+    parser.add_argument(
+        "--character",
+        default=None,
+        metavar="FILE.glb",
+        help="the player's puppet is this rigged humanoid (.glb), the puppet's clips retargeted to it",
+    )
+    parser.add_argument(
+        "--joint-map",
+        default=None,
+        metavar="FILE",
+        help='with --character: JSON {"file joint": "puppet role"} when its names and shape do not tell',
+    )
+    parser.epilog = (
+        "exit codes: 0 the session ran; 2 a bad option value, no display for a window, an input "
+        "that cannot be opened, or a recording of another game"
+    )
 
 
 def resolve_source(source: str, game: str) -> str:
@@ -152,8 +187,17 @@ def run(args: argparse.Namespace) -> int:
         print(f"--record: replacing the existing {args.record}", file=sys.stderr)
     source = resolve_source(args.source, args.game)
     try:
-        hub = make_hub(source, args.osc_host, args.osc_port, args.osc_senders, args.serial_port, args.baud,
-                       args.web_host, args.web_port, args.silent_after)
+        hub = make_hub(
+            source,
+            args.osc_host,
+            args.osc_port,
+            args.osc_senders,
+            args.serial_port,
+            args.baud,
+            args.web_host,
+            args.web_port,
+            args.silent_after,
+        )
     except (ValueError, OSError, RecordingError) as exc:
         print(f"cannot open input {source!r}: {exc}", file=sys.stderr)
         return 2
@@ -178,12 +222,24 @@ def run(args: argparse.Namespace) -> int:
             from engine.cliplib.character import library_character
             from engine.cliplib.library import ClipLibrary, default_library_dir
 
-            character = (character_setup(args.character, args.joint_map) if args.character is not None
-                         else library_character(ClipLibrary(args.clips or default_library_dir())))
+            character = (
+                character_setup(args.character, args.joint_map)
+                if args.character is not None
+                else library_character(ClipLibrary(args.clips or default_library_dir()))
+            )
             if character is not None:
                 setup = {**game.prepare(options), "character": character}
-        activity = build_activity(args.game, seed, hub, setup=setup, options=options, record=args.record,
-                                  source_label=source, clips=clips, view=args.view)
+        activity = build_activity(
+            args.game,
+            seed,
+            hub,
+            setup=setup,
+            options=options,
+            record=args.record,
+            source_label=source,
+            clips=clips,
+            view=args.view,
+        )
     except (GameOptionError, OSError, ValueError) as exc:
         hub.close()
         print(f"error: {exc}", file=sys.stderr)

@@ -28,13 +28,21 @@ def configure(parser: argparse.ArgumentParser) -> None:
     from puppetphone.runargs import add_run_arguments
 
     parser.add_argument("file", metavar="FILE", help="a recording made with play --record")
-    parser.add_argument("--verify", action="store_true",
-                        help="print the verification line (every step's state hash is always compared)")
-    parser.add_argument("--allow-truncated", action="store_true",
-                        help="a recording cut short (killed mid-write) replays its complete frames with exit 0")
+    parser.add_argument(
+        "--verify", action="store_true", help="print the verification line (every step's state hash is always compared)"
+    )
+    parser.add_argument(
+        "--allow-truncated",
+        action="store_true",
+        help="a recording cut short (killed mid-write) replays its complete frames with exit 0",
+    )
     add_run_arguments(parser, screenshot_at=True)
-    parser.add_argument("--view", choices=("orbit", "phone"), default="orbit",
-                        help="phone: see the scene from the recorded controller; V switches")
+    parser.add_argument(
+        "--view",
+        choices=("orbit", "phone"),
+        default="orbit",
+        help="phone: see the scene from the recorded controller; V switches",
+    )
     parser.epilog = "exit codes: 0 replayed and matched; 1 a hash differs or the file is damaged/cut; 2 cannot replay"
 
 
@@ -75,8 +83,14 @@ def run(args: argparse.Namespace) -> int:
         return _replay_tool(entry, rec, args, cut_short)
     try:
         game = load_game(h.game)
-        activity = build_activity(h.game, h.seed, InputHub(replay=ReplaySource(rec)), setup=game.replay_setup(h.setup),
-                                  verify=rec, view=args.view)
+        activity = build_activity(
+            h.game,
+            h.seed,
+            InputHub(replay=ReplaySource(rec)),
+            setup=game.replay_setup(h.setup),
+            verify=rec,
+            view=args.view,
+        )
     except (GameOptionError, ValueError, KeyError, OSError) as exc:
         print(f"error: cannot rebuild the recorded {h.game!r} session: {exc}", file=sys.stderr)
         return 2

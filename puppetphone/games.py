@@ -19,7 +19,6 @@ from puppetphone.registry import GAMES, load_game
 __all__ = ["GAMES", "load_game", "make_app"]
 
 
-
 def make_app(game: str, seed: int, hub: InputHub, setup: dict[str, Any] | None = None) -> App:
     """A headless simulation of ``game``: the setup, input first, then the game's plugins.
 

@@ -31,30 +31,53 @@ UP_AXES = ("x", "-x", "y", "-y", "z", "-z")
 
 def add_motion_options(parser: argparse.ArgumentParser) -> None:
     """``--animation``, ``--units``, ``--height``, ``--up`` and ``--joint-map``."""
-    parser.add_argument("--animation", metavar="NAME|INDEX",
-                        help="glTF/GLB: which animation (name or 0-based index; default the first)")
-    parser.add_argument("--units", choices=UNIT_NAMES,
-                        help="length unit of a BVH/glTF file (default: judged by the figure's leg length or size; "
-                             "cmu = the CMU database's 1/0.45 inch; a figure no unit fits is scaled to an adult's "
-                             "size and says so)")
-    parser.add_argument("--height", type=float, metavar="METRES",
-                        help="instead of --units: scale the figure so it stands this tall (any size, not a unit's)")
-    parser.add_argument("--up", choices=UP_AXES, metavar="AXIS",
-                        help="the file's up axis: x, y, z, -x, -y or -z (write --up=-z); default judged by the figure "
-                             "(a Blender export keeps z up); the figure is stood up with it")
-    parser.add_argument("--joint-map", metavar="FILE",
-                        help="JSON object of source joint name -> puppet joint name, for a skeleton no built-in map fits")
+    parser.add_argument(
+        "--animation", metavar="NAME|INDEX", help="glTF/GLB: which animation (name or 0-based index; default the first)"
+    )
+    parser.add_argument(
+        "--units",
+        choices=UNIT_NAMES,
+        help="length unit of a BVH/glTF file (default: judged by the figure's leg length or size; "
+        "cmu = the CMU database's 1/0.45 inch; a figure no unit fits is scaled to an adult's "
+        "size and says so)",
+    )
+    parser.add_argument(
+        "--height",
+        type=float,
+        metavar="METRES",
+        help="instead of --units: scale the figure so it stands this tall (any size, not a unit's)",
+    )
+    parser.add_argument(
+        "--up",
+        choices=UP_AXES,
+        metavar="AXIS",
+        help="the file's up axis: x, y, z, -x, -y or -z (write --up=-z); default judged by the figure "
+        "(a Blender export keeps z up); the figure is stood up with it",
+    )
+    parser.add_argument(
+        "--joint-map",
+        metavar="FILE",
+        help="JSON object of source joint name -> puppet joint name, for a skeleton no built-in map fits",
+    )
 
 
 def add_export_options(parser: argparse.ArgumentParser) -> None:
     """``--fps`` and ``--closing-frame`` / ``--no-closing-frame`` for loops written to BVH/glTF."""
-    parser.add_argument("--fps", type=float, metavar="N",
-                        help="frame rate of a BVH/glTF loop (default: the source's nominal rate); the loop is "
-                             "resampled to a whole number of frames at exactly this rate (it stretches by under "
-                             "half a frame)")
-    parser.add_argument("--closing-frame", action=argparse.BooleanOptionalAction, default=None,
-                        help="repeat the first pose at the end of a BVH loop, so Blender's Cycles modifier "
-                             "loops without skipping a pose (default: on for BVH)")
+    parser.add_argument(
+        "--fps",
+        type=float,
+        metavar="N",
+        help="frame rate of a BVH/glTF loop (default: the source's nominal rate); the loop is "
+        "resampled to a whole number of frames at exactly this rate (it stretches by under "
+        "half a frame)",
+    )
+    parser.add_argument(
+        "--closing-frame",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="repeat the first pose at the end of a BVH loop, so Blender's Cycles modifier "
+        "loops without skipping a pose (default: on for BVH)",
+    )
 
 
 def motion_options(args: argparse.Namespace) -> dict[str, Any]:

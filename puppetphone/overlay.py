@@ -17,7 +17,6 @@ of the lines stacked at the top, and fades out after :data:`games.common.NOTICE_
 from __future__ import annotations
 
 from collections import Counter
-
 from dataclasses import dataclass
 
 from engine.components import Name
@@ -31,8 +30,21 @@ from games.common import Notice
 from input.hub import InputHub
 from puppetphone.web_pairing import draw_web_pairing, web_pairing_lines
 
-__all__ = ["OverlayState", "draw_overlay", "overlay_lines", "help_lines", "notice", "text_scale", "source_kinds",
-           "HELP_KEYS", "COLORS", "MAX_PUPPET_LINES", "SOURCE_TAGS", "TIP_STEPS", "NO_VIEW"]
+__all__ = [
+    "OverlayState",
+    "draw_overlay",
+    "overlay_lines",
+    "help_lines",
+    "notice",
+    "text_scale",
+    "source_kinds",
+    "HELP_KEYS",
+    "COLORS",
+    "MAX_PUPPET_LINES",
+    "SOURCE_TAGS",
+    "TIP_STEPS",
+    "NO_VIEW",
+]
 
 #: Puppets named one per line in the overlay; the others are summed up in one line.
 MAX_PUPPET_LINES = 4
@@ -78,8 +90,9 @@ class OverlayState:
         self.tip, self.tip_until = text, frame + TIP_STEPS
 
 
-def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: bool,
-                  state: OverlayState | None = None) -> list[str]:
+def overlay_lines(
+    world: World, game: Game, hub: InputHub, fps: float, paused: bool, state: OverlayState | None = None
+) -> list[str]:
     """The overlay's text, top to bottom (the notice apart: see :func:`draw_overlay`)."""
     state = state or OverlayState()
     hint = f"   {HELP_KEYS}: help" if game.controls and not state.help_visible else ""
@@ -95,8 +108,11 @@ def overlay_lines(world: World, game: Game, hub: InputHub, fps: float, paused: b
     lines += web_pairing_lines(hub)
     for st in hub.statuses():
         # A source nothing has reached yet is waiting, not gone: "[gone]" is for a phone that was there.
-        light = "[live]" if st.connected and st.packets_per_s > 0 else (
-            "[idle]" if st.connected else ("[gone]" if st.packets else "[waiting for a phone]"))
+        light = (
+            "[live]"
+            if st.connected and st.packets_per_s > 0
+            else ("[idle]" if st.connected else ("[gone]" if st.packets else "[waiting for a phone]"))
+        )
         err = f"  {st.last_error}" if st.last_error else ""
         lines.append(f"{light} {st.name}: {st.packets_per_s:5.1f} packets/s, dropped {st.dropped}{err}")
         if st.locked_out:
@@ -177,8 +193,16 @@ def _pairing_lines(source: object) -> list[str]:
     return lines
 
 
-def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fps: float, paused: bool,
-                 state: OverlayState | None = None, size: tuple[int, int] = _DESIGN_SIZE) -> None:
+def draw_overlay(
+    scene: RenderScene,
+    world: World,
+    game: Game,
+    hub: InputHub,
+    fps: float,
+    paused: bool,
+    state: OverlayState | None = None,
+    size: tuple[int, int] = _DESIGN_SIZE,
+) -> None:
     """Add the overlay's lines, the help (if shown), the notice (if any) and, while a web source waits
     for its phone, the QR code to the scene, sized for ``size`` (the window's; the QR code stays square)."""
     state = state or OverlayState()
@@ -192,5 +216,6 @@ def draw_overlay(scene: RenderScene, world: World, game: Game, hub: InputHub, fp
     if shown is None and state.tip and world.frame < state.tip_until:
         shown = (state.tip, 1.0)
     if shown is not None:
-        scene.add_text(shown[0], size=_scaled(_NOTICE_SIZE, scale), color=COLORS["notice"], anchor=_NOTICE_ANCHOR,
-                       alpha=shown[1])
+        scene.add_text(
+            shown[0], size=_scaled(_NOTICE_SIZE, scale), color=COLORS["notice"], anchor=_NOTICE_ANCHOR, alpha=shown[1]
+        )

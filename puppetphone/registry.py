@@ -56,9 +56,9 @@ def load_game(name: str) -> Game:
     """The game object of a registered game; ``ValueError`` lists the known ones."""
     if name not in GAMES:
         raise ValueError(f"unknown game {name!r}; games are {', '.join(GAMES)}")
-    return importlib.import_module(GAMES[name].module).GAME  # type: ignore[no-any-return]  # a game module's GAME
+    return importlib.import_module(GAMES[name].module).GAME
 
 
 def load_tool(entry: Entry) -> ToolKind:
     """The tool of a registered entry."""
-    return importlib.import_module(entry.module).TOOL  # type: ignore[no-any-return]  # a tool module's TOOL
+    return importlib.import_module(entry.module).TOOL

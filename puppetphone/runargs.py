@@ -46,19 +46,40 @@ def quality_name(text: str) -> str:
 
 def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = False) -> None:
     """Add the shared session options to a sub-command."""
-    parser.add_argument("--headless", action="store_true",
-                        help="no window: render off-screen (EGL), for servers, tests and screenshots")
+    parser.add_argument(
+        "--headless", action="store_true", help="no window: render off-screen (EGL), for servers, tests and screenshots"
+    )
     parser.add_argument("--frames", type=steps, default=None, metavar="N", help="stop after N simulation steps")
-    parser.add_argument("--screenshot", type=image_path, default=None, metavar="IMAGE",
-                        help="write the last frame as PNG or JPEG (by suffix)")
+    parser.add_argument(
+        "--screenshot",
+        type=image_path,
+        default=None,
+        metavar="IMAGE",
+        help="write the last frame as PNG or JPEG (by suffix)",
+    )
     if screenshot_at:
-        parser.add_argument("--screenshot-at", type=steps, default=None, metavar="N",
-                            help="take the screenshot after step N instead of at the end")
-    parser.add_argument("--size", type=window_size, default=(1280, 720), metavar="WxH",
-                        help=f"window or image size, sides up to {MAX_WINDOW} (default 1280x720)")
-    parser.add_argument("--quality", type=quality_name, default="auto", metavar="LEVEL",
-                        help="drawing quality: low, medium, high or auto (default: chosen from the measured "
-                             "frame time in a window, high headless; G changes it while playing)")
+        parser.add_argument(
+            "--screenshot-at",
+            type=steps,
+            default=None,
+            metavar="N",
+            help="take the screenshot after step N instead of at the end",
+        )
+    parser.add_argument(
+        "--size",
+        type=window_size,
+        default=(1280, 720),
+        metavar="WxH",
+        help=f"window or image size, sides up to {MAX_WINDOW} (default 1280x720)",
+    )
+    parser.add_argument(
+        "--quality",
+        type=quality_name,
+        default="auto",
+        metavar="LEVEL",
+        help="drawing quality: low, medium, high or auto (default: chosen from the measured "
+        "frame time in a window, high headless; G changes it while playing)",
+    )
 
 
 #: The environment variable that names a file for the HUD's text (``RunOptions.hud_dump``).
@@ -71,7 +92,15 @@ def run_options(args: argparse.Namespace, title: str, *, pace: bool = False) -> 
 
     width, height = args.size
     hud = os.environ.get(HUD_DUMP_ENV)
-    return RunOptions(headless=args.headless, frames=args.frames, screenshot=args.screenshot,
-                      screenshot_at=getattr(args, "screenshot_at", None), width=width, height=height,
-                      title=title, pace=pace, hud_dump=Path(hud) if hud else None,
-                      quality=getattr(args, "quality", "auto"))
+    return RunOptions(
+        headless=args.headless,
+        frames=args.frames,
+        screenshot=args.screenshot,
+        screenshot_at=getattr(args, "screenshot_at", None),
+        width=width,
+        height=height,
+        title=title,
+        pace=pace,
+        hud_dump=Path(hud) if hud else None,
+        quality=getattr(args, "quality", "auto"),
+    )

@@ -64,8 +64,9 @@ class GameSimulation:
         hub: the session's hub (its sources and statuses are what the overlay shows).
     """
 
-    def __init__(self, game: Game, app: App, handed: _Handed, hub: InputHub, orbit: OrbitCamera,
-                 view: str = "orbit") -> None:
+    def __init__(
+        self, game: Game, app: App, handed: _Handed, hub: InputHub, orbit: OrbitCamera, view: str = "orbit"
+    ) -> None:
         self.game, self.app, self.hub, self.orbit, self.view = game, app, hub, orbit, view
         self._handed = handed
         self.overlay = OverlayState()
@@ -132,10 +133,19 @@ class GameSimulation:
         self.game.close(self.app.world)
 
 
-def build_activity(game_name: str, seed: int, hub: InputHub, *, setup: dict[str, Any] | None = None,
-                   options: dict[str, str] | None = None, record: Path | None = None, source_label: str = "",
-                   verify: Recording | None = None, clips: dict[str, Any] | None = None,
-                   view: str = "orbit") -> Session:
+def build_activity(
+    game_name: str,
+    seed: int,
+    hub: InputHub,
+    *,
+    setup: dict[str, Any] | None = None,
+    options: dict[str, str] | None = None,
+    record: Path | None = None,
+    source_label: str = "",
+    verify: Recording | None = None,
+    clips: dict[str, Any] | None = None,
+    view: str = "orbit",
+) -> Session:
     """The session of ``game_name``.
 
     Args:

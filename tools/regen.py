@@ -45,8 +45,12 @@ def _screenshots() -> None:
         print(f"wrote {path}")
 
 
-TARGETS: dict[str, Callable[[], None]] = {"assets": _assets, "demos": _demos, "recordings": _recordings,
-                                          "screenshots": _screenshots}
+TARGETS: dict[str, Callable[[], None]] = {
+    "assets": _assets,
+    "demos": _demos,
+    "recordings": _recordings,
+    "screenshots": _screenshots,
+}
 ORDER = ("assets", "demos", "recordings", "screenshots")
 
 
@@ -68,10 +72,12 @@ def main(argv: list[str] | None = None) -> int:
     It lives in the repository, not in the installed package: it writes ``tests/data`` and
     ``docs/``, which only a checkout has.
     """
-    parser = argparse.ArgumentParser(prog="python -m tools.regen",
-                                     description="rebuild the shipped recordings, demos, screenshots and assets")
-    parser.add_argument("targets", nargs="+", metavar="TARGET", choices=(*ORDER, "all"),
-                        help=f"{', '.join(ORDER)} or all")
+    parser = argparse.ArgumentParser(
+        prog="python -m tools.regen", description="rebuild the shipped recordings, demos, screenshots and assets"
+    )
+    parser.add_argument(
+        "targets", nargs="+", metavar="TARGET", choices=(*ORDER, "all"), help=f"{', '.join(ORDER)} or all"
+    )
     args = parser.parse_args(argv)
     regenerate(args.targets)
     return 0

@@ -23,7 +23,6 @@ from pathlib import Path
 import numpy as np
 
 import games.snowman
-
 from engine.app import App
 from engine.components import Transform
 from engine.ecs import Entity, World
@@ -118,8 +117,10 @@ class Director:
         self.bot.wait(0.4)
         self.bot.release()
         self.bot.wait(0.3)
-        self.say(f"rolled ball {ball}: r={self.world.get(ball, Prop).radius:.3f} at {self.pos(ball).round(2)}; "
-                 f"{self.state(who)} at {self.pos(who).round(2)}")
+        self.say(
+            f"rolled ball {ball}: r={self.world.get(ball, Prop).radius:.3f} at {self.pos(ball).round(2)}; "
+            f"{self.state(who)} at {self.pos(who).round(2)}"
+        )
         return ball
 
     def lift_onto(self, ball: Entity, lower: Entity, notches: int) -> None:
@@ -172,8 +173,10 @@ class Director:
                     self.say(f"snowman {number} is entity {e} at {self.pos(e).round(2)}")
                     return e
             self.bot.step()
-        raise RuntimeError(f"snowman {number} did not come alive; balls: "
-                           + ", ".join(f"{b}:{self.pos(b).round(2)} r={self.world.get(b, Prop).radius:.2f}" for b in self.balls()))
+        raise RuntimeError(
+            f"snowman {number} did not come alive; balls: "
+            + ", ".join(f"{b}:{self.pos(b).round(2)} r={self.world.get(b, Prop).radius:.2f}" for b in self.balls())
+        )
 
 
 def _arc(centre: tuple[float, float], radius: float, a0: float, a1: float, n: int) -> list[np.ndarray]:
@@ -219,8 +222,10 @@ def play(d: Director) -> None:
     d.wait_for_snowman(2)
     d.bot.wait(1.5)
     stats = w.resource(SnowmanStats)
-    d.say(f"done: {stats.built} snowmen built, {stats.balls_started} balls started; "
-          + ", ".join(f"{e}: {d.state(e)} at {d.pos(e).round(2)}" for e, _ in w.query(Brain)))
+    d.say(
+        f"done: {stats.built} snowmen built, {stats.balls_started} balls started; "
+        + ", ".join(f"{e}: {d.state(e)} at {d.pos(e).round(2)}" for e, _ in w.query(Brain))
+    )
 
 
 def build_demo(path: Path = DEMO_PATH, log: Log = print) -> tuple[App, dict[str, int]]:
@@ -238,7 +243,9 @@ def build_demo(path: Path = DEMO_PATH, log: Log = print) -> tuple[App, dict[str,
         play(director)
     finally:
         recorder.close()
-    log(f"recorded {app.world.frame} frames ({app.world.frame * app.world.dt:.1f} s) to {path}; stages {director.stages}")
+    log(
+        f"recorded {app.world.frame} frames ({app.world.frame * app.world.dt:.1f} s) to {path}; stages {director.stages}"
+    )
     return app, director.stages
 
 

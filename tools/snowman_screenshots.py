@@ -22,13 +22,14 @@ from pathlib import Path
 
 import numpy as np
 
+from authoring.session import Session
 from engine.camera import OrbitCamera
 from engine.components import Stick, Transform
 from engine.ecs import World
 from engine.ragdoll.components import Prop
 from engine.render.scene import RenderScene
 from engine.render.target import save_image
-from engine.runner import RunOptions, Runner
+from engine.runner import Runner, RunOptions
 from engine.statemachine import Brain
 from engine.statemachine.puppet import PuppetState
 from games.snowman.components import Snowman
@@ -36,7 +37,6 @@ from games.snowman.game import GAME
 from input.hub import InputHub
 from input.recording import read_recording
 from input.replay import ReplaySource
-from authoring.session import Session
 from puppetphone.session import build_activity
 from tools import REPO
 from tools.snowman_demo import DEMO_PATH
@@ -50,8 +50,10 @@ FIELD_CAMERA = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), yaw=0.15, pitch=0.1
 
 
 def _rolling_big(world: World) -> bool:
-    return any(brain.active == PuppetState.ROLL_SNOWBALL and not world.has(e, Snowman) and _rolled_radius(world) > 0.3
-               for e, brain in world.query(Brain))
+    return any(
+        brain.active == PuppetState.ROLL_SNOWBALL and not world.has(e, Snowman) and _rolled_radius(world) > 0.3
+        for e, brain in world.query(Brain)
+    )
 
 
 def _rolled_radius(world: World) -> float:
@@ -59,8 +61,10 @@ def _rolled_radius(world: World) -> float:
 
 
 def _lifted_high(world: World) -> bool:
-    return any(s.grabbed is not None and world.has(s.grabbed, Prop) and world.get(s.grabbed, Transform).position[1] > 1.0
-               for _, s in world.query(Stick))
+    return any(
+        s.grabbed is not None and world.has(s.grabbed, Prop) and world.get(s.grabbed, Transform).position[1] > 1.0
+        for _, s in world.query(Stick)
+    )
 
 
 def _carrying(world: World) -> bool:
@@ -114,8 +118,13 @@ def take_screenshots(out: Path = OUT, width: int = 960, height: int = 540) -> li
     """Replay the demo through the runner and write one JPEG per stage, the last frame and the field view."""
     out.mkdir(parents=True, exist_ok=True)
     rec = read_recording(DEMO_PATH)
-    activity = build_activity("snowman", rec.header.seed, InputHub(replay=ReplaySource(rec)),
-                              setup=GAME.replay_setup(rec.header.setup), verify=rec)
+    activity = build_activity(
+        "snowman",
+        rec.header.seed,
+        InputHub(replay=ReplaySource(rec)),
+        setup=GAME.replay_setup(rec.header.setup),
+        verify=rec,
+    )
     view = _DemoView(activity)
     runner = Runner(RunOptions(headless=True, width=width, height=height))
     seen: dict[str, int] = {}

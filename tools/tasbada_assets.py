@@ -80,8 +80,8 @@ def draw_room(seed: int = 7) -> Image.Image:
     # Rug.
     d.polygon([(270, 400), (700, 400), (800, 520), (170, 520)], fill=(150, 52, 60))
     d.polygon([(290, 410), (684, 410), (774, 508), (196, 508)], outline=(222, 190, 120), width=4)
-    room = _shadow(room, (140, 360, 300, 395))      # plant
-    room = _shadow(room, (470, 425, 620, 460))      # pot
+    room = _shadow(room, (140, 360, 300, 395))  # plant
+    room = _shadow(room, (470, 425, 620, 460))  # pot
     room = _shadow(room, (760, 330, 880, 352), 80)  # lamp
     d = ImageDraw.Draw(room)
     # Potted plant (left).
@@ -113,11 +113,11 @@ def draw_selfie(seed: int = 11, sweater: tuple[int, int, int] = (34, 138, 146)) 
     img = Image.fromarray(_grad(h, w, (205, 210, 214), (170, 176, 182)).astype(np.uint8), "RGB")
     d = ImageDraw.Draw(img)
     shade = tuple(int(c * 0.78) for c in sweater)
-    d.ellipse((150, 300, 490, 640), fill=sweater)             # shoulders and torso
+    d.ellipse((150, 300, 490, 640), fill=sweater)  # shoulders and torso
     d.polygon([(300, 310), (340, 310), (320, 350)], fill=shade)  # collar
-    d.rectangle((292, 240, 348, 320), fill=(224, 176, 146))     # neck
-    d.ellipse((250, 90, 390, 270), fill=(232, 186, 154))        # face
-    d.chord((240, 70, 400, 210), 180, 360, fill=(70, 46, 30))   # hair
+    d.rectangle((292, 240, 348, 320), fill=(224, 176, 146))  # neck
+    d.ellipse((250, 90, 390, 270), fill=(232, 186, 154))  # face
+    d.chord((240, 70, 400, 210), 180, 360, fill=(70, 46, 30))  # hair
     for ex in (292, 348):
         d.ellipse((ex - 9, 168, ex + 9, 182), fill=(250, 250, 250))
         d.ellipse((ex - 4, 170, ex + 4, 180), fill=(40, 30, 20))

@@ -46,8 +46,9 @@ class _Driver:
         return self.app.world
 
     def _event(self, kind: int, pos: tuple[float, float]) -> None:
-        ev = SimpleNamespace(type=kind, pos=(float(pos[0]), float(pos[1])), button=1,
-                             buttons=(1 if self.pressed else 0, 0, 0))
+        ev = SimpleNamespace(
+            type=kind, pos=(float(pos[0]), float(pos[1])), button=1, buttons=(1 if self.pressed else 0, 0, 0)
+        )
         self.mouse.handle_event(ev, self.camera, SIZE, now=self.world.time)
 
     def step(self, n: int = 1) -> None:

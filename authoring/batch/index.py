@@ -40,9 +40,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from engine.errors import FormatError
 from authoring.batch.row_sums import COLUMNS, intact, row_sum, typed
 from authoring.batch.worker import TakeOutcome
+from engine.errors import FormatError
 
 __all__ = ["INDEX_NAME", "SCHEMA_VERSION", "ClipEntry", "LibraryIndex", "LibraryIndexError", "TakeEntry", "read_index"]
 
@@ -153,8 +153,10 @@ class LibraryIndex:
             damage = [str(row[0]) for row in self.con.execute("PRAGMA quick_check").fetchall()]
             if damage != ["ok"]:
                 self.con.close()
-                raise LibraryIndexError(f"{self.path} is damaged ({'; '.join(damage)[:120]}); move it away "
-                                        "and run cycles again to rebuild it from the clip files' sources")
+                raise LibraryIndexError(
+                    f"{self.path} is damaged ({'; '.join(damage)[:120]}); move it away "
+                    "and run cycles again to rebuild it from the clip files' sources"
+                )
             self.con.executescript(_SCHEMA)
             meta_rows = self.con.execute("SELECT * FROM meta").fetchall()
         except sqlite3.DatabaseError as exc:
@@ -167,8 +169,10 @@ class LibraryIndex:
         if version > SCHEMA_VERSION:
             raise LibraryIndexError(f"{self.path} has schema {version}; this puppetphone reads up to {SCHEMA_VERSION}")
         if version >= 2 and (bad := [str(row[0])[:40] for row in meta_rows if not intact("meta", row)]):
-            raise LibraryIndexError(f"{self.path}: its {', '.join(map(repr, bad))} setting is damaged (checksum "
-                                    "mismatch); move the index away and run cycles again to rebuild it")
+            raise LibraryIndexError(
+                f"{self.path}: its {', '.join(map(repr, bad))} setting is damaged (checksum "
+                "mismatch); move the index away and run cycles again to rebuild it"
+            )
         built = meta.get("options")
         if built is not None and built != options_key:
             raise LibraryIndexError(f"{self.libdir} was built with {built}; use the same options or another -o")
@@ -228,8 +232,9 @@ class LibraryIndex:
 
     def cached_hash(self, path: str, size: int, mtime_ns: int) -> str | None:
         """The hash recorded for ``path`` if its size and mtime are unchanged."""
-        row = self.con.execute("SELECT * FROM sources WHERE path = ? AND size = ? AND mtime_ns = ?",
-                               (path, size, mtime_ns)).fetchone()
+        row = self.con.execute(
+            "SELECT * FROM sources WHERE path = ? AND size = ? AND mtime_ns = ?", (path, size, mtime_ns)
+        ).fetchone()
         if row is not None and not intact("sources", row):
             self._notice("a damaged row in sources (checksum mismatch): its file is read again")
             return None
@@ -247,13 +252,46 @@ class LibraryIndex:
         """One take and its clips, in one transaction (``files`` already written, relative to the library)."""
         with self.con:
             self.con.execute("DELETE FROM clips WHERE take = ?", (outcome.digest,))
-            _insert(self.con, "takes", (outcome.digest, outcome.source, licence, outcome.outcome, outcome.reason,
-                                        outcome.frames, outcome.fps, outcome.dims, len(outcome.clips), outcome.seconds))
+            _insert(
+                self.con,
+                "takes",
+                (
+                    outcome.digest,
+                    outcome.source,
+                    licence,
+                    outcome.outcome,
+                    outcome.reason,
+                    outcome.frames,
+                    outcome.fps,
+                    outcome.dims,
+                    len(outcome.clips),
+                    outcome.seconds,
+                ),
+            )
             for clip, file in zip(outcome.clips, files, strict=True):
-                _insert(self.con, "clips", (file, outcome.digest, clip.segment, clip.start_frame, clip.end_frame,
-                                            clip.start_s, clip.end_s, clip.kind, clip.period, clip.cycles,
-                                            clip.closure_error, clip.spread, clip.speed, clip.dims, outcome.source,
-                                            licence, hashlib.sha256(clip.data).hexdigest()))
+                _insert(
+                    self.con,
+                    "clips",
+                    (
+                        file,
+                        outcome.digest,
+                        clip.segment,
+                        clip.start_frame,
+                        clip.end_frame,
+                        clip.start_s,
+                        clip.end_s,
+                        clip.kind,
+                        clip.period,
+                        clip.cycles,
+                        clip.closure_error,
+                        clip.spread,
+                        clip.speed,
+                        clip.dims,
+                        outcome.source,
+                        licence,
+                        hashlib.sha256(clip.data).hexdigest(),
+                    ),
+                )
 
 
 def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
@@ -272,8 +310,10 @@ def read_index(libdir: str | Path) -> tuple[list[TakeEntry], list[ClipEntry]]:
             _checked_rows(con, "meta", "key", path)
             _checked_rows(con, "sources", "path", path)
             takes = [TakeEntry(**row) for row in _checked_rows(con, "takes", "source, hash", path)]
-            clips = [ClipEntry(**row, path=libdir / str(row["file"]))
-                     for row in _checked_rows(con, "clips", "source, start_frame, file", path)]
+            clips = [
+                ClipEntry(**row, path=libdir / str(row["file"]))
+                for row in _checked_rows(con, "clips", "source, start_frame, file", path)
+            ]
         finally:
             con.close()
     except sqlite3.DatabaseError as exc:
@@ -294,7 +334,9 @@ def _checked_rows(con: sqlite3.Connection, table: str, order: str, path: Path) -
     out = []
     for row in cur:
         if summed and not intact(table, row):
-            raise LibraryIndexError(f"{path}: a row of {table} ({str(row[0])[:60]!r}) is damaged (checksum mismatch); "
-                                    "run cycles again on the same sources to redo its take")
+            raise LibraryIndexError(
+                f"{path}: a row of {table} ({str(row[0])[:60]!r}) is damaged (checksum mismatch); "
+                "run cycles again on the same sources to redo its take"
+            )
         out.append(dict(zip(names[:-1] if summed else names, row[:-1] if summed else row, strict=True)))
     return out

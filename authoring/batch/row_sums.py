@@ -22,12 +22,37 @@ _T = {"TEXT": str, "INTEGER": int, "REAL": float}
 #: Every table's columns and their types, in order (``row_sum`` comes last in the file).
 COLUMNS: dict[str, tuple[tuple[str, str], ...]] = {
     "meta": (("key", "TEXT"), ("value", "TEXT")),
-    "takes": (("hash", "TEXT"), ("source", "TEXT"), ("licence", "TEXT"), ("outcome", "TEXT"), ("reason", "TEXT"),
-              ("frames", "INTEGER"), ("fps", "REAL"), ("dims", "INTEGER"), ("clips", "INTEGER"), ("seconds", "REAL")),
-    "clips": (("file", "TEXT"), ("take", "TEXT"), ("segment", "INTEGER"), ("start_frame", "INTEGER"),
-              ("end_frame", "INTEGER"), ("start_s", "REAL"), ("end_s", "REAL"), ("kind", "TEXT"), ("period", "REAL"),
-              ("cycles", "INTEGER"), ("closure_error", "REAL"), ("spread", "REAL"), ("speed", "REAL NULL"),
-              ("dims", "INTEGER"), ("source", "TEXT"), ("licence", "TEXT"), ("sha256", "TEXT")),
+    "takes": (
+        ("hash", "TEXT"),
+        ("source", "TEXT"),
+        ("licence", "TEXT"),
+        ("outcome", "TEXT"),
+        ("reason", "TEXT"),
+        ("frames", "INTEGER"),
+        ("fps", "REAL"),
+        ("dims", "INTEGER"),
+        ("clips", "INTEGER"),
+        ("seconds", "REAL"),
+    ),
+    "clips": (
+        ("file", "TEXT"),
+        ("take", "TEXT"),
+        ("segment", "INTEGER"),
+        ("start_frame", "INTEGER"),
+        ("end_frame", "INTEGER"),
+        ("start_s", "REAL"),
+        ("end_s", "REAL"),
+        ("kind", "TEXT"),
+        ("period", "REAL"),
+        ("cycles", "INTEGER"),
+        ("closure_error", "REAL"),
+        ("spread", "REAL"),
+        ("speed", "REAL NULL"),
+        ("dims", "INTEGER"),
+        ("source", "TEXT"),
+        ("licence", "TEXT"),
+        ("sha256", "TEXT"),
+    ),
     "sources": (("path", "TEXT"), ("size", "INTEGER"), ("mtime_ns", "INTEGER"), ("hash", "TEXT")),
 }
 
@@ -51,4 +76,3 @@ def intact(table: str, row: Sequence[Any]) -> bool:
     """Whether a row read back (its values then ``row_sum``) is what was written."""
     *values, digest = row
     return len(values) == len(COLUMNS[table]) and row_sum(table, values) == digest
-

@@ -28,7 +28,18 @@ from authoring.batch.index import LibraryIndex
 from authoring.batch.worker import BatchOptions, TakeOutcome, TakeTask, process_take, warm_up
 from engine.atomic import atomic_write_bytes
 
-__all__ = ["BatchError", "Library", "Plan", "SourceError", "collect_sources", "default_jobs", "file_hash", "licence_of", "plan_batch", "run_tasks"]
+__all__ = [
+    "BatchError",
+    "Library",
+    "Plan",
+    "SourceError",
+    "collect_sources",
+    "default_jobs",
+    "file_hash",
+    "licence_of",
+    "plan_batch",
+    "run_tasks",
+]
 
 CLIPS_DIR = "clips"
 WATCH_EVERY = 0.5  # seconds between a pool worker's checks that the main process is alive
@@ -160,8 +171,14 @@ class Library:
         return files
 
 
-def run_tasks(tasks: list[TakeTask], options: BatchOptions, jobs: int = 1, scheduler: str | None = None,
-              on_start: Callable[[int], None] | None = None, send_bytes: bool = False) -> Iterator[TakeOutcome]:
+def run_tasks(
+    tasks: list[TakeTask],
+    options: BatchOptions,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    on_start: Callable[[int], None] | None = None,
+    send_bytes: bool = False,
+) -> Iterator[TakeOutcome]:
     """Process the tasks and yield each outcome as it arrives.
 
     ``scheduler`` (a Dask address, ``tcp://host:8786``) sends every task to the cluster,
@@ -185,10 +202,14 @@ def run_tasks(tasks: list[TakeTask], options: BatchOptions, jobs: int = 1, sched
             yield process_take(task, options)
 
 
-def _pool(tasks: list[TakeTask], options: BatchOptions, jobs: int, on_start: Callable[[int], None] | None) -> Iterator[TakeOutcome]:
+def _pool(
+    tasks: list[TakeTask], options: BatchOptions, jobs: int, on_start: Callable[[int], None] | None
+) -> Iterator[TakeOutcome]:
     # forkserver: workers start from a clean process, not a fork of one that may hold threads (a progress bar's).
     ctx = multiprocessing.get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_start_worker, initargs=(os.getpid(),)) as pool:
+    with ProcessPoolExecutor(
+        max_workers=jobs, mp_context=ctx, initializer=_start_worker, initargs=(os.getpid(),)
+    ) as pool:
         if on_start:
             on_start(jobs)
         futures = [pool.submit(process_take, task, options) for task in tasks]
@@ -227,8 +248,9 @@ def _start_worker(main_pid: int) -> None:
     warm_up()
 
 
-def _dask(tasks: list[TakeTask], options: BatchOptions, address: str, on_start: Callable[[int], None] | None,
-          send_bytes: bool) -> Iterator[TakeOutcome]:
+def _dask(
+    tasks: list[TakeTask], options: BatchOptions, address: str, on_start: Callable[[int], None] | None, send_bytes: bool
+) -> Iterator[TakeOutcome]:
     try:
         from distributed import Client
         from distributed import as_completed as dask_completed

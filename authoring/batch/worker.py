@@ -186,7 +186,7 @@ def _without_path(error: BaseException, path: Path) -> str:
     message = str(error)
     if not message.startswith(str(path)):
         return message
-    rest = message[len(str(path)):]
+    rest = message[len(str(path)) :]
     line, colon, why = rest.lstrip(":").partition(":")
     if colon and line.strip().isdigit():  # "PATH:12: why" -> "line 12: why"
         return f"line {line.strip()}:{why}"
@@ -205,18 +205,44 @@ def _process(task: TakeTask, options: BatchOptions) -> TakeOutcome:
                 path.write_bytes(task.data)
             perf = _load(path)
         except (OSError, ValueError) as exc:  # TrajectoryError and the format errors are ValueErrors
-            return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {_without_path(exc, path)}"[:500], 0, 0.0, 0,
-                               time.perf_counter() - t0)
+            return TakeOutcome(
+                task.source,
+                task.digest,
+                "failed",
+                f"cannot read: {_without_path(exc, path)}"[:500],
+                0,
+                0.0,
+                0,
+                time.perf_counter() - t0,
+            )
         except Exception as exc:  # noqa: BLE001 -- a reader bug must not stop the batch; the reason names it
-            return TakeOutcome(task.source, task.digest, "failed", f"cannot read: {type(exc).__name__}: {exc}"[:500],
-                               0, 0.0, 0, time.perf_counter() - t0)
+            return TakeOutcome(
+                task.source,
+                task.digest,
+                "failed",
+                f"cannot read: {type(exc).__name__}: {exc}"[:500],
+                0,
+                0.0,
+                0,
+                time.perf_counter() - t0,
+            )
         traj = perf.trajectory
 
         note = (perf.motion.unit_note or "") if perf.motion is not None else ""
 
         def outcome(kind: str, reason: str, clips: tuple[ClipOut, ...] = ()) -> TakeOutcome:
-            return TakeOutcome(task.source, task.digest, kind, reason, traj.num_samples, 1.0 / traj.dt, traj.dims,
-                               time.perf_counter() - t0, clips, note)
+            return TakeOutcome(
+                task.source,
+                task.digest,
+                kind,
+                reason,
+                traj.num_samples,
+                1.0 / traj.dt,
+                traj.dims,
+                time.perf_counter() - t0,
+                clips,
+                note,
+            )
 
         if options.retarget and perf.clip is None:
             return outcome("refused", "--retarget puppet needs a skeletal take (BVH)")
@@ -227,8 +253,9 @@ def _process(task: TakeTask, options: BatchOptions) -> TakeOutcome:
     return outcome("looped" if clips else "refused", reason, tuple(clips))
 
 
-def _extract_animations(path: Path, first: Performance, options: BatchOptions, name: str,
-                        workdir: Path) -> tuple[list[ClipOut], str]:
+def _extract_animations(
+    path: Path, first: Performance, options: BatchOptions, name: str, workdir: Path
+) -> tuple[list[ClipOut], str]:
     """:func:`_extract_all` for every animation of a glTF file (one take each), or for the one take of any other."""
     import dataclasses
 
@@ -266,8 +293,9 @@ def _extract_all(perf: Performance, options: BatchOptions, name: str, workdir: P
     return [], refusals[0] if refusals else "no cycle"
 
 
-def _extract_segment(perf: Performance, seg: Segment, k: int, name: str, options: BatchOptions, workdir: Path,
-                     refusals: list[str]) -> ClipOut | None:
+def _extract_segment(
+    perf: Performance, seg: Segment, k: int, name: str, options: BatchOptions, workdir: Path, refusals: list[str]
+) -> ClipOut | None:
     """One segment's loop as a :class:`ClipOut`, or ``None`` with its refusal appended to ``refusals``."""
     import dataclasses
 
@@ -288,9 +316,18 @@ def _extract_segment(perf: Performance, seg: Segment, k: int, name: str, options
     speed = _speed(result, part)
     lead = perf.skipped * traj.dt  # file time of the trajectory's first sample
     return ClipOut(
-        segment=k, start_frame=seg.start + perf.skipped, end_frame=seg.stop + perf.skipped,
-        start_s=round(float(traj.times[seg.start]) + lead, 6), end_s=round(seg.t1 + lead, 6),
-        period=round(result.period, 6), cycles=perf.performed or result.cycles, closure_error=float(result.closure_error),
-        spread=round(result.spread, 6), speed=None if speed is None else round(speed, 4), dims=traj.dims,
-        kind=kind_of(name, speed), suffix=suffix, data=data,
+        segment=k,
+        start_frame=seg.start + perf.skipped,
+        end_frame=seg.stop + perf.skipped,
+        start_s=round(float(traj.times[seg.start]) + lead, 6),
+        end_s=round(seg.t1 + lead, 6),
+        period=round(result.period, 6),
+        cycles=perf.performed or result.cycles,
+        closure_error=float(result.closure_error),
+        spread=round(result.spread, 6),
+        speed=None if speed is None else round(speed, 4),
+        dims=traj.dims,
+        kind=kind_of(name, speed),
+        suffix=suffix,
+        data=data,
     )

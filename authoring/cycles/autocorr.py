@@ -69,4 +69,3 @@ def pose_period(traj: Trajectory, values: NDArray[np.float64], min_lag: int, max
     top = float(r[peaks].max())
     lag = int(peaks[np.flatnonzero(r[peaks] >= _FUNDAMENTAL * top)[0]])
     return lag, float(r[lag])
-

@@ -56,7 +56,9 @@ class AlignedCycles:
         return int(self.values.shape[0])
 
 
-def sample_linear(times: NDArray[np.float64], values: NDArray[np.float64], at: NDArray[np.float64]) -> NDArray[np.float64]:
+def sample_linear(
+    times: NDArray[np.float64], values: NDArray[np.float64], at: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """Values at times ``at`` by linear interpolation of the rows (all columns at once)."""
     at = np.clip(at, times[0], times[-1])
     i = np.clip(np.searchsorted(times, at, side="right") - 1, 0, len(times) - 2)
@@ -76,7 +78,9 @@ def _dip_time(times: NDArray[np.float64], row: NDArray[np.float64], j: int) -> f
     return float(times[j] + x * (times[j + 1] - times[j]) if x >= 0 else times[j] + x * (times[j] - times[j - 1]))
 
 
-def align_cycles(traj: Trajectory, descriptor: Descriptor, cuts: NDArray[np.int64], samples: int, tolerance: float = 1.0 / 8.0) -> AlignedCycles:
+def align_cycles(
+    traj: Trajectory, descriptor: Descriptor, cuts: NDArray[np.int64], samples: int, tolerance: float = 1.0 / 8.0
+) -> AlignedCycles:
     """Correspondences by ``d_D`` between the cycles ``cuts [p, 2]``, then a common time base."""
     t = traj.times
     cuts = np.asarray(cuts, dtype=np.int64).reshape(-1, 2)

@@ -69,9 +69,18 @@ def spread(traj: Trajectory, aligned: AlignedCycles, weights: NDArray[np.float64
     return dev / sig if sig > 0 else float("inf")
 
 
-def best_cut(traj: Trajectory, desc: Descriptor, agree: list[PointPeriod], period: float, samples: int,
-             weights: NDArray[np.float64], search: PeriodSearch, anchors: int, min_cycles: int,
-             good_spread: float) -> tuple[Cut | None, int]:
+def best_cut(
+    traj: Trajectory,
+    desc: Descriptor,
+    agree: list[PointPeriod],
+    period: float,
+    samples: int,
+    weights: NDArray[np.float64],
+    search: PeriodSearch,
+    anchors: int,
+    min_cycles: int,
+    good_spread: float,
+) -> tuple[Cut | None, int]:
     """The tightest alignment among up to ``anchors`` candidates; also the most whole cycles any could cut."""
     ranked = sorted(agree, key=lambda f: (abs(f.period - period) > 0.03 * period, -len(f.matches), f.score))
     best: Cut | None = None
@@ -91,21 +100,44 @@ def best_cut(traj: Trajectory, desc: Descriptor, agree: list[PointPeriod], perio
     return best, most
 
 
-def try_multiples(traj: Trajectory, desc: Descriptor, rows: NDArray[np.float64], points: NDArray[np.int64],
-                  current: Cut, weights: NDArray[np.float64], search: PeriodSearch, agreement: float,
-                  anchors: int, min_cycles: int, good_spread: float) -> Cut:
+def try_multiples(
+    traj: Trajectory,
+    desc: Descriptor,
+    rows: NDArray[np.float64],
+    points: NDArray[np.int64],
+    current: Cut,
+    weights: NDArray[np.float64],
+    search: PeriodSearch,
+    agreement: float,
+    anchors: int,
+    min_cycles: int,
+    good_spread: float,
+) -> Cut:
     """Replace a poorly aligned cut by one at a multiple of its period when that aligns far better."""
     index = {int(p): a for a, p in enumerate(points)}
     dt = traj.dt
     options = []
     for factor in MULTIPLES:
-        redone = [match_chain(traj.times, rows[index[f.index]], f.index, round(factor * f.period / dt), search) for f in current.points]
+        redone = [
+            match_chain(traj.times, rows[index[f.index]], f.index, round(factor * f.period / dt), search)
+            for f in current.points
+        ]
         redone = [f for f in redone if f.period > 0 and len(f.matches) >= 2]
         if len(redone) < 2:
             continue
         agree, period = consensus(redone, agreement)
-        cut, _ = best_cut(traj, desc, agree, period, max(8, round(period / dt)), weights, search, anchors,
-                          max(min_cycles, 3), good_spread)
+        cut, _ = best_cut(
+            traj,
+            desc,
+            agree,
+            period,
+            max(8, round(period / dt)),
+            weights,
+            search,
+            anchors,
+            max(min_cycles, 3),
+            good_spread,
+        )
         if cut is not None and cut.spread < 0.5 * current.spread:
             options.append(cut)
     if not options:

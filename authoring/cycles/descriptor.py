@@ -79,7 +79,14 @@ class _GramRows:
         self.bounds = [(i + k_max - k, i + k_max + k + 1) for k in range(k_max + 1)]
         self.own = reduce(np.add, (self._box(a, b, a, b, diagonal=True) for a, b in self.bounds))
 
-    def _box(self, a: NDArray[np.int64], b: NDArray[np.int64], c: NDArray[np.int64], d: NDArray[np.int64], diagonal: bool = False) -> NDArray[np.float64]:
+    def _box(
+        self,
+        a: NDArray[np.int64],
+        b: NDArray[np.int64],
+        c: NDArray[np.int64],
+        d: NDArray[np.int64],
+        diagonal: bool = False,
+    ) -> NDArray[np.float64]:
         s = self.table
         if diagonal:
             return s[b, d] - s[a, d] - s[b, c] + s[a, c]
@@ -101,7 +108,14 @@ class Descriptor:
         cache_limit: ``auto`` keeps the whole stacked descriptor when it has at most this many numbers.
     """
 
-    def __init__(self, times: ArrayLike, values: ArrayLike, k: int = K_DEFAULT, strategy: str = "auto", cache_limit: int = CACHE_LIMIT) -> None:
+    def __init__(
+        self,
+        times: ArrayLike,
+        values: ArrayLike,
+        k: int = K_DEFAULT,
+        strategy: str = "auto",
+        cache_limit: int = CACHE_LIMIT,
+    ) -> None:
         t = np.asarray(times, dtype=np.float64)
         v = np.asarray(values, dtype=np.float64)
         if v.ndim != 2 or len(v) != len(t):
@@ -134,7 +148,10 @@ class Descriptor:
         self._d2 = central_difference(t, self._d1)
         if strategy == "stacked":
             self._stacked = (self._stack(self._d1), self._stack(self._d2))
-            self._norms = (np.einsum("ij,ij->i", self._stacked[0], self._stacked[0]), np.einsum("ij,ij->i", self._stacked[1], self._stacked[1]))
+            self._norms = (
+                np.einsum("ij,ij->i", self._stacked[0], self._stacked[0]),
+                np.einsum("ij,ij->i", self._stacked[1], self._stacked[1]),
+            )
 
     def _stack(self, deriv: NDArray[np.float64]) -> NDArray[np.float64]:
         """``[T, (K+1)·N]``: the window sums side by side (the paper's stacked descriptor)."""
@@ -149,7 +166,9 @@ class Descriptor:
         """Number of samples ``T``."""
         return len(self.times)
 
-    def _sq_distances(self, deriv: NDArray[np.float64], queries: NDArray[np.int64], norms: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def _sq_distances(
+        self, deriv: NDArray[np.float64], queries: NDArray[np.int64], norms: NDArray[np.float64] | None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``Σ_k ‖H^k_q − H^k_j‖²`` as ``[Q, T]``, plus the per-sample ``Σ_k ‖H^k_j‖²`` (computed if not given)."""
         n = len(deriv)
         cross = np.zeros((len(queries), n))

@@ -147,8 +147,15 @@ def _travel(traj: Trajectory, aligned: AlignedCycles) -> NDArray[np.float64]:
     return travel
 
 
-def _pose_cut(traj: Trajectory, desc: Descriptor, values: NDArray[np.float64], weights: NDArray[np.float64],
-              points: NDArray[np.int64], opt: CycleOptions, vote: float | None) -> Cut | None:
+def _pose_cut(
+    traj: Trajectory,
+    desc: Descriptor,
+    values: NDArray[np.float64],
+    weights: NDArray[np.float64],
+    points: NDArray[np.int64],
+    opt: CycleOptions,
+    vote: float | None,
+) -> Cut | None:
     """The cut at the whole pose's autocorrelation period (:mod:`authoring.cycles.autocorr`), when it differs from the vote.
 
     The chains are walked at that period from the probe points and from the earliest
@@ -167,8 +174,18 @@ def _pose_cut(traj: Trajectory, desc: Descriptor, values: NDArray[np.float64], w
     if not found:
         return None
     agree, period = consensus(found, opt.agreement)
-    cut, _ = best_cut(traj, desc, agree, period, opt.samples or max(8, round(period / dt)), weights, opt.search,
-                      opt.anchors, opt.min_cycles, opt.good_spread)
+    cut, _ = best_cut(
+        traj,
+        desc,
+        agree,
+        period,
+        opt.samples or max(8, round(period / dt)),
+        weights,
+        opt.search,
+        opt.anchors,
+        opt.min_cycles,
+        opt.good_spread,
+    )
     return cut if cut is not None and cut.spread <= opt.max_spread else None
 
 
@@ -208,7 +225,9 @@ def _single_threaded_blas() -> contextlib.AbstractContextManager[object]:
     return threadpool_limits(limits=1, user_api="blas")
 
 
-def _extract(traj: Trajectory, rng: np.random.Generator, opt: CycleOptions, report: Callable[[str, float], None]) -> CycleResult:
+def _extract(
+    traj: Trajectory, rng: np.random.Generator, opt: CycleOptions, report: Callable[[str, float], None]
+) -> CycleResult:
     n = traj.num_samples
     if n < 2 * opt.search.min_period + 1:
         raise CycleError(f"no period found: {n} samples are too few for two cycles of at least {opt.search.min_period}")
@@ -222,7 +241,11 @@ def _extract(traj: Trajectory, rng: np.random.Generator, opt: CycleOptions, repo
     rows = desc.rows(points)
     report("period", 0.35)
     per = search_periods(traj.times, rows, points, opt.search)
-    found = [match_chain(traj.times, rows[a], int(points[a]), int(per[a]), opt.search) for a in range(len(points)) if per[a] > 0]
+    found = [
+        match_chain(traj.times, rows[a], int(points[a]), int(per[a]), opt.search)
+        for a in range(len(points))
+        if per[a] > 0
+    ]
     found = [f for f in found if f.period > 0 and len(f.matches) >= 2]
     dt = traj.dt
     settings = (opt.search, opt.anchors, opt.min_cycles, opt.good_spread)

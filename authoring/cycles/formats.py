@@ -38,8 +38,17 @@ from engine.io.motion_file import MotionFile, MotionFileError, load_motion
 from engine.npz_safe import MAX_NPZ_BYTES, read_bounded, read_npz
 from engine.root_curve import RootCurve
 
-__all__ = ["INPUT_SUFFIXES", "OUTPUT_SUFFIXES", "Performance", "load_performance", "loop_clip", "save_loop",
-           "performance_from_motion", "seamless_repeats", "is_seamless"]
+__all__ = [
+    "INPUT_SUFFIXES",
+    "OUTPUT_SUFFIXES",
+    "Performance",
+    "load_performance",
+    "loop_clip",
+    "save_loop",
+    "performance_from_motion",
+    "seamless_repeats",
+    "is_seamless",
+]
 
 INPUT_SUFFIXES = suffixes(foreign=True, readable=True) + suffixes(skeletal=False, readable=True)
 """What ``cycle`` and ``cycles`` read: files from other tools and every trajectory format."""
@@ -160,8 +169,9 @@ def performance_from_motion(motion: MotionFile, items: list[str] | None = None) 
     names.append(f"{sk.names[0]}.heading")
     its.append(Item(f"{sk.names[0]}.heading", "position", column, column + 1, travel=True))
     traj = Trajectory.uniform(np.concatenate(cols, axis=1), clip.fps, its)
-    return Performance(traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column,
-                       performed)
+    return Performance(
+        traj, tuple(names), path, clip, tuple(joints), motion.skipped, motion, tuple(translated), column, performed
+    )
 
 
 def _items_from_names(names: list[str]) -> list[Item]:
@@ -204,7 +214,9 @@ def _load_csv(path: Path, items: list[str] | None) -> Performance:
     return _from_columns(path, data[:, 0], data[:, 1:], header[1:], items)
 
 
-def _from_columns(path: Path, times: NDArray[np.float64], values: NDArray[np.float64], names: list[str], items: list[str] | None) -> Performance:
+def _from_columns(
+    path: Path, times: NDArray[np.float64], values: NDArray[np.float64], names: list[str], items: list[str] | None
+) -> Performance:
     its = _items_from_names(names)
     chosen = _select([it.name for it in its], items, "item")
     keep = [it for it in its if it.name in chosen]
@@ -310,11 +322,15 @@ def load_performance(path: str | Path, items: list[str] | None = None, **motion_
     if fmt is not None and fmt.foreign:
         perf = _load_skeletal(path, items, {k: v for k, v in motion_options.items() if v is not None})
     elif fmt is None or fmt.name not in loaders:
-        raise TrajectoryError(f"{path}: unknown input type {path.suffix.lower()!r}; use one of {', '.join(INPUT_SUFFIXES)}")
+        raise TrajectoryError(
+            f"{path}: unknown input type {path.suffix.lower()!r}; use one of {', '.join(INPUT_SUFFIXES)}"
+        )
     else:
         given = sorted(k for k, v in motion_options.items() if v is not None)
         if given:
-            raise TrajectoryError(f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to BVH/glTF input")
+            raise TrajectoryError(
+                f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to BVH/glTF input"
+            )
         perf = loaders[fmt.name](path, items)
     frames = len(perf.trajectory.times)
     if frames < MIN_FRAMES:  # the feature and period analyses difference neighbouring frames
@@ -340,12 +356,14 @@ def loop_clip(result: CycleResult, perf: Performance, name: str | None = None) -
         first = 3 + 4 * len(perf.joints)
         for k, j in enumerate(perf.translated):
             translations[:, j] = result.loop[:, first + 3 * k : first + 3 * k + 3]
-    return Clip(name or f"{src.name}_cycle", src.skeleton, s / result.period, root, rots, loop=True,
-                translations=translations)
+    return Clip(
+        name or f"{src.name}_cycle", src.skeleton, s / result.period, root, rots, loop=True, translations=translations
+    )
 
 
-def _world_root(result: CycleResult, perf: Performance, level: NDArray[np.float64]
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def _world_root(
+    result: CycleResult, perf: Performance, level: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The loop's world root position, root rotation and per-cycle travel (heading restored)."""
     if perf.heading is None:
         return result.loop[:, 0:3], level, result.travel[:3]
@@ -380,12 +398,18 @@ def _in_place(clip: Clip, curve: RootCurve | None, travel: NDArray[np.float64]) 
         return clip, curve
     ground = travel * [1.0, 0.0, 1.0]
     start = clip.root[0] * [1.0, 0.0, 1.0]  # the in-place root starts over the origin; so does the curve
-    return (clip.travel_as_root_motion(ground),
-            None if curve is None else RootCurve(curve.control - start, travel - ground))
+    return (
+        clip.travel_as_root_motion(ground),
+        None if curve is None else RootCurve(curve.control - start, travel - ground),
+    )
 
 
 def save_loop(
-    result: CycleResult, perf: Performance, path: str | Path, fps: float | None = None, closing_frame: bool | None = None
+    result: CycleResult,
+    perf: Performance,
+    path: str | Path,
+    fps: float | None = None,
+    closing_frame: bool | None = None,
 ) -> Path:
     """Write the loop as ``.bvh``, ``.ppclip``, ``.glb``/``.gltf`` (skeletal input), ``.csv`` or ``.npz``, atomically.
 
@@ -396,7 +420,9 @@ def save_loop(
     path = Path(path)
     fmt = motion_format(path)
     if fmt is None or path.suffix.lower() not in OUTPUT_SUFFIXES:
-        raise TrajectoryError(f"{path}: unknown output type {path.suffix.lower()!r}; use one of {', '.join(OUTPUT_SUFFIXES)}")
+        raise TrajectoryError(
+            f"{path}: unknown output type {path.suffix.lower()!r}; use one of {', '.join(OUTPUT_SUFFIXES)}"
+        )
     if fmt.name == "ppclip":
         from authoring.cycles.root_curve import loop_root_curve
         from engine.clipfile import save_clip
@@ -424,6 +450,12 @@ def save_loop(
             w.writerow([repr(float(t)), *(repr(float(x)) for x in row)])
         return atomic_write_bytes(path, buf.getvalue().encode())
     out = io.BytesIO()
-    np.savez_compressed(out, times=result.loop_times, values=result.loop, names=np.array(perf.names),
-                        period=np.float64(result.period), travel=result.travel)
+    np.savez_compressed(
+        out,
+        times=result.loop_times,
+        values=result.loop,
+        names=np.array(perf.names),
+        period=np.float64(result.period),
+        travel=result.travel,
+    )
     return atomic_write_bytes(path, out.getvalue())

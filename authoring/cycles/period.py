@@ -133,7 +133,9 @@ def _inliers(values: NDArray[np.float64], separation: float) -> NDArray[np.bool_
     return logs <= cut
 
 
-def _flat_sets(times: NDArray[np.float64], sets: list[NDArray[np.int64]]) -> tuple[NDArray[np.float64], NDArray[np.int64], float]:
+def _flat_sets(
+    times: NDArray[np.float64], sets: list[NDArray[np.int64]]
+) -> tuple[NDArray[np.float64], NDArray[np.int64], float]:
     """All ``J_i`` in one sorted array: row ``p`` is shifted by ``p · stride`` so one searchsorted serves all."""
     span = float(times[-1] - times[0])
     stride = 4.0 * span + 1.0
@@ -142,7 +144,9 @@ def _flat_sets(times: NDArray[np.float64], sets: list[NDArray[np.int64]]) -> tup
     return flat, idx, stride
 
 
-def search_periods(times: NDArray[np.float64], rows: NDArray[np.float64], points: NDArray[np.int64], search: PeriodSearch) -> NDArray[np.int64]:
+def search_periods(
+    times: NDArray[np.float64], rows: NDArray[np.float64], points: NDArray[np.int64], search: PeriodSearch
+) -> NDArray[np.int64]:
     """The minimal passing integer period (samples) for each probe point; 0 where none passes."""
     n = len(times)
     dt = float(np.median(np.diff(times)))
@@ -196,7 +200,14 @@ def search_periods(times: NDArray[np.float64], rows: NDArray[np.float64], points
     return np.where(ok.any(axis=1), cands[first], 0).astype(np.int64)
 
 
-def match_chain(times: NDArray[np.float64], row: NDArray[np.float64], index: int, period_samples: int, search: PeriodSearch, iterations: int = 4) -> PointPeriod:
+def match_chain(
+    times: NDArray[np.float64],
+    row: NDArray[np.float64],
+    index: int,
+    period_samples: int,
+    search: PeriodSearch,
+    iterations: int = 4,
+) -> PointPeriod:
     """Clean ``J_i`` for a found period: one match per repetition, then refine the period.
 
     Walks forwards and backwards from ``i`` as the search did, but picks, among the
@@ -221,7 +232,15 @@ def match_chain(times: NDArray[np.float64], row: NDArray[np.float64], index: int
     return best
 
 
-def _chain(times: NDArray[np.float64], row: NDArray[np.float64], cand: NDArray[np.int64], index: int, per: float, period_samples: int, search: PeriodSearch) -> PointPeriod:
+def _chain(
+    times: NDArray[np.float64],
+    row: NDArray[np.float64],
+    cand: NDArray[np.int64],
+    index: int,
+    per: float,
+    period_samples: int,
+    search: PeriodSearch,
+) -> PointPeriod:
     """One walk of the chain with period ``per`` seconds."""
     dt = float(np.median(np.diff(times)))
     tol = math.ceil(per / dt * search.timing_tolerance) * dt

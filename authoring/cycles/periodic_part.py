@@ -116,11 +116,13 @@ def steps_part(perf: Performance, offset: int = 0) -> StepsPart | None:
         return None
     lag = lo + int(peaks[np.argmax(r[peaks])])
     width = _WINDOW * lag
-    local = np.array([_correlation(x[s : s + width], x[s + lag : s + lag + width])
-                      for s in range(len(x) - width - lag + 1)])
+    local = np.array(
+        [_correlation(x[s : s + width], x[s + lag : s + lag + width]) for s in range(len(x) - width - lag + 1)]
+    )
     run = _longest_run(local >= CLOSE)
     if run is None:
         return None
     first, last = run
-    return StepsPart(first * step, min(n, (last + width + lag) * step), lag * step * dt,
-                     float(np.median(local[first : last + 1])))
+    return StepsPart(
+        first * step, min(n, (last + width + lag) * step), lag * step * dt, float(np.median(local[first : last + 1]))
+    )

@@ -24,7 +24,9 @@ __all__ = ["plot_cycle"]
 GREEN = "#1a9e3a"
 
 
-def plot_cycle(traj: Trajectory, result: CycleResult, path: str | Path, names: tuple[str, ...] = (), columns: int = 3) -> Path:
+def plot_cycle(
+    traj: Trajectory, result: CycleResult, path: str | Path, names: tuple[str, ...] = (), columns: int = 3
+) -> Path:
     """Draw the performance, cuts, aligned cycles and loop into a PNG at ``path``."""
     import matplotlib
 
@@ -44,7 +46,9 @@ def plot_cycle(traj: Trajectory, result: CycleResult, path: str | Path, names: t
         top.plot(traj.times, traj.values[:, c], lw=1.0, color=colors[n % len(colors)], label=label)
     for cut in np.unique(result.aligned.cuts):
         top.axvline(traj.times[cut], color="crimson", lw=0.8, ls="--")
-    top.set_title(f"performance: {result.cycles} cycles, period {result.period:.3f} s ({result.period_samples:.1f} samples)")
+    top.set_title(
+        f"performance: {result.cycles} cycles, period {result.period:.3f} s ({result.period_samples:.1f} samples)"
+    )
     top.set_xlabel("time (s)")
     top.legend(loc="upper right", fontsize=8)
     left = fig.add_subplot(2, 2, 3)

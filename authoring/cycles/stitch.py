@@ -38,7 +38,9 @@ def loop_gap(traj: Trajectory, curve: NDArray[np.float64], travel: NDArray[np.fl
     return gap
 
 
-def stitch(traj: Trajectory, curve: NDArray[np.float64], phases: NDArray[np.float64], travel: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def stitch(
+    traj: Trajectory, curve: NDArray[np.float64], phases: NDArray[np.float64], travel: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The stitched curve ``[S+1, N]`` on ``phases`` (0..1) and the gap ``d_ex`` that was spread.
 
     Args:

@@ -149,14 +149,18 @@ def make_performance(
     return Performance(Trajectory(t, values, tuple(items)), float(period), truth, starts)
 
 
-def repeat_loop(loop: NDArray[np.float64], times: int, rng: np.random.Generator, noise: float = 0.01) -> NDArray[np.float64]:
+def repeat_loop(
+    loop: NDArray[np.float64], times: int, rng: np.random.Generator, noise: float = 0.01
+) -> NDArray[np.float64]:
     """A seamless loop ``[F, N]`` played ``times`` times with Gaussian noise (share of each column's std)."""
     rep = np.tile(loop, (times, 1))
     scale = np.maximum(np.std(loop, axis=0), 1e-9)
     return rep + noise * scale * rng.normal(size=rep.shape)
 
 
-def loop_error(loop: NDArray[np.float64], truth: Callable[[NDArray[np.float64]], NDArray[np.float64]], offsets: int = 720) -> tuple[float, float]:
+def loop_error(
+    loop: NDArray[np.float64], truth: Callable[[NDArray[np.float64]], NDArray[np.float64]], offsets: int = 720
+) -> tuple[float, float]:
     """How far an extracted loop ``[S, N]`` is from the ground truth, whatever phase it starts at.
 
     Returns ``(relative_rms, phase)``: the RMS difference over the RMS variation of the
@@ -190,8 +194,11 @@ def loop_error(loop: NDArray[np.float64], truth: Callable[[NDArray[np.float64]],
 
 
 def mixed_take(
-    dims: int, rng: np.random.Generator, activities: tuple[tuple[float, int], ...] = ((1.0, 6), (1.6, 5), (0.7, 7)),
-    fps: float = 60.0, fade: float = 0.3,
+    dims: int,
+    rng: np.random.Generator,
+    activities: tuple[tuple[float, int], ...] = ((1.0, 6), (1.6, 5), (0.7, 7)),
+    fps: float = 60.0,
+    fade: float = 0.3,
 ) -> tuple[Trajectory, list[Performance], NDArray[np.float64]]:
     """One long take of several activities in a row (jumping jacks, then twists, then squats).
 

@@ -91,8 +91,10 @@ def _describe(perf: Performance, seg: Segment, offset: int, period: float, cycle
     f0, f1 = seg.start + offset + perf.skipped, seg.stop - 1 + offset + perf.skipped
     t0 = float(times[seg.start + offset])
     t1 = float(times[seg.stop + offset]) if seg.stop + offset < len(times) else float(times[-1] + perf.trajectory.dt)
-    return (f"frames {f0}–{f1} loop with period {period:.2f} s ({cycles} cycles); "
-            f"try --start {round(t0, 2):g} --end {round(t1, 2):g}")
+    return (
+        f"frames {f0}–{f1} loop with period {period:.2f} s ({cycles} cycles); "
+        f"try --start {round(t0, 2):g} --end {round(t1, 2):g}"
+    )
 
 
 def refusal_hint(perf: Performance, analysed: Performance, offset: int = 0, seed: int = 0) -> str | None:
@@ -128,8 +130,10 @@ def _steps_hint(perf: Performance, analysed: Performance, offset: int, seed: int
         said = _describe(perf, seg, offset, result.period, result.cycles)
         if items is None:
             return f"the steps repeat there: {said}"
-        return (f"the whole pose varies, but the steps repeat: {said.replace(' loop ', ' loop by the legs ')} "
-                f"--items {' '.join(items)}")
+        return (
+            f"the whole pose varies, but the steps repeat: {said.replace(' loop ', ' loop by the legs ')} "
+            f"--items {' '.join(items)}"
+        )
     return None
 
 

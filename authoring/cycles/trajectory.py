@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from engine.errors import FormatError
 from engine import quat
+from engine.errors import FormatError
 
 __all__ = ["KINDS", "Item", "Trajectory", "TrajectoryError", "continuous_quaternions"]
 
@@ -63,7 +63,9 @@ class Item:
             raise TrajectoryError(f"item {self.name!r}: empty or negative column range {self.start}:{self.stop}")
         width = _WIDTH.get(self.kind)
         if self.kind == "rotation" and self.stop - self.start != 4:
-            raise TrajectoryError(f"item {self.name!r}: a rotation is 4 quaternion columns, got {self.stop - self.start}")
+            raise TrajectoryError(
+                f"item {self.name!r}: a rotation is 4 quaternion columns, got {self.stop - self.start}"
+            )
         if width is not None and self.kind != "rotation" and self.stop - self.start > width:
             raise TrajectoryError(f"item {self.name!r}: a {self.kind} has at most {width} columns")
 
@@ -102,8 +104,9 @@ class Trajectory:
             raise TrajectoryError(f"the trajectory contains NaN or infinite values{where}")
         big = max(float(np.abs(t).max(initial=0.0)), float(np.abs(v).max(initial=0.0)))
         if big > MAX_MAGNITUDE:  # finite, but the fit's sums of squares would overflow to inf
-            raise TrajectoryError(f"the trajectory holds a value of {big:.3g}; values and times stay within "
-                                  f"±{MAX_MAGNITUDE:g}")
+            raise TrajectoryError(
+                f"the trajectory holds a value of {big:.3g}; values and times stay within ±{MAX_MAGNITUDE:g}"
+            )
         if len(t) > 1 and not np.all(np.diff(t) > 0):
             i = int(np.argmin(np.diff(t)))
             raise TrajectoryError(f"times must increase strictly (frame {i + 1}: {t[i + 1]} after {t[i]})")
@@ -166,7 +169,9 @@ class Trajectory:
             return w
         speed = np.diff(self.values, axis=0) / np.diff(self.times)[:, None]
         for kind in KINDS:
-            cols = np.concatenate([np.arange(it.start, it.stop) for it in self.items if it.kind == kind] or [np.zeros(0, int)])
+            cols = np.concatenate(
+                [np.arange(it.start, it.stop) for it in self.items if it.kind == kind] or [np.zeros(0, int)]
+            )
             if len(cols) == 0:
                 continue
             rms = float(np.sqrt(np.mean(speed[:, cols] ** 2)))

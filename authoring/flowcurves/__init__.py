@@ -20,5 +20,16 @@ from authoring.flowcurves.scene import FlowObject, FlowScene, Primitive
 from authoring.flowcurves.securves import SECurve, compute_securves
 from authoring.flowcurves.session import FlowSession
 
-__all__ = ["FlowObject", "FlowScene", "Primitive", "Hermite", "fit_stroke", "FlowNetwork", "SECurve",
-           "compute_securves", "SceneDeformer", "FlowSession", "scene_from_data"]
+__all__ = [
+    "FlowObject",
+    "FlowScene",
+    "Primitive",
+    "Hermite",
+    "fit_stroke",
+    "FlowNetwork",
+    "SECurve",
+    "compute_securves",
+    "SceneDeformer",
+    "FlowSession",
+    "scene_from_data",
+]

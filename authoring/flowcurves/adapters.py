@@ -22,15 +22,21 @@ __all__ = ["objects_from_data", "scene_from_data", "mesh_from_data", "mesh_data"
 def mesh_from_data(m: dict[str, Any]) -> TriMesh:
     """A triangle mesh from its plain description."""
     colors = m.get("face_colors")
-    return TriMesh(np.array(m["vertices"], dtype=np.float64), np.array(m["faces"], dtype=np.int64),
-                   tuple(float(c) for c in m.get("color", (0.6, 0.6, 0.6))),  # type: ignore[arg-type]
-                   None if colors is None else np.array(colors, dtype=np.float64))
+    return TriMesh(
+        np.array(m["vertices"], dtype=np.float64),
+        np.array(m["faces"], dtype=np.int64),
+        tuple(float(c) for c in m.get("color", (0.6, 0.6, 0.6))),  # type: ignore[arg-type]
+        None if colors is None else np.array(colors, dtype=np.float64),
+    )
 
 
 def mesh_data(mesh: TriMesh) -> dict[str, Any]:
     """The plain description of a mesh (vertices rounded to a micrometre, as flow files keep them)."""
-    out: dict[str, Any] = {"vertices": np.round(mesh.vertices, 6).tolist(), "faces": mesh.faces.tolist(),
-                           "color": [float(c) for c in mesh.color]}
+    out: dict[str, Any] = {
+        "vertices": np.round(mesh.vertices, 6).tolist(),
+        "faces": mesh.faces.tolist(),
+        "color": [float(c) for c in mesh.color],
+    }
     if mesh.face_colors is not None:
         out["face_colors"] = mesh.face_colors.tolist()
     return out
@@ -38,11 +44,23 @@ def mesh_data(mesh: TriMesh) -> dict[str, Any]:
 
 def objects_from_data(objects: list[dict[str, Any]]) -> list[FlowObject]:
     """Flow objects from their plain description."""
-    return [FlowObject(str(o["name"]), str(o["group"]),
-                       [Primitive(np.array(p["a"], dtype=np.float64), np.array(p["b"], dtype=np.float64),
-                                  float(p["radius"]), tuple(float(c) for c in p["color"]))  # type: ignore[arg-type]
-                        for p in o.get("primitives", [])],
-                       mesh_from_data(o["mesh"]) if o.get("mesh") is not None else None) for o in objects]
+    return [
+        FlowObject(
+            str(o["name"]),
+            str(o["group"]),
+            [
+                Primitive(
+                    np.array(p["a"], dtype=np.float64),
+                    np.array(p["b"], dtype=np.float64),
+                    float(p["radius"]),
+                    tuple(float(c) for c in p["color"]),
+                )  # type: ignore[arg-type]
+                for p in o.get("primitives", [])
+            ],
+            mesh_from_data(o["mesh"]) if o.get("mesh") is not None else None,
+        )
+        for o in objects
+    ]
 
 
 def scene_from_data(name: str, objects: list[dict[str, Any]], camera: Camera, size: tuple[int, int]) -> FlowScene:

@@ -86,11 +86,13 @@ class ArapSystem:
         soft: ``[S, V]`` rows pulled to their targets with ``weight`` (SEcurve samples).
     """
 
-    def __init__(self, rest: F, triangles: I, hard: sp.spmatrix, soft: sp.spmatrix,
-                 weight: float = W_SHAPE) -> None:
+    def __init__(self, rest: F, triangles: I, hard: sp.spmatrix, soft: sp.spmatrix, weight: float = W_SHAPE) -> None:
         self.rest, self.triangles, self.weight = np.asarray(rest, dtype=np.float64), triangles, weight
         n = len(self.rest)
-        self.hard, self.soft = sp.csr_matrix(hard, shape=(hard.shape[0], n)), sp.csr_matrix(soft, shape=(soft.shape[0], n))
+        self.hard, self.soft = (
+            sp.csr_matrix(hard, shape=(hard.shape[0], n)),
+            sp.csr_matrix(soft, shape=(soft.shape[0], n)),
+        )
         self.rest_edges = _rest_edges(self.rest, triangles)
         a = laplacian(n, triangles) + weight * (self.soft.T @ self.soft) + EPS * sp.identity(n)
         m = self.hard.shape[0]
@@ -116,11 +118,14 @@ class ArapSystem:
         ang = np.arctan2(m10 - m01, m00 + m11)
         c, s = np.tile(np.cos(ang), 3), np.tile(np.sin(ang), 3)
         rx, ry = c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]
-        return np.c_[np.bincount(self._ei, rx, n) - np.bincount(self._ej, rx, n),
-                     np.bincount(self._ei, ry, n) - np.bincount(self._ej, ry, n)]
+        return np.c_[
+            np.bincount(self._ei, rx, n) - np.bincount(self._ej, rx, n),
+            np.bincount(self._ei, ry, n) - np.bincount(self._ej, ry, n),
+        ]
 
-    def solve(self, hard_targets: F, soft_targets: F, iterations: int = 10, x0: F | None = None,
-              dense: bool = False) -> F:
+    def solve(
+        self, hard_targets: F, soft_targets: F, iterations: int = 10, x0: F | None = None, dense: bool = False
+    ) -> F:
         """Local/global iterations from ``x0`` (the rest pose by default); ``dense`` is the baseline
         that solves the same KKT system with a dense LU every iteration."""
         n = len(self.rest)
@@ -141,8 +146,12 @@ class ArapSystem:
         """The same constraints met by plain Laplacian editing (every rotation the identity):
         the non-rigid answer ARAP improves on, kept as a reference for tests."""
         n = len(self.rest)
-        rhs = np.vstack([laplacian(n, self.triangles) @ self.rest + self.weight * (self.soft.T @ soft_targets)
-                         + EPS * self.rest, np.asarray(hard_targets, dtype=np.float64).reshape(-1, 2)])
+        rhs = np.vstack(
+            [
+                laplacian(n, self.triangles) @ self.rest + self.weight * (self.soft.T @ soft_targets) + EPS * self.rest,
+                np.asarray(hard_targets, dtype=np.float64).reshape(-1, 2),
+            ]
+        )
         return self.lu.solve(rhs)[:n]
 
     def energy(self, x: F) -> float:

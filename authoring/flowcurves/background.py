@@ -29,7 +29,9 @@ def _find_securves(scene: FlowScene, out: Any) -> None:
     from authoring.flowcurves.securves import compute_securves
 
     try:
-        found = compute_securves(scene, SceneDeformer(scene).rasters, lambda k, n, name: out.put(("progress", k, n, name)))
+        found = compute_securves(
+            scene, SceneDeformer(scene).rasters, lambda k, n, name: out.put(("progress", k, n, name))
+        )
         out.put(("done", found))
     except Exception as exc:  # noqa: BLE001 - sent to the editor, which says it
         out.put(("error", f"{type(exc).__name__}: {exc}"))

@@ -98,8 +98,9 @@ def _cma() -> ModuleType:
     return cma
 
 
-def abstract_contour(outline: ArrayLike, n: int = CONTROL_POINTS, max_evaluations: int = 1500,
-                     seed: int = 1) -> Hermite:
+def abstract_contour(
+    outline: ArrayLike, n: int = CONTROL_POINTS, max_evaluations: int = 1500, seed: int = 1
+) -> Hermite:
     """The abstract contour around outline pixels ``[N, 2]`` (an object's or a group's)."""
     cma = _cma()
 
@@ -120,8 +121,9 @@ def abstract_contour(outline: ArrayLike, n: int = CONTROL_POINTS, max_evaluation
         q[:n] += lo
         return Hermite(q, closed=True)
 
-    es = cma.CMAEvolutionStrategy(x0, 0.08, {"seed": seed, "maxfevals": max_evaluations, "verbose": -9,
-                                             "tolfunrel": 1e-4, "tolfun": 1e-3})
+    es = cma.CMAEvolutionStrategy(
+        x0, 0.08, {"seed": seed, "maxfevals": max_evaluations, "verbose": -9, "tolfunrel": 1e-4, "tolfun": 1e-3}
+    )
     while not es.stop():
         xs = es.ask()
         es.tell(xs, [contour_energy(curve_of(v), pts, box_area) for v in xs])

@@ -85,8 +85,9 @@ def _on_flow(flow: F, arc: F, at: F) -> F:
     return p
 
 
-def correspond(securves: list[tuple[F, bool]], flow: ArrayLike, d_m: float = D_M, theta_m: float = THETA_M,
-               s_min: float = S_MIN) -> list[Segment]:
+def correspond(
+    securves: list[tuple[F, bool]], flow: ArrayLike, d_m: float = D_M, theta_m: float = THETA_M, s_min: float = S_MIN
+) -> list[Segment]:
     """Segments of the SEcurves ``[(points, closed), …]`` that the flow curve (a dense polyline) takes."""
     g = np.asarray(flow, dtype=np.float64)
     g_tan, g_arc = tangents(g), _arc(g)

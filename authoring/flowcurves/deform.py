@@ -73,12 +73,14 @@ class Solve:
 class SceneDeformer:
     """A scene's grids and contacts, ready to follow flow curves."""
 
-    def __init__(self, scene: FlowScene, rasters: list[Raster] | None = None, spacing: float = GRID_SPACING,
-                 stride: int = 2) -> None:
+    def __init__(
+        self, scene: FlowScene, rasters: list[Raster] | None = None, spacing: float = GRID_SPACING, stride: int = 2
+    ) -> None:
         self.scene = scene
         self.rasters = rasters or [rasterize(o, scene.camera, scene.size, stride) for o in scene.objects]
-        self.embeddings = [Embedding.of(o, r, scene.camera, scene.size, spacing)
-                           for o, r in zip(scene.objects, self.rasters)]
+        self.embeddings = [
+            Embedding.of(o, r, scene.camera, scene.size, spacing) for o, r in zip(scene.objects, self.rasters)
+        ]
         self.contacts: list[Contact] = find_contacts(scene)
         parent = list(range(len(scene.objects)))
 
@@ -103,8 +105,10 @@ class SceneDeformer:
         pick = np.argmin(depth, axis=1)
         bare = ~np.isfinite(depth).any(axis=1)
         if bare.any():  # the nearest grid only for the pixels no object covers
-            near = np.stack([((xy[bare, None, :] - self.embeddings[o].grid.vertices[None]) ** 2).sum(-1).min(1)
-                             for o in objects], axis=1)
+            near = np.stack(
+                [((xy[bare, None, :] - self.embeddings[o].grid.vertices[None]) ** 2).sum(-1).min(1) for o in objects],
+                axis=1,
+            )
             pick[bare] = np.argmin(near, axis=1)
         return np.asarray(objects, dtype=np.int64)[pick]
 
@@ -141,13 +145,17 @@ class SceneDeformer:
             return self._cache[1], offsets, 0.0
         t0 = time.perf_counter()
         if self._hard is None or self._hard[0] != key[0]:  # contact rows change only with the active objects
-            blocks = [[(c.a, c.points, 1.0)] + ([(c.b, c.points, -1.0)] if c.b is not None else [])
-                      for c in self.contacts if c.a in offsets]
+            blocks = [
+                [(c.a, c.points, 1.0)] + ([(c.b, c.points, -1.0)] if c.b is not None else [])
+                for c in self.contacts
+                if c.a in offsets
+            ]
             self._hard = (key[0], self._rows(blocks, offsets, n))
         rest = np.vstack([self.embeddings[o].grid.vertices for o in active])
         tris = np.vstack([self.embeddings[o].grid.triangles + offsets[o] for o in active])
-        system = ArapSystem(rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n),
-                            self.shape_weight)
+        system = ArapSystem(
+            rest, tris, self._hard[1], self._rows([[(o, xy, 1.0)] for o, xy in soft], offsets, n), self.shape_weight
+        )
         self._cache = (key, system)
         return system, offsets, (time.perf_counter() - t0) * 1e3
 
@@ -207,7 +215,7 @@ class SceneDeformer:
                     hi = mid
             reach, x, tilt = lo, x_lo, tilt_lo
         solve_ms = (time.perf_counter() - t0) * 1e3
-        verts = {o: x[offsets[o]:offsets[o] + len(self.embeddings[o].grid.vertices)] for o in active}
+        verts = {o: x[offsets[o] : offsets[o] + len(self.embeddings[o].grid.vertices)] for o in active}
         return Solve(verts, [s for s, _, _ in taken], factor_ms, solve_ms, system, offsets, reach, tilt)
 
     def max_tilt(self, x: F, offsets: dict[int, int]) -> float:
@@ -218,7 +226,7 @@ class SceneDeformer:
             if o not in offsets:
                 continue
             emb = self.embeddings[o]
-            v = x[offsets[o]:offsets[o] + len(emb.grid.vertices)]
+            v = x[offsets[o] : offsets[o] + len(emb.grid.vertices)]
             tilts.append(base_tilt_deg(emb.grid.vertices, v, _SCREEN_UP))
             if emb.obj.mesh is not None:
                 rest = emb.obj.points()

@@ -60,8 +60,7 @@ class Grid:
         t, bary = self.locate(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
         cols = self.triangles[t]
         n = len(t)
-        return sp.csr_matrix((bary.ravel(), (np.repeat(np.arange(n), 3), cols.ravel())),
-                             shape=(n, len(self.vertices)))
+        return sp.csr_matrix((bary.ravel(), (np.repeat(np.arange(n), 3), cols.ravel())), shape=(n, len(self.vertices)))
 
 
 def build_grid(raster: Raster, spacing: float = GRID_SPACING) -> Grid:
@@ -105,8 +104,9 @@ class Embedding:
     distances: F
 
     @classmethod
-    def of(cls, obj: FlowObject, raster: Raster, camera: Camera, size: tuple[int, int],
-           spacing: float = GRID_SPACING) -> Embedding:
+    def of(
+        cls, obj: FlowObject, raster: Raster, camera: Camera, size: tuple[int, int], spacing: float = GRID_SPACING
+    ) -> Embedding:
         grid = build_grid(raster, spacing)
         pts = obj.points()
         xy = camera.project(pts, size[0], size[1])

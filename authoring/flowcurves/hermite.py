@@ -127,8 +127,13 @@ def control_count(length: float, screen_width: float) -> int:
     return max(2, math.ceil(3 * 4 * length / screen_width) + 1)
 
 
-def fit_stroke(samples: ArrayLike, screen_width: float, n: int | None = None,
-               w_fit: float = W_FIT, w_curvature: float = W_CURVATURE) -> Hermite:
+def fit_stroke(
+    samples: ArrayLike,
+    screen_width: float,
+    n: int | None = None,
+    w_fit: float = W_FIT,
+    w_curvature: float = W_CURVATURE,
+) -> Hermite:
     """Eq. 3.6: the Hermite curve through stroke samples with a curvature penalty.
 
     Samples are parametrised by chord length; the curvature integral uses 64 equally

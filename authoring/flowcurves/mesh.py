@@ -54,8 +54,10 @@ class TriMesh:
         self.faces = np.asarray(self.faces, dtype=np.int64).reshape(-1, 3)
         v, t = len(self.vertices), len(self.faces)
         if not 3 <= v <= MAX_MESH_VERTICES or not 1 <= t <= MAX_MESH_TRIANGLES:
-            raise MeshError(f"a flow mesh needs 3..{MAX_MESH_VERTICES} vertices and 1..{MAX_MESH_TRIANGLES} "
-                            f"triangles, not {v} and {t}")
+            raise MeshError(
+                f"a flow mesh needs 3..{MAX_MESH_VERTICES} vertices and 1..{MAX_MESH_TRIANGLES} "
+                f"triangles, not {v} and {t}"
+            )
         if not np.isfinite(self.vertices).all():
             raise MeshError("a mesh vertex is not finite")
         if self.faces.min() < 0 or self.faces.max() >= v:
@@ -74,8 +76,9 @@ class TriMesh:
         return TriMesh(np.array(vertices, dtype=np.float64), self.faces, self.color, self.face_colors)
 
 
-def rasterize_mesh(mesh: TriMesh, camera: Camera, size: tuple[int, int], x0: int, y0: int, stride: int,
-                   shape: tuple[int, int]) -> F:
+def rasterize_mesh(
+    mesh: TriMesh, camera: Camera, size: tuple[int, int], x0: int, y0: int, stride: int, shape: tuple[int, int]
+) -> F:
     """Eye distance ``[ny, nx]`` of the mesh at pixel centres ``(x0 + i·stride, y0 + j·stride)`` (inf: uncovered)."""
     from authoring.flowcurves.scene import pixel_rays
 
@@ -114,7 +117,7 @@ def rasterize_mesh(mesh: TriMesh, camera: Camera, size: tuple[int, int], x0: int
     return depth
 
 
-def _accessor(doc: dict, blob: bytes, index: object, width: int) -> NDArray[np.float64]:  # type: ignore[type-arg]
+def _accessor(doc: dict, blob: bytes, index: object, width: int) -> NDArray[np.float64]:
     """One accessor of an embedded-buffer GLB as ``[count, width]`` (float32 or unsigned integer data)."""
     kinds = {5126: "<f4", 5125: "<u4", 5123: "<u2", 5121: "u1"}
     accessors = doc.get("accessors", [])
@@ -173,8 +176,11 @@ def read_glb_mesh(path: Path, color: tuple[float, float, float] = (0.6, 0.6, 0.6
                 if prim.get("mode", 4) != 4 or "POSITION" not in prim.get("attributes", {}):
                     continue
                 pos = _accessor(doc, blob, prim["attributes"]["POSITION"], 3)
-                idx = (_accessor(doc, blob, prim["indices"], 1).ravel() if "indices" in prim
-                       else np.arange(len(pos), dtype=np.float64))
+                idx = (
+                    _accessor(doc, blob, prim["indices"], 1).ravel()
+                    if "indices" in prim
+                    else np.arange(len(pos), dtype=np.float64)
+                )
                 if len(idx) % 3 or (len(idx) and idx.max() >= len(pos)):
                     raise MeshError("a primitive's indices are not whole triangles of its vertices")
                 base = sum(len(v) for v in verts)
@@ -192,7 +198,7 @@ def read_glb_mesh(path: Path, color: tuple[float, float, float] = (0.6, 0.6, 0.6
         raise MeshError(f"{path}: {exc}") from None
 
 
-def _node_matrix(node: dict) -> F:  # type: ignore[type-arg]
+def _node_matrix(node: dict) -> F:
     """A node's local transform (its parents are not composed: a prop is a flat list of nodes)."""
     if "matrix" in node:
         m = np.asarray(node["matrix"], dtype=np.float64)
@@ -205,9 +211,13 @@ def _node_matrix(node: dict) -> F:  # type: ignore[type-arg]
     if t.shape != (3,) or q.shape != (4,) or s.shape != (3,) or not np.isfinite(np.r_[t, q, s]).all():
         raise MeshError("a node's translation, rotation or scale is malformed")
     x, y, z, w = q / max(float(np.linalg.norm(q)), 1e-12)
-    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    r = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
     out = np.eye(4)
     out[:3, :3] = r * s
     out[:3, 3] = t

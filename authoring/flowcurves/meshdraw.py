@@ -48,9 +48,18 @@ def _skinned(mesh: TriMesh) -> SkinnedMeshes:
     for c in np.unique(colors, axis=0):
         faces = mesh.faces[(colors == c).all(axis=1)]
         linear = tuple(float(x) for x in np.asarray(c) ** 2.2) + (1.0,)
-        prims.append(SkinnedPrimitive(positions, normals, uv, joints, weights,
-                                      np.ascontiguousarray(faces.ravel(), dtype=np.uint32),
-                                      linear, None))  # type: ignore[arg-type]  # a 4-tuple built from an array
+        prims.append(
+            SkinnedPrimitive(
+                positions,
+                normals,
+                uv,
+                joints,
+                weights,
+                np.ascontiguousarray(faces.ravel(), dtype=np.uint32),
+                linear,
+                None,
+            )
+        )  # type: ignore[arg-type]  # a 4-tuple built from an array
     return SkinnedMeshes(0, tuple(prims), ())
 
 

@@ -76,8 +76,9 @@ def _extend(curve: F, others: list[tuple[int, F, F]], d_max: float, theta_max: f
     return (np.array(added) if added else np.zeros((0, 2))), used
 
 
-def average_curves(curves: list[F], screen_width: float, d_max: float = D_MAX,
-                   theta_max: float = THETA_MAX) -> list[Hermite]:
+def average_curves(
+    curves: list[F], screen_width: float, d_max: float = D_MAX, theta_max: float = THETA_MAX
+) -> list[Hermite]:
     """Step 1: extended, clustered and averaged SEcurves as smooth Hermite curves."""
     curves = [resample_polyline(c, max(8, len(c))) for c in curves if len(c) >= 2]
     data = [(k, c, tangents(c)) for k, c in enumerate(curves)]
@@ -144,11 +145,11 @@ class _Bend:
         n = self.n
         f = free.reshape(*free.shape[:-1], 2 * n - 2, 2)
         fix = np.broadcast_to(self.fixed, (*free.shape[:-1], 2, 2))
-        return np.concatenate([fix[..., 0:1, :], f[..., : n - 1, :], fix[..., 1:2, :], f[..., n - 1:, :]], axis=-2)
+        return np.concatenate([fix[..., 0:1, :], f[..., : n - 1, :], fix[..., 1:2, :], f[..., n - 1 :, :]], axis=-2)
 
     def _free(self, gq: F) -> F:
         n = self.n
-        return np.concatenate([gq[..., 1:n, :], gq[..., n + 1:, :]], axis=-2).reshape(*gq.shape[:-2], -1)
+        return np.concatenate([gq[..., 1:n, :], gq[..., n + 1 :, :]], axis=-2).reshape(*gq.shape[:-2], -1)
 
     def batch(self, free: F, gradient: bool = False) -> F | tuple[F, F]:
         """Energies ``[b, k]`` of the candidates ``[b, k, 4n−4]`` (and their gradients, shaped as ``free``)."""
@@ -200,14 +201,15 @@ def _problem(curves: list[Hermite], centre: ArrayLike) -> _Bend:
 
 def _free_of(curve: Hermite) -> F:
     n = curve.n
-    return np.vstack([curve.q[1:n], curve.q[n + 1:]]).ravel()
+    return np.vstack([curve.q[1:n], curve.q[n + 1 :]]).ravel()
 
 
 def bend_curve(curve: Hermite, centre: ArrayLike, start: Hermite | None = None, max_iterations: int = 200) -> Hermite:
     """Eq. 3.8 with ``γ(0)`` and ``γ'(0)`` held: the rest of the curve turns to point at ``centre``."""
     energy = _problem([curve], centre)
-    res = minimize(energy, _free_of(start or curve), jac=True, method="BFGS",
-                   options={"maxiter": max_iterations, "gtol": 1e-5})
+    res = minimize(
+        energy, _free_of(start or curve), jac=True, method="BFGS", options={"maxiter": max_iterations, "gtol": 1e-5}
+    )
     return Hermite(energy.assemble(res.x[None, None])[0, 0])
 
 

@@ -31,8 +31,9 @@ _DENSE = 128
 _REG = 32
 
 
-def principal_curve(samples: ArrayLike, n: int = CONTROL_POINTS, max_iterations: int = 400,
-                    tolerance: float = 0.02) -> Hermite:
+def principal_curve(
+    samples: ArrayLike, n: int = CONTROL_POINTS, max_iterations: int = 400, tolerance: float = 0.02
+) -> Hermite:
     """Eq. 3.1 iterated until no control point moves by more than ``tolerance`` pixels.
 
     With w2 = 1000 w1 a step moves the shape ~1 % of the way, so on a bent band this

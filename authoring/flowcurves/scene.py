@@ -62,9 +62,11 @@ class FlowObject:
 
     def with_points(self, pts: F) -> FlowObject:
         """A copy whose primitive end points and mesh vertices are ``pts`` (radii, triangles, colours kept)."""
-        prims = [Primitive(np.array(pts[2 * i]), np.array(pts[2 * i + 1]), p.radius, p.color)
-                 for i, p in enumerate(self.primitives)]
-        mesh = None if self.mesh is None else self.mesh.with_vertices(pts[2 * len(self.primitives):])
+        prims = [
+            Primitive(np.array(pts[2 * i]), np.array(pts[2 * i + 1]), p.radius, p.color)
+            for i, p in enumerate(self.primitives)
+        ]
+        mesh = None if self.mesh is None else self.mesh.with_vertices(pts[2 * len(self.primitives) :])
         return FlowObject(self.name, self.group, prims, mesh)
 
 

@@ -92,8 +92,16 @@ def compute_securves(scene: FlowScene, rasters: list[Raster], progress=None) -> 
             out.append(SECurve(spine, False, "principal", members, spine, thin))
             spines.append((spine, members))
         else:
-            out.append(SECurve(contour.sample(96), True, "contour", members,
-                               spine if _elongation(pixels) >= ELONGATED else None, thin))
+            out.append(
+                SECurve(
+                    contour.sample(96),
+                    True,
+                    "contour",
+                    members,
+                    spine if _elongation(pixels) >= ELONGATED else None,
+                    thin,
+                )
+            )
     out.extend(_group_contours(spines, rasters))
     return out
 

@@ -57,8 +57,11 @@ class FlowSession:
 
     def __post_init__(self) -> None:
         self.deformer = SceneDeformer(self.scene)
-        self.auto_securves = self.securves if self.securves is not None else compute_securves(
-            self.scene, self.deformer.rasters, self.progress)
+        self.auto_securves = (
+            self.securves
+            if self.securves is not None
+            else compute_securves(self.scene, self.deformer.rasters, self.progress)
+        )
         self.network: FlowNetwork | None = None
         self._network_key: tuple[float, ...] | None = None
         self.result = Solve({}, [], 0.0, 0.0)
@@ -76,7 +79,10 @@ class FlowSession:
         hit = [i for i, r in enumerate(self.deformer.rasters) if np.isfinite(r.depth_at(pts)).any()]
         if hit:
             return hit
-        d = [float(np.sqrt(((pts[:, None] - e.grid.vertices[None]) ** 2).sum(-1)).min()) for e in self.deformer.embeddings]
+        d = [
+            float(np.sqrt(((pts[:, None] - e.grid.vertices[None]) ** 2).sum(-1)).min())
+            for e in self.deformer.embeddings
+        ]
         return [int(np.argmin(d))]
 
     def add(self, kind: str, points: ArrayLike, d_max: float = D_MAX) -> None:
@@ -138,7 +144,9 @@ class FlowSession:
 
     def spines(self) -> list[SECurve]:
         """The open curves a centre-point's network grows from and acts on."""
-        return [SECurve(s.spine, False, "spine", s.objects, s.spine) for s in self.all_securves() if s.spine is not None]
+        return [
+            SECurve(s.spine, False, "spine", s.objects, s.spine) for s in self.all_securves() if s.spine is not None
+        ]
 
     def update(self, warm: bool = False) -> None:
         """Solve the scene for the current edits."""
@@ -148,6 +156,7 @@ class FlowSession:
         if not centres:
             self.network = None
         self.flows = strokes + network
-        self.result = self.deformer.solve([([dense(f) for f in strokes], self.all_securves()),
-                                           ([dense(f) for f in network], self.spines())])
+        self.result = self.deformer.solve(
+            [([dense(f) for f in strokes], self.all_securves()), ([dense(f) for f in network], self.spines())]
+        )
         self.objects = self.deformer.deformed_objects(self.result)

@@ -26,11 +26,21 @@ import math
 from pathlib import Path
 from typing import Any
 
-from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
+from engine.errors import FormatError
 from engine.npz_safe import read_bounded
 
-__all__ = ["FlowFileError", "parse_flow", "parse_objects", "load_flow", "save_flow", "flow_document", "FORMAT", "VERSION", "MAX_FILE"]
+__all__ = [
+    "FlowFileError",
+    "parse_flow",
+    "parse_objects",
+    "load_flow",
+    "save_flow",
+    "flow_document",
+    "FORMAT",
+    "VERSION",
+    "MAX_FILE",
+]
 
 FORMAT, VERSION = "puppetphone-flow", 1
 MAX_FILE = 8 * 1024 * 1024
@@ -85,12 +95,18 @@ def parse_objects(value: Any) -> list[dict[str, Any]]:
             raise FlowFileError(f"object {name!r} appears twice"[:200])
         names.add(name)
         prims = []
-        for p in _list({"primitives": o.get("primitives", [])}, "primitives", MAX_PRIMITIVES,
-                       f"primitives of {name!r}"[:200]):
+        for p in _list(
+            {"primitives": o.get("primitives", [])}, "primitives", MAX_PRIMITIVES, f"primitives of {name!r}"[:200]
+        ):
             p = _dict(p, "a primitive")
-            prims.append({"a": _vec(p.get("a"), 3, "a primitive end"), "b": _vec(p.get("b"), 3, "a primitive end"),
-                          "radius": _num(p.get("radius"), "a primitive radius", 1e-4, 1e3),
-                          "color": _vec(p.get("color"), 3, "a primitive colour", 0.0, 1.0)})
+            prims.append(
+                {
+                    "a": _vec(p.get("a"), 3, "a primitive end"),
+                    "b": _vec(p.get("b"), 3, "a primitive end"),
+                    "radius": _num(p.get("radius"), "a primitive radius", 1e-4, 1e3),
+                    "color": _vec(p.get("color"), 3, "a primitive colour", 0.0, 1.0),
+                }
+            )
         entry: dict[str, Any] = {"name": name, "group": group, "primitives": prims}
         if o.get("mesh") is not None:
             entry["mesh"] = _mesh(o["mesh"], f"the mesh of {name!r}"[:200], budget)
@@ -114,10 +130,11 @@ def _mesh(value: Any, what: str, budget: list[int]) -> dict[str, Any]:
     faces = _list(m, "faces", MAX_MESH_TRIANGLES, f"{what}: faces")
     if not faces:
         raise FlowFileError(f"{what} has no triangle")
-    out: dict[str, Any] = {"vertices": [_vec(v, 3, "a mesh vertex") for v in verts],
-                           "faces": [[int(_num(i, "a triangle corner", 0, len(verts) - 1)) for i in _ints(f)]
-                                     for f in faces],
-                           "color": _vec(m.get("color", [0.6, 0.6, 0.6]), 3, "a mesh colour", 0.0, 1.0)}
+    out: dict[str, Any] = {
+        "vertices": [_vec(v, 3, "a mesh vertex") for v in verts],
+        "faces": [[int(_num(i, "a triangle corner", 0, len(verts) - 1)) for i in _ints(f)] for f in faces],
+        "color": _vec(m.get("color", [0.6, 0.6, 0.6]), 3, "a mesh colour", 0.0, 1.0),
+    }
     if m.get("face_colors") is not None:
         colors = _list(m, "face_colors", MAX_MESH_TRIANGLES, f"{what}: face colours")
         if len(colors) != len(faces):
@@ -142,9 +159,12 @@ def parse_flow(doc: Any) -> dict[str, Any]:
         raise FlowFileError("scene must be a name")
     size = [int(_num(x, "size", 1, 8192)) for x in _vec(d.get("size"), 2, "size", 1, 8192)]
     cam = _dict(d.get("camera"), "camera")
-    camera = {"target": _vec(cam.get("target"), 3, "camera target"), "yaw": _num(cam.get("yaw"), "camera yaw"),
-              "pitch": _num(cam.get("pitch"), "camera pitch", -1.6, 1.6),
-              "distance": _num(cam.get("distance"), "camera distance", 1e-3, 1e4)}
+    camera = {
+        "target": _vec(cam.get("target"), 3, "camera target"),
+        "yaw": _num(cam.get("yaw"), "camera yaw"),
+        "pitch": _num(cam.get("pitch"), "camera pitch", -1.6, 1.6),
+        "distance": _num(cam.get("distance"), "camera distance", 1e-3, 1e4),
+    }
     edits = []
     total = 0
     for e in _list(d, "edits", MAX_EDITS, "edits"):
@@ -157,11 +177,23 @@ def parse_flow(doc: Any) -> dict[str, Any]:
             raise FlowFileError(f"more than {MAX_POINTS} edit points in all")
         if not pts or (e["kind"] != "centre" and len(pts) < 2):
             raise FlowFileError(f"a {e['kind']} edit needs {'a point' if e['kind'] == 'centre' else 'two points'}")
-        edits.append({"kind": e["kind"], "points": [_vec(p, 2, "an edit point") for p in pts],
-                      "d_max": _num(e.get("d_max", 60.0), "d_max", 1.0, 10000.0)})
+        edits.append(
+            {
+                "kind": e["kind"],
+                "points": [_vec(p, 2, "an edit point") for p in pts],
+                "d_max": _num(e.get("d_max", 60.0), "d_max", 1.0, 10000.0),
+            }
+        )
     objects = parse_objects(d.get("objects"))
-    return {"format": FORMAT, "version": VERSION, "scene": scene, "size": size, "camera": camera,
-            "edits": edits, "objects": objects}
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "scene": scene,
+        "size": size,
+        "camera": camera,
+        "edits": edits,
+        "objects": objects,
+    }
 
 
 def load_flow(path: Path) -> dict[str, Any]:
@@ -184,15 +216,37 @@ def flow_document(session) -> dict[str, Any]:  # type: ignore[no-untyped-def]
     cam = session.scene.camera
     from authoring.flowcurves.adapters import mesh_data
 
-    objects = [{"name": o.name, "group": o.group,
-                "primitives": [{"a": [round(float(v), 6) for v in p.a], "b": [round(float(v), 6) for v in p.b],
-                                "radius": float(p.radius), "color": [float(c) for c in p.color]}
-                               for p in o.primitives],
-                **({"mesh": mesh_data(o.mesh)} if o.mesh is not None else {})} for o in session.objects]
-    return {"format": FORMAT, "version": VERSION, "scene": session.scene.name, "size": list(session.scene.size),
-            "camera": {"target": [float(v) for v in cam.target], "yaw": float(cam.yaw), "pitch": float(cam.pitch),
-                       "distance": float(cam.distance)},
-            "edits": [e.as_json() for e in session.edits], "objects": objects}
+    objects = [
+        {
+            "name": o.name,
+            "group": o.group,
+            "primitives": [
+                {
+                    "a": [round(float(v), 6) for v in p.a],
+                    "b": [round(float(v), 6) for v in p.b],
+                    "radius": float(p.radius),
+                    "color": [float(c) for c in p.color],
+                }
+                for p in o.primitives
+            ],
+            **({"mesh": mesh_data(o.mesh)} if o.mesh is not None else {}),
+        }
+        for o in session.objects
+    ]
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "scene": session.scene.name,
+        "size": list(session.scene.size),
+        "camera": {
+            "target": [float(v) for v in cam.target],
+            "yaw": float(cam.yaw),
+            "pitch": float(cam.pitch),
+            "distance": float(cam.distance),
+        },
+        "edits": [e.as_json() for e in session.edits],
+        "objects": objects,
+    }
 
 
 def save_flow(session, path: Path) -> None:  # type: ignore[no-untyped-def]

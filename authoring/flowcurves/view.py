@@ -41,8 +41,14 @@ def draw_objects(scene: RenderScene, objects: list[FlowObject], rest: list[FlowO
         scene.add_spheres(a, r, color=c)
 
 
-def draw_screen_polyline(scene: RenderScene, flow: FlowScene, xy: NDArray[np.float64], color: tuple[float, float, float],
-                         width: float = 3.0, closed: bool = False) -> None:
+def draw_screen_polyline(
+    scene: RenderScene,
+    flow: FlowScene,
+    xy: NDArray[np.float64],
+    color: tuple[float, float, float],
+    width: float = 3.0,
+    closed: bool = False,
+) -> None:
     """A pixel polyline drawn over everything."""
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     if len(xy) < 2:

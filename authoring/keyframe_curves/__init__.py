@@ -11,4 +11,13 @@ Not to be confused with ch. 5's :mod:`authoring.mocurves` (cycles of performed m
 from authoring.keyframe_curves.limits import retime_segment, segment_bounds
 from authoring.keyframe_curves.solver import CurveEdit, CurveSettings, Drag, Hold, TangentSolver, curve_rig
 
-__all__ = ["CurveEdit", "CurveSettings", "Drag", "Hold", "TangentSolver", "curve_rig", "retime_segment", "segment_bounds"]
+__all__ = [
+    "CurveEdit",
+    "CurveSettings",
+    "Drag",
+    "Hold",
+    "TangentSolver",
+    "curve_rig",
+    "retime_segment",
+    "segment_bounds",
+]

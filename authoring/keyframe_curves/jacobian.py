@@ -17,8 +17,8 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.ik._fk import _jumps
-from engine.ik.jacobian import ball_axis_columns
 from engine.ik._vec import cross
+from engine.ik.jacobian import ball_axis_columns
 from engine.ik.rig import IKRig
 
 __all__ = ["batch_points"]

@@ -29,8 +29,16 @@ from engine import quat
 from engine.keyframes import BezierCurves, KeyframedClip
 from engine.skeleton import Skeleton
 
-__all__ = ["rest_clip", "insert_key", "delete_key", "move_key", "set_key_channels", "pose_channels", "key_frames",
-           "MIN_KEY_GAP_FRAMES"]
+__all__ = [
+    "rest_clip",
+    "insert_key",
+    "delete_key",
+    "move_key",
+    "set_key_channels",
+    "pose_channels",
+    "key_frames",
+    "MIN_KEY_GAP_FRAMES",
+]
 
 F = NDArray[np.float64]
 

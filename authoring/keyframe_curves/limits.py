@@ -23,7 +23,9 @@ __all__ = ["segment_bounds", "retime_segment"]
 F = NDArray[np.float64]
 
 
-def segment_bounds(curves: BezierCurves, k: int, channels: ArrayLike, lower: ArrayLike, upper: ArrayLike) -> tuple[F, F]:
+def segment_bounds(
+    curves: BezierCurves, k: int, channels: ArrayLike, lower: ArrayLike, upper: ArrayLike
+) -> tuple[F, F]:
     """``(lo, hi)`` ``[4C']`` of ``[θ^X_{k+}, θ^Y_{k+}, θ^X_{k+1−}, θ^Y_{k+1−}]`` per channel block.
 
     Args:

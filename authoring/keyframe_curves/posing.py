@@ -11,12 +11,13 @@ it is from the target (the residual the editor shows).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from authoring.keyframe_curves.keys import pose_channels, set_key_channels
-from engine.ik import IKRig, Pin, humanoid_rig, solve_ik
 from engine.ik import Effector as _Effector
+from engine.ik import IKRig, Pin, humanoid_rig, solve_ik
 from engine.keyframes import KeyframedClip
 from engine.skeleton import Skeleton
 

@@ -20,13 +20,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from engine.errors import FormatError
 from authoring.keyframe_curves import keys as key_ops
 from authoring.keyframe_curves.limits import retime_segment
 from authoring.keyframe_curves.posing import KeyPose, pose_key
 from authoring.keyframe_curves.solver import CurveEdit, Drag, Hold, TangentSolver, curve_rig
 from authoring.paired_save import entry_for, write_pair
 from engine.clipfile import MAX_FILE as MAX_CLIP_FILE
+from engine.errors import FormatError
 from engine.ik import humanoid_rig
 from engine.keyframes import BezierCurves, KeyframedClip, keyframe_clip
 from engine.npz_safe import read_bounded
@@ -229,7 +229,9 @@ class CurveSession:
         """
         self.solver.clip = self.state.clip
         res = self.solver.drag(Drag(joint, time, position=position, orientation=orientation), self.holds)
-        clip = res.clip if res.reached else self._closest(res, joint, time, None if orientation is not None else position)
+        clip = (
+            res.clip if res.reached else self._closest(res, joint, time, None if orientation is not None else position)
+        )
         if clip is self.state.clip:
             return res
         if commit:

@@ -46,7 +46,7 @@ from authoring.keyframe_curves.jacobian import _fk, batch_points
 from authoring.keyframe_curves.limits import segment_bounds
 from engine import quat
 from engine.ik import IKRig
-from engine.keyframes import KeyframedClip, bezier_basis_slope, bezier_basis
+from engine.keyframes import KeyframedClip, bezier_basis, bezier_basis_slope
 from engine.qp import LeastSquaresQP
 
 __all__ = ["Drag", "Hold", "CurveSettings", "CurveEdit", "TangentSolver", "curve_rig"]
@@ -309,7 +309,7 @@ class TangentSolver:
     def _linearise(self, seg: _Segment, clip: KeyframedClip, times: F, joints: list[int], pts: list[F],
                    rot_joint: int | None) -> tuple[F, F, F | None, F | None]:  # fmt: skip
         """Points ``[T,3]`` and their Jacobians ``[3T, 4C']`` (and the effector's orientation/Jacobian)."""
-        curves, ch, rig, sk = clip.curves, seg.channels, self.rig, self.rig.skeleton
+        curves, ch, rig, _sk = clip.curves, seg.channels, self.rig, self.rig.skeleton
         k = seg.k
         kk, lam_all = curves.parameter(times)
         c_all = curves.evaluate(kk, lam_all)
@@ -324,12 +324,18 @@ class TangentSolver:
         dy = d0 * v0 + dtp * ya + d1 * v1 + dtm * yb
         slope = dy / np.where(np.abs(dx) > 1e-12, dx, 1e-12)
         main = (kk == k)[:, None]
-        left = (kk == (-1 if seg.left is None else seg.left))[:, None] * seg.s_left  # θ_k as the left segment's in-handle
-        right = (kk == (-1 if seg.right is None else seg.right))[:, None] * seg.s_right  # θ_{k+1} as the right one's out
+        left = (kk == (-1 if seg.left is None else seg.left))[
+            :, None
+        ] * seg.s_left  # θ_k as the left segment's in-handle
+        right = (kk == (-1 if seg.right is None else seg.right))[
+            :, None
+        ] * seg.s_right  # θ_{k+1} as the right one's out
         dc = np.concatenate([(-slope * tp) * main + (-slope * tm) * left, tp * main + tm * left,
                              (-slope * tm) * main + (-slope * tp) * right, tm * main + tp * right], axis=1)  # fmt: skip
         nc = ch.size
-        pos, js, rot_now, jo = batch_points(rig, c_all, np.asarray(joints, dtype=np.int64), np.asarray(pts), ch, rot_joint)
+        pos, js, rot_now, jo = batch_points(
+            rig, c_all, np.asarray(joints, dtype=np.int64), np.asarray(pts), ch, rot_joint
+        )
         jac = (np.tile(js, (1, 1, 4)) * dc[:, None, :]).reshape(3 * len(times), 4 * nc)
         rot_jac = None if jo is None else np.tile(jo, (1, 4)) * dc[0][None]
         return pos, jac, rot_now, rot_jac
@@ -429,7 +435,16 @@ class TangentSolver:
             t_ds, t_drho = residuals(t_pos, t_rot)
             t_merit = merit(t_ds, t_drho)
             if t_merit < cur or done_of(t_ds, t_drho):
-                clip, pos, jac, rot_now, rot_jac, ds, drho, cur = trial, t_pos, t_jac, t_rot, t_rjac, t_ds, t_drho, t_merit
+                clip, pos, jac, rot_now, rot_jac, ds, drho, cur = (
+                    trial,
+                    t_pos,
+                    t_jac,
+                    t_rot,
+                    t_rjac,
+                    t_ds,
+                    t_drho,
+                    t_merit,
+                )
                 radius = min(2.0 * radius, 4.0 * st.step_radius)
                 box_r = min(1.5 * box_r, 2.5 * st.tangent_radius)
                 mu *= 0.25

@@ -36,7 +36,14 @@ from authoring.mocurves.spatial import (
     scale_arrow,
     set_positions,
 )
-from authoring.mocurves.storage import EXPORT_SUFFIXES, SessionFileError, bake_root_motion, export_clip, load_session, save_session
+from authoring.mocurves.storage import (
+    EXPORT_SUFFIXES,
+    SessionFileError,
+    bake_root_motion,
+    export_clip,
+    load_session,
+    save_session,
+)
 from authoring.mocurves.timewarp import W_SOFT, W_STRONG, TimeWarp, TimeWarpError
 
 __all__ = [

@@ -66,7 +66,11 @@ def plane_from_stroke(a: ArrayLike, b: ArrayLike, view_dir: ArrayLike, allowed: 
     a, b, v = (np.asarray(x, dtype=np.float64) for x in (a, b, view_dir))
     n = np.cross(b - a, v)
     length = float(np.linalg.norm(n))
-    if not np.isfinite(length) or length < 1e-9 * max(float(np.linalg.norm(b - a) * np.linalg.norm(v)), 1e-12) or length == 0:
+    if (
+        not np.isfinite(length)
+        or length < 1e-9 * max(float(np.linalg.norm(b - a) * np.linalg.norm(v)), 1e-12)
+        or length == 0
+    ):
         raise ValueError("contact stroke is too short or parallel to the view: draw a line across the curves")
     n = n / length
     if np.dot(np.asarray(allowed, dtype=np.float64) - a, n) < 0:
@@ -192,7 +196,7 @@ def solve_contacts(clip: Clip, joints: Sequence[int], plane: ContactPlane, *,
             old = float(np.dot(projected[last, i] - projected[first, i], direction))
             nw = float(np.dot(new[last, i] - new[first, i], direction))
             ratios.append(nw / old if abs(old) > 1e-6 else 1.0)
-        for r, (first, last, _) in enumerate(ends):
+        for r, (_, last, _) in enumerate(ends):
             nxt_first = ends[(r + 1) % len(ends)][0]
             _rescale_swing(new[:, i], projected[:, i], last, nxt_first, direction, ratios[r], n)
         stretch[i] = float(np.mean(ratios))

@@ -80,13 +80,19 @@ class EditSession:
             raise ValueError(f"clip {clip.name!r} has {clip.num_frames} frames; a cycle needs at least 4")
         if scales is None:
             scales = clip.scales
-        s = np.ones((clip.num_frames, clip.skeleton.num_joints)) if scales is None else np.array(scales, dtype=np.float64)
+        s = (
+            np.ones((clip.num_frames, clip.skeleton.num_joints))
+            if scales is None
+            else np.array(scales, dtype=np.float64)
+        )
         if s.shape != (clip.num_frames, clip.skeleton.num_joints) or not np.all(s > 0):
             raise ValueError(f"scales must be positive [{clip.num_frames},{clip.skeleton.num_joints}]")
         s.setflags(write=False)
         frozen = {k: frozenset(int(i) for i in v) for k, v in (pins or {}).items()}
         if root_curve is not None and root_curve.count > clip.num_frames:
-            raise ValueError(f"a root curve of {root_curve.count} control points does not fit {clip.num_frames} keypoints")
+            raise ValueError(
+                f"a root curve of {root_curve.count} control points does not fit {clip.num_frames} keypoints"
+            )
         self._state = EditState(clip, s, frozen, root_curve=root_curve)
         self._undo: list[EditState] = []
         self._redo: list[EditState] = []
@@ -111,10 +117,7 @@ class EditSession:
         st = self.state
         if self._channel is None or self._channel[0] is not st:
             unit = bool(np.all(st.scales == 1.0))
-            if unit and st.clip.scales is None:
-                clip = st.clip
-            else:
-                clip = replace(st.clip, scales=None if unit else st.scales)
+            clip = st.clip if unit and st.clip.scales is None else replace(st.clip, scales=None if unit else st.scales)
             self._channel = (st, clip)
         return self._channel[1]
 
@@ -228,7 +231,9 @@ class EditSession:
         st = self._state
         curve = mocurves(st.clip, st.scales)[item]
         clip = spatial.move_control_point(st.clip, curve.joint, curve.positions, self.control_count(item), index, delta)
-        root_curve = st.root_curve.moved(index, delta) if curve.joint == 0 and st.root_curve is not None else st.root_curve
+        root_curve = (
+            st.root_curve.moved(index, delta) if curve.joint == 0 and st.root_curve is not None else st.root_curve
+        )
         return self._push(replace(st, clip=clip, root_curve=root_curve, label=f"move {item} control {index}"))
 
     # -- temporal edits ---------------------------------------------------------------------

@@ -27,16 +27,24 @@ from typing import Any
 
 import numpy as np
 
-from engine.errors import FormatError
 from authoring.mocurves.session import EditSession
 from authoring.paired_save import entry_for, write_pair
 from engine import quat
 from engine.clip import Clip
 from engine.clipfile import load_clip_curve, save_clip
+from engine.errors import FormatError
 from engine.io.formats import motion_format, suffixes
 from engine.npz_safe import read_bounded
 
-__all__ = ["save_session", "load_session", "side_path", "export_clip", "bake_root_motion", "SessionFileError", "EXPORT_SUFFIXES"]
+__all__ = [
+    "save_session",
+    "load_session",
+    "side_path",
+    "export_clip",
+    "bake_root_motion",
+    "SessionFileError",
+    "EXPORT_SUFFIXES",
+]
 
 SIDE_FORMAT = "puppetphone-mocurves"
 SIDE_VERSION = 1
@@ -136,7 +144,9 @@ def load_session(path: str | Path) -> EditSession:
     except SessionFileError as exc:
         raise SessionFileError(f"{side_file}: {exc}") from None
     if entry is None:
-        raise SessionFileError(f"{side_file}: belongs to another version of {p.name}; move it away to open the clip alone")
+        raise SessionFileError(
+            f"{side_file}: belongs to another version of {p.name}; move it away to open the clip alone"
+        )
     return EditSession(clip, scales, tau=tau, sigma=sigma, pins=pins, root_curve=root_curve)
 
 
@@ -151,9 +161,12 @@ def _side_values(side: Any, clip: Clip) -> tuple[np.ndarray, int, float, dict[st
         raise SessionFileError(f"version {version} is newer than this build reads ({SIDE_VERSION})")
     frames, joints = clip.num_frames, clip.skeleton.num_joints
     rows = side.get("scales")
-    if (not isinstance(rows, list) or len(rows) != frames
-            or not all(isinstance(r, list) and len(r) == joints for r in rows)
-            or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for r in rows for x in r)):
+    if (
+        not isinstance(rows, list)
+        or len(rows) != frames
+        or not all(isinstance(r, list) and len(r) == joints for r in rows)
+        or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for r in rows for x in r)
+    ):
         raise SessionFileError(f"scales must be {frames} rows of {joints} numbers")
     scales = np.array(rows, dtype=np.float64)
     if not (np.isfinite(scales).all() and (scales > 0).all() and (scales <= MAX_SCALE).all()):
@@ -165,9 +178,11 @@ def _side_values(side: Any, clip: Clip) -> tuple[np.ndarray, int, float, dict[st
         raise SessionFileError("sigma must be a number in (0, 10]")
     pins = side.get("pins", {})
     if not isinstance(pins, dict) or not all(
-            isinstance(k, str) and isinstance(v, list)
-            and all(isinstance(i, int) and not isinstance(i, bool) and 0 <= i < frames for i in v)
-            for k, v in pins.items()):
+        isinstance(k, str)
+        and isinstance(v, list)
+        and all(isinstance(i, int) and not isinstance(i, bool) and 0 <= i < frames for i in v)
+        for k, v in pins.items()
+    ):
         raise SessionFileError(f"pins must map item names to keypoints in 0..{frames - 1}")
     return scales, tau, float(sigma), pins
 

@@ -75,8 +75,11 @@ def packed(space: BlendSpace, tracks: list[NDArray[np.bool_]] | None) -> Packed 
         rotations=np.ascontiguousarray(np.concatenate([c.rotations for c in clips]), dtype=np.float64),
         tables=np.ascontiguousarray(np.concatenate([t for t, _ in space.sync._root_tables]), dtype=np.float64),
         cycles=np.stack([c for _, c in space.sync._root_tables]).astype(np.float64),
-        contacts=(np.zeros((int(frames.sum()), 0)) if tracks is None
-                  else np.concatenate([np.asarray(t, dtype=np.float64) for t in tracks])),
+        contacts=(
+            np.zeros((int(frames.sum()), 0))
+            if tracks is None
+            else np.concatenate([np.asarray(t, dtype=np.float64) for t in tracks])
+        ),
     )
     _CACHE[key] = (space, result)
     return result
@@ -129,9 +132,31 @@ def _root_row(tables: F, cycles: F, base: int, n: int, k: int, time: float, fps:
 
 
 @njit
-def play(pk_points: F, durations: F, fps: F, frames: I, start: I, knot_x: F, knot_y: F, roots: F, rotations: F,
-         tables: F, cycles: F, contacts: F, points: F, phase: F, rate: F, dt: float,
-         w_out: F, phase_out: F, travel: F, turn: F, root_out: F, rot_out: F, votes: F) -> None:
+def play(
+    pk_points: F,
+    durations: F,
+    fps: F,
+    frames: I,
+    start: I,
+    knot_x: F,
+    knot_y: F,
+    roots: F,
+    rotations: F,
+    tables: F,
+    cycles: F,
+    contacts: F,
+    points: F,
+    phase: F,
+    rate: F,
+    dt: float,
+    w_out: F,
+    phase_out: F,
+    travel: F,
+    turn: F,
+    root_out: F,
+    rot_out: F,
+    votes: F,
+) -> None:
     """Play ``dt`` seconds of every puppet (blend ``points [P,N]``, ``phase``, ``rate [P]``): weights, new
     phase, root travel (clip frame) and turn, the blended pose at the new phase and the feet's votes."""
     k_all = pk_points.shape[0]
@@ -163,8 +188,15 @@ def play(pk_points: F, durations: F, fps: F, frames: I, start: I, knot_x: F, kno
             for c in range(4):
                 rot_out[p, j, c] = 0.0
         # every clip's joints are turned into the hemisphere of the heaviest clip's (blend_quaternions)
-        _frame_rotations(rotations, start[ref], frames[ref],
-                         _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1) * fps[ref], ref_rot, ref_rot, False)
+        _frame_rotations(
+            rotations,
+            start[ref],
+            frames[ref],
+            _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1) * fps[ref],
+            ref_rot,
+            ref_rot,
+            False,
+        )
         for k in range(k_all):
             n = frames[k]
             t1 = _clip_time(knot_x[k], knot_y[k], durations[k], ph1)
@@ -195,8 +227,9 @@ def play(pk_points: F, durations: F, fps: F, frames: I, start: I, knot_x: F, kno
 
 
 @njit
-def _frame_rotations(rotations: F, first: int, n: int, frame: float, ref: F, out: F, accumulate: bool,
-                     wn: float = 1.0) -> None:
+def _frame_rotations(
+    rotations: F, first: int, n: int, frame: float, ref: F, out: F, accumulate: bool, wn: float = 1.0
+) -> None:
     """A loop's joint rotations at fractional ``frame`` (slerp between its frames, :meth:`Clip.frame_pair`):
     stored in ``out``, or (``accumulate``) turned into ``ref``'s hemisphere and added with weight ``wn``."""
     f = frame % n
@@ -205,8 +238,11 @@ def _frame_rotations(rotations: F, first: int, n: int, frame: float, ref: F, out
     a = f - math.floor(f)
     r0, r1 = first + i0, first + i1
     for j in range(rotations.shape[1]):
-        q = qslerp((rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
-                   (rotations[r1, j, 0], rotations[r1, j, 1], rotations[r1, j, 2], rotations[r1, j, 3]), a)
+        q = qslerp(
+            (rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
+            (rotations[r1, j, 0], rotations[r1, j, 1], rotations[r1, j, 2], rotations[r1, j, 3]),
+            a,
+        )
         if not accumulate:
             for c in range(4):
                 out[j, c] = q[c]

@@ -41,8 +41,8 @@ from engine.blend.measure import contact_votes
 from engine.blend.pose_blend import crossfade, fade_weight
 from engine.blend.space import BlendSpace
 from engine.clip import Clip
-from engine.components import LocalPose, Puppet, Transform
 from engine.clips.contacts import foot_contacts
+from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import World
 from engine.ik.system import IKRequest
 from engine.pose import Pose
@@ -187,8 +187,13 @@ def _override(player: LocomotionPlayer, loco: LocomotionSet, dt: float) -> tuple
         raise KeyError(f"clip {player.override!r} is not in the locomotion set; available: {sorted(loco.clips)}")
     t0, t1 = player.override_time, player.override_time + (0.0 if player.override_scrub else dt)
     fade = player.override_fade
-    if (not clip.loop and not player.override_hold and not player.override_scrub and not player.override_stopping
-            and t1 >= clip.duration - fade):
+    if (
+        not clip.loop
+        and not player.override_hold
+        and not player.override_scrub
+        and not player.override_stopping
+        and t1 >= clip.duration - fade
+    ):
         player.override_stopping = True
     step = dt / fade if fade > 0 else 1.0
     step = -step if player.override_stopping else step
@@ -244,16 +249,42 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
     return out  # type: ignore[return-value]
 
 
-def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F,
-                   dt: float) -> tuple[F, F, F, F, F, F | None]:
+def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F, dt: float) -> tuple[F, F, F, F, F, F | None]:
     """:meth:`BlendSpace.advance`, :meth:`~BlendSpace.sample` and :func:`contact_votes` of a group in one
     compiled pass: (root, rotations, new phase, travel, turn, votes or ``None``)."""
     count, joints, legs = len(points), pk.rotations.shape[1], pk.contacts.shape[1]
-    w, new_phase, travel, turn = np.empty((count, len(pk.points))), np.empty(count), np.empty((count, 3)), np.empty(count)
+    w, new_phase, travel, turn = (
+        np.empty((count, len(pk.points))),
+        np.empty(count),
+        np.empty((count, 3)),
+        np.empty(count),
+    )
     root, rots, votes = np.empty((count, 3)), np.empty((count, joints, 4)), np.empty((count, legs))
-    _kernel.play(pk.points, pk.durations, pk.fps, pk.frames, pk.start, pk.knot_x, pk.knot_y, pk.roots, pk.rotations,
-                 pk.tables, pk.cycles, pk.contacts, np.ascontiguousarray(points, dtype=np.float64), phase,
-                 np.ascontiguousarray(rates, dtype=np.float64), dt, w, new_phase, travel, turn, root, rots, votes)
+    _kernel.play(
+        pk.points,
+        pk.durations,
+        pk.fps,
+        pk.frames,
+        pk.start,
+        pk.knot_x,
+        pk.knot_y,
+        pk.roots,
+        pk.rotations,
+        pk.tables,
+        pk.cycles,
+        pk.contacts,
+        np.ascontiguousarray(points, dtype=np.float64),
+        phase,
+        np.ascontiguousarray(rates, dtype=np.float64),
+        dt,
+        w,
+        new_phase,
+        travel,
+        turn,
+        root,
+        rots,
+        votes,
+    )
     return root, rots, new_phase, travel, turn, (votes if legs else None)
 
 

@@ -60,8 +60,9 @@ def probe_grid(dims: int, density: int | Sequence[int]) -> tuple[F, tuple[int, .
 
 
 @jit.njit
-def _idw_kernel(x: F, dist: F, idx: NDArray[np.int64], probes: F, scaled: F, slopes: F, use_slopes: bool,
-                power: float, out: F) -> None:
+def _idw_kernel(
+    x: F, dist: F, idx: NDArray[np.int64], probes: F, scaled: F, slopes: F, use_slopes: bool, power: float, out: F
+) -> None:
     """:meth:`LookupTable._idw` for requests ``x [Q, M]`` with their neighbours ``dist``/``idx [Q, k]``, compiled:
     weights ``(d₀/d)^q``, each probe's value (plus its slope times the offset), normalised, clamped to [0, 1]."""
     n, m = probes.shape[1], x.shape[1]
@@ -237,9 +238,17 @@ class LookupTable:
             k, n = dist.shape[-1], self.probes.shape[1]
             flat = dist.reshape(-1, k)
             out = np.empty((flat.shape[0], n))
-            _idw_kernel(x.reshape(-1, x.shape[-1]), flat, idx.reshape(-1, k), self.probes, self._scaled_values,
-                        _NO_SLOPES if self.slopes is None else self.slopes, self.slopes is not None,
-                        float(self.power), out)
+            _idw_kernel(
+                x.reshape(-1, x.shape[-1]),
+                flat,
+                idx.reshape(-1, k),
+                self.probes,
+                self._scaled_values,
+                _NO_SLOPES if self.slopes is None else self.slopes,
+                self.slopes is not None,
+                float(self.power),
+                out,
+            )
             return out.reshape(dist.shape[:-1] + (n,))
         exact = dist[..., 0] <= 1e-12
         # Weights relative to the nearest probe: (d0/d)^q stays finite for any q.
@@ -308,9 +317,7 @@ class LookupTable:
             d[k] *= self.keep_cost
             cost = float(np.linalg.norm(d))
             got = float(c[k] * self.scale[k] + self.offset[k])
-            if abs(want - got) > 1e-9 and not (
-                want * got > 0 and 1.0 / self.max_rate <= want / got <= self.max_rate
-            ):
+            if abs(want - got) > 1e-9 and not (want * got > 0 and 1.0 / self.max_rate <= want / got <= self.max_rate):
                 cost += 1e3
             if cost < best_cost:
                 best, best_cost = c, cost

@@ -22,7 +22,15 @@ from engine import quat
 from engine.blend.space import BlendSpace
 from engine.fk import forward_kinematics, world_points
 
-__all__ = ["Playback", "play", "measure_locomotion", "foot_slide", "blended_contacts", "contact_votes", "LOCOMOTION_PROPERTIES"]
+__all__ = [
+    "Playback",
+    "play",
+    "measure_locomotion",
+    "foot_slide",
+    "blended_contacts",
+    "contact_votes",
+    "LOCOMOTION_PROPERTIES",
+]
 
 F = NDArray[np.float64]
 LOCOMOTION_PROPERTIES: tuple[str, ...] = ("speed", "height")

@@ -98,7 +98,9 @@ def _channels(poses: Sequence[Pose]) -> tuple[F | None, F | None]:
     scales = None
     if any(p.scales is not None for p in poses):
         ones = np.ones(np.shape(poses[0].rotations)[:-1])
-        scales = np.stack([ones if p.scales is None else np.asarray(p.scales, dtype=np.float64) for p in poses], axis=-2)
+        scales = np.stack(
+            [ones if p.scales is None else np.asarray(p.scales, dtype=np.float64) for p in poses], axis=-2
+        )
     return offsets, scales
 
 

@@ -152,8 +152,13 @@ class BlendSpace:
         times = self.sync.clip_times(phase, active)
         clips = [self.clips[k] for k in active]
         pairs = [c.frame_pair(times[..., i]) for i, c in enumerate(clips)]
-        root = np.stack([c.root[i0] + a[..., None] * (c.root[i1] - c.root[i0])
-                         for c, (i0, i1, a) in zip(clips, pairs, strict=True)], axis=-2)  # [..., K', 3]
+        root = np.stack(
+            [
+                c.root[i0] + a[..., None] * (c.root[i1] - c.root[i0])
+                for c, (i0, i1, a) in zip(clips, pairs, strict=True)
+            ],
+            axis=-2,
+        )  # [..., K', 3]
         # one slerp for every active clip (Clip.sample's, element for element, without K' dispatches)
         r0 = np.stack([c.rotations[i0] for c, (i0, _, _) in zip(clips, pairs, strict=True)])
         r1 = np.stack([c.rotations[i1] for c, (_, i1, _) in zip(clips, pairs, strict=True)])

@@ -163,7 +163,9 @@ class SyncGroup:
         """Blended root travel ``[..., 3]`` (clip frame) and heading change ``[...]`` from ``phase0`` to ``phase1``."""
         p0, p1 = np.broadcast_arrays(np.asarray(phase0, dtype=np.float64), np.asarray(phase1, dtype=np.float64))
         w = np.asarray(weights, dtype=np.float64)
-        active = np.flatnonzero(np.any(w.reshape(-1, len(self.clips)) > 0.0, axis=0))  # clips without weight add nothing
+        active = np.flatnonzero(
+            np.any(w.reshape(-1, len(self.clips)) > 0.0, axis=0)
+        )  # clips without weight add nothing
         trans, head = self.root_motion(np.stack([p0, p1]), active)  # one pass over the clips for both ends
         t0, t1, h0, h1 = trans[0], trans[1], head[0], head[1]
         w = w[..., active]

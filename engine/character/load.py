@@ -38,8 +38,10 @@ F64 = NDArray[np.float64]
 MAX_CHARACTER = 8 << 20
 """Bytes of a character file a recording carries (CesiumMan is 0.5 MB; its header's limit is 16 MB)."""
 
-_HOW = ("map its joints to the puppet's roles in a JSON file {\"file joint\": \"puppet role\", …} and pass "
-        f"--joint-map FILE (roles: {', '.join(JOINTS)})")
+_HOW = (
+    'map its joints to the puppet\'s roles in a JSON file {"file joint": "puppet role", …} and pass '
+    f"--joint-map FILE (roles: {', '.join(JOINTS)})"
+)
 
 
 class CharacterError(ValueError):
@@ -83,8 +85,10 @@ def read_character(path: str | Path, joint_map: dict[str, str] | None = None) ->
     """
     path = Path(path)
     if path.suffix.lower() != ".glb":
-        raise CharacterError(f"{path}: a character is one .glb file (a .gltf's outside buffers and "
-                             f"images cannot travel in a recording); export it as .glb")
+        raise CharacterError(
+            f"{path}: a character is one .glb file (a .gltf's outside buffers and "
+            f"images cannot travel in a recording); export it as .glb"
+        )
     try:
         size = path.stat().st_size
         if size > MAX_CHARACTER:
@@ -118,8 +122,14 @@ def character_from_bytes(data: bytes, name: str, joint_map: dict[str, str] | Non
         raise CharacterError(f"{name}: {exc}") from None
 
 
-def _roles(asset: GltfAsset, names: list[str], parents: NDArray[np.int64], rest: F64,
-           joint_map: dict[str, str] | None, name: str) -> dict[str, str]:
+def _roles(
+    asset: GltfAsset,
+    names: list[str],
+    parents: NDArray[np.int64],
+    rest: F64,
+    joint_map: dict[str, str] | None,
+    name: str,
+) -> dict[str, str]:
     """Puppet role → joint name, all 17 of them, or a refusal saying which are missing and how to map them."""
     if joint_map is not None:
         unknown = sorted(set(joint_map.values()) - set(names))
@@ -139,7 +149,8 @@ def _roles(asset: GltfAsset, names: list[str], parents: NDArray[np.int64], rest:
                 raise CharacterError(
                     f"{name}: not a humanoid the puppet can be: its joint names ({shown}) follow none of the "
                     f"known families ({', '.join(JOINT_MAPS)}), leaving {_count(missing)} without a joint, and by "
-                    f"its shape {by_shape}; if it is a humanoid, {_HOW}") from None
+                    f"its shape {by_shape}; if it is a humanoid, {_HOW}"
+                ) from None
     missing = [r for r in JOINTS if r not in roles]
     if missing:
         raise CharacterError(f"{name}: {_count(missing)} without a joint; {_HOW}")
@@ -179,8 +190,9 @@ def _segment_distance(points: F64, a: F64, b: F64) -> F64:
     return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
 
 
-def _build(asset: GltfAsset, meshes: SkinnedMeshes, name: str, digest: str,
-           joint_map: dict[str, str] | None) -> Character:
+def _build(
+    asset: GltfAsset, meshes: SkinnedMeshes, name: str, digest: str, joint_map: dict[str, str] | None
+) -> Character:
     skin = asset.skins[meshes.skin]
     nodes = list(skin.joints)
     names = [asset.names[n] for n in nodes]
@@ -194,8 +206,9 @@ def _build(asset: GltfAsset, meshes: SkinnedMeshes, name: str, digest: str,
     # The mesh in the file's rest pose, and which puppet joint mostly moves each vertex.
     mats = skin_matrices(asset, world, meshes.skin)
     verts = np.concatenate([blend_skin(p.positions, p.joints, p.weights, mats) for p in meshes.primitives])
-    owner = np.concatenate([drivers[p.joints[np.arange(len(p.joints)), np.argmax(p.weights, axis=1)]]
-                            for p in meshes.primitives])
+    owner = np.concatenate(
+        [drivers[p.joints[np.arange(len(p.joints)), np.argmax(p.weights, axis=1)]] for p in meshes.primitives]
+    )
     positions = {r: rest[row_of[roles[r]]] for r in JOINTS}
     floor = float(verts[:, 1].min())
     rig0 = build_rig(positions, floor)
@@ -204,12 +217,14 @@ def _build(asset: GltfAsset, meshes: SkinnedMeshes, name: str, digest: str,
     sizes = {"head": float(v[:, 1].max() - p[JOINTS.index("head"), 1])}
     hands = [v[owner == JOINTS.index(f"{s}_hand")] for s in "lr"]
     if all(len(h) for h in hands):
-        sizes["hand"] = float(np.mean([np.linalg.norm(h - p[JOINTS.index(f"{s}_hand")], axis=1).max()
-                                       for h, s in zip(hands, "lr")]))
+        sizes["hand"] = float(
+            np.mean([np.linalg.norm(h - p[JOINTS.index(f"{s}_hand")], axis=1).max() for h, s in zip(hands, "lr")])
+        )
     feet = [v[owner == JOINTS.index(f"{s}_foot")] for s in "lr"]
     if all(len(f) for f in feet):
-        sizes["toe"] = 0.9 * float(np.mean([(f[:, 2] - p[JOINTS.index(f"{s}_foot"), 2]).max()
-                                            for f, s in zip(feet, "lr")]))
+        sizes["toe"] = 0.9 * float(
+            np.mean([(f[:, 2] - p[JOINTS.index(f"{s}_foot"), 2]).max() for f, s in zip(feet, "lr")])
+        )
     radii = {}
     base = rig0.skeleton
     for j, role in enumerate(JOINTS):

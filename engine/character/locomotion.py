@@ -31,8 +31,13 @@ def character_clips(character: Character, clips: Mapping[str, Clip]) -> dict[str
     return {name: retarget_proportions(clip, character.rig.skeleton) for name, clip in clips.items()}
 
 
-def character_locomotion(character: Character, clips: Mapping[str, Clip], density: int = 31,
-                         dt: float = 1.0 / 60.0, cache_dir: Path | None = None) -> LocomotionSet:
+def character_locomotion(
+    character: Character,
+    clips: Mapping[str, Clip],
+    density: int = 31,
+    dt: float = 1.0 / 60.0,
+    cache_dir: Path | None = None,
+) -> LocomotionSet:
     """The character's locomotion set over ``clips`` retargeted, its table from the disk cache when measured before.
 
     Args:
@@ -42,7 +47,8 @@ def character_locomotion(character: Character, clips: Mapping[str, Clip], densit
     key = (character.digest, set_digest(clips), density, dt)
     if key not in _BUILT:
         own = character_clips(character, clips)
-        cache = MeasureCache(cache_dir or default_cache_dir(),
-                             f"character:{character.digest}:{set_digest(own)}:{density}:{dt!r}")
+        cache = MeasureCache(
+            cache_dir or default_cache_dir(), f"character:{character.digest}:{set_digest(own)}:{density}:{dt!r}"
+        )
         _BUILT[key] = build_locomotion(own, density, dt, memo=cache)
     return _BUILT[key]

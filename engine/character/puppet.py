@@ -41,7 +41,15 @@ from engine.skeleton import Skeleton
 from engine.skinning import SkinBinding
 from engine.statemachine.puppet.body import PuppetTuning
 
-__all__ = ["CharacterSkin", "spawn_character", "character_profile", "skinned_instances", "standing_height", "character_tuning", "MANNEQUIN_MASS"]
+__all__ = [
+    "CharacterSkin",
+    "spawn_character",
+    "character_profile",
+    "skinned_instances",
+    "standing_height",
+    "character_tuning",
+    "MANNEQUIN_MASS",
+]
 
 MANNEQUIN_MASS = 70.0
 """kg: the mannequin's body mass (``default_profile``'s), the reference a character's is scaled from."""
@@ -78,15 +86,30 @@ def character_tuning(sk: Skeleton) -> PuppetTuning:
     every drag."""
     s = float(sk.offsets[0, 1]) / humanoid_skeleton().offsets[0, 1]
     base = PuppetTuning()
-    return replace(base, stand_height=float(sk.offsets[0, 1]), crouch_height=base.crouch_height * s,
-                   crouch_enter=base.crouch_enter * s, crouch_exit=base.crouch_exit * s,
-                   lift_limit=base.lift_limit * max(s, 0.5), max_speed=base.max_speed * s,
-                   flick_launch_speed=base.flick_launch_speed * float(np.sqrt(s)), reach=base.reach * s,
-                   front=base.front * s)
+    return replace(
+        base,
+        stand_height=float(sk.offsets[0, 1]),
+        crouch_height=base.crouch_height * s,
+        crouch_enter=base.crouch_enter * s,
+        crouch_exit=base.crouch_exit * s,
+        lift_limit=base.lift_limit * max(s, 0.5),
+        max_speed=base.max_speed * s,
+        flick_launch_speed=base.flick_launch_speed * float(np.sqrt(s)),
+        reach=base.reach * s,
+        front=base.front * s,
+    )
 
 
-def spawn_character(world: World, character: Character, clips: Mapping[str, Clip], position: ArrayLike = (0.0, 0.0, 0.0),
-                    heading: float = 0.0, *, name: str = "puppet", extra: tuple[object, ...] = ()) -> Entity:
+def spawn_character(
+    world: World,
+    character: Character,
+    clips: Mapping[str, Clip],
+    position: ArrayLike = (0.0, 0.0, 0.0),
+    heading: float = 0.0,
+    *,
+    name: str = "puppet",
+    extra: tuple[object, ...] = (),
+) -> Entity:
     """A puppet that is ``character``: its set built (or found) from ``clips``, its ragdoll, its skin.
 
     Args:
@@ -104,14 +127,23 @@ def spawn_character(world: World, character: Character, clips: Mapping[str, Clip
         by_name = {c.name: c for c in clips.values()}
         library.contact_tracks[key] = [foot_contacts(by_name[c.name]) for c in library[key].space.clips]
     sk = character.rig.skeleton
-    e = spawn_puppet(world, position, heading, skeleton=sk, library_key=key, tuning=character_tuning(sk), name=name,
-                     extra=(*extra, CharacterSkin(character.binding)))
+    e = spawn_puppet(
+        world,
+        position,
+        heading,
+        skeleton=sk,
+        library_key=key,
+        tuning=character_tuning(sk),
+        name=name,
+        extra=(*extra, CharacterSkin(character.binding)),
+    )
     world.get(e, Ragdoll).profile = character_profile(sk)  # before any physics step builds the body
     return e
 
 
-def skinned_instances(world: World, alpha: float, outlined: set[Entity] | frozenset[Entity] = frozenset()
-                      ) -> list[SkinnedInstance]:
+def skinned_instances(
+    world: World, alpha: float, outlined: set[Entity] | frozenset[Entity] = frozenset()
+) -> list[SkinnedInstance]:
     """Every skinned puppet posed as its FK last left it (interpolated by ``alpha``)."""
     out = []
     for e, skin, wpose in world.query(CharacterSkin, WorldPose):

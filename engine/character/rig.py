@@ -33,8 +33,16 @@ __all__ = ["CharacterRig", "build_rig", "LIMB_BONES", "RigError"]
 F64 = NDArray[np.float64]
 
 #: Joints whose bone (towards their child) keeps the puppet's rest direction.
-LIMB_BONES = ("l_upper_arm", "l_lower_arm", "r_upper_arm", "r_lower_arm",
-              "l_upper_leg", "l_lower_leg", "r_upper_leg", "r_lower_leg")
+LIMB_BONES = (
+    "l_upper_arm",
+    "l_lower_arm",
+    "r_upper_arm",
+    "r_lower_arm",
+    "l_upper_leg",
+    "l_lower_leg",
+    "r_upper_leg",
+    "r_lower_leg",
+)
 
 
 class RigError(ValueError):
@@ -75,8 +83,12 @@ def _facing(p: dict[str, F64]) -> F64:
     return np.stack([x, [0.0, 1.0, 0.0], z])  # rows: where the file's axes go; applied as m @ v
 
 
-def build_rig(positions: dict[str, F64], floor: float, sizes: dict[str, float] | None = None,
-              radii: dict[str, float] | None = None) -> CharacterRig:
+def build_rig(
+    positions: dict[str, F64],
+    floor: float,
+    sizes: dict[str, float] | None = None,
+    radii: dict[str, float] | None = None,
+) -> CharacterRig:
     """The puppet skeleton of a character from its roles' rest positions in the file.
 
     Args:

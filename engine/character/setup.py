@@ -22,8 +22,12 @@ __all__ = ["encode", "decode", "character_setup"]
 
 def encode(data: bytes, name: str, joint_map: dict[str, str] | None = None) -> dict[str, Any]:
     """The set-up value of a character file's ``data`` (and the ``--joint-map`` it was opened with)."""
-    return {"name": name, "sha256": hashlib.sha256(data).hexdigest(), "glb": base64.b64encode(data).decode("ascii"),
-            "joint_map": dict(sorted(joint_map.items())) if joint_map else None}
+    return {
+        "name": name,
+        "sha256": hashlib.sha256(data).hexdigest(),
+        "glb": base64.b64encode(data).decode("ascii"),
+        "joint_map": dict(sorted(joint_map.items())) if joint_map else None,
+    }
 
 
 def decode(value: Any) -> Character:
@@ -38,8 +42,10 @@ def decode(value: Any) -> Character:
     if len(value["glb"]) > 4 * (MAX_CHARACTER // 3 + 1):
         raise CharacterError(f"the recorded character is over {MAX_CHARACTER >> 20} MB")
     joint_map = value.get("joint_map")
-    if joint_map is not None and not (isinstance(joint_map, dict) and all(
-            isinstance(k, str) and k in JOINTS and isinstance(v, str) for k, v in joint_map.items())):
+    if joint_map is not None and not (
+        isinstance(joint_map, dict)
+        and all(isinstance(k, str) and k in JOINTS and isinstance(v, str) for k, v in joint_map.items())
+    ):
         raise CharacterError("the recorded character's joint map is not {puppet role: file joint}")
     try:
         data = base64.b64decode(value["glb"], validate=True)

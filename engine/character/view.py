@@ -22,8 +22,9 @@ from engine.skeleton import Skeleton
 __all__ = ["character_instance"]
 
 
-def character_instance(character: Character, skeleton: Skeleton, root: ArrayLike, rotations: ArrayLike,
-                       outline: bool = False) -> SkinnedInstance:
+def character_instance(
+    character: Character, skeleton: Skeleton, root: ArrayLike, rotations: ArrayLike, outline: bool = False
+) -> SkinnedInstance:
     """``character`` in the pose ``(root [3], rotations [J,4])`` of ``skeleton`` (the puppet's), at its size.
 
     Raises:

@@ -30,8 +30,15 @@ __all__ = ["MeasureCache", "default_cache_dir", "code_fingerprint"]
 
 F = NDArray[np.float64]
 _ENGINE = Path(__file__).resolve().parents[1]
-_MEASURING = ("blend/measure.py", "blend/space.py", "blend/sync.py", "blend/pose_blend.py", "clip.py", "quat.py",
-              "fk.py")
+_MEASURING = (
+    "blend/measure.py",
+    "blend/space.py",
+    "blend/sync.py",
+    "blend/pose_blend.py",
+    "clip.py",
+    "quat.py",
+    "fk.py",
+)
 
 
 def default_cache_dir() -> Path:
@@ -95,8 +102,12 @@ class MeasureCache:
         self.misses += 1
         values = np.asarray(measure(probes), dtype=np.float64)
         buf = io.BytesIO()
-        np.savez(buf, probes=probes, values=values,
-                 sha256=np.frombuffer(self._digest(np.asarray(probes, dtype=np.float64), values), dtype=np.uint8))
+        np.savez(
+            buf,
+            probes=probes,
+            values=values,
+            sha256=np.frombuffer(self._digest(np.asarray(probes, dtype=np.float64), values), dtype=np.uint8),
+        )
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             atomic_write_bytes(self.path, buf.getvalue())

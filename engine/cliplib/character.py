@@ -35,8 +35,12 @@ def set_character(library: ClipLibrary, path: str | Path, joint_map: dict[str, s
     character, data = read_character(path, joint_map)
     library.root.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(library.root / CHARACTER_FILE, data)
-    entry = {"file": CHARACTER_FILE, "name": character.name, "sha256": hashlib.sha256(data).hexdigest(),
-             "joint_map": dict(sorted(joint_map.items())) if joint_map else None}
+    entry = {
+        "file": CHARACTER_FILE,
+        "name": character.name,
+        "sha256": hashlib.sha256(data).hexdigest(),
+        "joint_map": dict(sorted(joint_map.items())) if joint_map else None,
+    }
     library._write_manifest(library.entries(), character=entry)
     return character
 
@@ -60,20 +64,25 @@ def library_character(library: ClipLibrary) -> dict[str, Any] | None:
     if entry is None:
         return None
     where = library.manifest_path
-    if not (isinstance(entry, dict) and entry.get("file") == CHARACTER_FILE
-            and isinstance(entry.get("name"), str) and isinstance(entry.get("sha256"), str)):
+    if not (
+        isinstance(entry, dict)
+        and entry.get("file") == CHARACTER_FILE
+        and isinstance(entry.get("name"), str)
+        and isinstance(entry.get("sha256"), str)
+    ):
         raise ClipLibraryError(f"{where}: the character entry needs file {CHARACTER_FILE!r}, a name and a sha256")
     joint_map = entry.get("joint_map")
-    if joint_map is not None and not (isinstance(joint_map, dict) and all(
-            k in JOINTS and isinstance(v, str) for k, v in joint_map.items())):
+    if joint_map is not None and not (
+        isinstance(joint_map, dict) and all(k in JOINTS and isinstance(v, str) for k, v in joint_map.items())
+    ):
         raise ClipLibraryError(f"{where}: the character's joint map is not {{puppet role: file joint}}")
     try:
         data = (library.root / CHARACTER_FILE).read_bytes()
     except OSError as exc:
         raise ClipLibraryError(f"library {library.root}: cannot read its character: {exc.strerror}") from None
     if hashlib.sha256(data).hexdigest() != entry["sha256"]:
-        raise ClipLibraryError(f"library {library.root}: {CHARACTER_FILE} changed since it was added; "
-                               f"add it again (puppetphone clips add FILE.glb --role character)")
+        raise ClipLibraryError(
+            f"library {library.root}: {CHARACTER_FILE} changed since it was added; "
+            f"add it again (puppetphone clips add FILE.glb --role character)"
+        )
     return encode(data, entry["name"], joint_map)
-
-

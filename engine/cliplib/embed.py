@@ -49,9 +49,15 @@ def encode(clips: Mapping[str, Clip]) -> dict[str, Any]:
         if clip.root_motion is not None:
             parts += [clip.root_motion.translation, clip.root_motion.heading[:, None]]
         raw = b"".join(np.ascontiguousarray(p, dtype="<f8").tobytes() for p in parts)
-        out[role] = {"name": clip.name, "fps": clip.fps, "loop": clip.loop, "markers": dict(clip.markers),
-                     "frames": clip.num_frames, "root_motion": clip.root_motion is not None,
-                     "data": base64.b64encode(zlib.compress(raw, 9)).decode("ascii")}
+        out[role] = {
+            "name": clip.name,
+            "fps": clip.fps,
+            "loop": clip.loop,
+            "markers": dict(clip.markers),
+            "frames": clip.num_frames,
+            "root_motion": clip.root_motion is not None,
+            "data": base64.b64encode(zlib.compress(raw, 9)).decode("ascii"),
+        }
     return {"sha256": _payload_digest(out), "clips": out}
 
 
@@ -72,8 +78,9 @@ def _clip(role: str, e: Any, skeleton: Skeleton) -> Clip:
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= _MAX_FRAMES:
         raise ClipLibraryError(f"recorded clip {role!r}: frames {repr(frames)[:20]} is not in 1..{_MAX_FRAMES}")
     if not isinstance(markers, dict) or not all(
-            isinstance(k, str) and isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-            for k, v in markers.items()):
+        isinstance(k, str) and isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        for k, v in markers.items()
+    ):
         raise ClipLibraryError(f"recorded clip {role!r}: markers must map names to finite times")
     j = skeleton.num_joints
     per_frame = 3 + 4 * j + (4 if rm else 0)
@@ -119,7 +126,9 @@ def decode(value: Any, skeleton: Skeleton) -> dict[str, Clip]:
     j = skeleton.num_joints
     total = sum(_declared_bytes(e, j) for e in value["clips"].values())
     if total > _MAX_DECODED:
-        raise ClipLibraryError(f"the recorded clips would take {total >> 20} MB decoded; the limit is {_MAX_DECODED >> 20} MB")
+        raise ClipLibraryError(
+            f"the recorded clips would take {total >> 20} MB decoded; the limit is {_MAX_DECODED >> 20} MB"
+        )
     clips = {}
     for role, e in value["clips"].items():
         try:

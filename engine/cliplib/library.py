@@ -29,15 +29,24 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
 from engine.clip import Clip
 from engine.clipfile import ClipFileError, load_clip, save_clip
 from engine.cliplib.roles import RoleError, check_role, check_set, normalise_role
+from engine.errors import FormatError
 from engine.skeleton import Skeleton
 
-__all__ = ["ClipLibrary", "ClipLibraryError", "Entry", "default_library_dir", "clip_digest", "set_digest",
-           "MANIFEST", "FORMAT", "VERSION"]
+__all__ = [
+    "ClipLibrary",
+    "ClipLibraryError",
+    "Entry",
+    "default_library_dir",
+    "clip_digest",
+    "set_digest",
+    "MANIFEST",
+    "FORMAT",
+    "VERSION",
+]
 
 MANIFEST = "clips.json"
 FORMAT = "puppetphone-clips"
@@ -58,8 +67,14 @@ def default_library_dir() -> Path:
 def clip_digest(clip: Clip) -> str:
     """SHA-256 of everything about a clip that changes how it plays (independent of file bytes)."""
     h = hashlib.sha256()
-    meta = {"name": clip.name, "fps": clip.fps, "loop": clip.loop, "markers": dict(sorted(clip.markers.items())),
-            "joints": list(clip.skeleton.names), "parents": [int(p) for p in clip.skeleton.parents]}
+    meta = {
+        "name": clip.name,
+        "fps": clip.fps,
+        "loop": clip.loop,
+        "markers": dict(sorted(clip.markers.items())),
+        "joints": list(clip.skeleton.names),
+        "parents": [int(p) for p in clip.skeleton.parents],
+    }
     h.update(json.dumps(meta, sort_keys=True).encode())
     arrays = [clip.root, clip.rotations, clip.skeleton.offsets, clip.skeleton.tips, clip.skeleton.radii]
     if clip.root_motion is not None:
@@ -149,8 +164,10 @@ class ClipLibrary:
             except (ClipFileError, OSError) as exc:
                 raise ClipLibraryError(f"library {self.root}: {role}: {exc}") from None
             if clip_digest(clip) != e.sha256:
-                raise ClipLibraryError(f"library {self.root}: {e.file} changed since it was added as the {role}; "
-                                       f"add it again (puppetphone clips add … --role {role})")
+                raise ClipLibraryError(
+                    f"library {self.root}: {e.file} changed since it was added as the {role}; "
+                    f"add it again (puppetphone clips add … --role {role})"
+                )
             out[role] = clip
         return out
 

@@ -81,9 +81,16 @@ def plant_feet(clip: Clip, iterations: int = 3, fade_seconds: float = 0.15) -> C
             u, lo, f = sk.index(upper), sk.index(lower), sk.index(foot)
             target = pos[:, f] + _correction(contacts[:, side], drift[:, side], fade)
             pole = pos[:, lo] - 0.5 * (pos[:, u] + pos[:, f])
-            sol = solve_leg(pos[:, u], wrot[:, int(sk.parents[u])], target, pole, wrot[:, f],
-                            float(np.linalg.norm(sk.offsets[lo])), float(np.linalg.norm(sk.offsets[f])),
-                            max_reach=0.9995)
+            sol = solve_leg(
+                pos[:, u],
+                wrot[:, int(sk.parents[u])],
+                target,
+                pole,
+                wrot[:, f],
+                float(np.linalg.norm(sk.offsets[lo])),
+                float(np.linalg.norm(sk.offsets[f])),
+                max_reach=0.9995,
+            )
             rot[:, u], rot[:, lo], rot[:, f] = sol.upper, sol.knee, sol.foot
         clip = replace(clip, rotations=rot)
     return clip

@@ -26,8 +26,17 @@ from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
 from engine.skeleton import Skeleton
 
-__all__ = ["ROLES", "CYCLIC", "TRAVELLING", "RoleError", "normalise_role", "check_role", "conform", "check_set",
-           "RoleSpec"]
+__all__ = [
+    "ROLES",
+    "CYCLIC",
+    "TRAVELLING",
+    "RoleError",
+    "normalise_role",
+    "check_role",
+    "conform",
+    "check_set",
+    "RoleSpec",
+]
 
 _UP = np.array([0.0, 1.0, 0.0])
 FPS = 60.0
@@ -108,20 +117,24 @@ def check_role(clip: Clip, role: str, skeleton: Skeleton) -> None:
         raise RoleError(
             f"clip {clip.name!r} is on a {clip.skeleton.num_joints}-joint skeleton "
             f"({', '.join(clip.skeleton.names[:4])}…), not the puppet's {skeleton.num_joints} joints: "
-            "retarget it (cycle --retarget puppet, or clips add does it for BVH/glTF sources)")
+            "retarget it (cycle --retarget puppet, or clips add does it for BVH/glTF sources)"
+        )
     spec = ROLES.get(role)
     if spec is None:
         return
     if spec.loop is True and not clip.loop:
-        raise RoleError(f"a {role} must be a loop and {clip.name!r} is not one: "
-                        "extract a cycle with `puppetphone cycle`")
+        raise RoleError(
+            f"a {role} must be a loop and {clip.name!r} is not one: extract a cycle with `puppetphone cycle`"
+        )
     if spec.loop is True:
         if clip.num_frames < 8:
             raise RoleError(f"{clip.name!r} has {clip.num_frames} frames; a {role} cycle needs at least 8")
         seam, step, joint = _seam_jump(clip)
         if seam > max(_SEAM_FACTOR * step, 2.0):
-            raise RoleError(f"{clip.name!r} does not loop: its last frame jumps {seam:.0f}° at {joint} back to "
-                            f"the first (its steps inside are up to {step:.1f}°)")
+            raise RoleError(
+                f"{clip.name!r} does not loop: its last frame jumps {seam:.0f}° at {joint} back to "
+                f"the first (its steps inside are up to {step:.1f}°)"
+            )
     if spec.speed is not None:
         lo, hi = spec.speed
         v = _ground_speed(clip)
@@ -134,13 +147,17 @@ def check_role(clip: Clip, role: str, skeleton: Skeleton) -> None:
         crouched = h < _CROUCH_FRACTION * stand
         if crouched != spec.crouched:
             pose = "crouched" if crouched else "standing"
-            raise RoleError(f"a {role} is {'crouched' if spec.crouched else 'standing'} and {clip.name!r} is {pose}: "
-                            f"hips at {h:.2f} m of the puppet's {stand:.2f} m")
+            raise RoleError(
+                f"a {role} is {'crouched' if spec.crouched else 'standing'} and {clip.name!r} is {pose}: "
+                f"hips at {h:.2f} m of the puppet's {stand:.2f} m"
+            )
     if role in TRAVELLING:
         contacts = foot_contacts(_with_travel_root_motion(_facing_travel(clip)), max_speed=0.6)
         if not contacts[:, 0].any() or not contacts[:, 1].any():
-            raise RoleError(f"a {role} plants both feet in turn; in {clip.name!r} "
-                            f"{'the left' if not contacts[:, 0].any() else 'the right'} foot never touches the ground")
+            raise RoleError(
+                f"a {role} plants both feet in turn; in {clip.name!r} "
+                f"{'the left' if not contacts[:, 0].any() else 'the right'} foot never touches the ground"
+            )
 
 
 def _yaw_quat(angle: float) -> np.ndarray:
@@ -222,5 +239,6 @@ def check_set(clips: dict[str, Clip]) -> None:
     speeds = {r: _ground_speed(clips[r]) for r in CYCLIC if r in clips}
     for slow, fast in (("idle", "walk"), ("walk", "run"), ("crouch_idle", "crouch_walk")):
         if slow in speeds and fast in speeds and not speeds[slow] < speeds[fast]:
-            raise RoleError(f"the {slow} ({speeds[slow]:.2f} m/s) must be slower than the {fast} "
-                            f"({speeds[fast]:.2f} m/s)")
+            raise RoleError(
+                f"the {slow} ({speeds[slow]:.2f} m/s) must be slower than the {fast} ({speeds[fast]:.2f} m/s)"
+            )

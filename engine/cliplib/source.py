@@ -23,8 +23,14 @@ SOURCE_SUFFIXES = suffixes(skeletal=True, readable=True)
 """What ``clips add`` reads: every clip format of :data:`engine.io.formats.FORMATS`."""
 
 
-def read_motion(path: str | Path, animation: int | str | None = None, units: str | None = None,
-                joint_map: dict[str, str] | None = None, up: str | None = None, height: float | None = None) -> Clip:
+def read_motion(
+    path: str | Path,
+    animation: int | str | None = None,
+    units: str | None = None,
+    joint_map: dict[str, str] | None = None,
+    up: str | None = None,
+    height: float | None = None,
+) -> Clip:
     """The clip in ``path`` (a glTF's chosen animation; a CMU BVH without its T-pose lead-in).
 
     A file that already is a loop (``cycle -o loop.bvh`` closes its loop with the first
@@ -37,9 +43,14 @@ def read_motion(path: str | Path, animation: int | str | None = None, units: str
     return read_source(path, animation, units, joint_map, up, height)[0]
 
 
-def read_source(path: str | Path, animation: int | str | None = None, units: str | None = None,
-                joint_map: dict[str, str] | None = None, up: str | None = None,
-                height: float | None = None) -> tuple[Clip, str | None]:
+def read_source(
+    path: str | Path,
+    animation: int | str | None = None,
+    units: str | None = None,
+    joint_map: dict[str, str] | None = None,
+    up: str | None = None,
+    height: float | None = None,
+) -> tuple[Clip, str | None]:
     """:func:`read_motion`'s clip and the note to show the user about its size (``None``: read in a unit as a human).
 
     The note is :attr:`~engine.io.motion_file.MotionFile.unit_note`: a figure scaled to a
@@ -48,8 +59,9 @@ def read_source(path: str | Path, animation: int | str | None = None, units: str
     path = Path(path)
     fmt = motion_format(path)
     if fmt is None or fmt.read is None:
-        raise ValueError(f"{path.name}: unknown motion type {path.suffix.lower()!r}; "
-                         f"use one of {', '.join(SOURCE_SUFFIXES)}")
+        raise ValueError(
+            f"{path.name}: unknown motion type {path.suffix.lower()!r}; use one of {', '.join(SOURCE_SUFFIXES)}"
+        )
     motion = fmt.read(path, animation=animation, units=units, joint_map=joint_map, up=up, height=height)
     return motion.clip, motion.unit_note
 

@@ -152,7 +152,14 @@ def assemble(
         legs.append(leg)
     travel = np.zeros((n, 3)) if intent.travel is None else np.asarray(intent.travel, dtype=np.float64)
     travel = (travel - travel[0]) * np.array([1.0, 0.0, 1.0])
-    carrier = Clip(name, skeleton, fps, travel + np.array([0.0, 1.0, 0.0]), np.tile(quat.IDENTITY, (n, skeleton.num_joints, 1)), loop)
+    carrier = Clip(
+        name,
+        skeleton,
+        fps,
+        travel + np.array([0.0, 1.0, 0.0]),
+        np.tile(quat.IDENTITY, (n, skeleton.num_joints, 1)),
+        loop,
+    )
     root_motion = carrier.extract_root_motion().root_motion
     root = intent.pelvis_pos - travel
     clip = Clip(name, skeleton, fps, root, rot, loop, markers=dict(markers or {}))

@@ -53,8 +53,20 @@ class PoseKey:
 
     def at(self, t: float) -> PoseKey:
         """The same pose at another time (a hold)."""
-        return PoseKey(t, self.pelvis, self.pelvis_ypr, self.spine, self.chest, self.neck, self.head,
-                       self.arms, self.ankles, self.foot_pitch, self.foot_yaw, self.hand)
+        return PoseKey(
+            t,
+            self.pelvis,
+            self.pelvis_ypr,
+            self.spine,
+            self.chest,
+            self.neck,
+            self.head,
+            self.arms,
+            self.ankles,
+            self.foot_pitch,
+            self.foot_yaw,
+            self.hand,
+        )
 
 
 _FIELDS = ("pelvis", "pelvis_ypr", "spine", "chest", "neck", "head", "arms", "ankles", "foot_pitch", "foot_yaw", "hand")

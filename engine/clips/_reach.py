@@ -45,7 +45,9 @@ def lower_to_reach(
     allowed = np.full(len(y), np.inf)
     for s, side in enumerate(("l", "r")):
         up = skeleton.index(f"{side}_upper_leg")
-        length = sum(float(np.linalg.norm(skeleton.offsets[skeleton.index(f"{side}_{b}")])) for b in ("lower_leg", "foot"))
+        length = sum(
+            float(np.linalg.norm(skeleton.offsets[skeleton.index(f"{side}_{b}")])) for b in ("lower_leg", "foot")
+        )
         hip_off = quat.rotate(pelvis_rot, skeleton.offsets[up])
         hip = pelvis_pos + hip_off
         horiz2 = np.sum((ankles[:, s, [0, 2]] - hip[:, [0, 2]]) ** 2, axis=-1)

@@ -60,8 +60,17 @@ def contact_sheet(clips: Mapping[str, Clip], path: str | Path, frames: int = 8) 
                     ax.plot([sign * p[a, h] + shift, sign * p[b, h] + shift], [p[a, 1], p[b, 1]], color=c, lw=1.6)
                 for s, c in ((0, "tab:blue"), (1, "tab:red")):
                     heel, toe = soles[f, s]
-                    ax.plot([sign * p[feet[s], h] + shift, sign * heel[h] + shift, sign * toe[h] + shift,
-                             sign * p[feet[s], h] + shift], [p[feet[s], 1], heel[1], toe[1], p[feet[s], 1]], color=c, lw=1.2)
+                    ax.plot(
+                        [
+                            sign * p[feet[s], h] + shift,
+                            sign * heel[h] + shift,
+                            sign * toe[h] + shift,
+                            sign * p[feet[s], h] + shift,
+                        ],
+                        [p[feet[s], 1], heel[1], toe[1], p[feet[s], 1]],
+                        color=c,
+                        lw=1.2,
+                    )
                     if contact[f, s]:
                         ax.plot(sign * 0.5 * (heel[h] + toe[h]) + shift, -0.04, marker="^", color=c, ms=5)
                 ax.add_patch(Circle((sign * p[head, h] + shift, p[head, 1] + 0.1), 0.1, fill=False, color="0.2"))
@@ -71,9 +80,12 @@ def contact_sheet(clips: Mapping[str, Clip], path: str | Path, frames: int = 8) 
             ax.set_ylim(-0.2, 2.0)
             ax.set_xlim(-0.8, gap * (frames - 1) + 0.8)
             slide = foot_sliding(clip, contact)
-            ax.set_title(f"{name} ({'side, facing right' if col == 0 else 'front'}): {clip.num_frames} frames @ "
-                         f"{clip.fps:g} fps, {clip.average_speed():.2f} m/s, foot sliding "
-                         f"{1000 * slide[0]:.1f}/{1000 * slide[1]:.1f} mm/s", fontsize=9)
+            ax.set_title(
+                f"{name} ({'side, facing right' if col == 0 else 'front'}): {clip.num_frames} frames @ "
+                f"{clip.fps:g} fps, {clip.average_speed():.2f} m/s, foot sliding "
+                f"{1000 * slide[0]:.1f}/{1000 * slide[1]:.1f} mm/s",
+                fontsize=9,
+            )
             ax.tick_params(labelsize=6)
     fig.tight_layout()
     out = Path(path)

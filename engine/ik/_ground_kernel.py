@@ -58,8 +58,7 @@ def _q(a: F, i: int) -> tuple[float, float, float, float]:
 
 
 @njit
-def legs_fk(parents: I, roots: F, rots: F, offs: F, legs: I, soles: F,
-            ankles: F, qfeet: F, hips: F, sole: F) -> None:
+def legs_fk(parents: I, roots: F, rots: F, offs: F, legs: I, soles: F, ankles: F, qfeet: F, hips: F, sole: F) -> None:
     """Fill ``ankles``/``hips``/``sole [P,L,3]`` and ``qfeet [P,L,4]`` for legs ``legs [L,3]`` (upper, lower, foot)."""
     n = rots.shape[1]
     pos, wrot = np.empty((n, 3)), np.empty((n, 4))
@@ -78,8 +77,21 @@ def legs_fk(parents: I, roots: F, rots: F, offs: F, legs: I, soles: F,
 
 
 @njit
-def legs_targets(sole: F, qfeet: F, height: F, normal: F, weight: F, soles: F, tips: F, heels: F,
-                 align_height: float, contact_height: float, targets: F, new_rot: F, floor: F) -> None:
+def legs_targets(
+    sole: F,
+    qfeet: F,
+    height: F,
+    normal: F,
+    weight: F,
+    soles: F,
+    tips: F,
+    heels: F,
+    align_height: float,
+    contact_height: float,
+    targets: F,
+    new_rot: F,
+    floor: F,
+) -> None:
     """Feet turned to the slope (``new_rot``), ankle ``targets`` at the clip's clearance over the ground
     and lifted out of it, and the ``floor`` point under each sole, all ``[P, L, …]``."""
     for p in range(sole.shape[0]):
@@ -112,8 +124,9 @@ def _angle(u: tuple[float, float, float], v: tuple[float, float, float]) -> floa
 
 
 @njit
-def _about(point: tuple[float, float, float], centre: tuple[float, float, float],
-           q: tuple[float, float, float, float]) -> tuple[float, float, float]:
+def _about(
+    point: tuple[float, float, float], centre: tuple[float, float, float], q: tuple[float, float, float, float]
+) -> tuple[float, float, float]:
     d = qrot(q, (point[0] - centre[0], point[1] - centre[1], point[2] - centre[2]))
     return (centre[0] + d[0], centre[1] + d[1], centre[2] + d[2])
 
@@ -124,8 +137,18 @@ def _sub(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[
 
 
 @njit
-def _solve_limb(parents: I, pos: F, wrot: F, rot: F, ia: int, ib: int, ic: int, target: tuple[float, float, float],
-                pole: tuple[float, float, float], end: tuple[float, float, float, float]) -> None:
+def _solve_limb(
+    parents: I,
+    pos: F,
+    wrot: F,
+    rot: F,
+    ia: int,
+    ib: int,
+    ic: int,
+    target: tuple[float, float, float],
+    pole: tuple[float, float, float],
+    end: tuple[float, float, float, float],
+) -> None:
     """:func:`engine.ik._limb.solve_limb` with a pole and an end rotation, weight 1, on FK'd ``pos``/``wrot``;
     writes the three local rotations into ``rot``."""
     a, b, c = _v(pos, ia), _v(pos, ib), _v(pos, ic)
@@ -175,8 +198,20 @@ def _solve_limb(parents: I, pos: F, wrot: F, rot: F, ia: int, ib: int, ic: int, 
 
 
 @njit
-def legs_solve(parents: I, roots: F, rots: F, offs: F, legs: I, knees: F, targets: F, new_rot: F, ankles: F,
-               hips: F, max_pelvis_shift: float, shift: F) -> None:
+def legs_solve(
+    parents: I,
+    roots: F,
+    rots: F,
+    offs: F,
+    legs: I,
+    knees: F,
+    targets: F,
+    new_rot: F,
+    ankles: F,
+    hips: F,
+    max_pelvis_shift: float,
+    shift: F,
+) -> None:
     """Shift each pelvis (``roots`` and ``shift [P]`` written) and solve every leg onto its target, in place."""
     n = rots.shape[1]
     pos, wrot = np.empty((n, 3)), np.empty((n, 4))
@@ -211,9 +246,23 @@ def _smooth(w: float) -> float:
 
 
 @njit
-def lock_group(idx: I, targets: F, new_rot: F, floor: F, tips: F, dt: float, settings: F, points: F, weights: F,
-               planted: NDArray[np.bool_], stepping: NDArray[np.bool_], yaw: F, animated: F, contacts: F,
-               settle: NDArray[np.bool_]) -> None:
+def lock_group(
+    idx: I,
+    targets: F,
+    new_rot: F,
+    floor: F,
+    tips: F,
+    dt: float,
+    settings: F,
+    points: F,
+    weights: F,
+    planted: NDArray[np.bool_],
+    stepping: NDArray[np.bool_],
+    yaw: F,
+    animated: F,
+    contacts: F,
+    settle: NDArray[np.bool_],
+) -> None:
     """:func:`engine.ik.grounding._lock_group` and :func:`engine.ik.foot_lock.lock_feet` for puppets ``idx``
     (lock state ``[G, L, …]`` advanced in place; their ``targets``/``new_rot`` rows moved to the locks).
 
@@ -258,8 +307,9 @@ def lock_group(idx: I, targets: F, new_rot: F, floor: F, tips: F, dt: float, set
                 weights[g, k] = 1.0
             dx, dz = points[g, k, 0] - toe[k, 0], points[g, k, 2] - toe[k, 2]
             gap[k] = math.sqrt(dx * dx + dz * dz) + 0.15 * (0.0 if start[k] else twist[k])
-            misplaced[k] = ((planted[g, k] or start[k]) and st and still[k]
-                            and (gap[k] > settle_gap or twist[k] > settle_twist))
+            misplaced[k] = (
+                (planted[g, k] or start[k]) and st and still[k] and (gap[k] > settle_gap or twist[k] > settle_twist)
+            )
         far = 0.0
         for k in range(legs):
             far = max(far, gap[k] if misplaced[k] else 0.0)

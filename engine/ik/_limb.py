@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.ik._scalar import (
-    Q,
     Q_ID,
+    Q,
     V,
     add,
     between,

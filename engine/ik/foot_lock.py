@@ -79,8 +79,16 @@ class FootLock:
 
     def settings(self) -> tuple[float, ...]:
         """The lock's tuning (not its state): puppets that share it are locked in one array pass."""
-        return (self.release_time, self.max_stretch, self.release_height, self.settle_gap, self.max_twist,
-                self.settle_twist, self.step_time, self.step_height)
+        return (
+            self.release_time,
+            self.max_stretch,
+            self.release_height,
+            self.settle_gap,
+            self.max_twist,
+            self.settle_twist,
+            self.step_time,
+            self.step_height,
+        )
 
 
 _TOE = 0.15  # m from the ankle to the toe tip: what a turn of the foot moves its end by, per radian
@@ -91,9 +99,20 @@ def smoothstep(w: F) -> F:
     return w * w * (3.0 - 2.0 * w)
 
 
-def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArray[np.bool_], toes: F, contacts: F,
-              clearance: F, twist: F, settle: NDArray[np.bool_], still: NDArray[np.bool_], dt: float, lock: FootLock) -> tuple[F, F, NDArray[np.bool_],
-                                                                                            NDArray[np.bool_], F]:
+def lock_feet(
+    points: F,
+    weights: F,
+    planted: NDArray[np.bool_],
+    stepping: NDArray[np.bool_],
+    toes: F,
+    contacts: F,
+    clearance: F,
+    twist: F,
+    settle: NDArray[np.bool_],
+    still: NDArray[np.bool_],
+    dt: float,
+    lock: FootLock,
+) -> tuple[F, F, NDArray[np.bool_], NDArray[np.bool_], F]:
     """Advance the locks one step and say where each toe should go.
 
     Args:
@@ -146,8 +165,11 @@ def lock_feet(points: F, weights: F, planted: NDArray[np.bool_], stepping: NDArr
     progress = 1.0 - weights
     along = np.where(stepping, 1.0 - smoothstep(np.clip((progress - 0.25) / 0.5, 0.0, 1.0)), smoothstep(weights))
     targets = toes + along[..., None] * (points - toes)
-    lift = np.where(stepping, np.sin(np.pi * progress) * np.minimum(0.5 * gap + 0.04, lock.step_height),
-                    np.where(fading, 4.0 * weights * (1.0 - weights) * np.minimum(0.5 * gap, lock.step_height), 0.0))
+    lift = np.where(
+        stepping,
+        np.sin(np.pi * progress) * np.minimum(0.5 * gap + 0.04, lock.step_height),
+        np.where(fading, 4.0 * weights * (1.0 - weights) * np.minimum(0.5 * gap, lock.step_height), 0.0),
+    )
     targets[..., 1] = toes[..., 1] + lift
     return points, weights, planted, stepping, targets
 

@@ -26,13 +26,21 @@ from numpy.typing import ArrayLike, NDArray
 from engine import jit, quat
 from engine.ik import _ground_kernel as _kernel
 from engine.ik._limb import solve_limb
-from engine.ik.foot_lock import FootLock, floor_lift, lock_feet, smoothstep
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
 from engine.ik._vec import path_fk
+from engine.ik.foot_lock import FootLock, floor_lift, lock_feet, smoothstep
 from engine.pose import Pose
 from engine.skeleton import Skeleton
 
-__all__ = ["GroundQuery", "PlaneGround", "HeightfieldGround", "Leg", "HUMANOID_LEGS", "ground_feet", "ground_feet_batch"]
+__all__ = [
+    "GroundQuery",
+    "PlaneGround",
+    "HeightfieldGround",
+    "Leg",
+    "HUMANOID_LEGS",
+    "ground_feet",
+    "ground_feet_batch",
+]
 
 F = NDArray[np.float64]
 GroundQuery = Callable[[F, F], tuple[F, F]]
@@ -103,8 +111,17 @@ HUMANOID_LEGS: tuple[Leg, ...] = (
 )
 
 
-def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_rot: F, floor: F, normal: F,
-                   locks: Sequence[FootLock | None] | None, dt: float, weight: F) -> F:
+def _lock_and_lift(
+    skeleton: Skeleton,
+    legs: tuple[Leg, ...],
+    targets: F,
+    new_rot: F,
+    floor: F,
+    normal: F,
+    locks: Sequence[FootLock | None] | None,
+    dt: float,
+    weight: F,
+) -> F:
     """Ankle targets ``[P, L, 3]`` with no toe or heel under the ground and planted feet locked
     (position and heading: ``new_rot [P, L, 4]``, the feet's rotations, is turned in place).
 
@@ -128,8 +145,9 @@ def _lock_and_lift(skeleton: Skeleton, legs: tuple[Leg, ...], targets: F, new_ro
     return targets
 
 
-def _apply_locks(locks: Sequence[FootLock | None], targets: F, new_rot: F, toes: F, floor: F, tips: F,
-                 dt: float) -> None:
+def _apply_locks(
+    locks: Sequence[FootLock | None], targets: F, new_rot: F, toes: F, floor: F, tips: F, dt: float
+) -> None:
     """Hold planted toes where they landed: ``targets`` and ``new_rot`` changed in place, the locks advanced."""
     groups: dict[tuple[float, ...], list[int]] = {}
     for p, lock in enumerate(locks):
@@ -150,8 +168,9 @@ def _fit_lock(lock: FootLock, toes: F) -> None:
         lock.yaw = np.full(count, np.nan)
 
 
-def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, toes: F, floor: F, tips: F,
-                dt: float) -> None:
+def _lock_group(
+    idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, toes: F, floor: F, tips: F, dt: float
+) -> None:
     """Lock the feet of puppets ``idx`` (their ``group`` of locks, one setting) in place, as arrays ``[G, L]``."""
     if jit.enabled():
         _lock_group_compiled(idx, group, targets, new_rot, floor, tips, dt)
@@ -169,17 +188,28 @@ def _lock_group(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_r
     still = np.linalg.norm((toe - animated)[..., [0, 2]], axis=-1) <= _STILL * max(dt, 1e-9)
     contacts = np.stack([np.broadcast_to(np.asarray(g.contacts, dtype=np.float64), (tips.shape[0],)) for g in group])
     points, weights, planted, stepping, placed = lock_feet(
-        np.stack([g.points for g in group]), weights, np.stack([g.planted for g in group]),
-        np.stack([g.stepping for g in group]), toe, contacts, toe[..., 1] - floor[idx, :, 1], np.abs(twist),
-        np.array([g.settle for g in group]), still, dt, group[0])
+        np.stack([g.points for g in group]),
+        weights,
+        np.stack([g.planted for g in group]),
+        np.stack([g.stepping for g in group]),
+        toe,
+        contacts,
+        toe[..., 1] - floor[idx, :, 1],
+        np.abs(twist),
+        np.array([g.settle for g in group]),
+        still,
+        dt,
+        group[0],
+    )
     for k, g in enumerate(group):
         g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
         g.yaw, g.animated = held_yaw[k], toe[k].copy()
     targets[idx] += placed - toe
 
 
-def _lock_group_compiled(idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, floor: F, tips: F,
-                         dt: float) -> None:
+def _lock_group_compiled(
+    idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, floor: F, tips: F, dt: float
+) -> None:
     """:func:`_lock_group` on the compiled kernel: the locks' state gathered into ``[G, L]`` arrays, one pass,
     each lock given its rows back."""
     legs = tips.shape[0]
@@ -194,9 +224,23 @@ def _lock_group_compiled(idx: NDArray[np.int64], group: list[FootLock], targets:
     stepping = np.array([g.stepping for g in group], dtype=bool)
     yaw, animated = np.array([g.yaw for g in group]), np.array([g.animated for g in group])
     settle = np.array([g.settle for g in group], dtype=bool)
-    _kernel.lock_group(np.asarray(idx, dtype=np.int64), targets, new_rot, np.ascontiguousarray(floor),
-                       np.ascontiguousarray(tips, dtype=np.float64), dt, np.array(group[0].settings()), points,
-                       weights, planted, stepping, yaw, animated, contacts, settle)
+    _kernel.lock_group(
+        np.asarray(idx, dtype=np.int64),
+        targets,
+        new_rot,
+        np.ascontiguousarray(floor),
+        np.ascontiguousarray(tips, dtype=np.float64),
+        dt,
+        np.array(group[0].settings()),
+        points,
+        weights,
+        planted,
+        stepping,
+        yaw,
+        animated,
+        contacts,
+        settle,
+    )
     for k, g in enumerate(group):
         g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
         g.yaw, g.animated = yaw[k], animated[k]
@@ -268,8 +312,17 @@ def ground_feet(
         targets.append(sub((s[0], h * weight + ch, s[2]), qrot(r, leg.sole)))
     floor = np.array([[(sl[0], h * weight, sl[2]) for sl, h in zip(sole, height, strict=True)]])
     rotations = np.array([new_rot])
-    fixed = _lock_and_lift(skeleton, legs, np.array([targets]), rotations, floor, np.array([normal]),
-                           None if lock is None else [lock], dt, np.array([weight]))[0]
+    fixed = _lock_and_lift(
+        skeleton,
+        legs,
+        np.array([targets]),
+        rotations,
+        floor,
+        np.array([normal]),
+        None if lock is None else [lock],
+        dt,
+        np.array([weight]),
+    )[0]
     targets = [tuple(t) for t in fixed.tolist()]
     new_rot = [tuple(r) for r in rotations[0].tolist()]
     # Pelvis: follow the lowest foot (negative into dips, positive onto steps).
@@ -327,8 +380,21 @@ def ground_feet_batch(
     off = skeleton.offsets if offsets is None else np.asarray(offsets, dtype=np.float64)
     idx = [(skeleton.index(leg.upper), skeleton.index(leg.lower), skeleton.index(leg.foot)) for leg in legs]
     if jit.enabled():
-        return _ground_compiled(skeleton, roots, rotations, ground, legs, off, idx, align_height, contact_height,
-                                max_pelvis_shift, w, locks, dt)
+        return _ground_compiled(
+            skeleton,
+            roots,
+            rotations,
+            ground,
+            legs,
+            off,
+            idx,
+            align_height,
+            contact_height,
+            max_pelvis_shift,
+            w,
+            locks,
+            dt,
+        )
     soles = np.array([leg.sole for leg in legs])
     ankle, qfoot, hip = [], [], []
     for u, _, f in idx:
@@ -350,8 +416,10 @@ def ground_feet_batch(
     targets = _lock_and_lift(skeleton, legs, flat - quat.rotate(new_rot, soles), new_rot, floor, normal, locks, dt, w)
     shift = np.clip(np.min(targets[..., 1] - ankles[..., 1], axis=1), -max_pelvis_shift, max_pelvis_shift)
     offs = np.broadcast_to(off, rotations.shape[:-2] + off.shape[-2:])
-    lengths = np.stack([np.linalg.norm(offs[..., lo, :], axis=-1) + np.linalg.norm(offs[..., f, :], axis=-1)
-                        for _, lo, f in idx], axis=-1)
+    lengths = np.stack(
+        [np.linalg.norm(offs[..., lo, :], axis=-1) + np.linalg.norm(offs[..., f, :], axis=-1) for _, lo, f in idx],
+        axis=-1,
+    )
     shift = _reach_shift(np.stack(hip, axis=1), targets, lengths, shift, max_pelvis_shift)
     roots[:, 1] += shift
     hips = {int(skeleton.parents[u]) for u, _, _ in idx}
@@ -366,9 +434,21 @@ def ground_feet_batch(
     return shift
 
 
-def _ground_compiled(skeleton: Skeleton, roots: F, rotations: F, ground: GroundQuery, legs: tuple[Leg, ...], off: F,
-                     idx: list[tuple[int, int, int]], align_height: float, contact_height: float,
-                     max_pelvis_shift: float, w: F, locks: Sequence[FootLock | None] | None, dt: float) -> F:
+def _ground_compiled(
+    skeleton: Skeleton,
+    roots: F,
+    rotations: F,
+    ground: GroundQuery,
+    legs: tuple[Leg, ...],
+    off: F,
+    idx: list[tuple[int, int, int]],
+    align_height: float,
+    contact_height: float,
+    max_pelvis_shift: float,
+    w: F,
+    locks: Sequence[FootLock | None] | None,
+    dt: float,
+) -> F:
     """:func:`ground_feet_batch` on the compiled kernels (:mod:`engine.ik._ground_kernel`); the locks in numpy."""
     p, n = rotations.shape[0], len(legs)
     given_roots, given_rotations = roots, rotations  # the kernels write C-contiguous doubles; copied back below
@@ -388,13 +468,38 @@ def _ground_compiled(skeleton: Skeleton, roots: F, rotations: F, ground: GroundQ
     if not (np.all(np.isfinite(height)) and np.all(np.isfinite(normal))):
         raise ValueError("ground query returned non-finite values")
     targets, new_rot, floor = np.empty((p, n, 3)), np.empty((p, n, 4)), np.empty((p, n, 3))
-    _kernel.legs_targets(sole, qfeet, height, normal, np.ascontiguousarray(w), soles, tips, heels, align_height,
-                         contact_height, targets, new_rot, floor)
+    _kernel.legs_targets(
+        sole,
+        qfeet,
+        height,
+        normal,
+        np.ascontiguousarray(w),
+        soles,
+        tips,
+        heels,
+        align_height,
+        contact_height,
+        targets,
+        new_rot,
+        floor,
+    )
     if locks is not None:
         _apply_locks(locks, targets, new_rot, targets + quat.rotate(new_rot, tips), floor, tips, dt)
     shift = np.empty(p)
-    _kernel.legs_solve(skeleton.parents, roots, rotations, offs, leg_idx, knees, targets, new_rot, ankles, hips,
-                       max_pelvis_shift, shift)
+    _kernel.legs_solve(
+        skeleton.parents,
+        roots,
+        rotations,
+        offs,
+        leg_idx,
+        knees,
+        targets,
+        new_rot,
+        ankles,
+        hips,
+        max_pelvis_shift,
+        shift,
+    )
     if roots is not given_roots:
         given_roots[...] = roots
     if rotations is not given_rotations:
@@ -402,8 +507,17 @@ def _ground_compiled(skeleton: Skeleton, roots: F, rotations: F, ground: GroundQ
     return shift
 
 
-def _solve_legs(skeleton: Skeleton, roots: F, rotations: F, off: F, hip: int, idx: list[tuple[int, int, int]],
-                legs: tuple[Leg, ...], targets: F, new_rot: F) -> None:
+def _solve_legs(
+    skeleton: Skeleton,
+    roots: F,
+    rotations: F,
+    off: F,
+    hip: int,
+    idx: list[tuple[int, int, int]],
+    legs: tuple[Leg, ...],
+    targets: F,
+    new_rot: F,
+) -> None:
     """Every leg of every puppet in one batched two-bone solve.
 
     The legs hang from one joint, so each is a chain ``hip → upper → lower → foot`` of its
@@ -427,6 +541,13 @@ def _solve_legs(skeleton: Skeleton, roots: F, rotations: F, off: F, hip: int, id
     lp, lr = path_fk(chain, root, leg_rot, 2, leg_off)
     knee = np.array([leg.knee_forward for leg in legs])[:, None, :]
     pole = lp[2] + quat.rotate(lr[0], knee)
-    two_bone_ik(chain, pose, (1, 2, 3), np.moveaxis(targets, 1, 0), pole,
-                end_rotation=np.moveaxis(new_rot, 1, 0), offsets=leg_off)
+    two_bone_ik(
+        chain,
+        pose,
+        (1, 2, 3),
+        np.moveaxis(targets, 1, 0),
+        pole,
+        end_rotation=np.moveaxis(new_rot, 1, 0),
+        offsets=leg_off,
+    )
     rotations[..., chains, :] = np.moveaxis(leg_rot[..., 1:, :], 0, -2)

@@ -14,17 +14,16 @@ since numpy's per-call cost made this stage 10 ms per puppet.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine.ik._limb import solve_limb
 from engine.ik._scalar import (
-    Q,
     Q_ID,
+    Q,
     V,
     add,
     chain_fk,

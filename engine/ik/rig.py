@@ -120,17 +120,17 @@ class IKRig:
             anc[j, j] = True
             if skeleton.parents[j] >= 0:
                 anc[j] |= anc[skeleton.parents[j]]
-        arrays = dict(
-            kinds=kinds,
-            axes=axes,
-            lower=np.array(lo),
-            upper=np.array(hi),
-            stiffness=np.array(st),
-            dof_joint=np.array(dof_joint, dtype=np.int64),
-            dof_slot=np.array(dof_slot, dtype=np.int64),
-            dof_translation=np.array(dof_trans, dtype=bool),
-            ancestors=anc,
-        )
+        arrays = {
+            "kinds": kinds,
+            "axes": axes,
+            "lower": np.array(lo),
+            "upper": np.array(hi),
+            "stiffness": np.array(st),
+            "dof_joint": np.array(dof_joint, dtype=np.int64),
+            "dof_slot": np.array(dof_slot, dtype=np.int64),
+            "dof_translation": np.array(dof_trans, dtype=bool),
+            "ancestors": anc,
+        }
         for a in arrays.values():
             a.setflags(write=False)
         return cls(skeleton=skeleton, **arrays)
@@ -210,7 +210,7 @@ def humanoid_rig(skeleton: Skeleton, *, root_translation: bool = False) -> IKRig
         "r_foot": ((-0.8, -0.4, -0.4), (0.9, 0.4, 0.4)),
     }
     limits: dict[str, tuple[ArrayLike, ArrayLike]] = dict(ball)
-    limits.update({k: (0.0, 2.6) for k in ("l_lower_leg", "r_lower_leg", "l_lower_arm", "r_lower_arm")})
+    limits.update(dict.fromkeys(("l_lower_leg", "r_lower_leg", "l_lower_arm", "r_lower_arm"), (0.0, 2.6)))
     stiff = {"hips": 6.0, "spine": 4.0, "chest": 4.0, "neck": 2.0, "head": 2.0}
     hinges = {"l_lower_leg": (1, 0, 0), "r_lower_leg": (1, 0, 0), "l_lower_arm": (-1, 0, 0), "r_lower_arm": (-1, 0, 0)}
     return IKRig.build(skeleton, hinges=hinges, limits=limits, stiffness=stiff, root_translation=root_translation)

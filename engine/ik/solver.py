@@ -175,7 +175,7 @@ def solve_ik(
     prob = _Problem(rig, tuple(effectors), tuple(pins))
     cols = prob.columns
     c, pre = rig.to_coordinates(root0, rot0)
-    stiff2 = (settings.w_d * rig.stiffness[cols] ** 2 + settings.regularization)
+    stiff2 = settings.w_d * rig.stiffness[cols] ** 2 + settings.regularization
 
     def evaluate(cc: F) -> tuple[F, F, F, F, F]:
         r, q = rig.to_pose(cc, pre, root0)

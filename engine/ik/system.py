@@ -87,7 +87,6 @@ class IKRigCache:
             self.rigs[key] = cached
         return cached
 
-
     def same_as(self, skeleton: Skeleton) -> Skeleton:
         """The first skeleton seen equal to ``skeleton`` (puppets spawned alike share one batch)."""
         found = self.canonical.get(id(skeleton))
@@ -98,8 +97,12 @@ class IKRigCache:
 
 
 def _same(a: Skeleton, b: Skeleton) -> bool:
-    return (a.names == b.names and np.array_equal(a.parents, b.parents) and np.array_equal(a.offsets, b.offsets)
-            and np.array_equal(a.tips, b.tips))
+    return (
+        a.names == b.names
+        and np.array_equal(a.parents, b.parents)
+        and np.array_equal(a.offsets, b.offsets)
+        and np.array_equal(a.tips, b.tips)
+    )
 
 
 def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]], cache: IKRigCache) -> set[int]:
@@ -121,8 +124,16 @@ def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]
         rots = np.array([local.rotations for _, local, _ in group], dtype=np.float64)
         offsets = np.array([p.joint_offsets() for p, _, _ in group])
         weights = np.array([req.grounding_weight for _, _, req in group])
-        shift = ground_feet_batch(sk, roots, rots, query, offsets=offsets, weight=weights,
-                                  locks=[req.foot_lock for _, _, req in group], dt=world.dt)
+        shift = ground_feet_batch(
+            sk,
+            roots,
+            rots,
+            query,
+            offsets=offsets,
+            weight=weights,
+            locks=[req.foot_lock for _, _, req in group],
+            dt=world.dt,
+        )
         finite = np.isfinite(roots).all(axis=1) & np.isfinite(rots).all(axis=(1, 2))
         for i, (puppet, local, req) in enumerate(group):
             done.add(id(req))
@@ -160,8 +171,11 @@ def ik_system(world: World) -> None:
                 pose.rotations[:] = res.rotations if res.reached else res.closest_rotations
         if req.grounding:
             query = ground.query if ground is not None else PlaneGround()
-            req.pelvis_shift = float(ground_feet(sk, pose, query, offsets=offsets, weight=req.grounding_weight,
-                                                 lock=req.foot_lock, dt=world.dt))
+            req.pelvis_shift = float(
+                ground_feet(
+                    sk, pose, query, offsets=offsets, weight=req.grounding_weight, lock=req.foot_lock, dt=world.dt
+                )
+            )
         else:
             req.foot_lock.weights = np.zeros_like(req.foot_lock.weights)
             req.foot_lock.planted = np.zeros_like(req.foot_lock.planted)

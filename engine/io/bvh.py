@@ -24,8 +24,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
+from engine.errors import FormatError
 from engine.npz_safe import read_bounded
 
 if TYPE_CHECKING:
@@ -266,8 +266,14 @@ def parse_bvh(text: str, source: str = "<string>") -> BvhMotion:
         bad = np.argwhere(~(np.abs(data) <= MAX_VALUE))[0]
         raise BvhError(f"{source}: frame {bad[0]} holds a NaN, infinite or absurd value (beyond ±{MAX_VALUE:g})")
     return BvhMotion(
-        tuple(names), np.array(parents, dtype=np.int64), np.array(offsets).reshape(-1, 3),
-        end_sites, tuple(channels), frame_time, data, source,
+        tuple(names),
+        np.array(parents, dtype=np.int64),
+        np.array(offsets).reshape(-1, 3),
+        end_sites,
+        tuple(channels),
+        frame_time,
+        data,
+        source,
     )
 
 
@@ -303,8 +309,12 @@ def _motion_block(lines: list[str], start: int, n_frames: int, width: int, sourc
     if data.size == 0:
         data = np.zeros((0, width))
     if len(data) != n_frames:
-        warnings.warn(BvhWarning(f"{source}: 'Frames: {n_frames}' but the file holds {len(data)} complete frames; "
-                                 f"reading {len(data)}"), stacklevel=3)
+        warnings.warn(
+            BvhWarning(
+                f"{source}: 'Frames: {n_frames}' but the file holds {len(data)} complete frames; reading {len(data)}"
+            ),
+            stacklevel=3,
+        )
     return data
 
 
@@ -348,8 +358,14 @@ def format_bvh(motion: BvhMotion) -> str:
         pad = "  " * depth
         if closing:
             if j in motion.end_sites:
-                out.extend([f"{pad}  End Site", f"{pad}  {{",
-                            f"{pad}    OFFSET {' '.join(_num(v) for v in motion.end_sites[j].tolist())}", f"{pad}  }}"])
+                out.extend(
+                    [
+                        f"{pad}  End Site",
+                        f"{pad}  {{",
+                        f"{pad}    OFFSET {' '.join(_num(v) for v in motion.end_sites[j].tolist())}",
+                        f"{pad}  }}",
+                    ]
+                )
             out.append(pad + "}")
             continue
         visited.append(j)

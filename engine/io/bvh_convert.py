@@ -42,7 +42,6 @@ from engine.skeleton import Skeleton
 __all__ = ["bvh_to_clip", "clip_to_bvh", "detect_unit_scale", "detect_tpose_frames", "skip_leading_tpose"]
 
 
-
 def _replaces_offset(motion: BvhMotion, j: int, axes: list[int], cols: list[int]) -> bool:
     """Whether joint ``j``'s position channels are its translation (True) or added to its OFFSET."""
     off = motion.offsets[j]
@@ -78,7 +77,9 @@ def _local_tracks(
                 order += c[0].lower()
         if pos_axes:
             has_pos[j] = True
-            replace = positions == "replace" or (positions == "auto" and _replaces_offset(motion, j, pos_axes, pos_cols))
+            replace = positions == "replace" or (
+                positions == "auto" and _replaces_offset(motion, j, pos_axes, pos_cols)
+            )
             base = 0.0 if replace else motion.offsets[j, pos_axes]
             trans[:, j, pos_axes] = motion.data[:, pos_cols] + base
         if order:
@@ -96,7 +97,10 @@ def detect_unit_scale(skeleton: Skeleton) -> float:
 
 
 def bvh_to_clip(
-    motion: BvhMotion, scale: float | None = None, skip_frames: int = 0, name: str | None = None,
+    motion: BvhMotion,
+    scale: float | None = None,
+    skip_frames: int = 0,
+    name: str | None = None,
     positions: str = "auto",
 ) -> Clip:
     """A clip of ``motion`` in metres (``scale`` = metres per file unit, auto-detected when ``None``).
@@ -117,7 +121,9 @@ def bvh_to_clip(
     for j, tip in motion.end_sites.items():
         tips[j] = tip
     moves = has_pos & (np.ptp(trans, axis=0).max(axis=1) > 1e-9 * max(1.0, float(np.abs(trans).max())))
-    names, parents, trans, rots, moves, tips = fold_root(list(motion.names), motion.parents.copy(), trans, rots, moves, tips)
+    names, parents, trans, rots, moves, tips = fold_root(
+        list(motion.names), motion.parents.copy(), trans, rots, moves, tips
+    )
     # Non-root joints keep one offset: the mean of their (normally constant) position channels.
     offsets = trans.mean(axis=0)
     offsets[0] = trans[0, 0]  # the root's rest position: where the clip starts
@@ -154,8 +160,9 @@ def clip_to_bvh(clip: Clip, order: str = "ZXY", unit: float = 100.0) -> BvhMotio
     if sorted(order) != ["X", "Y", "Z"]:
         raise ValueError(f"rotation order must be a permutation of XYZ, got {order!r}")
     if clip.scales is not None:
-        warnings.warn(BvhWarning(f"clip {clip.name!r}: BVH has no scale channels; the clip's scale is dropped"),
-                      stacklevel=2)
+        warnings.warn(
+            BvhWarning(f"clip {clip.name!r}: BVH has no scale channels; the clip's scale is dropped"), stacklevel=2
+        )
     sk = clip.skeleton
     perm = _dfs_order(sk.parents)
     inv = np.empty(len(perm), dtype=np.int64)
@@ -183,8 +190,9 @@ def clip_to_bvh(clip: Clip, order: str = "ZXY", unit: float = 100.0) -> BvhMotio
     end_sites = {k: sk.tips[j] * unit for k, j in enumerate(perm) if j in leaves or np.any(sk.tips[j])}
     offsets = sk.offsets[perm] * unit
     offsets[0] = 0.0  # the root's position channels say where it is; a zero OFFSET leaves no doubt
-    return BvhMotion(tuple(sk.names[j] for j in perm), parents, offsets, end_sites,
-                     channels, 1.0 / clip.fps, data, clip.name)
+    return BvhMotion(
+        tuple(sk.names[j] for j in perm), parents, offsets, end_sites, channels, 1.0 / clip.fps, data, clip.name
+    )
 
 
 def detect_tpose_frames(motion: BvhMotion, max_lead: int = 30) -> int:

@@ -75,12 +75,22 @@ def _read_ppclip(path: Path, **options: Any) -> MotionFile:
 
     given = sorted(k for k, v in options.items() if v is not None and k != "joint_map")  # a map retargets any clip
     if given:
-        raise MotionFileError(f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to a "
-                              f"file from another tool ({', '.join(suffixes(foreign=True))})")
+        raise MotionFileError(
+            f"{path}: {', '.join('--' + k.replace('_', '-') for k in given)} only apply to a "
+            f"file from another tool ({', '.join(suffixes(foreign=True))})"
+        )
     clip = load_clip(path)
-    return MotionFile(clip, path, Units("m", 1.0, "a .ppclip is in metres"), "the .ppclip's rate",
-                      up=UpAxis("y", "a .ppclip is Y up"), height=figure_height(clip), seamless=clip.loop,
-                      file_frames=clip.num_frames, file_joints=clip.skeleton.num_joints)
+    return MotionFile(
+        clip,
+        path,
+        Units("m", 1.0, "a .ppclip is in metres"),
+        "the .ppclip's rate",
+        up=UpAxis("y", "a .ppclip is Y up"),
+        height=figure_height(clip),
+        seamless=clip.loop,
+        file_frames=clip.num_frames,
+        file_joints=clip.skeleton.num_joints,
+    )
 
 
 def _write_bvh(clip: Clip, path: Path) -> Path:
@@ -124,13 +134,26 @@ def motion_format(path: str | Path) -> MotionFormat | None:
     return next((f for f in FORMATS.values() if suffix in f.suffixes), None)
 
 
-def suffixes(*, skeletal: bool | None = None, foreign: bool | None = None, readable: bool | None = None,
-             writable: bool | None = None) -> tuple[str, ...]:
+def suffixes(
+    *,
+    skeletal: bool | None = None,
+    foreign: bool | None = None,
+    readable: bool | None = None,
+    writable: bool | None = None,
+) -> tuple[str, ...]:
     """The suffixes of the formats matching every condition given (``None``: either way), in table order."""
+
     def fits(f: MotionFormat) -> bool:
         can_read = f.read is not None if f.skeletal else f.reads
         can_write = f.write is not None if f.skeletal else f.writes
-        return all(want is None or have == want for want, have in ((skeletal, f.skeletal), (foreign, f.foreign),
-                                                                    (readable, can_read), (writable, can_write)))
+        return all(
+            want is None or have == want
+            for want, have in (
+                (skeletal, f.skeletal),
+                (foreign, f.foreign),
+                (readable, can_read),
+                (writable, can_write),
+            )
+        )
 
     return tuple(s for f in FORMATS.values() if fits(f) for s in f.suffixes)

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from engine.errors import FormatError
 from engine import quat
+from engine.errors import FormatError
 from engine.npz_safe import read_bounded
 
 __all__ = ["GltfError", "GltfAsset", "GltfSkin", "GltfChannel", "GltfAnimation", "read_gltf", "parse_glb", "accessor"]
@@ -157,9 +157,10 @@ def _beside(base: Path, uri: Any, what: str) -> Path:
     """
     name = urllib.parse.unquote(uri) if isinstance(uri, str) else ""
     parts = Path(name).parts
-    if (not name or Path(name).is_absolute() or ".." in parts or urllib.parse.urlsplit(uri).scheme
-            or "\\" in name):
-        raise GltfError(f"{what}: uri {str(uri)[:60]!r} is not a file beside the glTF (no absolute paths, schemes or ..)")
+    if not name or Path(name).is_absolute() or ".." in parts or urllib.parse.urlsplit(uri).scheme or "\\" in name:
+        raise GltfError(
+            f"{what}: uri {str(uri)[:60]!r} is not a file beside the glTF (no absolute paths, schemes or ..)"
+        )
     path = base / name
     try:
         inside = path.resolve().is_relative_to(base.resolve())
@@ -364,7 +365,9 @@ def _asset(doc: dict[str, Any], buffers: list[bytes], source: str) -> GltfAsset:
             interp = sampler.get("interpolation", "LINEAR")
             width = {"translation": 3, "scale": 3, "rotation": 4}.get(target["path"])
             if width is not None and values.shape[1] != width:
-                raise GltfError(f"{source}: animation {a}: {target['path']} keys have {values.shape[1]} numbers, not {width}")
+                raise GltfError(
+                    f"{source}: animation {a}: {target['path']} keys have {values.shape[1]} numbers, not {width}"
+                )
             if target["path"] == "rotation":
                 values = quat.from_xyzw(values)
             if interp not in ("LINEAR", "STEP", "CUBICSPLINE"):
@@ -374,7 +377,11 @@ def _asset(doc: dict[str, Any], buffers: list[bytes], source: str) -> GltfAsset:
                 raise GltfError(f"{source}: animation {a}: {len(times)} keys but {len(values)} values")
             chans.append(GltfChannel(int(target["node"]), target["path"], interp, times, values))
         extra = anim.get("extras")
-        anims.append(GltfAnimation(anim.get("name", f"animation{a}"), tuple(chans), dict(extra) if isinstance(extra, dict) else {}))
+        anims.append(
+            GltfAnimation(
+                anim.get("name", f"animation{a}"), tuple(chans), dict(extra) if isinstance(extra, dict) else {}
+            )
+        )
     names = tuple(node.get("name") or f"node{i}" for i, node in enumerate(nodes))
     extras = tuple(dict(node.get("extras", {})) if isinstance(node.get("extras"), dict) else {} for node in nodes)
     return GltfAsset(names, parents, trans, rot, scale, extras, tuple(skins), tuple(anims), source)

@@ -52,8 +52,12 @@ def sample_channel(channel: GltfChannel, t: NDArray[np.float64]) -> F64:
     elif channel.interpolation == "CUBICSPLINE":
         u2, u3 = u * u, u * u * u
         h = [2 * u3 - 3 * u2 + 1, (u3 - 2 * u2 + u) * dt, -2 * u3 + 3 * u2, (u3 - u2) * dt]
-        out = (h[0][:, None] * vals[i, 1] + h[1][:, None] * vals[i, 2]
-               + h[2][:, None] * vals[i + 1, 1] + h[3][:, None] * vals[i + 1, 0])
+        out = (
+            h[0][:, None] * vals[i, 1]
+            + h[1][:, None] * vals[i, 2]
+            + h[2][:, None] * vals[i + 1, 1]
+            + h[3][:, None] * vals[i + 1, 0]
+        )
     elif rotation:
         out = quat.slerp(point[i], point[i + 1], u)
     else:
@@ -171,7 +175,9 @@ def _build(
     tips = np.array([asset.extras[n].get("tip", (0.0, 0.0, 0.0)) for n in nodes], dtype=np.float64) * wscale[:, None]
     radii = [asset.extras[n].get("radius") for n in nodes]
     before = len(nodes)
-    names, parents, trans, rots, moves, tips = fold_root([asset.names[n] for n in nodes], parents, trans, rots, moves, tips)
+    names, parents, trans, rots, moves, tips = fold_root(
+        [asset.names[n] for n in nodes], parents, trans, rots, moves, tips
+    )
     folded = before - len(names)
     if scales is not None:
         if folded and np.abs(scales[:, :folded] - 1.0).max() > 1e-5:
@@ -179,7 +185,7 @@ def _build(
         scales = scales[:, folded:]
     if len(set(names)) != len(names):
         names = [f"{nm}#{k}" if names.count(nm) > 1 else nm for k, nm in enumerate(names)]
-    radii = radii[len(radii) - len(names):]
+    radii = radii[len(radii) - len(names) :]
     r = np.array(radii, dtype=np.float64) * scale if all(isinstance(x, (int, float)) for x in radii) else None
     skeleton = Skeleton(tuple(names), parents, trans[0] * scale, tips * scale, r)  # type: ignore[arg-type]  # None: derived
     own_moves = own_moves[folded:]
@@ -263,8 +269,10 @@ def gltf_clip(
     rate = float(given)
     frames = anim.duration * rate
     if frames * max(asset.num_nodes, 1) > MAX_SAMPLES:  # key times far apart must not allocate gigabytes
-        raise GltfError(f"{asset.source}: animation {anim.name!r} would be {frames:.3g} frames of "
-                        f"{asset.num_nodes} nodes at {rate:g} fps; the limit is {MAX_SAMPLES} node-frames")
+        raise GltfError(
+            f"{asset.source}: animation {anim.name!r} would be {frames:.3g} frames of "
+            f"{asset.num_nodes} nodes at {rate:g} fps; the limit is {MAX_SAMPLES} node-frames"
+        )
     n = int(round(anim.duration * rate)) + 1
     t = np.minimum(anim.start + np.arange(n) / rate, anim.end)
     try:
@@ -277,18 +285,33 @@ def gltf_clip(
             translations = None if translations is None else translations[:-1]
             scales = None if scales is None else scales[:-1]
         markers = anim.extras.get("markers", {})
-        markers = {str(k): float(v) for k, v in markers.items()
-                   if isinstance(v, (int, float)) and math.isfinite(v)} if isinstance(markers, dict) else {}
-        return Clip(str(anim.name), skeleton, rate, root, rots, loop=loop, markers=markers,
-                    translations=translations, scales=scales)
+        markers = (
+            {str(k): float(v) for k, v in markers.items() if isinstance(v, (int, float)) and math.isfinite(v)}
+            if isinstance(markers, dict)
+            else {}
+        )
+        return Clip(
+            str(anim.name),
+            skeleton,
+            rate,
+            root,
+            rots,
+            loop=loop,
+            markers=markers,
+            translations=translations,
+            scales=scales,
+        )
     except GltfError:
         raise
     except (ValueError, IndexError, KeyError, TypeError) as exc:  # a skin or tracks that make no skeleton or clip
-        raise GltfError(f"{asset.source}: animation {anim.name!r} does not make a clip "
-                        f"({type(exc).__name__}: {exc})"[:300]) from None
+        raise GltfError(
+            f"{asset.source}: animation {anim.name!r} does not make a clip ({type(exc).__name__}: {exc})"[:300]
+        ) from None
 
 
-def load_gltf_clips(path: str | os.PathLike[str], fps: float | None = None, skin: int = 0, scale: float = 1.0) -> list[Clip]:
+def load_gltf_clips(
+    path: str | os.PathLike[str], fps: float | None = None, skin: int = 0, scale: float = 1.0
+) -> list[Clip]:
     """Every animation of a ``.glb``/``.gltf`` file as a clip on the file's skin."""
     asset = read_gltf(path)
     return [gltf_clip(asset, k, skin, fps, scale) for k in range(len(asset.animations))]

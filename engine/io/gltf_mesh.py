@@ -73,8 +73,9 @@ def _int(value: Any, what: str, limit: int, source: str) -> int:
     return value
 
 
-def _texture(doc: dict[str, Any], buffers: list[bytes], material: dict[str, Any],
-             source: str) -> NDArray[np.uint8] | None:
+def _texture(
+    doc: dict[str, Any], buffers: list[bytes], material: dict[str, Any], source: str
+) -> NDArray[np.uint8] | None:
     """The base colour image of ``material``, decoded, or None when it has none or it lives outside the file."""
     info = material.get("pbrMetallicRoughness", {}).get("baseColorTexture")
     if info is None:
@@ -96,8 +97,9 @@ def _texture(doc: dict[str, Any], buffers: list[bytes], material: dict[str, Any]
         raise GltfError(f"{source}: a base colour texture cannot be decoded: {exc}") from None
 
 
-def _primitive(doc: dict[str, Any], buffers: list[bytes], prim: dict[str, Any], joints: int,
-               source: str) -> SkinnedPrimitive:
+def _primitive(
+    doc: dict[str, Any], buffers: list[bytes], prim: dict[str, Any], joints: int, source: str
+) -> SkinnedPrimitive:
     attrs = prim.get("attributes", {})
     pos = accessor(doc, buffers, attrs["POSITION"], source)
     v = len(pos)
@@ -123,10 +125,7 @@ def _primitive(doc: dict[str, Any], buffers: list[bytes], prim: dict[str, Any], 
         raise GltfError(f"{source}: {int((total <= 1e-6).sum())} vertices have no skin weight")
     weights = weights / total[:, None]
     normals = per_vertex("NORMAL", 3)
-    if "indices" in prim:
-        idx = accessor(doc, buffers, prim["indices"], source)[:, 0]
-    else:
-        idx = np.arange(v, dtype=np.float64)
+    idx = accessor(doc, buffers, prim["indices"], source)[:, 0] if "indices" in prim else np.arange(v, dtype=np.float64)
     if len(idx) % 3 or len(idx) > 3 * MAX_TRIANGLES or (idx < 0).any() or (idx >= v).any():
         raise GltfError(f"{source}: a primitive's indices are not whole triangles within its {v} vertices")
     if normals is None:
@@ -137,11 +136,15 @@ def _primitive(doc: dict[str, Any], buffers: list[bytes], prim: dict[str, Any], 
     factor = material.get("pbrMetallicRoughness", {}).get("baseColorFactor", [1.0, 1.0, 1.0, 1.0])
     color = np.clip(np.asarray(factor, dtype=np.float64).reshape(4), 0.0, 1.0)
     return SkinnedPrimitive(
-        positions=pos.astype(np.float32), normals=normals.astype(np.float32),
+        positions=pos.astype(np.float32),
+        normals=normals.astype(np.float32),
         uv=(uv if uv is not None else np.zeros((v, 2))).astype(np.float32),
-        joints=joint_idx.astype(np.uint16), weights=weights.astype(np.float32), indices=idx.astype(np.uint32),
+        joints=joint_idx.astype(np.uint16),
+        weights=weights.astype(np.float32),
+        indices=idx.astype(np.uint32),
         color=(float(color[0]), float(color[1]), float(color[2]), float(color[3])),
-        texture=_texture(doc, buffers, material, source))
+        texture=_texture(doc, buffers, material, source),
+    )
 
 
 def _face_normals(pos: NDArray[np.float64], idx: NDArray[np.int64]) -> NDArray[np.float64]:
@@ -157,8 +160,11 @@ def _face_normals(pos: NDArray[np.float64], idx: NDArray[np.int64]) -> NDArray[n
 def _has_texture(doc: dict[str, Any], prim: dict[str, Any]) -> bool:
     materials = doc.get("materials", [])
     m = prim.get("material")
-    return isinstance(m, int) and 0 <= m < len(materials) and \
-        "baseColorTexture" in materials[m].get("pbrMetallicRoughness", {})
+    return (
+        isinstance(m, int)
+        and 0 <= m < len(materials)
+        and "baseColorTexture" in materials[m].get("pbrMetallicRoughness", {})
+    )
 
 
 def read_skinned_meshes(path: str | os.PathLike[str], skin: int = 0) -> SkinnedMeshes:

@@ -28,9 +28,9 @@ import numpy as np
 
 from engine import quat
 from engine.atomic import atomic_write_bytes
-from engine.io.formats import FORMATS
 from engine.clip import Clip
 from engine.fk import forward_kinematics
+from engine.io.formats import FORMATS
 
 __all__ = ["write_gltf", "gltf_bytes", "container_bytes"]
 
@@ -48,8 +48,12 @@ class _Bin:
         data = np.ascontiguousarray(array, dtype="<f4")
         raw = data.tobytes()
         self.views.append({"buffer": 0, "byteOffset": self.size, "byteLength": len(raw)})
-        acc: dict[str, Any] = {"bufferView": len(self.views) - 1, "componentType": 5126, "count": int(len(data)),
-                               "type": kind}
+        acc: dict[str, Any] = {
+            "bufferView": len(self.views) - 1,
+            "componentType": 5126,
+            "count": int(len(data)),
+            "type": kind,
+        }
         if minmax:
             flat = data.reshape(len(data), -1)
             acc["min"] = flat.min(axis=0).astype(float).tolist()
@@ -95,7 +99,9 @@ def _document(clip: Clip) -> tuple[dict[str, Any], bytes]:
     samplers = [{"input": t_acc, "output": buf.add(root, "VEC3"), "interpolation": "LINEAR"}]
     channels = [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]
     for j in range(j_count):
-        samplers.append({"input": t_acc, "output": buf.add(quat.to_xyzw(rots[:, j]), "VEC4"), "interpolation": "LINEAR"})
+        samplers.append(
+            {"input": t_acc, "output": buf.add(quat.to_xyzw(rots[:, j]), "VEC4"), "interpolation": "LINEAR"}
+        )
         channels.append({"sampler": len(samplers) - 1, "target": {"node": j, "path": "rotation"}})
     for j in range(1, j_count):
         if trans is not None and np.ptp(trans[:, j], axis=0).max() > 1e-9:
@@ -103,8 +109,13 @@ def _document(clip: Clip) -> tuple[dict[str, Any], bytes]:
             channels.append({"sampler": len(samplers) - 1, "target": {"node": j, "path": "translation"}})
     for j in range(j_count):
         if scales is not None and np.abs(scales[:, j] - 1.0).max() > 1e-9:
-            samplers.append({"input": t_acc, "output": buf.add(np.repeat(scales[:, j, None], 3, axis=1), "VEC3"),
-                             "interpolation": "LINEAR"})
+            samplers.append(
+                {
+                    "input": t_acc,
+                    "output": buf.add(np.repeat(scales[:, j, None], 3, axis=1), "VEC3"),
+                    "interpolation": "LINEAR",
+                }
+            )
             channels.append({"sampler": len(samplers) - 1, "target": {"node": j, "path": "scale"}})
     blob = buf.blob()
     doc: dict[str, Any] = {
@@ -113,10 +124,14 @@ def _document(clip: Clip) -> tuple[dict[str, Any], bytes]:
         "scenes": [{"nodes": [0]}],
         "nodes": nodes,
         "skins": [{"name": sk.names[0], "joints": list(range(j_count)), "skeleton": 0, "inverseBindMatrices": ibm_acc}],
-        "animations": [{
-            "name": clip.name, "channels": channels, "samplers": samplers,
-            "extras": {"loop": bool(clip.loop), "fps": float(clip.fps), "markers": dict(clip.markers)},
-        }],
+        "animations": [
+            {
+                "name": clip.name,
+                "channels": channels,
+                "samplers": samplers,
+                "extras": {"loop": bool(clip.loop), "fps": float(clip.fps), "markers": dict(clip.markers)},
+            }
+        ],
         "accessors": buf.accessors,
         "bufferViews": buf.views,
         "buffers": [{"byteLength": len(blob)}],
@@ -139,8 +154,15 @@ def container_bytes(doc: dict, blob: bytes, binary: bool) -> bytes:
     js += b" " * ((-len(js)) % 4)
     blob += b"\0" * ((-len(blob)) % 4)
     total = 12 + 8 + len(js) + 8 + len(blob)
-    return b"".join([struct.pack("<4sII", b"glTF", 2, total), struct.pack("<I4s", len(js), b"JSON"), js,
-                     struct.pack("<I4s", len(blob), b"BIN\0"), blob])
+    return b"".join(
+        [
+            struct.pack("<4sII", b"glTF", 2, total),
+            struct.pack("<I4s", len(js), b"JSON"),
+            js,
+            struct.pack("<I4s", len(blob), b"BIN\0"),
+            blob,
+        ]
+    )
 
 
 def write_gltf(path: str | os.PathLike[str], clip: Clip) -> Path:

@@ -72,8 +72,9 @@ def _limb(chain: list[int], pos: F64) -> tuple[int, int, int] | None:
     return chain[i], chain[i + 1], chain[i + 2]
 
 
-def guess_roles_by_shape(names: tuple[str, ...] | list[str], parents: NDArray[np.int64],
-                         positions: F64) -> dict[str, str]:
+def guess_roles_by_shape(
+    names: tuple[str, ...] | list[str], parents: NDArray[np.int64], positions: F64
+) -> dict[str, str]:
     """Puppet role → joint name, from world ``positions [J,3]`` of a pose where the figure stands.
 
     Y up is tried first, then Z up; the first under which the shape is a standing humanoid wins.
@@ -96,15 +97,22 @@ def guess_roles_by_shape(names: tuple[str, ...] | list[str], parents: NDArray[np
             raise y_up from None
 
 
-def _roles(names: tuple[str, ...] | list[str], parents: NDArray[np.int64], pos: F64, kids: list[list[int]],
-           leaves: list[int], up_axis: int) -> dict[str, str]:
+def _roles(
+    names: tuple[str, ...] | list[str],
+    parents: NDArray[np.int64],
+    pos: F64,
+    kids: list[list[int]],
+    leaves: list[int],
+    up_axis: int,
+) -> dict[str, str]:
     height = float(np.ptp(pos[leaves, up_axis]))
     if height <= 0.0:
         raise ValueError("the skeleton is flat: no joint stands above another")
     across = max(float(np.ptp(pos[:, a])) for a in (0, 1, 2) if a != up_axis)
     if height < 0.6 * across:  # even arms spread in a T-pose span about the height
-        raise ValueError(f"the figure is {across / height:.1f} times wider or longer than tall: "
-                         f"not a standing humanoid")
+        raise ValueError(
+            f"the figure is {across / height:.1f} times wider or longer than tall: not a standing humanoid"
+        )
     h = pos[:, up_axis] - pos[leaves, up_axis].min()
     by_height = sorted(leaves, key=lambda j: h[j])
     first = by_height[0]
@@ -119,8 +127,10 @@ def _roles(names: tuple[str, ...] | list[str], parents: NDArray[np.int64], pos: 
     leg_roots = {_chain(parents, hips, leaf)[0] for leaf in (first, other)}
     on_ground = [j for j in by_height[2:] if h[j] < 0.15 * height and not leg_roots & set(_path_up(parents, j))]
     if on_ground:
-        raise ValueError(f"{len(on_ground) + 2} limbs reach the ground ({names[on_ground[0]]!r} besides the legs): "
-                         f"not a standing humanoid")
+        raise ValueError(
+            f"{len(on_ground) + 2} limbs reach the ground ({names[on_ground[0]]!r} besides the legs): "
+            f"not a standing humanoid"
+        )
     if leg_roots & set(_path_up(parents, by_height[-1])):
         raise ValueError("the highest branch end is on a leg: not a standing humanoid")
     up = np.zeros(3)
@@ -152,8 +162,17 @@ def _forward(pos: F64, kids: list[list[int]], feet: list[int], up_axis: int) -> 
     return direction / np.linalg.norm(direction)
 
 
-def _upper_body(names: tuple[str, ...] | list[str], parents: NDArray[np.int64], pos: F64, kids: list[list[int]],
-                hips: int, leg_roots: set[int], h: F64, side: F64, roles: dict[str, str]) -> None:
+def _upper_body(
+    names: tuple[str, ...] | list[str],
+    parents: NDArray[np.int64],
+    pos: F64,
+    kids: list[list[int]],
+    hips: int,
+    leg_roots: set[int],
+    h: F64,
+    side: F64,
+    roles: dict[str, str],
+) -> None:
     """Spine, chest, neck, head and arms, where the shape has them (a legs-only rig keeps the legs).
 
     The upper body's branch ends are every leaf under the hips but the legs' (hands hang below

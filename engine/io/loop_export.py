@@ -63,12 +63,14 @@ def opened(clip: Clip) -> Clip:
     n = clip.num_frames - 1
     tr = None if clip.translations is None else clip.translations[:n]
     sc = None if clip.scales is None else clip.scales[:n]
-    return replace(clip, root=clip.root[:n], rotations=clip.rotations[:n], loop=True, translations=tr, scales=sc,
-                   root_motion=None)
+    return replace(
+        clip, root=clip.root[:n], rotations=clip.rotations[:n], loop=True, translations=tr, scales=sc, root_motion=None
+    )
 
 
-def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None,
-                 turn: float = 0.0) -> tuple[Clip, NDArray[np.float64]]:
+def loop_at_rate(
+    clip: Clip, rate: float, travel: ArrayLike | None = None, turn: float = 0.0
+) -> tuple[Clip, NDArray[np.float64]]:
     """The loop resampled to ``n = round(duration · rate)`` frames played at exactly ``rate`` fps, and its travel.
 
     ``travel`` is the root's travel over one cycle (so the last-to-first segment moves on
@@ -86,6 +88,13 @@ def loop_at_rate(clip: Clip, rate: float, travel: ArrayLike | None = None,
     pose = whole.sample(t)
     stretch = n / rate / clip.duration - 1.0
     root = pose.root + np.outer(np.arange(n) / n, stretch * shift)
-    out = replace(whole, fps=float(rate), root=root, rotations=pose.rotations, loop=True,
-                  translations=pose.offsets, scales=pose.scales)
+    out = replace(
+        whole,
+        fps=float(rate),
+        root=root,
+        rotations=pose.rotations,
+        loop=True,
+        translations=pose.offsets,
+        scales=pose.scales,
+    )
     return out, (1.0 + stretch) * shift

@@ -18,8 +18,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from engine.errors import FormatError
 from engine.clip import Clip
+from engine.errors import FormatError
 from engine.io.bvh import BvhError, BvhWarning, read_bvh
 from engine.io.formats import motion_format, suffixes
 from engine.io.gltf import GltfError, read_gltf
@@ -28,9 +28,16 @@ from engine.io.up_axis import UpAxis, figure_height, given_up, judge_up, stood_u
 from engine.npz_safe import read_bounded
 from engine.skeleton import Skeleton
 
-__all__ = ["MOTION_SUFFIXES", "MotionFile", "MotionFileError", "load_motion", "load_motion_loop", "load_joint_map",
-           "to_puppet",
-           "scaled_clip"]
+__all__ = [
+    "MOTION_SUFFIXES",
+    "MotionFile",
+    "MotionFileError",
+    "load_motion",
+    "load_motion_loop",
+    "load_joint_map",
+    "to_puppet",
+    "scaled_clip",
+]
 
 MOTION_SUFFIXES = suffixes(foreign=True)
 """Files from other tools (BVH, glTF, GLB): :data:`engine.io.formats.FORMATS` says which."""
@@ -92,10 +99,18 @@ class MotionFile:
     def summary(self) -> dict[str, Any]:
         """What ``--json`` reports about the input."""
         out: dict[str, Any] = {
-            "units": self.units.name, "unit_scale": self.units.scale, "units_basis": self.units.basis,
-            "up": self.up.name, "up_basis": self.up.basis, "height": round(self.height, 4),
-            "fps": self.clip.fps, "fps_basis": self.fps_basis, "frames": self.clip.num_frames,
-            "joints": self.clip.skeleton.num_joints, "file_frames": self.file_frames, "file_joints": self.file_joints,
+            "units": self.units.name,
+            "unit_scale": self.units.scale,
+            "units_basis": self.units.basis,
+            "up": self.up.name,
+            "up_basis": self.up.basis,
+            "height": round(self.height, 4),
+            "fps": self.clip.fps,
+            "fps_basis": self.fps_basis,
+            "frames": self.clip.num_frames,
+            "joints": self.clip.skeleton.num_joints,
+            "file_frames": self.file_frames,
+            "file_joints": self.file_joints,
         }
         if self.units.target is not None:
             out["scaled_to"] = self.units.target
@@ -120,12 +135,18 @@ def scaled_clip(clip: Clip, k: float) -> Clip:
     rm = clip.root_motion
     if rm is not None:
         rm = replace(rm, translation=rm.translation * k)
-    return replace(clip, skeleton=skeleton, root=clip.root * k, root_motion=rm,
-                   translations=None if clip.translations is None else clip.translations * k)
+    return replace(
+        clip,
+        skeleton=skeleton,
+        root=clip.root * k,
+        root_motion=rm,
+        translations=None if clip.translations is None else clip.translations * k,
+    )
 
 
-def _units(clip: Clip, units: str | None, metric: bool, joint_map: dict[str, str] | None,
-           height: float | None = None) -> Units:
+def _units(
+    clip: Clip, units: str | None, metric: bool, joint_map: dict[str, str] | None, height: float | None = None
+) -> Units:
     if height is not None:
         if units is not None:
             raise MotionFileError("give --units or --height, not both")
@@ -153,8 +174,16 @@ def _stood(clip: Clip, up: str | None, joint_map: dict[str, str] | None) -> tupl
     return stood_up(clip, axis), axis
 
 
-def _finish(raw: Clip, path: Path, units: str | None, up: str | None, metric: bool,
-            joint_map: dict[str, str] | None, height: float | None, **decided: Any) -> MotionFile:
+def _finish(
+    raw: Clip,
+    path: Path,
+    units: str | None,
+    up: str | None,
+    metric: bool,
+    joint_map: dict[str, str] | None,
+    height: float | None,
+    **decided: Any,
+) -> MotionFile:
     """The file's clip stood up and in metres, with those decisions (``decided``: the format's own)."""
     standing, axis = _stood(raw, up, joint_map)
     unit = _units(standing, units, metric=metric, joint_map=joint_map, height=height)
@@ -162,8 +191,14 @@ def _finish(raw: Clip, path: Path, units: str | None, up: str | None, metric: bo
     return MotionFile(clip, path, unit, up=axis, height=figure_height(clip), **decided)
 
 
-def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[str, str] | None,
-              up: str | None, height: float | None) -> MotionFile:
+def _load_bvh(
+    path: Path,
+    units: str | None,
+    skip_tpose: bool,
+    joint_map: dict[str, str] | None,
+    up: str | None,
+    height: float | None,
+) -> MotionFile:
     from engine.io.bvh_convert import detect_tpose_frames
 
     with warnings.catch_warnings(record=True) as caught:
@@ -174,12 +209,31 @@ def _load_bvh(path: Path, units: str | None, skip_tpose: bool, joint_map: dict[s
         raise MotionFileError(f"{path}: the file holds no frames")
     lead = detect_tpose_frames(motion) if skip_tpose else 0
     raw = motion.to_clip(scale=1.0, skip_frames=lead)
-    return _finish(raw, path, units, up, False, joint_map, height, fps_basis="BVH Frame Time", skipped=lead, warnings=told,
-                   file_frames=motion.num_frames, file_joints=motion.num_joints)
+    return _finish(
+        raw,
+        path,
+        units,
+        up,
+        False,
+        joint_map,
+        height,
+        fps_basis="BVH Frame Time",
+        skipped=lead,
+        warnings=told,
+        file_frames=motion.num_frames,
+        file_joints=motion.num_joints,
+    )
 
 
-def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: float | None,
-               joint_map: dict[str, str] | None, up: str | None, height: float | None) -> MotionFile:
+def _load_gltf(
+    path: Path,
+    units: str | None,
+    animation: int | str | None,
+    fps: float | None,
+    joint_map: dict[str, str] | None,
+    up: str | None,
+    height: float | None,
+) -> MotionFile:
     from engine.io.gltf_clip import animation_rate, find_animation, gltf_clip
 
     asset = read_gltf(path)
@@ -187,9 +241,20 @@ def _load_gltf(path: Path, units: str | None, animation: int | str | None, fps: 
     index = asset.animations.index(anim)
     raw = gltf_clip(asset, index, fps=fps)
     keys = max((len(c.times) for c in anim.channels), default=0)
-    return _finish(raw, path, units, up, True, joint_map, height, fps_basis=animation_rate(anim, fps)[1],
-                   animation=anim.name, animations=tuple(a.name for a in asset.animations),
-                   file_frames=keys, file_joints=len(asset.skins[0].joints) if asset.skins else raw.skeleton.num_joints)
+    return _finish(
+        raw,
+        path,
+        units,
+        up,
+        True,
+        joint_map,
+        height,
+        fps_basis=animation_rate(anim, fps)[1],
+        animation=anim.name,
+        animations=tuple(a.name for a in asset.animations),
+        file_frames=keys,
+        file_joints=len(asset.skins[0].joints) if asset.skins else raw.skeleton.num_joints,
+    )
 
 
 def load_motion(
@@ -225,8 +290,9 @@ def load_motion(
         raise FileNotFoundError(f"no such file: {path}")
     fmt = motion_format(path)
     if fmt is None or not fmt.foreign:
-        raise MotionFileError(f"{path}: not a motion file ({path.suffix.lower() or 'no suffix'}); "
-                              f"use one of {', '.join(MOTION_SUFFIXES)}")
+        raise MotionFileError(
+            f"{path}: not a motion file ({path.suffix.lower() or 'no suffix'}); use one of {', '.join(MOTION_SUFFIXES)}"
+        )
     try:
         if fmt.name == "bvh":
             if animation is not None:
@@ -255,8 +321,9 @@ def load_motion_loop(
     """
     from engine.io.loop_export import is_seamless, opened
 
-    whole = load_motion(path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False, up=up,
-                        height=height)
+    whole = load_motion(
+        path, animation=animation, units=units, joint_map=joint_map, skip_tpose=False, up=up, height=height
+    )
     if whole.clip.loop:
         return whole
     if is_seamless(whole.clip):
@@ -281,7 +348,11 @@ def load_joint_map(path: str | Path) -> dict[str, str]:
         raise MotionFileError(f"{path}: not a readable joint map ({type(exc).__name__}: {exc})"[:300]) from None
     except RecursionError:
         raise MotionFileError(f"{path}: not a readable joint map (JSON nested too deeply)") from None
-    if not isinstance(data, dict) or not data or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
+    if (
+        not isinstance(data, dict)
+        or not data
+        or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items())
+    ):
         raise MotionFileError(f"{path}: a joint map is a JSON object of source joint name -> puppet joint name")
     puppet = humanoid_skeleton().names
     unknown = sorted({v for v in data.values() if v not in puppet})

@@ -40,6 +40,7 @@ LARGE_TRANSLATION = 0.02  # share of the source leg length
 class RetargetWarning(UserWarning):
     """Retargeting dropped motion the puppet cannot play (translation or scale channels)."""
 
+
 F64 = NDArray[np.float64]
 _AXES = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0], [0, 0, -1]], dtype=np.float64)
 
@@ -129,10 +130,16 @@ def _warn_dropped(clip: Clip, target: Skeleton, a_pos: F64, tmap: dict[int, int]
     scale = max(_source_leg(target, a_pos, tmap), 1e-9)
     worst = int(np.argmax(moved))
     if moved[worst] > LARGE_TRANSLATION * scale:
-        channels = " and ".join(n for n, v in (("translation", clip.translations), ("scale", clip.scales)) if v is not None)
-        warnings.warn(RetargetWarning(
-            f"clip {clip.name!r}: the puppet's bones are rigid; its {channels} channel is dropped, which moves "
-            f"{src.names[worst]!r} by up to {moved[worst]:.3g} m ({moved[worst] / scale:.0%} of the leg)"), stacklevel=3)
+        channels = " and ".join(
+            n for n, v in (("translation", clip.translations), ("scale", clip.scales)) if v is not None
+        )
+        warnings.warn(
+            RetargetWarning(
+                f"clip {clip.name!r}: the puppet's bones are rigid; its {channels} channel is dropped, which moves "
+                f"{src.names[worst]!r} by up to {moved[worst]:.3g} m ({moved[worst] / scale:.0%} of the leg)"
+            ),
+            stacklevel=3,
+        )
 
 
 def _source_leg(target: Skeleton, a_pos: F64, tmap: dict[int, int]) -> float:
@@ -259,8 +266,11 @@ def retarget_proportions(clip: Clip, target: Skeleton, name: str | None = None) 
     if src.names != target.names or not np.array_equal(src.parents, target.parents):
         raise ValueError(f"clip {clip.name!r}: the target must have the same joints and hierarchy as its skeleton")
     ends = [(f"{s}_upper_leg", f"{s}_foot") for s in ("l", "r")]
-    ratios = [leg_length(target, *leg) / leg_length(src, *leg) for leg in ends
-              if all(n in src.names for n in leg) and leg_length(src, *leg) > 1e-9]
+    ratios = [
+        leg_length(target, *leg) / leg_length(src, *leg)
+        for leg in ends
+        if all(n in src.names for n in leg) and leg_length(src, *leg) > 1e-9
+    ]
     k = float(np.mean(ratios)) if ratios else float(target.offsets[0, 1] / max(src.offsets[0, 1], 1e-9))
     root = k * np.asarray(clip.root, dtype=np.float64)
     floor = _floor_level(src, clip.root, clip.rotations)
@@ -275,8 +285,16 @@ def retarget_proportions(clip: Clip, target: Skeleton, name: str | None = None) 
     motion = clip.root_motion
     if motion is not None:
         motion = RootMotion(k * np.asarray(motion.translation, dtype=np.float64), np.array(motion.heading))
-    return Clip(name or clip.name, target, clip.fps, root, rotations, loop=clip.loop, root_motion=motion,
-                markers=dict(clip.markers))
+    return Clip(
+        name or clip.name,
+        target,
+        clip.fps,
+        root,
+        rotations,
+        loop=clip.loop,
+        root_motion=motion,
+        markers=dict(clip.markers),
+    )
 
 
 _LEGS = (("l_upper_leg", "l_lower_leg", "l_foot"), ("r_upper_leg", "r_lower_leg", "r_foot"))
@@ -294,8 +312,9 @@ def _ankle_goal(clip: Clip, target: Skeleton, leg: list[int], k: float) -> F64:
     return goal - quat.rotate(s_rot[:, foot], target.tips[foot])
 
 
-def _reach_drop(target: Skeleton, root: F64, rotations: F64, legs: list[list[int]], goals: list[F64],
-                most: float = 0.995) -> float:
+def _reach_drop(
+    target: Skeleton, root: F64, rotations: F64, legs: list[list[int]], goals: list[F64], most: float = 0.995
+) -> float:
     """How far to lower the whole clip so every ankle goal is within ``most`` of its leg's length.
 
     The character's ankle may sit higher over its sole than the source's, scaled: standing the

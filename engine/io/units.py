@@ -79,8 +79,12 @@ def given_height(height: float, measured: float) -> Units:
         raise ValueError(f"--height must be a positive number of metres, got {height:g}")
     if not measured > 0:
         raise ValueError("--height: the figure has no height to scale (every joint at one level)")
-    return Units(SCALED, height / measured, f"--height {height:g} m (the figure is {measured:.4g} file units tall)",
-                 target=f"a {height:g} m tall figure")
+    return Units(
+        SCALED,
+        height / measured,
+        f"--height {height:g} m (the figure is {measured:.4g} file units tall)",
+        target=f"a {height:g} m tall figure",
+    )
 
 
 def _nearest(value: float, target: float, among: tuple[str, ...] = tuple(UNITS)) -> str:
@@ -153,8 +157,12 @@ def _fit_or_scale(measure: float, reference: float, part: str, prefix: str = "")
     said = f"{prefix}{part} length {measure:.4g} file units"
     if abs(np.log(implied / reference)) <= np.log(FIT):
         return Units(name, UNITS[name], said)
-    return Units(SCALED, reference / measure, f"{said} fits no unit (in {name} a {implied:.3g} m {part}): "
-                                              f"scaled to a {reference:g} m {part}", target=f"a {reference:g} m {part}")
+    return Units(
+        SCALED,
+        reference / measure,
+        f"{said} fits no unit (in {name} a {implied:.3g} m {part}): scaled to a {reference:g} m {part}",
+        target=f"a {reference:g} m {part}",
+    )
 
 
 def judge_units(skeleton: Skeleton, metric: bool = False, joint_map: dict[str, str] | None = None) -> Units:
@@ -179,8 +187,14 @@ def judge_units(skeleton: Skeleton, metric: bool = False, joint_map: dict[str, s
     lo, hi = _CHARACTER_EXTENT
     for name in ("m", "cm", "mm") if metric else _EXTENT_ORDER:
         if lo <= extent * UNITS[name] <= hi:
-            return Units(name, UNITS[name], f"no legs: figure extent {extent:.4g} file units, a {extent * UNITS[name]:.3g} m "
-                                            f"figure in {name}")
-    return Units(SCALED, HUMAN_HEIGHT / extent,
-                 f"no legs: figure extent {extent:.4g} file units fits no unit: scaled to {HUMAN_HEIGHT:g} m",
-                 target=f"a {HUMAN_HEIGHT:g} m figure")
+            return Units(
+                name,
+                UNITS[name],
+                f"no legs: figure extent {extent:.4g} file units, a {extent * UNITS[name]:.3g} m figure in {name}",
+            )
+    return Units(
+        SCALED,
+        HUMAN_HEIGHT / extent,
+        f"no legs: figure extent {extent:.4g} file units fits no unit: scaled to {HUMAN_HEIGHT:g} m",
+        target=f"a {HUMAN_HEIGHT:g} m figure",
+    )

@@ -99,13 +99,19 @@ def judge_up(clip: Clip, joint_map: dict[str, str] | None = None, convention: st
     if names[best] == convention:
         return UpAxis(convention, f"head above the feet along {convention} in {share:.0%} of frames")
     if share < _MAJORITY:
-        return UpAxis(convention, f"the format's convention (head above the feet along {names[best]} in only "
-                                  f"{share:.0%} of frames)")
+        return UpAxis(
+            convention,
+            f"the format's convention (head above the feet along {names[best]} in only {share:.0%} of frames)",
+        )
     travel = clip.root[-1] - clip.root[0]
     along = float(np.dot(travel, AXES[names[best]]))
-    if abs(along) > 0.5 * float(np.linalg.norm(travel)) and abs(along) > 0.25 * float(np.median(np.linalg.norm(rise, axis=1))):
-        return UpAxis(convention, f"the format's convention (the figure travels head first along {names[best]}: "
-                                  "lying or crawling)")
+    if abs(along) > 0.5 * float(np.linalg.norm(travel)) and abs(along) > 0.25 * float(
+        np.median(np.linalg.norm(rise, axis=1))
+    ):
+        return UpAxis(
+            convention,
+            f"the format's convention (the figure travels head first along {names[best]}: lying or crawling)",
+        )
     return UpAxis(names[best], f"head above the feet along {names[best]} in {share:.0%} of frames")
 
 

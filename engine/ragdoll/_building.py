@@ -94,7 +94,7 @@ class Building:
         for p, (a, b) in enumerate(pool.dofs):
             self._owners[a:b] = p
         for k, ps in enumerate(self._props.values()):
-            self._owners[ps.dadr:ps.dadr + 6] = len(pool.keys) + k
+            self._owners[ps.dadr : ps.dadr + 6] = len(pool.keys) + k
         restore(m, d, old)
         m.tree_sleep_policy[:] = int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER)  # props and borrowed slots
         for i, ps_ in enumerate(self._pool.slots):
@@ -105,8 +105,8 @@ class Building:
         for ps in self._props.values():
             if ps.init is not None:
                 pos, rot, vel = ps.init
-                d.qpos[ps.qadr:ps.qadr + 7] = np.concatenate([pos, rot])
-                d.qvel[ps.dadr:ps.dadr + 6] = vel
+                d.qpos[ps.qadr : ps.qadr + 7] = np.concatenate([pos, rot])
+                d.qvel[ps.dadr : ps.dadr + 6] = vel
                 ps.init = None
 
     def _assign(self) -> None:
@@ -120,8 +120,10 @@ class Building:
                 self._give_back(slot)
         # simulated ragdolls first, then the animated ones near them; past MAX_SLOTS of a kind the
         # rest stay out this step (an animated one then passes through, it does not crash the game)
-        joining = sorted((k for k in order if self._ragdolls[k].in_model and self._ragdolls[k].pool < 0),
-                         key=lambda k: (self._ragdolls[k].cmd.kinematic, k))
+        joining = sorted(
+            (k for k in order if self._ragdolls[k].in_model and self._ragdolls[k].pool < 0),
+            key=lambda k: (self._ragdolls[k].cmd.kinematic, k),
+        )
         short: dict[bytes, int] = {}
         for k in joining:
             short[self._ragdolls[k].kind] = short.get(self._ragdolls[k].kind, 0) + 1
@@ -134,7 +136,7 @@ class Building:
                 # compiling is superlinear in the pool's size, so doubling would cost more than it saves
                 self._pool.grow_to(slot.spec, min(MAX_SLOTS, max(have + CHUNK, -(-5 * (have - free + need) // 4))))
                 self._dirty = True
-        room = {kind: 0 for kind in {self._ragdolls[k].kind for k in joining}}
+        room = dict.fromkeys({self._ragdolls[k].kind for k in joining}, 0)
         self.left_out = 0
         for k in joining:
             slot = self._ragdolls[k]

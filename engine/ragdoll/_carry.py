@@ -27,7 +27,8 @@ def snapshot(m: mujoco.MjModel | None, d: mujoco.MjData | None) -> Snapshot:
         q0, v0 = m.jnt_qposadr[j], m.jnt_dofadr[j]
         nq, nv = _SIZES.get(int(m.jnt_type[j]), (1, 1))
         snap["joint"][m.joint(j).name] = np.concatenate(
-            [d.qpos[q0:q0 + nq], d.qvel[v0:v0 + nv], d.qacc_warmstart[v0:v0 + nv]])
+            [d.qpos[q0 : q0 + nq], d.qvel[v0 : v0 + nv], d.qacc_warmstart[v0 : v0 + nv]]
+        )
     for b in np.nonzero(m.body_mocapid >= 0)[0]:
         i = m.body_mocapid[b]
         snap["mocap"][m.body(int(b)).name] = np.concatenate([d.mocap_pos[i], d.mocap_quat[i]])
@@ -44,9 +45,9 @@ def restore(m: mujoco.MjModel, d: mujoco.MjData, snap: Snapshot) -> None:
             continue
         q0, v0 = m.jnt_qposadr[j], m.jnt_dofadr[j]
         nq, nv = _SIZES.get(int(m.jnt_type[j]), (1, 1))
-        d.qpos[q0:q0 + nq] = saved[:nq]
-        d.qvel[v0:v0 + nv] = saved[nq:nq + nv]
-        d.qacc_warmstart[v0:v0 + nv] = saved[nq + nv:]
+        d.qpos[q0 : q0 + nq] = saved[:nq]
+        d.qvel[v0 : v0 + nv] = saved[nq : nq + nv]
+        d.qacc_warmstart[v0 : v0 + nv] = saved[nq + nv :]
     for b in np.nonzero(m.body_mocapid >= 0)[0]:
         saved = snap["mocap"].get(m.body(int(b)).name)
         if saved is not None:

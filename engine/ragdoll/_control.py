@@ -51,8 +51,14 @@ def hinge_angles(rot: _F, axes: _F) -> _F:
     return 2.0 * np.arctan2(np.sum(h[..., 1:] * axes, axis=-1), h[..., 0])
 
 
-def apply_commands(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, cmds: list[Command], dt: float,
-                   ghost: NDArray[np.bool_] | None = None) -> None:
+def apply_commands(
+    L: Layout,
+    m: mujoco.MjModel,
+    d: mujoco.MjData,
+    cmds: list[Command],
+    dt: float,
+    ghost: NDArray[np.bool_] | None = None,
+) -> None:
     """Turn every ragdoll's command into servo targets, gains, pins, holds and placements
     (``ghost [P]``: which simulated ragdolls pass through other ragdolls this step)."""
     if not cmds:

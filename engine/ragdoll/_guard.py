@@ -56,12 +56,13 @@ def velocity_limits(m: mujoco.MjModel) -> NDArray[np.float64]:
     limit = np.full(m.nv, MAX_ANGULAR)
     for j in np.nonzero(m.jnt_type == int(mujoco.mjtJoint.mjJNT_FREE))[0]:
         a = int(m.jnt_dofadr[j])
-        limit[a:a + 3] = MAX_LINEAR
+        limit[a : a + 3] = MAX_LINEAR
     return limit
 
 
-def guarded_step(m: mujoco.MjModel, d: mujoco.MjData, substeps: int, limit: NDArray[np.float64],
-                 owners: NDArray[np.int64]) -> str | None:
+def guarded_step(
+    m: mujoco.MjModel, d: mujoco.MjData, substeps: int, limit: NDArray[np.float64], owners: NDArray[np.int64]
+) -> str | None:
     """Advance ``substeps`` MuJoCo steps with bounded velocities; on failure restore the state
     from before the step, with every body that owns a bad degree of freedom at rest.
 

@@ -49,7 +49,9 @@ def reach(skeleton: Skeleton, profile: RagdollProfile, offsets: _F) -> float:
     return float(np.max(chain + tips + r))
 
 
-def near_simulated(centres: _F, radii: _F, sources: _F, source_radii: _F, inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
+def near_simulated(
+    centres: _F, radii: _F, sources: _F, source_radii: _F, inside: NDArray[np.bool_]
+) -> NDArray[np.bool_]:
     """Which animated ragdolls (spheres ``centres [A,3]``, ``radii [A]``) are near a simulated
     body or prop (``sources [S,3]``, ``source_radii [S]``); ``inside [A]`` says which are in the
     model now (they stay until :data:`LEAVE`, the others join under :data:`ENTER`)."""

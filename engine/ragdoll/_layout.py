@@ -122,7 +122,7 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         put("hinge_owner", np.full(len(hinge), p))
         put("hinge_q", m.jnt_qposadr[jid[hinge]])
         put("hinge_d", m.jnt_dofadr[jid[hinge]])
-        put("hinge_c", m.actuator_ctrladr[act[len(ball):]])
+        put("hinge_c", m.actuator_ctrladr[act[len(ball) :]])
         put("hinge_axis", pr.hinge_axis[hinge].reshape(-1, 3))
         put("hinge_range", pr.hinge_range[hinge].reshape(-1, 2))
         put("act", act)
@@ -149,16 +149,41 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
             return np.zeros((0, *shape), dtype=dtype)
         return np.concatenate(parts).astype(dtype).reshape(-1, *shape) if shape else np.concatenate(parts).astype(dtype)
 
-    ints = ("root_q", "root_d", "ball_src", "ball_owner", "ball_q", "ball_d", "ball_c", "hinge_src", "hinge_owner",
-            "hinge_q", "hinge_d", "hinge_c", "act", "act_owner", "body", "body_owner", "geom", "geom_owner",
-            "pin_eq", "pin_mocap", "hold_mocap")
+    ints = (
+        "root_q",
+        "root_d",
+        "ball_src",
+        "ball_owner",
+        "ball_q",
+        "ball_d",
+        "ball_c",
+        "hinge_src",
+        "hinge_owner",
+        "hinge_q",
+        "hinge_d",
+        "hinge_c",
+        "act",
+        "act_owner",
+        "body",
+        "body_owner",
+        "geom",
+        "geom_owner",
+        "pin_eq",
+        "pin_mocap",
+        "hold_mocap",
+    )
     floats = ("ball_twist", "ball_cone", "act_kp", "act_kv", "ball_lead", "hinge_lead")
     return Layout(
-        keys=[f.spec.key for f in fragments], starts=np.array(starts, dtype=np.int64),
-        dofs=cat("dofs", np.int64, (2,)), ball_axis=cat("ball_axis", np.float64, (3,)),
-        hinge_axis=cat("hinge_axis", np.float64, (3,)), hinge_range=cat("hinge_range", np.float64, (2,)),
-        hold_eq=hold_eq, hold_joint=hold_joint,
-        **{n: cat(n, np.int64) for n in ints}, **{n: cat(n, np.float64) for n in floats},
+        keys=[f.spec.key for f in fragments],
+        starts=np.array(starts, dtype=np.int64),
+        dofs=cat("dofs", np.int64, (2,)),
+        ball_axis=cat("ball_axis", np.float64, (3,)),
+        hinge_axis=cat("hinge_axis", np.float64, (3,)),
+        hinge_range=cat("hinge_range", np.float64, (2,)),
+        hold_eq=hold_eq,
+        hold_joint=hold_joint,
+        **{n: cat(n, np.int64) for n in ints},
+        **{n: cat(n, np.float64) for n in floats},
     )
 
 
@@ -190,5 +215,10 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
         if owner in ("ball_owner", "hinge_owner"):
             src = names[0]
             fields[src] = fields[src] - pool.starts[idx][new_owner] + starts[new_owner]
-    return Layout(keys=list(keys), starts=starts, hold_eq=[pool.hold_eq[i] for i in slots],
-                  hold_joint=[pool.hold_joint[i] for i in slots], **fields)  # type: ignore[arg-type]
+    return Layout(
+        keys=list(keys),
+        starts=starts,
+        hold_eq=[pool.hold_eq[i] for i in slots],
+        hold_joint=[pool.hold_joint[i] for i in slots],
+        **fields,
+    )  # type: ignore[arg-type]

@@ -31,7 +31,18 @@ from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, ragdoll_fragment, rd_name
 
-__all__ = ["CHUNK", "INITIAL", "MAX_SLOTS", "PoolSlot", "RagdollPool", "kind_of", "park", "settle", "update_sleep", "wake"]
+__all__ = [
+    "CHUNK",
+    "INITIAL",
+    "MAX_SLOTS",
+    "PoolSlot",
+    "RagdollPool",
+    "kind_of",
+    "park",
+    "settle",
+    "update_sleep",
+    "wake",
+]
 
 CHUNK = 4  # slots: the pool grows in multiples of this
 INITIAL = 96  # slots of a kind compiled at a crowd's first build at most: ten of a hundred falling pull ~60 in
@@ -46,8 +57,17 @@ def kind_of(spec: RagdollSpec) -> bytes:
     sk, pr = spec.skeleton, spec.profile
     h = hashlib.blake2b(digest_size=16)
     h.update("\0".join(sk.names).encode())
-    parts = [np.asarray(sk.parents), np.asarray(sk.tips, dtype=np.float64), spec.offsets, pr.radii, pr.masses,
-             pr.hinge_axis, pr.hinge_range, pr.cone, pr.twist]
+    parts = [
+        np.asarray(sk.parents),
+        np.asarray(sk.tips, dtype=np.float64),
+        spec.offsets,
+        pr.radii,
+        pr.masses,
+        pr.hinge_axis,
+        pr.hinge_range,
+        pr.cone,
+        pr.twist,
+    ]
     for a in parts:
         h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
     h.update(repr((pr.kinds, pr.holdable, pr.frequency, pr.damping_ratio, pr.joint_damping, pr.friction)).encode())
@@ -92,10 +112,15 @@ class RagdollPool:
         for _ in range(want - have):
             i = len(self.slots)
             new = rd_name(i, "")
-            frag = RagdollFragment(dataclasses.replace(tpl.spec, key=i),
-                                   *(tuple(line.replace(old, new) for line in lines)
-                                     for lines in (tpl.body, tpl.contact, tpl.equality, tpl.actuator)),
-                                   tpl.kp, tpl.kv)
+            frag = RagdollFragment(
+                dataclasses.replace(tpl.spec, key=i),
+                *(
+                    tuple(line.replace(old, new) for line in lines)
+                    for lines in (tpl.body, tpl.contact, tpl.equality, tpl.actuator)
+                ),
+                tpl.kp,
+                tpl.kv,
+            )
             self.slots.append(PoolSlot(kind, frag))
         return True
 
@@ -121,19 +146,22 @@ def update_sleep(m: mujoco.MjModel, d: mujoco.MjData) -> None:
     d.ntree_awake = int(awake.sum())
     tree = m.body_treeid
     mocap = m.body_mocapid[m.body_rootid] >= 0
-    state = np.where(tree < 0, np.where(mocap, int(mujoco.mjtSleepState.mjS_AWAKE), int(mujoco.mjtSleepState.mjS_STATIC)),
-                     awake[np.maximum(tree, 0)].astype(np.int32))
+    state = np.where(
+        tree < 0,
+        np.where(mocap, int(mujoco.mjtSleepState.mjS_AWAKE), int(mujoco.mjtSleepState.mjS_STATIC)),
+        awake[np.maximum(tree, 0)].astype(np.int32),
+    )
     d.body_awake[:] = state
     ind = np.nonzero(state != 0)[0]
-    d.body_awake_ind[:len(ind)] = ind
+    d.body_awake_ind[: len(ind)] = ind
     d.nbody_awake = len(ind)
     par = np.nonzero(state[m.body_parentid] != 0)[0]
     par = par[par > 0]
-    d.parent_awake_ind[:len(par)] = par
+    d.parent_awake_ind[: len(par)] = par
     d.nparent_awake = len(par)
     b = m.dof_bodyid
     dofs = np.nonzero((tree[b] >= 0) & (state[b] == 1))[0]
-    d.dof_awake_ind[:len(dofs)] = dofs
+    d.dof_awake_ind[: len(dofs)] = dofs
     d.nv_awake = len(dofs)
 
 
@@ -155,19 +183,19 @@ def park(m: mujoco.MjModel, d: mujoco.MjData, pool: Layout, slot: int) -> None:
     m.actuator_gainprm[acts, 0] = 0.0
     m.actuator_biasprm[acts, :3] = 0.0
     d.eq_active[eqs] = 0
-    d.xfrc_applied[b0:b0 + nb] = 0.0
-    d.qfrc_applied[v0:v0 + nv] = 0.0
+    d.xfrc_applied[b0 : b0 + nb] = 0.0
+    d.qfrc_applied[v0 : v0 + nv] = 0.0
     jnts = np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]
     for j in jnts:  # the rest pose, parked apart from every other slot
         q = int(m.jnt_qposadr[j])
         if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
-            d.qpos[q:q + 7] = [*(_PARK + [4.0 * slot, 0.0, 0.0]), 1.0, 0.0, 0.0, 0.0]
+            d.qpos[q : q + 7] = [*(_PARK + [4.0 * slot, 0.0, 0.0]), 1.0, 0.0, 0.0, 0.0]
         elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
-            d.qpos[q:q + 4] = [1.0, 0.0, 0.0, 0.0]
+            d.qpos[q : q + 4] = [1.0, 0.0, 0.0, 0.0]
         else:
             d.qpos[q] = 0.0
-    d.qvel[v0:v0 + nv] = 0.0
-    d.qacc_warmstart[v0:v0 + nv] = 0.0
+    d.qvel[v0 : v0 + nv] = 0.0
+    d.qacc_warmstart[v0 : v0 + nv] = 0.0
     m.tree_sleep_policy[tree] = int(mujoco.mjtSleepPolicy.mjSLEEP_ALLOWED)
     d.tree_asleep[tree] = _AWAKE  # until :func:`settle` puts it to sleep where it now is
 

@@ -55,7 +55,7 @@ class Readback:
         L = self.layout
         assert L is not None
         p = L.ordinal(key)
-        return Pose(roots[p].copy(), rot[L.starts[p]:L.starts[p + 1]].copy())
+        return Pose(roots[p].copy(), rot[L.starts[p] : L.starts[p + 1]].copy())
 
     def body_positions(self, key: int) -> _F:
         """World positions ``[J,3]`` of the ragdoll's joint origins."""
@@ -76,7 +76,7 @@ class Readback:
         L, d = self.layout, self.data
         assert L is not None and d is not None
         rd = int(L.root_d[L.ordinal(key)])
-        return d.qvel[rd:rd + 6].copy()
+        return d.qvel[rd : rd + 6].copy()
 
     def kinetic_energy(self, key: int) -> float:
         """Kinetic energy (J) of one ragdoll, ½ vᵀMv over its own degrees of freedom (0 for an

@@ -80,8 +80,15 @@ class Ragdoll:
     still_frames: int = 0
     kinetic_energy: float = 0.0
 
-    def set_mode(self, mode: RagdollMode, *, muscle: float | None = None, pin: float | None = None,
-                 blend: float | None = None, immediate: bool = False) -> None:
+    def set_mode(
+        self,
+        mode: RagdollMode,
+        *,
+        muscle: float | None = None,
+        pin: float | None = None,
+        blend: float | None = None,
+        immediate: bool = False,
+    ) -> None:
         """Switch mode; the weights ramp to the mode's targets (or the ones given).
 
         Args:
@@ -90,14 +97,21 @@ class Ragdoll:
             immediate: jump to the targets now instead of ramping.
         """
         m, p, b = _TARGETS[mode]
-        targets = (_unit(m if muscle is None else muscle, "muscle"), _unit(p if pin is None else pin, "pin"),
-                   _unit(b if blend is None else blend, "blend"))
+        targets = (
+            _unit(m if muscle is None else muscle, "muscle"),
+            _unit(p if pin is None else pin, "pin"),
+            _unit(b if blend is None else blend, "blend"),
+        )
         self.mode = mode
         self.muscle_target, self.pin_target, self.blend_target = targets
         if mode is not RagdollMode.LIMP:
             self.settled, self.still_frames = False, 0
         if immediate:
-            self.muscle_weight, self.pin_weight, self.blend_weight = self.muscle_target, self.pin_target, self.blend_target
+            self.muscle_weight, self.pin_weight, self.blend_weight = (
+                self.muscle_target,
+                self.pin_target,
+                self.blend_target,
+            )
 
     def ramp(self, dt: float) -> None:
         """Move every weight towards its target by ``dt / transition_time``."""

@@ -30,8 +30,16 @@ from engine.ragdoll.blend import max_rotation_jump
 from engine.ragdoll.components import Ragdoll
 
 __all__ = [
-    "LyingOrientation", "lying_orientation", "lying_heading", "update_settle", "settled", "GetUpBlend",
-    "SETTLE_FRAMES", "SETTLE_ENERGY_PER_KG", "SETTLE_SPEED", "pick_get_up_clip",
+    "LyingOrientation",
+    "lying_orientation",
+    "lying_heading",
+    "update_settle",
+    "settled",
+    "GetUpBlend",
+    "SETTLE_FRAMES",
+    "SETTLE_ENERGY_PER_KG",
+    "SETTLE_SPEED",
+    "pick_get_up_clip",
 ]
 
 SETTLE_FRAMES = 15
@@ -66,8 +74,9 @@ def settled(ragdoll: Ragdoll) -> bool:
     return ragdoll.settled
 
 
-def lying_orientation(pelvis_rotation: ArrayLike, forward: ArrayLike = (0.0, 0.0, 1.0),
-                      threshold: float = 0.5) -> LyingOrientation:
+def lying_orientation(
+    pelvis_rotation: ArrayLike, forward: ArrayLike = (0.0, 0.0, 1.0), threshold: float = 0.5
+) -> LyingOrientation:
     """Face-up when the pelvis' forward axis points up (cosine above ``threshold``), face-down
     when it points down, otherwise on the side."""
     f = quat.rotate(np.asarray(pelvis_rotation, dtype=np.float64), np.asarray(forward, dtype=np.float64))
@@ -79,8 +88,9 @@ def lying_orientation(pelvis_rotation: ArrayLike, forward: ArrayLike = (0.0, 0.0
     return LyingOrientation.SIDE
 
 
-def lying_heading(pelvis_rotation: ArrayLike, spine: ArrayLike = (0.0, 1.0, 0.0),
-                  forward: ArrayLike = (0.0, 0.0, 1.0)) -> float:
+def lying_heading(
+    pelvis_rotation: ArrayLike, spine: ArrayLike = (0.0, 1.0, 0.0), forward: ArrayLike = (0.0, 0.0, 1.0)
+) -> float:
     """Yaw (rad about +Y, 0 = +Z) of a lying body: where its spine points on the ground.
 
     Falls back to the facing direction when the spine is nearly vertical (sitting, standing).
@@ -112,8 +122,9 @@ class GetUpBlend:
         margin: the blend's per-frame rotation is kept under ``margin`` × the clip's own largest jump.
     """
 
-    def __init__(self, start: Pose, clip: Clip, dt: float, min_frames: int = 6, max_frames: int = 120,
-                 margin: float = 0.9) -> None:
+    def __init__(
+        self, start: Pose, clip: Clip, dt: float, min_frames: int = 6, max_frames: int = 120, margin: float = 0.9
+    ) -> None:
         if start.rotations.shape != clip.rotations.shape[1:]:
             raise ValueError(f"start pose has {start.rotations.shape[0]} joints, clip {clip.rotations.shape[1]}")
         if not start.is_finite():

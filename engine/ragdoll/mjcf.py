@@ -37,8 +37,21 @@ PROP_BITS = (11, 31)
 ANIMATED_BITS = (4, 2)
 GHOST_BITS = (8, 16)
 
-__all__ = ["GROUND_BITS", "SIMULATED_BITS", "PROP_BITS", "ANIMATED_BITS", "GHOST_BITS", "RagdollSpec", "PropSpec", "RagdollFragment", "ragdoll_fragment", "build_mjcf", "rd_name", "prop_name",
-           "self_collision_excludes"]
+__all__ = [
+    "GROUND_BITS",
+    "SIMULATED_BITS",
+    "PROP_BITS",
+    "ANIMATED_BITS",
+    "GHOST_BITS",
+    "RagdollSpec",
+    "PropSpec",
+    "RagdollFragment",
+    "ragdoll_fragment",
+    "build_mjcf",
+    "rd_name",
+    "prop_name",
+    "self_collision_excludes",
+]
 
 
 @dataclass(frozen=True)
@@ -92,8 +105,9 @@ def _f(values: NDArray[np.float64] | tuple[float, ...] | float) -> str:
     return " ".join(f"{float(v):.17g}" for v in np.atleast_1d(np.asarray(values, dtype=np.float64)))
 
 
-def _segment_distance(a0: NDArray[np.float64], a1: NDArray[np.float64], b0: NDArray[np.float64],
-                      b1: NDArray[np.float64]) -> float:
+def _segment_distance(
+    a0: NDArray[np.float64], a1: NDArray[np.float64], b0: NDArray[np.float64], b1: NDArray[np.float64]
+) -> float:
     """Closest distance between segments ``a0a1`` and ``b0b1`` (degenerate segments allowed)."""
     d1, d2, r = a1 - a0, b1 - b0, a0 - b0
     a, e, f = float(d1 @ d1), float(d2 @ d2), float(d2 @ r)
@@ -117,8 +131,9 @@ def _segment_distance(a0: NDArray[np.float64], a1: NDArray[np.float64], b0: NDAr
     return float(np.linalg.norm((a0 + s * d1) - (b0 + t * d2)))
 
 
-def self_collision_excludes(skeleton: Skeleton, profile: RagdollProfile, offsets: NDArray[np.float64],
-                            min_links: int = 3, margin: float = 0.01) -> list[tuple[int, int]]:
+def self_collision_excludes(
+    skeleton: Skeleton, profile: RagdollProfile, offsets: NDArray[np.float64], min_links: int = 3, margin: float = 0.01
+) -> list[tuple[int, int]]:
     """Joint pairs that must not collide: fewer than ``min_links`` apart, or touching at rest."""
     n = skeleton.num_joints
     anc = [[j] for j in range(n)]
@@ -162,25 +177,35 @@ def ragdoll_fragment(spec: RagdollSpec) -> RagdollFragment:
             body.append(f'{pad}  <freejoint name="{name}"/>')
             body.append(f'{pad}  <site name="{name}_pin"/>')
         elif kind == "ball":
-            body.append(f'{pad}  <joint name="{name}" type="ball" range="0 {_f(pr.cone[j])}" solreflimit="0.005 1" solimplimit="0.95 0.99 0.001" '
-                        f'damping="{_f(damping[j])}" armature="{_f(armature[j])}"/>')
+            body.append(
+                f'{pad}  <joint name="{name}" type="ball" range="0 {_f(pr.cone[j])}" solreflimit="0.005 1" solimplimit="0.95 0.99 0.001" '
+                f'damping="{_f(damping[j])}" armature="{_f(armature[j])}"/>'
+            )
             actuator.append(f'<orientation name="{name}" joint="{name}" kp="{_f(kp[j])}" kv="{_f(kv[j])}"/>')
         else:
-            body.append(f'{pad}  <joint name="{name}" type="hinge" axis="{_f(pr.hinge_axis[j])}" '
-                        f'range="{_f(pr.hinge_range[j])}" solreflimit="0.005 1" solimplimit="0.95 0.99 0.001" damping="{_f(damping[j])}" '
-                        f'armature="{_f(armature[j])}"/>')
+            body.append(
+                f'{pad}  <joint name="{name}" type="hinge" axis="{_f(pr.hinge_axis[j])}" '
+                f'range="{_f(pr.hinge_range[j])}" solreflimit="0.005 1" solimplimit="0.95 0.99 0.001" damping="{_f(damping[j])}" '
+                f'armature="{_f(armature[j])}"/>'
+            )
             actuator.append(f'<position name="{name}" joint="{name}" kp="{_f(kp[j])}" kv="{_f(kv[j])}"/>')
         friction = f'friction="{_f(pr.friction)} 0.02 0.01"'
         if np.allclose(p0[j], p1[j]):
-            body.append(f'{pad}  <geom name="{name}" type="sphere" pos="{_f(p0[j])}" size="{_f(r[j])}" '
-                        f'mass="{_f(pr.masses[j])}" {friction}/>')
+            body.append(
+                f'{pad}  <geom name="{name}" type="sphere" pos="{_f(p0[j])}" size="{_f(r[j])}" '
+                f'mass="{_f(pr.masses[j])}" {friction}/>'
+            )
         else:
-            body.append(f'{pad}  <geom name="{name}" type="capsule" fromto="{_f(p0[j])} {_f(p1[j])}" '
-                        f'size="{_f(r[j])}" mass="{_f(pr.masses[j])}" {friction}/>')
+            body.append(
+                f'{pad}  <geom name="{name}" type="capsule" fromto="{_f(p0[j])} {_f(p1[j])}" '
+                f'size="{_f(r[j])}" mass="{_f(pr.masses[j])}" {friction}/>'
+            )
         if sk.names[j] in pr.holdable:
             body.append(f'{pad}  <site name="{name}_hold" pos="{_f(0.5 * (p0[j] + p1[j]))}"/>')
-            equality.append(f'<connect name="{name}_hold" site1="{name}_hold" site2="{rd_name(k, "hold")}" '
-                            f'active="false" solref="0.06 0.6"/>')
+            equality.append(
+                f'<connect name="{name}_hold" site1="{name}_hold" site2="{rd_name(k, "hold")}" '
+                f'active="false" solref="0.06 0.6"/>'
+            )
         for c in children[j]:
             emit(c, depth + 1)
         body.append(f"{pad}</body>")
@@ -188,17 +213,26 @@ def ragdoll_fragment(spec: RagdollSpec) -> RagdollFragment:
     emit(0, 2)
     root = rd_name(k, sk.names[0])
     for part in ("pin", "hold"):
-        body.append(f'    <body name="{rd_name(k, part)}" mocap="true" pos="{_f(off[0])}">'
-                    f'<site name="{rd_name(k, part)}"/></body>')
-    equality.append(f'<weld name="{rd_name(k, "pin")}" site1="{root}_pin" site2="{rd_name(k, "pin")}" '
-                    f'active="false" solref="0.02 1"/>')
+        body.append(
+            f'    <body name="{rd_name(k, part)}" mocap="true" pos="{_f(off[0])}">'
+            f'<site name="{rd_name(k, part)}"/></body>'
+        )
+    equality.append(
+        f'<weld name="{rd_name(k, "pin")}" site1="{root}_pin" site2="{rd_name(k, "pin")}" '
+        f'active="false" solref="0.02 1"/>'
+    )
     for a, b in self_collision_excludes(sk, pr, off):
         contact.append(f'<exclude body1="{rd_name(k, sk.names[a])}" body2="{rd_name(k, sk.names[b])}"/>')
     return RagdollFragment(spec, tuple(body), tuple(contact), tuple(equality), tuple(actuator), kp, kv)
 
 
-def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequence[PropSpec], timestep: float,
-               ground_friction: float = 1.0, sleep: bool = False) -> str:
+def build_mjcf(
+    ragdolls: Sequence[RagdollSpec | RagdollFragment],
+    props: Sequence[PropSpec],
+    timestep: float,
+    ground_friction: float = 1.0,
+    sleep: bool = False,
+) -> str:
     """The whole physics scene as an MJCF string, ragdolls (specs or rendered) and props in the order given
     (``sleep``: enable MuJoCo's sleeping, with which the ragdoll pool parks its free slots)."""
     body: list[str] = []
@@ -214,10 +248,12 @@ def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequenc
     for p in props:
         n = prop_name(p.key)
         # condim 6: rolling and torsional friction, so a snowball slows down as it rolls.
-        body.append(f'    <body name="{n}" pos="0 {_f(p.radius)} 0"><freejoint name="{n}"/>'
-                    f'<geom name="{n}" type="sphere" size="{_f(p.radius)}" mass="{_f(p.mass)}" condim="6" '
-                    f'contype="{PROP_BITS[0]}" conaffinity="{PROP_BITS[1]}" '
-                    f'friction="{_f(p.friction)} 0.005 0.002"/></body>')
+        body.append(
+            f'    <body name="{n}" pos="0 {_f(p.radius)} 0"><freejoint name="{n}"/>'
+            f'<geom name="{n}" type="sphere" size="{_f(p.radius)}" mass="{_f(p.mass)}" condim="6" '
+            f'contype="{PROP_BITS[0]}" conaffinity="{PROP_BITS[1]}" '
+            f'friction="{_f(p.friction)} 0.005 0.002"/></body>'
+        )
     sections = [
         '<mujoco model="puppetphone">',
         '  <compiler angle="radian" autolimits="true"/>',
@@ -227,8 +263,10 @@ def build_mjcf(ragdolls: Sequence[RagdollSpec | RagdollFragment], props: Sequenc
         f'  <default><geom solref="0.005 1" solimp="0.95 0.99 0.001" contype="{SIMULATED_BITS[0]}" '
         f'conaffinity="{SIMULATED_BITS[1]}"/></default>',
         # sleeping parks the pool's free ragdoll slots (engine.ragdoll._pool); nothing falls asleep by itself
-        (f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"'
-         + ('><flag sleep="enable"/></option>' if sleep else "/>")),
+        (
+            f'  <option timestep="{_f(timestep)}" gravity="0 -9.81 0" integrator="implicitfast"'
+            + ('><flag sleep="enable"/></option>' if sleep else "/>")
+        ),
         "  <worldbody>",
         f'    <geom name="ground" type="plane" size="0 0 1" zaxis="0 1 0" contype="{GROUND_BITS[0]}" conaffinity="{GROUND_BITS[1]}" friction="{_f(ground_friction)} 0.005 0.002"/>',
         *body,

@@ -94,8 +94,15 @@ class PhysicsWorld(Readback, Building):
         return self.timestep * self.substeps
 
     # -- membership ---------------------------------------------------------------------
-    def add_ragdoll(self, key: int, skeleton: Skeleton, profile: RagdollProfile, root: ArrayLike,
-                    rotations: ArrayLike, offsets: ArrayLike | None = None) -> None:
+    def add_ragdoll(
+        self,
+        key: int,
+        skeleton: Skeleton,
+        profile: RagdollProfile,
+        root: ArrayLike,
+        rotations: ArrayLike,
+        offsets: ArrayLike | None = None,
+    ) -> None:
         """Add a ragdoll for puppet ``key`` at rest in the given pose (built at the next use)."""
         if key in self._ragdolls or key in self._props:
             raise ValueError(f"entity {key} is already in the physics world")
@@ -110,8 +117,16 @@ class PhysicsWorld(Readback, Building):
         self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind)
         self._sized = False
 
-    def add_prop(self, key: int, radius: float, mass: float, position: ArrayLike,
-                 rotation: ArrayLike | None = None, velocity: ArrayLike | None = None, friction: float = 1.0) -> None:
+    def add_prop(
+        self,
+        key: int,
+        radius: float,
+        mass: float,
+        position: ArrayLike,
+        rotation: ArrayLike | None = None,
+        velocity: ArrayLike | None = None,
+        friction: float = 1.0,
+    ) -> None:
         """Add a sphere prop (snowball) for entity ``key`` (built at the next use)."""
         if key in self._ragdolls or key in self._props:
             raise ValueError(f"entity {key} is already in the physics world")
@@ -176,8 +191,16 @@ class PhysicsWorld(Readback, Building):
         except KeyError:
             raise KeyError(f"entity {key} has no ragdoll in the physics world") from None
 
-    def drive(self, key: int, root: ArrayLike, rotations: ArrayLike, muscle: float, pin: float,
-              gravity_support: float = 0.0, kinematic: bool = False) -> None:
+    def drive(
+        self,
+        key: int,
+        root: ArrayLike,
+        rotations: ArrayLike,
+        muscle: float,
+        pin: float,
+        gravity_support: float = 0.0,
+        kinematic: bool = False,
+    ) -> None:
         """Set the ragdoll's command for the next steps.
 
         Args:
@@ -263,21 +286,22 @@ class PhysicsWorld(Readback, Building):
         assert L is not None and d is not None
         p = L.ordinal(key)
         rq, rd = int(L.root_q[p]), int(L.root_d[p])
-        d.qpos[rq:rq + 3] = root
-        d.qpos[rq + 3:rq + 7] = rot[0]
+        d.qpos[rq : rq + 3] = root
+        d.qpos[rq + 3 : rq + 7] = rot[0]
         b = L.ball_owner == p
         ball = rot[L.ball_src[b] - L.starts[p]]
         d.qpos[L.ball_q[b][:, None] + np.arange(4)] = ball
         h = L.hinge_owner == p
         hinge = hinge_angles(rot[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])
         d.qpos[L.hinge_q[h]] = hinge
-        d.qvel[L.dofs[p, 0]:L.dofs[p, 1]] = 0.0
+        d.qvel[L.dofs[p, 0] : L.dofs[p, 1]] = 0.0
         if before is not None:  # the same target velocities as an animated (kinematic) placement
             r0, q0 = before
-            d.qvel[rd:rd + 3] = (root - r0) / self.dt
-            d.qvel[rd + 3:rd + 6] = quat.rotate(q0[0], quat.log(quat.mul(quat.conjugate(q0[0]), rot[0]))) / self.dt
-            d.qvel[L.ball_d[b][:, None] + np.arange(3)] = quat.log(
-                quat.mul(quat.conjugate(q0[L.ball_src[b] - L.starts[p]]), ball)) / self.dt
+            d.qvel[rd : rd + 3] = (root - r0) / self.dt
+            d.qvel[rd + 3 : rd + 6] = quat.rotate(q0[0], quat.log(quat.mul(quat.conjugate(q0[0]), rot[0]))) / self.dt
+            d.qvel[L.ball_d[b][:, None] + np.arange(3)] = (
+                quat.log(quat.mul(quat.conjugate(q0[L.ball_src[b] - L.starts[p]]), ball)) / self.dt
+            )
             d.qvel[L.hinge_d[h]] = (hinge - hinge_angles(q0[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])) / self.dt
         d.mocap_pos[L.pin_mocap[p]] = root
         d.mocap_quat[L.pin_mocap[p]] = rot[0]
@@ -340,7 +364,7 @@ class PhysicsWorld(Readback, Building):
         """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
         if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._moved:
             rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
-            return np.asarray(self.data.qpos[rq:rq + 3])
+            return np.asarray(self.data.qpos[rq : rq + 3])
         return slot.cmd.root
 
     def _prop_sphere(self, key: int) -> tuple[_F, float]:
@@ -349,7 +373,7 @@ class PhysicsWorld(Readback, Building):
         if ps.init is not None or self.data is None:
             pos, vel = (ps.init[0], ps.init[2]) if ps.init is not None else (np.zeros(3), np.zeros(6))
         else:
-            pos, vel = self.data.qpos[ps.qadr:ps.qadr + 3], self.data.qvel[ps.dadr:ps.dadr + 3]
+            pos, vel = self.data.qpos[ps.qadr : ps.qadr + 3], self.data.qvel[ps.dadr : ps.dadr + 3]
         return np.asarray(pos), ps.spec.radius + float(np.linalg.norm(vel[:3])) * LOOKAHEAD
 
     def mujoco_name(self, key: int, part: str) -> str:
@@ -383,7 +407,11 @@ class PhysicsWorld(Readback, Building):
         s = self._prop(key)
         d = self.data
         assert d is not None
-        return d.qpos[s.qadr:s.qadr + 3].copy(), d.qpos[s.qadr + 3:s.qadr + 7].copy(), d.qvel[s.dadr:s.dadr + 6].copy()
+        return (
+            d.qpos[s.qadr : s.qadr + 3].copy(),
+            d.qpos[s.qadr + 3 : s.qadr + 7].copy(),
+            d.qvel[s.dadr : s.dadr + 6].copy(),
+        )
 
     def prop_radius(self, key: int) -> float:
         """Current radius of a prop."""
@@ -422,8 +450,8 @@ class PhysicsWorld(Readback, Building):
         vel = np.asarray(velocity, dtype=np.float64).reshape(6)
         if not (np.isfinite(pos).all() and np.isfinite(vel).all()):
             raise ValueError(f"prop {key}: pose or velocity has NaN or infinite values")
-        d.qpos[s.qadr:s.qadr + 7] = np.concatenate([pos, quat.normalize(rotation)])
-        d.qvel[s.dadr:s.dadr + 6] = vel
+        d.qpos[s.qadr : s.qadr + 7] = np.concatenate([pos, quat.normalize(rotation)])
+        d.qvel[s.dadr : s.dadr + 6] = vel
 
     # -- hashing --------------------------------------------------------------------------
     def state_bytes(self) -> bytes:
@@ -437,8 +465,16 @@ class PhysicsWorld(Readback, Building):
             return b"empty"
         state = np.empty(mujoco.mj_stateSize(m, _STATE))
         mujoco.mj_getState(m, d, state, _STATE)
-        parts: list[bytes | np.ndarray] = [self._digest, state, m.actuator_gainprm[:, 0], m.actuator_biasprm[:, :3],
-                                           m.eq_solref, m.geom_size[:, 0], m.body_mass, m.geom_contype]
+        parts: list[bytes | np.ndarray] = [
+            self._digest,
+            state,
+            m.actuator_gainprm[:, 0],
+            m.actuator_biasprm[:, :3],
+            m.eq_solref,
+            m.geom_size[:, 0],
+            m.body_mass,
+            m.geom_contype,
+        ]
         pooled = bool(self._pool.slots)
         if pooled:  # (a model of props alone hashes as it did before the pool)
             parts += [m.tree_sleep_policy, d.tree_asleep]
@@ -446,6 +482,12 @@ class PhysicsWorld(Readback, Building):
             c = self._ragdolls[k].cmd
             if pooled:
                 parts.append(np.array([self._ragdolls[k].pool]))
-            parts += [c.root, c.rot, np.array([c.muscle, c.pin, c.support, c.kinematic]), c.hold_target,
-                      (c.hold or "").encode(), b"L" if c.last is None else c.last[0].tobytes() + c.last[1].tobytes()]
+            parts += [
+                c.root,
+                c.rot,
+                np.array([c.muscle, c.pin, c.support, c.kinematic]),
+                c.hold_target,
+                (c.hold or "").encode(),
+                b"L" if c.last is None else c.last[0].tobytes() + c.last[1].tobytes(),
+            ]
         return b"".join(p if isinstance(p, bytes) else np.ascontiguousarray(p).tobytes() for p in parts)

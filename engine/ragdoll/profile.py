@@ -82,7 +82,14 @@ class RagdollProfile:
         n = len(self.kinds)
         if n == 0 or self.kinds[0] != "free" or any(k not in JOINT_KINDS[1:] for k in self.kinds[1:]):
             raise ValueError("profile kinds: joint 0 must be 'free', the others 'ball' or 'hinge'")
-        shapes = {"radii": (n,), "masses": (n,), "hinge_axis": (n, 3), "hinge_range": (n, 2), "cone": (n,), "twist": (n,)}
+        shapes = {
+            "radii": (n,),
+            "masses": (n,),
+            "hinge_axis": (n, 3),
+            "hinge_range": (n, 2),
+            "cone": (n,),
+            "twist": (n,),
+        }
         for name, shape in shapes.items():
             value = np.array(getattr(self, name), dtype=np.float64).reshape(shape)
             value.setflags(write=False)
@@ -186,8 +193,15 @@ def default_profile(
     for h in holdable:
         skeleton.index(h)
     return RagdollProfile(
-        tuple(kinds), r, m, np.array(axes), np.array(ranges), np.array(cones), np.array(twists),
-        frequency=frequency, holdable=tuple(holdable),
+        tuple(kinds),
+        r,
+        m,
+        np.array(axes),
+        np.array(ranges),
+        np.array(cones),
+        np.array(twists),
+        frequency=frequency,
+        holdable=tuple(holdable),
     )
 
 

@@ -59,14 +59,17 @@ def physics_step(world: World) -> None:
     """The physics-stage system (needs the :class:`PhysicsWorld` resource)."""
     pw = world.resource(PhysicsWorld)
     if abs(pw.dt - world.dt) > 1e-9:
-        raise ValueError(f"physics steps {pw.dt:.6f} s but the world steps {world.dt:.6f} s: "
-                         "set PhysicsWorld(timestep=world.dt / substeps)")
+        raise ValueError(
+            f"physics steps {pw.dt:.6f} s but the world steps {world.dt:.6f} s: "
+            "set PhysicsWorld(timestep=world.dt / substeps)"
+        )
     _sync(world, pw)
     rows = world.query(Ragdoll, Puppet, LocalPose)
     animated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is RagdollMode.ANIMATED]
     simulated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is not RagdollMode.ANIMATED]
-    refused = pw.drive_animated([e for e, _, _ in animated], [p.root for _, _, p in animated],
-                                [p.rotations for _, _, p in animated])
+    refused = pw.drive_animated(
+        [e for e, _, _ in animated], [p.root for _, _, p in animated], [p.rotations for _, _, p in animated]
+    )
     targets: dict[Entity, Pose] = {}
     for e, rd, pose in simulated:
         rd.ramp(world.dt)
@@ -81,7 +84,7 @@ def physics_step(world: World) -> None:
         pw.recoveries += 1
         pose = world.get(e, LocalPose)
         pose.root, pose.rotations = pw.target(e).root, pw.target(e).rotations
-    for e, rd, _ in animated:
+    for _, rd, _ in animated:
         rd.ramp(world.dt)
         # not simulated: the body is its animation (no energy of its own, nothing to settle)
         rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
@@ -115,8 +118,13 @@ def install_physics(app: App, timestep: float | None = None, substeps: int = 8) 
     app.add_system("physics", physics_step)
 
 
-def spawn_snowball(world: World, position: ArrayLike, radius: float = 0.15, mass: float | None = None,
-                   velocity: ArrayLike | None = None) -> Entity:
+def spawn_snowball(
+    world: World,
+    position: ArrayLike,
+    radius: float = 0.15,
+    mass: float | None = None,
+    velocity: ArrayLike | None = None,
+) -> Entity:
     """Spawn a snowball prop now (position of its centre; velocity linear ``[3]`` or full ``[6]``)."""
     vel = np.zeros(6)
     if velocity is not None:

@@ -26,8 +26,9 @@ def grid_triangles(rows: int, cols: int, wrap: bool = True) -> NDArray[np.int32]
     return np.array(tris, dtype=np.int32)
 
 
-def ground_rings(rings: int = 24, segments: int = 40,
-                 inner: float = 0.002) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
+def ground_rings(
+    rings: int = 24, segments: int = 40, inner: float = 0.002
+) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """Vertices ``[V,3]`` (unit direction x, z; radius as a fraction of the ground's extent) and triangles.
 
     The first ring has radius 0 (the centre under the camera), then radii grow

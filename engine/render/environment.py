@@ -68,18 +68,23 @@ class Environment:
         self._buffers: list[moderngl.Buffer] = []
         self._ground_mesh = self._keep(*mesh_buffers(ctx, env_meshes.ground_rings()))
         self._vaos: dict[str, moderngl.VertexArray] = {}
-        for name, mesh, fmt in (("sky", env_meshes.sky_sphere(), ("3f", "in_dir")),
-                                ("ridge", env_meshes.ridge_strip(), ("4f", "in_ridge"))):
+        for name, mesh, fmt in (
+            ("sky", env_meshes.sky_sphere(), ("3f", "in_dir")),
+            ("ridge", env_meshes.ridge_strip(), ("4f", "in_ridge")),
+        ):
             vbo, ibo = self._keep(*mesh_buffers(ctx, mesh))
             self._vaos[name] = ctx.vertex_array(self._programs[name], [(vbo, *fmt)], ibo, 4)
-        square, unit = self._keep(ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype=np.float32).tobytes()),
-                                  ctx.buffer(np.array([0, 0, 1, 0, 0, 1, 1, 1], dtype=np.float32).tobytes()))
+        square, unit = self._keep(
+            ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype=np.float32).tobytes()),
+            ctx.buffer(np.array([0, 0, 1, 0, 0, 1, 1, 1], dtype=np.float32).tobytes()),
+        )
         self._vaos["sun"] = ctx.vertex_array(self._programs["sun"], [(square, "2f", "in_corner")])
         for name in ("shadow", "marks"):
             self._vaos[name] = ctx.vertex_array(self._programs[name], [(unit, "2f", "in_corner")])
         self._prints = Instances(ctx, 4 * PRINT_STRIDE)
-        self._vaos["prints"] = ctx.vertex_array(self._programs["prints"], [(square, "2f", "in_corner"),
-                                                                          (self._prints.buf, *_PRINT_FMT)])
+        self._vaos["prints"] = ctx.vertex_array(
+            self._programs["prints"], [(square, "2f", "in_corner"), (self._prints.buf, *_PRINT_FMT)]
+        )
         self._marks_tex: moderngl.Texture | None = None
         self._marks_src: bytes = b""
         self._common: dict[str, Any] = {}
@@ -136,8 +141,9 @@ class Environment:
         ctx.disable(moderngl.BLEND)
         ctx.depth_func = "<"
 
-    def draw_decals(self, scene: RenderScene, shadow_rect: tuple[float, float, float, float] | None,
-                    mask: moderngl.Texture | None) -> None:
+    def draw_decals(
+        self, scene: RenderScene, shadow_rect: tuple[float, float, float, float] | None, mask: moderngl.Texture | None
+    ) -> None:
         """Ground shadow (``None``: the ground read it itself), snow track and footprints, each over the
         rectangle it covers.
 
@@ -154,8 +160,12 @@ class Environment:
         if shadow_rect is not None and mask is not None:
             prog = self._programs["shadow"]
             mask.use(location=4)
-            for name, value in (("u_rect", shadow_rect), ("u_height", height), ("u_ground_mask", 4),
-                                ("u_shadow_strength", 0.9)):
+            for name, value in (
+                ("u_rect", shadow_rect),
+                ("u_height", height),
+                ("u_ground_mask", 4),
+                ("u_shadow_strength", 0.9),
+            ):
                 set_uniform(prog, name, value)
             self._vaos["shadow"].render(moderngl.TRIANGLE_STRIP)
         if scene.marks is not None:
@@ -187,9 +197,14 @@ class Environment:
         w, d = marks.cell * nx, marks.cell * nz
         prog = self._programs["marks"]
         u0, v0 = (rect[0] - marks.x0) / w, (rect[1] - marks.z0) / d
-        for name, value in (("u_rect", rect), ("u_height", height), ("u_marks", 5),
-                            ("u_marks_texel", (1.0 / nx, 1.0 / nz)), ("u_groove", 1.6),
-                            ("u_uv_rect", (u0, v0, rect[2] / w, rect[3] / d))):
+        for name, value in (
+            ("u_rect", rect),
+            ("u_height", height),
+            ("u_marks", 5),
+            ("u_marks_texel", (1.0 / nx, 1.0 / nz)),
+            ("u_groove", 1.6),
+            ("u_uv_rect", (u0, v0, rect[2] / w, rect[3] / d)),
+        ):
             set_uniform(prog, name, value)
         self._vaos["marks"].render(moderngl.TRIANGLE_STRIP)
 

@@ -51,8 +51,9 @@ def _bones(parents: bytes, tips: bytes) -> tuple[_Idx, _Idx, _Idx, _Idx]:
     return par[child], child, owner, leaves
 
 
-def puppet_capsules(skeleton: Skeleton, positions: NDArray[np.float64], rotations: NDArray[np.float64]
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+def puppet_capsules(
+    skeleton: Skeleton, positions: NDArray[np.float64], rotations: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
     """Capsules ``(a [B,3], b [B,3], radius [B], joint [B])`` of one posed puppet.
 
     ``joint`` is the joint whose radius (and per-joint colour) each capsule takes.
@@ -77,19 +78,21 @@ def puppet_capsules(skeleton: Skeleton, positions: NDArray[np.float64], rotation
         b.append(start + tip * keep)
         r.append(np.broadcast_to(rad, (*lead, len(leaves))))
         owner.append(leaves)
-    return (np.concatenate(a, axis=-2), np.concatenate(b, axis=-2), np.concatenate(r, axis=-1),
-            np.concatenate(owner))
+    return (np.concatenate(a, axis=-2), np.concatenate(b, axis=-2), np.concatenate(r, axis=-1), np.concatenate(owner))
 
 
-def _add_puppets(scene: RenderScene, skeleton: Skeleton, poses: list[WorldPose], looks: list[Appearance],
-                 alpha: float) -> None:
+def _add_puppets(
+    scene: RenderScene, skeleton: Skeleton, poses: list[WorldPose], looks: list[Appearance], alpha: float
+) -> None:
     """Capsules of puppets sharing ``skeleton``, posed and interpolated together, in one call.
 
     A crowd of a thousand cost half a second a frame puppet by puppet (an interpolation
     and a capsule fill each, in small numpy calls); stacked, it is a few dozen calls.
     """
-    stack = {name: np.stack([getattr(w, name) for w in poses])
-             for name in ("positions", "rotations", "prev_positions", "prev_rotations")}
+    stack = {
+        name: np.stack([getattr(w, name) for w in poses])
+        for name in ("positions", "rotations", "prev_positions", "prev_rotations")
+    }
     pos = stack["prev_positions"] + alpha * (stack["positions"] - stack["prev_positions"])
     rot = quat.nlerp(stack["prev_rotations"], stack["rotations"], alpha)
     a, b, r, owner = puppet_capsules(skeleton, pos, rot)

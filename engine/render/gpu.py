@@ -44,8 +44,9 @@ def set_uniform(prog: moderngl.Program, name: str, value: Any) -> None:
         u.value = value
 
 
-def mesh_buffers(ctx: moderngl.Context,
-                 mesh: tuple[NDArray[Any], NDArray[Any]]) -> tuple[moderngl.Buffer, moderngl.Buffer]:
+def mesh_buffers(
+    ctx: moderngl.Context, mesh: tuple[NDArray[Any], NDArray[Any]]
+) -> tuple[moderngl.Buffer, moderngl.Buffer]:
     """Vertex and index buffers of a ``(vertices, triangles)`` mesh."""
     return ctx.buffer(np.ascontiguousarray(mesh[0]).tobytes()), ctx.buffer(np.ascontiguousarray(mesh[1]).tobytes())
 
@@ -62,16 +63,23 @@ class LodBatches:
             ``stride_bytes`` long.
     """
 
-    def __init__(self, ctx: moderngl.Context, program: moderngl.Program,
-                 meshes: list[tuple[NDArray[Any], NDArray[Any]]], fmt: tuple[str, ...], stride_bytes: int) -> None:
+    def __init__(
+        self,
+        ctx: moderngl.Context,
+        program: moderngl.Program,
+        meshes: list[tuple[NDArray[Any], NDArray[Any]]],
+        fmt: tuple[str, ...],
+        stride_bytes: int,
+    ) -> None:
         self._levels: list[tuple[moderngl.VertexArray, Instances]] = []
         self._buffers: list[moderngl.Buffer] = []
         for mesh in meshes:
             vbo, ibo = mesh_buffers(ctx, mesh)
             inst = Instances(ctx, stride_bytes)
             self._buffers += [vbo, ibo, inst.buf]
-            self._levels.append((ctx.vertex_array(program, [(vbo, "4f", "in_vert"), (inst.buf, *fmt)], ibo, 4,
-                                                  skip_errors=True), inst))
+            self._levels.append(
+                (ctx.vertex_array(program, [(vbo, "4f", "in_vert"), (inst.buf, *fmt)], ibo, 4, skip_errors=True), inst)
+            )
 
     def upload(self, rows: NDArray[np.float32], level: NDArray[np.intp]) -> None:
         """Give each level the rows whose ``level`` index names it (order kept)."""

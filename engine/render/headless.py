@@ -31,8 +31,9 @@ def egl_available() -> str | None:
 class HeadlessTarget:
     """An off-screen ``width`` x ``height`` target; pass ``ctx`` to share an existing context."""
 
-    def __init__(self, width: int, height: int, *, samples: int | None = None,
-                 ctx: moderngl.Context | None = None) -> None:
+    def __init__(
+        self, width: int, height: int, *, samples: int | None = None, ctx: moderngl.Context | None = None
+    ) -> None:
         self.ctx = ctx if ctx is not None else moderngl.create_standalone_context(backend="egl", require=330)
         self._own_ctx = ctx is None
         self.buffers = OffscreenBuffers(self.ctx, width, height, samples)

@@ -26,6 +26,7 @@ from engine.render.shadows import CAPSULE_FMT
 
 __all__ = ["IMPOSTOR_VS", "IMPOSTOR_FS", "IMPOSTOR_DEPTH_FS", "box_corners", "Impostors"]
 
+
 def box_corners() -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """The cube ``[-1, 1]³``: eight corners and twelve triangles, counter-clockwise seen from outside."""
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float32)
@@ -117,7 +118,9 @@ vec3 hit_point(out vec3 ro, out vec3 rd) {
 }
 """
 
-IMPOSTOR_FS = _HIT + """
+IMPOSTOR_FS = (
+    _HIT
+    + """
 flat in vec3 v_color;
 flat in float v_fog;
 out vec4 f_color;
@@ -132,8 +135,11 @@ void main() {
     f_color = vec4(finish(mix(c, u_horizon_lin * SKY_GAIN, v_fog)), 1.0);
 }
 """
+)
 
-IMPOSTOR_DEPTH_FS = _HIT + """
+IMPOSTOR_DEPTH_FS = (
+    _HIT
+    + """
 out vec4 f_color;
 void main() {
     vec3 ro, rd;
@@ -141,6 +147,7 @@ void main() {
     f_color = vec4(1.0);
 }
 """
+)
 
 
 class Impostors:
@@ -155,9 +162,11 @@ class Impostors:
         self._inst = Instances(ctx, 4 * CAPSULE_STRIDE)
         self._shadow_inst = Instances(ctx, 4 * CAPSULE_STRIDE)
         self._vaos = {
-            name: ctx.vertex_array(prog, [(self._vbo, "3f", "in_corner"), (inst.buf, *CAPSULE_FMT)], self._ibo, 4,
-                                   skip_errors=True)
-            for name, prog, inst in (("lit", self.lit, self._inst), ("depth", self.depth, self._shadow_inst))}
+            name: ctx.vertex_array(
+                prog, [(self._vbo, "3f", "in_corner"), (inst.buf, *CAPSULE_FMT)], self._ibo, 4, skip_errors=True
+            )
+            for name, prog, inst in (("lit", self.lit, self._inst), ("depth", self.depth, self._shadow_inst))
+        }
 
     def draw(self, rows: NDArray[np.float32], eye: NDArray[np.float64]) -> None:
         """Lit solids seen from ``eye`` (the frame's uniforms are already set on :attr:`lit`).
@@ -171,8 +180,7 @@ class Impostors:
         self._vaos["lit"].render(moderngl.TRIANGLES, instances=self._inst.count)
         self.ctx.cull_face = "back"
 
-    def draw_depth(self, rows: NDArray[np.float32], light_vp: NDArray[np.float64],
-                   look: NDArray[np.float64]) -> None:
+    def draw_depth(self, rows: NDArray[np.float32], light_vp: NDArray[np.float64], look: NDArray[np.float64]) -> None:
         """The solids into the bound shadow map; ``look``: the unit direction the light's rays travel."""
         if not self._shadow_inst.upload(rows):
             return

@@ -19,8 +19,17 @@ from numpy.typing import NDArray
 
 from engine.render.meshes import capsule_mesh
 
-__all__ = ["CAPSULE_LEVELS", "SPHERE_LEVELS", "LEVELS", "LIMITS", "SILHOUETTE_ERROR_PX", "level_limits",
-           "choose_levels", "choose_levels_orthographic", "level_meshes"]
+__all__ = [
+    "CAPSULE_LEVELS",
+    "SPHERE_LEVELS",
+    "LEVELS",
+    "LIMITS",
+    "SILHOUETTE_ERROR_PX",
+    "level_limits",
+    "choose_levels",
+    "choose_levels_orthographic",
+    "level_meshes",
+]
 
 CAPSULE_LEVELS: tuple[tuple[int, int], ...] = ((6, 2), (8, 2), (12, 3), (16, 4), (24, 6))
 """(segments around, rings per end cap) from coarse to fine."""
@@ -45,8 +54,9 @@ def level_meshes(kind: str) -> list[tuple[NDArray[np.float32], NDArray[np.int32]
     return [capsule_mesh(segments, rings, band=kind == "capsules") for segments, rings in LEVELS[kind]]
 
 
-def choose_levels(rows: NDArray[np.float32], eye: NDArray[np.float64], px_per_metre: float,
-                  limits: NDArray[np.float64]) -> NDArray[np.intp]:
+def choose_levels(
+    rows: NDArray[np.float32], eye: NDArray[np.float64], px_per_metre: float, limits: NDArray[np.float64]
+) -> NDArray[np.intp]:
     """The level index for each capsule row (ends ``a``, ``b`` in columns 0-5, radius in 6).
 
     The on-screen radius is taken at the capsule's point nearest the eye, so a long
@@ -61,8 +71,9 @@ def choose_levels(rows: NDArray[np.float32], eye: NDArray[np.float64], px_per_me
     return np.searchsorted(limits, radius_px)
 
 
-def choose_levels_orthographic(rows: NDArray[np.float32], px_per_metre: float,
-                               limits: NDArray[np.float64]) -> NDArray[np.intp]:
+def choose_levels_orthographic(
+    rows: NDArray[np.float32], px_per_metre: float, limits: NDArray[np.float64]
+) -> NDArray[np.intp]:
     """The level index for each capsule row seen through an orthographic projection (the
     sun's shadow map), where the size on screen does not depend on distance."""
     return np.searchsorted(limits, rows[:, 6].astype(np.float64) * px_per_metre)

@@ -16,8 +16,9 @@ from numpy.typing import NDArray
 __all__ = ["capsule_mesh", "sphere_mesh", "box_mesh"]
 
 
-def _orient_outward(pos: NDArray[np.float64], tris: NDArray[np.int64],
-                    centre_of: NDArray[np.float64]) -> NDArray[np.int64]:
+def _orient_outward(
+    pos: NDArray[np.float64], tris: NDArray[np.int64], centre_of: NDArray[np.float64]
+) -> NDArray[np.int64]:
     """Flip triangles whose winding faces inwards (normal points towards ``centre_of``)."""
     p0, p1, p2 = pos[tris[:, 0]], pos[tris[:, 1]], pos[tris[:, 2]]
     n = np.cross(p1 - p0, p2 - p0)
@@ -49,8 +50,9 @@ def _grid_tris(row0: int, row1: int, segments: int) -> list[tuple[int, int, int]
     return out
 
 
-def capsule_mesh(segments: int = 12, rings: int = 3, *,
-                 band: bool = True) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
+def capsule_mesh(
+    segments: int = 12, rings: int = 3, *, band: bool = True
+) -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """Vertices ``[V,4]`` (unit direction xyz, end flag) and triangle indices ``[T,3]``.
 
     With ``band=False`` the cylinder between the caps is left out: a sphere mesh.

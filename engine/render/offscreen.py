@@ -44,15 +44,18 @@ class OffscreenBuffers:
     def _make(self, width: int, height: int) -> None:
         size = (width, height)
         ctx = self.ctx
-        self.resolved = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4)],
-                                        depth_attachment=ctx.depth_renderbuffer(size))
+        self.resolved = ctx.framebuffer(
+            color_attachments=[ctx.renderbuffer(size, 4)], depth_attachment=ctx.depth_renderbuffer(size)
+        )
         # The same colour renderbuffer without depth: what a window presents (a blit to
         # the default framebuffer must not include depth, whose format may differ).
         self.colour_only = ctx.framebuffer(color_attachments=[self.resolved.color_attachments[0]])
         self._msaa = None
         if self.samples:
-            self._msaa = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size, 4, samples=self.samples)],
-                                         depth_attachment=ctx.depth_renderbuffer(size, samples=self.samples))
+            self._msaa = ctx.framebuffer(
+                color_attachments=[ctx.renderbuffer(size, 4, samples=self.samples)],
+                depth_attachment=ctx.depth_renderbuffer(size, samples=self.samples),
+            )
         self.size = size
 
     @property

@@ -107,9 +107,14 @@ def _in_view(rows: NDArray[np.float32], vp: NDArray[np.float64]) -> NDArray[np.i
     return np.nonzero(np.all(distance >= -radius[:, None], axis=1))[0]
 
 
-def _shadow_key(scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
-                rows: dict[str, NDArray[np.float32]], light_vp: NDArray[np.float64],
-                rect: tuple[float, float, float, float], how: tuple[object, bool]) -> bytes | None:
+def _shadow_key(
+    scene: RenderScene,
+    casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+    rows: dict[str, NDArray[np.float32]],
+    light_vp: NDArray[np.float64],
+    rect: tuple[float, float, float, float],
+    how: tuple[object, bool],
+) -> bytes | None:
     """A digest of everything the shadow map and the ground mask are drawn from, ``None`` if that
     cannot be told (skinned characters: their poses live in textures).
 
@@ -153,8 +158,9 @@ class Renderer:
             "box_flat": ctx.program(vertex_shader=h + S.BOX_VS, fragment_shader=h + S.FLAT_FS),
             "cone": ctx.program(vertex_shader=h + S.CONE_VS, fragment_shader=lit + S.LIT_FS),
             "upscale": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + _UPSCALE_FS),
-            "sky_photo": ctx.program(vertex_shader=h + E.SKY_VS,
-                                     fragment_shader=h + E.PHOTO_DEFINE + S.LIGHTING + E.BACKGROUND + E.SKY_FS),
+            "sky_photo": ctx.program(
+                vertex_shader=h + E.SKY_VS, fragment_shader=h + E.PHOTO_DEFINE + S.LIGHTING + E.BACKGROUND + E.SKY_FS
+            ),
             "line": ctx.program(vertex_shader=h + S.LINE_VS, fragment_shader=h + S.LINE_FS),
             "point": ctx.program(vertex_shader=h + S.POINT_VS, fragment_shader=h + S.POINT_FS),
             "text": ctx.program(vertex_shader=h + S.TEXT_VS, fragment_shader=h + S.TEXT_FS),
@@ -163,36 +169,56 @@ class Renderer:
             "skinned_flat": ctx.program(vertex_shader=h + SKIN_VS, fragment_shader=h + S.FLAT_FS),
         }
         self.skinned = SkinnedDraw(ctx, p["skinned"], p["skinned_flat"])
-        strides = {"capsules": CAPSULE_STRIDE, "spheres": CAPSULE_STRIDE, "boxes": BOX_STRIDE,
-                   "lines": LINE_STRIDE, "points": POINT_STRIDE, "cones": CONE_STRIDE}
+        strides = {
+            "capsules": CAPSULE_STRIDE,
+            "spheres": CAPSULE_STRIDE,
+            "boxes": BOX_STRIDE,
+            "lines": LINE_STRIDE,
+            "points": POINT_STRIDE,
+            "cones": CONE_STRIDE,
+        }
         # Capsules and spheres have one buffer per level of detail (self._lod, below).
         self._inst = {k: Instances(ctx, 4 * strides[k]) for k in ("boxes", "cones", "lines", "points")}
         self._outline_inst = {k: Instances(ctx, 4 * strides[k]) for k in _SOLIDS}
         self._buffers: list[moderngl.Buffer] = []
         self._vaos: dict[str, moderngl.VertexArray] = {}
         # Lit capsules and spheres: one batch per level of detail.
-        self._lod = {kind: LodBatches(ctx, p["capsule"], level_meshes(kind), CAPSULE_FMT, 4 * CAPSULE_STRIDE)
-                     for kind in LEVELS}
+        self._lod = {
+            kind: LodBatches(ctx, p["capsule"], level_meshes(kind), CAPSULE_FMT, 4 * CAPSULE_STRIDE) for kind in LEVELS
+        }
         # Outlines (a few focused items) take the default meshes.
         for kind, mesh in (("capsules", meshes.capsule_mesh()), ("spheres", meshes.sphere_mesh())):
             vbo, ibo = self._keep(mesh_buffers(ctx, mesh))
             self._vaos[kind + "_flat"] = ctx.vertex_array(
-                p["capsule_flat"], [(vbo, "4f", "in_vert"), (self._outline_inst[kind].buf, *CAPSULE_FMT)], ibo, 4,
-                skip_errors=True)
+                p["capsule_flat"],
+                [(vbo, "4f", "in_vert"), (self._outline_inst[kind].buf, *CAPSULE_FMT)],
+                ibo,
+                4,
+                skip_errors=True,
+            )
         vbo, ibo = self._keep(mesh_buffers(ctx, meshes.box_mesh()))
-        for suffix, prog, inst in (("", "box", self._inst["boxes"]),
-                                   ("_flat", "box_flat", self._outline_inst["boxes"])):
+        for suffix, prog, inst in (
+            ("", "box", self._inst["boxes"]),
+            ("_flat", "box_flat", self._outline_inst["boxes"]),
+        ):
             self._vaos["boxes" + suffix] = ctx.vertex_array(
-                p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True)
+                p[prog], [(vbo, "3f 3f", "in_pos", "in_normal"), (inst.buf, *BOX_FMT)], ibo, 4, skip_errors=True
+            )
         vbo, ibo = self._keep(mesh_buffers(ctx, cone_mesh()))
         self._vaos["cones"] = ctx.vertex_array(
-            p["cone"], [(vbo, "4f", "in_vert"), (self._inst["cones"].buf, *CAPSULE_FMT)], ibo, 4, skip_errors=True)
-        unit, seg = self._keep(tuple(ctx.buffer(np.array(v, dtype=np.float32).tobytes()) for v in (
-            [0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])))
+            p["cone"], [(vbo, "4f", "in_vert"), (self._inst["cones"].buf, *CAPSULE_FMT)], ibo, 4, skip_errors=True
+        )
+        unit, seg = self._keep(
+            tuple(
+                ctx.buffer(np.array(v, dtype=np.float32).tobytes())
+                for v in ([0, 0, 1, 0, 0, 1, 1, 1], [0, -1, 1, -1, 0, 1, 1, 1])
+            )
+        )
         self._vaos["text"] = ctx.vertex_array(p["text"], [(unit, "2f", "in_corner")])
         self._vaos["overlay"] = ctx.vertex_array(p["overlay"], [(unit, "2f", "in_corner")])
         self._vaos["lines"] = ctx.vertex_array(
-            p["line"], [(seg, "2f", "in_corner"), (self._inst["lines"].buf, *_LINE_FMT)], skip_errors=True)
+            p["line"], [(seg, "2f", "in_corner"), (self._inst["lines"].buf, *_LINE_FMT)], skip_errors=True
+        )
         self._vaos["points"] = ctx.vertex_array(p["point"], [(self._inst["points"].buf, *_POINT_FMT)], skip_errors=True)
         for name in ("sky_photo", "upscale"):
             self._vaos[name] = ctx.vertex_array(p[name], [])
@@ -219,8 +245,11 @@ class Renderer:
         bench drawing one still frame again and again times the shadows a moving scene pays; the
         runner turns it on for play."""
 
-    def _more_casters(self, scene: RenderScene, impostors: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
-                      ) -> Callable[[NDArray[np.float64]], None] | None:
+    def _more_casters(
+        self,
+        scene: RenderScene,
+        impostors: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+    ) -> Callable[[NDArray[np.float64]], None] | None:
         """What the shadow map draws besides its meshes: skinned characters, and the round solids
         ``impostors`` holds (by kind: rows, levels) when they are drawn as impostors."""
         if not scene.skinned and not impostors:
@@ -233,6 +262,7 @@ class Renderer:
                 self.impostors.draw_depth(np.concatenate([rows for rows, _ in impostors.values()]), light_vp, look)
             if scene.skinned:
                 self.skinned.draw_depth(scene.skinned, light_vp)
+
         return draw
 
     def _keep(self, bufs: tuple[moderngl.Buffer, ...]) -> tuple[moderngl.Buffer, ...]:
@@ -253,8 +283,9 @@ class Renderer:
         the context must be current, as for :meth:`render`)."""
         if (quality.shadow_map, quality.shadow_mask) != (self.shadows.map_size, self.shadows.mask_size):
             self.shadows.release()
-            self.shadows = Shadows(self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask,
-                                   self._inst["cones"])
+            self.shadows = Shadows(
+                self.ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask, self._inst["cones"]
+            )
             self._shadow_key = None
         self.quality = quality
 
@@ -289,8 +320,10 @@ class Renderer:
         vp = camera.view_projection(w / h)
         self._mark(None)
         eye = np.asarray(camera.eye, dtype=np.float64)
-        rows = {k: _nearest_first(getattr(scene, k).data, eye) if k in (*_SOLIDS, "cones") else getattr(scene, k).data
-                for k in _KINDS}
+        rows = {
+            k: _nearest_first(getattr(scene, k).data, eye) if k in (*_SOLIDS, "cones") else getattr(scene, k).data
+            for k in _KINDS
+        }
         counts = {k: self._inst[k].upload(rows[k]) for k in ("boxes", "cones", "lines", "points")}
         # Coarser meshes where fewer pixels are drawn, or where the level allows a larger outline error.
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0)) / self.quality.silhouette_px
@@ -313,8 +346,13 @@ class Renderer:
             casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
             key = _shadow_key(scene, casters, rows, light_vp, rect, (self.shadows, impostors))
             if key is None or key != self._shadow_key or not self.reuse_shadows:
-                self.shadows.render(scene, {} if impostors else casters, light_vp, rect,
-                                    more_casters=self._more_casters(scene, casters if impostors else {}))
+                self.shadows.render(
+                    scene,
+                    {} if impostors else casters,
+                    light_vp,
+                    rect,
+                    more_casters=self._more_casters(scene, casters if impostors else {}),
+                )
             self._shadow_key = key
         self._mark("shadows")
 
@@ -367,8 +405,9 @@ class Renderer:
         ctx.enable_only(moderngl.NOTHING)
         self._mark("text")
 
-    def _draw_environment(self, scene: RenderScene, camera: Camera,
-                          rect: tuple[float, float, float, float] | None) -> None:
+    def _draw_environment(
+        self, scene: RenderScene, camera: Camera, rect: tuple[float, float, float, float] | None
+    ) -> None:
         """Ground, ridge, sky and sun, then the decals on the ground (see :mod:`engine.render.environment`)."""
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST)
@@ -380,13 +419,25 @@ class Renderer:
         detail = self.quality.ground_detail and g.snow > 0
         self.shadows.mask.use(location=4)
         if g.visible:
-            self.env.draw_ground(scene, detail, photo, {
-                "u_center": (float(eye[0]), 0.0, float(eye[2])), "u_extent": min(camera.far * 0.9, 150.0),
-                "u_height": float(g.height), "u_ground_lin": _linear(g.color), "u_snow": float(g.snow),
-                "u_grid_spacing": float(g.grid_spacing), "u_grid_lin": _linear(g.grid_color),
-                "u_grid_strength": float(g.grid_strength), "u_noise": 3, "u_ground_mask": 4,
-                "u_rect": rect if rect is not None else (0.0, 0.0, 1.0, 1.0),
-                "u_shadow_strength": 0.9 if rect is not None else 0.0})
+            self.env.draw_ground(
+                scene,
+                detail,
+                photo,
+                {
+                    "u_center": (float(eye[0]), 0.0, float(eye[2])),
+                    "u_extent": min(camera.far * 0.9, 150.0),
+                    "u_height": float(g.height),
+                    "u_ground_lin": _linear(g.color),
+                    "u_snow": float(g.snow),
+                    "u_grid_spacing": float(g.grid_spacing),
+                    "u_grid_lin": _linear(g.grid_color),
+                    "u_grid_strength": float(g.grid_strength),
+                    "u_noise": 3,
+                    "u_ground_mask": 4,
+                    "u_rect": rect if rect is not None else (0.0, 0.0, 1.0, 1.0),
+                    "u_shadow_strength": 0.9 if rect is not None else 0.0,
+                },
+            )
         self.env.draw_sky(scene, photo, float(g.height))
         if photo:
             ctx.depth_func = "<="
@@ -407,8 +458,14 @@ class Renderer:
         set_uniform(self._programs["upscale"], "u_tex", 0)
         self._vaos["upscale"].render(moderngl.TRIANGLES, vertices=3)
 
-    def _set_frame_uniforms(self, scene: RenderScene, camera: Camera, vp: NDArray[np.float64],
-                            light_vp: NDArray[np.float64] | None, size: tuple[int, int]) -> None:
+    def _set_frame_uniforms(
+        self,
+        scene: RenderScene,
+        camera: Camera,
+        vp: NDArray[np.float64],
+        light_vp: NDArray[np.float64] | None,
+        size: tuple[int, int],
+    ) -> None:
         w, h = size
         sun = scene.sun
         L = np.asarray(sun.direction, dtype=np.float64)
@@ -427,18 +484,30 @@ class Renderer:
             img_aspect, view_aspect = bg.shape[1] / bg.shape[0], w / h
             bg_scale = (view_aspect / img_aspect, 1.0) if view_aspect < img_aspect else (1.0, img_aspect / view_aspect)
         common = {
-            "u_view_proj": vp, "u_eye": eye, "u_cam": eye, "u_sun_dir": L,
+            "u_view_proj": vp,
+            "u_eye": eye,
+            "u_cam": eye,
+            "u_sun_dir": L,
             "u_sun_color": tuple(c * sun.intensity for c in _linear(sun.color)),
-            "u_sky_lin": _linear(scene.sky_color), "u_horizon_lin": _linear(scene.horizon_color),
-            "u_ambient": float(sun.ambient), "u_light_vp": light_vp if light_vp is not None else np.eye(4),
-            "u_shadow_map": 1, "u_shadows_on": 0.0 if light_vp is None else 1.0,
+            "u_sky_lin": _linear(scene.sky_color),
+            "u_horizon_lin": _linear(scene.horizon_color),
+            "u_ambient": float(sun.ambient),
+            "u_light_vp": light_vp if light_vp is not None else np.eye(4),
+            "u_shadow_map": 1,
+            "u_shadows_on": 0.0 if light_vp is None else 1.0,
             "u_shadow_texel": 1.0 / self.shadows.map_size,
             "u_softness": float(np.clip(sun.softness / texel_world, 0.5, 4.0)),
-            "u_normal_bias": max(3.0 * texel_world, 0.01), "u_depth_bias": 0.01 * depth_per_m,
-            "u_fog_density": 0.015, "u_px_scale": 2.0 * tan_half / h, "u_px_per_unit": h / (2.0 * tan_half),
-            "u_viewport": (float(w), float(h)), "u_background": 2,
-            "u_fade": 1.0 if bg is None else float(scene.background_fade), "u_bg_scale": bg_scale,
-            "u_inv_view_proj": np.linalg.inv(vp), "u_inflate_px": 0.0,
+            "u_normal_bias": max(3.0 * texel_world, 0.01),
+            "u_depth_bias": 0.01 * depth_per_m,
+            "u_fog_density": 0.015,
+            "u_px_scale": 2.0 * tan_half / h,
+            "u_px_per_unit": h / (2.0 * tan_half),
+            "u_viewport": (float(w), float(h)),
+            "u_background": 2,
+            "u_fade": 1.0 if bg is None else float(scene.background_fade),
+            "u_bg_scale": bg_scale,
+            "u_inv_view_proj": np.linalg.inv(vp),
+            "u_inflate_px": 0.0,
         }
         for prog in (*self._programs.values(), self.impostors.lit):
             for name, value in common.items():
@@ -482,8 +551,12 @@ class Renderer:
             tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes())
             tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
             tex.use(location=0)
-            for name, value in (("u_rect", ov.rect), ("u_alpha", ov.alpha), ("u_depth", depth),
-                                ("u_photo", 1.0 if ov.photo else 0.0)):
+            for name, value in (
+                ("u_rect", ov.rect),
+                ("u_alpha", ov.alpha),
+                ("u_depth", depth),
+                ("u_photo", 1.0 if ov.photo else 0.0),
+            ):
                 set_uniform(prog, name, value)
             self._vaos["overlay"].render(moderngl.TRIANGLE_STRIP)
             tex.release()

@@ -31,8 +31,22 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine.io.gltf_mesh import SkinnedMeshes
 
-__all__ = ["RenderScene", "SkinnedInstance", "Rows", "Ground", "GroundMarks", "Sun", "TextLine", "Overlay",
-           "CAPSULE_STRIDE", "BOX_STRIDE", "LINE_STRIDE", "POINT_STRIDE", "CONE_STRIDE", "PRINT_STRIDE"]
+__all__ = [
+    "RenderScene",
+    "SkinnedInstance",
+    "Rows",
+    "Ground",
+    "GroundMarks",
+    "Sun",
+    "TextLine",
+    "Overlay",
+    "CAPSULE_STRIDE",
+    "BOX_STRIDE",
+    "LINE_STRIDE",
+    "POINT_STRIDE",
+    "CONE_STRIDE",
+    "PRINT_STRIDE",
+]
 
 CAPSULE_STRIDE = 11
 BOX_STRIDE = 14
@@ -190,8 +204,11 @@ class SkinnedInstance:
         points = []
         for prim in self.meshes.primitives:
             step = max(1, len(prim.positions) // 128)
-            m = np.einsum("vk,vkij->vij", prim.weights[::step].astype(np.float64),
-                          np.asarray(self.matrices, dtype=np.float64)[prim.joints[::step].astype(np.int64)])
+            m = np.einsum(
+                "vk,vkij->vij",
+                prim.weights[::step].astype(np.float64),
+                np.asarray(self.matrices, dtype=np.float64)[prim.joints[::step].astype(np.int64)],
+            )
             rest = prim.positions[::step].astype(np.float64)
             points.append(np.einsum("vij,vj->vi", m[:, :3, :3], rest) + m[:, :3, 3])
         every = np.vstack(points)
@@ -243,36 +260,52 @@ class RenderScene:
         self.skinned.clear()
 
     # -- builders ---------------------------------------------------------------------
-    def add_capsules(self, a: ArrayLike, b: ArrayLike, radius: ArrayLike,
-                     color: ArrayLike = (0.8, 0.8, 0.8), outline: ArrayLike = False) -> None:
+    def add_capsules(
+        self,
+        a: ArrayLike,
+        b: ArrayLike,
+        radius: ArrayLike,
+        color: ArrayLike = (0.8, 0.8, 0.8),
+        outline: ArrayLike = False,
+    ) -> None:
         """Append ``N`` capsules from ``a [N,3]`` to ``b [N,3]`` (one group: broadcasting applies)."""
         a_arr = np.asarray(a, dtype=np.float64).reshape(-1, 3)
         self._fill_capsule_rows(self.capsules, len(a_arr), a_arr, b, radius, color, outline)
 
-    def add_capsule(self, a: ArrayLike, b: ArrayLike, radius: float,
-                    color: ArrayLike = (0.8, 0.8, 0.8), outline: bool = False) -> None:
+    def add_capsule(
+        self, a: ArrayLike, b: ArrayLike, radius: float, color: ArrayLike = (0.8, 0.8, 0.8), outline: bool = False
+    ) -> None:
         """Append one capsule."""
         self.add_capsules(a, b, radius, color, outline)
 
-    def add_spheres(self, center: ArrayLike, radius: ArrayLike,
-                    color: ArrayLike = (0.95, 0.95, 0.97), outline: ArrayLike = False) -> None:
+    def add_spheres(
+        self, center: ArrayLike, radius: ArrayLike, color: ArrayLike = (0.95, 0.95, 0.97), outline: ArrayLike = False
+    ) -> None:
         """Append ``N`` spheres at ``center [N,3]``."""
         c = np.asarray(center, dtype=np.float64).reshape(-1, 3)
         self._fill_capsule_rows(self.spheres, len(c), c, c, radius, color, outline)
 
-    def add_sphere(self, center: ArrayLike, radius: float,
-                   color: ArrayLike = (0.95, 0.95, 0.97), outline: bool = False) -> None:
+    def add_sphere(
+        self, center: ArrayLike, radius: float, color: ArrayLike = (0.95, 0.95, 0.97), outline: bool = False
+    ) -> None:
         """Append one sphere."""
         self.add_spheres(center, radius, color, outline)
 
-    def add_cones(self, base: ArrayLike, apex: ArrayLike, radius: ArrayLike,
-                  color: ArrayLike = (0.16, 0.36, 0.24), snow: ArrayLike = 0.0) -> None:
+    def add_cones(
+        self,
+        base: ArrayLike,
+        apex: ArrayLike,
+        radius: ArrayLike,
+        color: ArrayLike = (0.16, 0.36, 0.24),
+        snow: ArrayLike = 0.0,
+    ) -> None:
         """Append ``N`` cones from a base disc of ``radius`` at ``base [N,3]`` to ``apex [N,3]``; ``snow`` in [0, 1]."""
         a = np.asarray(base, dtype=np.float64).reshape(-1, 3)
         self._fill_capsule_rows(self.cones, len(a), a, apex, radius, color, np.clip(np.asarray(snow, float), 0, 1))
 
-    def add_prints(self, xz: ArrayLike, heading: ArrayLike, length: float = 0.26, width: float = 0.11,
-                   strength: ArrayLike = 1.0) -> None:
+    def add_prints(
+        self, xz: ArrayLike, heading: ArrayLike, length: float = 0.26, width: float = 0.11, strength: ArrayLike = 1.0
+    ) -> None:
         """Append ``N`` footprints at ``xz [N,2]`` pointing along ``heading [N]`` (radians from +x towards +z)."""
         p = _col(xz, np.asarray(xz).reshape(-1, 2).shape[0], 2, "xz")
         n = len(p)
@@ -281,8 +314,14 @@ class RenderScene:
         rows[:, 0:2], rows[:, 2], rows[:, 3] = p, np.cos(h), np.sin(h)
         rows[:, 4], rows[:, 5], rows[:, 6] = 0.5 * length, 0.5 * width, np.clip(_col(strength, n, 1, "strength"), 0, 1)
 
-    def add_boxes(self, center: ArrayLike, half_extents: ArrayLike, rotation: ArrayLike = (1.0, 0.0, 0.0, 0.0),
-                  color: ArrayLike = (0.7, 0.6, 0.5), outline: ArrayLike = False) -> None:
+    def add_boxes(
+        self,
+        center: ArrayLike,
+        half_extents: ArrayLike,
+        rotation: ArrayLike = (1.0, 0.0, 0.0, 0.0),
+        color: ArrayLike = (0.7, 0.6, 0.5),
+        outline: ArrayLike = False,
+    ) -> None:
         """Append ``N`` oriented boxes (rotation as (w,x,y,z) quaternions)."""
         c = _col(center, np.asarray(center).reshape(-1, 3).shape[0], 3, "center")
         n = len(c)
@@ -296,13 +335,20 @@ class RenderScene:
         rows = self.boxes.extend(n)
         rows[:, 0:3], rows[:, 3:6], rows[:, 6:10], rows[:, 10:13], rows[:, 13] = c, h, q, col, out
 
-    def add_box(self, center: ArrayLike, half_extents: ArrayLike, rotation: ArrayLike = (1.0, 0.0, 0.0, 0.0),
-                color: ArrayLike = (0.7, 0.6, 0.5), outline: bool = False) -> None:
+    def add_box(
+        self,
+        center: ArrayLike,
+        half_extents: ArrayLike,
+        rotation: ArrayLike = (1.0, 0.0, 0.0, 0.0),
+        color: ArrayLike = (0.7, 0.6, 0.5),
+        outline: bool = False,
+    ) -> None:
         """Append one oriented box."""
         self.add_boxes(center, half_extents, rotation, color, outline)
 
-    def add_lines(self, p0: ArrayLike, p1: ArrayLike, color: ArrayLike = (0.1, 0.1, 0.1),
-                  width: ArrayLike = 2.0) -> None:
+    def add_lines(
+        self, p0: ArrayLike, p1: ArrayLike, color: ArrayLike = (0.1, 0.1, 0.1), width: ArrayLike = 2.0
+    ) -> None:
         """Append ``N`` debug line segments ``p0 [N,3] -> p1 [N,3]``, ``width`` in pixels."""
         a = _col(p0, np.asarray(p0).reshape(-1, 3).shape[0], 3, "p0")
         n = len(a)
@@ -314,8 +360,9 @@ class RenderScene:
         """Append one line segment."""
         self.add_lines(p0, p1, color, width)
 
-    def add_polyline(self, points: ArrayLike, color: ArrayLike = (0.1, 0.1, 0.1), width: float = 2.0,
-                     closed: bool = False) -> None:
+    def add_polyline(
+        self, points: ArrayLike, color: ArrayLike = (0.1, 0.1, 0.1), width: float = 2.0, closed: bool = False
+    ) -> None:
         """Append the segments joining consecutive ``points [N,3]`` (a curve, a trajectory)."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if closed and len(p) > 2:
@@ -323,8 +370,9 @@ class RenderScene:
         if len(p) >= 2:
             self.add_lines(p[:-1], p[1:], color, width)
 
-    def add_points(self, pos: ArrayLike, size: ArrayLike = 0.03, color: ArrayLike = (1.0, 1.0, 1.0),
-                   pixels: bool = False) -> None:
+    def add_points(
+        self, pos: ArrayLike, size: ArrayLike = 0.03, color: ArrayLike = (1.0, 1.0, 1.0), pixels: bool = False
+    ) -> None:
         """Append ``N`` round points (snowflakes, curve keypoints); ``size`` is a diameter in metres or pixels."""
         p = _col(pos, np.asarray(pos).reshape(-1, 3).shape[0], 3, "pos")
         n = len(p)
@@ -335,9 +383,16 @@ class RenderScene:
         rows = self.points.extend(n)
         rows[:, 0:3], rows[:, 3], rows[:, 4:7], rows[:, 7] = p, s, col, 1.0 if pixels else 0.0
 
-    def add_text(self, text: str, x: float | None = None, y: float | None = None, size: int = 18,
-                 color: tuple[float, float, float] = (1.0, 1.0, 1.0), anchor: tuple[float, float] | None = None,
-                 alpha: float = 1.0) -> None:
+    def add_text(
+        self,
+        text: str,
+        x: float | None = None,
+        y: float | None = None,
+        size: int = 18,
+        color: tuple[float, float, float] = (1.0, 1.0, 1.0),
+        anchor: tuple[float, float] | None = None,
+        alpha: float = 1.0,
+    ) -> None:
         """Append an overlay line; without ``x``/``y`` it stacks below the previous auto-placed line
         (see :class:`TextLine` for ``anchor`` and ``alpha``)."""
         if not isinstance(text, str):
@@ -364,8 +419,14 @@ class RenderScene:
                 raise ValueError(f"background fade must be in [0, 1], got {fade}")
             self.background_fade = float(fade)
 
-    def add_overlay(self, image: ArrayLike, rect: tuple[float, float, float, float] = (0.0, 0.0, 1.0, 1.0),
-                    depth_at: ArrayLike | None = None, photo: bool = False, alpha: float = 1.0) -> None:
+    def add_overlay(
+        self,
+        image: ArrayLike,
+        rect: tuple[float, float, float, float] = (0.0, 0.0, 1.0, 1.0),
+        depth_at: ArrayLike | None = None,
+        photo: bool = False,
+        alpha: float = 1.0,
+    ) -> None:
         """Append an :class:`Overlay` (drawn after the 3-D scene, before the text)."""
         img = np.asarray(image)
         if img.ndim != 3 or img.shape[2] != 4 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
@@ -375,8 +436,7 @@ class RenderScene:
         r = (r0, r1, r2, r3)
         if not (r[0] < r[2] and r[1] < r[3]):
             raise ValueError(f"overlay rect must be (u0, v0, u1, v1) with u0 < u1 and v0 < v1, got {rect}")
-        self.overlays.append(Overlay(np.ascontiguousarray(img), r, at, bool(photo),
-                                     float(np.clip(alpha, 0.0, 1.0))))
+        self.overlays.append(Overlay(np.ascontiguousarray(img), r, at, bool(photo), float(np.clip(alpha, 0.0, 1.0))))
 
     # -- views ------------------------------------------------------------------------
     def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
@@ -408,8 +468,15 @@ class RenderScene:
         return np.vstack(los).min(axis=0).astype(np.float64), np.vstack(his).max(axis=0).astype(np.float64)
 
     @staticmethod
-    def _fill_capsule_rows(target: Rows, n: int, a: NDArray[np.float64], b: ArrayLike, radius: ArrayLike,
-                           color: ArrayLike, outline: ArrayLike) -> NDArray[np.float32]:
+    def _fill_capsule_rows(
+        target: Rows,
+        n: int,
+        a: NDArray[np.float64],
+        b: ArrayLike,
+        radius: ArrayLike,
+        color: ArrayLike,
+        outline: ArrayLike,
+    ) -> NDArray[np.float32]:
         b_arr = _col(b, n, 3, "b")
         r = _col(radius, n, 1, "radius")
         if np.any(r < 0):

@@ -16,8 +16,24 @@ the ground (:mod:`engine.render.shadows`).
 
 from __future__ import annotations
 
-__all__ = ["HEADER", "LIGHTING", "CAPSULE_VS", "CONE_VS", "BOX_VS", "LIT_FS", "FLAT_FS", "DEPTH_FS", "LINE_VS",
-           "LINE_FS", "POINT_VS", "POINT_FS", "TEXT_VS", "TEXT_FS", "OVERLAY_VS", "OVERLAY_FS"]
+__all__ = [
+    "HEADER",
+    "LIGHTING",
+    "CAPSULE_VS",
+    "CONE_VS",
+    "BOX_VS",
+    "LIT_FS",
+    "FLAT_FS",
+    "DEPTH_FS",
+    "LINE_VS",
+    "LINE_FS",
+    "POINT_VS",
+    "POINT_FS",
+    "TEXT_VS",
+    "TEXT_FS",
+    "OVERLAY_VS",
+    "OVERLAY_FS",
+]
 
 HEADER = "#version 330 core\n"
 

@@ -15,8 +15,20 @@ the ground, :data:`engine.render.shaders_env.BACKGROUND`).
 
 from __future__ import annotations
 
-__all__ = ["GROUND_MESH_VS", "GROUND_MESH_FS", "SKY_DOME_VS", "COLOR_FS", "RIDGE_VS", "SUN_VS", "SUN_FS",
-           "DECAL_VS", "SHADOW_DECAL_FS", "MARKS_FS", "PRINT_VS", "PRINT_FS"]
+__all__ = [
+    "GROUND_MESH_VS",
+    "GROUND_MESH_FS",
+    "SKY_DOME_VS",
+    "COLOR_FS",
+    "RIDGE_VS",
+    "SUN_VS",
+    "SUN_FS",
+    "DECAL_VS",
+    "SHADOW_DECAL_FS",
+    "MARKS_FS",
+    "PRINT_VS",
+    "PRINT_FS",
+]
 
 # The ground mesh: rings around the camera (in_ring: unit direction xz, radius in metres).
 GROUND_MESH_VS = """

@@ -104,8 +104,14 @@ class Shadows:
         map_size: side of the object shadow map; mask_size: side of the ground mask.
     """
 
-    def __init__(self, ctx: moderngl.Context, boxes: Instances, map_size: int = 1024, mask_size: int = 512,
-                 cones: Instances | None = None) -> None:
+    def __init__(
+        self,
+        ctx: moderngl.Context,
+        boxes: Instances,
+        map_size: int = 1024,
+        mask_size: int = 512,
+        cones: Instances | None = None,
+    ) -> None:
         if map_size < 16 or mask_size < 16:
             raise ValueError(f"shadow sizes must be at least 16, got {map_size} and {mask_size}")
         self.ctx = ctx
@@ -118,21 +124,31 @@ class Shadows:
             "mask": ctx.program(vertex_shader=h + E.FULLSCREEN_VS, fragment_shader=h + E.MASK_FS),
         }
         # Casters at the coarsest level whose outline stays within a shadow-map texel.
-        self._lod = {kind: LodBatches(ctx, progs["capsule_depth"], level_meshes(kind), CAPSULE_FMT, 4 * CAPSULE_STRIDE)
-                     for kind in LEVELS}
+        self._lod = {
+            kind: LodBatches(ctx, progs["capsule_depth"], level_meshes(kind), CAPSULE_FMT, 4 * CAPSULE_STRIDE)
+            for kind in LEVELS
+        }
         self._boxes = boxes
         self._buffers = list(mesh_buffers(ctx, meshes.box_mesh()))
-        self._box_vao = ctx.vertex_array(progs["box_depth"], [(self._buffers[0], "3f 3f", "in_pos", "in_normal"),
-                                                             (boxes.buf, *BOX_FMT)], self._buffers[1], 4,
-                                         skip_errors=True)
+        self._box_vao = ctx.vertex_array(
+            progs["box_depth"],
+            [(self._buffers[0], "3f 3f", "in_pos", "in_normal"), (boxes.buf, *BOX_FMT)],
+            self._buffers[1],
+            4,
+            skip_errors=True,
+        )
         self._mask_vao = ctx.vertex_array(progs["mask"], [])
         self._cones = cones
         self._cone_vao = None
         if cones is not None:
             self._buffers += list(mesh_buffers(ctx, cone_mesh()))
-            self._cone_vao = ctx.vertex_array(progs["cone_depth"], [(self._buffers[2], "4f", "in_vert"),
-                                                                   (cones.buf, *CAPSULE_FMT)], self._buffers[3], 4,
-                                              skip_errors=True)
+            self._cone_vao = ctx.vertex_array(
+                progs["cone_depth"],
+                [(self._buffers[2], "4f", "in_vert"), (cones.buf, *CAPSULE_FMT)],
+                self._buffers[3],
+                4,
+                skip_errors=True,
+            )
         self.depth = ctx.depth_texture((map_size, map_size))
         self.depth.compare_func = "<="
         self.depth.filter = (moderngl.LINEAR, moderngl.LINEAR)
@@ -143,9 +159,14 @@ class Shadows:
         self.mask.repeat_x = self.mask.repeat_y = False
         self._mask_fbo = ctx.framebuffer([self.mask])
 
-    def render(self, scene: RenderScene, casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
-               light_vp: NDArray[np.float64], rect: tuple[float, float, float, float],
-               more_casters: Callable[[NDArray[np.float64]], None] | None = None) -> None:
+    def render(
+        self,
+        scene: RenderScene,
+        casters: dict[str, tuple[NDArray[np.float32], NDArray[np.intp]]],
+        light_vp: NDArray[np.float64],
+        rect: tuple[float, float, float, float],
+        more_casters: Callable[[NDArray[np.float64]], None] | None = None,
+    ) -> None:
         """Draw the object shadow map and the ground mask for this frame.
 
         ``casters`` maps "capsules" and "spheres" to the scene's rows and the level each
@@ -184,9 +205,14 @@ class Shadows:
         # texels it crosses wherever it falls between their centres, rather than flicker.
         uv_per_metre = float(np.linalg.norm(light_vp[0, :3])) / 2.0
         spread = max(0.5 * scene.sun.softness, 0.5 * max(rect[2], rect[3]) / self.mask_size)
-        for name, value in (("u_shadow_map", 0), ("u_light_vp", light_vp), ("u_rect", rect),
-                            ("u_height", float(scene.ground.height)), ("u_spread", spread * uv_per_metre),
-                            ("u_depth_bias", 0.01 * float(np.linalg.norm(light_vp[2, :3])) / 2.0)):
+        for name, value in (
+            ("u_shadow_map", 0),
+            ("u_light_vp", light_vp),
+            ("u_rect", rect),
+            ("u_height", float(scene.ground.height)),
+            ("u_spread", spread * uv_per_metre),
+            ("u_depth_bias", 0.01 * float(np.linalg.norm(light_vp[2, :3])) / 2.0),
+        ):
             set_uniform(mask, name, value)
         self._mask_vao.render(moderngl.TRIANGLES, vertices=3)
 

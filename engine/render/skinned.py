@@ -95,8 +95,15 @@ def _vertices(p: SkinnedPrimitive) -> bytes:
 class _PrimitiveGPU:
     """Buffers, vertex arrays and base-colour texture of one primitive."""
 
-    def __init__(self, ctx: moderngl.Context, prim: SkinnedPrimitive, lit: moderngl.Program,
-                 feedback: moderngl.Program, depth: moderngl.Program, flat: moderngl.Program) -> None:
+    def __init__(
+        self,
+        ctx: moderngl.Context,
+        prim: SkinnedPrimitive,
+        lit: moderngl.Program,
+        feedback: moderngl.Program,
+        depth: moderngl.Program,
+        flat: moderngl.Program,
+    ) -> None:
         self.vbo = ctx.buffer(_vertices(prim))
         self.ibo = ctx.buffer(np.ascontiguousarray(prim.indices, dtype=np.uint32).tobytes())
         self.lit = ctx.vertex_array(lit, [(self.vbo, *_VERTEX_FMT)], self.ibo, 4, skip_errors=True)

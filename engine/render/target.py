@@ -91,8 +91,15 @@ def save_image(pixels: NDArray[np.uint8], path: str | Path) -> Path:
     return p
 
 
-def make_target(headless: bool, width: int = 1280, height: int = 720, *, title: str = "PuppetPhone",
-                samples: int | None = None, vsync: bool = True) -> RenderTarget:
+def make_target(
+    headless: bool,
+    width: int = 1280,
+    height: int = 720,
+    *,
+    title: str = "PuppetPhone",
+    samples: int | None = None,
+    vsync: bool = True,
+) -> RenderTarget:
     """A window (``headless=False``) or an off-screen target of ``width`` x ``height``.
 
     ``samples``: MSAA samples; ``None`` chooses (4 on a GPU, 0 on llvmpipe).

@@ -65,15 +65,18 @@ def _open_display() -> None:
                 os.environ["SDL_VIDEODRIVER"] = explicit
             else:
                 del os.environ["SDL_VIDEODRIVER"]
-    raise NoDisplayError(f"no display (SDL chose its {driver!r} video driver; SDL said: {first}{retry}): a window "
-                         "cannot be shown here; use --headless to run without one")
+    raise NoDisplayError(
+        f"no display (SDL chose its {driver!r} video driver; SDL said: {first}{retry}): a window "
+        "cannot be shown here; use --headless to run without one"
+    )
 
 
 class WindowTarget:
     """An on-screen target; ``closed`` turns true when the user closes the window."""
 
-    def __init__(self, width: int, height: int, *, title: str = "PuppetPhone", samples: int | None = None,
-                 vsync: bool = True) -> None:
+    def __init__(
+        self, width: int, height: int, *, title: str = "PuppetPhone", samples: int | None = None, vsync: bool = True
+    ) -> None:
         import pygame
 
         _open_display()

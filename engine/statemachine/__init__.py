@@ -15,5 +15,15 @@ from engine.statemachine.machine import (
     step_machines,
 )
 
-__all__ = ["ANY", "BatchGuard", "BatchUpdate", "Brain", "State", "StateMachine", "TraceEntry", "Transition",
-           "step_machine", "step_machines"]
+__all__ = [
+    "ANY",
+    "BatchGuard",
+    "BatchUpdate",
+    "Brain",
+    "State",
+    "StateMachine",
+    "TraceEntry",
+    "Transition",
+    "step_machine",
+    "step_machines",
+]

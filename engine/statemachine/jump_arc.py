@@ -139,7 +139,9 @@ class JumpTracker:
             self.off_line_for = 0.0
         return None
 
-    def update(self, point: NDArray[np.float64], velocity: NDArray[np.float64], dt: float, height_above_ground: float) -> JumpStatus:
+    def update(
+        self, point: NDArray[np.float64], velocity: NDArray[np.float64], dt: float, height_above_ground: float
+    ) -> JumpStatus:
         """Take one frame of the stick tip; returns the jump's status."""
         vy = float(velocity[1])
         horizontal = np.array([velocity[0], velocity[2]])

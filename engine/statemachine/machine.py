@@ -151,8 +151,14 @@ class Brain:
 class StateMachine(Generic[C]):
     """An immutable graph of states and transitions with a default state."""
 
-    def __init__(self, name: str, states: Sequence[State[C]], transitions: Sequence[Transition[C]], default: str,
-                 initial: str | None = None) -> None:
+    def __init__(
+        self,
+        name: str,
+        states: Sequence[State[C]],
+        transitions: Sequence[Transition[C]],
+        default: str,
+        initial: str | None = None,
+    ) -> None:
         self.name = name
         self.states = {s.name: s for s in states}
         if len(self.states) != len(states):
@@ -179,9 +185,11 @@ class StateMachine(Generic[C]):
             self._outgoing[s] = out
             # A state is stepped over arrays only if every way out of it has an array guard
             # (event transitions need no guard: an entity with events is stepped alone).
-            self._batchable[s] = state.batch_update is not None and (
-                state.fits is _always or state.batch_fits is not None) and all(
-                t.batch_guard is not None or t.guard is None for t in out)
+            self._batchable[s] = (
+                state.batch_update is not None
+                and (state.fits is _always or state.batch_fits is not None)
+                and all(t.batch_guard is not None or t.guard is None for t in out)
+            )
 
     def new_brain(self) -> Brain:
         """A component starting in the initial state (``enter`` runs on the first step)."""

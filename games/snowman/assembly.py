@@ -25,8 +25,9 @@ class Ball:
     radius: float
 
 
-def resting_matrix(centers: NDArray[np.float64], radii: NDArray[np.float64], gap: float = 0.06,
-                   off_axis: float = 0.45) -> NDArray[np.bool_]:
+def resting_matrix(
+    centers: NDArray[np.float64], radii: NDArray[np.float64], gap: float = 0.06, off_axis: float = 0.45
+) -> NDArray[np.bool_]:
     """``[N, N]`` booleans: entry ``[u, l]`` says ball ``u`` sits on top of ball ``l``.
 
     On top means: centre above, horizontally within ``off_axis`` of the lower radius, and
@@ -38,7 +39,11 @@ def resting_matrix(centers: NDArray[np.float64], radii: NDArray[np.float64], gap
     d = c[:, None, :] - c[None, :, :]
     horizontal = np.hypot(d[..., 0], d[..., 2])
     touch = r[:, None] + r[None, :]
-    return (d[..., 1] > 0) & (horizontal <= off_axis * r[None, :]) & (np.abs(np.linalg.norm(d, axis=-1) - touch) <= gap * touch)
+    return (
+        (d[..., 1] > 0)
+        & (horizontal <= off_axis * r[None, :])
+        & (np.abs(np.linalg.norm(d, axis=-1) - touch) <= gap * touch)
+    )
 
 
 def find_snowmen(balls: list[Ball], on_ground: float = 0.1) -> list[list[Ball]]:

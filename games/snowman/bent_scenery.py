@@ -23,7 +23,15 @@ if TYPE_CHECKING:
     from authoring.flowcurves.scene import FlowScene
     from engine.camera import OrbitCamera
 
-__all__ = ["scenery_objects", "prepare_flow", "recorded_flow", "BentScenery", "bent_scenery", "TRUNK_COLOR", "SNOW_COLOR"]
+__all__ = [
+    "scenery_objects",
+    "prepare_flow",
+    "recorded_flow",
+    "BentScenery",
+    "bent_scenery",
+    "TRUNK_COLOR",
+    "SNOW_COLOR",
+]
 
 TRUNK_COLOR = (0.36, 0.25, 0.17)
 SNOW_COLOR = (0.95, 0.97, 1.0)
@@ -42,15 +50,28 @@ def scenery_objects() -> list[dict[str, Any]]:
     out = []
     for t, (x, z, s) in enumerate(TREES):
         base, group = np.array([x, 0.0, z]), f"tree{t}"
-        out.append({"name": f"{group}.trunk", "group": group,
-                    "primitives": [_prim(base, base + [0, 1.2 * s, 0], 0.12 * s, TRUNK_COLOR)]})
+        out.append(
+            {
+                "name": f"{group}.trunk",
+                "group": group,
+                "primitives": [_prim(base, base + [0, 1.2 * s, 0], 0.12 * s, TRUNK_COLOR)],
+            }
+        )
         for k, (h, r) in enumerate(_TIERS):
             c = base + [0, h * s, 0]
-            out.append({"name": f"{group}.tier{k}", "group": group, "primitives": [
-                _prim(c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, (0.16, 0.36 - 0.03 * k, 0.24))]})
+            out.append(
+                {
+                    "name": f"{group}.tier{k}",
+                    "group": group,
+                    "primitives": [
+                        _prim(c - [0, 0.05 * s, 0], c + [0, 0.35 * s, 0], r * s * 0.9, (0.16, 0.36 - 0.03 * k, 0.24))
+                    ],
+                }
+            )
             cap = c + [0, 0.45 * s, 0]
-            out.append({"name": f"{group}.cap{k}", "group": group,
-                        "primitives": [_prim(cap, cap, 0.35 * r * s, SNOW_COLOR)]})
+            out.append(
+                {"name": f"{group}.cap{k}", "group": group, "primitives": [_prim(cap, cap, 0.35 * r * s, SNOW_COLOR)]}
+            )
     for k, (x, z, r) in enumerate(ROCKS):
         centre = [x, 0.6 * r, z]
         out.append({"name": f"rock{k}", "group": f"rock{k}", "primitives": [_prim(centre, centre, r, ROCK_COLOR)]})
@@ -94,7 +115,9 @@ def check_objects(objects: list[dict[str, Any]]) -> None:
     want = {o["name"]: (o["group"], len(o["primitives"])) for o in scenery_objects()}
     have = {o["name"]: (o["group"], len(o["primitives"])) for o in objects}
     if have != want:
-        missing = sorted(set(want) - set(have)) or sorted(set(have) - set(want)) or ["groups or primitive counts differ"]
+        missing = (
+            sorted(set(want) - set(have)) or sorted(set(have) - set(want)) or ["groups or primitive counts differ"]
+        )
         raise GameOptionError(f"flow: the file's objects are not this field's ({', '.join(missing[:3])})")
 
 

@@ -44,13 +44,16 @@ _BUTTONS = np.array([[0.0, 0.45 * k, 0.95] for k in (-0.6, 0.0, 0.6)])
 def _joint_indices(sk: Skeleton) -> dict[str, list[int]]:
     """The joints a snowman is drawn from, looked up once per rig."""
     j = sk.index
-    return {"legs": [j(f"{side}_{bone}") for side in "lr" for bone in _LEG],
-            "arms": [j(f"{side}_{bone}") for side in "lr" for bone in _ARM],
-            "body": [j("hips"), j("spine"), j("chest"), j("head")]}
+    return {
+        "legs": [j(f"{side}_{bone}") for side in "lr" for bone in _LEG],
+        "arms": [j(f"{side}_{bone}") for side in "lr" for bone in _ARM],
+        "body": [j("hips"), j("spine"), j("chest"), j("head")],
+    }
 
 
-def _snowman_rows(snowman: Snowman, sk: Skeleton, pos: np.ndarray, rot: np.ndarray,
-                  joints: dict[str, list[int]]) -> tuple[np.ndarray, ...]:
+def _snowman_rows(
+    snowman: Snowman, sk: Skeleton, pos: np.ndarray, rot: np.ndarray, joints: dict[str, list[int]]
+) -> tuple[np.ndarray, ...]:
     """One snowman's capsules (a, b, radius) and spheres (centre, radius, is-a-ball)."""
     shape = snowman.shape
     hips_i, spine_i, chest_i, head_i = joints["body"]
@@ -61,15 +64,23 @@ def _snowman_rows(snowman: Snowman, sk: Skeleton, pos: np.ndarray, rot: np.ndarr
     feet, hands = [legs[2], legs[5]], [arms[2], arms[5]]
     # Every offset that turns with a bone, rotated in one call: foot and hand tips, the
     # spine's "up" (Eq. 6.4's p_up), eyes and nose on the head, buttons on the chest.
-    local = np.vstack([sk.tips[feet], sk.tips[hands], [[0.0, spine_len, 0.0]], _EYES * rh, _NOSE * rh,
-                       _BUTTONS * (shape.middle or 0.0)])
+    local = np.vstack(
+        [
+            sk.tips[feet],
+            sk.tips[hands],
+            [[0.0, spine_len, 0.0]],
+            _EYES * rh,
+            _NOSE * rh,
+            _BUTTONS * (shape.middle or 0.0),
+        ]
+    )
     turn = rot[feet + hands + [hips_i] + [head_i] * 4 + [chest_i] * 3]
     moved = quat.rotate(turn, local)
     foot_tips, hand_tips, up = pos[feet] + moved[0:2], pos[hands] + moved[2:4], hips + moved[4]
     eyes, nose = head + moved[5:7], head + moved[7:9]
     leg_a = np.vstack([pos[legs[0:3]], pos[legs[3:6]]])
     leg_b = np.vstack([pos[legs[1:3]], foot_tips[0:1], pos[legs[4:6]], foot_tips[1:2]])
-    arm_pts = [np.vstack([pos[arms[k:k + 3]], hand_tips[k // 3]]) for k in (0, 3)]
+    arm_pts = [np.vstack([pos[arms[k : k + 3]], hand_tips[k // 3]]) for k in (0, 3)]
     cap_a = np.vstack([leg_a, arm_pts[0][:-1], arm_pts[1][:-1], nose[0:1]])
     cap_b = np.vstack([leg_b, arm_pts[0][1:], arm_pts[1][1:], nose[1:2]])
     cap_r = np.concatenate([sk.radii[legs], np.full(6, sk.radii[arms[0]]), [0.07 * rh]])

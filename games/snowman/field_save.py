@@ -32,11 +32,11 @@ from typing import Any
 
 import numpy as np
 
-from engine.errors import FormatError
 from engine.app import App
 from engine.atomic import WriteError, atomic_write_bytes, set_aside
 from engine.components import Transform
 from engine.ecs import World
+from engine.errors import FormatError
 from engine.npz_safe import read_bounded
 from engine.ragdoll.components import Prop
 from engine.recovery import Rescue
@@ -49,8 +49,20 @@ from games.snowman.rules import spawn_ball
 from games.snowman.snow import SnowField
 from input.sample import RESET, RESTORE, SAVE, InputFrame
 
-__all__ = ["FIELD_VERSION", "FieldError", "FieldSlot", "snapshot", "restore", "spawn_first_puppet", "field_commands",
-           "default_field_path", "load_field", "install_field_slot", "prepare", "replay_setup"]
+__all__ = [
+    "FIELD_VERSION",
+    "FieldError",
+    "FieldSlot",
+    "snapshot",
+    "restore",
+    "spawn_first_puppet",
+    "field_commands",
+    "default_field_path",
+    "load_field",
+    "install_field_slot",
+    "prepare",
+    "replay_setup",
+]
 
 FIELD_VERSION = 1
 # Limits of a field file. Counts bound the step time (1,000 balls made a step take half a
@@ -81,8 +93,9 @@ class FieldSlot:
     rescue: Rescue | None = None  # F5 when ``path`` refuses the save: the recovery folder (engine.recovery)
 
 
-def spawn_first_puppet(world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0),
-                       heading: float = 0.0) -> int:
+def spawn_first_puppet(
+    world: World, position: np.ndarray | tuple[float, float, float] = (0.0, 0.0, 0.0), heading: float = 0.0
+) -> int:
     """The player's puppet (red), as at the start of a game."""
     from games.common import spawn_player
 
@@ -95,7 +108,11 @@ def _encode_depth(depth: np.ndarray) -> dict[str, Any]:
 
 
 def _decode_depth(data: Any, shape: tuple[int, ...] | None) -> np.ndarray:
-    if not isinstance(data, dict) or not isinstance(data.get("shape"), list) or not isinstance(data.get("zlib_f8"), str):
+    if (
+        not isinstance(data, dict)
+        or not isinstance(data.get("shape"), list)
+        or not isinstance(data.get("zlib_f8"), str)
+    ):
         raise FieldError("snow grid must be an object with a shape list and zlib_f8 text")
     grid = data["shape"]
     if len(grid) != 2 or not all(isinstance(n, int) and not isinstance(n, bool) and 0 < n <= MAX_GRID for n in grid):
@@ -125,14 +142,31 @@ def snapshot(world: World) -> dict[str, Any]:
     stats = world.resource(SnowmanStats)
     return {
         "version": FIELD_VERSION,
-        "balls": [{"position": tr.position.tolist(), "radius": float(prop.radius), "snow": float(sb.snow),
-                   "on": index.get(world.get(e, Stacked).on) if world.has(e, Stacked) else None}
-                  for e, prop, tr, sb in balls],
-        "snowmen": [{"number": s.number, "bottom": s.shape.bottom, "middle": s.shape.middle, "head": s.shape.head,
-                     "position": world.get(e, Transform).position.tolist(), "heading": float(world.get(e, PuppetBody).heading)}
-                    for e, s in world.query(Snowman)],
-        "puppets": [{"position": world.get(e, Transform).position.tolist(), "heading": float(body.heading)}
-                    for e, body in world.query(PuppetBody) if not world.has(e, Snowman)],
+        "balls": [
+            {
+                "position": tr.position.tolist(),
+                "radius": float(prop.radius),
+                "snow": float(sb.snow),
+                "on": index.get(world.get(e, Stacked).on) if world.has(e, Stacked) else None,
+            }
+            for e, prop, tr, sb in balls
+        ],
+        "snowmen": [
+            {
+                "number": s.number,
+                "bottom": s.shape.bottom,
+                "middle": s.shape.middle,
+                "head": s.shape.head,
+                "position": world.get(e, Transform).position.tolist(),
+                "heading": float(world.get(e, PuppetBody).heading),
+            }
+            for e, s in world.query(Snowman)
+        ],
+        "puppets": [
+            {"position": world.get(e, Transform).position.tolist(), "heading": float(body.heading)}
+            for e, body in world.query(PuppetBody)
+            if not world.has(e, Snowman)
+        ],
         "snow": _encode_depth(world.resource(SnowField).depth),
         "stats": {"built": stats.built, "balls_started": stats.balls_started},
     }
@@ -196,9 +230,11 @@ def _check(snap: Any, field_shape: tuple[int, ...] | None) -> np.ndarray | None:
         _count(s.get("number"), "snowman number", 1_000_000)
         middle = s.get("middle")
         try:
-            SnowmanShape(_number(s.get("bottom"), "snowman bottom", 1e-3, MAX_RADIUS),
-                         None if middle is None else _number(middle, "snowman middle", 1e-3, MAX_RADIUS),
-                         _number(s.get("head"), "snowman head", 1e-3, MAX_RADIUS))
+            SnowmanShape(
+                _number(s.get("bottom"), "snowman bottom", 1e-3, MAX_RADIUS),
+                None if middle is None else _number(middle, "snowman middle", 1e-3, MAX_RADIUS),
+                _number(s.get("head"), "snowman head", 1e-3, MAX_RADIUS),
+            )
         except ValueError as exc:
             raise FieldError(str(exc)) from None
     for p in _list(snap, "puppets", MAX_PUPPETS):
@@ -254,8 +290,14 @@ def restore(world: World, snap: dict[str, Any]) -> None:
 
 def start_snapshot() -> dict[str, Any]:
     """A new game: untouched snow, the puppet at the centre, no balls, nothing built."""
-    return {"version": FIELD_VERSION, "balls": [], "snowmen": [], "snow": None,
-            "puppets": [{"position": [0.0, 0.0, 0.0], "heading": 0.0}], "stats": {"built": 0, "balls_started": 0}}
+    return {
+        "version": FIELD_VERSION,
+        "balls": [],
+        "snowmen": [],
+        "snow": None,
+        "puppets": [{"position": [0.0, 0.0, 0.0], "heading": 0.0}],
+        "stats": {"built": 0, "balls_started": 0},
+    }
 
 
 def default_field_path() -> Path:
@@ -314,8 +356,10 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
             print(f"snowman: {exc}; {move}, starting on a fresh field", file=sys.stderr)
             return {"field": None, "save_to": str(path)}
         if bad is None:
-            raise GameOptionError(f"snowman field {path} is not a field this program saved ({exc}); "
-                                  "it is left as it is: choose another file with --set field=PATH") from None
+            raise GameOptionError(
+                f"snowman field {path} is not a field this program saved ({exc}); "
+                "it is left as it is: choose another file with --set field=PATH"
+            ) from None
         print(f"snowman: {exc}; set aside as {bad}, starting on a fresh field", file=sys.stderr)
         saved = None
     return {"field": saved, "save_to": str(path)}
@@ -367,8 +411,11 @@ def field_commands(world: World) -> None:
 
             saved = slot.rescue.save(write)
             if saved.recovered:  # the game goes on; the field is on disk all the same, and in the slot for F9
-                _tell(world, f"field NOT saved to its file: kept in {saved.path}",
-                      f" ({saved.why}; play it with --set field={saved.path})")
+                _tell(
+                    world,
+                    f"field NOT saved to its file: kept in {saved.path}",
+                    f" ({saved.why}; play it with --set field={saved.path})",
+                )
             elif saved.path is None:  # nowhere at all: the field stays in the slot for F9, F5 tries again
                 _tell(world, "field NOT saved to disk (F9 still restores it, F5 tries again)", f": {saved.why}")
             else:

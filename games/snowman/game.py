@@ -22,10 +22,17 @@ from games.base import Game
 from games.snowman.bent_scenery import prepare_flow, recorded_flow
 from games.snowman.components import SnowmanStats, StackWatch
 from games.snowman.draw import draw_snowman_game, draw_snowman_state
-from games.snowman.footprints import Footprints, leave_footprints
 from games.snowman.field_save import field_commands, install_field_slot, prepare, replay_setup, spawn_first_puppet
-from games.snowman.rules import (aim_putdown_on_stacks, assemble_snowmen, grow_snowballs, snow_drag, snowmen_standing,
-                                 start_snowballs, stick_stacked_balls)
+from games.snowman.footprints import Footprints, leave_footprints
+from games.snowman.rules import (
+    aim_putdown_on_stacks,
+    assemble_snowmen,
+    grow_snowballs,
+    snow_drag,
+    snowmen_standing,
+    start_snowballs,
+    stick_stacked_balls,
+)
 from games.snowman.scenery import build_scenery
 from games.snowman.snow import SnowField
 
@@ -75,7 +82,9 @@ def camera() -> OrbitCamera:
 def status(world: World) -> list[str]:
     """Counter of snowmen built, and a hint while a stack waits for its head (the overlay shows the controls)."""
     stats = world.resource(SnowmanStats)
-    lines = [f"snowmen built: {stats.built}   standing: {snowmen_standing(world)}   snowballs started: {stats.balls_started}"]
+    lines = [
+        f"snowmen built: {stats.built}   standing: {snowmen_standing(world)}   snowballs started: {stats.balls_started}"
+    ]
     if world.resource(StackWatch).headless:
         lines.append("a snowman body is waiting for its head: put a smaller ball on top")
     return lines
@@ -104,7 +113,16 @@ def replay_game(recorded: dict[str, Any]) -> dict[str, Any]:
     return setup
 
 
-GAME = Game(name="snowman", install=install, draw=draw_snowman_game, camera=camera, status=status, controls=CONTROLS,
-            options={"field": "", "flow": ""}, option_help=OPTION_HELP, prepare=prepare_game, replay_setup=replay_game,
-            draw_state=draw_snowman_state)
-
+GAME = Game(
+    name="snowman",
+    install=install,
+    draw=draw_snowman_game,
+    camera=camera,
+    status=status,
+    controls=CONTROLS,
+    options={"field": "", "flow": ""},
+    option_help=OPTION_HELP,
+    prepare=prepare_game,
+    replay_setup=replay_game,
+    draw_state=draw_snowman_state,
+)

@@ -24,7 +24,16 @@ from engine.humanoid import HIP_HEIGHT as HUMAN_HIPS
 from engine.humanoid import humanoid_skeleton
 from engine.skeleton import Skeleton
 
-__all__ = ["SnowmanShape", "snowman_skeleton", "bezier_spine", "spine_control_point", "leg_scale", "middle_ball_parameter", "BEND", "HUMAN_HIPS"]
+__all__ = [
+    "SnowmanShape",
+    "snowman_skeleton",
+    "bezier_spine",
+    "spine_control_point",
+    "leg_scale",
+    "middle_ball_parameter",
+    "BEND",
+    "HUMAN_HIPS",
+]
 
 BEND = 0.3
 
@@ -108,7 +117,9 @@ def middle_ball_parameter(shape: SnowmanShape) -> float:
     return (shape.bottom + shape.middle) / (shape.bottom + 2.0 * shape.middle)
 
 
-def spine_control_point(p_pelvis: NDArray[np.float64], p_chest: NDArray[np.float64], p_up: NDArray[np.float64], b: float = BEND) -> NDArray[np.float64]:
+def spine_control_point(
+    p_pelvis: NDArray[np.float64], p_chest: NDArray[np.float64], p_up: NDArray[np.float64], b: float = BEND
+) -> NDArray[np.float64]:
     """Eq. 6.4: the Bézier's middle control point, ``(p_pelvis + (1−b)·p_chest + b·p_up)/2``."""
     return (np.asarray(p_pelvis) + (1.0 - b) * np.asarray(p_chest) + b * np.asarray(p_up)) / 2.0
 

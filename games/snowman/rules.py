@@ -29,8 +29,20 @@ from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, S
 from games.snowman.rig import SnowmanShape
 from games.snowman.snow import SnowField
 
-__all__ = ["stick_stacked_balls", "grow_snowballs", "start_snowballs", "assemble_snowmen", "spawn_ball", "snow_drag", "aim_putdown_on_stacks",
-           "snowmen_standing", "MAX_RADIUS", "MAX_BALLS", "SNOW_DRAG", "HEAD_RATIO"]
+__all__ = [
+    "stick_stacked_balls",
+    "grow_snowballs",
+    "start_snowballs",
+    "assemble_snowmen",
+    "spawn_ball",
+    "snow_drag",
+    "aim_putdown_on_stacks",
+    "snowmen_standing",
+    "MAX_RADIUS",
+    "MAX_BALLS",
+    "SNOW_DRAG",
+    "HEAD_RATIO",
+]
 
 MAX_RADIUS = 0.6
 MAX_BALLS = 24
@@ -45,7 +57,12 @@ HEAD_RATIO = 0.6
 def spawn_ball(world: World, position: np.ndarray, radius: float) -> int:
     """A snowball entity: physical, grabbable, growing."""
     pos = np.array([position[0], radius, position[2]], dtype=np.float64)
-    return world.spawn(Transform(pos), Prop(radius=radius), Snowball(last=pos.copy(), snow=radius), Grabbable(radius=radius + 0.05, kind="snowball"))
+    return world.spawn(
+        Transform(pos),
+        Prop(radius=radius),
+        Snowball(last=pos.copy(), snow=radius),
+        Grabbable(radius=radius + 0.05, kind="snowball"),
+    )
 
 
 def _held(world: World) -> set[int]:
@@ -99,12 +116,12 @@ def grow_snowballs(world: World) -> None:
     field = world.resource(SnowField)
     for _, ball, prop, tr, grab in world.query(Snowball, Prop, Transform, Grabbable):
         here = tr.position.copy()
-        if np.isfinite(ball.last).all() and here[1] - prop.radius < 0.03 and prop.radius < MAX_RADIUS:
-            if float(np.hypot(*(here - ball.last)[[0, 2]])) > 1e-4:
-                ball.snow = min(field.roll(ball.last, here, max(ball.snow, prop.radius)), MAX_RADIUS)
-                if ball.snow - prop.radius >= GROWTH_STEP or ball.snow >= MAX_RADIUS:
-                    prop.radius = ball.snow
-                    grab.radius = prop.radius + 0.05
+        rolling = np.isfinite(ball.last).all() and here[1] - prop.radius < 0.03 and prop.radius < MAX_RADIUS
+        if rolling and float(np.hypot(*(here - ball.last)[[0, 2]])) > 1e-4:
+            ball.snow = min(field.roll(ball.last, here, max(ball.snow, prop.radius)), MAX_RADIUS)
+            if ball.snow - prop.radius >= GROWTH_STEP or ball.snow >= MAX_RADIUS:
+                prop.radius = ball.snow
+                grab.radius = prop.radius + 0.05
         ball.last = here
 
 
@@ -155,7 +172,13 @@ def start_snowballs(world: World) -> None:
     for e, body, brain, tr, player in world.query(PuppetBody, Brain, Transform, LocomotionPlayer):
         # The puppet itself must be under way (not only the stick): a ball packed at the
         # feet of a puppet still crouching in place lands in its hands' collision shapes.
-        if brain.active != PuppetState.CROUCH or body.held_by is None or body.speed < 0.3 or player.speed < 0.3 or brain.time_in_state < 0.4:
+        if (
+            brain.active != PuppetState.CROUCH
+            or body.held_by is None
+            or body.speed < 0.3
+            or player.speed < 0.3
+            or brain.time_in_state < 0.4
+        ):
             continue
         if count >= MAX_BALLS or prop_in_front(world, e, body, 1.0) is not None:
             continue
@@ -203,4 +226,8 @@ def assemble_snowmen(world: World) -> None:
 
 def snowmen_standing(world: World) -> int:
     """How many snowmen are alive and on their feet (not a ragdoll)."""
-    return sum(1 for _, _, brain in world.query(Snowman, Brain) if brain.active not in (PuppetState.RAGDOLL, PuppetState.GET_UP))
+    return sum(
+        1
+        for _, _, brain in world.query(Snowman, Brain)
+        if brain.active not in (PuppetState.RAGDOLL, PuppetState.GET_UP)
+    )

@@ -40,9 +40,9 @@ def build_scenery(world: World) -> None:
     if flow:
         bent, trunks, rocks = bent_scenery(flow)
         world.insert_resource(bent)
-    for (x, z, s), base in zip(TREES, trunks):
+    for (_x, _z, s), base in zip(TREES, trunks):
         world.spawn(Transform(np.array(base, dtype=np.float64), scale=s), Obstacle(radius=0.9 * s, height=3.2 * s))
-    for (x, z, r), centre in zip(ROCKS, rocks):
+    for (_x, _z, r), centre in zip(ROCKS, rocks):
         world.spawn(
             Transform(np.array(centre, dtype=np.float64)),
             Obstacle(radius=r, height=1.2 * r),

@@ -56,8 +56,13 @@ class Sprites:
     """Stage 2 onwards: the room without its props and their shadows, and each prop's texture,
     shadow and depth point (built once per set of marks)."""
 
-    def __init__(self, base: NDArray[np.uint8], textures: list[PropTexture], shadows: list[Shadow],
-                 depth_at: list[tuple[float, float, float] | None]) -> None:
+    def __init__(
+        self,
+        base: NDArray[np.uint8],
+        textures: list[PropTexture],
+        shadows: list[Shadow],
+        depth_at: list[tuple[float, float, float] | None],
+    ) -> None:
         self.base = base
         self.textures = textures
         self.shadows = shadows
@@ -78,8 +83,9 @@ class Layers:
         self.ui = ui
 
 
-def build_sprites(photo: NDArray[np.uint8], marks: list[Mark], ground_v: float = 0.555,
-                  light_deg: float | None = None) -> Sprites:
+def build_sprites(
+    photo: NDArray[np.uint8], marks: list[Mark], ground_v: float = 0.555, light_deg: float | None = None
+) -> Sprites:
     """Matte every mark (GrabCut), find its shadow, and clean both out of the photo (once per set of marks)."""
     from games.tasbada.view import floor_point
 
@@ -107,8 +113,14 @@ DEPTH_BIAS = 0.12
 """Metres a prop's depth is brought forward from its base (it stands on that floor row)."""
 
 
-def _button(d: ImageDraw.ImageDraw, rect: tuple[float, float, float, float], label: str, size: tuple[int, int],
-            hot: bool, enabled: bool = True) -> None:
+def _button(
+    d: ImageDraw.ImageDraw,
+    rect: tuple[float, float, float, float],
+    label: str,
+    size: tuple[int, int],
+    hot: bool,
+    enabled: bool = True,
+) -> None:
     w, h = size
     box = (rect[0] * w, rect[1] * h, rect[2] * w, rect[3] * h)
     fill = (ACCENT if hot else PAPER) if enabled else (200, 200, 200)
@@ -136,10 +148,16 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
     d.ellipse((hx - hr, gy - hr, hx + hr, gy + hr), fill=line[:3] + (230,), outline=INK + (255,), width=3)
     for s in (-1.0, 1.0):  # up and down arrows on the knob
         tip, side = gy + s * hr * 0.75, gy + s * hr * 0.25
-        d.polygon([(hx, tip), (hx - hr * 0.35, side), (hx + hr * 0.35, side)],
-                  fill=INK + (255,))
-    d.text((hx + hr + 6, gy - 6), "floor line (drag the knob)", font=font(int(h * 0.028)), fill=(255, 255, 255, 255),
-           anchor="lb", stroke_width=2, stroke_fill=INK + (255,))
+        d.polygon([(hx, tip), (hx - hr * 0.35, side), (hx + hr * 0.35, side)], fill=INK + (255,))
+    d.text(
+        (hx + hr + 6, gy - 6),
+        "floor line (drag the knob)",
+        font=font(int(h * 0.028)),
+        fill=(255, 255, 255, 255),
+        anchor="lb",
+        stroke_width=2,
+        stroke_fill=INK + (255,),
+    )
     for i, m in enumerate(q.marks):
         pts = m.points * np.array([w, h])
         color = (255, 120, 60, 255) if i == 0 else (90, 200, 255, 255)
@@ -151,16 +169,26 @@ def _draw_real(img: Image.Image, q: Quest) -> None:
             d.polygon([tuple(p) for p in pts], outline=color, fill=color[:3] + (40,), width=4)
         u0, v0, _, _ = m.bbox
         tag = "narrator" if i == 0 else f"prop {i}"
-        d.text((u0 * w + 4, v0 * h - 4), tag, font=font(int(h * 0.03)), fill=color, anchor="lb",
-               stroke_width=2, stroke_fill=INK + (255,))
+        d.text(
+            (u0 * w + 4, v0 * h - 4),
+            tag,
+            font=font(int(h * 0.03)),
+            fill=color,
+            anchor="lb",
+            stroke_width=2,
+            stroke_fill=INK + (255,),
+        )
     if len(q.path) > 1:
         d.line([(x * w, y * h) for x, y in q.path], fill=(255, 255, 255, 255), width=3)
         (x0, y0), (x1, y1) = q.path[0], q.path[-1]
         d.rectangle((min(x0, x1) * w, min(y0, y1) * h, max(x0, x1) * w, max(y0, y1) * h), outline=(255, 255, 255, 120))
     for b in marking.REAL_BUTTONS:
         _button(d, b.rect, b.label, (w, h), b.contains(q.pointer), enabled=bool(q.marks or q.undo))
-    hint = ("Drag a box (or draw a lasso) around a thing in your room; the first one will talk."
-            if not q.marks else f"{len(q.marks)} marked. Mark more, drag the floor line's knob, then press Done.")
+    hint = (
+        "Drag a box (or draw a lasso) around a thing in your room; the first one will talk."
+        if not q.marks
+        else f"{len(q.marks)} marked. Mark more, drag the floor line's knob, then press Done."
+    )
     _banner(d, hint, (w, h))
     _pointer(d, q, (w, h))
 
@@ -177,19 +205,22 @@ def _deform(t: PropTexture, m: narrator.PropMotion, img_h: int) -> Deform:
     return Deform(hop=m.hop * img_h, sx=m.sx, sy=m.sy, lean=m.lean, mouth=m.mouth)
 
 
-def _prop(background: NDArray[np.uint8], sp: Sprites, i: int, m: narrator.PropMotion,
-          narrator_face: bool) -> tuple[NDArray[np.uint8], tuple[int, int]]:
+def _prop(
+    background: NDArray[np.uint8], sp: Sprites, i: int, m: narrator.PropMotion, narrator_face: bool
+) -> tuple[NDArray[np.uint8], tuple[int, int]]:
     """Deform prop ``i``, darken the backdrop with the shadow it casts now; its picture and top-left."""
     h, w = background.shape[:2]
     tex = sp.textures[i]
     d = _deform(tex, m, h)
     rgba, origin = deform(tex, d)
-    dark, (sx0, sy0) = cast(rgba[..., 3].astype(np.float32) / 255.0, origin, tex.base[1], sp.shadows[i], (w, h),
-                            lift=d.hop)
+    dark, (sx0, sy0) = cast(
+        rgba[..., 3].astype(np.float32) / 255.0, origin, tex.base[1], sp.shadows[i], (w, h), lift=d.hop
+    )
     if dark.size:
         region = background[sy0 : sy0 + dark.shape[0], sx0 : sx0 + dark.shape[1]]
-        region[:] = np.clip(region.astype(np.float32) * (1.0 - dark[: region.shape[0], : region.shape[1], None]),
-                            0, 255).astype(np.uint8)
+        region[:] = np.clip(
+            region.astype(np.float32) * (1.0 - dark[: region.shape[0], : region.shape[1], None]), 0, 255
+        ).astype(np.uint8)
     if narrator_face:
         pic = Image.fromarray(rgba, "RGBA")
         _eyes(ImageDraw.Draw(pic, "RGBA"), tex, d, m, origin)
@@ -197,8 +228,9 @@ def _prop(background: NDArray[np.uint8], sp: Sprites, i: int, m: narrator.PropMo
     return rgba, origin
 
 
-def _eyes(dr: ImageDraw.ImageDraw, tex: PropTexture, d: Deform, m: narrator.PropMotion,
-          origin: tuple[int, int]) -> None:
+def _eyes(
+    dr: ImageDraw.ImageDraw, tex: PropTexture, d: Deform, m: narrator.PropMotion, origin: tuple[int, int]
+) -> None:
     """The narrator's eyes, riding on the deformed surface (they blink and follow the avatar)."""
     bx, by = tex.base
     s = min(tex.width, tex.height)
@@ -233,7 +265,9 @@ def _bubble(d: ImageDraw.ImageDraw, text: str, anchor: tuple[float, float], size
         d.text((bx + 18, by + 12 + i * lh), line, font=f, fill=INK + (255,))
 
 
-def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: float, color: tuple[float, float, float]) -> None:
+def _selfie_pip(
+    img: Image.Image, selfie: Image.Image | None, q: Quest, now: float, color: tuple[float, float, float]
+) -> None:
     w, h = img.size
     if selfie is None:
         return
@@ -247,13 +281,27 @@ def _selfie_pip(img: Image.Image, selfie: Image.Image | None, q: Quest, now: flo
         d.rectangle((x - 3, y - 3, x + pw + 3, y + ph + 3), outline=PAPER + (255,), width=4)
         if counting:
             n = 3 - q.line
-            d.text((x + pw / 2, y + ph / 2), str(n), font=font(int(ph * 0.5)), fill=(255, 255, 255, 230), anchor="mm",
-                   stroke_width=3, stroke_fill=INK + (255,))
+            d.text(
+                (x + pw / 2, y + ph / 2),
+                str(n),
+                font=font(int(ph * 0.5)),
+                fill=(255, 255, 255, 230),
+                anchor="mm",
+                stroke_width=3,
+                stroke_fill=INK + (255,),
+            )
         else:
             c = tuple(int(255 * v) for v in color)
             d.rectangle((x, y + ph + 10, x + pw, y + ph + 44), fill=c + (255,), outline=PAPER + (255,), width=3)
-            d.text((x + pw / 2, y + ph + 27), "your colour", font=font(20), fill=(255, 255, 255, 255), anchor="mm",
-                   stroke_width=2, stroke_fill=INK + (255,))
+            d.text(
+                (x + pw / 2, y + ph + 27),
+                "your colour",
+                font=font(20),
+                fill=(255, 255, 255, 255),
+                anchor="mm",
+                stroke_width=2,
+                stroke_fill=INK + (255,),
+            )
     if q.script == "selfie" and q.line == 3 and now - q.line_t < 0.25:
         d.rectangle((0, 0, w, h), fill=(255, 255, 255, int(220 * (1 - (now - q.line_t) / 0.25))))
 
@@ -264,8 +312,13 @@ def _picker(img: Image.Image, q: Quest) -> None:
     d = ImageDraw.Draw(img, "RGBA")
     u0, v0, u1, v1 = picker.PANEL
     d.rounded_rectangle((u0 * w, v0 * h, u1 * w, v1 * h), radius=14, fill=PAPER + (225,), outline=INK + (255,), width=3)
-    d.text(((u0 + u1) / 2 * w, v0 * h + 8), "Pose your avatar: drag the dots", font=font(int(h * 0.026)),
-           fill=INK + (255,), anchor="mt")
+    d.text(
+        ((u0 + u1) / 2 * w, v0 * h + 8),
+        "Pose your avatar: drag the dots",
+        font=font(int(h * 0.026)),
+        fill=INK + (255,),
+        anchor="mt",
+    )
 
     def px(name: str) -> tuple[float, float]:
         p = picker.to_panel(q.pose[name])
@@ -277,15 +330,22 @@ def _picker(img: Image.Image, q: Quest) -> None:
     if "l_shoulder" in q.pose and "r_shoulder" in q.pose:
         (lx, ly), (rx, ry) = px("l_shoulder"), px("r_shoulder")
         r = abs(lx - rx) * 0.42
-        d.ellipse(((lx + rx) / 2 - r, (ly + ry) / 2 - 2.6 * r, (lx + rx) / 2 + r, (ly + ry) / 2 - 0.6 * r),
-                  outline=INK + (255,), width=5)
+        d.ellipse(
+            ((lx + rx) / 2 - r, (ly + ry) / 2 - 2.6 * r, (lx + rx) / 2 + r, (ly + ry) / 2 - 0.6 * r),
+            outline=INK + (255,),
+            width=5,
+        )
     for name in picker.HANDLES:
         if name in q.pose:
             x, y = px(name)
             hot = q.gesture == "pose:" + name
             r = 9 if hot else 7
-            d.ellipse((x - r, y - r, x + r, y + r), fill=(ACCENT if hot else (255, 120, 60)) + (255,),
-                      outline=INK + (255,), width=2)
+            d.ellipse(
+                (x - r, y - r, x + r, y + r),
+                fill=(ACCENT if hot else (255, 120, 60)) + (255,),
+                outline=INK + (255,),
+                width=2,
+            )
 
 
 _THUMBS: dict[tuple[int, int, int], tuple[Image.Image, Image.Image]] = {}
@@ -307,16 +367,28 @@ def _menu(img: Image.Image, q: Quest) -> None:
     w, h = img.size
     d = ImageDraw.Draw(img, "RGBA")
     d.rectangle((0, 0, w, h), fill=(10, 10, 20, 150))
-    d.text((w / 2, h * 0.12), "Tasbada — where shall we go?", font=font(int(h * 0.05)), fill=(255, 255, 255, 255),
-           anchor="mm")
+    d.text(
+        (w / 2, h * 0.12),
+        "Tasbada — where shall we go?",
+        font=font(int(h * 0.05)),
+        fill=(255, 255, 255, 255),
+        anchor="mm",
+    )
     reached = [s for s in STAGES if s in q.reached or s in q.saved_reached]
     for b in marking.menu_buttons(reached, q.stage == MENU):
         _button(d, b.rect, b.label, (w, h), b.contains(q.pointer))
     _pointer(d, q, (w, h))
 
 
-def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, selfie: Image.Image | None,
-            color: tuple[float, float, float], gaze: float) -> Layers:
+def compose(
+    photo: Image.Image,
+    sprites: Sprites | None,
+    q: Quest,
+    now: float,
+    selfie: Image.Image | None,
+    color: tuple[float, float, float],
+    gaze: float,
+) -> Layers:
     """This frame's layers: the backdrop ``[H,W,3]``, the living props, the interface ``[H,W,4]``.
 
     The interface (marks, floor line, buttons, speech bubbles, the selfie, the menu) is
@@ -361,8 +433,7 @@ def compose(photo: Image.Image, sprites: Sprites | None, q: Quest, now: float, s
     if q.menu_open or q.stage == MENU:
         _menu(ui, q)
     else:
-        _button(d, marking.MENU_BUTTON.rect, marking.MENU_BUTTON.label, (w, h),
-                marking.MENU_BUTTON.contains(q.pointer))
+        _button(d, marking.MENU_BUTTON.rect, marking.MENU_BUTTON.label, (w, h), marking.MENU_BUTTON.contains(q.pointer))
     return Layers(background, props, np.asarray(ui).copy())
 
 

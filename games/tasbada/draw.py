@@ -35,7 +35,9 @@ _TREES = np.c_[_RNG.uniform(-9, 9, 26), np.zeros(26), _RNG.uniform(-14, -2.5, 26
 _TREES = _TREES[np.abs(_TREES[:, 0]) > 2.2]
 _ISLANDS = np.c_[_RNG.uniform(-10, 10, 7), _RNG.uniform(3.5, 6.5, 7), _RNG.uniform(-18, -8, 7)]
 _STARS = np.c_[_RNG.uniform(-30, 30, 120), _RNG.uniform(6, 22, 120), _RNG.uniform(-40, -15, 120)]
-_CRYSTAL_ROT = quat.mul(quat.from_axis_angle([0.0, 0.0, 1.0], math.pi / 4), quat.from_axis_angle([1.0, 0.0, 0.0], math.pi / 4))
+_CRYSTAL_ROT = quat.mul(
+    quat.from_axis_angle([0.0, 0.0, 1.0], math.pi / 4), quat.from_axis_angle([1.0, 0.0, 0.0], math.pi / 4)
+)
 
 
 def dissolve(q: Quest, now: float) -> float:
@@ -119,7 +121,11 @@ def _crystals(scene: RenderScene, world: World, q: Quest, now: float, gate: np.n
             if k >= 1.0 or gate is None:
                 continue
             s = 0.17 * (1.0 - k)
-            p = tf.position + (gate + np.array([0.0, 1.6, 0.0]) - tf.position) * k + np.array([0.0, math.sin(k * math.pi), 0.0])
+            p = (
+                tf.position
+                + (gate + np.array([0.0, 1.6, 0.0]) - tf.position) * k
+                + np.array([0.0, math.sin(k * math.pi), 0.0])
+            )
         if s > 0.005:
             scene.add_box(p, (s, s, s), spin, color)
             scene.add_points(p[None], 0.4 * s / 0.17, color)
@@ -198,5 +204,3 @@ def draw(world: World, scene: RenderScene, alpha: float) -> None:
         _creature(scene, tf.position, CREATURE_COLORS[c.index % 3], now + c.index * 0.4, freed >= 0)
     _crystals(scene, world, q, now, gate_pos)
     _virtual(scene, f, now)
-
-

@@ -48,8 +48,12 @@ def _tube(base: F, height: float, r0: float, r1: float, rings: int, sides: int) 
 
 def _octahedron(centre: F, half: float, turn: float) -> tuple[F, list[list[int]]]:
     c, s = math.cos(turn), math.sin(turn)
-    ring = [np.array([c * half, 0.0, s * half]), np.array([-s * half, 0.0, c * half]),
-            np.array([-c * half, 0.0, -s * half]), np.array([s * half, 0.0, -c * half])]
+    ring = [
+        np.array([c * half, 0.0, s * half]),
+        np.array([-s * half, 0.0, c * half]),
+        np.array([-c * half, 0.0, -s * half]),
+        np.array([s * half, 0.0, -c * half]),
+    ]
     verts = [centre + [0.0, 1.3 * half, 0.0], centre - [0.0, 1.3 * half, 0.0]] + [centre + r for r in ring]
     faces = []
     for k in range(4):
@@ -68,10 +72,8 @@ def crystal_tree(base: Any, height: float, turn: float = 0.0, crystal: int = 0) 
     verts = np.vstack([trunk, gem, base + [0.0, height, 0.0]])
     top = 12 * 8
     faces = tf + [[f + n for f in tri] for tri in gf] + [[top + s, tip, top + (s + 1) % 8] for s in range(8)]
-    colors = ([list(TRUNK_COLOR)] * len(tf) + [list(CRYSTAL_COLORS[crystal % 2])] * len(gf)
-              + [list(TRUNK_COLOR)] * 8)
-    return {"vertices": np.round(verts, 6).tolist(), "faces": faces, "color": list(TRUNK_COLOR),
-            "face_colors": colors}
+    colors = [list(TRUNK_COLOR)] * len(tf) + [list(CRYSTAL_COLORS[crystal % 2])] * len(gf) + [list(TRUNK_COLOR)] * 8
+    return {"vertices": np.round(verts, 6).tolist(), "faces": faces, "color": list(TRUNK_COLOR), "face_colors": colors}
 
 
 def island(centre: Any, size: float) -> dict[str, Any]:
@@ -80,16 +82,20 @@ def island(centre: Any, size: float) -> dict[str, Any]:
     slab, sf = _tube(centre - [0.0, 0.12 * size, 0.0], 0.24 * size, 0.9 * size, 0.9 * size, 2, 8)
     n = len(slab)
     ang = 2.0 * np.pi * np.arange(8) / 8
-    rock = np.vstack([centre + np.c_[0.85 * size * np.cos(ang), np.full(8, -0.12 * size), 0.85 * size * np.sin(ang)],
-                      centre + [0.0, -0.9 * size, 0.0], centre + [0.0, 0.12 * size, 0.0]])
+    rock = np.vstack(
+        [
+            centre + np.c_[0.85 * size * np.cos(ang), np.full(8, -0.12 * size), 0.85 * size * np.sin(ang)],
+            centre + [0.0, -0.9 * size, 0.0],
+            centre + [0.0, 0.12 * size, 0.0],
+        ]
+    )
     rf = [[n + s, n + (s + 1) % 8, n + 8] for s in range(8)]
     top = [[16 + s, n + 9, 16 + (s + 1) % 8] for s in range(8)]
     verts = np.vstack([slab, rock])
     faces = sf + rf + top
     colors = [list(GRASS_COLOR)] * (len(sf) + len(top))
-    colors[len(sf):] = [list(ROCK_COLOR)] * len(rf) + [list(GRASS_COLOR)] * len(top)
-    return {"vertices": np.round(verts, 6).tolist(), "faces": faces, "color": list(GRASS_COLOR),
-            "face_colors": colors}
+    colors[len(sf) :] = [list(ROCK_COLOR)] * len(rf) + [list(GRASS_COLOR)] * len(top)
+    return {"vertices": np.round(verts, 6).tolist(), "faces": faces, "color": list(GRASS_COLOR), "face_colors": colors}
 
 
 def flow_objects() -> list[dict[str, Any]]:
@@ -99,8 +105,14 @@ def flow_objects() -> list[dict[str, Any]]:
     for k in range(7):
         x = -3.6 + 1.2 * k + rng.uniform(-0.25, 0.25)
         z = -1.0 - rng.uniform(0.0, 2.0)
-        out.append({"name": f"tree{k}", "group": f"tree{k}", "primitives": [],
-                    "mesh": crystal_tree([x, 0.0, z], 1.6 + 0.6 * rng.uniform(), rng.uniform(0, np.pi), k)})
+        out.append(
+            {
+                "name": f"tree{k}",
+                "group": f"tree{k}",
+                "primitives": [],
+                "mesh": crystal_tree([x, 0.0, z], 1.6 + 0.6 * rng.uniform(), rng.uniform(0, np.pi), k),
+            }
+        )
     for k in range(3):
         c = [-3.0 + 3.0 * k + rng.uniform(-0.4, 0.4), 3.3 + 0.5 * rng.uniform(), -4.0 - rng.uniform(0.0, 1.5)]
         out.append({"name": f"island{k}", "group": f"island{k}", "primitives": [], "mesh": island(c, 0.8)})

@@ -66,7 +66,7 @@ OPTION_HELP = {
     "webcam": "auto|off: a live webcam backdrop when no photo is given",
     "pose": "auto|off: find the player's pose in the selfie (MediaPipe, the [pose] extra) or pose by hand",
     "light": "DEGREES, any finite number: where shadows fall on the floor (0 right, 90 back, 180 left; "
-             "unset: measured from the photo)",
+    "unset: measured from the photo)",
 }
 
 
@@ -93,8 +93,10 @@ def prepare(options: dict[str, str]) -> dict[str, Any]:
             print(f"tasbada: {exc}; {move}, starting a new journey", file=sys.stderr)
         else:
             if bad is None:
-                raise GameOptionError(f"tasbada save {save} is not progress this program saved ({exc}); it is "
-                                      "left as it is: choose another file with --set save=PATH") from None
+                raise GameOptionError(
+                    f"tasbada save {save} is not progress this program saved ({exc}); it is "
+                    "left as it is: choose another file with --set save=PATH"
+                ) from None
             print(f"tasbada: {exc}; set aside as {bad}, starting a new journey", file=sys.stderr)
     photo = options["photo"] or os.environ.get("TASBADA_PHOTO", "")
     if not photo and progress is not None and progress.photo and Path(progress.photo).is_file():
@@ -155,8 +157,9 @@ def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
         GameOptionError: a value of the wrong type or range (the recording was altered).
     """
     try:
-        reached, marks, ground_v = checked_progress(recorded.get("reached", []), recorded.get("marks", []),
-                                                    recorded.get("ground_v"))
+        reached, marks, ground_v = checked_progress(
+            recorded.get("reached", []), recorded.get("marks", []), recorded.get("ground_v")
+        )
     except SaveError as exc:
         raise GameOptionError(f"the recorded progress: {exc}") from None
     aspect, light, note = recorded.get("pose_aspect", 1.0), recorded.get("light"), recorded.get("pose_note", "")
@@ -166,8 +169,17 @@ def replay_setup(recorded: dict[str, Any]) -> dict[str, Any]:
         raise GameOptionError(f"the recorded light {repr(light)[:30]} is not a finite number of degrees")
     if not isinstance(note, str):
         raise GameOptionError("the recorded pose_note is not text")
-    return {**recorded, "save_to": "", "webcam": False, "photo": "", "selfie": "", "reached": reached,
-            "marks": [m.to_json() for m in marks], "ground_v": ground_v, "pose_note": note[:500]}
+    return {
+        **recorded,
+        "save_to": "",
+        "webcam": False,
+        "photo": "",
+        "selfie": "",
+        "reached": reached,
+        "marks": [m.to_json() for m in marks],
+        "ground_v": ground_v,
+        "pose_note": note[:500],
+    }
 
 
 def install(app: App) -> None:
@@ -194,8 +206,13 @@ def install(app: App) -> None:
     elif not photo:
         message = f"using the photo {SHIPPED_PHOTO.name}"
     light = setup.get("light")
-    reality = Reality(photo or SHIPPED_PHOTO, setup.get("selfie", "") or SHIPPED_SELFIE, webcam, message,
-                      light_deg=float(light) if isinstance(light, (int, float)) and np.isfinite(light) else None)
+    reality = Reality(
+        photo or SHIPPED_PHOTO,
+        setup.get("selfie", "") or SHIPPED_SELFIE,
+        webcam,
+        message,
+        light_deg=float(light) if isinstance(light, (int, float)) and np.isfinite(light) else None,
+    )
     reality.pose_note = str(setup.get("pose_note", ""))
     save_to = setup.get("save_to", "")
     slot = SaveSlot(Path(save_to) if save_to else None)
@@ -240,8 +257,17 @@ def close(world: World) -> None:
         reality.close()
 
 
-GAME = Game(name="tasbada", install=install, draw=draw_mod.draw, camera=_camera, status=status, controls=CONTROLS,
-            controls_now=controls_now,
-            options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto",
-                     "light": ""}, option_help=OPTION_HELP, prepare=prepare,
-            replay_setup=replay_setup, close=close)
+GAME = Game(
+    name="tasbada",
+    install=install,
+    draw=draw_mod.draw,
+    camera=_camera,
+    status=status,
+    controls=CONTROLS,
+    controls_now=controls_now,
+    options={"save": "", "photo": "", "selfie": "", "webcam": "auto", "pose": "auto", "light": ""},
+    option_help=OPTION_HELP,
+    prepare=prepare,
+    replay_setup=replay_setup,
+    close=close,
+)

@@ -65,7 +65,9 @@ def fit_photo(img: U8, size: tuple[int, int] = PHOTO_SIZE) -> U8:
     return np.asarray(out).copy()
 
 
-def clothes_color(selfie: U8, k: int = 3, region: tuple[float, float, float, float] = TORSO) -> tuple[float, float, float]:
+def clothes_color(
+    selfie: U8, k: int = 3, region: tuple[float, float, float, float] = TORSO
+) -> tuple[float, float, float]:
     """The representative colour of the clothes: the biggest k-means cluster in the torso region (sRGB 0..1)."""
     from scipy.cluster.vq import kmeans2
 

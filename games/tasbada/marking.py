@@ -20,8 +20,20 @@ from numpy.typing import NDArray
 
 from games.tasbada.quest import Mark
 
-__all__ = ["Button", "REAL_BUTTONS", "MENU_BUTTON", "MAX_MARKS", "MIN_SIZE", "GROUND_GRAB", "GROUND_HANDLE_U",
-           "classify_path", "hit_button", "menu_buttons", "clamp_ground", "on_ground_handle"]
+__all__ = [
+    "Button",
+    "REAL_BUTTONS",
+    "MENU_BUTTON",
+    "MAX_MARKS",
+    "MIN_SIZE",
+    "GROUND_GRAB",
+    "GROUND_HANDLE_U",
+    "classify_path",
+    "hit_button",
+    "menu_buttons",
+    "clamp_ground",
+    "on_ground_handle",
+]
 
 MAX_MARKS = 4
 MIN_SIZE = 0.025
@@ -69,11 +81,11 @@ def menu_buttons(reached: list[str], startup: bool = False) -> list[Button]:
     """
     items = [(f"restart:{s}", f"Restart from: {s}") for s in reached]
     last = reached[-1] if reached else "real"
-    items += [("restart:new", "New journey (forget the marks)"),
-              ("close", f"Continue: {last}" if startup else "Back")]
+    items += [("restart:new", "New journey (forget the marks)"), ("close", f"Continue: {last}" if startup else "Back")]
     top, h, gap = 0.2, 0.085, 0.02
-    return [Button(a, label, (0.3, top + i * (h + gap), 0.7, top + i * (h + gap) + h))
-            for i, (a, label) in enumerate(items)]
+    return [
+        Button(a, label, (0.3, top + i * (h + gap), 0.7, top + i * (h + gap) + h)) for i, (a, label) in enumerate(items)
+    ]
 
 
 def hit_button(buttons: tuple[Button, ...] | list[Button], p: NDArray[np.float64]) -> Button | None:

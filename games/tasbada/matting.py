@@ -81,8 +81,12 @@ def matte(photo: NDArray[np.uint8], mark: Mark) -> Matte:
 
     h, w = photo.shape[:2]
     u0, v0, u1, v1 = mark.bbox
-    crop = (max(int(np.floor(u0 * w)) - _MARGIN, 0), max(int(np.floor(v0 * h)) - _MARGIN, 0),
-            min(int(np.ceil(u1 * w)) + _MARGIN, w), min(int(np.ceil(v1 * h)) + _MARGIN, h))
+    crop = (
+        max(int(np.floor(u0 * w)) - _MARGIN, 0),
+        max(int(np.floor(v0 * h)) - _MARGIN, 0),
+        min(int(np.ceil(u1 * w)) + _MARGIN, w),
+        min(int(np.ceil(v1 * h)) + _MARGIN, h),
+    )
     x0, y0, x1, y1 = crop
     if x1 - x0 < 8 or y1 - y0 < 8:
         return Matte(np.ones((max(y1 - y0, 1), max(x1 - x0, 1)), dtype=np.float32), crop)
@@ -91,11 +95,20 @@ def matte(photo: NDArray[np.uint8], mark: Mark) -> Matte:
     bgd, fgd = np.zeros((1, 65), np.float64), np.zeros((1, 65), np.float64)
     cv2.setRNGSeed(12345)
     if (mask == cv2.GC_PR_FGD).any() and (mask == cv2.GC_BGD).any():
-        cv2.grabCut(patch, mask, None, bgd, fgd, _ITERATIONS,  # type: ignore[call-overload]  # rect unused with a mask
-                    cv2.GC_INIT_WITH_MASK)
+        cv2.grabCut(
+            patch,
+            mask,
+            None,
+            bgd,
+            fgd,
+            _ITERATIONS,  # type: ignore[call-overload]  # rect unused with a mask
+            cv2.GC_INIT_WITH_MASK,
+        )
     hard = np.isin(mask, (cv2.GC_FGD, cv2.GC_PR_FGD)).astype(np.uint8)
     # Slivers of the room along the prop (a strip of skirting board) are thinner than any part of it.
-    hard = np.asarray(cv2.morphologyEx(hard, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))), np.uint8)
+    hard = np.asarray(
+        cv2.morphologyEx(hard, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))), np.uint8
+    )
     hard = _largest_parts(hard)
     if hard.mean() < 0.02:  # nothing stood out: keep the marked region itself
         hard = (_seed((h, w), mark, crop) == cv2.GC_PR_FGD).astype(np.uint8)

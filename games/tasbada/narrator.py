@@ -64,8 +64,9 @@ class PropMotion:
     lean: float = 0.0
 
 
-def prop_motion(t: float, phase: float = 0.0, talking: bool = False, energy: float = 1.0,
-                gaze: float = 0.0) -> PropMotion:
+def prop_motion(
+    t: float, phase: float = 0.0, talking: bool = False, energy: float = 1.0, gaze: float = 0.0
+) -> PropMotion:
     """The motion of a prop alive for ``t`` seconds.
 
     Args:

@@ -25,9 +25,23 @@ from engine.ecs import Entity, World
 from games.tasbada.quest import Mark, Quest
 from games.tasbada.view import QUEST_HALF_WIDTH, floor_depth, floor_point, to_image
 
-__all__ = ["Creature", "Crystal", "Gate", "Layout", "layout", "spawn_objects", "despawn_objects",
-           "avatar_position", "milestone_step", "follow_system", "CAGE_REACH", "CRYSTAL_REACH", "GATE_REACH",
-           "GATE_DELAY", "CREATURE_COLORS"]
+__all__ = [
+    "Creature",
+    "Crystal",
+    "Gate",
+    "Layout",
+    "layout",
+    "spawn_objects",
+    "despawn_objects",
+    "avatar_position",
+    "milestone_step",
+    "follow_system",
+    "CAGE_REACH",
+    "CRYSTAL_REACH",
+    "GATE_REACH",
+    "GATE_DELAY",
+    "CREATURE_COLORS",
+]
 
 CAGE_REACH = 0.8
 CRYSTAL_REACH = 0.6
@@ -175,7 +189,7 @@ def milestone_step(world: World, q: Quest) -> list[str]:
     if pos is None:
         return []
     hits: list[str] = []
-    for _, c, tf in world.query(Creature, Transform):
+    for _, c, _ in world.query(Creature, Transform):
         if q.freed[c.index] < 0 and _xz(pos, c.home) < CAGE_REACH:
             q.freed[c.index] = now
             hits.append(f"freed {sum(t >= 0 for t in q.freed)}")

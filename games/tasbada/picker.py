@@ -21,9 +21,20 @@ __all__ = ["PANEL", "HANDLES", "BONES", "to_panel", "from_panel", "picker_step",
 PANEL = (0.02, 0.26, 0.22, 0.86)
 """The picker's rectangle on the photo ``(u0, v0, u1, v1)``."""
 HANDLES = ("l_elbow", "r_elbow", "l_wrist", "r_wrist", "l_knee", "r_knee", "l_ankle", "r_ankle")
-BONES = (("l_shoulder", "r_shoulder"), ("l_hip", "r_hip"), ("l_shoulder", "l_hip"), ("r_shoulder", "r_hip"),
-         ("l_shoulder", "l_elbow"), ("l_elbow", "l_wrist"), ("r_shoulder", "r_elbow"), ("r_elbow", "r_wrist"),
-         ("l_hip", "l_knee"), ("l_knee", "l_ankle"), ("r_hip", "r_knee"), ("r_knee", "r_ankle"))
+BONES = (
+    ("l_shoulder", "r_shoulder"),
+    ("l_hip", "r_hip"),
+    ("l_shoulder", "l_hip"),
+    ("r_shoulder", "r_hip"),
+    ("l_shoulder", "l_elbow"),
+    ("l_elbow", "l_wrist"),
+    ("r_shoulder", "r_elbow"),
+    ("r_elbow", "r_wrist"),
+    ("l_hip", "l_knee"),
+    ("l_knee", "l_ankle"),
+    ("r_hip", "r_knee"),
+    ("r_knee", "r_ankle"),
+)
 _REACH = 0.025
 """How close (image units) a press must be to a handle to grab it."""
 
@@ -43,8 +54,10 @@ def to_panel(xy: list[float]) -> NDArray[np.float64]:
 def from_panel(p: NDArray[np.float64]) -> list[float]:
     """Photo coordinates → a keypoint normalised in the panel (kept inside it)."""
     u0, v0, u1, v1 = PANEL
-    return [round(float(np.clip((p[0] - u0) / (u1 - u0), 0.02, 0.98)), 4),
-            round(float(np.clip((p[1] - v0) / (v1 - v0), 0.02, 0.98)), 4)]
+    return [
+        round(float(np.clip((p[0] - u0) / (u1 - u0), 0.02, 0.98)), 4),
+        round(float(np.clip((p[1] - v0) / (v1 - v0), 0.02, 0.98)), 4),
+    ]
 
 
 def picker_step(q: Quest, pressed: bool, released: bool) -> bool:

@@ -31,17 +31,32 @@ from numpy.typing import NDArray
 __all__ = ["KEYPOINTS", "estimate", "lift", "default_keypoints", "validate", "POSE_JOINTS"]
 
 KEYPOINTS: dict[str, int] = {
-    "l_shoulder": 11, "r_shoulder": 12, "l_elbow": 13, "r_elbow": 14, "l_wrist": 15, "r_wrist": 16,
-    "l_hip": 23, "r_hip": 24, "l_knee": 25, "r_knee": 26, "l_ankle": 27, "r_ankle": 28,
+    "l_shoulder": 11,
+    "r_shoulder": 12,
+    "l_elbow": 13,
+    "r_elbow": 14,
+    "l_wrist": 15,
+    "r_wrist": 16,
+    "l_hip": 23,
+    "r_hip": 24,
+    "l_knee": 25,
+    "r_knee": 26,
+    "l_ankle": 27,
+    "r_ankle": 28,
 }
 """Our names → MediaPipe landmark indices (``l_`` is the person's left, on the image's right)."""
 _VISIBLE = 0.3
 """Least MediaPipe visibility for a keypoint to count (a partly hidden elbow still says where the arm goes)."""
-_LIMBS = (("upper_arm", "shoulder", "elbow", "lower_arm"), ("lower_arm", "elbow", "wrist", "hand"),
-          ("upper_leg", "hip", "knee", "lower_leg"), ("lower_leg", "knee", "ankle", "foot"))
+_LIMBS = (
+    ("upper_arm", "shoulder", "elbow", "lower_arm"),
+    ("lower_arm", "elbow", "wrist", "hand"),
+    ("upper_leg", "hip", "knee", "lower_leg"),
+    ("lower_leg", "knee", "ankle", "foot"),
+)
 """(bone, from keypoint, to keypoint, the joint placed at the 'to' keypoint)."""
-POSE_JOINTS = tuple(f"{s}_{b}" for s in ("l", "r") for b in ("upper_arm", "lower_arm", "hand", "upper_leg",
-                                                             "lower_leg", "foot"))
+POSE_JOINTS = tuple(
+    f"{s}_{b}" for s in ("l", "r") for b in ("upper_arm", "lower_arm", "hand", "upper_leg", "lower_leg", "foot")
+)
 """The joints the selfie poses (the torso and head keep the animation's)."""
 
 
@@ -53,15 +68,20 @@ def estimate(img: NDArray[np.uint8]) -> tuple[dict[str, list[float]] | None, str
     try:
         from mediapipe.python.solutions import pose as mp_pose
     except ImportError:
-        return None, ("pose: no pose estimator installed (pip install 'puppetphone[pose]'); "
-                      "drag the avatar's hands and feet to pose it")
+        return None, (
+            "pose: no pose estimator installed (pip install 'puppetphone[pose]'); "
+            "drag the avatar's hands and feet to pose it"
+        )
     with mp_pose.Pose(static_image_mode=True, model_complexity=1, enable_segmentation=False) as est:
         result = est.process(np.ascontiguousarray(img[..., :3]))
     if result.pose_landmarks is None:
         return None, "pose: no person found in the selfie; drag the avatar's hands and feet to pose it"
     lm = result.pose_landmarks.landmark
-    points = {name: [round(float(lm[i].x), 4), round(float(lm[i].y), 4)]
-              for name, i in KEYPOINTS.items() if lm[i].visibility >= _VISIBLE}
+    points = {
+        name: [round(float(lm[i].x), 4), round(float(lm[i].y), 4)]
+        for name, i in KEYPOINTS.items()
+        if lm[i].visibility >= _VISIBLE
+    }
     if "l_shoulder" not in points or "r_shoulder" not in points:
         return None, "pose: the selfie shows no shoulders; drag the avatar's hands and feet to pose it"
     return points, f"pose: {len(points)} keypoints found in the selfie (MediaPipe pose, bundled model)"
@@ -87,9 +107,20 @@ def validate(points: Any) -> dict[str, list[float]] | None:
 
 def default_keypoints() -> dict[str, list[float]]:
     """A relaxed standing pose in selfie coordinates (where the picker's handles start)."""
-    return {"l_shoulder": [0.6, 0.3], "r_shoulder": [0.4, 0.3], "l_elbow": [0.63, 0.45], "r_elbow": [0.37, 0.45],
-            "l_wrist": [0.64, 0.6], "r_wrist": [0.36, 0.6], "l_hip": [0.56, 0.6], "r_hip": [0.44, 0.6],
-            "l_knee": [0.57, 0.78], "r_knee": [0.43, 0.78], "l_ankle": [0.57, 0.96], "r_ankle": [0.43, 0.96]}
+    return {
+        "l_shoulder": [0.6, 0.3],
+        "r_shoulder": [0.4, 0.3],
+        "l_elbow": [0.63, 0.45],
+        "r_elbow": [0.37, 0.45],
+        "l_wrist": [0.64, 0.6],
+        "r_wrist": [0.36, 0.6],
+        "l_hip": [0.56, 0.6],
+        "r_hip": [0.44, 0.6],
+        "l_knee": [0.57, 0.78],
+        "r_knee": [0.43, 0.78],
+        "l_ankle": [0.57, 0.96],
+        "r_ankle": [0.43, 0.96],
+    }
 
 
 def _targets(points: dict[str, list[float]], aspect: float) -> dict[str, NDArray[np.float64]]:

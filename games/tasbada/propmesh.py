@@ -62,8 +62,9 @@ class PropTexture:
         self.mouth_w = 0.16 * min(self.width, self.height * 1.2)
         self.mouth_x = float(self.base[0])
 
-    def forward(self, x: NDArray[np.float64], y: NDArray[np.float64], d: Deform) -> tuple[NDArray[np.float64],
-                                                                                           NDArray[np.float64]]:
+    def forward(
+        self, x: NDArray[np.float64], y: NDArray[np.float64], d: Deform
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Photo pixel positions on the rest prop → where they are drawn under ``d``."""
         bx, by = self.base
         X, Y = x - bx, by - y
@@ -84,7 +85,7 @@ class PropTexture:
         if d.mouth <= 0:
             return np.zeros_like(Y)
         above = np.clip((Y - self.mouth_y) / self._fall_height(), 0.0, 1.0)
-        return np.where(Y >= self.mouth_y, self._gap(X, d) * (1.0 - above), 0.0)
+        return np.where(self.mouth_y <= Y, self._gap(X, d) * (1.0 - above), 0.0)
 
 
 def deform(tex: PropTexture, d: Deform) -> tuple[NDArray[np.uint8], tuple[int, int]]:
@@ -118,14 +119,21 @@ def deform(tex: PropTexture, d: Deform) -> tuple[NDArray[np.uint8], tuple[int, i
         Y = np.where(up, Yu, Y)
     mapx = (bx + X - x0).astype(np.float32)
     mapy = (by - Y - y0).astype(np.float32)
-    out = np.asarray(cv2.remap(tex.rgba, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0),
-                     np.uint8)
+    out = np.asarray(
+        cv2.remap(tex.rgba, mapx, mapy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0), np.uint8
+    )
     if gap is not None and inside_mouth.any():
         lip_y = np.asarray(by - tex.mouth_y - y0, dtype=np.float32)
-        a = cv2.remap(tex.rgba[..., 3], mapx, np.full_like(mapy, lip_y), cv2.INTER_LINEAR,
-                      borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+        a = cv2.remap(
+            tex.rgba[..., 3],
+            mapx,
+            np.full_like(mapy, lip_y),
+            cv2.INTER_LINEAR,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=0,
+        )
         shade = np.clip((Ya - tex.mouth_y) / np.maximum(gap, 1.0), 0.0, 1.0)
-        inner = (np.array(MOUTH_COLOR, dtype=np.float32)[None, None, :] * (0.6 + 0.4 * shade[..., None]))
+        inner = np.array(MOUTH_COLOR, dtype=np.float32)[None, None, :] * (0.6 + 0.4 * shade[..., None])
         out[inside_mouth, :3] = inner[inside_mouth].astype(np.uint8)
         out[inside_mouth, 3] = a[inside_mouth]
     return out, (ox, oy)

@@ -38,8 +38,14 @@ class Reality:
 
     SIM_STATE = False
 
-    def __init__(self, photo: str | Path = SHIPPED_PHOTO, selfie: str | Path = SHIPPED_SELFIE,
-                 webcam: Webcam | None = None, message: str = "", light_deg: float | None = None) -> None:
+    def __init__(
+        self,
+        photo: str | Path = SHIPPED_PHOTO,
+        selfie: str | Path = SHIPPED_SELFIE,
+        webcam: Webcam | None = None,
+        message: str = "",
+        light_deg: float | None = None,
+    ) -> None:
         self.photo_path = str(photo)
         self.photo = fit_photo(load_image(photo))
         self.selfie_img = load_image(selfie)

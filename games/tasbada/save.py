@@ -21,16 +21,25 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-
 from typing import Any
 
-from engine.errors import FormatError
 from engine.atomic import atomic_write_bytes
+from engine.errors import FormatError
 from engine.npz_safe import read_bounded
 from games.tasbada.quest import STAGES, Mark, Quest
 
-__all__ = ["SAVE_VERSION", "SaveError", "Progress", "default_save_path", "save_progress", "load_progress",
-           "progress_of", "checked_progress", "SAVE_HEADS", "MAX_FILE"]
+__all__ = [
+    "SAVE_VERSION",
+    "SaveError",
+    "Progress",
+    "default_save_path",
+    "save_progress",
+    "load_progress",
+    "progress_of",
+    "checked_progress",
+    "SAVE_HEADS",
+    "MAX_FILE",
+]
 
 SAVE_VERSION = 1
 #: A real save is a few KB (a few marks of a few hundred points).
@@ -78,9 +87,15 @@ def save_progress(path: str | os.PathLike[str], progress: Progress) -> Path:
     Raises:
         WriteError: nothing was written (full disk, folder in the way, a foreign file).
     """
-    data = {"format": "tasbada-progress", "version": SAVE_VERSION, "reached": progress.reached,
-            "stage": progress.stage, "ground_v": round(progress.ground_v, 6),
-            "marks": [m.to_json() for m in progress.marks], "photo": progress.photo}
+    data = {
+        "format": "tasbada-progress",
+        "version": SAVE_VERSION,
+        "reached": progress.reached,
+        "stage": progress.stage,
+        "ground_v": round(progress.ground_v, 6),
+        "marks": [m.to_json() for m in progress.marks],
+        "photo": progress.photo,
+    }
     return atomic_write_bytes(path, json.dumps(data, indent=1).encode(), expect_head=SAVE_HEADS)
 
 
@@ -101,8 +116,11 @@ def checked_progress(reached: Any, marks: Any, ground_v: Any) -> tuple[list[str]
     checked = []
     for m in marks:
         points = m.get("points") if isinstance(m, dict) else None
-        if (not isinstance(points, list) or len(points) > MAX_POINTS
-                or not all(isinstance(p, list) and len(p) == 2 and all(map(_is_number, p)) for p in points)):
+        if (
+            not isinstance(points, list)
+            or len(points) > MAX_POINTS
+            or not all(isinstance(p, list) and len(p) == 2 and all(map(_is_number, p)) for p in points)
+        ):
             raise SaveError(f"a mark must have at most {MAX_POINTS} points of two numbers each")
         try:
             checked.append(Mark.from_json(m))

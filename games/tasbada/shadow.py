@@ -55,8 +55,13 @@ def _luma(img: NDArray[np.uint8]) -> NDArray[np.float32]:
     return (img[..., :3].astype(np.float32) @ np.array([0.299, 0.587, 0.114], dtype=np.float32)) + 1.0
 
 
-def find_shadow(photo: NDArray[np.uint8], m: Matte, floor_row: float, others: NDArray[np.float32] | None = None,
-                light_deg: float | None = None) -> Shadow:
+def find_shadow(
+    photo: NDArray[np.uint8],
+    m: Matte,
+    floor_row: float,
+    others: NDArray[np.float32] | None = None,
+    light_deg: float | None = None,
+) -> Shadow:
     """The shadow of the prop with matte ``m`` on the floor below image row ``floor_row`` (pixels).
 
     ``others`` masks the other props (never taken for shadow); ``light_deg`` overrides the
@@ -102,8 +107,9 @@ def find_shadow(photo: NDArray[np.uint8], m: Matte, floor_row: float, others: ND
     return Shadow((float(light[0]), float(light[1])), strength, soft.astype(np.float32), r, True)
 
 
-def _ratio(photo: NDArray[np.uint8], blocked: NDArray[np.bool_], height: float,
-           around: tuple[float, float], reach: float) -> NDArray[np.float32]:
+def _ratio(
+    photo: NDArray[np.uint8], blocked: NDArray[np.bool_], height: float, around: tuple[float, float], reach: float
+) -> NDArray[np.float32]:
     """Light received / light the floor would get without a small dark patch, per pixel (1 far from ``around``).
 
     The unshadowed light is the *bright envelope* of the luminance: a greyscale closing
@@ -130,8 +136,9 @@ def _ratio(photo: NDArray[np.uint8], blocked: NDArray[np.bool_], height: float,
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (max(kx // k, 1) | 1, max(ky // k, 1) | 1))
     env = cv2.morphologyEx(lum_small, cv2.MORPH_CLOSE, kernel)
     env = cv2.resize(cv2.GaussianBlur(env, (0, 0), 0.75), (x1 - x0, y1 - y0), interpolation=cv2.INTER_LINEAR)
-    props = cv2.inpaint(np.ascontiguousarray(crop), cv2.dilate(hole, np.ones((3, 3), np.uint8)) * 255, 3,
-                        cv2.INPAINT_TELEA)
+    props = cv2.inpaint(
+        np.ascontiguousarray(crop), cv2.dilate(hole, np.ones((3, 3), np.uint8)) * 255, 3, cv2.INPAINT_TELEA
+    )
     lum = cv2.GaussianBlur(_luma(np.asarray(props, np.uint8)), (0, 0), 1.5)
     out = np.ones((h, w), dtype=np.float32)
     out[y0:y1, x0:x1] = np.minimum(lum / np.maximum(env, 1.0), 1.5)
@@ -154,8 +161,14 @@ def remove_shadows(photo: NDArray[np.uint8], shadows: list[Shadow]) -> NDArray[n
     return np.clip(out + 0.5, 0, 255).astype(np.uint8)
 
 
-def cast(alpha: NDArray[np.float32], origin: tuple[int, int], base_y: float, s: Shadow,
-         size: tuple[int, int], lift: float = 0.0) -> tuple[NDArray[np.float32], tuple[int, int]]:
+def cast(
+    alpha: NDArray[np.float32],
+    origin: tuple[int, int],
+    base_y: float,
+    s: Shadow,
+    size: tuple[int, int],
+    lift: float = 0.0,
+) -> tuple[NDArray[np.float32], tuple[int, int]]:
     """The shadow a (deformed) prop casts: ``(darkness [h,w] 0..1, top-left (x, y))`` on a picture of ``size``.
 
     ``alpha`` is the prop's silhouette with its top-left at ``origin`` (pixels), standing on
@@ -181,10 +194,17 @@ def cast(alpha: NDArray[np.float32], origin: tuple[int, int], base_y: float, s: 
     if x1 - x0 < 2 or y1 - y0 < 2:
         return np.zeros((0, 0), np.float32), (0, 0)
     # Forward map in local coordinates: x' = (x+ox) + (by-(y+oy))·lx - x0, y' = by + (by-(y+oy))·ly - y0.
-    mat = np.array([[1.0, -lx, ox + (base_y - oy) * lx - x0],
-                    [0.0, -ly, base_y + (base_y - oy) * ly - y0]], dtype=np.float64)
-    out = cv2.warpAffine(alpha.astype(np.float32), mat, (x1 - x0, y1 - y0), flags=cv2.INTER_LINEAR,
-                         borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    mat = np.array(
+        [[1.0, -lx, ox + (base_y - oy) * lx - x0], [0.0, -ly, base_y + (base_y - oy) * ly - y0]], dtype=np.float64
+    )
+    out = cv2.warpAffine(
+        alpha.astype(np.float32),
+        mat,
+        (x1 - x0, y1 - y0),
+        flags=cv2.INTER_LINEAR,
+        borderMode=cv2.BORDER_CONSTANT,
+        borderValue=0,
+    )
     out = cv2.GaussianBlur(out, (0, 0), blur)
     fade = s.strength / (1.0 + 0.012 * lift)
     return np.clip(out * fade, 0.0, 1.0).astype(np.float32), (x0, y0)

@@ -11,5 +11,12 @@ from input.web.cert import WebCertificate, load_or_create
 from input.web.protocol import ControllerMessage, WebMessageError, parse_message
 from input.web.server import DEFAULT_WEB_PORT, WebSource
 
-__all__ = ["WebSource", "DEFAULT_WEB_PORT", "WebCertificate", "load_or_create", "ControllerMessage",
-           "WebMessageError", "parse_message"]
+__all__ = [
+    "WebSource",
+    "DEFAULT_WEB_PORT",
+    "WebCertificate",
+    "load_or_create",
+    "ControllerMessage",
+    "WebMessageError",
+    "parse_message",
+]

@@ -58,7 +58,7 @@ def fingerprint(der: bytes) -> str:
     import hashlib
 
     digest = hashlib.sha256(der).hexdigest().upper()
-    return ":".join(digest[i:i + 2] for i in range(0, len(digest), 2))
+    return ":".join(digest[i : i + 2] for i in range(0, len(digest), 2))
 
 
 def _usable(cert_path: Path, key_path: Path) -> tuple[bytes | None, str]:
@@ -89,8 +89,12 @@ def _create(addresses: list[str]) -> tuple[bytes, bytes, bytes]:
     from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
 
     key = ec.generate_private_key(ec.SECP256R1())
-    name = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "PuppetPhone controller"),
-                      x509.NameAttribute(NameOID.ORGANIZATION_NAME, "PuppetPhone")])
+    name = x509.Name(
+        [
+            x509.NameAttribute(NameOID.COMMON_NAME, "PuppetPhone controller"),
+            x509.NameAttribute(NameOID.ORGANIZATION_NAME, "PuppetPhone"),
+        ]
+    )
     alt: list[x509.GeneralName] = [x509.DNSName("localhost"), x509.IPAddress(ipaddress.ip_address("127.0.0.1"))]
     for a in addresses:
         try:
@@ -100,15 +104,22 @@ def _create(addresses: list[str]) -> tuple[bytes, bytes, bytes]:
         if x509.IPAddress(ip) not in alt:
             alt.append(x509.IPAddress(ip))
     now = _dt.datetime.now(_dt.UTC)
-    cert = (x509.CertificateBuilder().subject_name(name).issuer_name(name).public_key(key.public_key())
-            .serial_number(x509.random_serial_number())
-            .not_valid_before(now - _dt.timedelta(minutes=5)).not_valid_after(now + _dt.timedelta(days=VALID_DAYS))
-            .add_extension(x509.SubjectAlternativeName(alt), critical=False)
-            .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
-            .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), critical=False)
-            .sign(key, hashes.SHA256()))
-    key_pem = key.private_bytes(serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
-                                serialization.NoEncryption())
+    cert = (
+        x509.CertificateBuilder()
+        .subject_name(name)
+        .issuer_name(name)
+        .public_key(key.public_key())
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(now - _dt.timedelta(minutes=5))
+        .not_valid_after(now + _dt.timedelta(days=VALID_DAYS))
+        .add_extension(x509.SubjectAlternativeName(alt), critical=False)
+        .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+        .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), critical=False)
+        .sign(key, hashes.SHA256())
+    )
+    key_pem = key.private_bytes(
+        serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()
+    )
     return cert.public_bytes(serialization.Encoding.PEM), key_pem, cert.public_bytes(serialization.Encoding.DER)
 
 
@@ -124,8 +135,10 @@ def load_or_create(addresses: list[str], folder: Path | None = None) -> WebCerti
     if der is not None:
         return WebCertificate(cert_path, key_path, fingerprint(der), created=False)
     if why:
-        print(f"web: the certificate in {folder} cannot be used ({why}): made a new one; "
-              "phones must accept it again", file=sys.stderr)
+        print(
+            f"web: the certificate in {folder} cannot be used ({why}): made a new one; phones must accept it again",
+            file=sys.stderr,
+        )
     folder.mkdir(parents=True, exist_ok=True)
     cert_pem, key_pem, der = _create(addresses)
     old = os.umask(0o077)  # the key is the user's alone

@@ -46,10 +46,7 @@ def web_link(source: object) -> WebLink:
     from input.pairing import lan_addresses
 
     host: str = source.host  # type: ignore[attr-defined]
-    if host in ("0.0.0.0", ""):
-        addresses = lan_addresses() or ["127.0.0.1"]
-    else:
-        addresses = [host]
+    addresses = lan_addresses() or ["127.0.0.1"] if host in ("0.0.0.0", "") else [host]
     urls = [source.url(a) for a in addresses]  # type: ignore[attr-defined]
     loopback = all(a.startswith(_LOOPBACK) for a in addresses)
     return WebLink(urls, source.certificate.fingerprint, loopback)  # type: ignore[attr-defined]
@@ -62,8 +59,9 @@ def _session_file(folder: Path | None) -> Path:
 def publish(link: WebLink, folder: Path | None = None) -> Path:
     """Write the running session's link for ``devices`` (readable by the user only)."""
     path = _session_file(folder)
-    data = json.dumps({"pid": os.getpid(), "urls": link.urls, "fingerprint": link.fingerprint,
-                       "loopback_only": link.loopback_only}).encode()
+    data = json.dumps(
+        {"pid": os.getpid(), "urls": link.urls, "fingerprint": link.fingerprint, "loopback_only": link.loopback_only}
+    ).encode()
     old = os.umask(0o077)
     try:
         atomic_write_bytes(path, data)

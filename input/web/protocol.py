@@ -40,12 +40,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from engine.errors import FormatError
 from engine import quat
+from engine.errors import FormatError
 from input.phone_frames import arkit_to_stick, phone_to_stick
 
-__all__ = ["ControllerMessage", "Ping", "Ack", "WebMessageError", "parse_message", "to_sample_fields",
-           "orientation_to_quat", "MAX_MESSAGE_BYTES", "CROUCH_DEPTH", "KINDS", "PageClock"]
+__all__ = [
+    "ControllerMessage",
+    "Ping",
+    "Ack",
+    "WebMessageError",
+    "parse_message",
+    "to_sample_fields",
+    "orientation_to_quat",
+    "MAX_MESSAGE_BYTES",
+    "CROUCH_DEPTH",
+    "KINDS",
+    "PageClock",
+]
 
 #: A reading is about 200 bytes; anything much longer is not from the page.
 MAX_MESSAGE_BYTES = 1024
@@ -175,10 +186,19 @@ def parse_message(text: str | bytes) -> ControllerMessage | Ping | Ack:
         raise WebMessageError("crouch is out of range")
     # rotationRate is (alpha, beta, gamma) = about device (z, x, y), deg/s.
     angular = None if rot is None else np.array([rot[1], rot[2], rot[0]]) * _DEG
-    return ControllerMessage(seq=seq, t=t, kind=kind, orientation=orientation, position=position,
-                             acceleration=acc, angular_velocity=angular, touch=_flag(msg.get("touch"), "touch"),
-                             jump=_flag(msg.get("jump"), "jump"), calibrate=_flag(msg.get("cal"), "cal"),
-                             crouch=crouch)
+    return ControllerMessage(
+        seq=seq,
+        t=t,
+        kind=kind,
+        orientation=orientation,
+        position=position,
+        acceleration=acc,
+        angular_velocity=angular,
+        touch=_flag(msg.get("touch"), "touch"),
+        jump=_flag(msg.get("jump"), "jump"),
+        calibrate=_flag(msg.get("cal"), "cal"),
+        crouch=crouch,
+    )
 
 
 def to_sample_fields(msg: ControllerMessage, source: str, received: float) -> dict[str, Any]:
@@ -186,9 +206,18 @@ def to_sample_fields(msg: ControllerMessage, source: str, received: float) -> di
     clock at the sensor event: :class:`PageClock` maps the page's ``t`` onto it)."""
     position = np.zeros(3) if msg.position is None else msg.position.copy()
     position[1] -= CROUCH_DEPTH * msg.crouch
-    return {"time": received, "source": source, "orientation": msg.orientation, "position": position,
-            "angular_velocity": msg.angular_velocity, "acceleration": msg.acceleration, "touch": msg.touch,
-            "mode": "device", "flick": msg.jump, "calibrate": msg.calibrate}
+    return {
+        "time": received,
+        "source": source,
+        "orientation": msg.orientation,
+        "position": position,
+        "angular_velocity": msg.angular_velocity,
+        "acceleration": msg.acceleration,
+        "touch": msg.touch,
+        "mode": "device",
+        "flick": msg.jump,
+        "calibrate": msg.calibrate,
+    }
 
 
 class PageClock:

@@ -28,8 +28,9 @@ FIELD_HALF_SIZE = 40.0
 
 
 def _ground_mesh(half: float, height: float) -> tuple[bytes, bytes]:
-    pos = np.array([[-half, height, -half], [half, height, -half], [half, height, half], [-half, height, half]],
-                   dtype="<f4")
+    pos = np.array(
+        [[-half, height, -half], [half, height, -half], [half, height, half], [-half, height, half]], dtype="<f4"
+    )
     idx = np.array([0, 2, 1, 0, 3, 2], dtype="<u2")
     return pos.tobytes(), idx.tobytes()
 
@@ -44,42 +45,82 @@ def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
         offset = sum(len(c) for c in chunks)
         chunks.append(raw + b"\0" * ((-len(raw)) % 4))
         views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(raw)})
-        accessors.append({"bufferView": len(views) - 1, "componentType": component, "count": count,
-                          "type": kind, **extra})
+        accessors.append(
+            {"bufferView": len(views) - 1, "componentType": component, "count": count, "type": kind, **extra}
+        )
         return len(accessors) - 1
 
     g = scene.ground
     pos, idx = _ground_mesh(FIELD_HALF_SIZE, g.height)
-    p_acc = add(pos, 5126, 4, "VEC3", min=[-FIELD_HALF_SIZE, g.height, -FIELD_HALF_SIZE],
-                max=[FIELD_HALF_SIZE, g.height, FIELD_HALF_SIZE])
+    p_acc = add(
+        pos,
+        5126,
+        4,
+        "VEC3",
+        min=[-FIELD_HALF_SIZE, g.height, -FIELD_HALF_SIZE],
+        max=[FIELD_HALF_SIZE, g.height, FIELD_HALF_SIZE],
+    )
     i_acc = add(idx, 5123, 6, "SCALAR")
     rows = {}
     for kind in KINDS:
         data = state.rows[kind]
-        rows[kind] = {"accessor": add(data.astype("<i2").tobytes(), 5122, int(data.size) or 1, "SCALAR")
-                      if data.size else None, "rows": int(len(data)), "columns": len(SCALES[kind]),
-                      "scales": list(SCALES[kind])}
+        rows[kind] = {
+            "accessor": add(data.astype("<i2").tobytes(), 5122, int(data.size) or 1, "SCALAR") if data.size else None,
+            "rows": int(len(data)),
+            "columns": len(SCALES[kind]),
+            "scales": list(SCALES[kind]),
+        }
     marks = None
     if state.marks is not None:
         m = state.marks
         nz, nx = m.cells.shape
-        marks = {"accessor": add(m.cells.tobytes(), 5121, int(m.cells.size), "SCALAR"), "nx": nx, "nz": nz,
-                 "x0": m.x0, "z0": m.z0, "cell": m.cell}
+        marks = {
+            "accessor": add(m.cells.tobytes(), 5121, int(m.cells.size), "SCALAR"),
+            "nx": nx,
+            "nz": nz,
+            "x0": m.x0,
+            "z0": m.z0,
+            "cell": m.cell,
+        }
     blob = b"".join(chunks)
     cam = state.camera
     doc = {
         "asset": {"version": "2.0", "generator": "PuppetPhone scene stream"},
         "scene": 0,
-        "scenes": [{"name": "field", "nodes": [0], "extras": {"puppetphone": {
-            "version": FRAME_VERSION, "step": state.step, "rows": rows, "marks": marks, "ground": asdict(g), "sun": asdict(scene.sun),
-            "sky": list(scene.sky_color), "horizon": list(scene.horizon_color),
-            "outline": list(scene.outline_color),
-            "camera": {"position": list(cam.position), "rotation": list(cam.rotation), "fov_y": cam.fov_y}}}}],
+        "scenes": [
+            {
+                "name": "field",
+                "nodes": [0],
+                "extras": {
+                    "puppetphone": {
+                        "version": FRAME_VERSION,
+                        "step": state.step,
+                        "rows": rows,
+                        "marks": marks,
+                        "ground": asdict(g),
+                        "sun": asdict(scene.sun),
+                        "sky": list(scene.sky_color),
+                        "horizon": list(scene.horizon_color),
+                        "outline": list(scene.outline_color),
+                        "camera": {"position": list(cam.position), "rotation": list(cam.rotation), "fov_y": cam.fov_y},
+                    }
+                },
+            }
+        ],
         "nodes": [{"name": "ground", "mesh": 0}],
-        "meshes": [{"name": "ground", "primitives": [{"attributes": {"POSITION": p_acc}, "indices": i_acc,
-                                                       "material": 0}]}],
-        "materials": [{"name": "snow", "pbrMetallicRoughness": {"baseColorFactor": [*g.color, 1.0],
-                                                                 "metallicFactor": 0.0, "roughnessFactor": 0.9}}],
+        "meshes": [
+            {"name": "ground", "primitives": [{"attributes": {"POSITION": p_acc}, "indices": i_acc, "material": 0}]}
+        ],
+        "materials": [
+            {
+                "name": "snow",
+                "pbrMetallicRoughness": {
+                    "baseColorFactor": [*g.color, 1.0],
+                    "metallicFactor": 0.0,
+                    "roughnessFactor": 0.9,
+                },
+            }
+        ],
         "buffers": [{"byteLength": len(blob)}],
         "bufferViews": views,
         "accessors": accessors,
@@ -95,8 +136,8 @@ def read_scene_glb(data: bytes) -> tuple[dict, SceneState]:
     if magic != b"glTF" or total != len(data):
         raise ValueError("not a whole GLB")
     js_len, _ = struct.unpack_from("<I4s", data, 12)
-    doc = json.loads(data[20:20 + js_len])
-    blob = data[20 + js_len + 8:]
+    doc = json.loads(data[20 : 20 + js_len])
+    blob = data[20 + js_len + 8 :]
     extras = doc["scenes"][0]["extras"]["puppetphone"]
     rows = {}
     for kind in KINDS:
@@ -114,6 +155,7 @@ def read_scene_glb(data: bytes) -> tuple[dict, SceneState]:
         cells = np.frombuffer(blob, np.uint8, view["byteLength"], view["byteOffset"]).reshape(info["nz"], info["nx"])
         marks = MarksGrid(cells.copy(), info["x0"], info["z0"], info["cell"])
     cam = extras["camera"]
-    state = SceneState(extras["step"], 0.0, CameraPose(tuple(cam["position"]), tuple(cam["rotation"]), cam["fov_y"]),
-                       rows, marks)
+    state = SceneState(
+        extras["step"], 0.0, CameraPose(tuple(cam["position"]), tuple(cam["rotation"]), cam["fov_y"]), rows, marks
+    )
     return extras, state

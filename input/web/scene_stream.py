@@ -42,18 +42,28 @@ from numpy.typing import NDArray
 
 from engine.render.scene import RenderScene
 
-__all__ = ["SceneState", "CameraPose", "MarksGrid", "KINDS", "SCALES", "quantise", "encode_frame", "decode_frame",
-           "FrameError", "FRAME_VERSION"]
+__all__ = [
+    "SceneState",
+    "CameraPose",
+    "MarksGrid",
+    "KINDS",
+    "SCALES",
+    "quantise",
+    "encode_frame",
+    "decode_frame",
+    "FrameError",
+    "FRAME_VERSION",
+]
 
 FRAME_VERSION = 2
 _MM, _C, _Q = 1000.0, 255.0, 32767.0
 #: Per kind, the scale of each column of the scene's rows (value × scale, rounded, is sent).
 SCALES: dict[str, tuple[float, ...]] = {
-    "capsules": (_MM,) * 7 + (_C,) * 3 + (1.0,),          # a[3] b[3] radius colour[3] outline
-    "spheres": (_MM,) * 7 + (_C,) * 3 + (1.0,),           # centre twice, radius, colour, outline
+    "capsules": (_MM,) * 7 + (_C,) * 3 + (1.0,),  # a[3] b[3] radius colour[3] outline
+    "spheres": (_MM,) * 7 + (_C,) * 3 + (1.0,),  # centre twice, radius, colour, outline
     "boxes": (_MM,) * 6 + (_Q,) * 4 + (_C,) * 3 + (1.0,),  # centre, half extents, rotation, colour, outline
-    "lines": (_MM,) * 6 + (_C,) * 3 + (10.0,),            # p0, p1, colour, width (1/10 px)
-    "points": (_MM,) * 4 + (_C,) * 3 + (1.0,),            # position, size, colour, size-in-pixels flag
+    "lines": (_MM,) * 6 + (_C,) * 3 + (10.0,),  # p0, p1, colour, width (1/10 px)
+    "points": (_MM,) * 4 + (_C,) * 3 + (1.0,),  # position, size, colour, size-in-pixels flag
     "prints": (_MM,) * 2 + (_Q,) * 2 + (_MM,) * 2 + (_C,),  # footprint: x z, heading cos sin, half sizes, strength
 }
 KINDS = tuple(SCALES)
@@ -90,8 +100,11 @@ class MarksGrid:
 
     def same_grid(self, other: MarksGrid | None) -> bool:
         """Whether ``other`` covers the same cells (so only values need sending)."""
-        return (other is not None and other.cells.shape == self.cells.shape
-                and (other.x0, other.z0, other.cell) == (self.x0, self.z0, self.cell))
+        return (
+            other is not None
+            and other.cells.shape == self.cells.shape
+            and (other.x0, other.z0, other.cell) == (self.x0, self.z0, self.cell)
+        )
 
 
 @dataclass(frozen=True)
@@ -107,8 +120,12 @@ class SceneState:
     @staticmethod
     def empty() -> SceneState:
         """The state a phone has before its first frame: no rows."""
-        return SceneState(-1, 0.0, CameraPose((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), 60.0),
-                          {k: np.zeros((0, len(s)), dtype=np.int16) for k, s in SCALES.items()})
+        return SceneState(
+            -1,
+            0.0,
+            CameraPose((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), 60.0),
+            {k: np.zeros((0, len(s)), dtype=np.int16) for k, s in SCALES.items()},
+        )
 
 
 def quantise(scene: RenderScene, step: int, published: float, camera: CameraPose) -> SceneState:
@@ -143,12 +160,14 @@ def _encode_marks(base: MarksGrid | None, marks: MarksGrid | None) -> bytes:
     flat = np.flatnonzero(changed)
     if (r1 - r0) * (c1 - c0) <= 5 * len(flat):
         return b"\2" + head + _RECT.pack(r0, c0, r1 - r0, c1 - c0) + marks.cells[r0:r1, c0:c1].tobytes()
-    return (b"\3" + head + _COUNT.pack(len(flat)) + flat.astype("<u4").tobytes()
-            + marks.cells.reshape(-1)[flat].tobytes())
+    return (
+        b"\3" + head + _COUNT.pack(len(flat)) + flat.astype("<u4").tobytes() + marks.cells.reshape(-1)[flat].tobytes()
+    )
 
 
 def _decode_marks(base: MarksGrid | None, data: bytes, at: int) -> tuple[MarksGrid | None, int]:
     """The tracks after a frame's tracks part at ``at``, and where the part ends."""
+
     def need(n: int) -> None:
         if at + n > len(data):
             raise FrameError("frame ends inside its tracks")
@@ -177,7 +196,7 @@ def _decode_marks(base: MarksGrid | None, data: bytes, at: int) -> tuple[MarksGr
         if r0 + h > nz or c0 + w > nx:
             raise FrameError("tracks rectangle outside the grid")
         need(h * w)
-        cells[r0:r0 + h, c0:c0 + w] = np.frombuffer(data, np.uint8, h * w, at).reshape(h, w)
+        cells[r0 : r0 + h, c0 : c0 + w] = np.frombuffer(data, np.uint8, h * w, at).reshape(h, w)
         at += h * w
     else:
         need(_COUNT.size)
@@ -195,8 +214,11 @@ def _decode_marks(base: MarksGrid | None, data: bytes, at: int) -> tuple[MarksGr
 def encode_frame(base: SceneState, state: SceneState) -> bytes:
     """The bytes that take a phone holding ``base`` to ``state``."""
     cam = state.camera
-    out = [_HEADER.pack(b"PF", FRAME_VERSION, 0, state.step & 0xFFFFFFFF, state.published, *cam.position,
-                        *cam.rotation, cam.fov_y)]
+    out = [
+        _HEADER.pack(
+            b"PF", FRAME_VERSION, 0, state.step & 0xFFFFFFFF, state.published, *cam.position, *cam.rotation, cam.fov_y
+        )
+    ]
     for kind in KINDS:
         new, old = state.rows[kind], base.rows[kind]
         n = len(new)
@@ -252,7 +274,9 @@ def decode_frame(base: SceneState, data: bytes) -> SceneState:
             (bits,) = _COLUMNS.unpack_from(data, at)
             columns = np.array([(bits >> c) & 1 for c in range(len(scales))], dtype=bool)
             at += _COLUMNS.size
-            changed = np.unpackbits(np.frombuffer(data, np.uint8, mask_len, at), count=n, bitorder="little").astype(bool)
+            changed = np.unpackbits(np.frombuffer(data, np.uint8, mask_len, at), count=n, bitorder="little").astype(
+                bool
+            )
             at += mask_len
             count = int(changed.sum()) * int(columns.sum())
             width = 1 if mode == 1 else 2
@@ -270,5 +294,5 @@ def decode_frame(base: SceneState, data: bytes) -> SceneState:
     marks, at = _decode_marks(base.marks, data, at)
     if at != len(data):
         raise FrameError("bytes after the tracks")
-    pose = CameraPose(tuple(cam[0:3]), tuple(cam[3:7]), cam[7])  # type: ignore[arg-type]  # lengths are fixed above
+    pose = CameraPose(tuple(cam[0:3]), tuple(cam[3:7]), cam[7])
     return SceneState(step, published, pose, rows, marks)

@@ -64,11 +64,17 @@ __all__ = ["WebSource", "DEFAULT_WEB_PORT", "PAGE_FILES", "FRAMES_IN_FLIGHT"]
 DEFAULT_WEB_PORT = 8443
 _JS = "text/javascript; charset=utf-8"
 #: The page's files and their content types (served from the package, no build step).
-PAGE_FILES = {"/": ("index.html", "text/html; charset=utf-8"), "/index.html": ("index.html", "text/html; charset=utf-8"),
-              "/app.js": ("app.js", _JS), "/stream.js": ("stream.js", _JS),
-              "/stream_worker.js": ("stream_worker.js", _JS), "/render_worker.js": ("render_worker.js", _JS),
-              "/render.js": ("render.js", _JS),
-              "/placement.js": ("placement.js", _JS), "/style.css": ("style.css", "text/css; charset=utf-8")}
+PAGE_FILES = {
+    "/": ("index.html", "text/html; charset=utf-8"),
+    "/index.html": ("index.html", "text/html; charset=utf-8"),
+    "/app.js": ("app.js", _JS),
+    "/stream.js": ("stream.js", _JS),
+    "/stream_worker.js": ("stream_worker.js", _JS),
+    "/render_worker.js": ("render_worker.js", _JS),
+    "/render.js": ("render.js", _JS),
+    "/placement.js": ("placement.js", _JS),
+    "/style.css": ("style.css", "text/css; charset=utf-8"),
+}
 #: Scene frames a connection may have sent and not yet had acknowledged.
 FRAMES_IN_FLIGHT = 2
 _TOKEN_PAGES = {"/", "/index.html", "/ws"}
@@ -104,9 +110,17 @@ class WebSource(PoseSource):
         OSError: the port cannot be bound or the certificate folder cannot be written.
     """
 
-    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_WEB_PORT, max_controllers: int = 1,
-                 max_rate: float = 240.0, certificate: WebCertificate | None = None, token: str | None = None,
-                 capacity: int = 256, silent_after: float = 2.0) -> None:
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        port: int = DEFAULT_WEB_PORT,
+        max_controllers: int = 1,
+        max_rate: float = 240.0,
+        certificate: WebCertificate | None = None,
+        token: str | None = None,
+        capacity: int = 256,
+        silent_after: float = 2.0,
+    ) -> None:
         if max_controllers < 1:
             raise ValueError(f"max_controllers must be at least 1, not {max_controllers}")
         if not 0 <= port <= 65535:
@@ -181,9 +195,18 @@ class WebSource(PoseSource):
         from websockets.asyncio.server import serve
 
         self._loop = asyncio.get_running_loop()
-        async with serve(self._connection, sock=self._sock, ssl=self._ssl,
-                         process_request=self._http, max_size=_FRAME_LIMIT, max_queue=32,
-                         ping_interval=5, ping_timeout=10, close_timeout=1, server_header="PuppetPhone"):
+        async with serve(
+            self._connection,
+            sock=self._sock,
+            ssl=self._ssl,
+            process_request=self._http,
+            max_size=_FRAME_LIMIT,
+            max_queue=32,
+            ping_interval=5,
+            ping_timeout=10,
+            close_timeout=1,
+            server_header="PuppetPhone",
+        ):
             while not self.stopping.is_set():
                 await asyncio.sleep(0.05)
 
@@ -201,16 +224,24 @@ class WebSource(PoseSource):
             self.refused += 1
             self.drop("wrong session token", route)
             body = b"This controller link is not for the running game: scan its QR code again.\n"
-            return Response(403, "Forbidden", Headers([("Content-Type", "text/plain; charset=utf-8"),
-                                                      ("Content-Length", str(len(body)))]), body)
+            return Response(
+                403,
+                "Forbidden",
+                Headers([("Content-Type", "text/plain; charset=utf-8"), ("Content-Length", str(len(body)))]),
+                body,
+            )
         if route == "/ws":
             return None
         if route not in PAGE_FILES:
             return connection.respond(404, "Not found\n")
         name, ctype = PAGE_FILES[route]
         body = _page(name)
-        return Response(200, "OK", Headers([("Content-Type", ctype), ("Content-Length", str(len(body))),
-                                           ("Cache-Control", "no-store")]), body)
+        return Response(
+            200,
+            "OK",
+            Headers([("Content-Type", ctype), ("Content-Length", str(len(body))), ("Cache-Control", "no-store")]),
+            body,
+        )
 
     async def _connection(self, ws: Any) -> None:
         slot = next((i for i in range(1, self.max_controllers + 1) if i not in self._slots), None)
@@ -315,4 +346,3 @@ class WebSource(PoseSource):
             while len(self.page_times) > 4096:
                 self.page_times.popitem(last=False)
         return None
-

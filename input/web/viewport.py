@@ -33,8 +33,11 @@ __all__ = ["PhoneViewport", "camera_pose"]
 def camera_pose(camera: Camera) -> CameraPose:
     """A camera's eye, orientation (camera → world) and vertical field of view."""
     q = quat.from_matrix(camera.rotation)
-    return CameraPose(tuple(float(v) for v in camera.eye), tuple(float(v) for v in q),  # type: ignore[arg-type]
-                      float(camera.fov_y))
+    return CameraPose(
+        tuple(float(v) for v in camera.eye),
+        tuple(float(v) for v in q),  # type: ignore[arg-type]
+        float(camera.fov_y),
+    )
 
 
 class PhoneViewport:
@@ -46,8 +49,9 @@ class PhoneViewport:
         fallback: the camera used while no controller drives a stick.
     """
 
-    def __init__(self, source: WebSource, draw: Callable[[World, RenderScene, float], None],
-                 fallback: Callable[[], Camera]) -> None:
+    def __init__(
+        self, source: WebSource, draw: Callable[[World, RenderScene, float], None], fallback: Callable[[], Camera]
+    ) -> None:
         self.source = source
         self.draw = draw
         self.fallback = fallback

@@ -22,10 +22,10 @@ import time
 import numpy as np
 from scipy.interpolate import LinearNDInterpolator, RBFInterpolator
 
-from puppetphone.bench.figures import Figure, median_time
 from engine.blend import LookupTable, build_locomotion, foot_slide, measure_locomotion, play
-from engine.blend.measure import blended_contacts
 from engine.blend.locomotion import LocomotionSet
+from engine.blend.measure import blended_contacts
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "request_grid", "linear_mapping"]
 
@@ -57,7 +57,9 @@ def _speed_error(loco: LocomotionSet, p: np.ndarray, u: np.ndarray) -> np.ndarra
     return 100.0 * np.abs(played / u[:, 0] - 1.0)
 
 
-def _slide(loco: LocomotionSet, p: np.ndarray, u: np.ndarray | None, seconds: float = 3.0, dt: float = 1.0 / 60.0) -> float:
+def _slide(
+    loco: LocomotionSet, p: np.ndarray, u: np.ndarray | None, seconds: float = 3.0, dt: float = 1.0 / 60.0
+) -> float:
     """Mean foot speed in contact (cm/s), the puppet carried at the requested speed ``u`` (or by root motion)."""
     from engine.clips import foot_contacts
 
@@ -85,10 +87,21 @@ def run() -> list[Figure]:
     plain = LookupTable(table.probes, table.values, table.properties, table.grid_shape, gradients=False)
     plain_err = _speed_error(loco, plain.query(u), u)
     figs += [
-        Figure(NAME, "speed_error_median_pct", float(np.median(idw_err)), "%", "linear mapping", float(np.median(lin_err))),
+        Figure(
+            NAME, "speed_error_median_pct", float(np.median(idw_err)), "%", "linear mapping", float(np.median(lin_err))
+        ),
         Figure(NAME, "speed_error_max_pct", float(idw_err.max()), "%", "linear mapping", float(lin_err.max())),
-        Figure(NAME, "plain_idw_speed_error_median_pct", float(np.median(plain_err)), "%", "linear mapping", float(np.median(lin_err))),
-        Figure(NAME, "plain_idw_speed_error_max_pct", float(plain_err.max()), "%", "linear mapping", float(lin_err.max())),
+        Figure(
+            NAME,
+            "plain_idw_speed_error_median_pct",
+            float(np.median(plain_err)),
+            "%",
+            "linear mapping",
+            float(np.median(lin_err)),
+        ),
+        Figure(
+            NAME, "plain_idw_speed_error_max_pct", float(plain_err.max()), "%", "linear mapping", float(lin_err.max())
+        ),
         Figure(NAME, "requests_inside", float(len(u)), "count"),
         Figure(NAME, "lookup_build_s", build_s, "s"),
     ]
@@ -105,7 +118,9 @@ def run() -> list[Figure]:
     one_u, one_x = u[len(u) // 2], xs[len(u) // 2][None]
     idw_one = median_time(lambda: table.query(one_u))
     figs += [
-        Figure(NAME, "linear_nd_speed_error_median_pct", float(np.median(lnd_err)), "%", "idw", float(np.median(idw_err))),
+        Figure(
+            NAME, "linear_nd_speed_error_median_pct", float(np.median(lnd_err)), "%", "idw", float(np.median(idw_err))
+        ),
         Figure(NAME, "linear_nd_speed_error_max_pct", float(lnd_err.max()), "%", "idw", float(idw_err.max())),
         Figure(NAME, "rbf_speed_error_median_pct", float(np.median(rbf_err)), "%", "idw", float(np.median(idw_err))),
         Figure(NAME, "rbf_speed_error_max_pct", float(rbf_err.max()), "%", "idw", float(idw_err.max())),
@@ -116,7 +131,14 @@ def run() -> list[Figure]:
     # Foot sliding over a dozen requests spread over the feasible set.
     pick = u[np.linspace(0, len(u) - 1, 12).astype(int)]
     figs.append(
-        Figure(NAME, "foot_slide_cm_s", _slide(loco, table.query(pick), pick), "cm/s", "linear mapping", _slide(loco, linear_mapping(loco, pick), pick))
+        Figure(
+            NAME,
+            "foot_slide_cm_s",
+            _slide(loco, table.query(pick), pick),
+            "cm/s",
+            "linear mapping",
+            _slide(loco, linear_mapping(loco, pick), pick),
+        )
     )
     figs.append(Figure(NAME, "foot_slide_root_motion_cm_s", _slide(loco, table.query(pick), None), "cm/s"))
     figs.append(Figure(NAME, "foot_slide_clips_alone_cm_s", _slide(loco, loco.space.points, None), "cm/s"))
@@ -136,7 +158,14 @@ def run() -> list[Figure]:
     big = build_locomotion(clips, density=64).table
     q = big.values[len(big.values) // 3] + 0.004
     figs.append(
-        Figure(NAME, "lookup_us", median_time(lambda: big.query(q)) * 1e6, "us", f"brute force over {len(big.probes)} probes", median_time(lambda: big.query_brute(q)) * 1e6)
+        Figure(
+            NAME,
+            "lookup_us",
+            median_time(lambda: big.query(q)) * 1e6,
+            "us",
+            f"brute force over {len(big.probes)} probes",
+            median_time(lambda: big.query_brute(q)) * 1e6,
+        )
     )
     figs.append(Figure(NAME, "resolve_us", median_time(lambda: table.resolve(one_u)) * 1e6, "us"))
     figs += _runtime(loco)
@@ -162,7 +191,7 @@ def _runtime(loco: LocomotionSet) -> list[Figure]:
         app.run_steps(3)
         tick = [0]
 
-        def step() -> None:
+        def step(tick: list[int] = tick, players: list[LocomotionPlayer] = players, app: App = app) -> None:
             tick[0] += 1
             for j, p in enumerate(players):
                 p.speed = 0.3 + 0.02 * j + 0.001 * (tick[0] % 50)

@@ -23,9 +23,19 @@ from typing import Any
 
 __all__ = ["Chromium", "find_chromium", "ChromiumError"]
 
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--ignore-certificate-errors", "--remote-debugging-port=0", "--remote-allow-origins=*")
+FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--ignore-certificate-errors",
+    "--remote-debugging-port=0",
+    "--remote-allow-origins=*",
+)
 
 
 SENSORS = ("relative-orientation", "accelerometer", "linear-acceleration", "gyroscope")
@@ -55,8 +65,12 @@ class Chromium:
         if exe is None:
             raise ChromiumError("no chromium executable (apt-get install chromium)")
         self._dir = tempfile.mkdtemp(prefix="pp-chromium-")
-        self.proc = subprocess.Popen([exe, *FLAGS, f"--user-data-dir={self._dir}", "about:blank"],
-                                     stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.proc = subprocess.Popen(
+            [exe, *FLAGS, f"--user-data-dir={self._dir}", "about:blank"],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         self._id = 0
         self._stack = contextlib.ExitStack()
         self.events: list[dict[str, Any]] = []
@@ -88,8 +102,9 @@ class Chromium:
             with urlopen(f"http://127.0.0.1:{port}/json/list", timeout=5) as r:
                 pages = [t for t in json.load(r) if t.get("type") == "page"]
             if pages:
-                return self._stack.enter_context(connect(pages[0]["webSocketDebuggerUrl"], max_size=None,
-                                                         open_timeout=timeout))
+                return self._stack.enter_context(
+                    connect(pages[0]["webSocketDebuggerUrl"], max_size=None, open_timeout=timeout)
+                )
             time.sleep(0.1)
         raise ChromiumError("chromium has no page")
 
@@ -141,8 +156,10 @@ class Chromium:
 
     def centre(self, element_id: str) -> tuple[float, float]:
         """The centre of a page element, in CSS pixels."""
-        r = self.evaluate(f"(() => {{ const r = document.getElementById({element_id!r}).getBoundingClientRect();"
-                          " return [r.x + r.width / 2, r.y + r.height / 2]; })()")
+        r = self.evaluate(
+            f"(() => {{ const r = document.getElementById({element_id!r}).getBoundingClientRect();"
+            " return [r.x + r.width / 2, r.y + r.height / 2]; })()"
+        )
         return float(r[0]), float(r[1])
 
     def click(self, element_id: str) -> None:
@@ -180,13 +197,18 @@ class Chromium:
         else:
             self.send("Emulation.setSensorOverrideReadings", **params)
 
-    def motion(self, linear: tuple[float, float, float], gravity: tuple[float, float, float],
-               rotation: tuple[float, float, float]) -> None:
+    def motion(
+        self,
+        linear: tuple[float, float, float],
+        gravity: tuple[float, float, float],
+        rotation: tuple[float, float, float],
+    ) -> None:
         """Set the motion sensors: linear acceleration and gravity (m/s²), rotation rate (rad/s)."""
         total = tuple(a + g for a, g in zip(linear, gravity, strict=True))
         for kind, v in (("linear-acceleration", linear), ("accelerometer", total), ("gyroscope", rotation)):
-            self.call("Emulation.setSensorOverrideReadings", type=kind,
-                      reading={"xyz": {"x": v[0], "y": v[1], "z": v[2]}})
+            self.call(
+                "Emulation.setSensorOverrideReadings", type=kind, reading={"xyz": {"x": v[0], "y": v[1], "z": v[2]}}
+            )
 
     def screenshot(self, path: Path) -> Path:
         """A PNG of the page."""

@@ -46,7 +46,7 @@ def cmu_walk():  # type: ignore[no-untyped-def]
     return conform(loop_clip(extract_cycle(perf.trajectory, np.random.default_rng(0)), perf), "walk")
 
 
-def _start_times(clips: dict) -> tuple[float, float]:  # type: ignore[type-arg]
+def _start_times(clips: dict) -> tuple[float, float]:
     from engine.cliplib.authored import AuthoredClips, authored_locomotion
 
     with tempfile.TemporaryDirectory() as cache:
@@ -61,7 +61,7 @@ def _start_times(clips: dict) -> tuple[float, float]:  # type: ignore[type-arg]
     return float(np.median(warm)), cold
 
 
-def _walk(speed: float, clips: dict | None):  # type: ignore[no-untyped-def, type-arg]
+def _walk(speed: float, clips: dict | None):
     from puppetphone.clip_walk import record_stick_walk, walk_figures
 
     with tempfile.TemporaryDirectory() as d:
@@ -71,8 +71,8 @@ def _walk(speed: float, clips: dict | None):  # type: ignore[no-untyped-def, typ
 
 def run() -> list[Figure]:
     """Measure and return the figures."""
-    from engine.clips import default_clips
     from engine.cliplib.embed import encode
+    from engine.clips import default_clips
 
     walk = cmu_walk()
     authored = {"walk": walk if walk is not None else default_clips()["walk"].resampled(50.0)}
@@ -90,12 +90,25 @@ def run() -> list[Figure]:
     sweep_a = [_walk(v, payload) for v in SWEEP]
     sweep_b = [_walk(v, None) for v in SWEEP]
     figs += [
-        Figure(BENCH, "foot_slide_sweep_mean", float(np.mean([f.foot_slide for f in sweep_a])), "m/s",
-               "built-in walk", float(np.mean([f.foot_slide for f in sweep_b]))),
-        Figure(BENCH, "speed_error_pct_sweep_max", max(f.speed_error_pct for f in sweep_a), "%",
-               "built-in walk", max(f.speed_error_pct for f in sweep_b)),
+        Figure(
+            BENCH,
+            "foot_slide_sweep_mean",
+            float(np.mean([f.foot_slide for f in sweep_a])),
+            "m/s",
+            "built-in walk",
+            float(np.mean([f.foot_slide for f in sweep_b])),
+        ),
+        Figure(
+            BENCH,
+            "speed_error_pct_sweep_max",
+            max(f.speed_error_pct for f in sweep_a),
+            "%",
+            "built-in walk",
+            max(f.speed_error_pct for f in sweep_b),
+        ),
     ]
     for v, a, b in zip(SWEEP, sweep_a, sweep_b, strict=True):
-        figs.append(Figure(BENCH, f"foot_slide_at_{round(v * 10):02d}dms", a.foot_slide, "m/s", "built-in walk",
-                           b.foot_slide))
+        figs.append(
+            Figure(BENCH, f"foot_slide_at_{round(v * 10):02d}dms", a.foot_slide, "m/s", "built-in walk", b.foot_slide)
+        )
     return figs

@@ -22,11 +22,11 @@ import time
 
 import numpy as np
 
-from puppetphone.bench.figures import Figure
 from engine import jit
 from engine.app import STAGES, App
 from engine.ik.system import IKRigCache
 from engine.ragdoll.physics import PhysicsWorld
+from puppetphone.bench.figures import Figure
 
 __all__ = ["run", "crowd_app", "timed_steps", "STEPS", "BUDGET_MS"]
 
@@ -81,21 +81,39 @@ def run() -> list[Figure]:
     stages: dict[str, np.ndarray] = {}
     for n in (1, 10, 100):
         total, stages = timed_steps(crowd_app(n))
-        figures.append(Figure(_BENCH, f"crowd_step_ms_{n}", float(np.median(total)) * 1e3, "ms",
-                              "60 Hz budget", BUDGET_MS))
+        figures.append(
+            Figure(_BENCH, f"crowd_step_ms_{n}", float(np.median(total)) * 1e3, "ms", "60 Hz budget", BUDGET_MS)
+        )
     with jit.use(False):
         numpy_total, numpy_stages = timed_steps(crowd_app(100))
     for stage, t in stages.items():
         if stage in _KERNEL_STAGES and jit.enabled():
-            figures.append(Figure(_BENCH, f"crowd_system_ms_{stage}_100", float(np.median(t)) * 1e3, "ms",
-                                  "numpy path, same run", float(np.median(numpy_stages[stage])) * 1e3))
+            figures.append(
+                Figure(
+                    _BENCH,
+                    f"crowd_system_ms_{stage}_100",
+                    float(np.median(t)) * 1e3,
+                    "ms",
+                    "numpy path, same run",
+                    float(np.median(numpy_stages[stage])) * 1e3,
+                )
+            )
         else:
             figures.append(Figure(_BENCH, f"crowd_system_ms_{stage}_100", float(np.median(t)) * 1e3, "ms"))
     if jit.enabled():
-        figures.append(Figure(_BENCH, "crowd_step_ms_100_numpy", float(np.median(numpy_total)) * 1e3, "ms",
-                              "this run's crowd_step_ms_100 (compiled)", figures[2].value))
+        figures.append(
+            Figure(
+                _BENCH,
+                "crowd_step_ms_100_numpy",
+                float(np.median(numpy_total)) * 1e3,
+                "ms",
+                "this run's crowd_step_ms_100 (compiled)",
+                figures[2].value,
+            )
+        )
     old, _ = timed_steps(crowd_app(100, old=True))
     new = figures[2].value
-    figures.append(Figure(_BENCH, "crowd_step_ms_100_old", float(np.median(old)) * 1e3, "ms",
-                          "this run's crowd_step_ms_100", new))
+    figures.append(
+        Figure(_BENCH, "crowd_step_ms_100_old", float(np.median(old)) * 1e3, "ms", "this run's crowd_step_ms_100", new)
+    )
     return figures

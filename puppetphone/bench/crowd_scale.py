@@ -22,9 +22,9 @@ import time
 import mujoco
 import numpy as np
 
+from engine.ragdoll import PhysicsWorld, Ragdoll, RagdollMode
 from puppetphone.bench.crowd import BUDGET_MS, crowd_app, timed_steps
 from puppetphone.bench.figures import Figure
-from engine.ragdoll import PhysicsWorld, Ragdoll, RagdollMode
 
 __all__ = ["AFTER", "FALLERS", "REPEATS", "fall_run", "run"]
 
@@ -75,17 +75,36 @@ def run() -> list[Figure]:
     figures = []
     for n in (300, 1000):
         runs = [float(np.median(timed_steps(crowd_app(n, seed=s), STEPS)[0])) for s in range(1, REPEATS + 1)]
-        figures.append(Figure(_BENCH, f"crowd_step_ms_{n}", float(np.median(runs)) * 1e3, "ms", "60 Hz budget", BUDGET_MS))
+        figures.append(
+            Figure(_BENCH, f"crowd_step_ms_{n}", float(np.median(runs)) * 1e3, "ms", "60 Hz budget", BUDGET_MS)
+        )
     worst, physics, raw = [], [], []
     for s in range(1, REPEATS + 1):
         total, phys, r = fall_run(seed=s)
         worst.append(float(total.max()))
         physics.append(float(np.median(phys)))
         raw.append(r)
-    figures.append(Figure(_BENCH, "crowd_fall_worst_step_ms_100", float(np.median(worst)) * 1e3, "ms",
-                          "60 Hz budget", BUDGET_MS))
-    figures.append(Figure(_BENCH, "crowd_fall_physics_ms_100", float(np.median(physics)) * 1e3, "ms",
-                          "raw mj_step, same model and state", float(np.median(raw)) * 1e3))
-    figures.append(Figure(_BENCH, "crowd_start_s_1000", float(np.median([_start_s(1000) for _ in range(REPEATS)])), "s",
-                          "issue target", 3.0))
+    figures.append(
+        Figure(_BENCH, "crowd_fall_worst_step_ms_100", float(np.median(worst)) * 1e3, "ms", "60 Hz budget", BUDGET_MS)
+    )
+    figures.append(
+        Figure(
+            _BENCH,
+            "crowd_fall_physics_ms_100",
+            float(np.median(physics)) * 1e3,
+            "ms",
+            "raw mj_step, same model and state",
+            float(np.median(raw)) * 1e3,
+        )
+    )
+    figures.append(
+        Figure(
+            _BENCH,
+            "crowd_start_s_1000",
+            float(np.median([_start_s(1000) for _ in range(REPEATS)])),
+            "s",
+            "issue target",
+            3.0,
+        )
+    )
     return figures

@@ -30,10 +30,10 @@ import time
 import numpy as np
 
 from authoring.keyframe_curves import CurveSettings, Drag, Hold, TangentSolver
-from puppetphone.bench.figures import Figure
 from engine.ik import IKRig
 from engine.keyframes import BezierCurves, KeyframedClip
 from engine.skeleton import Skeleton
+from puppetphone.bench.figures import Figure
 
 __all__ = ["run", "CONFIGS", "THESIS_MS", "build_case"]
 
@@ -82,7 +82,9 @@ def _tree(config: str, n: int) -> tuple[Skeleton, int, list[tuple[int, bool]], l
         side = -1.0 if k == 0 else 0.0
         for i in range(b):
             parents.append(t - 1 if i == 0 else start + i - 1)
-            offsets.append(np.array([side * LINK, LINK, LINK * k]) / np.sqrt(2) if i == 0 else np.array([0.0, LINK, 0.0]))
+            offsets.append(
+                np.array([side * LINK, LINK, LINK * k]) / np.sqrt(2) if i == 0 else np.array([0.0, LINK, 0.0])
+            )
         tips.append((start, start + b - 1))
         start += b
     j_count = len(parents)
@@ -102,7 +104,9 @@ def _tree(config: str, n: int) -> tuple[Skeleton, int, list[tuple[int, bool]], l
     return sk, eff, holds, moving, still
 
 
-def build_case(config: str, dof: int, frames: int, seed: int = 0) -> tuple[TangentSolver, Drag, list[Hold], list[np.ndarray]]:
+def build_case(
+    config: str, dof: int, frames: int, seed: int = 0
+) -> tuple[TangentSolver, Drag, list[Hold], list[np.ndarray]]:
     """The solver, a template drag, the holds and ``SOLVES`` reachable targets for one cell."""
     rng = np.random.default_rng(seed + 1000 * dof + 10 * frames + CONFIGS.index(config))
     sk, eff, holds, moving, still = _tree(config, dof // 12)
@@ -130,7 +134,7 @@ def build_case(config: str, dof: int, frames: int, seed: int = 0) -> tuple[Tange
     oy[:, frozen] = 0.0
     iy[:, frozen] = 0.0
     clip = KeyframedClip("bench", sk, BezierCurves(times, values, ox, oy, ix, iy), fps=FPS)
-    rig = IKRig.build(sk, limits={n: (-LIMIT, LIMIT) for n in sk.names}, root_translation=True)
+    rig = IKRig.build(sk, limits=dict.fromkeys(sk.names, (-LIMIT, LIMIT)), root_translation=True)
     # One segment's tangents, as Table 4.3 times them (every tangent broken: none linked to a neighbour).
     solver = TangentSolver(clip, rig, CurveSettings(linked_tangents=False), frozen=frozen)
     t = (1.5 * frames) / FPS
@@ -189,7 +193,9 @@ def run() -> list[Figure]:
         figures.append(Figure("curves", f"curves_reached_pct_{config}", float(np.min(reach)), "%", "all drags", 100.0))
         figures.append(Figure("curves", f"curves_error_mm_{config}", float(np.max(err)), "mm", "tolerance", 0.1))
         if config != "none":
-            figures.append(Figure("curves", f"curves_hold_error_mm_{config}", float(np.max(held)), "mm", "epsilon", 0.1))
+            figures.append(
+                Figure("curves", f"curves_hold_error_mm_{config}", float(np.max(held)), "mm", "epsilon", 0.1)
+            )
     from puppetphone.bench import curves_keys
 
     return figures + curves_keys.run()  # Table 4.1 like for like: keys to reach a motion

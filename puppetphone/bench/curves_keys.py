@@ -26,11 +26,11 @@ import numpy as np
 
 from authoring.keyframe_curves.keys import MIN_KEY_GAP_FRAMES, key_frames, pose_channels, set_key_channels
 from authoring.keyframe_curves.session import CurveSession
-from puppetphone.bench.figures import Figure
 from engine import quat
 from engine.clip import Clip
 from engine.clips import default_clips
 from engine.keyframes import BezierCurves, KeyframedClip
+from puppetphone.bench.figures import Figure
 
 __all__ = ["run", "author", "wave_clip", "TOLERANCE", "TRACKED", "MOTIONS"]
 
@@ -66,7 +66,10 @@ def _positions(clip: KeyframedClip | Clip, joints: list[int]) -> np.ndarray:
     from engine.fk import forward_kinematics
 
     baked = clip.bake() if isinstance(clip, KeyframedClip) else clip
-    out = [forward_kinematics(baked.skeleton, baked.root[f], baked.rotations[f])[0][joints] for f in range(baked.num_frames)]
+    out = [
+        forward_kinematics(baked.skeleton, baked.root[f], baked.rotations[f])[0][joints]
+        for f in range(baked.num_frames)
+    ]
     return np.array(out)
 
 
@@ -93,8 +96,9 @@ def _free(clip: KeyframedClip, frame: int) -> bool:
     return bool(np.all(np.abs(keys - frame) >= MIN_KEY_GAP_FRAMES))
 
 
-def _drag_in(session: CurveSession, target: Clip, joints: list[int], goal: np.ndarray, frame: int,
-             miss: np.ndarray) -> bool:
+def _drag_in(
+    session: CurveSession, target: Clip, joints: list[int], goal: np.ndarray, frame: int, miss: np.ndarray
+) -> bool:
     """Drag each tracked joint that misses at ``frame`` onto its target there (worst first); keep a drag that
     lowers the miss at that frame without raising the largest miss anywhere. True when one was kept."""
     sk = target.skeleton
@@ -133,7 +137,7 @@ def author(motion: str, curves: bool) -> tuple[int, int, float]:
         frame = next((int(f) for f in order if _free(session.clip, int(f))), None)
         if frame is None:
             break  # keys on every frame that could take one
-        worst = float(miss.max())
+        float(miss.max())
         if curves and _drag_in(session, target, joints, goal, frame, miss):
             ops += 1
             continue
@@ -157,5 +161,7 @@ def run() -> list[Figure]:
                               f"ops_{motion}_keyframing", float(k_ops)))  # fmt: skip
         figures.append(Figure("curves", f"miss_mm_{motion}_motion_curves", m_miss * 1e3, "mm",
                               "tolerance", TOLERANCE * 1e3))  # fmt: skip
-        figures.append(Figure("curves", f"miss_mm_{motion}_keyframing", k_miss * 1e3, "mm", "tolerance", TOLERANCE * 1e3))
+        figures.append(
+            Figure("curves", f"miss_mm_{motion}_keyframing", k_miss * 1e3, "mm", "tolerance", TOLERANCE * 1e3)
+        )
     return figures

@@ -34,7 +34,9 @@ def _time(dims: int, frames: int, repeats: int) -> float:
     # A period of about 1 s and as many cycles as fit: 120 fps for 1,000 frames is a mocap walk.
     fps = 120.0 if frames >= 900 else 60.0
     cycles = max(3, round(frames / fps))
-    perf = make_performance(dims, np.random.default_rng(dims + frames), cycles=cycles, period=frames / fps / cycles, fps=fps)
+    perf = make_performance(
+        dims, np.random.default_rng(dims + frames), cycles=cycles, period=frames / fps / cycles, fps=fps
+    )
     traj = perf.trajectory
     return median_time(lambda: extract_cycle(traj, np.random.default_rng(0)), repeats=repeats, min_time=0.0)
 
@@ -43,8 +45,15 @@ def _accuracy(seeds: int = 12, steady_ends: bool = True) -> tuple[list[float], l
     desc, fft = [], []
     for dims in (1, 2, 60, 254):
         for s in range(seeds):
-            perf = make_performance(dims, np.random.default_rng(1000 * dims + s), cycles=8, jitter=0.15, noise=0.02,
-                                    drift=0.1, steady_ends=steady_ends)
+            perf = make_performance(
+                dims,
+                np.random.default_rng(1000 * dims + s),
+                cycles=8,
+                jitter=0.15,
+                noise=0.02,
+                drift=0.1,
+                steady_ends=steady_ends,
+            )
             r = extract_cycle(perf.trajectory, np.random.default_rng(s))
             desc.append(100.0 * abs(r.period / perf.period - 1.0))
             f = autocorrelation_period(perf.trajectory)
@@ -79,13 +88,47 @@ def run() -> list[Figure]:
     if walk is not None:
         figs.append(Figure(BENCH, "cycle_s_mocap_walk_175d", walk, "s", "goal", 0.1))
     desc, fft = _accuracy()
-    figs.append(Figure(BENCH, "period_error_pct_descriptor", float(np.median(desc)), "%", "period_error_pct_fft", float(np.median(fft))))
-    figs.append(Figure(BENCH, "period_error_pct_descriptor_worst", float(np.max(desc)), "%", "period_error_pct_fft_worst", float(np.max(fft))))
+    figs.append(
+        Figure(
+            BENCH,
+            "period_error_pct_descriptor",
+            float(np.median(desc)),
+            "%",
+            "period_error_pct_fft",
+            float(np.median(fft)),
+        )
+    )
+    figs.append(
+        Figure(
+            BENCH,
+            "period_error_pct_descriptor_worst",
+            float(np.max(desc)),
+            "%",
+            "period_error_pct_fft_worst",
+            float(np.max(fft)),
+        )
+    )
     figs.append(Figure(BENCH, "period_error_pct_fft", float(np.median(fft)), "%"))
     # Every cycle jittered, ends included: the true mean is partly outside what any method sees.
     desc, fft = _accuracy(steady_ends=False)
-    figs.append(Figure(BENCH, "period_error_pct_descriptor_all_jittered", float(np.median(desc)), "%",
-                       "period_error_pct_fft_all_jittered", float(np.median(fft))))
-    figs.append(Figure(BENCH, "period_error_pct_descriptor_all_jittered_worst", float(np.max(desc)), "%",
-                       "period_error_pct_fft_all_jittered_worst", float(np.max(fft))))
+    figs.append(
+        Figure(
+            BENCH,
+            "period_error_pct_descriptor_all_jittered",
+            float(np.median(desc)),
+            "%",
+            "period_error_pct_fft_all_jittered",
+            float(np.median(fft)),
+        )
+    )
+    figs.append(
+        Figure(
+            BENCH,
+            "period_error_pct_descriptor_all_jittered_worst",
+            float(np.max(desc)),
+            "%",
+            "period_error_pct_fft_all_jittered_worst",
+            float(np.max(fft)),
+        )
+    )
     return figs

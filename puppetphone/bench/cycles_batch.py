@@ -53,8 +53,9 @@ def write_takes(folder: Path, count: int = TAKES, seed: int = 0) -> list[Path]:
             values = mixed_take(60, rng, fps=120.0)[0].values
         else:
             dims = (60, 120, 175, 240)[i % 4]
-            values = make_performance(dims, rng, cycles=int(rng.integers(5, 9)), period=float(rng.uniform(0.7, 1.4)),
-                                      fps=120.0).trajectory.values
+            values = make_performance(
+                dims, rng, cycles=int(rng.integers(5, 9)), period=float(rng.uniform(0.7, 1.4)), fps=120.0
+            ).trajectory.values
         path = folder / f"take_{i:03d}.npz"
         np.savez(path, values=values, fps=np.float64(120.0))
         paths.append(path)
@@ -86,8 +87,16 @@ def run() -> list[Figure]:
         baseline = 1.0 / float(np.median(per_take))
         figs = [Figure(BENCH, "cycles_per_s_cli_loop", baseline, "takes/s")]
         for name, extra in (("serial", ["--jobs", "1"]), ("pool2", ["--jobs", "2"])):
-            figs.append(Figure(BENCH, f"cycles_per_s_{name}", _batch_rate(work / "takes", work, extra), "takes/s",
-                               BASELINE, baseline))
+            figs.append(
+                Figure(
+                    BENCH,
+                    f"cycles_per_s_{name}",
+                    _batch_rate(work / "takes", work, extra),
+                    "takes/s",
+                    BASELINE,
+                    baseline,
+                )
+            )
         dask = _dask_rate(work)
         if dask is not None:
             figs.append(Figure(BENCH, "cycles_per_s_dask2", dask, "takes/s", BASELINE, baseline))

@@ -46,8 +46,9 @@ class Figure:
         return s
 
 
-def median_time(fn: Callable[[], Any], repeats: int = 15, min_time: float = 0.05,
-                clock: Callable[[], float] = time.perf_counter) -> float:
+def median_time(
+    fn: Callable[[], Any], repeats: int = 15, min_time: float = 0.05, clock: Callable[[], float] = time.perf_counter
+) -> float:
     """Median seconds per call of ``fn`` over ``repeats`` samples, each at least ``min_time`` long.
 
     ``clock`` is wall time by default; ``time.thread_time`` gives CPU time, which other people's

@@ -7,10 +7,10 @@ import time
 
 import numpy as np
 
-from puppetphone.bench.figures import Figure, median_time
 from engine import jit, quat
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "per_joint_fk"]
 
@@ -46,6 +46,7 @@ def run() -> list[Figure]:
     if jit.enabled():
         with jit.use(False):
             numpy_path = median_time(lambda: forward_kinematics(sk, roots, rots), clock=clock)
-        figures.append(Figure("fk", "fk_100_puppets_ms_compiled", batched * 1e3, "ms", "numpy levels, same run",
-                              numpy_path * 1e3))
+        figures.append(
+            Figure("fk", "fk_100_puppets_ms_compiled", batched * 1e3, "ms", "numpy levels, same run", numpy_path * 1e3)
+        )
     return figures

@@ -45,15 +45,15 @@ from authoring.flow_tool import FlowTool
 from authoring.flowcurves.deform import ITERATIONS, SceneDeformer
 from authoring.flowcurves.principal import principal_curve
 from authoring.flowcurves.securves import SECurve
+from games.snowman.bent_scenery import flow_scene
 from puppetphone.bench.figures import Figure, median_time
 from puppetphone.bench.flow_drag import drag_figures
 from puppetphone.bench.flow_mesh import lean_stroke, mesh_tree_problem
 from puppetphone.bench.flow_mesh import run as mesh_figures
-from games.snowman.bent_scenery import flow_scene
 
 __all__ = ["run", "field_problem", "THESIS_EDITS", "perform"]
 
-Op = tuple  # type: ignore[type-arg]  # a tool operation: ("press", x, y, shift) / ("move", x, y) / ("release", x, y) / ("key", name, ctrl)
+Op = tuple
 
 
 def _drag(points: list[tuple[float, float]]) -> list[list[Op]]:
@@ -113,13 +113,27 @@ def run() -> list[Figure]:
     dense = median_time(lambda: system.solve(hard, soft[0], ITERATIONS, dense=True), repeats=3, min_time=0.0) * 1e3
     cpu = _cpu_median(lambda: system.solve(hard, soft[next(steps) % 8], ITERATIONS))
     deformer._cache = None
-    factor = median_time(lambda: (setattr(deformer, "_cache", None), deformer._system(
-        list(offsets), [(o, seg.c[owners == o]) for seg, owners, _ in taken[0] for o in sorted(set(owners.tolist()))])),
-        repeats=5, min_time=0.0) * 1e3
-    return [Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system", dense),
-            Figure("flow", "flow_solve_cpu_ms_40_objects", cpu, "ms", "its wall time (shared cores)", solve),
-            Figure("flow", "flow_factor_ms_40_objects", factor, "ms", "one prefactored solve", solve),
-            *_scripted_edits(scene), *mesh_figures()]
+    factor = (
+        median_time(
+            lambda: (
+                setattr(deformer, "_cache", None),
+                deformer._system(
+                    list(offsets),
+                    [(o, seg.c[owners == o]) for seg, owners, _ in taken[0] for o in sorted(set(owners.tolist()))],
+                ),
+            ),
+            repeats=5,
+            min_time=0.0,
+        )
+        * 1e3
+    )
+    return [
+        Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system", dense),
+        Figure("flow", "flow_solve_cpu_ms_40_objects", cpu, "ms", "its wall time (shared cores)", solve),
+        Figure("flow", "flow_factor_ms_40_objects", factor, "ms", "one prefactored solve", solve),
+        *_scripted_edits(scene),
+        *mesh_figures(),
+    ]
 
 
 def _cpu_median(fn, repeats: int = 15) -> float:  # type: ignore[no-untyped-def]
@@ -148,11 +162,25 @@ def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
         while session.frame < activity.script_end:
             session.step()
         out.append(Figure("flow", f"flow_ops_{label}", activity.clicks, "operations per edit"))  # no human baseline
-        out.append(Figure("flow", f"flow_update_ms_{label}", float(np.median(activity.solve_ms)), "ms",
-                          "one frame at 60 Hz", 1000.0 / 60.0))
+        out.append(
+            Figure(
+                "flow",
+                f"flow_update_ms_{label}",
+                float(np.median(activity.solve_ms)),
+                "ms",
+                "one frame at 60 Hz",
+                1000.0 / 60.0,
+            )
+        )
     grouping = FlowTool(FlowSession(flow_scene(), securves=securves), None)
-    out.append(Figure("flow", "flow_ops_fig3_6_grouping", perform(grouping, THESIS_EDITS["fig3_6_grouping"]),
-                      "operations per edit"))
+    out.append(
+        Figure(
+            "flow",
+            "flow_ops_fig3_6_grouping",
+            perform(grouping, THESIS_EDITS["fig3_6_grouping"]),
+            "operations per edit",
+        )
+    )
     tree, tree_securves = mesh_tree_problem()
     stroke = FlowTool(FlowSession(tree, securves=tree_securves), None)
     ops = perform(stroke, _drag([(float(x), float(y)) for x, y in lean_stroke(tree_securves[0].points)]))

@@ -52,9 +52,29 @@ def drag_figures(scene, securves) -> list[Figure]:  # type: ignore[no-untyped-de
     net_warm = [_timed(lambda p=p: network.move(p, warm=True)) for p in path]
     net_cold = [_timed(lambda p=p: FlowNetwork.build(spines, p, width)) for p in path]
     warm_ms, cold_ms = np.median(warm, axis=0), np.median(cold, axis=0)  # [wall, cpu]
-    return [Figure("flow", "flow_drag_update_ms", float(warm_ms[0]), "ms",
-                   "the same update, network rebuilt cold", float(cold_ms[0])),
-            Figure("flow", "flow_drag_update_cpu_ms", float(warm_ms[1]), "ms",
-                   "the same update, network rebuilt cold (CPU)", float(cold_ms[1])),
-            Figure("flow", "flow_drag_network_ms", float(np.median(net_warm, axis=0)[0]), "ms",
-                   "a cold network build at the same points", float(np.median(net_cold, axis=0)[0]))]
+    return [
+        Figure(
+            "flow",
+            "flow_drag_update_ms",
+            float(warm_ms[0]),
+            "ms",
+            "the same update, network rebuilt cold",
+            float(cold_ms[0]),
+        ),
+        Figure(
+            "flow",
+            "flow_drag_update_cpu_ms",
+            float(warm_ms[1]),
+            "ms",
+            "the same update, network rebuilt cold (CPU)",
+            float(cold_ms[1]),
+        ),
+        Figure(
+            "flow",
+            "flow_drag_network_ms",
+            float(np.median(net_warm, axis=0)[0]),
+            "ms",
+            "a cold network build at the same points",
+            float(np.median(net_cold, axis=0)[0]),
+        ),
+    ]

@@ -43,8 +43,9 @@ def mesh_tree_problem(size: tuple[int, int] = (640, 480)):  # type: ignore[no-un
     from games.tasbada.flow_scene import crystal_tree
 
     data = [{"name": "tree", "group": "tree", "primitives": [], "mesh": crystal_tree([0.0, 0.0, 0.0], 2.2, 0.4, 0)}]
-    scene = scene_from_data("mesh-tree", data, OrbitCamera(target=np.array([0.0, 1.25, 0.0]), yaw=0.0, pitch=0.05,
-                                                            distance=4.2), size)
+    scene = scene_from_data(
+        "mesh-tree", data, OrbitCamera(target=np.array([0.0, 1.25, 0.0]), yaw=0.0, pitch=0.05, distance=4.2), size
+    )
     spine = principal_curve(rasterize(scene.objects[0], scene.camera, scene.size).pixels()).sample(48)
     return scene, [SECurve(spine, False, "principal", [0], spine)]
 
@@ -103,15 +104,28 @@ def run() -> list[Figure]:
     scene, session = bend()
     rest, moved = scene.objects[0].mesh, session.objects[0].mesh
     up = np.array([0.0, 1.0, 0.0])
-    tilt = max(base_tilt_deg(o.mesh.vertices, b.mesh.vertices, up)
-               for o, b in zip(scene.objects, session.objects) if o.mesh is not None and b.mesh is not None)
-    shift = np.linalg.norm(scene.camera.project(moved.vertices, *scene.size)
-                           - scene.camera.project(rest.vertices, *scene.size), axis=1)
+    tilt = max(
+        base_tilt_deg(o.mesh.vertices, b.mesh.vertices, up)
+        for o, b in zip(scene.objects, session.objects)
+        if o.mesh is not None and b.mesh is not None
+    )
+    shift = np.linalg.norm(
+        scene.camera.project(moved.vertices, *scene.size) - scene.camera.project(rest.vertices, *scene.size), axis=1
+    )
     top = float(shift[int(np.argmax(rest.vertices[:, 1]))])
     _, hard = bend(HARD_WEIGHT)
-    return [Figure("flow", "flow_mesh_contact_error_px", contact_error_px(scene, session.objects), "px",
-                   "the goal: 1 px", 1.0),
-            Figure("flow", "flow_mesh_base_tilt_deg_max", tilt, "deg", "the stated limit", MAX_BASE_TILT_DEG),
-            Figure("flow", "flow_mesh_bend_px", top, "px"),
-            Figure("flow", "flow_shape_residual_p90_px", float(np.percentile(shape_residuals(session), 90)), "px",
-                   "the constraints made hard", float(np.percentile(shape_residuals(hard), 90)))]
+    return [
+        Figure(
+            "flow", "flow_mesh_contact_error_px", contact_error_px(scene, session.objects), "px", "the goal: 1 px", 1.0
+        ),
+        Figure("flow", "flow_mesh_base_tilt_deg_max", tilt, "deg", "the stated limit", MAX_BASE_TILT_DEG),
+        Figure("flow", "flow_mesh_bend_px", top, "px"),
+        Figure(
+            "flow",
+            "flow_shape_residual_p90_px",
+            float(np.percentile(shape_residuals(session), 90)),
+            "px",
+            "the constraints made hard",
+            float(np.percentile(shape_residuals(hard), 90)),
+        ),
+    ]

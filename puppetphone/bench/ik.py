@@ -34,7 +34,6 @@ import time
 
 import numpy as np
 
-from puppetphone.bench.figures import Figure, median_time
 from engine import quat
 from engine.components import LocalPose, Puppet
 from engine.ecs import World
@@ -54,6 +53,7 @@ from engine.ik import (
 )
 from engine.pose import Pose
 from engine.skeleton import Skeleton
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "chain_skeleton", "chain_targets"]
 
@@ -106,7 +106,7 @@ def _tip(sk: Skeleton, root: np.ndarray, rot: np.ndarray) -> np.ndarray:
 def _ours(dof: int, pins: int) -> tuple[float, float, float, float, list[tuple[np.ndarray, np.ndarray]], IKRig]:
     joints = dof // 3
     sk = chain_skeleton(joints)
-    rig = IKRig.build(sk, limits={name: (-LIMIT, LIMIT) for name in sk.names})
+    rig = IKRig.build(sk, limits=dict.fromkeys(sk.names, (-LIMIT, LIMIT)))
     pj = pin_joints(joints, pins)
     cases = chain_targets(rig, pj, TARGETS, seed=dof * 10 + pins)
     times, errors, drifts, reached = [], [], [], 0
@@ -129,7 +129,9 @@ def _ours(dof: int, pins: int) -> tuple[float, float, float, float, list[tuple[n
     return ms, err, float(np.median(drifts)) * 1e3, 100.0 * reached / len(cases), cases, rig
 
 
-def _pink(rig: IKRig, pins: int, cases: list[tuple[np.ndarray, np.ndarray]], ours: tuple[float, float, float]) -> list[Figure]:
+def _pink(
+    rig: IKRig, pins: int, cases: list[tuple[np.ndarray, np.ndarray]], ours: tuple[float, float, float]
+) -> list[Figure]:
     """pink + daqp on the same chain and targets (nothing, with the reason printed, when not installed)."""
     import sys
 
@@ -247,7 +249,9 @@ def run() -> list[Figure]:
             figures.append(Figure("ik", f"ik_error_mm_{tag}", err_mm, "mm", "tolerance", 0.1))
             if pins:
                 # The band of Eq. 4.11 is ε = 0.1 mm per component, so a pin may drift √3·ε in distance.
-                figures.append(Figure("ik", f"ik_pin_error_mm_{tag}", drift_mm, "mm", "ε band bound √3·ε", 0.1 * 3**0.5))
+                figures.append(
+                    Figure("ik", f"ik_pin_error_mm_{tag}", drift_mm, "mm", "ε band bound √3·ε", 0.1 * 3**0.5)
+                )
             if dof == 168 and pins == 3:
                 figures.extend(_pink(rig, pins, cases, (ms, err_mm, drift_mm)))
             figures.append(Figure("ik", f"ik_reached_pct_{tag}", pct, "%"))

@@ -52,7 +52,12 @@ def _model(joints: int, link: float, tip: np.ndarray, limit: float):  # type: ig
 
 
 def pink_chain(
-    joints: int, link: float, tip: np.ndarray, limit: float, pins: list[int], cases: list[tuple[np.ndarray, np.ndarray]],
+    joints: int,
+    link: float,
+    tip: np.ndarray,
+    limit: float,
+    pins: list[int],
+    cases: list[tuple[np.ndarray, np.ndarray]],
     repeats: int = 1,
 ) -> tuple[float, float, float]:
     """``(median ms, median tip error mm, median worst pin drift mm)`` over ``cases``.
@@ -61,8 +66,8 @@ def pink_chain(
     model, limits, tasks and the pink ``Configuration`` (whose construction alone takes ~0.2 s
     here) are built outside the timing, as our rig is; a timed run starts at ``update(q0)``.
     """
-    import pinocchio as pin
     import pink
+    import pinocchio as pin
     from pink.limits import ConfigurationLimit
     from pink.tasks import FrameTask
 

@@ -26,9 +26,9 @@ def measure(steps: int = 240, dt: float = 1.0 / 60.0) -> np.ndarray:
 
     from engine.app import App
     from engine.components import Stick
+    from engine.pacing import RealTimePacer
     from input.hub import InputHub
     from input.osc import OscSource
-    from engine.pacing import RealTimePacer
     from input.plugin import install_input
     from input.sample import InputFrame
 

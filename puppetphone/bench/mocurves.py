@@ -17,9 +17,9 @@ from scipy.optimize import minimize
 
 from authoring.mocurves.contact import plane_from_stroke, solve_contacts
 from authoring.mocurves.timewarp import W_SOFT, W_STRONG, TimeWarp, _energy_rows
-from puppetphone.bench.figures import Figure, median_time
 from engine.clips import default_clips
 from engine.fk import forward_kinematics
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "slsqp_timewarp"]
 
@@ -56,7 +56,7 @@ def run() -> list[Figure]:
         warp = TimeWarp(n, 1.0)
         warp.solve(_drag(n))
         steps = iter(range(1, 10**9))
-        warm = median_time(lambda n=n, warp=warp: warp.solve(_drag(n, next(steps) % 20)), repeats=9) * 1e3
+        warm = median_time(lambda n=n, warp=warp, steps=steps: warp.solve(_drag(n, next(steps) % 20)), repeats=9) * 1e3
         base, base_value = ("scipy SLSQP, same QP", slsqp_ms) if n == 120 else ("goal at 120 keypoints", GOAL_MS)
         figures.append(Figure("mocurves", f"timewarp_ms_{n}", cold, "ms", base, base_value))
         figures.append(Figure("mocurves", f"timewarp_warm_ms_{n}", warm, "ms", "cold solve", cold))

@@ -55,8 +55,9 @@ def run() -> list[Figure]:
                 Figure(BENCH, f"{key}_fell", float(new.fell), "", "legacy controller", float(old.fell)),
             ]
             if new.time_to_90 is not None:
-                figs.append(Figure(BENCH, f"{key}_time_to_90", new.time_to_90, "s", "legacy controller",
-                                   old.time_to_90))
+                figs.append(
+                    Figure(BENCH, f"{key}_time_to_90", new.time_to_90, "s", "legacy controller", old.time_to_90)
+                )
             if new.time_to_rest is not None:
                 figs.append(Figure(BENCH, f"{key}_time_to_rest", new.time_to_rest, "s"))
             if character is not None:
@@ -73,8 +74,14 @@ def run() -> list[Figure]:
         apex = [r.apex_error for r in new if r.apex_error is not None]
         delay = [r.takeoff_delay for r in new if r.takeoff_delay is not None]
         figs += [
-            Figure(BENCH, f"{device}_jump_landed_pct", 100.0 * np.mean([r.landed for r in new]), "%",
-                   "legacy controller", 100.0 * np.mean([r.landed for r in old])),
+            Figure(
+                BENCH,
+                f"{device}_jump_landed_pct",
+                100.0 * np.mean([r.landed for r in new]),
+                "%",
+                "legacy controller",
+                100.0 * np.mean([r.landed for r in old]),
+            ),
             Figure(BENCH, f"{device}_jump_apex_error", float(np.max(apex)) if apex else float("nan"), "m"),
             Figure(BENCH, f"{device}_jump_takeoff_s", float(np.median(delay)) if delay else float("nan"), "s"),
         ]
@@ -85,8 +92,8 @@ def _character() -> dict[str, object] | None:
     """CesiumMan as a ``play --character`` set-up value, or ``None`` (said in one line) without the data."""
     import sys
 
-    from puppetphone.bench.render_skinned import character_file
     from engine.character.setup import character_setup
+    from puppetphone.bench.render_skinned import character_file
 
     path = character_file()
     if path is None:

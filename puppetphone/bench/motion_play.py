@@ -47,8 +47,20 @@ from input.mouse import MouseSource
 from input.sample import PoseSample
 from input.source import PoseSource
 
-__all__ = ["Case", "CASES", "straight", "Run", "drive", "motion_figures", "MotionFigures", "blend_alone_slide",
-           "JumpResult", "jump", "DEVICES", "CONTROLLERS"]
+__all__ = [
+    "Case",
+    "CASES",
+    "straight",
+    "Run",
+    "drive",
+    "motion_figures",
+    "MotionFigures",
+    "blend_alone_slide",
+    "JumpResult",
+    "jump",
+    "DEVICES",
+    "CONTROLLERS",
+]
 
 F = NDArray[np.float64]
 DEVICES = ("phone", "mouse")
@@ -136,8 +148,9 @@ class _Phone(PoseSource):
 class _Driver:
     """The sandbox with one puppet and one scripted device, stepping and recording."""
 
-    def __init__(self, device: str, controller: str, seed: int = 0, fps: float = 60.0,
-                 character: dict[str, object] | None = None) -> None:
+    def __init__(
+        self, device: str, controller: str, seed: int = 0, fps: float = 60.0, character: dict[str, object] | None = None
+    ) -> None:
         from puppetphone.games import load_game, make_app
 
         if device not in DEVICES or controller not in CONTROLLERS:
@@ -175,8 +188,16 @@ class _Driver:
     # -- devices ------------------------------------------------------------------
     def _phone_sample(self, t: float, touch: bool | None = None, calibrate: bool = False) -> None:
         position = self.offset + np.array([0.0, self.lift, 0.0])
-        self.source.push(PoseSample(time=t, source="phone", orientation=self.orientation, position=position,
-                                    touch=touch, calibrate=calibrate))
+        self.source.push(
+            PoseSample(
+                time=t,
+                source="phone",
+                orientation=self.orientation,
+                position=position,
+                touch=touch,
+                calibrate=calibrate,
+            )
+        )
 
     def _mouse_event(self, kind: int, t: float, **attrs: object) -> None:
         """Hand a mouse event to the source at its event time, or, drawing slowly (``burst`` steps
@@ -271,12 +292,23 @@ class _Driver:
     def result(self) -> Run:
         """The steps recorded since the grab."""
         rows = self._rows
-        return Run(self.world.dt, np.array([r[0] for r in rows]), np.array([r[1] for r in rows]),
-                   np.array([r[2] for r in rows]), [r[3] for r in rows], [r[4] for r in rows])
+        return Run(
+            self.world.dt,
+            np.array([r[0] for r in rows]),
+            np.array([r[1] for r in rows]),
+            np.array([r[2] for r in rows]),
+            [r[3] for r in rows],
+            [r[4] for r in rows],
+        )
 
 
-def drive(case: Case, device: str = "phone", controller: str = "spring", settle: float = 1.0,
-          character: dict[str, object] | None = None) -> Run:
+def drive(
+    case: Case,
+    device: str = "phone",
+    controller: str = "spring",
+    settle: float = 1.0,
+    character: dict[str, object] | None = None,
+) -> Run:
     """Play ``case`` with ``device`` and the given locomotion ``controller``; keep ``settle`` s after it.
     ``character`` (an :mod:`engine.character.setup` value) plays it with that character as the puppet."""
     d = _Driver(device, controller, character=character)
@@ -382,8 +414,15 @@ def _mouse_flick(t: float) -> float:
 Gesture = Callable[[float, F], tuple[F, float]]
 
 
-def jump(speed: float, device: str = "phone", controller: str = "spring",
-         gesture: Gesture | None = None, run_up: float = 1.5, after: float = 1.6, fps: float = 60.0) -> JumpResult:
+def jump(
+    speed: float,
+    device: str = "phone",
+    controller: str = "spring",
+    gesture: Gesture | None = None,
+    run_up: float = 1.5,
+    after: float = 1.6,
+    fps: float = 60.0,
+) -> JumpResult:
     """Walk or run at ``speed`` m/s for ``run_up`` s, flick, and keep going for ``after`` s.
 
     ``gesture(t, ground) -> (ground, lift)`` changes the stick from the flick on (``t`` s
@@ -409,7 +448,7 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
     fell = PuppetState.RAGDOLL in states
     reason = next((j.invalid.value for j in run.jumps if j.invalid is not None), None)
     jumped = [i for i, s in enumerate(states) if s == PuppetState.JUMP]
-    landed = bool(jumped) and PuppetState.LAND in states[jumped[0]:] and not fell
+    landed = bool(jumped) and PuppetState.LAND in states[jumped[0] :] and not fell
     apex_error = delay = None
     if jumped:
         air = [i for i in jumped if run.jumps[i].progress is not None]
@@ -423,5 +462,13 @@ def jump(speed: float, device: str = "phone", controller: str = "spring",
     if len(land) > 1:
         span = run.position[land[-1]] - run.position[land[0]]
         landing_speed = float(np.hypot(span[0], span[2]) / ((land[-1] - land[0]) * dt))
-    return JumpResult(landed, reason if fell else None, apex_error, delay, states, landing_speed,
-                      [float(p[1]) for p in run.position], d.airborne)
+    return JumpResult(
+        landed,
+        reason if fell else None,
+        apex_error,
+        delay,
+        states,
+        landing_speed,
+        [float(p[1]) for p in run.position],
+        d.airborne,
+    )

@@ -24,12 +24,12 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from puppetphone.bench.figures import Figure, median_time
 from engine import jit, quat
 from engine.blend.puppet import puppet_locomotion
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
 from engine.skeleton import Skeleton
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "cpu_time", "pinocchio_model", "REPEATS"]
 
@@ -89,13 +89,22 @@ def run() -> list[Figure]:
                 pin.forwardKinematics(model, data, q)
 
         theirs_us = cpu_time(pin_fk) * 1e6
-        figures.append(Figure(_BENCH, "peer_fk_100_puppets_us", ours * 1e6, "us", "pinocchio forwardKinematics x100",
-                              theirs_us))
+        figures.append(
+            Figure(_BENCH, "peer_fk_100_puppets_us", ours * 1e6, "us", "pinocchio forwardKinematics x100", theirs_us)
+        )
         if jit.enabled():  # the pure-numpy twin of our kernel beside the same peer
             with jit.use(False):
                 ours_numpy = cpu_time(lambda: forward_kinematics(sk, roots, rots))
-            figures.append(Figure(_BENCH, "peer_fk_100_puppets_us_numpy", ours_numpy * 1e6, "us",
-                                  "pinocchio forwardKinematics x100", theirs_us))
+            figures.append(
+                Figure(
+                    _BENCH,
+                    "peer_fk_100_puppets_us_numpy",
+                    ours_numpy * 1e6,
+                    "us",
+                    "pinocchio forwardKinematics x100",
+                    theirs_us,
+                )
+            )
     table = puppet_locomotion().table
     tree = cKDTree(table._scaled_values)
     k, power = min(table.neighbours, len(table.probes)), table.power
@@ -110,6 +119,14 @@ def run() -> list[Figure]:
     many = lo + rng.random((puppets, len(lo))) * (hi - lo)
     one = many[0]
     for name, u in (("peer_lookup_1_us", one), ("peer_lookup_100_us", many)):
-        figures.append(Figure(_BENCH, name, cpu_time(lambda u=u: table.query(u)) * 1e6, "us",
-                              "SciPy cKDTree query + textbook IDW", cpu_time(lambda u=u: textbook(u)) * 1e6))
+        figures.append(
+            Figure(
+                _BENCH,
+                name,
+                cpu_time(lambda u=u: table.query(u)) * 1e6,
+                "us",
+                "SciPy cKDTree query + textbook IDW",
+                cpu_time(lambda u=u: textbook(u)) * 1e6,
+            )
+        )
     return figures

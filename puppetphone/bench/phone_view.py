@@ -77,8 +77,14 @@ def stream_bytes(demo_steps: int = 1800, crowd_steps: int = 600) -> dict[str, fl
     s_coded, s_raw, s_puppets = _stream_cost(app, draw_snowman_state, min(demo_steps, len(rec.frames)))
     crowd = make_app("sandbox", 1, InputHub(), {"puppets": 50})
     c_coded, c_raw, puppets = _stream_cost(crowd, draw_world, crowd_steps)
-    return {"snowman_coded": s_coded, "snowman_raw": s_raw, "snowman_puppets": float(s_puppets),
-            "crowd_coded": c_coded, "crowd_raw": c_raw, "crowd_puppets": float(puppets)}
+    return {
+        "snowman_coded": s_coded,
+        "snowman_raw": s_raw,
+        "snowman_puppets": float(s_puppets),
+        "crowd_coded": c_coded,
+        "crowd_raw": c_raw,
+        "crowd_puppets": float(puppets),
+    }
 
 
 @dataclass(frozen=True)
@@ -100,11 +106,11 @@ class PageLatency:
 
 def page_latency(steps: int = 600) -> PageLatency:
     """Publication → receipt, decoding, availability and first drawing of each step on the page, and its fps."""
-    from puppetphone.bench.chromium import Chromium
     from engine.pacing import RealTimePacer
     from input.hub import InputHub
     from input.web.cert import load_or_create
     from input.web.server import WebSource
+    from puppetphone.bench.chromium import Chromium
     from puppetphone.session import build_activity
 
     with tempfile.TemporaryDirectory(prefix="pp-view-bench-") as folder:
@@ -136,8 +142,17 @@ def page_latency(steps: int = 600) -> PageLatency:
     published = {int(row[0]): row[1] for row in received}
     late = np.array([row for row in received if row[0] > 120])
     draw = np.array([t - published[s] for s, t in drawn if s in published and s > 120])
-    return PageLatency(late[:, 2] - late[:, 1], late[:, 3] - late[:, 1], late[:, 4] - late[:, 1], draw,
-                       float(np.median(fps[-3:])), resolution, int(frames), steps, str(where))
+    return PageLatency(
+        late[:, 2] - late[:, 1],
+        late[:, 3] - late[:, 1],
+        late[:, 4] - late[:, 1],
+        draw,
+        float(np.median(fps[-3:])),
+        resolution,
+        int(frames),
+        steps,
+        str(where),
+    )
 
 
 def client_latency(steps: int = 600) -> np.ndarray:
@@ -202,14 +217,38 @@ def run() -> list[Figure]:
     b = stream_bytes()
     per_s = 60.0
     figures = [
-        Figure("phone-view", "snowman_stream_kb_per_s", b["snowman_coded"] * per_s / 1000, "KB/s",
-               "raw float32 rows (straw man)", b["snowman_raw"] * per_s / 1000),
-        Figure("phone-view", "snowman_bytes_per_puppet_step", b["snowman_coded"] / b["snowman_puppets"], "B",
-               "raw float32 rows (straw man)", b["snowman_raw"] / b["snowman_puppets"]),
-        Figure("phone-view", "crowd50_stream_kb_per_s", b["crowd_coded"] * per_s / 1000, "KB/s",
-               "raw float32 rows (straw man)", b["crowd_raw"] * per_s / 1000),
-        Figure("phone-view", "crowd50_bytes_per_puppet_step", b["crowd_coded"] / b["crowd_puppets"], "B",
-               "raw float32 rows (straw man)", b["crowd_raw"] / b["crowd_puppets"]),
+        Figure(
+            "phone-view",
+            "snowman_stream_kb_per_s",
+            b["snowman_coded"] * per_s / 1000,
+            "KB/s",
+            "raw float32 rows (straw man)",
+            b["snowman_raw"] * per_s / 1000,
+        ),
+        Figure(
+            "phone-view",
+            "snowman_bytes_per_puppet_step",
+            b["snowman_coded"] / b["snowman_puppets"],
+            "B",
+            "raw float32 rows (straw man)",
+            b["snowman_raw"] / b["snowman_puppets"],
+        ),
+        Figure(
+            "phone-view",
+            "crowd50_stream_kb_per_s",
+            b["crowd_coded"] * per_s / 1000,
+            "KB/s",
+            "raw float32 rows (straw man)",
+            b["crowd_raw"] * per_s / 1000,
+        ),
+        Figure(
+            "phone-view",
+            "crowd50_bytes_per_puppet_step",
+            b["crowd_coded"] / b["crowd_puppets"],
+            "B",
+            "raw float32 rows (straw man)",
+            b["crowd_raw"] / b["crowd_puppets"],
+        ),
     ]
     net = client_latency()
     figures += [
@@ -221,13 +260,28 @@ def run() -> list[Figure]:
         return figures
     lat = page_latency()
     out = []
-    for name, values in (("page_decoded", lat.decoded_ms), ("page_available", lat.available_ms),
-                         ("page_drawn", lat.drawn_ms)):
+    for name, values in (
+        ("page_decoded", lat.decoded_ms),
+        ("page_available", lat.available_ms),
+        ("page_drawn", lat.drawn_ms),
+    ):
         for q in (50, 99):
-            out.append(Figure("phone-view", f"step_to_{name}_p{q}_ms", float(np.percentile(values, q)), "ms",
-                              "two steps", 2 * STEP_MS))
-    return figures + out + [
-        Figure("phone-view", "page_fps_390x844", lat.fps, "fps", "goal", 30.0),
-        Figure("phone-view", "page_resolution_scale", lat.resolution, "ratio", "full resolution", 1.0),
-        Figure("phone-view", "frames_sent_per_step", lat.frames / lat.steps, "ratio", "one per step", 1.0),
-    ]
+            out.append(
+                Figure(
+                    "phone-view",
+                    f"step_to_{name}_p{q}_ms",
+                    float(np.percentile(values, q)),
+                    "ms",
+                    "two steps",
+                    2 * STEP_MS,
+                )
+            )
+    return (
+        figures
+        + out
+        + [
+            Figure("phone-view", "page_fps_390x844", lat.fps, "fps", "goal", 30.0),
+            Figure("phone-view", "page_resolution_scale", lat.resolution, "ratio", "full resolution", 1.0),
+            Figure("phone-view", "frames_sent_per_step", lat.frames / lat.steps, "ratio", "one per step", 1.0),
+        ]
+    )

@@ -32,9 +32,9 @@ Problem = tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
 def _ik_problems() -> list[Problem]:
     """``(group, H, f, A, blo, bhi, lo, hi)`` of every IK step QP (dense form)."""
     import engine.ik.qp as ikqp
-    from puppetphone.bench.ik import LIMIT, TIP, chain_skeleton, chain_targets, pin_joints
     from engine import quat
     from engine.ik import Effector, IKRig, Pin, solve_ik
+    from puppetphone.bench.ik import LIMIT, TIP, chain_skeleton, chain_targets, pin_joints
 
     rec: list[Problem] = []
     orig = ikqp.StepQP.solve
@@ -47,7 +47,7 @@ def _ik_problems() -> list[Problem]:
         return orig(self, w, diag, js, ds, jr, blo, bhi, lo, hi)
 
     sk = chain_skeleton(56)
-    rig = IKRig.build(sk, limits={n: (-LIMIT, LIMIT) for n in sk.names})
+    rig = IKRig.build(sk, limits=dict.fromkeys(sk.names, (-LIMIT, LIMIT)))
     pj = pin_joints(56, 3)
     ikqp.StepQP.solve = spy  # type: ignore[method-assign]
     try:
@@ -99,7 +99,17 @@ def _proxsuite(probs: list[Problem]) -> list[np.ndarray]:
     for key, h, f, a, blo, bhi, lo, hi in probs:
         n, m = len(f), a.shape[0]
         big = 1e20
-        args = (h, f, None, None, a, np.maximum(blo, -big), np.minimum(bhi, big), np.maximum(lo, -big), np.minimum(hi, big))
+        args = (
+            h,
+            f,
+            None,
+            None,
+            a,
+            np.maximum(blo, -big),
+            np.minimum(bhi, big),
+            np.maximum(lo, -big),
+            np.minimum(hi, big),
+        )
         if key != cur:
             qp, cur = proxsuite.proxqp.dense.QP(n, 0, m, True), key
             qp.settings.eps_abs = 1e-6

@@ -14,7 +14,6 @@ import time
 
 import numpy as np
 
-from puppetphone.bench.figures import Figure, median_time
 from engine import quat
 from engine.app import App
 from engine.clip import Clip
@@ -22,6 +21,7 @@ from engine.components import LocalPose, Puppet
 from engine.ecs import World
 from engine.humanoid import humanoid_skeleton
 from engine.ragdoll import PhysicsWorld, Ragdoll, RagdollMode, default_profile, install_physics
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run"]
 
@@ -98,8 +98,16 @@ def run() -> list[Figure]:
         t0 = time.perf_counter()
         app.step()
         rebuild.append(time.perf_counter() - t0)
-    figures.append(Figure(BENCH, "ragdoll_add_ms", float(np.median(rebuild)) * 1e3, "ms",
-                          "one step of 10 active ragdolls", figures[-1].value))
+    figures.append(
+        Figure(
+            BENCH,
+            "ragdoll_add_ms",
+            float(np.median(rebuild)) * 1e3,
+            "ms",
+            "one step of 10 active ragdolls",
+            figures[-1].value,
+        )
+    )
     figures.append(Figure(BENCH, "ragdoll_track_error_deg", _tracking_error(clip), "deg"))
     assert pw.rebuilds >= 6
     return figures

@@ -46,8 +46,15 @@ WIDTH, HEIGHT = 1280, 720
 _ROW = 10  # puppets per row of the scene (seven stand in one row, a crowd of fifty in five)
 CROWD = 50
 BIG_CROWD = 100
-COLORS = ((0.85, 0.3, 0.25), (0.25, 0.5, 0.85), (0.3, 0.7, 0.35), (0.9, 0.7, 0.2), (0.6, 0.35, 0.75),
-          (0.2, 0.7, 0.7), (0.85, 0.5, 0.6))
+COLORS = (
+    (0.85, 0.3, 0.25),
+    (0.25, 0.5, 0.85),
+    (0.3, 0.7, 0.35),
+    (0.9, 0.7, 0.2),
+    (0.6, 0.35, 0.75),
+    (0.2, 0.7, 0.7),
+    (0.85, 0.5, 0.6),
+)
 
 
 def demo_scene(puppets: int = 7, snowballs: int = 20, seed: int = 1):  # type: ignore[no-untyped-def]
@@ -79,8 +86,9 @@ def demo_scene(puppets: int = 7, snowballs: int = 20, seed: int = 1):  # type: i
     scene.add_text("fps 60.0")
     scene.add_text("state: walk")
     rows = -(-puppets // per_row)
-    camera = OrbitCamera(target=np.array([0.0, 0.8, -0.65 * (rows - 1)]), yaw=0.35, pitch=0.28,
-                         distance=7.5 + 2.0 * (rows - 1))
+    camera = OrbitCamera(
+        target=np.array([0.0, 0.8, -0.65 * (rows - 1)]), yaw=0.35, pitch=0.28, distance=7.5 + 2.0 * (rows - 1)
+    )
     return scene, camera
 
 
@@ -153,8 +161,13 @@ def panda3d_peer() -> tuple[float, int] | str:
 
     if importlib.util.find_spec("panda3d") is None:
         return "render: [peers] Panda3D is not installed (pip install panda3d): render_fps_100_puppets vs 30 fps only"
-    done = subprocess.run([sys.executable, "-m", "puppetphone.bench.render_panda"], capture_output=True, text=True, timeout=900,
-                          check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "puppetphone.bench.render_panda"],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
     lines = done.stdout.split()
     if done.returncode != 0 or len(lines) < 2:
         return f"render: [peers] the Panda3D peer failed ({done.returncode}): {done.stderr.strip()[-200:]}"
@@ -180,13 +193,13 @@ def quality_figures() -> list[Figure]:
     """The issue's figures: the snowman frame per quality level, sky+ground vs a clear, 100 puppets at low."""
     import sys
 
-    from puppetphone.bench.snowman import loaded_app
     from engine.render.quality import QUALITIES
     from engine.render.renderer import Renderer
     from engine.render.scene import RenderScene
     from engine.render.target import make_target
     from games.snowman.game import GAME
     from input.hub import InputHub
+    from puppetphone.bench.snowman import loaded_app
     from puppetphone.overlay import draw_overlay
 
     app, hub = loaded_app(), InputHub()
@@ -226,15 +239,17 @@ def quality_figures() -> list[Figure]:
     figures = []
     try:
         t_clear, t_fill = cpu_frame_time(clear), cpu_frame_time(fill)
-        figures.append(Figure("render", "flat_fill_ms_1280x720", t_fill * 1e3, "ms", "clear of the screen",
-                              t_clear * 1e3))
+        figures.append(
+            Figure("render", "flat_fill_ms_1280x720", t_fill * 1e3, "ms", "clear of the screen", t_clear * 1e3)
+        )
         for name, quality in QUALITIES.items():
             renderer.set_quality(quality)
             t_game = cpu_frame_time(game_frame)
             t_env = cpu_frame_time(lambda: draw(empty, camera))
             figures.append(Figure("render", f"render_fps_snowman_{name}", 1.0 / t_game, "fps", "30 fps goal", 30.0))
-            figures.append(Figure("render", f"sky_ground_ms_{name}", t_env * 1e3, "ms", "clear of the screen",
-                                  t_clear * 1e3))
+            figures.append(
+                Figure("render", f"sky_ground_ms_{name}", t_env * 1e3, "ms", "clear of the screen", t_clear * 1e3)
+            )
         level = auto_level(renderer, game_frame)
         renderer.set_quality(QUALITIES[level])
         t_auto = cpu_frame_time(game_frame)
@@ -252,9 +267,16 @@ def quality_figures() -> list[Figure]:
         print(peer, file=sys.stderr)
         figures.append(Figure("render", f"render_fps_{BIG_CROWD}_puppets", 1.0 / t_crowd, "fps", "30 fps goal", 30.0))
     else:
-        figures.append(Figure("render", f"render_fps_{BIG_CROWD}_puppets", 1.0 / t_crowd, "fps",
-                              f"Panda3D, {BIG_CROWD} walking actors ({peer[1]} triangles, unlit, no shadows)",
-                              1.0 / peer[0]))
+        figures.append(
+            Figure(
+                "render",
+                f"render_fps_{BIG_CROWD}_puppets",
+                1.0 / t_crowd,
+                "fps",
+                f"Panda3D, {BIG_CROWD} walking actors ({peer[1]} triangles, unlit, no shadows)",
+                1.0 / peer[0],
+            )
+        )
         print("render: render_fps_100_puppets also against the 30 fps goal", file=sys.stderr)
     return figures
 

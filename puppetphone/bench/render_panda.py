@@ -27,10 +27,13 @@ def measure(actors: int = 100, frames: int = 5, repeats: int = 3) -> tuple[float
     """``(process CPU seconds per frame, triangles per frame)`` of ``actors`` walking pandas."""
     from direct.actor.Actor import Actor  # type: ignore[import-untyped]  # Panda3D ships no type stubs
     from direct.showbase.ShowBase import ShowBase  # type: ignore[import-untyped]  # (same)
-    from panda3d.core import loadPrcFileData  # type: ignore[import-untyped]  # (same)
+    from panda3d.core import loadPrcFileData
 
-    loadPrcFileData("", "window-type offscreen\nwin-size 1280 720\nload-display p3headlessgl\n"
-                        "audio-library-name null\ngl-finish true\nsync-video false\nnotify-level error\n")
+    loadPrcFileData(
+        "",
+        "window-type offscreen\nwin-size 1280 720\nload-display p3headlessgl\n"
+        "audio-library-name null\ngl-finish true\nsync-video false\nnotify-level error\n",
+    )
     base = ShowBase()
     per_row = 10
     triangles = 0
@@ -43,8 +46,12 @@ def measure(actors: int = 100, frames: int = 5, repeats: int = 3) -> tuple[float
         actor.reparentTo(base.render)
         actor.loop("walk", fromFrame=i % 7)
         if i == 0:
-            triangles = sum(g.getPrimitive(p).getNumFaces() for node in actor.findAllMatches("**/+GeomNode")
-                            for g in node.node().getGeoms() for p in range(g.getNumPrimitives()))
+            triangles = sum(
+                g.getPrimitive(p).getNumFaces()
+                for node in actor.findAllMatches("**/+GeomNode")
+                for g in node.node().getGeoms()
+                for p in range(g.getNumPrimitives())
+            )
     rows = -(-actors // per_row)
     centre_y, distance, pitch = 0.65 * (rows - 1), 7.5 + 2.0 * (rows - 1), 0.28
     base.camera.setPos(0.0, centre_y - distance * math.cos(pitch), 0.8 + distance * math.sin(pitch))

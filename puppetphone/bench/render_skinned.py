@@ -41,7 +41,6 @@ def run() -> list[Figure]:
     if path is None:
         print("render_skinned: CesiumMan.glb not found (set PUPPETPHONE_DATA): no skinned figures", file=sys.stderr)
         return []
-    from puppetphone.bench.render import cpu_frame_time
     from engine.camera import OrbitCamera
     from engine.fk import forward_kinematics
     from engine.io.gltf import read_gltf
@@ -53,6 +52,7 @@ def run() -> list[Figure]:
     from engine.render.scene import RenderScene, SkinnedInstance
     from engine.render.target import make_target
     from engine.skinning import SkinBinding
+    from puppetphone.bench.render import cpu_frame_time
 
     asset, meshes = read_gltf(path), read_skinned_meshes(path)
     clip = load_gltf_clips(path)[0]
@@ -78,8 +78,12 @@ def run() -> list[Figure]:
                 a, b, r, _ = puppet_capsules(puppet_clip.skeleton, ppos, prot)
                 mannequins.add_capsules(a, b, r, (0.8, 0.45, 0.35))
             rows = (n - 1) // _ROW + 1
-            camera = OrbitCamera(target=np.array([0.0, 0.8, -(rows - 1) * _SPACING / 2]), yaw=0.35, pitch=0.35,
-                                 distance=3.0 + 1.2 * min(n, _ROW) * _SPACING / 2 + rows * 0.6)
+            camera = OrbitCamera(
+                target=np.array([0.0, 0.8, -(rows - 1) * _SPACING / 2]),
+                yaw=0.35,
+                pitch=0.35,
+                distance=3.0 + 1.2 * min(n, _ROW) * _SPACING / 2 + rows * 0.6,
+            )
 
             def frame(scene: RenderScene, camera: OrbitCamera = camera) -> None:
                 renderer.render(scene, camera, target.begin())
@@ -88,8 +92,16 @@ def run() -> list[Figure]:
 
             t_skin = cpu_frame_time(lambda s=skinned: frame(s), frames=3 if n == 100 else 6)
             t_mann = cpu_frame_time(lambda s=mannequins: frame(s), frames=3 if n == 100 else 6)
-            figures.append(Figure("render", f"render_fps_skinned_{n}", 1.0 / t_skin, "fps",
-                                  f"{n} mannequins, same poses", 1.0 / t_mann))
+            figures.append(
+                Figure(
+                    "render",
+                    f"render_fps_skinned_{n}",
+                    1.0 / t_skin,
+                    "fps",
+                    f"{n} mannequins, same poses",
+                    1.0 / t_mann,
+                )
+            )
     finally:
         renderer.release()
         target.close()

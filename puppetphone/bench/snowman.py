@@ -51,8 +51,13 @@ def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1
         head = float(rng.uniform(0.4, 0.55) * bottom)
         angle = 2 * np.pi * i / max(snowmen, 1)
         world.resource(SnowmanStats).built += 1
-        bring_to_life(world, SnowmanShape(bottom, middle, head), np.array([3.5 * np.cos(angle), 0.0, 3.5 * np.sin(angle)]),
-                      float(rng.uniform(-np.pi, np.pi)), i + 1)
+        bring_to_life(
+            world,
+            SnowmanShape(bottom, middle, head),
+            np.array([3.5 * np.cos(angle), 0.0, 3.5 * np.sin(angle)]),
+            float(rng.uniform(-np.pi, np.pi)),
+            i + 1,
+        )
     for i in range(snowballs):
         r = float(rng.uniform(0.12, 0.35))
         ball = spawn_ball(world, np.array([rng.uniform(-6, 6), 0.0, rng.uniform(-5, 2)]), r)
@@ -83,18 +88,19 @@ def _render_fps(app) -> tuple[float, float | None]:  # type: ignore[no-untyped-d
     """Median frames per second of the game's full frame (world, scenery, snow, overlay) at
     1280x720, and the rate the same frames would run at with the cores free (see
     :mod:`puppetphone.bench.render`; ``None`` without ``/proc``)."""
-    from puppetphone.bench.render import unloaded_frame_time
     from engine.render.renderer import Renderer
     from engine.render.scene import RenderScene
     from engine.render.target import make_target
     from games.snowman.game import GAME
     from input.hub import InputHub
+    from puppetphone.bench.render import unloaded_frame_time
     from puppetphone.overlay import draw_overlay
 
     target = make_target(True, WIDTH, HEIGHT)
     renderer = Renderer(target.ctx)
     scene, camera, hub = RenderScene(), GAME.camera(), InputHub()
     try:
+
         def frame() -> None:
             scene.clear()
             GAME.draw(app.world, scene, 1.0)
@@ -122,5 +128,7 @@ def run() -> list[Figure]:
         Figure("snowman", "render_fps_vs_goal", fps_loaded, "fps", "goal", 30.0),
     ]
     if free_loaded is not None:
-        figures.append(Figure("snowman", "render_fps_unloaded", free_loaded, "fps", "empty field, unloaded", free_empty))
+        figures.append(
+            Figure("snowman", "render_fps_unloaded", free_loaded, "fps", "empty field, unloaded", free_empty)
+        )
     return figures

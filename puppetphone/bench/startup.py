@@ -23,8 +23,22 @@ __all__ = ["run", "child_cpu_s", "HEAVY", "REPEATS"]
 
 REPEATS = 3
 # the third-party packages `play snowman` imports (SciPy by the subpackages it loads)
-HEAVY = ("numpy", "scipy.spatial", "scipy.sparse", "scipy.linalg", "scipy.optimize", "scipy.interpolate",
-         "scipy.ndimage", "scipy.fft", "scipy.special", "mujoco", "moderngl", "daqp", "pythonosc", "websockets")
+HEAVY = (
+    "numpy",
+    "scipy.spatial",
+    "scipy.sparse",
+    "scipy.linalg",
+    "scipy.optimize",
+    "scipy.interpolate",
+    "scipy.ndimage",
+    "scipy.fft",
+    "scipy.special",
+    "mujoco",
+    "moderngl",
+    "daqp",
+    "pythonosc",
+    "websockets",
+)
 
 
 def child_cpu_s(args: list[str]) -> float:
@@ -49,6 +63,12 @@ def run() -> list[Figure]:
     starts = [child_cpu_s(play) for _ in range(REPEATS)]
     libs = [child_cpu_s(imports) for _ in range(REPEATS)]
     return [
-        Figure("startup", "startup_s_play_snowman", float(np.median(starts)), "s", "import of its heavy libraries",
-               float(np.median(libs))),
+        Figure(
+            "startup",
+            "startup_s_play_snowman",
+            float(np.median(starts)),
+            "s",
+            "import of its heavy libraries",
+            float(np.median(libs)),
+        ),
     ]

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import hashlib
 
-from puppetphone.bench.figures import Figure, median_time
 from engine.app import App
 from engine.ecs import World
 from engine.hashing import feed, state_hash
+from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "crowd_app", "field_by_field_hash", "PUPPETS"]
 

@@ -32,7 +32,6 @@ def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, wake: bo
     Raises:
         bench.chromium.ChromiumError: no Chromium, or it did not load the page.
     """
-    from puppetphone.bench.chromium import Chromium
     from engine.app import App
     from engine.components import Stick
     from engine.pacing import RealTimePacer
@@ -41,6 +40,7 @@ def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, wake: bo
     from input.sample import InputFrame
     from input.web.cert import load_or_create
     from input.web.server import WebSource
+    from puppetphone.bench.chromium import Chromium
 
     with tempfile.TemporaryDirectory(prefix="pp-web-bench-") as folder:
         src = WebSource(port=0, certificate=load_or_create([], Path(folder)), max_rate=1000.0)

@@ -14,7 +14,9 @@ from engine.humanoid import humanoid_skeleton
 FPS = 60.0
 
 
-def _perform(scene: RecordScene, seconds: float, period: float = 1.0, jitter: float = 0.12, offset: float = 0.0) -> None:
+def _perform(
+    scene: RecordScene, seconds: float, period: float = 1.0, jitter: float = 0.12, offset: float = 0.0
+) -> None:
     """A hand acting loops: the tempo drifts ±jitter, the drag draws a figure of eight."""
     phase = offset
     for k in range(int(seconds * FPS)):
@@ -23,8 +25,11 @@ def _perform(scene: RecordScene, seconds: float, period: float = 1.0, jitter: fl
         if scene.drive == "scale":
             scene.feed(np.array([1.0 + 0.3 * np.sin(p) ** 2]))
         else:
-            scene.feed(drag_rotation(200 * np.sin(p), 120 * np.sin(2 * p + 0.4), 720) if scene.drive == "rotation"
-                       else np.array([0.1 * np.sin(p), 0.95 + 0.03 * np.sin(2 * p), 0.0]))
+            scene.feed(
+                drag_rotation(200 * np.sin(p), 120 * np.sin(2 * p + 0.4), 720)
+                if scene.drive == "rotation"
+                else np.array([0.1 * np.sin(p), 0.95 + 0.03 * np.sin(2 * p), 0.0])
+            )
         scene.step(1.0 / FPS)
 
 
@@ -229,8 +234,27 @@ def test_author_record_command_headless(tmp_path: Path, capsys: pytest.CaptureFi
 
     out = tmp_path / "arm.ppclip"
     try:
-        code = main(["author", "record", "--headless", "--script", "loops", "--size", "160x120", "--countdown", "0.1",
-                     "--seconds", "6", "--frames", "500", "-o", str(out), "--screenshot", str(tmp_path / "s.png")])
+        code = main(
+            [
+                "author",
+                "record",
+                "--headless",
+                "--script",
+                "loops",
+                "--size",
+                "160x120",
+                "--countdown",
+                "0.1",
+                "--seconds",
+                "6",
+                "--frames",
+                "500",
+                "-o",
+                str(out),
+                "--screenshot",
+                str(tmp_path / "s.png"),
+            ]
+        )
     except Exception as exc:  # no EGL on this machine
         if "EGL" in str(exc) or "context" in str(exc).lower():
             pytest.skip(f"headless GL unavailable: {exc}")
@@ -256,8 +280,9 @@ def test_an_accepted_root_layer_keeps_the_extracted_curve_for_mocurves(tmp_path:
     fitted = scene.result.curves[f"{sk.names[0]}.translation"]
     assert np.array_equal(scene.root_curve.control, fitted.closed_control())
     # A rotation layer on top leaves the root, and so its curve, as it was.
-    arm = RecordScene(sk, "r_upper_arm", "rotation", base=clip, countdown=0.1, take_seconds=30.0,
-                      root_curve=scene.root_curve)
+    arm = RecordScene(
+        sk, "r_upper_arm", "rotation", base=clip, countdown=0.1, take_seconds=30.0, root_curve=scene.root_curve
+    )
     _run_take(arm)
     stacked = arm.accept()
     assert stacked is not None and np.array_equal(stacked.root, clip.root) and arm.root_curve is scene.root_curve

@@ -37,7 +37,14 @@ def test_tool_session_records_and_replays(tool, tmp_path, capsys):
 
 
 def test_operations_round_trip_and_old_forms_decode():
-    for op in (Press(1.0, 2.0, True), Move(3.0, 4.0), Release(5.0, 6.0), Orbit(-2.0, 1.0), Zoom(1.1), Key("s", True, False)):
+    for op in (
+        Press(1.0, 2.0, True),
+        Move(3.0, 4.0),
+        Release(5.0, 6.0),
+        Orbit(-2.0, 1.0),
+        Zoom(1.1),
+        Key("s", True, False),
+    ):
         assert decode(encode(op)) == op
     assert decode(("key", "tab", False)) == Key("tab")  # a record or flow session's key before shift was kept
     assert decode(("pointer", 10, 20)) == Move(10.0, 20.0)  # the record scene's sampled drag position
@@ -54,9 +61,13 @@ def test_bindings_are_one_mapping_left_acts_right_drag_orbits_wheel_zooms():
     ev = pygame.event.Event
     assert b.operation(ev(pygame.MOUSEBUTTONDOWN, button=1, pos=(10, 20)), (100, 100)) == Press(10.0, 20.0, False)
     assert b.operation(ev(pygame.MOUSEBUTTONDOWN, button=3, pos=(10, 20)), (100, 100)) is None
-    assert b.operation(ev(pygame.MOUSEMOTION, pos=(12, 20), rel=(2, 0), buttons=(0, 0, 1)), (100, 100)) == Orbit(2.0, 0.0)
+    assert b.operation(ev(pygame.MOUSEMOTION, pos=(12, 20), rel=(2, 0), buttons=(0, 0, 1)), (100, 100)) == Orbit(
+        2.0, 0.0
+    )
     b.operation(ev(pygame.MOUSEBUTTONUP, button=3, pos=(12, 20)), (100, 100))
-    assert b.operation(ev(pygame.MOUSEMOTION, pos=(13, 20), rel=(1, 0), buttons=(0, 0, 0)), (100, 100)) == Move(13.0, 20.0)
+    assert b.operation(ev(pygame.MOUSEMOTION, pos=(13, 20), rel=(1, 0), buttons=(0, 0, 0)), (100, 100)) == Move(
+        13.0, 20.0
+    )
     assert b.operation(ev(pygame.MOUSEWHEEL, y=1, x=0), (100, 100)) == Zoom(1 / 1.1)
     game = Bindings(pointer_acts=False)  # a game: the left button and the wheel are the mouse source's
     assert game.operation(ev(pygame.MOUSEBUTTONDOWN, button=1, pos=(10, 20)), (100, 100)) is None

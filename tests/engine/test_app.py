@@ -10,8 +10,11 @@ from engine.statemachine.puppet import install_puppets
 
 
 def _all_systems(app):
-    return [s for stage in ("input", "stick", "statemachine", "animation", "ik", "physics", "fk", "rules", "hash")
-            for s in app.systems(stage)]
+    return [
+        s
+        for stage in ("input", "stick", "statemachine", "animation", "ik", "physics", "fk", "rules", "hash")
+        for s in app.systems(stage)
+    ]
 
 
 def test_plugins_that_install_each_other_run_each_system_once():

@@ -32,9 +32,8 @@ def test_a_full_disk_is_one_line_and_the_old_file_is_intact(tmp_path: Path) -> N
 
 
 def test_a_read_only_folder_is_one_line(tmp_path: Path) -> None:
-    with read_only_folder(tmp_path / "ro") as ro:
-        with pytest.raises(WriteError, match="cannot save .*(ermission|ead-only)"):
-            atomic_write_bytes(ro / "x.json", b"OURS\n")
+    with read_only_folder(tmp_path / "ro") as ro, pytest.raises(WriteError, match="cannot save .*(ermission|ead-only)"):
+        atomic_write_bytes(ro / "x.json", b"OURS\n")
 
 
 def test_a_folder_in_the_way_is_a_write_error_not_a_traceback(tmp_path: Path) -> None:
@@ -84,8 +83,10 @@ def test_kill_9_at_any_point_of_a_save_leaves_the_old_or_the_new_file(tmp_path: 
     target = tmp_path / "save.bin"
     old = b"OURS\n" + b"o" * (4 << 20)
     atomic_write_bytes(target, old)
-    writer = ("import sys\nfrom engine.atomic import atomic_write_bytes\nprint('go', flush=True)\n"
-              "while True:\n    atomic_write_bytes(sys.argv[1], b'OURS\\n' + b'n' * (4 << 20))\n")
+    writer = (
+        "import sys\nfrom engine.atomic import atomic_write_bytes\nprint('go', flush=True)\n"
+        "while True:\n    atomic_write_bytes(sys.argv[1], b'OURS\\n' + b'n' * (4 << 20))\n"
+    )
     delays = np.random.default_rng(30).uniform(0.0, 0.3, 6)
     for delay in delays:
         with subprocess.Popen([sys.executable, "-c", writer, str(target)], stdout=subprocess.PIPE) as proc:

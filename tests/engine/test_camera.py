@@ -2,9 +2,9 @@
 
 import math
 
-from pyglm import glm
 import numpy as np
 import pytest
+from pyglm import glm
 
 from engine import quat
 from engine.camera import OrbitCamera, PhoneCamera, look_at, perspective
@@ -39,11 +39,13 @@ def test_yaw_zero_looks_down_minus_z_at_the_target():
     assert np.allclose(cam.right, [1, 0, 0])
 
 
-@pytest.mark.parametrize("make", [
-    lambda: OrbitCamera(target=np.array([0.2, 0.9, 0.1]), yaw=0.7, pitch=0.4, distance=6.0),
-    lambda: PhoneCamera(position=np.array([1.0, 1.6, 3.0]),
-                        orientation=quat.from_euler("YXZ", [0.3, -0.2, 0.1])),
-])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: OrbitCamera(target=np.array([0.2, 0.9, 0.1]), yaw=0.7, pitch=0.4, distance=6.0),
+        lambda: PhoneCamera(position=np.array([1.0, 1.6, 3.0]), orientation=quat.from_euler("YXZ", [0.3, -0.2, 0.1])),
+    ],
+)
 def test_project_and_ray_are_inverse(make):
     cam = make()
     w, h = 640, 360

@@ -101,7 +101,9 @@ def test_nan_clip_refused():
 
 def test_clip_file_round_trip(tmp_path):
     clip = walking_clip().extract_root_motion()
-    clip = Clip(clip.name, clip.skeleton, clip.fps, clip.root, clip.rotations, True, clip.root_motion, {"left_down": 0.0})
+    clip = Clip(
+        clip.name, clip.skeleton, clip.fps, clip.root, clip.rotations, True, clip.root_motion, {"left_down": 0.0}
+    )
     path = save_clip(clip, tmp_path / "walk.ppclip")
     back = load_clip(path)
     assert back.name == "walk" and back.loop and back.markers == {"left_down": 0.0}
@@ -167,20 +169,23 @@ def _rewrite_signed(path, change):
     _rewrite_header(path, both)
 
 
-@pytest.mark.parametrize("change,says", [
-    (lambda h, a: h.update(fps=float("nan")), "fps"),
-    (lambda h, a: h.update(fps=float("inf")), "fps"),
-    (lambda h, a: h.update(fps=-30), "fps"),
-    (lambda h, a: h.update(markers=[1, 2]), "markers"),
-    (lambda h, a: h.update(joints="Hips"), "joints"),
-    (lambda h, a: h.update(loop="yes"), "loop"),
-    (lambda h, a: a.update(offsets=np.full_like(a["offsets"], np.nan)), "offsets"),
-    (lambda h, a: a.update(radii=-a["radii"] - 0.1), "radii"),
-    (lambda h, a: a.update(root=a["root"] * 1e300), "root"),
-    (lambda h, a: a.update(rotations=a["rotations"] * 2.0), "unit"),
-    (lambda h, a: a.update(parents=a["parents"].astype(float)), "parents"),
-    (lambda h, a: a.update(rotations=a["rotations"][:, :2]), "inconsistent"),
-])
+@pytest.mark.parametrize(
+    "change,says",
+    [
+        (lambda h, a: h.update(fps=float("nan")), "fps"),
+        (lambda h, a: h.update(fps=float("inf")), "fps"),
+        (lambda h, a: h.update(fps=-30), "fps"),
+        (lambda h, a: h.update(markers=[1, 2]), "markers"),
+        (lambda h, a: h.update(joints="Hips"), "joints"),
+        (lambda h, a: h.update(loop="yes"), "loop"),
+        (lambda h, a: a.update(offsets=np.full_like(a["offsets"], np.nan)), "offsets"),
+        (lambda h, a: a.update(radii=-a["radii"] - 0.1), "radii"),
+        (lambda h, a: a.update(root=a["root"] * 1e300), "root"),
+        (lambda h, a: a.update(rotations=a["rotations"] * 2.0), "unit"),
+        (lambda h, a: a.update(parents=a["parents"].astype(float)), "parents"),
+        (lambda h, a: a.update(rotations=a["rotations"][:, :2]), "inconsistent"),
+    ],
+)
 def test_absurd_values_with_a_matching_checksum_are_refused(tmp_path, change, says):
     path = save_clip(walking_clip(), tmp_path / "walk.ppclip")
     _rewrite_signed(path, change)
@@ -213,7 +218,7 @@ def test_flipped_bytes_give_a_clip_error_and_nothing_else(tmp_path):
     path = tmp_path / "bad.ppclip"
     rng = np.random.default_rng(5)
     for pos in rng.integers(0, len(good), 300):
-        path.write_bytes(good[:pos] + bytes([good[pos] ^ 0x5A]) + good[pos + 1:])
+        path.write_bytes(good[:pos] + bytes([good[pos] ^ 0x5A]) + good[pos + 1 :])
         try:
             load_clip(path)
         except ClipFileError:

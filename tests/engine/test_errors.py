@@ -11,14 +11,24 @@ import pytest
 from engine.errors import FormatError
 
 FORMAT_ERRORS = [
-    ("authoring.batch.index", "LibraryIndexError"), ("authoring.cycles.trajectory", "TrajectoryError"),
-    ("authoring.flowcurves.storage", "FlowFileError"), ("authoring.keyframe_curves.session", "CurveFileError"),
-    ("authoring.mocurves.storage", "SessionFileError"), ("engine.clipfile", "ClipFileError"),
-    ("engine.cliplib.library", "ClipLibraryError"), ("engine.io.bvh", "BvhError"), ("engine.io.gltf", "GltfError"),
-    ("engine.io.motion_file", "MotionFileError"), ("engine.npz_safe", "NpzError"),
-    ("games.snowman.field_save", "FieldError"), ("games.tasbada.images", "PhotoError"),
-    ("games.tasbada.save", "SaveError"), ("input.codec", "CodecError"), ("input.hid_reports", "HidFormatError"),
-    ("input.recording", "RecordingError"), ("input.web.protocol", "WebMessageError"),
+    ("authoring.batch.index", "LibraryIndexError"),
+    ("authoring.cycles.trajectory", "TrajectoryError"),
+    ("authoring.flowcurves.storage", "FlowFileError"),
+    ("authoring.keyframe_curves.session", "CurveFileError"),
+    ("authoring.mocurves.storage", "SessionFileError"),
+    ("engine.clipfile", "ClipFileError"),
+    ("engine.cliplib.library", "ClipLibraryError"),
+    ("engine.io.bvh", "BvhError"),
+    ("engine.io.gltf", "GltfError"),
+    ("engine.io.motion_file", "MotionFileError"),
+    ("engine.npz_safe", "NpzError"),
+    ("games.snowman.field_save", "FieldError"),
+    ("games.tasbada.images", "PhotoError"),
+    ("games.tasbada.save", "SaveError"),
+    ("input.codec", "CodecError"),
+    ("input.hid_reports", "HidFormatError"),
+    ("input.recording", "RecordingError"),
+    ("input.web.protocol", "WebMessageError"),
     ("input.web.scene_stream", "FrameError"),
 ]
 

@@ -92,8 +92,12 @@ def test_scales_on_joints_with_children_reach_every_descendant():
     # offset, scaled by the chest's 0.8 x spine's 1.3), and the hand bone below it by 1.5 as well.
     plain, _ = forward_kinematics(sk, roots[0], rots[0])
     ua, la, hand = sk.index("l_upper_arm"), sk.index("l_lower_arm"), sk.index("l_hand")
-    assert np.linalg.norm(pos[0, la] - pos[0, ua]) == pytest.approx(1.5 * 1.3 * 0.8 * np.linalg.norm(plain[la] - plain[ua]))
-    assert np.linalg.norm(pos[0, hand] - pos[0, la]) == pytest.approx(1.5 * 1.3 * 0.8 * np.linalg.norm(plain[hand] - plain[la]))
+    assert np.linalg.norm(pos[0, la] - pos[0, ua]) == pytest.approx(
+        1.5 * 1.3 * 0.8 * np.linalg.norm(plain[la] - plain[ua])
+    )
+    assert np.linalg.norm(pos[0, hand] - pos[0, la]) == pytest.approx(
+        1.5 * 1.3 * 0.8 * np.linalg.norm(plain[hand] - plain[la])
+    )
 
 
 def test_inputs_of_any_float_type_are_computed_in_double_precision():
@@ -108,8 +112,9 @@ def test_inputs_of_any_float_type_are_computed_in_double_precision():
     offsets = (sk.offsets * 1.1).astype(np.float32)
     scales = rng.uniform(0.5, 2.0, sk.num_joints).astype(np.float32)
     pos, rot = forward_kinematics(sk, root, rots, offsets, scales)
-    ref, ref_rot = forward_kinematics(sk, root.astype(np.float64), rots.astype(np.float64),
-                                      offsets.astype(np.float64), scales.astype(np.float64))
+    ref, ref_rot = forward_kinematics(
+        sk, root.astype(np.float64), rots.astype(np.float64), offsets.astype(np.float64), scales.astype(np.float64)
+    )
     assert pos.dtype == np.float64 and rot.dtype == np.float64
     np.testing.assert_allclose(pos, ref, atol=1e-12)
     np.testing.assert_allclose(rot, ref_rot, atol=1e-12)

@@ -34,7 +34,7 @@ class Tagged:
 
 
 def wander(world):
-    for e, w, lp, tr in world.query(Wander, LocalPose, Transform):
+    for _e, w, lp, tr in world.query(Wander, LocalPose, Transform):
         tr.position = tr.position + world.rng.normal(scale=0.01 * w.speed, size=3)
         lp.root = tr.position + [0, 0.95, 0]
         lp.rotations = quat.normalize(lp.rotations + world.rng.normal(scale=0.01, size=lp.rotations.shape))
@@ -47,7 +47,9 @@ def run(seed, frames=600):
     app.add_system("animation", wander)
     sk = humanoid_skeleton()
     for k in range(3):
-        app.world.spawn(Wander(1.0 + k), Transform(np.array([k, 0.0, 0])), Puppet(sk), LocalPose(np.zeros(3), quat.identity(17)))
+        app.world.spawn(
+            Wander(1.0 + k), Transform(np.array([k, 0.0, 0])), Puppet(sk), LocalPose(np.zeros(3), quat.identity(17))
+        )
     hashes = []
     for _ in range(frames):
         app.step()

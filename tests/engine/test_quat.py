@@ -19,7 +19,9 @@ def random_quats(rng, n):
 def test_mul_matches_scipy_composition(rng):
     a, b = random_quats(rng, 50), random_quats(rng, 50)
     expected = (Rotation.from_quat(quat.to_xyzw(a)) * Rotation.from_quat(quat.to_xyzw(b))).as_quat()
-    np.testing.assert_allclose(quat.align_hemisphere(quat.mul(a, b)), quat.align_hemisphere(quat.from_xyzw(expected)), atol=1e-12)
+    np.testing.assert_allclose(
+        quat.align_hemisphere(quat.mul(a, b)), quat.align_hemisphere(quat.from_xyzw(expected)), atol=1e-12
+    )
 
 
 def test_rotate_matches_scipy(rng):
@@ -57,7 +59,11 @@ def test_euler_matches_scipy_intrinsic(rng, order):
     ours = quat.from_euler(order, ang)
     ref = quat.from_xyzw(Rotation.from_euler(order.upper(), ang).as_quat())
     np.testing.assert_allclose(quat.align_hemisphere(ours), quat.align_hemisphere(ref), atol=1e-12)
-    np.testing.assert_allclose(quat.align_hemisphere(quat.from_euler(order, quat.to_euler(order, ours))), quat.align_hemisphere(ours), atol=1e-9)
+    np.testing.assert_allclose(
+        quat.align_hemisphere(quat.from_euler(order, quat.to_euler(order, ours))),
+        quat.align_hemisphere(ours),
+        atol=1e-9,
+    )
 
 
 def test_swing_twist_recomposes_and_twist_is_about_axis(rng):

@@ -41,7 +41,9 @@ def test_a_later_session_never_overwrites_earlier_recovered_work(tmp_path: Path)
     assert (recovery_folder() / "field.json").read_bytes() == b"last week's"
 
 
-def test_a_full_disk_everywhere_is_one_line_and_nothing_is_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_full_disk_everywhere_is_one_line_and_nothing_is_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     with full_disk(tmp_path / "disk") as disk:
         monkeypatch.setenv("XDG_DATA_HOME", str(disk / "data"))
         saved = Rescue(disk / "field.json").save(_write(b"x" * (64 << 10)))

@@ -47,16 +47,19 @@ def test_clip_file_round_trip_with_and_without_curve(tmp_path):
         save_clip(clip, tmp_path / "x.ppclip", root_curve=_curve(k=31))
 
 
-@pytest.mark.parametrize("change,says", [
-    (lambda h, a: a.update(root_curve_control=np.full((6, 3), np.nan)), "root_curve_control holds NaN"),
-    (lambda h, a: a.update(root_curve_control=np.full((6, 3), 1e300)), "absurd"),
-    (lambda h, a: a.update(root_curve_control=np.zeros((6, 2))), "root_curve_control has shape"),
-    (lambda h, a: a.update(root_curve_control=np.zeros((3, 3))), "root curve has shapes"),
-    (lambda h, a: a.update(root_curve_control=np.zeros((31, 3))), "root curve has shapes"),
-    (lambda h, a: a.update(root_curve_travel=np.zeros(4)), "root curve has shapes"),
-    (lambda h, a: a.pop("root_curve_travel"), "incomplete"),
-    (lambda h, a: a.update(root_curve_travel=np.array(["a", "b", "c"])), "not numeric"),
-])
+@pytest.mark.parametrize(
+    "change,says",
+    [
+        (lambda h, a: a.update(root_curve_control=np.full((6, 3), np.nan)), "root_curve_control holds NaN"),
+        (lambda h, a: a.update(root_curve_control=np.full((6, 3), 1e300)), "absurd"),
+        (lambda h, a: a.update(root_curve_control=np.zeros((6, 2))), "root_curve_control has shape"),
+        (lambda h, a: a.update(root_curve_control=np.zeros((3, 3))), "root curve has shapes"),
+        (lambda h, a: a.update(root_curve_control=np.zeros((31, 3))), "root curve has shapes"),
+        (lambda h, a: a.update(root_curve_travel=np.zeros(4)), "root curve has shapes"),
+        (lambda h, a: a.pop("root_curve_travel"), "incomplete"),
+        (lambda h, a: a.update(root_curve_travel=np.array(["a", "b", "c"])), "not numeric"),
+    ],
+)
 def test_corrupt_curve_section_is_refused_in_one_line(tmp_path, change, says):
     path = save_clip(walking_clip(), tmp_path / "walk.ppclip", root_curve=_curve())
     _rewrite_signed(path, change)
@@ -66,8 +69,14 @@ def test_corrupt_curve_section_is_refused_in_one_line(tmp_path, change, says):
 
 
 @settings(max_examples=40, deadline=None)
-@given(arrays(np.float64, st.tuples(st.integers(0, 40), st.integers(1, 4)), elements=st.floats(allow_nan=True, allow_infinity=True)),
-       arrays(np.float64, st.integers(0, 5), elements=st.floats(allow_nan=True, allow_infinity=True)))
+@given(
+    arrays(
+        np.float64,
+        st.tuples(st.integers(0, 40), st.integers(1, 4)),
+        elements=st.floats(allow_nan=True, allow_infinity=True),
+    ),
+    arrays(np.float64, st.integers(0, 5), elements=st.floats(allow_nan=True, allow_infinity=True)),
+)
 def test_fuzzed_curve_sections_load_or_are_refused(tmp_path_factory, control, travel):
     path = save_clip(walking_clip(), tmp_path_factory.mktemp("fuzz") / "walk.ppclip")
     _rewrite_signed(path, lambda h, a: a.update(root_curve_control=control, root_curve_travel=travel))

@@ -13,7 +13,7 @@ import pytest
 
 from engine.camera import OrbitCamera
 from engine.render.scene import RenderScene
-from engine.runner import RunOptions, Runner
+from engine.runner import Runner, RunOptions
 
 
 class Counter:

@@ -29,8 +29,12 @@ def test_engine_fk_drives_the_skin_as_the_file_does(mocap_dir: Path, name: str, 
         pose = clip.sample(t)
         pos, rot = forward_kinematics(clip.skeleton, pose.root, pose.rotations, pose.offsets, pose.scales)
         ours = blend_skin(prim.positions, prim.joints, prim.weights, binding.matrices(pos, rot))
-        file = blend_skin(prim.positions, prim.joints, prim.weights,
-                          skin_matrices(asset, node_world_matrices(asset, anim, anim.start + t)))
+        file = blend_skin(
+            prim.positions,
+            prim.joints,
+            prim.weights,
+            skin_matrices(asset, node_world_matrices(asset, anim, anim.start + t)),
+        )
         c = fit_similarity(file, ours)
         height = float(np.ptp(ours[:, 1]))
         assert np.abs((c[:3, :3] @ file.T).T + c[:3, 3] - ours).max() < tolerance * max(height / 1.5, 1.0)
@@ -58,6 +62,10 @@ def test_a_skeleton_in_another_unit_carries_the_skin_in_that_unit(mocap_dir: Pat
     prim = meshes.primitives[0]
     ours = blend_skin(prim.positions, prim.joints, prim.weights, binding.matrices(pos, rot))
     anim = asset.animations[0]
-    file = blend_skin(prim.positions, prim.joints, prim.weights,
-                      skin_matrices(asset, node_world_matrices(asset, anim, anim.start + 0.5)))
+    file = blend_skin(
+        prim.positions,
+        prim.joints,
+        prim.weights,
+        skin_matrices(asset, node_world_matrices(asset, anim, anim.start + 0.5)),
+    )
     assert np.abs(ours - 0.01 * file).max() < 1e-6

@@ -36,19 +36,19 @@ def puppet(world, lift):
 
 def test_lifted_things_get_a_cue_resting_ones_do_not():
     world = World()
-    ball(world, [-3.0, 0.3, 0.0], 0.3)            # on the ground
-    ball(world, [0.0, 0.4, 0.0], 0.4)             # a big one on the ground...
-    ball(world, [0.0, 0.8 + 0.25, 0.0], 0.25)     # ...with one packed on top: resting
-    ball(world, [0.1, 2.0, 0.05], 0.2)            # held above the stack: lands on the top ball
-    ball(world, [3.0, 1.5, 1.0], 0.2)             # held over open snow
-    puppet(world, 0.0)                            # standing: no cue
+    ball(world, [-3.0, 0.3, 0.0], 0.3)  # on the ground
+    ball(world, [0.0, 0.4, 0.0], 0.4)  # a big one on the ground...
+    ball(world, [0.0, 0.8 + 0.25, 0.0], 0.25)  # ...with one packed on top: resting
+    ball(world, [0.1, 2.0, 0.05], 0.2)  # held above the stack: lands on the top ball
+    ball(world, [3.0, 1.5, 1.0], 0.2)  # held over open snow
+    puppet(world, 0.0)  # standing: no cue
     cues = height_cues(world, 1.0)
     assert len(cues) == 2
     over_stack, over_snow = sorted(cues, key=lambda c: c[0][0])
     assert np.allclose(over_snow[0], [3.0, 1.3, 1.0]) and over_snow[1] == 0.0
     top_ball_surface = 1.05 + np.sqrt(0.25**2 - 0.1**2 - 0.05**2)
     assert over_stack[1] == pytest.approx(top_ball_surface)  # the ring lands on the ball it would stack on
-    puppet(world, 0.8)                            # lifted by the stick
+    puppet(world, 0.8)  # lifted by the stick
     lifted = [c for c in height_cues(world, 1.0) if c[0][0] == pytest.approx(2.0)]
     assert len(lifted) == 1 and lifted[0][0][1] > 0.8 and lifted[0][1] == 0.0
 
@@ -95,10 +95,10 @@ def test_the_cue_shows_dark_on_the_snow_under_a_lifted_ball():
     ring = below + 0.15 * np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     mid = below + np.array([0.0, 0.6, 0.0])  # halfway up the drop line
     for point in [below, mid, *ring]:
-        (x, y), = np.round(cam.project([point], W, H)).astype(int)
+        ((x, y),) = np.round(cam.project([point], W, H)).astype(int)
         # the snow there is bright without the cue, and the cue makes it clearly dark (and bluish)
         assert before[y, x].sum() > 3 * 170, (point, before[y, x])
-        patch = after[y - 1:y + 2, x - 1:x + 2].reshape(-1, 3)
+        patch = after[y - 1 : y + 2, x - 1 : x + 2].reshape(-1, 3)
         darkest = patch[patch.sum(axis=1).argmin()]
         assert darkest.sum() < before[y, x].sum() - 300, (point, darkest, before[y, x])
         assert darkest[2] >= darkest[0]

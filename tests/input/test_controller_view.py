@@ -33,8 +33,9 @@ def test_no_controller_no_view():
 
 def test_a_6dof_phone_camera_is_its_own_pose():
     q_phone = quat.from_axis_angle([0.0, 1.0, 0.0], 0.4)  # an ARKit/WebXR camera turned left
-    sample = PoseSample(time=0.0, source="web:1", orientation=arkit_to_stick(q_phone),
-                        position=np.array([0.2, 0.1, 0.0]))
+    sample = PoseSample(
+        time=0.0, source="web:1", orientation=arkit_to_stick(q_phone), position=np.array([0.2, 0.1, 0.0])
+    )
     app = _app_with(sample)
     cam = controller_camera(app.world)
     assert cam is not None
@@ -49,6 +50,7 @@ def test_a_6dof_phone_camera_is_its_own_pose():
 
 
 def test_the_mouse_has_no_view_of_its_own():
-    sample = PoseSample(time=0.0, source="mouse", orientation=quat.identity(), position=np.array([0.0, 1.5, 4.0]),
-                        mode="world")
+    sample = PoseSample(
+        time=0.0, source="mouse", orientation=quat.identity(), position=np.array([0.0, 1.5, 4.0]), mode="world"
+    )
     assert controller_camera(_app_with(sample).world) is None

@@ -47,6 +47,7 @@ def _stick(app):  # type: ignore[no-untyped-def]
 
 # -- the mouse ------------------------------------------------------------------------------
 
+
 def _mouse_grab():  # type: ignore[no-untyped-def]
     mouse = MouseSource()
     app, puppet = _sandbox(mouse)
@@ -104,6 +105,7 @@ def test_a_slow_upward_mouse_drag_handled_in_bursts_is_not_a_flick():
 
 
 # -- devices in "device" mode: taps inside a step ---------------------------------------------
+
 
 def _tap_counted(app) -> None:  # type: ignore[no-untyped-def]
     """A tap (down and up) inside one step: both edges reached the stick (the first tap calibrates)."""

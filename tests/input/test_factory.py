@@ -27,13 +27,16 @@ from puppetphone.cli import build_parser
 
 def _cli(*args: str, data: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(data)}
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], env=env, capture_output=True, text=True, check=False,
-                          timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", *args], env=env, capture_output=True, text=True, check=False, timeout=120
+    )
 
 
 @pytest.mark.parametrize(("command", "value"), [("play", "0"), ("play", "1e308"), ("play", "nan"), ("author", "61")])
 def test_an_absurd_silence_is_refused_in_one_line_with_exit_2(tmp_path: Path, command: str, value: str) -> None:
-    line = ["play", "sandbox", "--headless", "--frames", "1"] if command == "play" else ["author", "record", "--headless"]
+    line = (
+        ["play", "sandbox", "--headless", "--frames", "1"] if command == "play" else ["author", "record", "--headless"]
+    )
     done = _cli(*line, f"--silent-after={value}", data=tmp_path)
     last = done.stderr.strip().splitlines()[-1]
     assert done.returncode == 2 and "--silent-after" in last and "out of range" in last, done.stderr
@@ -65,7 +68,9 @@ def test_an_osc_phone_keeps_its_puppet_through_the_silence_it_was_given(osc) -> 
         src.stop()
 
 
-def test_a_web_phone_is_released_after_the_silence_it_was_given(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_web_phone_is_released_after_the_silence_it_was_given(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))  # the certificate is made here, not in the user's folder
     args = _args("--source", "web", "--web-port", "0", "--silent-after", "0.3")
     hub = make_hub(args.source, web_host=args.web_host, web_port=args.web_port, silent_after=args.silent_after)

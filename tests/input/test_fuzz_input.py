@@ -29,18 +29,43 @@ from input.serial_parse import SerialStreamParser
 pytestmark = pytest.mark.fuzz
 
 DATA = Path(__file__).resolve().parent.parent / "data"
-ADDRESSES = ["/puppetphone/pose", "/puppetphone/orientation", "/puppetphone/touch", "/puppetphone/calibrate",
-             "/puppetphone/gyro", "/puppetphone/accel", "/ZIGSIM/d/quaternion", "/ZIGSIM/d/arkitposition",
-             "/ZIGSIM/d/arkitrotation", "/ZIGSIM/d/touch01", "/ZIGSIM/d/gyro", "/ZIGSIM/d/accel", "/rotationvector",
-             "/pose6dof", "/touch1", "/gyroscope", "/accelerometer", "/accxyz", "/gyrosc/quat", "/gyrosc/gyro",
-             "/gyrosc/rrate", "/gyrosc/accel", "/gyrosc/button", "/d/deviceinfo"]
+ADDRESSES = [
+    "/puppetphone/pose",
+    "/puppetphone/orientation",
+    "/puppetphone/touch",
+    "/puppetphone/calibrate",
+    "/puppetphone/gyro",
+    "/puppetphone/accel",
+    "/ZIGSIM/d/quaternion",
+    "/ZIGSIM/d/arkitposition",
+    "/ZIGSIM/d/arkitrotation",
+    "/ZIGSIM/d/touch01",
+    "/ZIGSIM/d/gyro",
+    "/ZIGSIM/d/accel",
+    "/rotationvector",
+    "/pose6dof",
+    "/touch1",
+    "/gyroscope",
+    "/accelerometer",
+    "/accxyz",
+    "/gyrosc/quat",
+    "/gyrosc/gyro",
+    "/gyrosc/rrate",
+    "/gyrosc/accel",
+    "/gyrosc/button",
+    "/d/deviceinfo",
+]
 
-numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True, width=32),
-                    st.floats(allow_nan=True, allow_infinity=True), st.integers(-2**31, 2**31 - 1),
-                    st.sampled_from([0.0, 1.0, -1.0, 0.5, 1e308, -1e308, 5e-324]))
+numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True, width=32),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-(2**31), 2**31 - 1),
+    st.sampled_from([0.0, 1.0, -1.0, 0.5, 1e308, -1e308, 5e-324]),
+)
 arguments = st.lists(st.one_of(numbers, st.text(max_size=8), st.booleans()), max_size=9)
-messages = st.tuples(st.one_of(st.sampled_from(ADDRESSES), st.text(min_size=1, max_size=20).map(lambda a: "/" + a)),
-                     arguments)
+messages = st.tuples(
+    st.one_of(st.sampled_from(ADDRESSES), st.text(min_size=1, max_size=20).map(lambda a: "/" + a)), arguments
+)
 
 
 def _message(address: str, args: list[object]) -> OscMessageBuilder:
@@ -90,10 +115,19 @@ def test_fuzz_osc_messages_decode_to_valid_samples_or_drops(osc_source, items, a
 
 
 def test_fuzz_osc_byte_mutations(campaign, mutations, fuzz_budget):
-    seeds = [_datagram([("/puppetphone/pose", [0.1, 0.2, 0.3, 1.0, 0.0, 0.0, 0.0])], False),
-             _datagram([("/ZIGSIM/d/quaternion", [0.0, 0.0, 0.0, 1.0]), ("/ZIGSIM/d/touch01", [0.1]),
-                        ("/ZIGSIM/d/gyro", [0.0, 0.5, 0.0]), ("/ZIGSIM/d/accel", [0.0, 0.0, 1.0])], True),
-             _datagram([("/rotationvector", [0.0, 0.0, 0.0, 1.0, 0.1])], False)]
+    seeds = [
+        _datagram([("/puppetphone/pose", [0.1, 0.2, 0.3, 1.0, 0.0, 0.0, 0.0])], False),
+        _datagram(
+            [
+                ("/ZIGSIM/d/quaternion", [0.0, 0.0, 0.0, 1.0]),
+                ("/ZIGSIM/d/touch01", [0.1]),
+                ("/ZIGSIM/d/gyro", [0.0, 0.5, 0.0]),
+                ("/ZIGSIM/d/accel", [0.0, 0.0, 1.0]),
+            ],
+            True,
+        ),
+        _datagram([("/rotationvector", [0.0, 0.0, 0.0, 1.0, 0.1])], False),
+    ]
     cases, seed = fuzz_budget(3000)
     c = campaign(())
     decoder = OscDecoder(on_drop=lambda reason, detail: None)
@@ -108,16 +142,24 @@ def test_fuzz_osc_byte_mutations(campaign, mutations, fuzz_budget):
     assert decoded > 0, "no mutated datagram decoded: a decoder dropping everything would pass"
 
 
-@given(st.lists(st.one_of(
-    st.lists(numbers, min_size=1, max_size=9).map(lambda v: ",".join(repr(float(x)) for x in v)),
-    st.lists(numbers, min_size=4, max_size=4).map(lambda v: "quat\t" + "\t".join(repr(float(x)) for x in v)),
-    st.text(max_size=40)), max_size=8), st.binary(max_size=64), st.integers(1, 64))
+@given(
+    st.lists(
+        st.one_of(
+            st.lists(numbers, min_size=1, max_size=9).map(lambda v: ",".join(repr(float(x)) for x in v)),
+            st.lists(numbers, min_size=4, max_size=4).map(lambda v: "quat\t" + "\t".join(repr(float(x)) for x in v)),
+            st.text(max_size=40),
+        ),
+        max_size=8,
+    ),
+    st.binary(max_size=64),
+    st.integers(1, 64),
+)
 def test_fuzz_serial_streams_give_unit_readings(lines, noise, chunk):
     data = ("\r\n".join(lines) + "\n").encode("utf-8", "replace") + noise
     p = SerialStreamParser()
     out = []
     for i in range(0, len(data), chunk):
-        out += p.feed(data[i:i + chunk])
+        out += p.feed(data[i : i + chunk])
     for r in out:
         q = np.array(r.quaternion)
         assert np.isfinite(q).all() and abs(np.linalg.norm(q) - 1.0) < 1e-9
@@ -126,8 +168,15 @@ def test_fuzz_serial_streams_give_unit_readings(lines, noise, chunk):
 
 
 def _frame() -> bytes:
-    s = PoseSample(time=1.0, source="osc:10.0.0.1", orientation=[1.0, 0.0, 0.0, 0.0], position=[0.1, 1.2, -0.3],
-                   angular_velocity=[0.0, 1.0, 0.0], acceleration=[0.0, 9.8, 0.0], touch=True)
+    s = PoseSample(
+        time=1.0,
+        source="osc:10.0.0.1",
+        orientation=[1.0, 0.0, 0.0, 0.0],
+        position=[0.1, 1.2, -0.3],
+        angular_velocity=[0.0, 1.0, 0.0],
+        acceleration=[0.0, 9.8, 0.0],
+        touch=True,
+    )
     return encode_frame(InputFrame(frame=7, samples=(s, s), events=(("connect", "osc:10.0.0.1"),)))
 
 
@@ -164,14 +213,20 @@ def header_path(tmp_path_factory):
 
 
 json_values = st.recursive(
-    st.one_of(st.none(), st.booleans(), st.integers(-2**70, 2**70), st.floats(allow_nan=True), st.text(max_size=10)),
+    st.one_of(st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True), st.text(max_size=10)),
     lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=8), inner, max_size=4)),
-    max_leaves=12)
+    max_leaves=12,
+)
 
 
-@given(st.dictionaries(st.sampled_from(["game", "seed", "dt", "sources", "format", "engine_version", "extra",
-                                        "other"]), json_values, max_size=8),
-       st.fixed_dictionaries({"game": st.just("sandbox"), "seed": st.just(0), "dt": st.just(1 / 60)}))
+@given(
+    st.dictionaries(
+        st.sampled_from(["game", "seed", "dt", "sources", "format", "engine_version", "extra", "other"]),
+        json_values,
+        max_size=8,
+    ),
+    st.fixed_dictionaries({"game": st.just("sandbox"), "seed": st.just(0), "dt": st.just(1 / 60)}),
+)
 def test_fuzz_recording_headers(header_path, fields, base):
     head = json.dumps({**base, **fields}).encode()
     path = header_path

@@ -11,8 +11,16 @@ import pytest
 
 from engine import quat
 from input.hid import HidSource, ImuIntegrator, SpaceMouseIntegrator, enumerate_supported
-from input.hid_reports import (DS4_DEFAULT, HidFormatError, ds4_calibration, dualsense_calibration, known_device,
-                               parse_ds4, parse_dualsense, parse_spacemouse)
+from input.hid_reports import (
+    DS4_DEFAULT,
+    HidFormatError,
+    ds4_calibration,
+    dualsense_calibration,
+    known_device,
+    parse_ds4,
+    parse_dualsense,
+    parse_spacemouse,
+)
 from input.sample import CONNECT, DISCONNECT, PoseSample
 
 
@@ -122,8 +130,12 @@ def test_known_devices_and_enumerate_filter():
     assert known_device(0x256F, 0xC635) == ("spacemouse", "SpaceMouse Compact")
     assert known_device(0x054C, 0x0CE6)[0] == "dualsense" and known_device(0x054C, 0x09CC)[0] == "ds4"
     assert known_device(0x1234, 0x5678) is None
-    devs = enumerate_supported(lambda: [{"vendor_id": 0x046D, "product_id": 0xC626, "path": b"x"},
-                                        {"vendor_id": 0x046D, "product_id": 0xC077, "path": b"y"}])
+    devs = enumerate_supported(
+        lambda: [
+            {"vendor_id": 0x046D, "product_id": 0xC626, "path": b"x"},
+            {"vendor_id": 0x046D, "product_id": 0xC077, "path": b"y"},
+        ]
+    )
     assert [d["name"] for d in devs] == ["SpaceNavigator"]
 
 

@@ -26,8 +26,14 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _replay(path: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(path), "--verify", "--headless"],
-                          env={**os.environ, "SDL_VIDEODRIVER": "dummy"}, capture_output=True, text=True, check=False, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", "replay", str(path), "--verify", "--headless"],
+        env={**os.environ, "SDL_VIDEODRIVER": "dummy"},
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=300,
+    )
 
 
 def _with_header(path: Path, edit) -> None:  # type: ignore[no-untyped-def]
@@ -35,15 +41,18 @@ def _with_header(path: Path, edit) -> None:  # type: ignore[no-untyped-def]
     data = path.read_bytes()
     n, _ = struct.unpack_from("<II", data, len(MAGIC))
     start = len(MAGIC) + 8
-    head = json.loads(data[start:start + n])
+    head = json.loads(data[start : start + n])
     edit(head)
     raw = json.dumps(head, sort_keys=True).encode()
-    path.write_bytes(MAGIC + struct.pack("<II", len(raw), zlib.crc32(raw)) + raw + data[start + n:])
+    path.write_bytes(MAGIC + struct.pack("<II", len(raw), zlib.crc32(raw)) + raw + data[start + n :])
 
 
 def test_the_list_is_exactly_what_constraints_pins() -> None:
-    pinned = [line.split("==")[0].strip().lower() for line in (ROOT / "constraints.txt").read_text().splitlines()
-              if "==" in line and not line.lstrip().startswith("#")]
+    pinned = [
+        line.split("==")[0].strip().lower()
+        for line in (ROOT / "constraints.txt").read_text().splitlines()
+        if "==" in line and not line.lstrip().startswith("#")
+    ]
     assert sorted(NUMERIC_LIBRARIES) == sorted(pinned)
 
 
@@ -51,11 +60,15 @@ def test_one_line_names_what_differs() -> None:
     now = {"mujoco": "3.17.0", "numpy": "2.4.6"}
     assert version_difference({"mujoco": "3.17.0", "numpy": "2.4.6"}, now) == ""
     assert version_difference({}, now) == ""  # an older recording: nothing to compare
-    assert version_difference({"mujoco": "4.0.0", "numpy": "2.4.6"}, now) == \
-        "recorded with mujoco 4.0.0, running 3.17.0: hashes may differ"
+    assert (
+        version_difference({"mujoco": "4.0.0", "numpy": "2.4.6"}, now)
+        == "recorded with mujoco 4.0.0, running 3.17.0: hashes may differ"
+    )
     two = version_difference({"mujoco": "4.0.0", "numpy": "2.3.0", "daqp": "0.11.0"}, now)
-    assert two == "recorded with mujoco 4.0.0, numpy 2.3.0, daqp 0.11.0; running mujoco 3.17.0, numpy 2.4.6, daqp none: " \
+    assert (
+        two == "recorded with mujoco 4.0.0, numpy 2.3.0, daqp 0.11.0; running mujoco 3.17.0, numpy 2.4.6, daqp none: "
         "hashes may differ"
+    )
 
 
 @pytest.fixture
@@ -89,7 +102,7 @@ def test_a_recording_from_before_the_versions_reads_and_verifies_with_no_note(re
     _with_header(recording, lambda head: head.pop("libraries"))
     raw = recording.read_bytes()
     (n,) = struct.unpack_from("<I", raw, len(MAGIC))
-    assert "libraries" not in json.loads(raw[len(MAGIC) + 8:len(MAGIC) + 8 + n])  # the old header
+    assert "libraries" not in json.loads(raw[len(MAGIC) + 8 : len(MAGIC) + 8 + n])  # the old header
     assert read_recording(recording).header.libraries == {}
     done = _replay(recording)
     assert done.returncode == 0 and "hashes may differ" not in done.stderr, done.stderr

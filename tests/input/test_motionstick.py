@@ -17,8 +17,15 @@ class Fed(PoseSource):
 
 def world_sample(direction, touch=None, pivot=(0.0, 1.5, -4.0), **kw):
     d = np.asarray(direction, float)
-    return PoseSample(time=0.0, source="m", orientation=quat.between([0, 0, 1], d / np.linalg.norm(d)),
-                      position=pivot, touch=touch, mode="world", **kw)
+    return PoseSample(
+        time=0.0,
+        source="m",
+        orientation=quat.between([0, 0, 1], d / np.linalg.norm(d)),
+        position=pivot,
+        touch=touch,
+        mode="world",
+        **kw,
+    )
 
 
 def setup(make_app):
@@ -34,7 +41,7 @@ def test_pick_and_shorten_geometry():
     down = np.array([0.0, -1.0, 1.0]) / np.sqrt(2)
     assert np.isclose(shorten(np.array([0, 1.0, 0]), down, 5.0), np.sqrt(2))  # hits the ground
     assert shorten(np.array([0, 1.0, 0]), np.array([0, 0, 1.0]), 5.0) == 5.0
-    post = dict(bases=np.array([[0.0, 0, 3]]), radii=np.array([0.5]), heights=np.array([2.0]))
+    post = {"bases": np.array([[0.0, 0, 3]]), "radii": np.array([0.5]), "heights": np.array([2.0])}
     assert np.isclose(shorten(np.array([0, 1.0, 0]), np.array([0, 0, 1.0]), 5.0, **post), 2.5)  # side wall
     assert shorten(np.array([0, 3.0, 0]), np.array([0, 0, 1.0]), 5.0, **post) == 5.0  # passes over it
     assert np.isclose(shorten(np.array([0, 4.0, 3]), np.array([0, -1.0, 0]), 5.0, **post), 2.0)  # top cap

@@ -29,7 +29,11 @@ def test_event_types_match_pygame():
     from input import mouse
 
     assert (mouse.MOUSEMOTION, mouse.MOUSEBUTTONDOWN, mouse.MOUSEBUTTONUP, mouse.MOUSEWHEEL) == (
-        pygame.MOUSEMOTION, pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEWHEEL)
+        pygame.MOUSEMOTION,
+        pygame.MOUSEBUTTONDOWN,
+        pygame.MOUSEBUTTONUP,
+        pygame.MOUSEWHEEL,
+    )
 
 
 def test_drag_in_the_plane_at_grab_depth_and_wheel(make_app):
@@ -65,7 +69,9 @@ def test_ground_plane_drag_keeps_height_and_wheel_lifts(make_app):
     stick = app.world.query(Stick)[0][1]
     assert stick.grabbed is not None
     height = stick.tip[1]
-    mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(300, py + 60), rel=(-100, 60), buttons=(1, 0, 0)), cam, size, now=0.5)
+    mouse.handle_event(
+        ev(pygame.MOUSEMOTION, pos=(300, py + 60), rel=(-100, 60), buttons=(1, 0, 0)), cam, size, now=0.5
+    )
     app.step()
     assert np.isclose(stick.tip[1], height)  # dragging stays on the horizontal plane
     assert stick.tip[2] < -0.5 or stick.tip[0] > 0.5  # and moved over the ground
@@ -79,8 +85,9 @@ def test_quick_upward_drag_is_one_flick():
     mouse = MouseSource()
     mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(400, 500), button=1), cam, size, now=0.0)
     for i, y in enumerate((400, 300, 200)):
-        mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(400, y), rel=(0, -100), buttons=(1, 0, 0)), cam, size,
-                           now=0.03 * (i + 1))
+        mouse.handle_event(
+            ev(pygame.MOUSEMOTION, pos=(400, y), rel=(0, -100), buttons=(1, 0, 0)), cam, size, now=0.03 * (i + 1)
+        )
     mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(400, 199), rel=(0, -1), buttons=(1, 0, 0)), cam, size, now=1.0)
     flicks = [s.flick for s in mouse.drain()]
     assert flicks == [False, True, False, False, False]
@@ -93,8 +100,9 @@ def test_a_flick_after_a_pause_is_judged_from_where_the_cursor_rested():
     cam, size = PinholeCamera(), (640, 360)
     mouse = MouseSource()
     mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(320, 200), button=1), cam, size, now=0.0)
-    first = mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(320, 170), rel=(0, -30), buttons=(1, 0, 0)), cam, size,
-                               now=0.6)
+    first = mouse.handle_event(
+        ev(pygame.MOUSEMOTION, pos=(320, 170), rel=(0, -30), buttons=(1, 0, 0)), cam, size, now=0.6
+    )
     assert first
     press, move = mouse.drain()
     assert move.flick  # 30 px of 360 within the window: a flick at once
@@ -103,6 +111,10 @@ def test_a_flick_after_a_pause_is_judged_from_where_the_cursor_rested():
     mouse.handle_event(ev(pygame.MOUSEBUTTONUP, pos=(320, 170), button=1), cam, size, now=0.7)
     mouse.handle_event(ev(pygame.MOUSEBUTTONDOWN, pos=(320, 200), button=1), cam, size, now=2.0)
     for k in range(1, 30):
-        mouse.handle_event(ev(pygame.MOUSEMOTION, pos=(320, 200 - 2 * k), rel=(0, -2), buttons=(1, 0, 0)), cam, size,
-                           now=2.0 + 0.05 * k)
+        mouse.handle_event(
+            ev(pygame.MOUSEMOTION, pos=(320, 200 - 2 * k), rel=(0, -2), buttons=(1, 0, 0)),
+            cam,
+            size,
+            now=2.0 + 0.05 * k,
+        )
     assert not any(s.flick for s in mouse.drain())

@@ -29,17 +29,20 @@ def dec():  # type: ignore[no-untyped-def]
     return d
 
 
-@pytest.mark.parametrize(("address", "args", "field", "expected"), [
-    ("/puppetphone/gyro", (0.1, 0.2, 0.3), "angular_velocity", [0.1, 0.2, 0.3]),
-    ("/puppetphone/accel", (0.0, 9.0, 1.0), "acceleration", [0.0, 9.0, 1.0]),  # m/s²
-    ("/gyroscope", (0.4, 0.0, -0.4), "angular_velocity", [0.4, 0.0, -0.4]),
-    ("/accelerometer", (0.0, 0.0, 9.8), "acceleration", [0.0, 0.0, 9.8]),  # m/s²
-    ("/gyrosc/rrate", (0.0, 1.5, 0.0), "angular_velocity", [0.0, 1.5, 0.0]),
-    ("/gyrosc/accel", (0.0, 0.0, -1.0), "acceleration", [0.0, 0.0, -G]),  # g
-    ("/ZIGSIM/d/accel", (0.5, 0.0, 0.0), "acceleration", [0.5 * G, 0.0, 0.0]),  # g
-    ("/accxyz", (0.0, 0.0, -1.0), "acceleration", [0.0, 0.0, -G]),  # g
-    ("/puppetphone/gyro", (1, 2, 3), "angular_velocity", [1.0, 2.0, 3.0]),  # OSC int32 arguments
-])
+@pytest.mark.parametrize(
+    ("address", "args", "field", "expected"),
+    [
+        ("/puppetphone/gyro", (0.1, 0.2, 0.3), "angular_velocity", [0.1, 0.2, 0.3]),
+        ("/puppetphone/accel", (0.0, 9.0, 1.0), "acceleration", [0.0, 9.0, 1.0]),  # m/s²
+        ("/gyroscope", (0.4, 0.0, -0.4), "angular_velocity", [0.4, 0.0, -0.4]),
+        ("/accelerometer", (0.0, 0.0, 9.8), "acceleration", [0.0, 0.0, 9.8]),  # m/s²
+        ("/gyrosc/rrate", (0.0, 1.5, 0.0), "angular_velocity", [0.0, 1.5, 0.0]),
+        ("/gyrosc/accel", (0.0, 0.0, -1.0), "acceleration", [0.0, 0.0, -G]),  # g
+        ("/ZIGSIM/d/accel", (0.5, 0.0, 0.0), "acceleration", [0.5 * G, 0.0, 0.0]),  # g
+        ("/accxyz", (0.0, 0.0, -1.0), "acceleration", [0.0, 0.0, -G]),  # g
+        ("/puppetphone/gyro", (1, 2, 3), "angular_velocity", [1.0, 2.0, 3.0]),  # OSC int32 arguments
+    ],
+)
 def test_each_sensor_address_feeds_its_field_in_si_units(dec, osc, address, args, field, expected) -> None:  # type: ignore[no-untyped-def]
     message, _ = osc
     s = dec.decode(message(address, *args), "p", 0.0)
@@ -80,8 +83,10 @@ def test_sensors2osc_rotation_takes_up_to_five_values() -> None:
     assert drops == ["/georotationvector: wrong arity: 6 arguments, expected 3..5"]
 
 
-@pytest.mark.parametrize(("x", "y", "down"), [(0.4, 0.6, True), (-1.0, 0.5, True), (0.5, -1.0, True),
-                                                (0.0, -1.0, True), (-1.0, 0.0, True), (-1.0, -1.0, False)])
+@pytest.mark.parametrize(
+    ("x", "y", "down"),
+    [(0.4, 0.6, True), (-1.0, 0.5, True), (0.5, -1.0, True), (0.0, -1.0, True), (-1.0, 0.0, True), (-1.0, -1.0, False)],
+)
 def test_sensors2osc_touch_is_up_only_at_minus_one_minus_one(dec, osc, x, y, down) -> None:  # type: ignore[no-untyped-def]
     message, _ = osc
     if not down:
@@ -95,8 +100,9 @@ def test_gyrosc_euler_angles_are_heading_then_pitch_then_roll(dec, osc) -> None:
     message, _ = osc
     pitch, roll, yaw = 0.3, 0.2, 0.5
     s = dec.decode(message("/gyrosc/gyro", pitch, roll, yaw), "g", 0.0)
-    device = quat.mul(quat.mul(quat.from_axis_angle(_Z, yaw), quat.from_axis_angle(_X, pitch)),
-                      quat.from_axis_angle(_Y, roll))
+    device = quat.mul(
+        quat.mul(quat.from_axis_angle(_Z, yaw), quat.from_axis_angle(_X, pitch)), quat.from_axis_angle(_Y, roll)
+    )
     assert np.allclose(s.orientation, phone_to_stick(device))
     assert dec.decode(message("/gyrosc/gyro", pitch, roll), "g", 0.1) is None
 
@@ -113,8 +119,10 @@ def test_gyrosc_button_takes_one_or_two_values(dec, osc) -> None:  # type: ignor
     message, _ = osc
     assert dec.decode(message("/gyrosc/button"), "g", 0.0) is None
     assert dec.decode(message("/gyrosc/button", 1.0, 1.0, 1.0), "g", 0.0) is None
-    assert [d for _, d in dec.drops] == ["/gyrosc/button: wrong arity: 0 arguments, expected 1..2",
-                                         "/gyrosc/button: wrong arity: 3 arguments, expected 1..2"]
+    assert [d for _, d in dec.drops] == [
+        "/gyrosc/button: wrong arity: 0 arguments, expected 1..2",
+        "/gyrosc/button: wrong arity: 3 arguments, expected 1..2",
+    ]
 
 
 @pytest.mark.parametrize("address", ["/ZIGSIM/d/touchradius1", "/ZIGSIM/d/touchforce1", "/d/touch01"])
@@ -134,7 +142,9 @@ def test_zigsim_gravity_is_ignored_silently(dec, osc) -> None:  # type: ignore[n
 def test_once_arkit_gives_the_attitude_coremotion_is_not_used(dec, osc) -> None:  # type: ignore[no-untyped-def]
     _, bundle = osc
     coremotion = [float(v) for v in quat.to_xyzw(quat.from_axis_angle(_X, 0.4))]
-    s = dec.decode(bundle(("/ZIGSIM/d/arkitrotation", 0.0, 0.0, 0.0, 1.0), ("/ZIGSIM/d/quaternion", *coremotion)), "z", 0.0)
+    s = dec.decode(
+        bundle(("/ZIGSIM/d/arkitrotation", 0.0, 0.0, 0.0, 1.0), ("/ZIGSIM/d/quaternion", *coremotion)), "z", 0.0
+    )
     assert np.allclose(s.orientation, arkit_to_stick([1.0, 0.0, 0.0, 0.0]))
     assert dec.decode(bundle(("/ZIGSIM/d/quaternion", *coremotion)), "z", 0.1) is None
 
@@ -173,8 +183,13 @@ def test_long_addresses_are_cut_in_the_detail(dec, osc) -> None:  # type: ignore
 
 def test_a_pattern_or_an_unknown_address_does_not_cost_the_rest_of_the_bundle(dec, osc) -> None:  # type: ignore[no-untyped-def]
     _, bundle = osc
-    s = dec.decode(bundle(("/*/quaternion", 0.0, 0.0, 0.0, 1.0), ("/nobody/here", 1.0),
-                          ("/ZIGSIM/d/arkitposition", 1.0, 2.0, 3.0)), "z", 0.0)
+    s = dec.decode(
+        bundle(
+            ("/*/quaternion", 0.0, 0.0, 0.0, 1.0), ("/nobody/here", 1.0), ("/ZIGSIM/d/arkitposition", 1.0, 2.0, 3.0)
+        ),
+        "z",
+        0.0,
+    )
     assert s is not None and np.allclose(s.position, [1.0, 2.0, 3.0])
     assert [r for r, _ in dec.drops] == ["address pattern", "unknown address"]
 
@@ -203,13 +218,16 @@ def test_calibrate_is_in_one_sample_only(dec, osc) -> None:  # type: ignore[no-u
 
 def test_the_log_filter_is_installed_once_and_drops_only_python_osc_lines(monkeypatch: pytest.MonkeyPatch) -> None:
     root = logging.getLogger()
-    monkeypatch.setattr(root, "filters", [f for f in root.filters if not isinstance(f, osc_profiles._PythonOscWarnings)])
+    monkeypatch.setattr(
+        root, "filters", [f for f in root.filters if not isinstance(f, osc_profiles._PythonOscWarnings)]
+    )
     OscDecoder(on_drop=lambda *a: None)
     OscDecoder(on_drop=lambda *a: None)
     ours = [f for f in root.filters if isinstance(f, osc_profiles._PythonOscWarnings)]
     assert len(ours) == 1
-    inside = logging.LogRecord("x", logging.WARNING, osc_profiles._PYTHONOSC_DIR + "/parsing/osc_types.py", 1, "m", None,
-                               None)
+    inside = logging.LogRecord(
+        "x", logging.WARNING, osc_profiles._PYTHONOSC_DIR + "/parsing/osc_types.py", 1, "m", None, None
+    )
     outside = logging.LogRecord("x", logging.WARNING, "/somewhere/else.py", 1, "m", None, None)
     assert not ours[0].filter(inside) and ours[0].filter(outside)
 

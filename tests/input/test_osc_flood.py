@@ -21,10 +21,10 @@ import numpy as np
 
 from engine.app import App
 from engine.components import Stick
+from engine.pacing import RealTimePacer
 from games.sandbox import GAME
 from input.hub import InputHub
 from input.osc import OscSource
-from engine.pacing import RealTimePacer
 from input.plugin import install_input
 from input.sample import InputFrame
 
@@ -105,8 +105,9 @@ def test_a_flood_leaves_the_phone_driving_every_step():
             app.step()
             time.sleep(1 / 60)
         assert app.world.query(Stick)[0][1].source == "osc:127.0.0.1", "the phone was not admitted"
-        flood = subprocess.Popen([sys.executable, "-c", FLOOD, str(src.port), "600", str(FLOOD_RATE)],
-                                 stdout=subprocess.DEVNULL)
+        flood = subprocess.Popen(
+            [sys.executable, "-c", FLOOD, str(src.port), "600", str(FLOOD_RATE)], stdout=subprocess.DEVNULL
+        )
         end = time.monotonic() + 30
         while _drops(src) < 200 and time.monotonic() < end:  # the flood is under way
             time.sleep(0.05)
@@ -133,8 +134,10 @@ def test_a_flood_leaves_the_phone_driving_every_step():
         phone.wait(5)
         hub.close()
     st = src.status()
-    print(f"flood: {STEPS} steps at {rate:.1f} steps/s (not asserted), phone samples in {with_phone}/{STEPS} steps, "
-          f"drops {st.drop_reasons}")
+    print(
+        f"flood: {STEPS} steps at {rate:.1f} steps/s (not asserted), phone samples in {with_phone}/{STEPS} steps, "
+        f"drops {st.drop_reasons}"
+    )
     # The phone's 60 Hz stream still reaches most steps (steps without one are clock jitter; before
     # the size and budget checks, a receiver busy decoding let 1 step in 100 see the phone).
     assert with_phone >= 0.6 * STEPS

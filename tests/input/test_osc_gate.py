@@ -92,8 +92,9 @@ def test_constructor_refuses_impossible_settings(source: Callable[..., OscSource
     assert not src.status().connected
 
 
-def test_a_candidate_is_admitted_after_exactly_admit_after_valid_samples(source: Callable[..., OscSource],
-                                                                         pose: bytes) -> None:
+def test_a_candidate_is_admitted_after_exactly_admit_after_valid_samples(
+    source: Callable[..., OscSource], pose: bytes
+) -> None:
     src = source()
     for i in range(ADMIT_AFTER - 1):
         src.handle_datagram(pose, PHONE, i / 60, 5000)
@@ -147,7 +148,7 @@ def test_candidates_are_bounded(source: Callable[..., OscSource], pose: bytes) -
 
 def test_the_rate_limit_is_a_token_bucket_refilled_at_max_rate(source: Callable[..., OscSource], pose: bytes) -> None:
     src = source(max_rate=10.0, admit_after=1)
-    for k in range(10):  # a full bucket: ten at once
+    for _k in range(10):  # a full bucket: ten at once
         src.handle_datagram(pose, PHONE, 0.0, 5000)
         src.drain()
     src.handle_datagram(pose, PHONE, 0.0, 5000)
@@ -224,8 +225,9 @@ def test_the_admitting_datagram_starts_the_full_budget(source: Callable[..., Osc
     assert "over budget" not in src.status().drop_reasons
 
 
-def test_other_ports_of_an_admitted_phone_have_their_own_bucket_and_budget(source: Callable[..., OscSource],
-                                                                          pose: bytes) -> None:
+def test_other_ports_of_an_admitted_phone_have_their_own_bucket_and_budget(
+    source: Callable[..., OscSource], pose: bytes
+) -> None:
     src = source(admit_after=1, max_rate=4.0, timeout=1.0)
     src.handle_datagram(pose, PHONE, 0.0, 5000)
     src.drain()
@@ -238,8 +240,9 @@ def test_other_ports_of_an_admitted_phone_have_their_own_bucket_and_budget(sourc
     assert (DISCONNECT, PHONE) in src.drain()
 
 
-def test_a_valid_pose_from_another_port_is_the_phones_and_keeps_it_alive(source: Callable[..., OscSource],
-                                                                        pose: bytes) -> None:
+def test_a_valid_pose_from_another_port_is_the_phones_and_keeps_it_alive(
+    source: Callable[..., OscSource], pose: bytes
+) -> None:
     src = source(admit_after=1, timeout=1.0)
     src.handle_datagram(pose, PHONE, 0.0, 5000)
     src.drain()
@@ -279,4 +282,3 @@ def test_quiet_senders_expire_after_the_timeout(source: Callable[..., OscSource]
     assert late.drain() == []
     late.handle_datagram(pose, PHONE, 1.03, 5000)
     assert (CONNECT, PHONE) in late.drain()
-

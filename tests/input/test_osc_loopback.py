@@ -13,8 +13,17 @@ import pytest
 
 from engine.components import Stick
 from input.hub import InputHub
-from input.osc import (ADMIT_AFTER, CANDIDATE_BUDGET, MAX_BUNDLE_DEPTH, MAX_CANDIDATES, MAX_DATAGRAM, MAX_MESSAGES, STEP_BUDGET, OscSource,
-                       bundle_shape)
+from input.osc import (
+    ADMIT_AFTER,
+    CANDIDATE_BUDGET,
+    MAX_BUNDLE_DEPTH,
+    MAX_CANDIDATES,
+    MAX_DATAGRAM,
+    MAX_MESSAGES,
+    STEP_BUDGET,
+    OscSource,
+    bundle_shape,
+)
 from input.sample import CONNECT, TOUCH_DOWN
 
 ZIG_SENDER = textwrap.dedent("""

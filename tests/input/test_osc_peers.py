@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from input.osc import ADMIT_AFTER, OscSource
 from input.sample import CONNECT, DISCONNECT, PoseSample
 
@@ -28,7 +26,7 @@ def test_a_forger_of_the_phones_address_does_not_starve_it(osc) -> None:  # type
                     src.handle_datagram(b"\x00garbage", PHONE, now + k * 1e-5, 40000 + k % 7)
             src.handle_datagram(pose, PHONE, now + 1e-3, 50123)
             per_step.append(len(_samples(src.drain())))
-        assert per_step[ADMIT_AFTER - 1:] == [1] * (120 - ADMIT_AFTER + 1)
+        assert per_step[ADMIT_AFTER - 1 :] == [1] * (120 - ADMIT_AFTER + 1)
         assert src.status().drop_reasons["over budget"] > 0  # the forger spent a budget of its own
     finally:
         src.stop()

@@ -39,9 +39,18 @@ def test_own_scheme_pose_touch_calibrate(dec, osc):
 def test_zigsim_bundle_is_one_sample_with_touch_while_present(dec, osc):
     _, bundle = osc
     q = pitch_xyzw(0.4)
-    s = dec.decode(bundle(("/ZIGSIM/dev1/quaternion", *q), ("/ZIGSIM/dev1/touch01", 0.1), ("/ZIGSIM/dev1/touch02", -0.2),
-                          ("/ZIGSIM/dev1/gyro", 0.0, 0.5, 0.0), ("/ZIGSIM/dev1/accel", 0.0, 0.0, 1.0),
-                          ("/dev1/deviceinfo", "iPhone", "dev1", "ios", "17", 1170, 2532)), "z", 0.0)
+    s = dec.decode(
+        bundle(
+            ("/ZIGSIM/dev1/quaternion", *q),
+            ("/ZIGSIM/dev1/touch01", 0.1),
+            ("/ZIGSIM/dev1/touch02", -0.2),
+            ("/ZIGSIM/dev1/gyro", 0.0, 0.5, 0.0),
+            ("/ZIGSIM/dev1/accel", 0.0, 0.0, 1.0),
+            ("/dev1/deviceinfo", "iPhone", "dev1", "ios", "17", 1170, 2532),
+        ),
+        "z",
+        0.0,
+    )
     assert s.touch is True
     expect = phone_to_stick(quat.from_xyzw(q))
     assert np.allclose(s.orientation, expect)
@@ -54,8 +63,15 @@ def test_zigsim_bundle_is_one_sample_with_touch_while_present(dec, osc):
 def test_zigsim_docs_prefix_and_arkit_six_dof(dec, osc):
     _, bundle = osc
     rot = [0.0, 0.0, 0.0, 1.0]
-    s = dec.decode(bundle(("/dev1/quaternion", *pitch_xyzw(0.2)), ("/dev1/arkitposition", 0.5, 1.2, -0.3),
-                          ("/dev1/arkitrotation", *rot)), "z", 0.0)
+    s = dec.decode(
+        bundle(
+            ("/dev1/quaternion", *pitch_xyzw(0.2)),
+            ("/dev1/arkitposition", 0.5, 1.2, -0.3),
+            ("/dev1/arkitrotation", *rot),
+        ),
+        "z",
+        0.0,
+    )
     assert np.allclose(s.position, [0.5, 1.2, -0.3])
     assert np.allclose(s.orientation, arkit_to_stick([1.0, 0, 0, 0]))  # ARKit attitude wins over CoreMotion
     assert np.allclose(quat.rotate(s.orientation, Z), [0, 0, -1])  # the back camera looks along -Z
@@ -86,25 +102,29 @@ def test_gyrosc_quaternion_order_is_configurable(osc):
     q = quat.from_axis_angle([1, 0, 0], 0.7)
     wxyz = OscDecoder(on_drop=lambda *a: None).decode(message("/gyrosc/quat", *map(float, q)), "g", 0.0)
     xyzw = OscDecoder(on_drop=lambda *a: None, gyrosc_order="xyzw").decode(
-        message("/gyrosc/quat", *map(float, quat.to_xyzw(q))), "g", 0.0)
+        message("/gyrosc/quat", *map(float, quat.to_xyzw(q))), "g", 0.0
+    )
     assert np.allclose(wxyz.orientation, xyzw.orientation)
     with pytest.raises(ValueError):
         OscDecoder(on_drop=lambda *a: None, gyrosc_order="wxyy")
 
 
-@pytest.mark.parametrize("packet,reason", [
-    (b"garbage!", "malformed packet"),
-    (b"", "malformed packet"),
-    ("trunc", "malformed packet"),
-    (("/puppetphone/orientation", float("nan"), 0.0, 0.0, 0.0), "non-finite value"),
-    (("/puppetphone/orientation", float("inf"), 0.0, 0.0, 0.0), "non-finite value"),
-    (("/puppetphone/orientation", "one", 0.0, 0.0, 0.0), "wrong type"),
-    (("/puppetphone/orientation", 1.0, 0.0), "wrong arity"),
-    (("/puppetphone/orientation", 2.0, 0.0, 0.0, 0.0), "non-unit quaternion"),
-    (("/ZIGSIM/x/quaternion", 0.0, 0.0, 0.0, 0.0), "non-unit quaternion"),
-    (("/nobody/sends/this", 1.0), "unknown address"),
-    (("/*/quaternion", 0.0, 0.0, 0.0, 1.0), "address pattern"),
-])
+@pytest.mark.parametrize(
+    "packet,reason",
+    [
+        (b"garbage!", "malformed packet"),
+        (b"", "malformed packet"),
+        ("trunc", "malformed packet"),
+        (("/puppetphone/orientation", float("nan"), 0.0, 0.0, 0.0), "non-finite value"),
+        (("/puppetphone/orientation", float("inf"), 0.0, 0.0, 0.0), "non-finite value"),
+        (("/puppetphone/orientation", "one", 0.0, 0.0, 0.0), "wrong type"),
+        (("/puppetphone/orientation", 1.0, 0.0), "wrong arity"),
+        (("/puppetphone/orientation", 2.0, 0.0, 0.0, 0.0), "non-unit quaternion"),
+        (("/ZIGSIM/x/quaternion", 0.0, 0.0, 0.0, 0.0), "non-unit quaternion"),
+        (("/nobody/sends/this", 1.0), "unknown address"),
+        (("/*/quaternion", 0.0, 0.0, 0.0, 1.0), "address pattern"),
+    ],
+)
 def test_bad_input_is_dropped_with_a_reason(dec, osc, packet, reason):
     message, _ = osc
     if packet == "trunc":
@@ -117,8 +137,11 @@ def test_bad_input_is_dropped_with_a_reason(dec, osc, packet, reason):
 
 def test_a_bad_message_in_a_bundle_does_not_lose_the_good_ones(dec, osc):
     _, bundle = osc
-    s = dec.decode(bundle(("/ZIGSIM/d/quaternion", float("nan"), 0.0, 0.0, 1.0), ("/ZIGSIM/d/arkitposition", 1.0, 2.0, 3.0)),
-                   "z", 0.0)
+    s = dec.decode(
+        bundle(("/ZIGSIM/d/quaternion", float("nan"), 0.0, 0.0, 1.0), ("/ZIGSIM/d/arkitposition", 1.0, 2.0, 3.0)),
+        "z",
+        0.0,
+    )
     assert np.allclose(s.position, [1, 2, 3]) and dec.drops == ["non-finite value"]
 
 

@@ -2,9 +2,13 @@ from input.pairing import PairingInfo, lan_addresses, pairing_info, qr_ascii
 
 
 def test_lines_name_addresses_devices_and_the_bind_warning():
-    info = PairingInfo(port=9000, bind_host="127.0.0.1", addresses=["192.168.1.5"],
-                       hid_devices=[{"name": "DualSense", "vendor_id": 0x054C, "product_id": 0x0CE6, "kind": "dualsense"}],
-                       serial_ports=[{"device": "/dev/ttyUSB0", "description": "CP2102"}])
+    info = PairingInfo(
+        port=9000,
+        bind_host="127.0.0.1",
+        addresses=["192.168.1.5"],
+        hid_devices=[{"name": "DualSense", "vendor_id": 0x054C, "product_id": 0x0CE6, "kind": "dualsense"}],
+        serial_ports=[{"device": "/dev/ttyUSB0", "description": "CP2102"}],
+    )
     text = "\n".join(info.lines())
     assert "192.168.1.5" in text and "osc.udp://192.168.1.5:9000/" in text
     assert "DualSense [054c:0ce6]" in text and "/dev/ttyUSB0" in text

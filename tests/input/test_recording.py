@@ -28,8 +28,16 @@ def record_session(make_app, path, steps=120, source="osc:192.168.1.23"):
     for i in range(steps):
         pitch = -0.3 + 0.2 * np.sin(i / 15) + rng.normal(0, 0.002)
         q = quat.from_axis_angle([1.0, 0.0, 0.0], pitch)
-        src.push(PoseSample(time=i / 60, source=source, orientation=q, angular_velocity=rng.normal(0, 1, 3),
-                            acceleration=[0.0, 9.81, 0.0], touch=(i in range(3, 5)) or (i >= 10 and i < 90)))
+        src.push(
+            PoseSample(
+                time=i / 60,
+                source=source,
+                orientation=q,
+                angular_velocity=rng.normal(0, 1, 3),
+                acceleration=[0.0, 9.81, 0.0],
+                touch=(i in range(3, 5)) or (i >= 10 and i < 90),
+            )
+        )
         app.step()
     rec.close()
     return app, rec
@@ -61,10 +69,10 @@ def test_cut_at_any_byte_recovers_every_complete_frame(make_app, tmp_path):
     data = path.read_bytes()
     full = read_recording(path)
     # Record boundaries: after the header, then after each record.
-    pos = len(MAGIC) + 8 + int.from_bytes(data[len(MAGIC):len(MAGIC) + 4], "little")
+    pos = len(MAGIC) + 8 + int.from_bytes(data[len(MAGIC) : len(MAGIC) + 4], "little")
     first, ends = pos, []
     while pos < len(data):
-        pos += 8 + int.from_bytes(data[pos:pos + 4], "little")
+        pos += 8 + int.from_bytes(data[pos : pos + 4], "little")
         ends.append(pos)
     assert ends[-1] == len(data) and len(ends) == 31  # 30 records and the closing one
     assert full.complete and len(full) == 30
@@ -98,8 +106,11 @@ def test_damaged_byte_and_bad_headers(make_app, tmp_path):
     path.write_bytes(bytes(data))
     r = read_recording(path)
     assert len(r) == 9 and "checksum" in r.problem and not r.cut
-    for bad, msg in ((b"not a recording", "bad magic"), (MAGIC + b"\x05", "cut inside its header"),
-                     (bytes(data[:20]), "cut inside its header")):
+    for bad, msg in (
+        (b"not a recording", "bad magic"),
+        (MAGIC + b"\x05", "cut inside its header"),
+        (bytes(data[:20]), "cut inside its header"),
+    ):
         path.write_bytes(bad)
         with pytest.raises(RecordingError, match=msg):
             read_recording(path)
@@ -168,8 +179,9 @@ def test_a_full_disk_moves_the_recording_to_the_recovery_folder_whole(make_app, 
         assert cut.hashes == whole.hashes[: len(cut)]
 
 
-def test_a_full_disk_everywhere_stops_the_recording_with_one_line_and_the_session_plays_on(make_app, tmp_path, capsys,
-                                                                                            monkeypatch):
+def test_a_full_disk_everywhere_stops_the_recording_with_one_line_and_the_session_plays_on(
+    make_app, tmp_path, capsys, monkeypatch
+):
     from tests.faults import full_disk
 
     with full_disk(tmp_path / "disk", free=8192) as disk:
@@ -194,8 +206,17 @@ def test_size_per_minute(make_app, tmp_path):
     rec = Recorder(path, RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
     for i in range(600):
         d = np.array([np.sin(i / 50), -0.3, 1.0])
-        src.push(PoseSample(time=i / 60, source="mouse", orientation=quat.between([0, 0, 1], d / np.linalg.norm(d)),
-                            position=[0, 1.5, -4], mode="world", plane_normal=[0, 0, 1], touch=i > 30))
+        src.push(
+            PoseSample(
+                time=i / 60,
+                source="mouse",
+                orientation=quat.between([0, 0, 1], d / np.linalg.norm(d)),
+                position=[0, 1.5, -4],
+                mode="world",
+                plane_normal=[0, 0, 1],
+                touch=i > 30,
+            )
+        )
         app.step()
     rec.close()
     per_min["mouse"] = (path.stat().st_size - 100) / 600 * 3600
@@ -218,21 +239,24 @@ def _with_header(path, header: bytes):
     return path
 
 
-@pytest.mark.parametrize("header,says", [
-    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "format": "1"}', "format"),
-    (b'{"game": "snowman", "seed": 0, "dt": "fast"}', "dt"),
-    (b'{"game": "snowman", "seed": 0, "dt": 1e308}', "dt"),
-    (b'{"game": "snowman", "seed": 0, "dt": 0}', "dt"),
-    (b'{"game": "snowman", "seed": -1, "dt": 0.0166}', "seed"),
-    (b'{"game": "snowman", "seed": true, "dt": 0.0166}', "seed"),
-    (b'{"game": ["snowman"], "seed": 0, "dt": 0.0166}', "game"),
-    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "extra": []}', "extra"),
-    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "sources": "osc"}', "sources"),
-    (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "hack": 1}', "unknown"),
-    (b'{"seed": 0, "dt": 0.0166}', "missing game"),
-    (b'[1, 2]', "object"),
-    (b"[" * 100_000 + b"]" * 100_000, "unreadable"),
-])
+@pytest.mark.parametrize(
+    "header,says",
+    [
+        (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "format": "1"}', "format"),
+        (b'{"game": "snowman", "seed": 0, "dt": "fast"}', "dt"),
+        (b'{"game": "snowman", "seed": 0, "dt": 1e308}', "dt"),
+        (b'{"game": "snowman", "seed": 0, "dt": 0}', "dt"),
+        (b'{"game": "snowman", "seed": -1, "dt": 0.0166}', "seed"),
+        (b'{"game": "snowman", "seed": true, "dt": 0.0166}', "seed"),
+        (b'{"game": ["snowman"], "seed": 0, "dt": 0.0166}', "game"),
+        (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "extra": []}', "extra"),
+        (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "sources": "osc"}', "sources"),
+        (b'{"game": "snowman", "seed": 0, "dt": 0.0166, "hack": 1}', "unknown"),
+        (b'{"seed": 0, "dt": 0.0166}', "missing game"),
+        (b"[1, 2]", "object"),
+        (b"[" * 100_000 + b"]" * 100_000, "unreadable"),
+    ],
+)
 def test_wrong_typed_or_absurd_header_fields_are_a_recording_error(tmp_path, header, says):
     with pytest.raises(RecordingError, match=says):
         read_recording(_with_header(tmp_path / "h.rec", header))

@@ -46,9 +46,9 @@ def recovered(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path / "data" / "puppetphone" / "recovered"
 
 
-def test_a_failed_write_goes_on_in_the_recovery_folder_whole(tmp_path: Path, recovered: Path,
-                                                             monkeypatch: pytest.MonkeyPatch,
-                                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_failed_write_goes_on_in_the_recovery_folder_whole(
+    tmp_path: Path, recovered: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=1, dt=0.02))
     for i in range(FSYNC_EVERY - 1):
         rec.write(frame(i), HASH, {"A": b"\x00\x01"})
@@ -57,8 +57,10 @@ def test_a_failed_write_goes_on_in_the_recovery_folder_whole(tmp_path: Path, rec
     rec.write(frame(FSYNC_EVERY - 1), HASH, {"A": b"\x00\x01"})  # the 60th record is synced: that fails
     assert calls and rec.path == recovered / "s.rec" and not rec.failed and rec.frames == FSYNC_EVERY
     err = capsys.readouterr().err
-    assert err == (f"recording {tmp_path / 's.rec'}: No space left on device after {FSYNC_EVERY - 1} frames; "
-                   f"it goes on in {recovered / 's.rec'} (replay that file)\n")
+    assert err == (
+        f"recording {tmp_path / 's.rec'}: No space left on device after {FSYNC_EVERY - 1} frames; "
+        f"it goes on in {recovered / 's.rec'} (replay that file)\n"
+    )
     for i in range(FSYNC_EVERY, FSYNC_EVERY + 5):
         rec.write(frame(i), HASH, {"A": b"\x00\x01"})
     rec.close()
@@ -68,8 +70,9 @@ def test_a_failed_write_goes_on_in_the_recovery_folder_whole(tmp_path: Path, rec
     assert rec.bytes + 8 == (recovered / "s.rec").stat().st_size
 
 
-def test_an_earlier_recovered_file_is_not_overwritten(tmp_path: Path, recovered: Path,
-                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+def test_an_earlier_recovered_file_is_not_overwritten(
+    tmp_path: Path, recovered: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     recovered.mkdir(parents=True)
     (recovered / "s.rec").write_bytes(b"an earlier session")
     rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=1, dt=0.02))
@@ -82,9 +85,9 @@ def test_an_earlier_recovered_file_is_not_overwritten(tmp_path: Path, recovered:
     assert read_recording(recovered / "s.1.rec").complete
 
 
-def test_a_recording_cut_under_the_recorder_stops_and_says_why(tmp_path: Path, recovered: Path,
-                                                             monkeypatch: pytest.MonkeyPatch,
-                                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_recording_cut_under_the_recorder_stops_and_says_why(
+    tmp_path: Path, recovered: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = tmp_path / "s.rec"
     rec = Recorder(path, RecordingHeader(game="t", seed=1, dt=0.02))
     for i in range(FSYNC_EVERY - 1):
@@ -94,8 +97,10 @@ def test_a_recording_cut_under_the_recorder_stops_and_says_why(tmp_path: Path, r
     path.write_bytes(b"0123456789")
     fail_fsync_once(monkeypatch, [])
     rec.write(frame(FSYNC_EVERY - 1), HASH)
-    assert rec.failed == (f"recording {path} stopped after {FSYNC_EVERY - 1} frames: No space left on device "
-                          f"(and not in {recovered} either: only 10 of its {expected} bytes can be read back)")
+    assert rec.failed == (
+        f"recording {path} stopped after {FSYNC_EVERY - 1} frames: No space left on device "
+        f"(and not in {recovered} either: only 10 of its {expected} bytes can be read back)"
+    )
     assert capsys.readouterr().err == rec.failed + "\n"
     assert rec.frames == FSYNC_EVERY - 1 and not (recovered / "s.rec").exists()
     rec.write(frame(FSYNC_EVERY), HASH)  # the session plays on: writes are ignored, not raised
@@ -103,9 +108,9 @@ def test_a_recording_cut_under_the_recorder_stops_and_says_why(tmp_path: Path, r
     assert rec.frames == FSYNC_EVERY - 1 and path.stat().st_size == 10
 
 
-def test_a_failing_sync_at_the_close_says_the_recording_may_be_incomplete(tmp_path: Path, recovered: Path,
-                                                                        monkeypatch: pytest.MonkeyPatch,
-                                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_failing_sync_at_the_close_says_the_recording_may_be_incomplete(
+    tmp_path: Path, recovered: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = tmp_path / "s.rec"
     rec = Recorder(path, RecordingHeader(game="t", seed=1, dt=0.02))
     rec.write(frame(0), HASH)
@@ -118,9 +123,9 @@ def test_a_failing_sync_at_the_close_says_the_recording_may_be_incomplete(tmp_pa
     assert capsys.readouterr().err == ""
 
 
-def test_a_failure_without_an_error_code_is_still_named(tmp_path: Path, recovered: Path,
-                                                        monkeypatch: pytest.MonkeyPatch,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_failure_without_an_error_code_is_still_named(
+    tmp_path: Path, recovered: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=1, dt=0.02))
     for i in range(FSYNC_EVERY - 1):
         rec.write(frame(i), HASH)

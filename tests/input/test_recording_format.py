@@ -38,7 +38,9 @@ HASH = "00112233445566778899aabbccddeeff"
 def frame(i: int) -> InputFrame:
     """A frame with one phone sample, so every record decodes to something checkable."""
     q = np.array([np.cos(i / 10), np.sin(i / 10), 0.0, 0.0])
-    return InputFrame(frame=i, samples=(PoseSample(time=i / 60, source="osc:10.0.0.2", orientation=q, touch=i % 2 == 0),))
+    return InputFrame(
+        frame=i, samples=(PoseSample(time=i / 60, source="osc:10.0.0.2", orientation=q, touch=i % 2 == 0),)
+    )
 
 
 def header_bytes(d: object) -> bytes:
@@ -63,10 +65,21 @@ def old_file(path: Path, fmt: int, frames: int) -> Path:
 
 
 def write(path: Path, parts: list[dict[str, bytes]], header: RecordingHeader | None = None) -> Recorder:
-    rec = Recorder(path, header or RecordingHeader(game="g", seed=3, dt=0.02, sources=["osc"], setup={"k": [1, 2]},
-                                                     extra={"note": "x"}, libraries={"numpy": "2.0.0"}))
+    rec = Recorder(
+        path,
+        header
+        or RecordingHeader(
+            game="g",
+            seed=3,
+            dt=0.02,
+            sources=["osc"],
+            setup={"k": [1, 2]},
+            extra={"note": "x"},
+            libraries={"numpy": "2.0.0"},
+        ),
+    )
     for i, p in enumerate(parts):
-        rec.write(frame(i), HASH[2 * i % 8:] + HASH[: 2 * i % 8], p)
+        rec.write(frame(i), HASH[2 * i % 8 :] + HASH[: 2 * i % 8], p)
     return rec
 
 
@@ -80,9 +93,17 @@ def test_a_recording_reads_back_exactly_what_was_written(tmp_path: Path) -> None
     assert r.complete and not r.cut and r.problem == "" and len(r) == 3
     h = r.header
     assert (h.game, h.seed, h.dt, h.sources, h.setup, h.extra, h.libraries, h.format) == (
-        "g", 3, 0.02, ["osc"], {"k": [1, 2]}, {"note": "x"}, {"numpy": "2.0.0"}, FORMAT_VERSION)
+        "g",
+        3,
+        0.02,
+        ["osc"],
+        {"k": [1, 2]},
+        {"note": "x"},
+        {"numpy": "2.0.0"},
+        FORMAT_VERSION,
+    )
     assert r.parts == parts
-    assert r.hashes == [HASH[2 * i % 8:] + HASH[: 2 * i % 8] for i in range(3)]
+    assert r.hashes == [HASH[2 * i % 8 :] + HASH[: 2 * i % 8] for i in range(3)]
     assert [f.frame for f in r.frames] == [0, 1, 2]
     np.testing.assert_array_equal(r.frames[2].samples[0].orientation, frame(2).samples[0].orientation)
     assert r.frames[1].samples[0].touch is False
@@ -163,7 +184,9 @@ def test_an_old_recording_without_parts_or_closing_record_is_complete(tmp_path: 
 def test_format_3_has_parts_but_no_closing_record(tmp_path: Path) -> None:
     """Format 3 files (before the closing record) read complete; a zero length there is a damaged record."""
     assert CLOSING_FORMAT == 4
-    payload = bytes.fromhex(HASH) + b"\x01" + struct.pack("<H", 1) + b"A" + b"\x01" + b"\x07\x08" + encode_frame(frame(0))
+    payload = (
+        bytes.fromhex(HASH) + b"\x01" + struct.pack("<H", 1) + b"A" + b"\x01" + b"\x07\x08" + encode_frame(frame(0))
+    )
     path = tmp_path / "3.rec"
     path.write_bytes(header_bytes({"game": "g", "seed": 1, "dt": 0.02, "format": 3}) + record(payload))
     r = read_recording(path)
@@ -182,8 +205,10 @@ def test_cut_and_damaged_records_are_told_apart(tmp_path: Path) -> None:
     start = len(data) - _LEN.size
     n1 = _LEN.unpack_from(data, records_start(data))[0]
     second = start - (_LEN.size + n1)
-    for cut_at, says in [(second + 3, f"cut inside the record of frame 1 (byte {second})"),
-                         (second + _LEN.size + 5, f"cut inside the record of frame 1 (byte {second})")]:
+    for cut_at, says in [
+        (second + 3, f"cut inside the record of frame 1 (byte {second})"),
+        (second + _LEN.size + 5, f"cut inside the record of frame 1 (byte {second})"),
+    ]:
         path.write_bytes(data[:cut_at])
         r = read_recording(path)
         assert r.cut and not r.complete and r.problem == says and len(r) == 1 and len(r.parts) == 1
@@ -202,16 +227,19 @@ def _one_record_file(path: Path, payload: bytes) -> Path:
     return path
 
 
-@pytest.mark.parametrize("parts,says", [
-    (b"", "record too short for its parts"),
-    (b"\x00", "record too short for its parts"),
-    (b"\x00\x01", "1 part digests for 0 part names"),
-    (b"\x01\x05\x00AB", "part names cut short"),
-    (b"\x01\x02\x00\xff\xfe\x01\x00\x00", "part names are not UTF-8"),
-    (b"\x01\x01\x00A", "record too short for its parts"),
-    (b"\x01\x03\x00A\nB\x02\x00\x00\x00", "2 part digests for 2 part names"),
-    (b"\x01\x03\x00A\nB\x01\x00\x00", "1 part digests for 2 part names"),
-])
+@pytest.mark.parametrize(
+    "parts,says",
+    [
+        (b"", "record too short for its parts"),
+        (b"\x00", "record too short for its parts"),
+        (b"\x00\x01", "1 part digests for 0 part names"),
+        (b"\x01\x05\x00AB", "part names cut short"),
+        (b"\x01\x02\x00\xff\xfe\x01\x00\x00", "part names are not UTF-8"),
+        (b"\x01\x01\x00A", "record too short for its parts"),
+        (b"\x01\x03\x00A\nB\x02\x00\x00\x00", "2 part digests for 2 part names"),
+        (b"\x01\x03\x00A\nB\x01\x00\x00", "1 part digests for 2 part names"),
+    ],
+)
 def test_a_broken_parts_block_is_an_undecodable_record(tmp_path: Path, parts: bytes, says: str) -> None:
     r = read_recording(_one_record_file(tmp_path / "p.rec", bytes.fromhex(HASH) + parts))
     assert not r.complete and not r.cut and len(r) == 0 and r.problem == f"undecodable record at frame 0: {says}"
@@ -234,11 +262,25 @@ def base(**over: object) -> dict[str, object]:
     return {"game": "g", "seed": 0, "dt": 0.02, **over}
 
 
-@pytest.mark.parametrize("d", [
-    base(game="x" * 64), base(game="x"), base(seed=2**63 - 1), base(seed=0), base(dt=MIN_DT), base(dt=MAX_DT), base(dt=1),
-    base(format=1), base(sources=[]), base(sources=["a", "b"]), base(engine_version="1.2"), base(extra={}),
-    base(libraries={}), base(setup={"a": 1}),
-])
+@pytest.mark.parametrize(
+    "d",
+    [
+        base(game="x" * 64),
+        base(game="x"),
+        base(seed=2**63 - 1),
+        base(seed=0),
+        base(dt=MIN_DT),
+        base(dt=MAX_DT),
+        base(dt=1),
+        base(format=1),
+        base(sources=[]),
+        base(sources=["a", "b"]),
+        base(engine_version="1.2"),
+        base(extra={}),
+        base(libraries={}),
+        base(setup={"a": 1}),
+    ],
+)
 def test_header_limits_are_inclusive(tmp_path: Path, d: dict[str, object]) -> None:
     path = tmp_path / "h.rec"
     fmt = d.get("format", FORMAT_VERSION)
@@ -248,25 +290,28 @@ def test_header_limits_are_inclusive(tmp_path: Path, d: dict[str, object]) -> No
     assert r.complete and r.header.game == d["game"] and r.header.seed == d["seed"] and r.header.dt == d["dt"]
 
 
-@pytest.mark.parametrize("d,says", [
-    (base(game=""), "bad header: game must be a name of 1..64 characters"),
-    (base(game="x" * 65), "bad header: game must be a name of 1..64 characters"),
-    (base(seed=2**63), "bad header: seed must be a whole number in 0..2\\*\\*63-1"),
-    (base(seed=1.0), "bad header: seed must be"),
-    (base(dt=MIN_DT * 0.99), f"bad header: dt must be a number of seconds in \\[{MIN_DT}, {MAX_DT}\\]"),
-    (base(dt=MAX_DT * 1.01), "bad header: dt must be"),
-    (base(dt=True), "bad header: dt must be"),
-    (base(format=0), "bad header: format must be a whole number from 1"),
-    (base(format=True), "bad header: format must be"),
-    (base(sources=[1]), "bad header: sources must be a list of names"),
-    (base(engine_version=1), "bad header: engine_version must be a string and extra an object"),
-    (base(libraries=[]), "bad header: libraries must be an object"),
-    (base(setup=[]), "bad header: setup must be an object"),
-    (base(zz=1, aa=2), "bad header: unknown fields 'aa', 'zz'"),
-    ([1, 2], "bad header: not a JSON object$"),
-    ({"game": "g"}, "bad header: missing dt, seed"),
-    (base(format=FORMAT_VERSION + 1), f"is format {FORMAT_VERSION + 1}; this build reads up to {FORMAT_VERSION}"),
-])
+@pytest.mark.parametrize(
+    "d,says",
+    [
+        (base(game=""), "bad header: game must be a name of 1..64 characters"),
+        (base(game="x" * 65), "bad header: game must be a name of 1..64 characters"),
+        (base(seed=2**63), "bad header: seed must be a whole number in 0..2\\*\\*63-1"),
+        (base(seed=1.0), "bad header: seed must be"),
+        (base(dt=MIN_DT * 0.99), f"bad header: dt must be a number of seconds in \\[{MIN_DT}, {MAX_DT}\\]"),
+        (base(dt=MAX_DT * 1.01), "bad header: dt must be"),
+        (base(dt=True), "bad header: dt must be"),
+        (base(format=0), "bad header: format must be a whole number from 1"),
+        (base(format=True), "bad header: format must be"),
+        (base(sources=[1]), "bad header: sources must be a list of names"),
+        (base(engine_version=1), "bad header: engine_version must be a string and extra an object"),
+        (base(libraries=[]), "bad header: libraries must be an object"),
+        (base(setup=[]), "bad header: setup must be an object"),
+        (base(zz=1, aa=2), "bad header: unknown fields 'aa', 'zz'"),
+        ([1, 2], "bad header: not a JSON object$"),
+        ({"game": "g"}, "bad header: missing dt, seed"),
+        (base(format=FORMAT_VERSION + 1), f"is format {FORMAT_VERSION + 1}; this build reads up to {FORMAT_VERSION}"),
+    ],
+)
 def test_a_bad_header_is_refused_with_one_line(tmp_path: Path, d: object, says: str) -> None:
     path = tmp_path / "h.rec"
     path.write_bytes(header_bytes(d) + _LEN.pack(0, 0))
@@ -286,13 +331,17 @@ def test_an_unknown_field_list_is_cut_short(tmp_path: Path) -> None:
 def test_header_damage_is_named(tmp_path: Path) -> None:
     path = tmp_path / "h.rec"
     good = header_bytes(base())
-    cases = [(b"PPREC!" + good[6:], "is not a PuppetPhone recording (bad magic)"),
-             (good[:9], "is cut inside its header"),
-             (good[:-1], "is cut inside its header"),
-             (good[:-2] + b"x}", "has a damaged header (checksum mismatch)"),
-             (MAGIC + _LEN.pack(MAX_HEADER + 1, 0), f"claims a {MAX_HEADER + 1}-byte header; the limit is {MAX_HEADER}")]
+    cases = [
+        (b"PPREC!" + good[6:], "is not a PuppetPhone recording (bad magic)"),
+        (good[:9], "is cut inside its header"),
+        (good[:-1], "is cut inside its header"),
+        (good[:-2] + b"x}", "has a damaged header (checksum mismatch)"),
+        (MAGIC + _LEN.pack(MAX_HEADER + 1, 0), f"claims a {MAX_HEADER + 1}-byte header; the limit is {MAX_HEADER}"),
+    ]
     bad_json = b"{nope"
-    cases.append((MAGIC + _LEN.pack(len(bad_json), zlib.crc32(bad_json)) + bad_json, "has an unreadable header: JSONDecodeError"))
+    cases.append(
+        (MAGIC + _LEN.pack(len(bad_json), zlib.crc32(bad_json)) + bad_json, "has an unreadable header: JSONDecodeError")
+    )
     for data, says in cases:
         path.write_bytes(data)
         with pytest.raises(RecordingError) as err:

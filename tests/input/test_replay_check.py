@@ -31,8 +31,9 @@ class Fed(PoseSource):
 
 def recording(hashes: list[str], parts: list[dict[str, bytes]] | None = None, first: int = 0) -> Recording:
     frames = [InputFrame(frame=first + i) for i in range(len(hashes))]
-    return Recording(header=RecordingHeader(game="t", seed=7, dt=1 / 60), frames=frames, hashes=hashes,
-                     parts=parts or [])
+    return Recording(
+        header=RecordingHeader(game="t", seed=7, dt=1 / 60), frames=frames, hashes=hashes, parts=parts or []
+    )
 
 
 def test_differing_parts_in_recorded_order_then_new() -> None:
@@ -112,15 +113,22 @@ def test_replay_source_serves_each_recorded_frame_and_counts_only_hits() -> None
     assert isinstance(hub.replay, ReplaySource) and hub.replay.recording.hashes == [H0]
 
 
-def test_verify_replays_a_recording_and_names_a_frame_out_of_step(tmp_path: Path,
-                                                                  make_app: Callable[[InputHub], App]) -> None:
+def test_verify_replays_a_recording_and_names_a_frame_out_of_step(
+    tmp_path: Path, make_app: Callable[[InputHub], App]
+) -> None:
     """A real (tiny) session verifies; a recording that starts at another frame than the app stops at once."""
     src = Fed("phone")
     app = make_app(InputHub([src]))
     rec = Recorder(tmp_path / "s.rec", RecordingHeader(game="t", seed=7, dt=app.world.dt)).attach(app)
     for i in range(4):  # the stick grabs and moves: the replay must feed the same input to match
-        src.push(PoseSample(time=i / 60, source="osc:1", orientation=quat.from_axis_angle([1.0, 0.0, 0.0], -0.3 + 0.1 * i),
-                            touch=True))
+        src.push(
+            PoseSample(
+                time=i / 60,
+                source="osc:1",
+                orientation=quat.from_axis_angle([1.0, 0.0, 0.0], -0.3 + 0.1 * i),
+                touch=True,
+            )
+        )
         app.step()
     rec.close()
     r = read_recording(tmp_path / "s.rec")

@@ -26,14 +26,17 @@ def teapot(q, counter=0):
     return out + bytes([0, counter]) + b"\r\n"
 
 
-@pytest.mark.parametrize("line,q,pos,touch", [
-    ("quat\t0.7071\t0.7071\t0\t0\r", (0.7071, 0.7071, 0, 0), None, None),
-    ("Quaternion: 1.0000, 0.0000, 0.0000, 0.0000", (1, 0, 0, 0), None, None),
-    ("1,0,0,0", (1, 0, 0, 0), None, None),
-    ("0.5 0.5 0.5 0.5 1", (0.5, 0.5, 0.5, 0.5), None, True),
-    ("1,0,0,0,0.1,0.2,0.3", (1, 0, 0, 0), (0.1, 0.2, 0.3), None),
-    ("1,0,0,0,0.1,0.2,0.3,0", (1, 0, 0, 0), (0.1, 0.2, 0.3), False),
-])
+@pytest.mark.parametrize(
+    "line,q,pos,touch",
+    [
+        ("quat\t0.7071\t0.7071\t0\t0\r", (0.7071, 0.7071, 0, 0), None, None),
+        ("Quaternion: 1.0000, 0.0000, 0.0000, 0.0000", (1, 0, 0, 0), None, None),
+        ("1,0,0,0", (1, 0, 0, 0), None, None),
+        ("0.5 0.5 0.5 0.5 1", (0.5, 0.5, 0.5, 0.5), None, True),
+        ("1,0,0,0,0.1,0.2,0.3", (1, 0, 0, 0), (0.1, 0.2, 0.3), None),
+        ("1,0,0,0,0.1,0.2,0.3,0", (1, 0, 0, 0), (0.1, 0.2, 0.3), False),
+    ],
+)
 def test_line_formats(line, q, pos, touch):
     r = parse_line(line)
     assert np.allclose(r.quaternion, np.array(q) / np.linalg.norm(q)) and r.touch == touch
@@ -46,16 +49,20 @@ def test_teapot_decode_negative_components():
 
 
 def test_stream_skips_banners_garbage_and_survives_any_chunking():
-    data = (b"Initializing I2C devices...\r\nDMP ready! Waiting for first interrupt...\r\n"
-            b"Orientation: 359.00, 1.00, 2.00\r\nquat\t1\t0\t0\t0\r\n\xff\xfe\x00" + teapot([0, 1, 0, 0], 1)
-            + b"Calibration: 3, 3, 3, 3\r\nquat\tnan\t0\t0\t0\r\n2,0,0,0\r\n" + teapot([0, 0, 1, 0], 2)
-            + b"Quaternion: 0.0, 0.0, 0.0, 1.0\r\n")
+    data = (
+        b"Initializing I2C devices...\r\nDMP ready! Waiting for first interrupt...\r\n"
+        b"Orientation: 359.00, 1.00, 2.00\r\nquat\t1\t0\t0\t0\r\n\xff\xfe\x00"
+        + teapot([0, 1, 0, 0], 1)
+        + b"Calibration: 3, 3, 3, 3\r\nquat\tnan\t0\t0\t0\r\n2,0,0,0\r\n"
+        + teapot([0, 0, 1, 0], 2)
+        + b"Quaternion: 0.0, 0.0, 0.0, 1.0\r\n"
+    )
     expect = [(1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1)]
     for size in (1, 3, 7, 64, len(data)):
         p = SerialStreamParser()
         out = []
         for i in range(0, len(data), size):
-            out += p.feed(data[i:i + size])
+            out += p.feed(data[i : i + size])
         assert [r.quaternion for r in out] == [tuple(map(float, q)) for q in expect], size
         assert p.skipped["not numeric"] == 2 and p.skipped["non-unit quaternion"] == 1
         assert p.skipped["non-finite value"] == 1 and p.skipped["binary garbage"] == 1
@@ -97,8 +104,11 @@ def _socat(tmp_path):
     a, b = tmp_path / "imu", tmp_path / "host"
     for p in (a, b):
         p.unlink(missing_ok=True)
-    proc = subprocess.Popen(["socat", f"pty,raw,echo=0,link={a}", f"pty,raw,echo=0,link={b}"],
-                            stderr=subprocess.DEVNULL, start_new_session=True)
+    proc = subprocess.Popen(
+        ["socat", f"pty,raw,echo=0,link={a}", f"pty,raw,echo=0,link={b}"],
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     assert _wait(lambda: a.exists() and b.exists())
     return proc, str(a), str(b)
 

@@ -29,8 +29,11 @@ def test_output_file(tmp_path):
     assert output_file(str(tmp_path / "new.rec")) == tmp_path / "new.rec"
     (tmp_path / "old.rec").write_bytes(b"x")
     assert output_file(str(tmp_path / "old.rec")) == tmp_path / "old.rec"  # replaced, and the command says so
-    for bad, reason in ((tmp_path / "missing" / "x.rec", "does not exist"), (tmp_path, "folder"),
-                        (Path("/dev/null"), "not a regular file")):
+    for bad, reason in (
+        (tmp_path / "missing" / "x.rec", "does not exist"),
+        (tmp_path, "folder"),
+        (Path("/dev/null"), "not a regular file"),
+    ):
         with pytest.raises(argparse.ArgumentTypeError, match=reason):
             output_file(str(bad))
 
@@ -39,20 +42,29 @@ def _play(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     script = Path(sys.executable).with_name("puppetphone")
     cmd = [str(script)] if script.exists() else [sys.executable, "-m", "puppetphone"]
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
-    return subprocess.run([*cmd, "play", "snowman", "--headless", "--frames", "1", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [*cmd, "play", "snowman", "--headless", "--frames", "1", *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
-@pytest.mark.parametrize("args,says", [
-    (("--source", "osc", "--osc-port", "70000"), "OSC port must be 0..65535"),
-    (("--source", "osc", "--osc-senders", "0"), "OSC senders must be at least 1"),
-    (("--size", "0x0"), "argument --size"),
-    (("--size", "20000x20000"), "argument --size"),
-    (("--record", "missing/x.rec"), "does not exist"),
-    (("--record", "."), "it is a folder"),
-    (("--frames", "-5"), "argument --frames"),
-    (("--seed", "-1"), "argument --seed"),
-])
+@pytest.mark.parametrize(
+    "args,says",
+    [
+        (("--source", "osc", "--osc-port", "70000"), "OSC port must be 0..65535"),
+        (("--source", "osc", "--osc-senders", "0"), "OSC senders must be at least 1"),
+        (("--size", "0x0"), "argument --size"),
+        (("--size", "20000x20000"), "argument --size"),
+        (("--record", "missing/x.rec"), "does not exist"),
+        (("--record", "."), "it is a folder"),
+        (("--frames", "-5"), "argument --frames"),
+        (("--seed", "-1"), "argument --seed"),
+    ],
+)
 def test_bad_values_give_one_line_and_exit_2(tmp_path, args, says):
     r = _play(*args, cwd=tmp_path)
     assert r.returncode == 2, r.stderr

@@ -20,21 +20,41 @@ from tests.engine.io.synthetic_bvh import human_bvh
 
 def _edit(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
-    return subprocess.run([sys.executable, "-m", "puppetphone", "author", "edit", *args, "--headless", "--frames", "10"],
-                          cwd=cwd, env=env, capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", "author", "edit", *args, "--headless", "--frames", "10"],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def test_author_edit_opens_a_bvh_and_a_glb(mocap_dir: Path, tmp_path: Path) -> None:
     r = _edit(str(mocap_dir / "cmu_16_15_walk_daz.bvh"), "--screenshot", "bvh.png", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "extracted a 1.1" in r.stderr and (tmp_path / "bvh.png").stat().st_size > 10_000
-    r = _edit(str(mocap_dir / "Fox.glb"), "--animation", "Walk", "--screenshot", "fox.png", "--record", "fox.rec",
-              cwd=tmp_path)
+    r = _edit(
+        str(mocap_dir / "Fox.glb"),
+        "--animation",
+        "Walk",
+        "--screenshot",
+        "fox.png",
+        "--record",
+        "fox.rec",
+        cwd=tmp_path,
+    )
     assert r.returncode == 0, r.stderr
     assert "a seamless loop of 17 frames" in r.stderr
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
-    again = subprocess.run([sys.executable, "-m", "puppetphone", "replay", "fox.rec", "--verify", "--headless"],
-                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    again = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "replay", "fox.rec", "--verify", "--headless"],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert again.returncode == 0, again.stdout + again.stderr  # the opened loop rides in the recording
 
 

@@ -13,8 +13,14 @@ REPO = Path(__file__).resolve().parents[2]
 
 def run(args: list[str], cwd: Path, env: dict[str, str] | None = None, code: str | None = None):  # type: ignore[no-untyped-def]
     command = [sys.executable, "-c", code, *args] if code else [sys.executable, "-m", "puppetphone", *args]
-    return subprocess.run(command, cwd=cwd, capture_output=True, text=True, timeout=300,
-                          env=env or {**os.environ, "SDL_VIDEODRIVER": "dummy"})
+    return subprocess.run(
+        command,
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env or {**os.environ, "SDL_VIDEODRIVER": "dummy"},
+    )
 
 
 def test_authoring_scenes_have_descriptions(tmp_path: Path) -> None:
@@ -24,8 +30,10 @@ def test_authoring_scenes_have_descriptions(tmp_path: Path) -> None:
 
 
 def test_cycle_plot_without_matplotlib_says_so_in_one_line(tmp_path: Path) -> None:
-    no_matplotlib = ("import sys; sys.modules['matplotlib'] = None; from puppetphone.cli import main; "
-                     "sys.argv[0] = 'puppetphone'; raise SystemExit(main(sys.argv[1:]))")
+    no_matplotlib = (
+        "import sys; sys.modules['matplotlib'] = None; from puppetphone.cli import main; "
+        "sys.argv[0] = 'puppetphone'; raise SystemExit(main(sys.argv[1:]))"
+    )
     bvh = REPO / "tests" / "data" / "puppet_walk_run.rec"
     done = run(["cycle", str(bvh), "-o", "loop.ppclip", "--plot", "loop.png"], tmp_path, code=no_matplotlib)
     assert done.returncode == 2

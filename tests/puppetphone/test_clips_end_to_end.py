@@ -28,8 +28,9 @@ SLIDE_BAR = 0.02  # m/s: planted feet in play (issue 28's bar), for mocap and bu
 
 
 def _run(*args: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess[str]:
-    out = subprocess.run([sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, env=env,
-                         cwd=cwd, timeout=300)
+    out = subprocess.run(
+        [sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=300
+    )
     assert out.returncode == 0, f"puppetphone {' '.join(args)}: {out.stderr}"
     return out
 
@@ -37,14 +38,26 @@ def _run(*args: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProc
 @pytest.fixture
 def env(tmp_path: Path) -> dict[str, str]:
     """A user whose data and cache folders are in the test's folder."""
-    e = dict(os.environ, SDL_VIDEODRIVER="dummy", SDL_AUDIODRIVER="dummy",
-             XDG_DATA_HOME=str(tmp_path / "data"), XDG_CACHE_HOME=str(tmp_path / "cache"))
-    return e
+    return dict(
+        os.environ,
+        SDL_VIDEODRIVER="dummy",
+        SDL_AUDIODRIVER="dummy",
+        XDG_DATA_HOME=str(tmp_path / "data"),
+        XDG_CACHE_HOME=str(tmp_path / "cache"),
+    )
 
 
 def test_cmu_walk_reaches_the_game(mocap_dir: Path, tmp_path: Path, env: dict[str, str]) -> None:
-    _run("cycle", str(mocap_dir / "cmu_16_15_walk_daz.bvh"), "--retarget", "puppet", "-o", "walk.ppclip",
-         env=env, cwd=tmp_path)
+    _run(
+        "cycle",
+        str(mocap_dir / "cmu_16_15_walk_daz.bvh"),
+        "--retarget",
+        "puppet",
+        "-o",
+        "walk.ppclip",
+        env=env,
+        cwd=tmp_path,
+    )
     added = _run("clips", "add", "walk.ppclip", "--role", "walk", "--clips", "lib", env=env, cwd=tmp_path)
     assert "added walk.ppclip as the walk" in added.stdout
     listed = _run("clips", "list", "--clips", "lib", env=env, cwd=tmp_path).stdout
@@ -60,8 +73,18 @@ def test_cmu_walk_reaches_the_game(mocap_dir: Path, tmp_path: Path, env: dict[st
         record_stick_walk(tmp_path / f"stick_{name}.rec", speed=speed)
         for clips, extra in (("authored", ["--clips", "lib"]), ("builtin", [])):
             out = f"{clips}_at_{name}.rec"
-            _run("play", "sandbox", "--headless", *extra, "--source", f"replay:stick_{name}.rec", "--record", out,
-                 env=env, cwd=tmp_path)
+            _run(
+                "play",
+                "sandbox",
+                "--headless",
+                *extra,
+                "--source",
+                f"replay:stick_{name}.rec",
+                "--record",
+                out,
+                env=env,
+                cwd=tmp_path,
+            )
             figures[clips, name] = walk_figures(tmp_path / out)
     for (clips, name), fig in sorted(figures.items()):
         print(f"{clips} clips at the {name} walk's speed: {fig}")
@@ -94,8 +117,9 @@ def test_a_default_library_changes_no_replay(tmp_path: Path, env: dict[str, str]
     out = _run("replay", str(shipped), "--verify", "--headless", env=env, cwd=tmp_path)
     assert "state hashes match" in out.stdout
     # play from that recording without --clips: the recorded (built-in) clips, same hashes.
-    _run("play", "sandbox", "--headless", "--source", f"replay:{shipped}", "--record", "again.rec",
-         env=env, cwd=tmp_path)
+    _run(
+        "play", "sandbox", "--headless", "--source", f"replay:{shipped}", "--record", "again.rec", env=env, cwd=tmp_path
+    )
     from input.recording import read_recording
 
     assert read_recording(tmp_path / "again.rec").hashes == read_recording(shipped).hashes
@@ -105,8 +129,21 @@ def test_a_default_library_changes_no_replay(tmp_path: Path, env: dict[str, str]
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-    _run("play", "sandbox", "--headless", "--source", "osc", "--osc-port", str(port), "--frames", "20",
-         "--record", "live.rec", env=env, cwd=tmp_path)
+    _run(
+        "play",
+        "sandbox",
+        "--headless",
+        "--source",
+        "osc",
+        "--osc-port",
+        str(port),
+        "--frames",
+        "20",
+        "--record",
+        "live.rec",
+        env=env,
+        cwd=tmp_path,
+    )
     from engine.cliplib.embed import decode
 
     setup = read_recording(tmp_path / "live.rec").header.setup

@@ -13,13 +13,30 @@ from input.recording import read_recording
 
 def puppetphone(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=600
+    )
 
 
 def test_a_recorded_take_replays_to_the_same_loop_without_writing(tmp_path: Path) -> None:
-    done = puppetphone("author", "record", "--script", "loops", "--headless", "--frames", "600", "--countdown", "1",
-                       "--seconds", "6", "--record", "take.rec", "-o", "loop.ppclip", cwd=tmp_path)
+    done = puppetphone(
+        "author",
+        "record",
+        "--script",
+        "loops",
+        "--headless",
+        "--frames",
+        "600",
+        "--countdown",
+        "1",
+        "--seconds",
+        "6",
+        "--record",
+        "take.rec",
+        "-o",
+        "loop.ppclip",
+        cwd=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     loop = load_clip(tmp_path / "loop.ppclip")
     assert loop.loop and loop.num_frames > 10  # the scripted performer's take became a clean loop
@@ -34,8 +51,22 @@ def test_a_recorded_take_replays_to_the_same_loop_without_writing(tmp_path: Path
 
 def test_a_take_of_another_tempo_is_a_divergence(tmp_path: Path) -> None:
     """The recording pins the take: replayed with a shorter countdown the state differs, and says where."""
-    done = puppetphone("author", "record", "--script", "loops", "--headless", "--frames", "120", "--countdown", "1",
-                       "--record", "take.rec", "-o", "loop.ppclip", cwd=tmp_path)
+    done = puppetphone(
+        "author",
+        "record",
+        "--script",
+        "loops",
+        "--headless",
+        "--frames",
+        "120",
+        "--countdown",
+        "1",
+        "--record",
+        "take.rec",
+        "-o",
+        "loop.ppclip",
+        cwd=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     from input.recording import Recorder
 
@@ -53,8 +84,20 @@ def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(tmp_
     from input.recording import Recorder
     from input.sample import TOOL, InputFrame
 
-    done = puppetphone("author", "record", "--script", "loops", "--headless", "--frames", "20",
-                       "--record", "take.rec", "-o", "loop.ppclip", cwd=tmp_path)
+    done = puppetphone(
+        "author",
+        "record",
+        "--script",
+        "loops",
+        "--headless",
+        "--frames",
+        "20",
+        "--record",
+        "take.rec",
+        "-o",
+        "loop.ppclip",
+        cwd=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     rec = read_recording(tmp_path / "take.rec")
     with Recorder(tmp_path / "forged.rec", rec.header) as out:
@@ -64,19 +107,40 @@ def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(tmp_
             out.write(frame, digest, parts)
     done = puppetphone("replay", "forged.rec", "--headless", cwd=tmp_path)
     assert done.returncode == 2 and "Traceback" not in done.stderr
-    assert done.stderr.strip() == "error: forged.rec: step 5: malformed tool operation '[\"zoom\", \"far\"'"
+    assert done.stderr.strip() == 'error: forged.rec: step 5: malformed tool operation \'["zoom", "far"\''
     with Recorder(tmp_path / "short.rec", rec.header) as out:  # well-formed, but missing its arguments
         for i, (frame, digest, parts) in enumerate(zip(rec.frames, rec.hashes, rec.parts, strict=True)):
             out.write(InputFrame(frame=frame.frame, events=((TOOL, '["press"]'),)) if i == 3 else frame, digest, parts)
     done = puppetphone("replay", "short.rec", "--headless", cwd=tmp_path)
-    assert done.returncode == 2 and done.stderr.strip().endswith("is not one a session knows (press, move, release, orbit, zoom, key, size with their arguments)")
+    assert done.returncode == 2 and done.stderr.strip().endswith(
+        "is not one a session knows (press, move, release, orbit, zoom, key, size with their arguments)"
+    )
 
 
 def test_a_scripted_pose_take_of_a_foot_records_and_replays(tmp_path: Path) -> None:
     """``--drive pose`` on a foot: position (by IK) and rotation in one take; the recording replays it."""
-    done = puppetphone("author", "record", "--item", "l_foot", "--drive", "pose", "--script", "loops", "--headless",
-                       "--frames", "600", "--countdown", "1", "--seconds", "6", "--record", "take.rec",
-                       "-o", "loop.ppclip", cwd=tmp_path)
+    done = puppetphone(
+        "author",
+        "record",
+        "--item",
+        "l_foot",
+        "--drive",
+        "pose",
+        "--script",
+        "loops",
+        "--headless",
+        "--frames",
+        "600",
+        "--countdown",
+        "1",
+        "--seconds",
+        "6",
+        "--record",
+        "take.rec",
+        "-o",
+        "loop.ppclip",
+        cwd=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     loop = load_clip(tmp_path / "loop.ppclip")
     import numpy as np
@@ -98,13 +162,13 @@ def test_a_six_dof_device_drives_position_and_rotation_together() -> None:
     import numpy as np
 
     from authoring.record_scene import RecordScene
+    from authoring.record_tool import RecordTool
+    from authoring.session import Session
     from engine import quat
     from engine.humanoid import humanoid_skeleton
     from input.hub import InputHub
     from input.sample import PoseSample
     from input.source import PoseSource
-    from authoring.record_tool import RecordTool
-    from authoring.session import Session
 
     class Phone(PoseSource):
         threaded = False

@@ -45,7 +45,9 @@ def test_headless_run_screenshots_and_exports(tmp_path):
     session.retime("l_foot", {10: 0.2})
     saved = save_session(session, tmp_path / "walk.ppclip")
     shot, bvh = tmp_path / "shot.png", tmp_path / "out.bvh"
-    args = parse(str(saved), "--headless", "--frames", "2", "--size", "320x180", "--screenshot", str(shot), "--export", str(bvh))
+    args = parse(
+        str(saved), "--headless", "--frames", "2", "--size", "320x180", "--screenshot", str(shot), "--export", str(bvh)
+    )
     assert run_edit(args) == 0
     assert shot.stat().st_size > 1000 and bvh.read_text().startswith("HIERARCHY")
 
@@ -64,12 +66,12 @@ def test_an_edit_session_records_and_replays_to_the_same_saved_clip(tmp_path):
     import numpy as np
     import pygame
 
-    from authoring.mocurves import save_session
-    from engine.runner import RunOptions, Runner
-    from input.recording import read_recording
     from authoring.edit_tool import reopen_edit
+    from authoring.mocurves import save_session
     from authoring.session import Session
+    from engine.runner import Runner, RunOptions
     from input.hub import InputHub
+    from input.recording import read_recording
     from input.replay import ReplaySource
 
     out, rec = tmp_path / "walk_edited.ppclip", tmp_path / "edit.rec"
@@ -104,8 +106,14 @@ def test_an_edit_session_records_and_replays_to_the_same_saved_clip(tmp_path):
     assert out.exists() and not np.allclose(read_clip_rotations(out), before), "the drag edited nothing"
 
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
-    done = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless"],
-                          capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless"],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"replayed {act.frame} frames, all {act.frame} state hashes match" in done.stdout
 
@@ -132,7 +140,9 @@ def test_a_take_opens_as_the_loop_of_the_part_picked(tmp_path, mocap_dir):
         pytest.skip(f"no headless GL: {reason}")
     out = tmp_path / "loop.ppclip"
     take = str(mocap_dir / "cmu_16_15_walk_daz.bvh")
-    args = parse(take, "--start", "0.1", "--end", "390f", "--headless", "--frames", "2", "--size", "160x90", "--export", str(out))
+    args = parse(
+        take, "--start", "0.1", "--end", "390f", "--headless", "--frames", "2", "--size", "160x90", "--export", str(out)
+    )
     assert run_edit(args) == 0
     clip = load_clip(out)
     assert clip.loop and clip.duration == pytest.approx(1.17, rel=0.04)

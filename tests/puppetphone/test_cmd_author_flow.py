@@ -33,9 +33,15 @@ def _bent_file(path: Path) -> Path:
             for p in o["primitives"]:
                 for end in ("a", "b"):
                     p[end][0] += 0.3 * p[end][1]
-    doc = {"format": FORMAT, "version": VERSION, "scene": "snowman", "size": [1280, 720],
-           "camera": {"target": [0, 0.8, 0], "yaw": 0.35, "pitch": 0.42, "distance": 17.0},
-           "edits": [{"kind": "stroke", "points": [[0, 0], [10, 10]], "d_max": 60}], "objects": objects}
+    doc = {
+        "format": FORMAT,
+        "version": VERSION,
+        "scene": "snowman",
+        "size": [1280, 720],
+        "camera": {"target": [0, 0.8, 0], "yaw": 0.35, "pitch": 0.42, "distance": 17.0},
+        "edits": [{"kind": "stroke", "points": [[0, 0], [10, 10]], "d_max": 60}],
+        "objects": objects,
+    }
     path.write_text(json.dumps(doc))
     return path
 
@@ -52,8 +58,11 @@ def test_a_scripted_stroke_bends_trees_and_saves(tmp_path: Path) -> None:
     doc = load_flow(out)
     assert [e["kind"] for e in doc["edits"]] == ["stroke"]
     rest = {o["name"]: o for o in scenery_objects()}
-    moved = {o["group"] for o in doc["objects"]
-             if np.abs(np.array(o["primitives"][0]["a"]) - rest[o["name"]]["primitives"][0]["a"]).max() > 0.05}
+    moved = {
+        o["group"]
+        for o in doc["objects"]
+        if np.abs(np.array(o["primitives"][0]["a"]) - rest[o["name"]]["primitives"][0]["a"]).max() > 0.05
+    }
     assert {"tree0", "tree4"} <= moved  # the two back trees beside the stroke bend
     assert not any(g.startswith("rock") for g in moved)
     assert shot.stat().st_size > 10000
@@ -68,8 +77,9 @@ def test_a_scripted_stroke_bends_trees_and_saves(tmp_path: Path) -> None:
 @needs_egl
 def test_the_bent_field_plays_and_replays_without_the_file(tmp_path: Path) -> None:
     flow = _bent_file(tmp_path / "lean.flow.json")
-    done = puppetphone("play", "snowman", "--flow", str(flow), "--headless", "--frames", "60", "--record", "bent.rec",
-                       cwd=tmp_path)
+    done = puppetphone(
+        "play", "snowman", "--flow", str(flow), "--headless", "--frames", "60", "--record", "bent.rec", cwd=tmp_path
+    )
     assert done.returncode == 0, done.stderr
     flow.unlink()  # the recording's header carries the bent scenery
     again = puppetphone("replay", "bent.rec", "--verify", "--headless", cwd=tmp_path)

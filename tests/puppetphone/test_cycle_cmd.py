@@ -11,8 +11,6 @@ import numpy as np
 import pytest
 
 from authoring.cycles.synthetic import make_performance
-from engine import quat
-from engine.clip import Clip
 from puppetphone.cli import main
 
 
@@ -20,7 +18,9 @@ def _csv(path: Path, dims: int = 3, seed: int = 0) -> float:
     perf = make_performance(dims, np.random.default_rng(seed), cycles=6)
     tr = perf.trajectory
     names = [f"c{i}" for i in range(dims)]
-    rows = [",".join(["time", *names])] + [",".join(repr(float(x)) for x in [t, *v]) for t, v in zip(tr.times, tr.values, strict=True)]
+    rows = [",".join(["time", *names])] + [
+        ",".join(repr(float(x)) for x in [t, *v]) for t, v in zip(tr.times, tr.values, strict=True)
+    ]
     path.write_text("\n".join(rows) + "\n")
     return perf.period
 
@@ -31,7 +31,17 @@ def _last_json(out: str) -> dict:
 
 def test_csv_to_csv_with_json_and_plot(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     period = _csv(tmp_path / "take.csv")
-    code = main(["cycle", str(tmp_path / "take.csv"), "-o", str(tmp_path / "loop.csv"), "--json", "--plot", str(tmp_path / "fig.png")])
+    code = main(
+        [
+            "cycle",
+            str(tmp_path / "take.csv"),
+            "-o",
+            str(tmp_path / "loop.csv"),
+            "--json",
+            "--plot",
+            str(tmp_path / "fig.png"),
+        ]
+    )
     assert code == 0
     summary = _last_json(capsys.readouterr().out)
     assert {"period_frames", "period_seconds", "cycles", "dims", "closure_error", "seconds"} <= set(summary)
@@ -75,20 +85,27 @@ def test_bvh_walk_to_clip(tmp_path: Path, mocap_dir: Path, capsys: pytest.Captur
     assert 136 <= summary["period_frames"] <= 144  # README: ≈140 frames at 120 fps
     assert summary["skipped_frames"] >= 1  # the T-pose lead-in
     given = summary["input"]  # counts as analysed and as in the file
-    assert given["file_frames"] == 472 and given["frames"] == 472 - given["skipped_frames"] and given["file_joints"] == 43
+    assert (
+        given["file_frames"] == 472 and given["frames"] == 472 - given["skipped_frames"] and given["file_joints"] == 43
+    )
     clip = load_clip(out)
     assert clip.loop and clip.duration == pytest.approx(summary["period_seconds"], rel=1e-6)
 
 
-def test_a_one_cycle_gltf_loop_reports_one_cycle(tmp_path: Path, mocap_dir: Path,
-                                                 capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["cycle", str(mocap_dir / "Fox.glb"), "--animation", "Walk", "-o", str(tmp_path / "w.glb"), "--json"]) == 0
+def test_a_one_cycle_gltf_loop_reports_one_cycle(
+    tmp_path: Path, mocap_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert (
+        main(["cycle", str(mocap_dir / "Fox.glb"), "--animation", "Walk", "-o", str(tmp_path / "w.glb"), "--json"]) == 0
+    )
     summary = _last_json(capsys.readouterr().out)
     assert summary["cycles"] == 1 and summary["input"]["file_joints"] == 24
 
 
 def test_jump_is_refused(tmp_path: Path, mocap_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(["cycle", str(mocap_dir / "cmu_13_32_forward_jump_NEGATIVE_daz.bvh"), "-o", str(tmp_path / "j.bvh"), "--json"])
+    code = main(
+        ["cycle", str(mocap_dir / "cmu_13_32_forward_jump_NEGATIVE_daz.bvh"), "-o", str(tmp_path / "j.bvh"), "--json"]
+    )
     assert code == 3
     assert "period" in _last_json(capsys.readouterr().out)["error"]
 
@@ -97,8 +114,20 @@ def test_console_entry_point(tmp_path: Path) -> None:
     """The real process: ``python -m puppetphone cycle`` prints the JSON as its last stdout line."""
     _csv(tmp_path / "take.csv", dims=2, seed=4)
     proc = subprocess.run(
-        [sys.executable, "-m", "puppetphone", "cycle", str(tmp_path / "take.csv"), "-o", str(tmp_path / "l.npz"), "--json"],
-        capture_output=True, text=True, timeout=120, check=False,
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "cycle",
+            str(tmp_path / "take.csv"),
+            "-o",
+            str(tmp_path / "l.npz"),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
     )
     assert proc.returncode == 0, proc.stderr
     assert _last_json(proc.stdout)["cycles"] >= 4
@@ -107,8 +136,9 @@ def test_console_entry_point(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("frames", [0, 1, 2, 3])
 @pytest.mark.parametrize("kind", ["bvh", "npz"])
-def test_too_few_frames_is_one_line_not_a_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                    kind: str, frames: int) -> None:
+def test_too_few_frames_is_one_line_not_a_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, frames: int
+) -> None:
     from tests.engine.io.synthetic_bvh import human_bvh
 
     if kind == "bvh":
@@ -127,7 +157,7 @@ def test_a_deeply_nested_joint_map_is_one_line(tmp_path: Path, capsys: pytest.Ca
 
     src, jm = tmp_path / "walk.bvh", tmp_path / "map.json"
     src.write_text(human_bvh())
-    jm.write_text("{\"a\": " + "[" * 100_000 + "]" * 100_000 + "}")
+    jm.write_text('{"a": ' + "[" * 100_000 + "]" * 100_000 + "}")
     assert main(["cycle", str(src), "--joint-map", str(jm), "-o", str(tmp_path / "out.ppclip")]) == 2
     assert "nested too deeply" in capsys.readouterr().err
 

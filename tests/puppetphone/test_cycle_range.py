@@ -37,8 +37,10 @@ def test_refusal_names_the_best_segment_and_the_hint_extracts_the_jumping_jacks(
     out = tmp_path / "loop.npz"
     whole = _cycle(str(tmp_path / "mixed.csv"), "-o", str(out))
     assert whole.returncode == 3 and not out.exists()
-    m = re.search(r"frames (\d+)–(\d+) loop with period ([\d.]+) s \((\d+) cycles\); try --start (\S+) --end (\S+)$",
-                  whole.stderr.strip())
+    m = re.search(
+        r"frames (\d+)–(\d+) loop with period ([\d.]+) s \((\d+) cycles\); try --start (\S+) --end (\S+)$",
+        whole.stderr.strip(),
+    )
     assert m, whole.stderr
     assert whole.stderr.count("\n") == 1  # one line
     f0, f1, period = int(m[1]), int(m[2]), float(m[3])
@@ -46,7 +48,9 @@ def test_refusal_names_the_best_segment_and_the_hint_extracts_the_jumping_jacks(
     assert period == pytest.approx(parts[0].period, abs=0.02)
     hinted = _cycle(str(tmp_path / "mixed.csv"), "-o", str(out), "--start", m[5], "--end", m[6], "--json")
     assert hinted.returncode == 0, hinted.stderr
-    assert json.loads(hinted.stdout.strip().splitlines()[-1])["period_seconds"] == pytest.approx(parts[0].period, rel=0.02)
+    assert json.loads(hinted.stdout.strip().splitlines()[-1])["period_seconds"] == pytest.approx(
+        parts[0].period, rel=0.02
+    )
     with np.load(out) as z:
         assert loop_error(z["values"], parts[0].truth)[0] < 0.1
 
@@ -62,17 +66,22 @@ def test_start_end_in_seconds_or_frames_extracts_each_activity(tmp_path: Path, w
         start, end = f"{bounds[which] + pad:.2f}", f"{bounds[which + 1] - pad:.2f}s"
     r = _cycle(str(tmp_path / "mixed.csv"), "-o", str(out), "--start", start, "--end", end, "--json")
     assert r.returncode == 0, r.stderr
-    assert json.loads(r.stdout.strip().splitlines()[-1])["period_seconds"] == pytest.approx(parts[which].period, rel=0.03)
+    assert json.loads(r.stdout.strip().splitlines()[-1])["period_seconds"] == pytest.approx(
+        parts[which].period, rel=0.03
+    )
     with np.load(out) as z:
         assert loop_error(z["values"], parts[which].truth)[0] < 0.1
 
 
-@pytest.mark.parametrize(("start", "end", "message"), [
-    ("3x", "5", "is not a time in seconds"),
-    ("-1", "5", "from 0 on"),
-    ("8", "4", "is not a range inside the take"),
-    ("0", "99", "is not a range inside the take"),
-])
+@pytest.mark.parametrize(
+    ("start", "end", "message"),
+    [
+        ("3x", "5", "is not a time in seconds"),
+        ("-1", "5", "from 0 on"),
+        ("8", "4", "is not a range inside the take"),
+        ("0", "99", "is not a range inside the take"),
+    ],
+)
 def test_bad_ranges_are_refused_in_one_line(tmp_path: Path, start: str, end: str, message: str) -> None:
     _write_csv(tmp_path / "mixed.csv")
     r = _cycle(str(tmp_path / "mixed.csv"), "-o", str(tmp_path / "o.csv"), "--start", start, "--end", end)

@@ -37,8 +37,14 @@ def _straight_walk_bvh(path: Path, frames: int = 600, fps: float = 60.0) -> Path
 
 def _cycle(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     exe = Path(sys.executable).with_name("puppetphone")
-    return subprocess.run([str(exe), "cycle", *args], cwd=cwd, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "PYTHONHASHSEED": "0"})
+    return subprocess.run(
+        [str(exe), "cycle", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONHASHSEED": "0"},
+    )
 
 
 def test_cycle_clip_opens_with_the_extractors_control_points(tmp_path: Path) -> None:
@@ -65,7 +71,9 @@ def test_cycle_clip_opens_with_the_extractors_control_points(tmp_path: Path) -> 
     assert session.control_count(root) == fitted.segments != EditSession(session.clip).control_count(root)
     assert np.allclose(session.control_points(root), expected.shown(), atol=1e-12)
     # The curve is the clip's root within the extractor's bound.
-    assert np.abs(expected.positions(session.clip.num_frames) - session.clip.root).max() <= 2 * max(fitted.max_error, 1e-3)
+    assert np.abs(expected.positions(session.clip.num_frames) - session.clip.root).max() <= 2 * max(
+        fitted.max_error, 1e-3
+    )
     # Other items still get MoCurves' own fit.
     assert session.control_count("l_hand") == max(4, session.clip.num_frames // 5)
 
@@ -104,8 +112,14 @@ def test_corrupt_curve_section_is_refused_by_author_edit(tmp_path: Path) -> None
     with pytest.raises(ClipFileError, match="root curve has shapes"):
         load_clip_curve(tmp_path / "walk.ppclip")
     exe = Path(sys.executable).with_name("puppetphone")
-    done = subprocess.run([str(exe), "author", "edit", "walk.ppclip", "--headless", "--frames", "1"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=300, env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
+    done = subprocess.run(
+        [str(exe), "author", "edit", "walk.ppclip", "--headless", "--frames", "1"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "SDL_VIDEODRIVER": "dummy"},
+    )
     assert done.returncode != 0 and "root curve has shapes" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
 
@@ -115,7 +129,10 @@ def test_swaying_walk_keeps_mocurves_own_fit(tmp_path: Path, mocap_dir: Path) ->
     done = _cycle(str(mocap_dir / "cmu_16_15_walk_daz.bvh"), "-o", "walk.ppclip", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     clip, curve = load_clip_curve(tmp_path / "walk.ppclip")
-    assert curve is None and load_session(tmp_path / "walk.ppclip").control_count(clip.skeleton.names[0]) == clip.num_frames // 5
+    assert (
+        curve is None
+        and load_session(tmp_path / "walk.ppclip").control_count(clip.skeleton.names[0]) == clip.num_frames // 5
+    )
 
 
 def test_a_retargeted_loop_plays_in_place_with_its_travel_as_root_motion(tmp_path: Path) -> None:

@@ -21,7 +21,9 @@ from authoring.batch.index import read_index
 from puppetphone.bench.cycles_batch import write_takes
 
 CLI = [sys.executable, "-m", "puppetphone", "cycles"]
-SUMMARY = re.compile(r"^cycles: (\d+) looped \((\d+) clips\), (\d+) refused, (\d+) failed, (\d+) already done, in [\d.]+ s")
+SUMMARY = re.compile(
+    r"^cycles: (\d+) looped \((\d+) clips\), (\d+) refused, (\d+) failed, (\d+) already done, in [\d.]+ s"
+)
 
 
 def _cycles(*args: str, timeout: float = 300) -> subprocess.CompletedProcess[str]:
@@ -35,8 +37,9 @@ def _content(lib: Path) -> tuple[list[tuple], list[tuple]]:
         import hashlib
 
         assert hashlib.sha256(c.path.read_bytes()).hexdigest() == c.sha256, c.file
-    return [(t.hash, t.source, t.outcome, t.reason, t.frames, t.dims, t.clips) for t in takes], \
-        [tuple(vars(c)[k] for k in vars(c) if k != "path") for c in clips]
+    return [(t.hash, t.source, t.outcome, t.reason, t.frames, t.dims, t.clips) for t in takes], [
+        tuple(vars(c)[k] for k in vars(c) if k != "path") for c in clips
+    ]
 
 
 def test_real_mocap_folder_then_nothing_to_do(mocap_dir: Path, tmp_path: Path) -> None:
@@ -57,7 +60,9 @@ def test_real_mocap_folder_then_nothing_to_do(mocap_dir: Path, tmp_path: Path) -
     assert jump.outcome == "refused" and jump.reason
     walk = next(c for c in entries if "cmu_16_15_walk" in c.source)
     assert walk.kind == "walk" and walk.period == pytest.approx(1.17, rel=0.03) and 0.7 < walk.speed < 1.6
-    assert walk.licence.startswith("CMU") and next(c for c in entries if "bandai" in c.source).licence.startswith("CC BY-NC")
+    assert walk.licence.startswith("CMU") and next(c for c in entries if "bandai" in c.source).licence.startswith(
+        "CC BY-NC"
+    )
     from engine.clipfile import load_clip
 
     assert load_clip(walk.path).loop
@@ -73,8 +78,12 @@ def test_killed_run_resumes_to_the_same_index(tmp_path: Path) -> None:
     reference = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "ref"), "--jobs", "2")
     assert reference.returncode == 0, reference.stderr
     lib = tmp_path / "lib"
-    proc = subprocess.Popen([*CLI, str(tmp_path / "takes"), "-o", str(lib), "--jobs", "1"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    proc = subprocess.Popen(
+        [*CLI, str(tmp_path / "takes"), "-o", str(lib), "--jobs", "1"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     done = 0
     deadline = time.monotonic() + 240
     while time.monotonic() < deadline and proc.poll() is None:
@@ -137,8 +146,9 @@ def test_dask_local_cluster_of_two_workers(tmp_path: Path) -> None:
     write_takes(tmp_path / "takes", count=8)
     local = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "local"), "--jobs", "1")
     assert local.returncode == 0, local.stderr
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address="127.0.0.1:0") as cluster:  # any free port, not 8787
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address="127.0.0.1:0"
+    ) as cluster:  # any free port, not 8787
         for mode in ([], ["--send-bytes"]):
             lib = tmp_path / f"dask{len(mode)}"
             r = _cycles(str(tmp_path / "takes"), "-o", str(lib), "--scheduler", cluster.scheduler_address, *mode)
@@ -153,8 +163,16 @@ def test_retarget_puppet_writes_clips_on_the_puppet_skeleton(mocap_dir: Path, tm
     from engine.clipfile import load_clip
     from engine.humanoid import humanoid_skeleton
 
-    r = _cycles(str(mocap_dir / "cmu_16_15_walk_daz.bvh"), str(mocap_dir / "bandai1_walk_normal_001.bvh"),
-                "-o", str(tmp_path / "lib"), "--retarget", "puppet", "--jobs", "1")
+    r = _cycles(
+        str(mocap_dir / "cmu_16_15_walk_daz.bvh"),
+        str(mocap_dir / "bandai1_walk_normal_001.bvh"),
+        "-o",
+        str(tmp_path / "lib"),
+        "--retarget",
+        "puppet",
+        "--jobs",
+        "1",
+    )
     assert r.returncode == 0, r.stderr
     _, clips = read_index(tmp_path / "lib")
     assert len(clips) == 2

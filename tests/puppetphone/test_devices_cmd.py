@@ -34,24 +34,38 @@ def test_the_play_command_devices_prints_listens_where_the_qr_code_points(tmp_pa
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path)}
-    shown = subprocess.run([sys.executable, "-m", "puppetphone", "devices", "--osc-port", str(port), "--no-qr"],
-                           capture_output=True, text=True, env=env, timeout=60).stdout
+    shown = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "devices", "--osc-port", str(port), "--no-qr"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    ).stdout
     urls = [w for w in shown.split() if w.startswith("(osc.udp://")]
     if not urls:
         pytest.skip("this machine has no LAN address to pair with")
-    address = urls[0][len("(osc.udp://"):].split(":")[0]
+    address = urls[0][len("(osc.udp://") :].split(":")[0]
     command = next(line.strip() for line in shown.splitlines() if line.strip().startswith("puppetphone play"))
     assert "127.0.0.1 only" in shown
     args = shlex.split(command)[1:] + ["--headless", "--frames", "900", "--record", "paired.rec"]
-    game = subprocess.Popen([sys.executable, "-m", "puppetphone", *args], cwd=tmp_path, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    game = subprocess.Popen(
+        [sys.executable, "-m", "puppetphone", *args],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         # The phone streams for as long as the game runs (a game starting slowly on a busy
         # machine misses the first packets, as it would on a real phone).
         i, deadline = 0, time.monotonic() + 60.0
         while game.poll() is None and time.monotonic() < deadline:
-            subprocess.run(["oscsend", address, str(port), "/ZIGSIM/pair/quaternion", "ffff", "0", "0",
-                            str(0.1 * (i % 3)), "1"], check=True, timeout=10)
+            subprocess.run(
+                ["oscsend", address, str(port), "/ZIGSIM/pair/quaternion", "ffff", "0", "0", str(0.1 * (i % 3)), "1"],
+                check=True,
+                timeout=10,
+            )
             i += 1
             time.sleep(0.03)
         out, err = game.communicate(timeout=120)
@@ -70,10 +84,30 @@ def test_devices_shows_the_running_web_session_with_its_qr_code(tmp_path):
     import sys
 
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path)}
-    idle = subprocess.run([sys.executable, "-m", "puppetphone", "devices", "--no-qr"], capture_output=True, text=True, env=env, timeout=60)
+    idle = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "devices", "--no-qr"], capture_output=True, text=True, env=env, timeout=60
+    )
     assert "no session is running" in idle.stdout and "--source web --web-host 0.0.0.0" in idle.stdout
-    game = subprocess.Popen([sys.executable, "-m", "puppetphone", "play", "sandbox", "--source", "web", "--web-port", "0", "--headless",
-                             "--frames", "600"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    game = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "play",
+            "sandbox",
+            "--source",
+            "web",
+            "--web-port",
+            "0",
+            "--headless",
+            "--frames",
+            "600",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert game.stderr is not None
         printed = ""
@@ -82,7 +116,9 @@ def test_devices_shows_the_running_web_session_with_its_qr_code(tmp_path):
             assert line, "play ended without printing its link"
             printed += line
         url = re.search(r"https://\S+", printed).group(0)
-        shown = subprocess.run([sys.executable, "-m", "puppetphone", "devices"], capture_output=True, text=True, env=env, timeout=60).stdout
+        shown = subprocess.run(
+            [sys.executable, "-m", "puppetphone", "devices"], capture_output=True, text=True, env=env, timeout=60
+        ).stdout
         assert url in shown and "Scan with the phone's camera" in shown and "█" in shown
         assert re.search(r"certificate SHA-256: ([0-9A-F]{2}:){31}[0-9A-F]{2}", shown)
         assert "this machine only; a phone on the LAN needs --web-host 0.0.0.0" in shown
@@ -92,5 +128,7 @@ def test_devices_shows_the_running_web_session_with_its_qr_code(tmp_path):
             game.kill()
         game.communicate()
     assert game.returncode == 0
-    after = subprocess.run([sys.executable, "-m", "puppetphone", "devices", "--no-qr"], capture_output=True, text=True, env=env, timeout=60)
+    after = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "devices", "--no-qr"], capture_output=True, text=True, env=env, timeout=60
+    )
     assert "no session is running" in after.stdout

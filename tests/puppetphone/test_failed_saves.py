@@ -24,8 +24,10 @@ import pytest
 
 from tests.faults import full_disk, read_only_folder
 
-needs_x = pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("xdotool")),
-                             reason="needs Xvfb and xdotool (Debian xvfb xdotool) to press keys in a real window")
+needs_x = pytest.mark.skipif(
+    not (shutil.which("Xvfb") and shutil.which("xdotool")),
+    reason="needs Xvfb and xdotool (Debian xvfb xdotool) to press keys in a real window",
+)
 
 
 def _env(data: Path, **extra: str) -> dict[str, str]:
@@ -36,8 +38,14 @@ def _env(data: Path, **extra: str) -> dict[str, str]:
 
 
 def _puppetphone(*args: str, data: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], env=_env(data), capture_output=True, text=True, check=False,
-                          timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", *args],
+        env=_env(data),
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=300,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -47,8 +55,11 @@ def display() -> Iterator[str]:
         if not Path(f"/tmp/.X11-unix/X{number}").exists() and not Path(f"/tmp/.X{number}-lock").exists():
             break
     name = f":{number}"
-    server = subprocess.Popen(["Xvfb", name, "-screen", "0", "1024x600x24", "-nolisten", "tcp"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    server = subprocess.Popen(
+        ["Xvfb", name, "-screen", "0", "1024x600x24", "-nolisten", "tcp"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     deadline = time.monotonic() + 20
     while not Path(f"/tmp/.X11-unix/X{number}").exists():
         assert server.poll() is None and time.monotonic() < deadline, "Xvfb did not start"
@@ -70,7 +81,13 @@ def _in_window(display: str, args: list[str], data: Path, keys: list[str], said:
         window = ""
         while not window:
             assert proc.poll() is None and time.monotonic() < deadline, log_err.read_text()
-            found = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", ""], env=env, capture_output=True, text=True, check=False)
+            found = subprocess.run(
+                ["xdotool", "search", "--onlyvisible", "--name", ""],
+                env=env,
+                capture_output=True,
+                text=True,
+                check=False,
+            )
             window = found.stdout.split()[-1] if found.stdout.split() else ""  # the only client of this X server
             time.sleep(0.2)
         subprocess.run(["xdotool", "windowfocus", "--sync", window], env=env, check=True, timeout=30)
@@ -94,8 +111,13 @@ def test_f5_on_a_full_disk_keeps_playing_and_the_field_is_in_the_recovery_folder
 
     data = tmp_path / "data"
     with full_disk(tmp_path / "disk", free=2048) as disk:
-        code, out, err = _in_window(display, ["play", "snowman", "--set", f"field={disk / 'field.json'}", "--size",
-                                              "480x270"], data, ["F5"], "field NOT saved")
+        code, out, err = _in_window(
+            display,
+            ["play", "snowman", "--set", f"field={disk / 'field.json'}", "--size", "480x270"],
+            data,
+            ["F5"],
+            "field NOT saved",
+        )
         assert not (disk / "field.json").exists()
     recovered = data / "puppetphone" / "recovered" / "field.json"
     line = next(x for x in out.splitlines() if "NOT saved" in x)
@@ -112,8 +134,13 @@ def test_ctrl_s_into_a_read_only_folder_keeps_the_edit_open_and_the_clip_reopens
 
     data = tmp_path / "data"
     with read_only_folder(tmp_path / "ro") as ro:
-        code, _, err = _in_window(display, ["author", "edit", "walk", "-o", str(ro / "walk_edited.ppclip"), "--size",
-                                            "480x270"], data, ["ctrl+s"], "saved instead to")
+        code, _, err = _in_window(
+            display,
+            ["author", "edit", "walk", "-o", str(ro / "walk_edited.ppclip"), "--size", "480x270"],
+            data,
+            ["ctrl+s"],
+            "saved instead to",
+        )
         assert not (ro / "walk_edited.ppclip").exists()
     recovered = data / "puppetphone" / "recovered" / "walk_edited.ppclip"
     assert code == 0 and "Traceback" not in err, err
@@ -128,11 +155,23 @@ def test_tasbada_progress_on_a_full_disk_is_kept_in_the_recovery_folder(tmp_path
 
     data = tmp_path / "data"
     with full_disk(tmp_path / "disk", free=512) as disk:
-        done = _puppetphone("play", "tasbada", "--headless", "--frames", "30", "--set", f"save={disk / 'journey.json'}",
-                            "--set", "webcam=off", data=data)
+        done = _puppetphone(
+            "play",
+            "tasbada",
+            "--headless",
+            "--frames",
+            "30",
+            "--set",
+            f"save={disk / 'journey.json'}",
+            "--set",
+            "webcam=off",
+            data=data,
+        )
     recovered = data / "puppetphone" / "recovered" / "journey.json"
     lines = [x for x in done.stderr.splitlines() if "NOT saved" in x]
-    assert done.returncode == 0 and "Traceback" not in done.stderr and "ran 30 steps" in done.stdout + done.stderr, done.stderr
+    assert done.returncode == 0 and "Traceback" not in done.stderr and "ran 30 steps" in done.stdout + done.stderr, (
+        done.stderr
+    )
     assert len(lines) == 1 and f"--set save={recovered}" in lines[0]
     assert load_progress(recovered).stage == "real"
 
@@ -140,7 +179,9 @@ def test_tasbada_progress_on_a_full_disk_is_kept_in_the_recovery_folder(tmp_path
 def test_a_recording_that_fills_the_disk_goes_on_in_the_recovery_folder_and_verifies(tmp_path: Path) -> None:
     data = tmp_path / "data"
     with full_disk(tmp_path / "disk", free=4096) as disk:
-        done = _puppetphone("play", "sandbox", "--headless", "--frames", "150", "--record", str(disk / "s.rec"), data=data)
+        done = _puppetphone(
+            "play", "sandbox", "--headless", "--frames", "150", "--record", str(disk / "s.rec"), data=data
+        )
     recovered = data / "puppetphone" / "recovered" / "s.rec"
     assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
     assert f"it goes on in {recovered}" in done.stderr and f"recorded 150 frames to {recovered}" in done.stderr

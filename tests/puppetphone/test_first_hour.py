@@ -45,19 +45,32 @@ class Window:
     def __init__(self, display: str, tmp: Path, args: list[str]) -> None:
         self.display, self.tmp = display, tmp
         self.hud_file = tmp / f"hud_{args[1]}.txt"
-        self.env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11", "XDG_DATA_HOME": str(tmp / "data"),
-                    "PUPPETPHONE_HUD_DUMP": str(self.hud_file), "SDL_VIDEO_X11_WMCLASS": "puppetphone"}
+        self.env = {
+            **os.environ,
+            "DISPLAY": display,
+            "SDL_VIDEODRIVER": "x11",
+            "XDG_DATA_HOME": str(tmp / "data"),
+            "PUPPETPHONE_HUD_DUMP": str(self.hud_file),
+            "SDL_VIDEO_X11_WMCLASS": "puppetphone",
+        }
         for name in ("TASBADA_SAVE", "TASBADA_PHOTO", "TASBADA_SELFIE", "SNOWMAN_FIELD"):
             self.env.pop(name, None)
-        self.proc = subprocess.Popen([sys.executable, "-m", "puppetphone", *args, "--size", f"{SIZE[0]}x{SIZE[1]}"],
-                                     env=self.env, cwd=tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "puppetphone", *args, "--size", f"{SIZE[0]}x{SIZE[1]}"],
+            env=self.env,
+            cwd=tmp,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         self.id = ""
         self.wait(lambda: self._find_window() and self.hud_file.exists(), 60, "the window to open and draw")
         self.xdo("windowfocus", "--sync", self.id)
 
     def _find_window(self) -> bool:
-        found = subprocess.run(["xdotool", "search", "--classname", "puppetphone"], env=self.env, capture_output=True,
-                               text=True)
+        found = subprocess.run(
+            ["xdotool", "search", "--classname", "puppetphone"], env=self.env, capture_output=True, text=True
+        )
         self.id = found.stdout.split()[0] if found.stdout.split() else ""
         return bool(self.id)
 
@@ -85,8 +98,12 @@ class Window:
     def screen(self) -> np.ndarray:
         """The window as the X server shows it, RGB in [0, 1]."""
         path = self.tmp / "window.png"
-        subprocess.run(["import", "-display", self.display, "-window", self.id, str(path)], check=True, timeout=30,
-                       capture_output=True)
+        subprocess.run(
+            ["import", "-display", self.display, "-window", self.id, str(path)],
+            check=True,
+            timeout=30,
+            capture_output=True,
+        )
         return np.asarray(Image.open(path).convert("RGB"), dtype=np.float64) / 255.0
 
     def move(self, px: tuple[float, float]) -> None:
@@ -174,8 +191,9 @@ def _play_snowman(display: str, tmp: Path) -> None:
 
         # Help: H hides it (the hint to bring it back stays), F1 shows it again.
         w.key("h")
-        w.wait(lambda: "mouse: press on the puppet" not in w.hud() and "H / F1: help" in w.hud(), 10,
-               "the help to hide")
+        w.wait(
+            lambda: "mouse: press on the puppet" not in w.hud() and "H / F1: help" in w.hud(), 10, "the help to hide"
+        )
         w.key("F1")
         w.sees("mouse: press on the puppet")
 
@@ -286,6 +304,8 @@ def _first_take(display: str, tmp: Path) -> None:
 
 
 def _tasbada_to_the_cages(display: str, tmp: Path) -> None:
+    from engine.components import Transform
+    from engine.statemachine.puppet.body import PuppetBody
     from games.tasbada.flow import restart_from
     from games.tasbada.game import GAME
     from games.tasbada.marking import menu_buttons
@@ -293,8 +313,6 @@ def _tasbada_to_the_cages(display: str, tmp: Path) -> None:
     from games.tasbada.quest import MIXED, PROPS_ALIVE, REAL, Mark, Quest
     from games.tasbada.save import Progress, save_progress
     from games.tasbada.view import game_camera
-    from engine.components import Transform
-    from engine.statemachine.puppet.body import PuppetBody
     from input.hub import InputHub
     from puppetphone.games import make_app
 
@@ -308,7 +326,7 @@ def _tasbada_to_the_cages(display: str, tmp: Path) -> None:
     q = app.world.resource(Quest)
     restart_from(app.world, q, MIXED)
     app.step()
-    (_, _, tr), = app.world.query(PuppetBody, Transform)
+    ((_, _, tr),) = app.world.query(PuppetBody, Transform)
     avatar = tr.position + np.array([0.0, 0.95, 0.0])
     home = min((c.home for _, c in app.world.query(Creature)), key=lambda h: np.linalg.norm(h - tr.position))
     cam = game_camera()

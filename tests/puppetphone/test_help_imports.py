@@ -7,16 +7,31 @@ Broken on purpose to see it fail: ``from engine.runner import RunOptions`` back 
 import subprocess
 import sys
 
-HEAVY = ("numpy", "pygame", "moderngl", "scipy", "mujoco", "engine.runner", "engine.render", "input.hub",
-         "input.osc", "input.web", "authoring", "games", "puppetphone.bench")
+HEAVY = (
+    "numpy",
+    "pygame",
+    "moderngl",
+    "scipy",
+    "mujoco",
+    "engine.runner",
+    "engine.render",
+    "input.hub",
+    "input.osc",
+    "input.web",
+    "authoring",
+    "games",
+    "puppetphone.bench",
+)
 
 
 def test_help_imports_no_heavy_module():
-    code = ("import contextlib, io, sys\n"
-            "from puppetphone.cli import main\n"
-            "with contextlib.redirect_stdout(io.StringIO()):\n"
-            "    try:\n        main(['--help'])\n    except SystemExit:\n        pass\n"
-            "print('\\n'.join(sorted(sys.modules)))\n")
+    code = (
+        "import contextlib, io, sys\n"
+        "from puppetphone.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    try:\n        main(['--help'])\n    except SystemExit:\n        pass\n"
+        "print('\\n'.join(sorted(sys.modules)))\n"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     loaded = [m for m in out if any(m == h or m.startswith(h + ".") for h in HEAVY)]
     assert not loaded, f"--help imported {loaded}"

@@ -35,8 +35,12 @@ def _kill_points(n: int = KILLS, seed: int = 30, longest: float = 0.6) -> list[f
 
 def _kill_after(argv: list[str], delay: float, env: dict[str, str] | None = None) -> None:
     """Start a saver, wait for its first save ("go"), let it run ``delay`` s more, SIGKILL it."""
-    with subprocess.Popen([sys.executable, "-c", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          env={**os.environ, "SDL_VIDEODRIVER": "dummy", **(env or {})}) as proc:
+    with subprocess.Popen(
+        [sys.executable, "-c", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env={**os.environ, "SDL_VIDEODRIVER": "dummy", **(env or {})},
+    ) as proc:
         assert proc.stdout is not None and proc.stderr is not None
         for line in proc.stdout:  # the command's own lines, then "go"
             if line == b"go\n":
@@ -82,8 +86,13 @@ def _clips_add(tmp_path: Path, points: list[float]) -> None:
         added.add(clip_digest(lib.load()["walk"]))  # it loads: the old walk or the new one, never none
         assert lib.entries()["walk"].sha256 == clip_digest(lib.load()["walk"])
     assert 1 <= len(added) <= 2
-    listed = subprocess.run([sys.executable, "-m", "puppetphone", "clips", "list", "--clips", str(library)],
-                            capture_output=True, text=True, check=False, timeout=120)
+    listed = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "clips", "list", "--clips", str(library)],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
     assert listed.returncode == 0 and "walk" in listed.stdout, listed.stderr
 
 
@@ -162,8 +171,14 @@ def _author_edit(tmp_path: Path, points: list[float]) -> None:
         session = load_session(out)  # the clip and its session file open together
         seen.add(clip_digest(session.clip))
     assert len(seen) > 1  # the kills did land between different saves
-    again = subprocess.run([sys.executable, "-m", "puppetphone", "author", "edit", str(out), "--headless", "--frames",
-                            "1"], capture_output=True, text=True, check=False, timeout=120, env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
+    again = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "author", "edit", str(out), "--headless", "--frames", "1"],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+        env={**os.environ, "SDL_VIDEODRIVER": "dummy"},
+    )
     assert again.returncode == 0, again.stderr
 
 
@@ -186,13 +201,25 @@ def _cycles(tmp_path: Path, points: list[float], count: int) -> None:
 
     write_takes(tmp_path / "takes", count=count)
     lib = tmp_path / "lib"
-    argv = [sys.executable, "-m", "puppetphone", "cycles", str(tmp_path / "takes"), "-o", str(lib), "--jobs", "1",
-            "--no-progress"]
+    argv = [
+        sys.executable,
+        "-m",
+        "puppetphone",
+        "cycles",
+        str(tmp_path / "takes"),
+        "-o",
+        str(lib),
+        "--jobs",
+        "1",
+        "--no-progress",
+    ]
     done: set[str] = set()
     for delay in points:
         if len(done) == count:  # the kills came too late to stop the last runs: nothing left to cut
             break
-        with subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True) as proc:
+        with subprocess.Popen(
+            argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+        ) as proc:
             deadline = time.monotonic() + 120  # a deadline for the test, not a measured time
             while proc.poll() is None and time.monotonic() < deadline:  # wait for this run's first new take
                 try:
@@ -245,8 +272,23 @@ def test_kill_9_during_record_leaves_every_frame_before_it_replaying(tmp_path: P
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
     rec = tmp_path / "s.rec"
     for delay in _kill_points(1, longest=0.5):  # one: every cut position is read in tests/input/test_recording.py
-        with subprocess.Popen([sys.executable, "-m", "puppetphone", "play", "sandbox", "--headless", "--frames", "1000000",
-                               "--record", str(rec)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) as proc:
+        with subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "puppetphone",
+                "play",
+                "sandbox",
+                "--headless",
+                "--frames",
+                "1000000",
+                "--record",
+                str(rec),
+            ],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        ) as proc:
             deadline = time.monotonic() + 120  # a deadline for the test, not a measured time
             while not (rec.exists() and rec.stat().st_size > 2000):  # past its header and a few records
                 assert proc.poll() is None and time.monotonic() < deadline
@@ -256,8 +298,14 @@ def test_kill_9_during_record_leaves_every_frame_before_it_replaying(tmp_path: P
             proc.wait(30)
         cut = read_recording(rec)
         assert not cut.complete and cut.cut and len(cut) > 0
-        check = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless",
-                                "--allow-truncated"], env=env, capture_output=True, text=True, check=False, timeout=300)
+        check = subprocess.run(
+            [sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless", "--allow-truncated"],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=False,
+            timeout=300,
+        )
         assert check.returncode == 0, check.stderr
         assert "ended without its closing record" in check.stderr or "cut inside" in check.stderr
         assert f"all {len(cut)} state hashes match" in check.stdout

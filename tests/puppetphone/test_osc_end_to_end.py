@@ -63,14 +63,37 @@ def test_play_osc_record_then_replay_verify(tmp_path):
     sender = subprocess.Popen([sys.executable, "-c", SENDER, str(port), "8"])
     try:
         play = subprocess.run(
-            [sys.executable, "-m", "puppetphone", "play", "snowman", "--headless", "--source", "osc",
-             "--osc-host", "127.0.0.1", "--osc-port", str(port), "--frames", "300", "--record", str(rec)],
-            capture_output=True, text=True, timeout=60)
+            [
+                sys.executable,
+                "-m",
+                "puppetphone",
+                "play",
+                "snowman",
+                "--headless",
+                "--source",
+                "osc",
+                "--osc-host",
+                "127.0.0.1",
+                "--osc-port",
+                str(port),
+                "--frames",
+                "300",
+                "--record",
+                str(rec),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
     finally:
         sender.kill()
         sender.wait()
     assert play.returncode == 0, play.stderr
-    replay = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless"],
-                            capture_output=True, text=True, timeout=60)
+    replay = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert replay.returncode == 0, replay.stderr
     assert "replayed 300 frames, all 300 state hashes match" in replay.stdout

@@ -44,12 +44,22 @@ def test_h_and_f1_hide_and_bring_back_the_help():
     from input.mouse import MouseSource
 
     session = build_activity("snowman", 0, InputHub([MouseSource()]), setup={})  # a fresh field that saves nowhere
-    controls = [line for line in session.simulation.game.controls if not line.startswith(("osc:", "web:", "hid:", "serial:"))]
+    controls = [
+        line for line in session.simulation.game.controls if not line.startswith(("osc:", "web:", "hid:", "serial:"))
+    ]
     assert controls and session.simulation.overlay.help_visible  # shown at the start
 
     def drawn() -> list[str]:
         scene = RenderScene()
-        draw_overlay(scene, session.simulation.app.world, session.simulation.game, session.hub, 60.0, False, session.simulation.overlay)
+        draw_overlay(
+            scene,
+            session.simulation.app.world,
+            session.simulation.game,
+            session.hub,
+            60.0,
+            False,
+            session.simulation.overlay,
+        )
         return texts(scene)
 
     assert all(line in drawn() for line in controls)
@@ -125,7 +135,16 @@ def _help_drawn(source_kind: str, size: tuple[int, int] = (1280, 720)) -> tuple[
     session = build_activity("snowman", 0, hub, setup={})
     try:
         scene = RenderScene()
-        draw_overlay(scene, session.simulation.app.world, session.simulation.game, hub, 60.0, False, session.simulation.overlay, size)
+        draw_overlay(
+            scene,
+            session.simulation.app.world,
+            session.simulation.game,
+            hub,
+            60.0,
+            False,
+            session.simulation.overlay,
+            size,
+        )
         return texts(scene), scene
     finally:
         hub.close()
@@ -160,7 +179,15 @@ def test_v_with_the_mouse_says_why_nothing_happens_and_the_tip_goes_away():
 
     def drawn() -> list[str]:
         scene = RenderScene()
-        draw_overlay(scene, session.simulation.app.world, session.simulation.game, session.hub, 60.0, False, session.simulation.overlay)
+        draw_overlay(
+            scene,
+            session.simulation.app.world,
+            session.simulation.game,
+            session.hub,
+            60.0,
+            False,
+            session.simulation.overlay,
+        )
         return texts(scene)
 
     assert NO_VIEW in drawn() and "no held controller to see from" in NO_VIEW

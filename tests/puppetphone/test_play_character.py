@@ -25,8 +25,10 @@ from puppetphone.games import load_game, make_app
 def _record(glb: Path, path: Path) -> list[str]:
     """Snowman with the character: grab it, walk it, lift it high and let go (it falls as a ragdoll)."""
     game = load_game("snowman")
-    setup = {**game.prepare({**game.options, "field": str(path.with_suffix(".field.json"))}),
-             "character": character_setup(str(glb))}
+    setup = {
+        **game.prepare({**game.options, "field": str(path.with_suffix(".field.json"))}),
+        "character": character_setup(str(glb)),
+    }
     mouse = MouseSource()
     app = make_app("snowman", 5, InputHub([mouse]), setup)
     header = RecordingHeader(game="snowman", seed=5, dt=app.world.dt, sources=["mouse"], setup=setup)
@@ -50,8 +52,9 @@ def _record(glb: Path, path: Path) -> list[str]:
     return states
 
 
-def test_a_character_session_replays_after_its_file_is_moved_away(mocap_dir: Path, tmp_path: Path,
-                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_character_session_replays_after_its_file_is_moved_away(
+    mocap_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """The set-up carries the file's bytes, not its path: the replay builds the same puppet without the file."""
     glb = tmp_path / "hero.glb"
     shutil.copy(mocap_dir / "CesiumMan.glb", glb)
@@ -62,16 +65,18 @@ def test_a_character_session_replays_after_its_file_is_moved_away(mocap_dir: Pat
     assert main(["replay", str(rec), "--verify", "--headless"]) == 0, capsys.readouterr().err
 
 
-def test_a_fox_is_refused_in_one_line_before_the_game_starts(mocap_dir: Path, capsys: pytest.CaptureFixture[str]
-                                                            ) -> None:
+def test_a_fox_is_refused_in_one_line_before_the_game_starts(
+    mocap_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["play", "snowman", "--headless", "--frames", "2", "--character", str(mocap_dir / "Fox.glb")]) == 2
     err = capsys.readouterr().err
     errors = [ln for ln in err.splitlines() if ln.startswith("error")]
     assert len(errors) == 1 and "--joint-map FILE" in errors[0] and "Traceback" not in err
 
 
-def test_a_recorded_character_that_was_altered_is_one_line(tmp_path: Path, mocap_dir: Path,
-                                                            capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_recorded_character_that_was_altered_is_one_line(
+    tmp_path: Path, mocap_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A crafted header's character is checked like the file was: exit 2, one line."""
     import json
     import struct

@@ -27,8 +27,9 @@ def puppetphone(*args: str, cwd: Path, data: Path) -> subprocess.CompletedProces
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(data)}
     for name in ("TASBADA_SAVE", "TASBADA_PHOTO", "TASBADA_SELFIE", "SNOWMAN_FIELD"):
         env.pop(name, None)
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=600
+    )
 
 
 def test_a_tasbada_game_started_from_a_save_replays_from_its_file_alone(tmp_path: Path) -> None:
@@ -36,8 +37,21 @@ def test_a_tasbada_game_started_from_a_save_replays_from_its_file_alone(tmp_path
     marks = [Mark("box", np.array([[0.2, 0.3], [0.4, 0.6]]))]
     save_progress(save, Progress(["real", "props alive"], marks, 0.71, "props alive"))
     before = save.read_bytes()
-    done = puppetphone("play", "tasbada", "--headless", "--frames", "90", "--set", f"save={save}", "--set",
-                       "webcam=off", "--record", "from_save.rec", cwd=tmp_path, data=tmp_path / "data")
+    done = puppetphone(
+        "play",
+        "tasbada",
+        "--headless",
+        "--frames",
+        "90",
+        "--set",
+        f"save={save}",
+        "--set",
+        "webcam=off",
+        "--record",
+        "from_save.rec",
+        cwd=tmp_path,
+        data=tmp_path / "data",
+    )
     assert done.returncode == 0, done.stderr
     setup = read_recording(tmp_path / "from_save.rec").header.setup
     assert setup["reached"] == ["real", "props alive"] and setup["ground_v"] == pytest.approx(0.71)
@@ -51,8 +65,19 @@ def test_a_tasbada_game_started_from_a_save_replays_from_its_file_alone(tmp_path
 
 
 def test_a_sandbox_scene_is_a_game_option_and_replays(tmp_path: Path) -> None:
-    done = puppetphone("play", "sandbox", "--headless", "--frames", "30", "--set", "scene=big_ball", "--record",
-                       "s.rec", cwd=tmp_path, data=tmp_path)
+    done = puppetphone(
+        "play",
+        "sandbox",
+        "--headless",
+        "--frames",
+        "30",
+        "--set",
+        "scene=big_ball",
+        "--record",
+        "s.rec",
+        cwd=tmp_path,
+        data=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     assert read_recording(tmp_path / "s.rec").header.setup == {"scene": "big_ball", "puppets": 1}
     assert puppetphone("replay", "s.rec", "--verify", "--headless", cwd=tmp_path, data=tmp_path).returncode == 0
@@ -65,12 +90,33 @@ def test_a_sandbox_scene_is_a_game_option_and_replays(tmp_path: Path) -> None:
 @needs_egl
 def test_replay_screenshot_writes_the_final_frame_or_a_chosen_one(tmp_path: Path) -> None:
     rec = Path(__file__).resolve().parents[1] / "data" / "puppet_walk_run.rec"
-    done = puppetphone("replay", str(rec), "--verify", "--headless", "--size", "320x180", "--screenshot", "end.png",
-                       cwd=tmp_path, data=tmp_path)
+    done = puppetphone(
+        "replay",
+        str(rec),
+        "--verify",
+        "--headless",
+        "--size",
+        "320x180",
+        "--screenshot",
+        "end.png",
+        cwd=tmp_path,
+        data=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     assert "state hashes match" in done.stdout and "screenshot: end.png" in done.stdout
-    done = puppetphone("replay", str(rec), "--headless", "--size", "320x180", "--screenshot", "start.png",
-                       "--screenshot-at", "1", cwd=tmp_path, data=tmp_path)
+    done = puppetphone(
+        "replay",
+        str(rec),
+        "--headless",
+        "--size",
+        "320x180",
+        "--screenshot",
+        "start.png",
+        "--screenshot-at",
+        "1",
+        cwd=tmp_path,
+        data=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     end, start = (np.asarray(Image.open(tmp_path / n), dtype=float) for n in ("end.png", "start.png"))
     assert end.shape == (180, 320, 3) and end.std() > 0.05 * 255
@@ -84,18 +130,29 @@ def _umask() -> int:
     return mask
 
 
-@pytest.mark.parametrize("args, says", [
-    (["play", "snowman", "--headless", "--frames", "-5"], "-5 is out of range"),
-    (["play", "snowman", "--headless", "--size", "0x0"], "out of range"),
-    (["play", "snowman", "--headless", "--screenshot", "x.bmp"], "use .png or .jpg"),
-    (["replay", "x.rec", "--headless", "--quality", "ultra"], "quality must be one of low, medium, high, auto"),
-    (["author", "edit", "walk", "--headless", "--bogus"], "usage: puppetphone author edit"),
-    (["play", "snowman", "--bogus"], "usage: puppetphone play"),
-    (["author", "edit", "walk", "--headless", "--export", "x.fbx"], "cannot export x.fbx: use one of .bvh, .glb, .gltf, .ppclip"),
-    (["author", "edit", str(Path(__file__).resolve().parents[2] / "README.md"), "--headless"], "is not a clip file"),
-    (["cycle", "in.bvh", "-o", "out.ppclip", "--plot", "x.gif"], "use .png or .jpg"),
-])
-def test_bad_command_lines_say_what_is_wrong_with_the_subcommand_usage(tmp_path: Path, args: list[str], says: str) -> None:
+@pytest.mark.parametrize(
+    "args, says",
+    [
+        (["play", "snowman", "--headless", "--frames", "-5"], "-5 is out of range"),
+        (["play", "snowman", "--headless", "--size", "0x0"], "out of range"),
+        (["play", "snowman", "--headless", "--screenshot", "x.bmp"], "use .png or .jpg"),
+        (["replay", "x.rec", "--headless", "--quality", "ultra"], "quality must be one of low, medium, high, auto"),
+        (["author", "edit", "walk", "--headless", "--bogus"], "usage: puppetphone author edit"),
+        (["play", "snowman", "--bogus"], "usage: puppetphone play"),
+        (
+            ["author", "edit", "walk", "--headless", "--export", "x.fbx"],
+            "cannot export x.fbx: use one of .bvh, .glb, .gltf, .ppclip",
+        ),
+        (
+            ["author", "edit", str(Path(__file__).resolve().parents[2] / "README.md"), "--headless"],
+            "is not a clip file",
+        ),
+        (["cycle", "in.bvh", "-o", "out.ppclip", "--plot", "x.gif"], "use .png or .jpg"),
+    ],
+)
+def test_bad_command_lines_say_what_is_wrong_with_the_subcommand_usage(
+    tmp_path: Path, args: list[str], says: str
+) -> None:
     done = puppetphone(*args, cwd=tmp_path, data=tmp_path)
     assert done.returncode == 2 and says in done.stderr and "Traceback" not in done.stderr
 
@@ -108,13 +165,25 @@ def test_version(tmp_path: Path) -> None:
 
 @needs_egl
 def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_shows_a_real_fps(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     import re
 
     monkeypatch.setenv("PUPPETPHONE_HUD_DUMP", str(tmp_path / "hud.txt"))
     for size in ("1280x720", "640x360"):
-        done = puppetphone("play", "snowman", "--headless", "--frames", "90", "--size", size, "--screenshot",
-                           f"{size}.png", cwd=tmp_path, data=tmp_path / "data")
+        done = puppetphone(
+            "play",
+            "snowman",
+            "--headless",
+            "--frames",
+            "90",
+            "--size",
+            size,
+            "--screenshot",
+            f"{size}.png",
+            cwd=tmp_path,
+            data=tmp_path / "data",
+        )
         assert done.returncode == 0, done.stderr
         # The mouse is a person's hand: a headless run with it is paced to real time, and the HUD says how fast
         # it went (flat out it would be hundreds of steps a second; it said 0.0 before).
@@ -124,6 +193,6 @@ def test_the_start_screen_leaves_the_puppet_in_sight_at_any_window_size_and_show
         r, g, b = shot[..., 0], shot[..., 1], shot[..., 2]
         h, w = r.shape
         puppet = (r > g + 0.25) & (r > b + 0.25)
-        assert puppet[h // 4: 3 * h // 4, w // 3: 2 * w // 3].sum() > 0.0004 * h * w, f"{size}: the puppet is hidden"
+        assert puppet[h // 4 : 3 * h // 4, w // 3 : 2 * w // 3].sum() > 0.0004 * h * w, f"{size}: the puppet is hidden"
         panels = (np.ptp(shot, axis=2) < 0.03) & (shot.mean(axis=2) < 0.35)  # the text's dark panels
         assert panels.mean() < 0.2, f"{size}: the overlay covers {panels.mean():.0%} of the window"

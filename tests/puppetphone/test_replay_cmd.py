@@ -21,8 +21,9 @@ REPO = Path(__file__).resolve().parents[2]
 # The snowman demo (4,666 steps, the longest replay) is replayed once per run, through this same
 # command, by tests/games/snowman/test_demo.py, which also checks the world it ends in.
 SNOWMAN_DEMO = REPO / "games" / "snowman" / "demo.rec"
-SHIPPED = sorted(p for p in [*(REPO / "tests" / "data").glob("*.rec"), *(REPO / "games").glob("*/demo.rec")]
-                 if p != SNOWMAN_DEMO)
+SHIPPED = sorted(
+    p for p in [*(REPO / "tests" / "data").glob("*.rec"), *(REPO / "games").glob("*/demo.rec")] if p != SNOWMAN_DEMO
+)
 
 
 class Fed(PoseSource):
@@ -57,12 +58,12 @@ def test_first_differing_frame_is_named(tmp_path, capsys):
 
     from input.recording import MAGIC
 
-    pos = len(MAGIC) + 8 + int.from_bytes(data[len(MAGIC):len(MAGIC) + 4], "little")
+    pos = len(MAGIC) + 8 + int.from_bytes(data[len(MAGIC) : len(MAGIC) + 4], "little")
     for _ in range(40):
-        pos += 8 + int.from_bytes(data[pos:pos + 4], "little")
-    n = int.from_bytes(data[pos:pos + 4], "little")
+        pos += 8 + int.from_bytes(data[pos : pos + 4], "little")
+    n = int.from_bytes(data[pos : pos + 4], "little")
     data[pos + 8] ^= 0xFF
-    data[pos + 4:pos + 8] = zlib.crc32(bytes(data[pos + 8:pos + 8 + n])).to_bytes(4, "little")
+    data[pos + 4 : pos + 8] = zlib.crc32(bytes(data[pos + 8 : pos + 8 + n])).to_bytes(4, "little")
     path.write_bytes(bytes(data))
     assert main(["replay", str(path), "--verify", "--headless"]) == 1
     assert "differs at frame 40" in capsys.readouterr().out
@@ -114,8 +115,13 @@ def test_a_device_or_pipe_is_refused(capsys):
 def test_every_shipped_recording_verifies_through_the_command(path):
     """As a user types it: a subprocess, the console script, the shipped file."""
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
-    done = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(path), "--verify", "--headless"],
-                          capture_output=True, text=True, env=env, timeout=600)
+    done = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "replay", str(path), "--verify", "--headless"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "state hashes match" in done.stdout
 

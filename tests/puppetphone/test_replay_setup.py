@@ -37,14 +37,19 @@ CASES = [
     ("tasbada", {"photo": [1, 2]}, None),  # a recorded path is never opened: the shipped photo shows
     ("sandbox", {"scene": [1, 2]}, "scene"),
     ("sandbox", {"puppets": None}, "puppets"),
-    ("author-record", {"item": "hips", "drive": "rotation", "countdown": 1e308, "seconds": 8.0, "seed": 0}, "countdown"),
+    (
+        "author-record",
+        {"item": "hips", "drive": "rotation", "countdown": 1e308, "seconds": 8.0, "seed": 0},
+        "countdown",
+    ),
     ("author-record", {"item": 5}, "item"),
 ]
 
 
 @pytest.mark.parametrize("game,setup,says", CASES)
-def test_a_crafted_setup_is_one_line_not_a_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                     game: str, setup: Any, says: str | None) -> None:
+def test_a_crafted_setup_is_one_line_not_a_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], game: str, setup: Any, says: str | None
+) -> None:
     code = main(["replay", str(_crafted(tmp_path / "c.rec", game, setup)), "--headless", "--frames", "2"])
     err = capsys.readouterr().err
     if says is None:
@@ -80,14 +85,25 @@ def test_a_replay_never_opens_a_clip_the_header_names(tmp_path: Path, capsys: py
     assert str(victim) not in opened
 
 
-def test_embedded_clips_beyond_the_set_limit_are_refused_before_decoding(tmp_path: Path,
-                                                                         capsys: pytest.CaptureFixture[str]) -> None:
+def test_embedded_clips_beyond_the_set_limit_are_refused_before_decoding(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """64 clips of 100,000 frames each, within the per-clip limits: 4.6 GB decoded on the old code."""
     from engine.cliplib import embed
 
     data = base64.b64encode(zlib.compress(bytes(100_000 * 87 * 8), 9)).decode()
-    clips = {f"walk_{i}": {"name": f"c{i}", "fps": 60, "loop": True, "markers": {}, "frames": 100_000,
-                           "root_motion": True, "data": data} for i in range(64)}
+    clips = {
+        f"walk_{i}": {
+            "name": f"c{i}",
+            "fps": 60,
+            "loop": True,
+            "markers": {},
+            "frames": 100_000,
+            "root_motion": True,
+            "data": data,
+        }
+        for i in range(64)
+    }
     setup = {"clips": {"sha256": embed._payload_digest(clips), "clips": clips}}
     rec = _crafted(tmp_path / "c.rec", "sandbox", setup)
     tracemalloc.start()

@@ -28,8 +28,12 @@ def test_tasbada_progress(tmp_path_factory, ground: float, boxes, stage: int) ->
     marks = [Mark("box", [[a, b], [c, d]]) for a, b, c, d in boxes]
     progress = Progress(list(STAGES[: stage + 1]), marks, round(ground, 6), STAGES[stage], "room.jpg")
     back = load_progress(save_progress(tmp_path_factory.mktemp("t") / "save.json", progress))
-    assert back is not None and (back.reached, back.stage, back.ground_v, back.photo) == \
-        (progress.reached, progress.stage, progress.ground_v, progress.photo)
+    assert back is not None and (back.reached, back.stage, back.ground_v, back.photo) == (
+        progress.reached,
+        progress.stage,
+        progress.ground_v,
+        progress.photo,
+    )
     assert [m.to_json() for m in back.marks] == [m.to_json() for m in marks]
 
 
@@ -79,7 +83,9 @@ def test_clip_library(tmp_path: Path) -> None:
     from engine.humanoid import humanoid_skeleton
 
     lib = ClipLibrary(tmp_path / "lib")
-    entry = lib.add(conform(default_clips()["walk"].resampled(50.0), "walk"), "walk", humanoid_skeleton(), default_clips())
+    entry = lib.add(
+        conform(default_clips()["walk"].resampled(50.0), "walk"), "walk", humanoid_skeleton(), default_clips()
+    )
     assert clip_digest(ClipLibrary(tmp_path / "lib").load()["walk"]) == entry.sha256
 
 

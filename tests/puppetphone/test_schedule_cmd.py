@@ -13,7 +13,7 @@ from puppetphone.games import GAMES, make_app
 
 def _documented_stages():
     doc = engine.app.__doc__
-    schedule = doc[doc.index("Frame schedule"):doc.index("Plugins\n")]
+    schedule = doc[doc.index("Frame schedule") : doc.index("Plugins\n")]
     return re.findall(r"^\d+\. ``(\w+)``", schedule, flags=re.MULTILINE)
 
 

@@ -21,10 +21,32 @@ def _free_port() -> int:
 
 def test_author_record_listens_on_the_given_web_port_and_prints_the_link(tmp_path):
     port = _free_port()
-    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path),
-           "XDG_STATE_HOME": str(tmp_path), "XDG_CONFIG_HOME": str(tmp_path)}
-    cmd = [sys.executable, "-m", "puppetphone", "author", "record", "--source", "web", "--web-host", "127.0.0.1",
-           "--web-port", str(port), "--headless", "--frames", "100000", "-o", str(tmp_path / "c.ppclip")]
+    env = {
+        **os.environ,
+        "SDL_VIDEODRIVER": "dummy",
+        "SDL_AUDIODRIVER": "dummy",
+        "XDG_DATA_HOME": str(tmp_path),
+        "XDG_STATE_HOME": str(tmp_path),
+        "XDG_CONFIG_HOME": str(tmp_path),
+    }
+    cmd = [
+        sys.executable,
+        "-m",
+        "puppetphone",
+        "author",
+        "record",
+        "--source",
+        "web",
+        "--web-host",
+        "127.0.0.1",
+        "--web-port",
+        str(port),
+        "--headless",
+        "--frames",
+        "100000",
+        "-o",
+        str(tmp_path / "c.ppclip"),
+    ]
     proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env)
     try:
         lines = []

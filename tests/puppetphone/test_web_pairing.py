@@ -35,9 +35,30 @@ ENV = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
 def test_the_window_shows_a_qr_code_that_carries_the_printed_link(tmp_path):
     cv2 = pytest.importorskip("cv2")
     shot = tmp_path / "pairing.png"
-    res = subprocess.run([sys.executable, "-m", "puppetphone", "play", "sandbox", "--source", "web", "--web-port", "0",
-                          "--headless", "--frames", "2", "--size", "960x540", "--screenshot", str(shot)],
-                         capture_output=True, text=True, timeout=120, env={**ENV, "XDG_DATA_HOME": str(tmp_path)})
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "play",
+            "sandbox",
+            "--source",
+            "web",
+            "--web-port",
+            "0",
+            "--headless",
+            "--frames",
+            "2",
+            "--size",
+            "960x540",
+            "--screenshot",
+            str(shot),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**ENV, "XDG_DATA_HOME": str(tmp_path)},
+    )
     assert res.returncode == 0, res.stderr
     link = re.search(r"(https://127\.0\.0\.1:\d+/\?t=\S+)", res.stderr).group(1)
     img = np.asarray(Image.open(shot).convert("RGB"))

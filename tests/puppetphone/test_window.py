@@ -21,16 +21,23 @@ from tests.puppetphone.xvfb import SCREEN, needs_x
 
 
 def _grab(display: str, path: Path) -> np.ndarray:
-    subprocess.run(["import", "-display", display, "-window", "root", str(path)], check=True, timeout=30,
-                   capture_output=True)
+    subprocess.run(
+        ["import", "-display", display, "-window", "root", str(path)], check=True, timeout=30, capture_output=True
+    )
     return np.asarray(Image.open(path).convert("RGB"), dtype=np.float64) / 255.0
 
 
 def _run_and_grab(display: str, args: list[str], tmp_path: Path, lit: float = 0.3) -> np.ndarray:
     """Run ``puppetphone ARGS`` in a window; the X screen once the window shows a scene."""
     env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11", "XDG_DATA_HOME": str(tmp_path / "data")}
-    proc = subprocess.Popen([sys.executable, "-m", "puppetphone", *args], env=env, cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "puppetphone", *args],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         deadline = time.monotonic() + 120
         screen = np.zeros((*SCREEN[::-1], 3))
@@ -64,8 +71,9 @@ def test_play_snowman_shows_the_puppet_on_snow_in_the_window(display: str, tmp_p
 
 @needs_x
 def test_play_tasbada_shows_the_photo_in_the_window(display: str, tmp_path: Path) -> None:
-    screen = _run_and_grab(display, ["play", "tasbada", "--frames", "100000", "--set", "webcam=off"], tmp_path,
-                           lit=0.15)
+    screen = _run_and_grab(
+        display, ["play", "tasbada", "--frames", "100000", "--set", "webcam=off"], tmp_path, lit=0.15
+    )
     # The room photo: a varied picture over most of the window, not a flat fill.
     assert screen.std() > 0.1 and (screen.mean(axis=2) > 0.05).mean() > 0.8
 
@@ -84,8 +92,14 @@ def test_author_edit_shows_the_character_and_its_curves(display: str, tmp_path: 
 def test_no_display_refuses_at_once_and_suggests_headless(tmp_path: Path) -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
     for args in (["play", "snowman"], ["author", "edit", "walk"], ["author", "record"]):
-        done = subprocess.run([sys.executable, "-m", "puppetphone", *args], env=env, cwd=tmp_path,
-                              capture_output=True, text=True, timeout=60)
+        done = subprocess.run(
+            [sys.executable, "-m", "puppetphone", *args],
+            env=env,
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         assert done.returncode == 2, (args, done.stdout, done.stderr)
         assert "no display" in done.stderr and "--headless" in done.stderr
         assert len(done.stderr.strip().splitlines()) == 1
@@ -97,8 +111,14 @@ def test_an_invisible_driver_fallback_names_sdls_error_and_tries_x11_by_name(tmp
             break
     env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
     env.update(DISPLAY=f":{number}", XDG_DATA_HOME=str(tmp_path / "data"))
-    done = subprocess.run([sys.executable, "-m", "puppetphone", "play", "snowman", "--frames", "5"], env=env,
-                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-m", "puppetphone", "play", "snowman", "--frames", "5"],
+        env=env,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 2, done.stderr
     ours = done.stderr.strip().splitlines()[-1]  # SDL's drivers may print their own lines before it
     assert ours.startswith("error: no display (SDL chose its ")
@@ -122,7 +142,8 @@ print(real(), os.environ.get("SDL_VIDEODRIVER", "unset"))
 def test_a_passing_offscreen_fallback_is_retried_with_x11_and_opens_the_window(display: str, tmp_path: Path) -> None:
     env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
     env["DISPLAY"] = display
-    done = subprocess.run([sys.executable, "-c", _FIRST_OFFSCREEN], env=env, cwd=tmp_path, capture_output=True,
-                          text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", _FIRST_OFFSCREEN], env=env, cwd=tmp_path, capture_output=True, text=True, timeout=120
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.split()[-2:] == ["x11", "unset"]  # x11 by name, the environment left as it was found

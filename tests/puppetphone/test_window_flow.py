@@ -18,9 +18,15 @@ from tests.puppetphone.xvfb import SCREEN, needs_x
 @needs_x
 def test_the_flow_editor_shows_the_scene_while_its_securves_are_found(display: str, tmp_path: Path) -> None:
     env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11", "XDG_DATA_HOME": str(tmp_path / "data")}
-    proc = subprocess.Popen([sys.executable, "-m", "puppetphone", "author", "flow", "--frames", "100000"], env=env,
-                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)  # fmt: skip  (its own group: the search's process ends with it)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "puppetphone", "author", "flow", "--frames", "100000"],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )  # fmt: skip  (its own group: the search's process ends with it)
     try:
         deadline = time.monotonic() + 60
         screen = np.zeros((SCREEN[1], SCREEN[0], 3))

@@ -9,8 +9,10 @@ from collections.abc import Iterator
 
 import pytest
 
-needs_x = pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("import")),
-                             reason="needs Xvfb and ImageMagick's import (Debian xvfb imagemagick)")
+needs_x = pytest.mark.skipif(
+    not (shutil.which("Xvfb") and shutil.which("import")),
+    reason="needs Xvfb and ImageMagick's import (Debian xvfb imagemagick)",
+)
 
 SCREEN = (1280, 800)
 
@@ -20,9 +22,12 @@ def display() -> Iterator[str]:
     """A fresh Xvfb display; its name. Xvfb picks a free number itself and writes it once it accepts
     connections (``-displayfd``), so tests running in parallel (pytest -n) never race for one."""
     read_end, write_end = os.pipe()
-    server = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", f"{SCREEN[0]}x{SCREEN[1]}x24",
-                               "-nolisten", "tcp"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              pass_fds=(write_end,))
+    server = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write_end), "-screen", "0", f"{SCREEN[0]}x{SCREEN[1]}x24", "-nolisten", "tcp"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        pass_fds=(write_end,),
+    )
     os.close(write_end)
     with os.fdopen(read_end) as announced:
         number = announced.readline().strip()

@@ -23,8 +23,17 @@ from engine.pose import Pose
 from engine.ragdoll.getup import GetUpBlend, LyingOrientation
 from engine.statemachine.jump_arc import JumpStatus, JumpTracker
 
-__all__ = ["PuppetBody", "PuppetTuning", "PoseOverride", "Jumping", "JumpPhase", "Landing", "GettingUp", "Handling",
-           "PUPPET_COMPONENTS"]
+__all__ = [
+    "PuppetBody",
+    "PuppetTuning",
+    "PoseOverride",
+    "Jumping",
+    "JumpPhase",
+    "Landing",
+    "GettingUp",
+    "Handling",
+    "PUPPET_COMPONENTS",
+]
 
 F = NDArray[np.float64]
 

@@ -27,8 +27,16 @@ from engine.statemachine.puppet.names import PuppetState
 from engine.statemachine.puppet.senses import holder
 from engine.statemachine.puppet.spec import PuppetStateDef, PuppetTransition, StateSpec
 
-__all__ = ["enter_ragdoll", "update_ragdoll", "ragdoll_settled", "enter_getup", "update_getup", "exit_getup", "getup_done",
-           "SPEC"]
+__all__ = [
+    "enter_ragdoll",
+    "update_ragdoll",
+    "ragdoll_settled",
+    "enter_getup",
+    "update_getup",
+    "exit_getup",
+    "getup_done",
+    "SPEC",
+]
 
 _HELD_JOINT = "chest"
 
@@ -120,16 +128,25 @@ def exit_getup(world: World, entity: Entity, brain: Brain) -> None:
 
 
 _RAGDOLL: PuppetStateDef = PuppetStateDef(
-    PuppetState.RAGDOLL, enter=enter_ragdoll, update=update_ragdoll,
-    description="default state: limp physics, hangs from the stick when held")
+    PuppetState.RAGDOLL,
+    enter=enter_ragdoll,
+    update=update_ragdoll,
+    description="default state: limp physics, hangs from the stick when held",
+)
 _GET_UP: PuppetStateDef = PuppetStateDef(
-    PuppetState.GET_UP, enter=enter_getup, update=update_getup, exit=exit_getup,
-    description="blend from the lying pose into the get-up clip")
+    PuppetState.GET_UP,
+    enter=enter_getup,
+    update=update_getup,
+    exit=exit_getup,
+    description="blend from the lying pose into the get-up clip",
+)
 
 SPEC = StateSpec(
     states=(_RAGDOLL, _GET_UP),
     transitions=(
-        PuppetTransition(PuppetState.RAGDOLL, PuppetState.GET_UP, guard=ragdoll_settled, crossfade=0.0, label="settled"),
+        PuppetTransition(
+            PuppetState.RAGDOLL, PuppetState.GET_UP, guard=ragdoll_settled, crossfade=0.0, label="settled"
+        ),
         PuppetTransition(PuppetState.GET_UP, PuppetState.LOCOMOTION, guard=getup_done, crossfade=0.2, label="standing"),
     ),
 )

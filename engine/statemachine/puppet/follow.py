@@ -85,8 +85,14 @@ def _wrap(angle: float) -> float:
     return float((angle + np.pi) % (2 * np.pi) - np.pi)
 
 
-def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer,
-                    speed_scale: float = 1.0, lead_band: float = 0.02) -> None:
+def follow_velocity(
+    world: World,
+    entity: Entity,
+    body: PuppetBody,
+    player: LocomotionPlayer,
+    speed_scale: float = 1.0,
+    lead_band: float = 0.02,
+) -> None:
     """Steer toward the stick: smooth the wanted velocity, turn toward it, request its speed.
 
     ``lead_band`` (m): how far the stick must lead before its velocity counts in full (see
@@ -107,8 +113,9 @@ def follow_velocity(world: World, entity: Entity, body: PuppetBody, player: Loco
     body.recent = np.vstack([body.recent[1:], body.walk_velocity])
 
 
-def _face(tr: Transform, body: PuppetBody, player: LocomotionPlayer, speed: float, dt: float,
-          speed_scale: float) -> None:
+def _face(
+    tr: Transform, body: PuppetBody, player: LocomotionPlayer, speed: float, dt: float, speed_scale: float
+) -> None:
     """Turn toward the smoothed velocity at a bounded rate; ask the clip for the speed the facing allows."""
     t = body.tuning
     v = body.walk_velocity
@@ -125,8 +132,9 @@ def _face(tr: Transform, body: PuppetBody, player: LocomotionPlayer, speed: floa
     player.speed = speed * facing * speed_scale
 
 
-def follow_released(dt: float, bodies: list[PuppetBody], transforms: list[Transform],
-                    players: list[LocomotionPlayer]) -> None:
+def follow_released(
+    dt: float, bodies: list[PuppetBody], transforms: list[Transform], players: list[LocomotionPlayer]
+) -> None:
     """:func:`follow_velocity` (``speed_scale`` 1) for puppets no stick holds, over arrays.
 
     Unheld, the spring pulls the request to rest; the spring step, the speed and the

@@ -26,8 +26,9 @@ def _wrap(angle: float) -> float:
     return float((angle + np.pi) % (2 * np.pi) - np.pi)
 
 
-def follow_stick_legacy(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer,
-                        speed_scale: float = 1.0) -> None:
+def follow_stick_legacy(
+    world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0
+) -> None:
     """Steer toward the stick's ground point: set heading and requested speed (hard-switched)."""
     tr = world.get(entity, Transform)
     t = body.tuning

@@ -48,8 +48,14 @@ __all__ = [
 ]
 
 
-def follow_stick(world: World, entity: Entity, body: PuppetBody, player: LocomotionPlayer, speed_scale: float = 1.0,
-                 lead_band: float = 0.02) -> None:
+def follow_stick(
+    world: World,
+    entity: Entity,
+    body: PuppetBody,
+    player: LocomotionPlayer,
+    speed_scale: float = 1.0,
+    lead_band: float = 0.02,
+) -> None:
     """Steer toward the stick's ground point: set heading and requested speed (the tuning's controller).
 
     The legacy controller comes as it was: without the leg IK's foot locks either."""
@@ -148,19 +154,35 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
 
 
 _LOCOMOTION: PuppetStateDef = PuppetStateDef(
-    PuppetState.LOCOMOTION, update=update_locomotion, fits=locomotion_fits, batch_update=update_locomotion_batch,
-    batch_fits=free_rows, description="idle / walk / run from the blend space; follows the stick")
+    PuppetState.LOCOMOTION,
+    update=update_locomotion,
+    fits=locomotion_fits,
+    batch_update=update_locomotion_batch,
+    batch_fits=free_rows,
+    description="idle / walk / run from the blend space; follows the stick",
+)
 _CROUCH: PuppetStateDef = PuppetStateDef(
-    PuppetState.CROUCH, update=update_crouch, fits=locomotion_fits,
-    description="crouch idle / crouch walk; hips as low as the stick holds them")
+    PuppetState.CROUCH,
+    update=update_crouch,
+    fits=locomotion_fits,
+    description="crouch idle / crouch walk; hips as low as the stick holds them",
+)
 
 SPEC = StateSpec(
     states=(_LOCOMOTION, _CROUCH),
     transitions=(
-        PuppetTransition(PuppetState.LOCOMOTION, PuppetState.CROUCH, guard=wants_crouch, batch_guard=held_rows,
-                         priority=5, crossfade=0.25, label="lowered"),
-        PuppetTransition(PuppetState.CROUCH, PuppetState.LOCOMOTION, guard=wants_stand, priority=5, crossfade=0.25,
-                         label="raised"),
+        PuppetTransition(
+            PuppetState.LOCOMOTION,
+            PuppetState.CROUCH,
+            guard=wants_crouch,
+            batch_guard=held_rows,
+            priority=5,
+            crossfade=0.25,
+            label="lowered",
+        ),
+        PuppetTransition(
+            PuppetState.CROUCH, PuppetState.LOCOMOTION, guard=wants_stand, priority=5, crossfade=0.25, label="raised"
+        ),
     ),
 )
 """Locomotion and Crouch, and the ways between them."""

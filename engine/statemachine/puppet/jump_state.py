@@ -38,8 +38,17 @@ from engine.statemachine.puppet.names import PuppetEvent, PuppetState
 from engine.statemachine.puppet.senses import holder, wanted_anchor
 from engine.statemachine.puppet.spec import PuppetStateDef, PuppetTransition, StateSpec, held_rows
 
-__all__ = ["enter_jump", "update_jump", "exit_jump", "enter_land", "update_land", "landing_done", "jump_wanted",
-           "arc_progress", "SPEC"]
+__all__ = [
+    "enter_jump",
+    "update_jump",
+    "exit_jump",
+    "enter_land",
+    "update_land",
+    "landing_done",
+    "jump_wanted",
+    "arc_progress",
+    "SPEC",
+]
 
 
 def jump_wanted(world: World, entity: Entity, brain: Brain) -> bool:
@@ -227,24 +236,46 @@ def landing_done(world: World, entity: Entity, brain: Brain) -> bool:
     return world.get(entity, Landing).timer >= world.get(entity, PuppetBody).tuning.landing
 
 
-_JUMP: PuppetStateDef = PuppetStateDef(PuppetState.JUMP, enter=enter_jump, update=update_jump, exit=exit_jump,
-                                       description="anticipation squat, then the tracked arc (Eq. 6.3)")
-_LAND: PuppetStateDef = PuppetStateDef(PuppetState.LAND, enter=enter_land, update=update_land,
-                                       description="absorbing crouch")
+_JUMP: PuppetStateDef = PuppetStateDef(
+    PuppetState.JUMP,
+    enter=enter_jump,
+    update=update_jump,
+    exit=exit_jump,
+    description="anticipation squat, then the tracked arc (Eq. 6.3)",
+)
+_LAND: PuppetStateDef = PuppetStateDef(
+    PuppetState.LAND, enter=enter_land, update=update_land, description="absorbing crouch"
+)
 
 SPEC = StateSpec(
     states=(_JUMP, _LAND),
     transitions=(
         # Jumps first: a flick wins over everything on the ground.
-        PuppetTransition(PuppetState.LOCOMOTION, PuppetState.JUMP, guard=jump_wanted, batch_guard=held_rows,
-                         priority=20, crossfade=0.1, label="flick"),
-        PuppetTransition(PuppetState.CROUCH, PuppetState.JUMP, guard=jump_wanted, batch_guard=held_rows,
-                         priority=20, crossfade=0.1, label="flick"),
-        PuppetTransition(PuppetState.JUMP, PuppetState.RAGDOLL, event=PuppetEvent.JUMP_INVALID, priority=30,
-                         crossfade=0.1),
+        PuppetTransition(
+            PuppetState.LOCOMOTION,
+            PuppetState.JUMP,
+            guard=jump_wanted,
+            batch_guard=held_rows,
+            priority=20,
+            crossfade=0.1,
+            label="flick",
+        ),
+        PuppetTransition(
+            PuppetState.CROUCH,
+            PuppetState.JUMP,
+            guard=jump_wanted,
+            batch_guard=held_rows,
+            priority=20,
+            crossfade=0.1,
+            label="flick",
+        ),
+        PuppetTransition(
+            PuppetState.JUMP, PuppetState.RAGDOLL, event=PuppetEvent.JUMP_INVALID, priority=30, crossfade=0.1
+        ),
         PuppetTransition(PuppetState.JUMP, PuppetState.LAND, event=PuppetEvent.LANDED, priority=25, crossfade=0.1),
-        PuppetTransition(PuppetState.LAND, PuppetState.LOCOMOTION, guard=landing_done, crossfade=0.15,
-                         label="absorbed"),
+        PuppetTransition(
+            PuppetState.LAND, PuppetState.LOCOMOTION, guard=landing_done, crossfade=0.15, label="absorbed"
+        ),
     ),
 )
 """Jump and Land: the flick into the jump, the jump's end (landed or invalid) and the landing's."""

@@ -36,9 +36,24 @@ from engine.statemachine.puppet.spec import PuppetStateDef, PuppetTransition, St
 _PICKUP_SPREAD = 0.35  # m to the side a small ball may be for a crouched puppet to turn and pick it up
 
 __all__ = [
-    "can_pick_up", "enter_pickup", "update_pickup", "pickup_done",
-    "update_carry", "exit_carry", "enter_putdown", "update_putdown", "putdown_done", "exit_putdown",
-    "putdown_spot", "can_roll", "enter_roll", "update_roll", "exit_roll", "stop_rolling", "carry_position", "wants_putdown",
+    "can_pick_up",
+    "enter_pickup",
+    "update_pickup",
+    "pickup_done",
+    "update_carry",
+    "exit_carry",
+    "enter_putdown",
+    "update_putdown",
+    "putdown_done",
+    "exit_putdown",
+    "putdown_spot",
+    "can_roll",
+    "enter_roll",
+    "update_roll",
+    "exit_roll",
+    "stop_rolling",
+    "carry_position",
+    "wants_putdown",
     "SPEC",
 ]
 
@@ -52,7 +67,11 @@ def _hands(world: World, entity: Entity, centre: np.ndarray, radius: float) -> N
 def carry_position(world: World, entity: Entity, body: PuppetBody, radius: float) -> np.ndarray:
     """Where a carried ball sits: in front of the chest."""
     tr = world.get(entity, Transform)
-    return tr.position + np.array([0.0, body.tuning.stand_height + 0.1, 0.0]) + heading_vector(body.heading) * (body.tuning.front + radius)
+    return (
+        tr.position
+        + np.array([0.0, body.tuning.stand_height + 0.1, 0.0])
+        + heading_vector(body.heading) * (body.tuning.front + radius)
+    )
 
 
 def can_pick_up(world: World, entity: Entity, brain: Brain) -> bool:
@@ -70,8 +89,9 @@ def enter_pickup(world: World, entity: Entity, brain: Brain) -> None:
     """Choose the ball and start reaching."""
     body = world.get(entity, PuppetBody)
     hand = world.get(entity, Handling)
-    hand.object = prop_in_front(world, entity, body, body.tuning.reach, body.tuning.carry_max_radius,
-                                spread=_PICKUP_SPREAD)
+    hand.object = prop_in_front(
+        world, entity, body, body.tuning.reach, body.tuning.carry_max_radius, spread=_PICKUP_SPREAD
+    )
     hand.raised, hand.timer = False, 0.0
     if hand.object is not None:  # a ball a little to the side: the puppet turns to it as it reaches
         d = world.get(hand.object, Transform).position - world.get(entity, Transform).position
@@ -142,7 +162,9 @@ def enter_putdown(world: World, entity: Entity, brain: Brain) -> None:
     if hand.object is None or not world.alive(hand.object):
         return
     prop = world.get(hand.object, Prop)
-    ahead = world.get(entity, Transform).position + heading_vector(body.heading) * (body.tuning.front + 0.03 + prop.radius)
+    ahead = world.get(entity, Transform).position + heading_vector(body.heading) * (
+        body.tuning.front + 0.03 + prop.radius
+    )
     hand.spot = np.array([ahead[0], prop.radius, ahead[2]])
     nearest = np.inf
     for e, other, otr in world.query(Prop, Transform):
@@ -268,26 +290,41 @@ def wants_putdown(world: World, entity: Entity, brain: Brain) -> bool:
 
 
 _S = PuppetState
-_PICK_UP: PuppetStateDef = PuppetStateDef(_S.PICK_UP, enter=enter_pickup, update=update_pickup,
-                                          description="hands reach a small ball and lift it")
-_CARRY: PuppetStateDef = PuppetStateDef(_S.CARRY, update=update_carry, exit=exit_carry, fits=locomotion_fits,
-                                        description="walk holding the ball")
-_PUT_DOWN: PuppetStateDef = PuppetStateDef(_S.PUT_DOWN, enter=enter_putdown, update=update_putdown, exit=exit_putdown,
-                                           description="lower the ball, onto another ball if one is in front")
-_ROLL: PuppetStateDef = PuppetStateDef(_S.ROLL_SNOWBALL, enter=enter_roll, update=update_roll, exit=exit_roll,
-                                       fits=locomotion_fits, description="crouch walk, both hands on the ball, pushing it")
+_PICK_UP: PuppetStateDef = PuppetStateDef(
+    _S.PICK_UP, enter=enter_pickup, update=update_pickup, description="hands reach a small ball and lift it"
+)
+_CARRY: PuppetStateDef = PuppetStateDef(
+    _S.CARRY, update=update_carry, exit=exit_carry, fits=locomotion_fits, description="walk holding the ball"
+)
+_PUT_DOWN: PuppetStateDef = PuppetStateDef(
+    _S.PUT_DOWN,
+    enter=enter_putdown,
+    update=update_putdown,
+    exit=exit_putdown,
+    description="lower the ball, onto another ball if one is in front",
+)
+_ROLL: PuppetStateDef = PuppetStateDef(
+    _S.ROLL_SNOWBALL,
+    enter=enter_roll,
+    update=update_roll,
+    exit=exit_roll,
+    fits=locomotion_fits,
+    description="crouch walk, both hands on the ball, pushing it",
+)
 
 SPEC = StateSpec(
     states=(_PICK_UP, _CARRY, _PUT_DOWN, _ROLL),
     transitions=(
-        PuppetTransition(_S.CROUCH, _S.PICK_UP, guard=can_pick_up, priority=10, crossfade=0.2,
-                         label="still over a small ball"),
+        PuppetTransition(
+            _S.CROUCH, _S.PICK_UP, guard=can_pick_up, priority=10, crossfade=0.2, label="still over a small ball"
+        ),
         PuppetTransition(_S.CROUCH, _S.ROLL_SNOWBALL, guard=can_roll, priority=8, crossfade=0.2, label="pushes a ball"),
         PuppetTransition(_S.PICK_UP, _S.CARRY, guard=pickup_done, crossfade=0.2, label="lifted"),
         PuppetTransition(_S.CARRY, _S.PUT_DOWN, guard=wants_putdown, priority=5, crossfade=0.2, label="lowered"),
         PuppetTransition(_S.PUT_DOWN, _S.LOCOMOTION, guard=putdown_done, crossfade=0.2, label="set down"),
-        PuppetTransition(_S.ROLL_SNOWBALL, _S.LOCOMOTION, guard=stop_rolling, priority=5, crossfade=0.25,
-                         label="stood up"),
+        PuppetTransition(
+            _S.ROLL_SNOWBALL, _S.LOCOMOTION, guard=stop_rolling, priority=5, crossfade=0.25, label="stood up"
+        ),
     ),
 )
 """The ball-handling states and the ways into and out of them."""

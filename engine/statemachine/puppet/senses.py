@@ -107,8 +107,9 @@ def sense_all(world: World, entities: list[Entity], bodies: list[PuppetBody]) ->
     return PuppetColumns(entities, bodies, held)
 
 
-def prop_in_front(world: World, entity: Entity, body: PuppetBody, reach: float, max_radius: float | None = None,
-                  spread: float = 0.25) -> Entity | None:
+def prop_in_front(
+    world: World, entity: Entity, body: PuppetBody, reach: float, max_radius: float | None = None, spread: float = 0.25
+) -> Entity | None:
     """The nearest free prop whose surface is within ``reach`` in front of the puppet, its centre at most
     ``spread`` (or its radius) to the side of the heading."""
     tr = world.get(entity, Transform)

@@ -15,10 +15,21 @@ from authoring.batch.worker import ClipOut, TakeOutcome
 
 
 def _outcome(digest: str, clips: int) -> TakeOutcome:
-    cs = tuple(ClipOut(k, 10 * k, 10 * k + 10, k / 6, k / 6 + 1.0, 1.0, 3, 0.0, 0.1, 1.2, 7, "walk", ".npz", b"x%d" % k)
-               for k in range(clips))
-    return TakeOutcome(f"/d/{digest}.bvh", digest, "looped" if clips else "refused", "" if clips else "no period",
-                       100, 60.0, 7, 0.5, cs)
+    cs = tuple(
+        ClipOut(k, 10 * k, 10 * k + 10, k / 6, k / 6 + 1.0, 1.0, 3, 0.0, 0.1, 1.2, 7, "walk", ".npz", b"x%d" % k)
+        for k in range(clips)
+    )
+    return TakeOutcome(
+        f"/d/{digest}.bvh",
+        digest,
+        "looped" if clips else "refused",
+        "" if clips else "no period",
+        100,
+        60.0,
+        7,
+        0.5,
+        cs,
+    )
 
 
 def _files(root: Path, outcome: TakeOutcome, files: list[str]) -> list[str]:
@@ -68,7 +79,9 @@ def test_sources_files_folders_globs_once_each(tmp_path: Path) -> None:
     (tmp_path / "a").mkdir()
     for name in ("a/x.bvh", "a/y.csv", "a/z.txt", "w.npz"):
         (tmp_path / name).write_text("")
-    found = collect_sources([str(tmp_path / "a"), str(tmp_path / "a" / "x.bvh"), str(tmp_path / "*.npz")], (".bvh", ".csv", ".npz"))
+    found = collect_sources(
+        [str(tmp_path / "a"), str(tmp_path / "a" / "x.bvh"), str(tmp_path / "*.npz")], (".bvh", ".csv", ".npz")
+    )
     assert [p.name for p in found] == ["x.bvh", "y.csv", "w.npz"]
 
 
@@ -125,7 +138,7 @@ def test_a_damaged_page_or_a_bad_schema_value_is_one_line(tmp_path: Path) -> Non
     index.record(outcome, _files(tmp_path / "b", outcome, [f"clips/a{k}.npz" for k in range(3)]), "CC0")
     index.close()
     data = bytearray((tmp_path / "b" / "index.sqlite").read_bytes())
-    data[4096 * 2: 4096 * 2 + 12] = b"\xff" * 12  # a b-tree page's header
+    data[4096 * 2 : 4096 * 2 + 12] = b"\xff" * 12  # a b-tree page's header
     (tmp_path / "b" / "index.sqlite").write_bytes(bytes(data))
     with pytest.raises(LibraryIndexError, match="damaged|not a library index"):
         LibraryIndex(tmp_path / "b", "opts")
@@ -151,10 +164,18 @@ def _library(root: Path) -> None:
     index.close()
 
 
-@pytest.mark.parametrize(("table", "needle"), [("meta", b"opts-only-here"), ("takes", b"a reason only here"),
-                                               ("clips", struct.pack(">d", 0.1)), ("sources", b"f" * 64)])
-def test_a_flipped_byte_in_any_row_of_any_table_is_noticed_in_one_line(tmp_path: Path, capsys, table: str,
-                                                                        needle: bytes) -> None:  # type: ignore[no-untyped-def]
+@pytest.mark.parametrize(
+    ("table", "needle"),
+    [
+        ("meta", b"opts-only-here"),
+        ("takes", b"a reason only here"),
+        ("clips", struct.pack(">d", 0.1)),
+        ("sources", b"f" * 64),
+    ],
+)
+def test_a_flipped_byte_in_any_row_of_any_table_is_noticed_in_one_line(
+    tmp_path: Path, capsys, table: str, needle: bytes
+) -> None:  # type: ignore[no-untyped-def]
     """Broken on purpose: with the row sums unchecked, the flipped reason, spread and source hash read back
     as valid values (every case but meta's options passes silently)."""
     _library(tmp_path)

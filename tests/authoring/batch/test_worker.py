@@ -45,8 +45,16 @@ def test_three_activities_three_clips_with_their_bounds() -> None:
     assert whole.outcome == "refused" and whole.reason and not whole.clips
 
 
-@pytest.mark.parametrize(("data", "name"), [(b"", "a.npz"), (b"\x00garbage", "b.bvh"), (b"time,a\n1,x\n", "c.csv"),
-                                            (b"HIERARCHY\nROOT Hips\n{\n", "d.bvh"), (b"x", "e.unknown")])
+@pytest.mark.parametrize(
+    ("data", "name"),
+    [
+        (b"", "a.npz"),
+        (b"\x00garbage", "b.bvh"),
+        (b"time,a\n1,x\n", "c.csv"),
+        (b"HIERARCHY\nROOT Hips\n{\n", "d.bvh"),
+        (b"x", "e.unknown"),
+    ],
+)
 def test_bad_takes_fail_with_a_reason(data: bytes, name: str) -> None:
     out = process_take(_task(data, name), BatchOptions())
     assert out.outcome == "failed" and out.reason.startswith("cannot read") and not out.clips
@@ -60,7 +68,9 @@ def test_non_repeating_take_is_refused() -> None:
 
 def test_retarget_needs_a_skeleton_and_retargets_a_bvh(mocap_dir: Path) -> None:
     perf = make_performance(4, np.random.default_rng(1))
-    assert process_take(_task(_npz(perf.trajectory.values)), BatchOptions(retarget="puppet")).reason.startswith("--retarget")
+    assert process_take(_task(_npz(perf.trajectory.values)), BatchOptions(retarget="puppet")).reason.startswith(
+        "--retarget"
+    )
     data = (mocap_dir / "cmu_16_15_walk_daz.bvh").read_bytes()
     out = process_take(_task(data, "cmu_16_15_walk_daz.bvh"), BatchOptions(retarget="puppet"))
     assert out.outcome == "looped"
@@ -91,8 +101,9 @@ def _two_animation_glb(clips: list) -> bytes:  # type: ignore[type-arg]
         doc["bufferViews"] += [{**v, "byteOffset": v.get("byteOffset", 0) + len(blob)} for v in more["bufferViews"]]
         doc["accessors"] += [{**a, "bufferView": a["bufferView"] + views} for a in more["accessors"]]
         anim = more["animations"][0]
-        anim["samplers"] = [{**s, "input": s["input"] + accessors, "output": s["output"] + accessors}
-                            for s in anim["samplers"]]
+        anim["samplers"] = [
+            {**s, "input": s["input"] + accessors, "output": s["output"] + accessors} for s in anim["samplers"]
+        ]
         doc["animations"].append(anim)
         blob += extra
     doc["buffers"][0]["byteLength"] = len(blob)

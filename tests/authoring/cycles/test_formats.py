@@ -15,7 +15,9 @@ from engine import quat
 
 
 def _write_csv(path: Path, t: np.ndarray, v: np.ndarray, names: list[str]) -> None:
-    lines = [",".join(["time", *names])] + [",".join(repr(float(x)) for x in [ti, *row]) for ti, row in zip(t, v, strict=True)]
+    lines = [",".join(["time", *names])] + [
+        ",".join(repr(float(x)) for x in [ti, *row]) for ti, row in zip(t, v, strict=True)
+    ]
     path.write_text("\n".join(lines) + "\n")
 
 

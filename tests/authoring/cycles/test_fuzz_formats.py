@@ -33,7 +33,8 @@ def test_fuzz_npz_performances(campaign, mutations, fuzz_budget, tmp_path, compr
     t, v = _performance()
     buf = io.BytesIO()
     (np.savez_compressed if compressed else np.savez)(
-        buf, times=t, values=v, names=np.array(["a.x", "a.y", "a.z", "s", "u", "w"]))
+        buf, times=t, values=v, names=np.array(["a.x", "a.y", "a.z", "s", "u", "w"])
+    )
     cases, seed = fuzz_budget(1000)
     c = campaign(TrajectoryError)
     path = tmp_path / "m.npz"
@@ -45,8 +46,9 @@ def test_fuzz_npz_performances(campaign, mutations, fuzz_budget, tmp_path, compr
 
 def test_fuzz_csv_performances(campaign, mutations, fuzz_budget, tmp_path):
     t, v = _performance()
-    text = "time,a.x,a.y,a.z,s,u,w\n" + "".join(",".join(repr(float(x)) for x in [ti, *row]) + "\n"
-                                                   for ti, row in zip(t, v, strict=True))
+    text = "time,a.x,a.y,a.z,s,u,w\n" + "".join(
+        ",".join(repr(float(x)) for x in [ti, *row]) + "\n" for ti, row in zip(t, v, strict=True)
+    )
     cases, seed = fuzz_budget(1200)
     c = campaign(TrajectoryError)
     path = tmp_path / "m.csv"

@@ -37,7 +37,9 @@ def test_a_weaving_walk_loops_once_the_heading_is_taken_out(tmp_path: Path) -> N
     # The loop walks forward in its own frame at the take's speed (1.2 m/s), in world terms again.
     clip = loop_clip(r, perf)
     pos = clip.root
-    assert np.linalg.norm(pos[-1, [0, 2]] - pos[0, [0, 2]]) == pytest.approx(1.2 * clip.duration * (1 - 1 / len(pos)), rel=0.1)
+    assert np.linalg.norm(pos[-1, [0, 2]] - pos[0, [0, 2]]) == pytest.approx(
+        1.2 * clip.duration * (1 - 1 / len(pos)), rel=0.1
+    )
     save_loop(r, perf, tmp_path / "loop.bvh")
     assert read_bvh(tmp_path / "loop.bvh").num_frames == round(r.period * 30) + 1
 
@@ -45,8 +47,13 @@ def test_a_weaving_walk_loops_once_the_heading_is_taken_out(tmp_path: Path) -> N
 def test_normalise_and_restore_are_inverse_on_a_curving_path() -> None:
     t = np.linspace(0.0, 2.0, 81)
     heading = 0.8 * t + 0.3
-    root = np.stack([-np.cos(heading) * 3.0, 0.9 + 0.02 * np.cos(9 * t), np.sin(heading) * 3.0], axis=1)  # walks forward
-    rot = quat.mul(quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), heading), quat.from_axis_angle(np.array([1.0, 0, 0]), 0.1 * np.sin(5 * t)))
+    root = np.stack(
+        [-np.cos(heading) * 3.0, 0.9 + 0.02 * np.cos(9 * t), np.sin(heading) * 3.0], axis=1
+    )  # walks forward
+    rot = quat.mul(
+        quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), heading),
+        quat.from_axis_angle(np.array([1.0, 0, 0]), 0.1 * np.sin(5 * t)),
+    )
     local, level, head = normalise(root, rot)
     assert np.allclose(yaw(level), 0.0, atol=1e-9) and np.allclose(head, heading)
     # On a circle the body-frame path is a straight line of the arc's length.

@@ -58,7 +58,9 @@ def test_gait_period_matches_foot_contacts(mocap_dir: Path, name: str, min_cycle
     path = mocap_dir / name
     truth = gait_period_frames(path)
     r = extract_cycle(load_performance(path).trajectory, np.random.default_rng(0), CycleOptions(min_cycles=min_cycles))
-    assert abs(r.period_samples / truth - 1.0) < 0.03, f"{name}: {r.period_samples:.1f} frames vs foot contacts {truth:.1f}"
+    assert abs(r.period_samples / truth - 1.0) < 0.03, (
+        f"{name}: {r.period_samples:.1f} frames vs foot contacts {truth:.1f}"
+    )
     assert r.closure_error < 1e-9
 
 
@@ -77,7 +79,9 @@ def test_punches(mocap_dir: Path, name: str, period: float) -> None:
 
 def test_forward_jump_is_refused(mocap_dir: Path) -> None:
     with pytest.raises(CycleError, match="period|cycles"):
-        extract_cycle(load_performance(mocap_dir / "cmu_13_32_forward_jump_NEGATIVE_daz.bvh").trajectory, np.random.default_rng(0))
+        extract_cycle(
+            load_performance(mocap_dir / "cmu_13_32_forward_jump_NEGATIVE_daz.bvh").trajectory, np.random.default_rng(0)
+        )
 
 
 def test_t_pose_lead_in_is_skipped(mocap_dir: Path) -> None:

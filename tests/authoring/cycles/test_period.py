@@ -11,7 +11,13 @@ from authoring.cycles.period import PeriodSearch, candidate_minima, match_chain,
 def _sine_rows(period_samples: float, n: int, points: list[int]) -> tuple[np.ndarray, np.ndarray]:
     t = np.arange(n) / 60.0
     phase = np.arange(n) / period_samples
-    v = np.stack([np.sin(2 * np.pi * phase + 0.3) + 0.2 * np.sin(6 * np.pi * phase + 2.0), 0.4 * np.sin(4 * np.pi * phase + 1.0)], axis=1)
+    v = np.stack(
+        [
+            np.sin(2 * np.pi * phase + 0.3) + 0.2 * np.sin(6 * np.pi * phase + 2.0),
+            0.4 * np.sin(4 * np.pi * phase + 1.0),
+        ],
+        axis=1,
+    )
     return t, Descriptor(t, v).rows(points)
 
 

@@ -49,18 +49,43 @@ def test_the_salsa_steps_repeat_closely_in_one_part(salsa) -> None:  # type: ign
     assert leg_joints(salsa) == ("hip", "lThigh", "lShin", "lFoot", "rThigh", "rShin", "rFoot")
 
 
-def test_the_refused_salsa_names_where_its_steps_loop_and_the_hint_loops(salsa, mocap_dir: Path,  # type: ignore[no-untyped-def]
-                                                                         tmp_path: Path) -> None:
+def test_the_refused_salsa_names_where_its_steps_loop_and_the_hint_loops(
+    salsa,
+    mocap_dir: Path,  # type: ignore[no-untyped-def]
+    tmp_path: Path,
+) -> None:
     hint = refusal_hint(salsa, salsa)
     assert hint is not None
-    m = re.search(r"frames (\d+)–(\d+) loop by the legs with period ([\d.]+) s \((\d+) cycles\); "
-                  r"try --start (\S+) --end (\S+) --items (.+)$", hint)
+    m = re.search(
+        r"frames (\d+)–(\d+) loop by the legs with period ([\d.]+) s \((\d+) cycles\); "
+        r"try --start (\S+) --end (\S+) --items (.+)$",
+        hint,
+    )
     assert m, hint
     start, end, items = m.group(5), m.group(6), m.group(7).split()
     assert 8.0 <= float(start) < float(end) <= 15.0
-    r = subprocess.run([sys.executable, "-m", "puppetphone", "cycle", str(mocap_dir / SALSA), "-o",
-                        str(tmp_path / "steps.bvh"), "--start", start, "--end", end, "--items", *items, "--json"],
-                       check=False, capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "cycle",
+            str(mocap_dir / SALSA),
+            "-o",
+            str(tmp_path / "steps.bvh"),
+            "--start",
+            start,
+            "--end",
+            end,
+            "--items",
+            *items,
+            "--json",
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0, r.stderr
     summary = json.loads(r.stdout.strip().splitlines()[-1])
     assert summary["period_seconds"] == pytest.approx(float(m.group(3)), abs=0.01) and summary["cycles"] >= 3

@@ -70,7 +70,7 @@ def test_cut_refuses_empty_and_outside() -> None:
 
 def test_real_mocap_walk_is_one_segment_and_the_jump_none(mocap_dir: Path) -> None:
     walk = load_performance(mocap_dir / "cmu_16_15_walk_daz.bvh").trajectory
-    (seg, result), = looping_segments(walk)
+    ((seg, result),) = looping_segments(walk)
     assert isinstance(result, CycleResult) and result.period == pytest.approx(1.17, rel=0.03)
     assert seg.t1 - seg.t0 > 0.9 * walk.times[-1]
     jump = load_performance(mocap_dir / "cmu_13_32_forward_jump_NEGATIVE_daz.bvh").trajectory

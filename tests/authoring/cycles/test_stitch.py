@@ -29,7 +29,9 @@ def test_vector_stitch_is_the_paper_formula() -> None:
 def test_travel_is_kept() -> None:
     tr = Trajectory(np.arange(3.0), np.zeros((3, 3)), (Item("root", "position", 0, 3, travel=True),))
     phases = np.linspace(0, 1, 21)
-    curve = np.stack([phases * 1.3 + 0.05 * np.sin(9 * phases), 0.1 * np.cos(2 * np.pi * phases) + 0.02, 0 * phases], axis=1)
+    curve = np.stack(
+        [phases * 1.3 + 0.05 * np.sin(9 * phases), 0.1 * np.cos(2 * np.pi * phases) + 0.02, 0 * phases], axis=1
+    )
     travel = np.array([1.3, 0.0, 0.0])
     out, _ = stitch(tr, curve, phases, travel)
     assert np.allclose(out[-1] - out[0], travel, atol=1e-14)

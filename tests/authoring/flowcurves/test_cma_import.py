@@ -20,8 +20,15 @@ print("matplotlib" in sys.modules)
 
 def test_a_contour_search_imports_no_plotting_and_prints_nothing(tmp_path: Path) -> None:
     env = dict(os.environ, MPLCONFIGDIR=str(tmp_path / "mpl"), PYTHONWARNINGS="always")
-    done = subprocess.run([sys.executable, "-c", _PROBE], check=False, capture_output=True, text=True, env=env, timeout=300,
-                          cwd=Path(__file__).resolve().parents[3])
+    done = subprocess.run(
+        [sys.executable, "-c", _PROBE],
+        check=False,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+        cwd=Path(__file__).resolve().parents[3],
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "False"
     assert done.stderr == ""

@@ -69,7 +69,7 @@ def _relative_energy(session) -> tuple[float, float]:  # type: ignore[no-untyped
     taken = session.deformer.segments([dense(f) for f in session.flows], session.all_securves())
     soft = np.vstack([t[owners == o] for _, owners, t in taken for o in sorted(set(owners.tolist()))])
     linear = system.linear_solve(session.deformer.hard_targets(r.offsets), soft)
-    rest_sq = float(np.sum(system._u ** 2))
+    rest_sq = float(np.sum(system._u**2))
     return system.energy(x) / rest_sq, arap_energy(system.rest, system.triangles, linear) / rest_sq
 
 

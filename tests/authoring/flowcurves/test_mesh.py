@@ -13,8 +13,8 @@ import pytest
 from authoring.flowcurves.mesh import MeshError, TriMesh, rasterize_mesh, read_glb_mesh
 from authoring.flowcurves.scene import FlowObject, FlowScene, rasterize
 from authoring.flowcurves.tilt import MAX_BASE_TILT_DEG, base_tilt_deg
-from puppetphone.bench.flow_mesh import bend, contact_error_px, mesh_tree_problem
 from engine.camera import OrbitCamera
+from puppetphone.bench.flow_mesh import bend, contact_error_px, mesh_tree_problem
 
 UP = np.array([0.0, 1.0, 0.0])
 
@@ -35,8 +35,9 @@ def test_one_mesh_bends_along_the_stroke(bent) -> None:  # type: ignore[no-untyp
     Broken by lifting only the first two vertices (what capsules had): the top does not move."""
     scene, session = bent
     rest, moved = scene.objects[0].mesh, session.objects[0].mesh
-    shift = np.linalg.norm(scene.camera.project(moved.vertices, *scene.size)
-                           - scene.camera.project(rest.vertices, *scene.size), axis=1)
+    shift = np.linalg.norm(
+        scene.camera.project(moved.vertices, *scene.size) - scene.camera.project(rest.vertices, *scene.size), axis=1
+    )
     top = int(np.argmax(rest.vertices[:, 1]))
     middle = slice(6 * 8, 7 * 8)  # the trunk's seventh ring of eight vertices
     assert shift[top] > 40.0
@@ -115,13 +116,20 @@ def _prop(path: Path, indices: list[int] | None = None) -> Path:
     pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=np.float32)
     idx = np.array(indices if indices is not None else [0, 1, 2, 1, 3, 2], dtype=np.uint16)
     blob = pos.tobytes() + idx.tobytes()
-    doc = {"asset": {"version": "2.0"}, "buffers": [{"byteLength": len(blob)}],
-           "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48,
-                                                                              "byteLength": 2 * len(idx)}],
-           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
-                         {"bufferView": 1, "componentType": 5123, "count": len(idx), "type": "SCALAR"}],
-           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-           "nodes": [{"mesh": 0, "translation": [2.0, 0.0, 0.0]}]}
+    doc = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": len(blob)}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 2 * len(idx)},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 1, "componentType": 5123, "count": len(idx), "type": "SCALAR"},
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0, "translation": [2.0, 0.0, 0.0]}],
+    }
     path.write_bytes(_glb(doc, blob))
     return path
 

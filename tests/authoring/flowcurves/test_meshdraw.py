@@ -27,8 +27,8 @@ def _render(viewer, objects, rest) -> np.ndarray:  # type: ignore[no-untyped-def
 
 
 def test_the_bent_crystal_is_drawn_where_the_bend_put_it() -> None:
-    from puppetphone.bench.flow_mesh import bend
     from engine.render import Viewer, make_target
+    from puppetphone.bench.flow_mesh import bend
 
     scene, session = bend()
     viewer = Viewer(make_target(True, *scene.size, samples=0))
@@ -46,7 +46,7 @@ def test_the_bent_crystal_is_drawn_where_the_bend_put_it() -> None:
 
     def px(img: np.ndarray, xy: np.ndarray) -> np.ndarray:
         x, y = int(xy[0]), int(xy[1])
-        return img[y - 1:y + 2, x - 1:x + 2].reshape(-1, img.shape[-1])[:, :3].mean(0)
+        return img[y - 1 : y + 2, x - 1 : x + 2].reshape(-1, img.shape[-1])[:, :3].mean(0)
 
     assert np.abs(px(bent, at_bent) - px(empty, at_bent)).max() > 30  # the crystal is drawn at its bent place
     assert np.abs(px(bent, at_rest) - px(empty, at_rest)).max() < 8  # and nothing is left where it stood

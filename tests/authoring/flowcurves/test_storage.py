@@ -44,14 +44,17 @@ def test_undo_and_redo_give_the_same_scene() -> None:
     assert (session.objects[0].points() == after).all()
 
 
-@pytest.mark.parametrize("change, words", [
-    (lambda d: d.update(version=2), "version"),
-    (lambda d: d["edits"][0].update(kind="spray"), "edit kind"),
-    (lambda d: d["edits"][0]["points"][0].__setitem__(0, float("nan")), "number"),
-    (lambda d: d["objects"][0]["primitives"][0].update(radius=-1), "radius"),
-    (lambda d: d.update(edits=[{"kind": "stroke", "points": [[0, 0]] * 30000}]), "entries"),
-    (lambda d: d["objects"].append(dict(d["objects"][0])), "twice"),
-])
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (lambda d: d.update(version=2), "version"),
+        (lambda d: d["edits"][0].update(kind="spray"), "edit kind"),
+        (lambda d: d["edits"][0]["points"][0].__setitem__(0, float("nan")), "number"),
+        (lambda d: d["objects"][0]["primitives"][0].update(radius=-1), "radius"),
+        (lambda d: d.update(edits=[{"kind": "stroke", "points": [[0, 0]] * 30000}]), "entries"),
+        (lambda d: d["objects"].append(dict(d["objects"][0])), "twice"),
+    ],
+)
 def test_bad_documents_are_refused_in_one_line(change, words: str) -> None:  # type: ignore[no-untyped-def]
     doc = json.loads(json.dumps(flow_document(_session())))
     change(doc)
@@ -70,9 +73,11 @@ def test_unreadable_files_are_flow_errors(tmp_path: Path) -> None:
         load_flow(tmp_path)
 
 
-_json = st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=8),
-                     lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=8), c, max_size=4),
-                     max_leaves=20)
+_json = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=8),
+    lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=8), c, max_size=4),
+    max_leaves=20,
+)
 
 
 @settings(max_examples=60, deadline=None)

@@ -59,7 +59,9 @@ def test_pose_key_holds_pins_within_eps_and_keeps_limits():
     # The static IK's ε (1e-4 m) bounds each coordinate of a pinned point's drift.
     assert np.abs(after[sk.index("r_foot")] - before[sk.index("r_foot")]).max() <= 1e-4
     rig = posing_rig(sk)
-    c, _ = rig.to_coordinates(res.clip.curves.values[1][:3], res.clip.pose_arrays(res.clip.curves.values[1][None])[1][0])
+    c, _ = rig.to_coordinates(
+        res.clip.curves.values[1][:3], res.clip.pose_arrays(res.clip.curves.values[1][None])[1][0]
+    )
     assert rig.within_limits(c, tol=1e-6)
 
 

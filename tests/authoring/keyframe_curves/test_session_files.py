@@ -16,15 +16,18 @@ def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
     return path, json.loads(keys_path(path).read_text())
 
 
-@pytest.mark.parametrize("edit,says", [
-    (lambda d: d.update(fps=1e308), "fps"),
-    (lambda d: d.update(fps=True), "fps"),
-    (lambda d: d.update(values=[[1e308] * len(r) for r in d["values"]]), "absurd"),
-    (lambda d: d.update(out_y=[[float("nan")] * len(r) for r in d["out_y"]]), "absurd"),
-    (lambda d: d.update(fps=1000, times=[0.0] + [1e5 + i for i in range(len(d["times"]) - 1)]), "frames"),
-    (lambda d: d.update(loop="yes"), "loop"),
-    (lambda d: d.update(values=[[1.0]]), "values"),
-])
+@pytest.mark.parametrize(
+    "edit,says",
+    [
+        (lambda d: d.update(fps=1e308), "fps"),
+        (lambda d: d.update(fps=True), "fps"),
+        (lambda d: d.update(values=[[1e308] * len(r) for r in d["values"]]), "absurd"),
+        (lambda d: d.update(out_y=[[float("nan")] * len(r) for r in d["out_y"]]), "absurd"),
+        (lambda d: d.update(fps=1000, times=[0.0] + [1e5 + i for i in range(len(d["times"]) - 1)]), "frames"),
+        (lambda d: d.update(loop="yes"), "loop"),
+        (lambda d: d.update(values=[[1.0]]), "values"),
+    ],
+)
 def test_a_bad_side_file_is_one_curve_file_error(saved, tmp_path: Path, edit, says: str) -> None:  # type: ignore[no-untyped-def]
     path, side = saved
     data = json.loads(json.dumps(side))

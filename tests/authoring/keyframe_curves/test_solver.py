@@ -5,7 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from authoring.keyframe_curves import CurveSettings, Drag, Hold, TangentSolver, curve_rig, retime_segment, segment_bounds
+from authoring.keyframe_curves import (
+    CurveSettings,
+    Drag,
+    Hold,
+    TangentSolver,
+    curve_rig,
+    retime_segment,
+    segment_bounds,
+)
 from engine.clips import default_clips
 from engine.ik import humanoid_rig
 from engine.keyframes import KeyframedClip, keyframe_clip
@@ -149,7 +157,7 @@ def test_free_chain_with_broken_tangents_converges_in_few_iterations():
     oy, iy = rng.uniform(-0.1, 0.1, (4, c)), rng.uniform(-0.1, 0.1, (4, c))
     oy[:, :3] = iy[:, :3] = 0.0
     clip = KeyframedClip("chain", sk, BezierCurves(times, values, ox, oy, ox, iy), fps=30.0)
-    rig = IKRig.build(sk, limits={name: (-1.5, 1.5) for name in sk.names}, root_translation=True)
+    rig = IKRig.build(sk, limits=dict.fromkeys(sk.names, (-1.5, 1.5)), root_translation=True)
     # A 10 µm tolerance: the tail shows whether the steps converge quadratically or crawl.
     # Broken as the user breaks them: each side its own variable, E_b between them (not linked).
     s = TangentSolver(clip, rig, CurveSettings(tolerance=1e-5, linked_tangents=False), frozen=range(3))
@@ -181,7 +189,9 @@ def _hand_path_after_drag(walk, linked: bool):  # type: ignore[no-untyped-def]
 
 def _sharpest_turn_deg(path):  # type: ignore[no-untyped-def]
     d = np.diff(path, axis=0)
-    cos = np.sum(d[1:] * d[:-1], axis=1) / np.maximum(np.linalg.norm(d[1:], axis=1) * np.linalg.norm(d[:-1], axis=1), 1e-12)
+    cos = np.sum(d[1:] * d[:-1], axis=1) / np.maximum(
+        np.linalg.norm(d[1:], axis=1) * np.linalg.norm(d[:-1], axis=1), 1e-12
+    )
     return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max())
 
 

@@ -53,7 +53,8 @@ def test_a_scale_edit_becomes_the_clips_scale_channel_and_shows_on_the_character
     plain, _ = forward_kinematics(sk, pose.root, pose.rotations)
     assert np.linalg.norm(pos[kids[0]] - pos[arm]) == pytest.approx(1.5 * np.linalg.norm(plain[kids[0]] - plain[arm]))
     assert np.linalg.norm(pos[arm] - pos[sk.parents[arm]]) == pytest.approx(
-        np.linalg.norm(plain[arm] - plain[sk.parents[arm]]))  # the forearm's own bone is its parent's to scale
+        np.linalg.norm(plain[arm] - plain[sk.parents[arm]])
+    )  # the forearm's own bone is its parent's to scale
     session.undo()
     assert session.clip.scales is None
 

@@ -17,7 +17,9 @@ def snapshot(session):
 
 def same(a, b):
     return all(
-        (x is None and y is None) or (isinstance(x, dict) and x == y) or (isinstance(x, np.ndarray) and x.tobytes() == y.tobytes())
+        (x is None and y is None)
+        or (isinstance(x, dict) and x == y)
+        or (isinstance(x, np.ndarray) and x.tobytes() == y.tobytes())
         for x, y in zip(a, b, strict=True)
     )
 

@@ -60,18 +60,21 @@ def test_exports_to_bvh_and_gltf_carry_the_travel(walk, tmp_path):
     assert not (tmp_path / "walk.fbx").exists()
 
 
-@pytest.mark.parametrize("edit,says", [
-    (lambda d: d.pop("scales"), "scales"),  # was a KeyError
-    (lambda d: d.update(scales=d["scales"][:-1]), "scales"),
-    (lambda d: d["scales"][0].__setitem__(0, float("inf")), "scales"),
-    (lambda d: d["scales"][0].__setitem__(0, "big"), "scales"),
-    (lambda d: d.update(pins={"l_foot": [10**9]}), "pins"),
-    (lambda d: d.update(pins=[1, 2]), "pins"),
-    (lambda d: d.update(tau=-3), "tau"),
-    (lambda d: d.update(sigma=float("nan")), "sigma"),
-    (lambda d: d.update(version="2"), "version"),
-    (lambda d: d.clear(), "not a MoCurves"),
-])
+@pytest.mark.parametrize(
+    "edit,says",
+    [
+        (lambda d: d.pop("scales"), "scales"),  # was a KeyError
+        (lambda d: d.update(scales=d["scales"][:-1]), "scales"),
+        (lambda d: d["scales"][0].__setitem__(0, float("inf")), "scales"),
+        (lambda d: d["scales"][0].__setitem__(0, "big"), "scales"),
+        (lambda d: d.update(pins={"l_foot": [10**9]}), "pins"),
+        (lambda d: d.update(pins=[1, 2]), "pins"),
+        (lambda d: d.update(tau=-3), "tau"),
+        (lambda d: d.update(sigma=float("nan")), "sigma"),
+        (lambda d: d.update(version="2"), "version"),
+        (lambda d: d.clear(), "not a MoCurves"),
+    ],
+)
 def test_a_damaged_side_file_is_a_session_file_error(walk, tmp_path, edit, says):
     path = save_session(EditSession(walk), tmp_path / "a.ppclip")
     side = tmp_path / "a.mocurves.json"

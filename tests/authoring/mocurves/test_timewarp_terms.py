@@ -39,11 +39,14 @@ def test_a_stretch_changes_the_period_and_every_gap_evenly() -> None:
     assert e["E_S"] == pytest.approx(0.0, abs=1e-20)  # evenly: no speed change, at the seam neither
 
 
-@pytest.mark.parametrize(("key", "e_v", "e_s"), [
-    (4, 2.0, 6.0),  # inside: gaps +d and -d; speed changes d, -2d, d
-    (0, 1.0, 2.0),  # the first keypoint alone (its copy N not moved): the seam term sees it
-    (N, 1.0, 2.0),  # the seam keypoint alone: the periodic term at i = 0 and the last inner one
-])
+@pytest.mark.parametrize(
+    ("key", "e_v", "e_s"),
+    [
+        (4, 2.0, 6.0),  # inside: gaps +d and -d; speed changes d, -2d, d
+        (0, 1.0, 2.0),  # the first keypoint alone (its copy N not moved): the seam term sees it
+        (N, 1.0, 2.0),  # the seam keypoint alone: the periodic term at i = 0 and the last inner one
+    ],
+)
 def test_one_keypoint_bumped(key: int, e_v: float, e_s: float) -> None:
     tw, d = _tw(), 0.01
     t = tw.times.copy()

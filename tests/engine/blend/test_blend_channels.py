@@ -36,8 +36,11 @@ def test_a_blend_space_blends_a_stretching_clip_with_a_rigid_one() -> None:
     j = sk.index("l_lower_leg")
     stretched = walk.offsets()
     stretched[:, j] *= 1.2
-    space = BlendSpace((replace(walk, translations=stretched, scales=np.full((walk.num_frames, sk.num_joints), 2.0)), run),
-                       np.array([[0.0], [1.0]]), ("speed",))
+    space = BlendSpace(
+        (replace(walk, translations=stretched, scales=np.full((walk.num_frames, sk.num_joints), 2.0)), run),
+        np.array([[0.0], [1.0]]),
+        ("speed",),
+    )
     pose = space.sample(np.array([0.5, 0.5]), 0.25)
     assert pose.offsets is not None and pose.scales is not None
     assert np.allclose(pose.offsets[j], sk.offsets[j] * 1.1) and np.allclose(pose.scales, 1.5)

@@ -33,9 +33,19 @@ def _crowd(compiled: bool, steps: int):  # type: ignore[no-untyped-def]
         for _ in range(steps):
             app.step()
             rows = sorted(app.world.query(LocalPose, Transform, LocomotionPlayer, IKRequest), key=lambda r: r[0])
-            out.append([(lp.root.copy(), lp.rotations.copy(), tr.position.copy(), tr.rotation.copy(), pl.phase,
-                         None if ik.foot_lock.contacts is None else np.array(ik.foot_lock.contacts))
-                        for _e, lp, tr, pl, ik in rows])
+            out.append(
+                [
+                    (
+                        lp.root.copy(),
+                        lp.rotations.copy(),
+                        tr.position.copy(),
+                        tr.rotation.copy(),
+                        pl.phase,
+                        None if ik.foot_lock.contacts is None else np.array(ik.foot_lock.contacts),
+                    )
+                    for _e, lp, tr, pl, ik in rows
+                ]
+            )
     return out
 
 

@@ -22,8 +22,9 @@ def loco(clips: dict[str, Clip]) -> LocomotionSet:
     return build_locomotion({**clips, "wave": one_shot}, density=21)
 
 
-def _app(loco: LocomotionSet, speed: float, heading: float = 0.0, height: float | None = None,
-         scale: float = 1.0) -> tuple[App, int]:
+def _app(
+    loco: LocomotionSet, speed: float, heading: float = 0.0, height: float | None = None, scale: float = 1.0
+) -> tuple[App, int]:
     app = App(seed=1, plugins=[install_blend])
     app.world.resource(BlendLibrary).add("humanoid", loco)
     tr = Transform(rotation=quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), heading))

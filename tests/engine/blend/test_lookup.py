@@ -29,7 +29,11 @@ def test_probe_grid_and_kuhn_triangulation_tile_the_cube() -> None:
 
 def test_closest_point_on_a_triangle() -> None:
     tri = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])
-    cases = [((0.2, 0.2, 1.0), (0.2, 0.2, 0.0)), ((2.0, -1.0, 0.0), (1.0, 0.0, 0.0)), ((1.0, 1.0, 0.0), (0.5, 0.5, 0.0))]
+    cases = [
+        ((0.2, 0.2, 1.0), (0.2, 0.2, 0.0)),
+        ((2.0, -1.0, 0.0), (1.0, 0.0, 0.0)),
+        ((1.0, 1.0, 0.0), (0.5, 0.5, 0.0)),
+    ]
     for x, want in cases:
         pt, _ = closest_point_on_simplices(tri, np.array(x))
         assert np.allclose(pt[0], want)

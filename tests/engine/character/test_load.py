@@ -54,7 +54,11 @@ def test_the_setup_value_rebuilds_the_character_and_refuses_an_altered_one(mocap
     altered = dict(value, glb=base64.b64encode(data[:-4] + b"\0\0\0\0").decode())
     with pytest.raises(CharacterError, match="does not match its hash"):
         decode(altered)
-    for bad in ([1], {"name": 1, "sha256": "", "glb": ""}, dict(value, joint_map={"tail": "x"}),
-                dict(value, glb="not base64!")):
+    for bad in (
+        [1],
+        {"name": 1, "sha256": "", "glb": ""},
+        dict(value, joint_map={"tail": "x"}),
+        dict(value, glb="not base64!"),
+    ):
         with pytest.raises(CharacterError):
             decode(bad)

@@ -79,8 +79,9 @@ def test_a_bent_knee_carries_the_foot_rigidly_with_the_puppets_shin(cesium) -> N
     pos1, rot1 = forward_kinematics(sk, sk.offsets[0], local)
     rest, bent = _skinned(ch.binding, pos0, rot0), _skinned(ch.binding, pos1, rot1)
     drivers = ch.binding.drivers
-    owned = np.concatenate([(p.weights * (drivers[p.joints] != foot)).sum(axis=1) < 1e-6
-                            for p in ch.binding.meshes.primitives])
+    owned = np.concatenate(
+        [(p.weights * (drivers[p.joints] != foot)).sum(axis=1) < 1e-6 for p in ch.binding.meshes.primitives]
+    )
     assert owned.sum() > 50
     in_foot0 = quat.rotate(quat.conjugate(rot0[foot]), rest[owned] - pos0[foot])
     in_foot1 = quat.rotate(quat.conjugate(rot1[foot]), bent[owned] - pos1[foot])

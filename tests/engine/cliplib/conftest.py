@@ -15,8 +15,11 @@ from engine.clip import Clip
 def cmu_walk_loop() -> Clip:
     """CMU 16_15 retargeted to the puppet and cut to one loop, as ``cycle --retarget puppet`` does."""
     env = os.environ.get("PUPPETPHONE_DATA")
-    found = [c for c in ([Path(env)] if env else []) + [Path(__file__).resolve().parents[4] / "shared" / "data"]
-             if (c / "mocap").is_dir()]
+    found = [
+        c
+        for c in ([Path(env)] if env else []) + [Path(__file__).resolve().parents[4] / "shared" / "data"]
+        if (c / "mocap").is_dir()
+    ]
     if not found:
         pytest.skip("real mocap data not found: set PUPPETPHONE_DATA or put shared/data beside the project")
     d = found[0]

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from engine.clips import default_clips
 from engine.cliplib.authored import AuthoredClips, authored_locomotion
 from engine.cliplib.cache import MeasureCache
 from engine.cliplib.roles import conform
+from engine.clips import default_clips
 
 
 def _authored() -> dict:

@@ -11,9 +11,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from engine.clips import default_clips
 from engine.cliplib.embed import decode, encode
 from engine.cliplib.library import ClipLibraryError, clip_digest
+from engine.clips import default_clips
 from engine.humanoid import humanoid_skeleton
 
 SK = humanoid_skeleton()
@@ -42,9 +42,17 @@ def test_tampering_is_refused() -> None:
             decode(other, SK)
 
 
-@given(st.dictionaries(st.sampled_from(["name", "fps", "loop", "frames", "root_motion", "markers", "data"]),
-                       st.none() | st.booleans() | st.integers(-5, 10**6) | st.floats() | st.text(max_size=20)
-                       | st.dictionaries(st.text(max_size=5), st.floats(), max_size=3)))
+@given(
+    st.dictionaries(
+        st.sampled_from(["name", "fps", "loop", "frames", "root_motion", "markers", "data"]),
+        st.none()
+        | st.booleans()
+        | st.integers(-5, 10**6)
+        | st.floats()
+        | st.text(max_size=20)
+        | st.dictionaries(st.text(max_size=5), st.floats(), max_size=3),
+    )
+)
 def test_fuzz_decode(entry: dict) -> None:
     base = encode({"walk": default_clips()["walk"]})["clips"]["walk"]
     clips = {"walk": {**base, **entry}}

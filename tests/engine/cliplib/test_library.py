@@ -12,9 +12,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from engine.clipfile import save_clip
-from engine.clips import default_clips
 from engine.cliplib.library import ClipLibrary, ClipLibraryError, clip_digest, default_library_dir
 from engine.cliplib.roles import conform
+from engine.clips import default_clips
 from engine.humanoid import humanoid_skeleton
 
 SK = humanoid_skeleton()
@@ -77,14 +77,19 @@ def test_a_clip_changed_behind_the_manifest_is_refused(tmp_path: Path) -> None:
         lib.load()
 
 
-@pytest.mark.parametrize(("text", "reason"), [
-    ("{", "not valid JSON"),
-    ("[]", "not a puppetphone-clips manifest"),
-    ('{"format": "puppetphone-clips", "version": 9, "clips": {}}', "version 9"),
-    ('{"format": "puppetphone-clips", "version": 1, "clips": {"walk": {"file": "../x.ppclip", "sha256": "0"}}}',
-     "a library clip is a .ppclip in the folder"),
-    ('{"format": "puppetphone-clips", "version": 1, "clips": {"walk": {"file": 3}}}', "needs 'file'"),
-])
+@pytest.mark.parametrize(
+    ("text", "reason"),
+    [
+        ("{", "not valid JSON"),
+        ("[]", "not a puppetphone-clips manifest"),
+        ('{"format": "puppetphone-clips", "version": 9, "clips": {}}', "version 9"),
+        (
+            '{"format": "puppetphone-clips", "version": 1, "clips": {"walk": {"file": "../x.ppclip", "sha256": "0"}}}',
+            "a library clip is a .ppclip in the folder",
+        ),
+        ('{"format": "puppetphone-clips", "version": 1, "clips": {"walk": {"file": 3}}}', "needs 'file'"),
+    ],
+)
 def test_a_damaged_manifest_is_refused_in_one_line(tmp_path: Path, text: str, reason: str) -> None:
     (tmp_path / "clips.json").write_text(text)
     with pytest.raises(ClipLibraryError, match=reason) as info:
@@ -92,9 +97,13 @@ def test_a_damaged_manifest_is_refused_in_one_line(tmp_path: Path, text: str, re
     assert "\n" not in str(info.value)
 
 
-@given(st.recursive(st.none() | st.booleans() | st.integers() | st.text(max_size=12),
-                    lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=8), c, max_size=4),
-                    max_leaves=20))
+@given(
+    st.recursive(
+        st.none() | st.booleans() | st.integers() | st.text(max_size=12),
+        lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=8), c, max_size=4),
+        max_leaves=20,
+    )
+)
 def test_fuzz_manifest(tmp_path_factory: pytest.TempPathFactory, value: object) -> None:
     folder = tmp_path_factory.mktemp("fuzz")
     doc = {"format": "puppetphone-clips", "version": 1, "clips": value}
@@ -105,8 +114,9 @@ def test_fuzz_manifest(tmp_path_factory: pytest.TempPathFactory, value: object) 
         assert "\n" not in str(exc)
 
 
-def test_a_clips_add_killed_after_writing_the_clip_leaves_the_library_loading(tmp_path: Path,
-                                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_clips_add_killed_after_writing_the_clip_leaves_the_library_loading(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The kill falls between the clip and the manifest: the old walk still loads, then the new one replaces it."""
     lib = ClipLibrary(tmp_path / "lib")
     first = lib.add(_slow_walk(), "walk", SK, default_clips())

@@ -9,10 +9,10 @@ import pytest
 
 from engine import quat
 from engine.clip import Clip, RootMotion
-from engine.clips import default_clips, foot_contacts, foot_sliding
-from engine.clips.contacts import world_poses
 from engine.cliplib.plant import plant_feet
 from engine.cliplib.roles import RoleError, check_role, check_set, conform, normalise_role
+from engine.clips import default_clips, foot_contacts, foot_sliding
+from engine.clips.contacts import world_poses
 from engine.humanoid import humanoid_skeleton
 
 SK = humanoid_skeleton()
@@ -24,8 +24,14 @@ def _baked(clip: Clip, turn: float = 0.7) -> Clip:
     q = quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), np.float64(turn))
     rots = np.array(clip.rotations)
     rots[:, 0] = quat.mul(q, rot[:, 0])
-    return replace(clip, root=quat.rotate(q, pos[:, 0]) + np.array([3.0, 0.0, -2.0]), rotations=rots, root_motion=None,
-                   markers={}, name="raw")
+    return replace(
+        clip,
+        root=quat.rotate(q, pos[:, 0]) + np.array([3.0, 0.0, -2.0]),
+        rotations=rots,
+        root_motion=None,
+        markers={},
+        name="raw",
+    )
 
 
 def test_role_names_normalise_and_bad_ones_are_refused() -> None:
@@ -42,13 +48,16 @@ def test_built_in_clips_fit_their_roles() -> None:
     check_set(clips)
 
 
-@pytest.mark.parametrize(("clip", "role", "reason"), [
-    ("idle", "walk", "no forward speed"),
-    ("get_up", "walk", "must be a loop"),
-    ("walk", "crouch_walk", "is standing"),
-    ("crouch_walk", "walk", "is crouched"),
-    ("walk", "idle", "ground speed of 1.30"),
-])
+@pytest.mark.parametrize(
+    ("clip", "role", "reason"),
+    [
+        ("idle", "walk", "no forward speed"),
+        ("get_up", "walk", "must be a loop"),
+        ("walk", "crouch_walk", "is standing"),
+        ("crouch_walk", "walk", "is crouched"),
+        ("walk", "idle", "ground speed of 1.30"),
+    ],
+)
 def test_a_clip_that_does_not_fit_is_refused_with_the_reason(clip: str, role: str, reason: str) -> None:
     with pytest.raises(RoleError, match=reason):
         check_role(default_clips()[clip], role, SK)
@@ -138,8 +147,13 @@ def _every(clip: Clip, k: int, n: int) -> Clip:
     idx = np.arange(n) * k
     rm = clip.root_motion
     assert rm is not None
-    return replace(clip, fps=clip.fps / k, root=clip.root[idx], rotations=clip.rotations[idx],
-                   root_motion=RootMotion(rm.translation[idx], rm.heading[idx]))
+    return replace(
+        clip,
+        fps=clip.fps / k,
+        root=clip.root[idx],
+        rotations=clip.rotations[idx],
+        root_motion=RootMotion(rm.translation[idx], rm.heading[idx]),
+    )
 
 
 def test_a_cycle_needs_at_least_eight_frames() -> None:

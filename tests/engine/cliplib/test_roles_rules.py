@@ -103,8 +103,9 @@ def test_crouched_means_hips_below_four_fifths_of_standing_height(hips: float, p
     low = replace(walk, root=walk.root - [0.0, float(walk.root[:, 1].mean()) - hips, 0.0], name="low")
     if pose == "standing":
         check_role(low, "walk", SK)
-        with pytest.raises(RoleError, match="a crouch_walk is crouched and 'low' is standing: hips at 0.80 m"
-                                            " of the puppet's 0.95 m"):
+        with pytest.raises(
+            RoleError, match="a crouch_walk is crouched and 'low' is standing: hips at 0.80 m of the puppet's 0.95 m"
+        ):
             check_role(low, "crouch_walk", SK)
     else:
         check_role(low, "crouch_walk", SK)
@@ -129,9 +130,12 @@ def test_a_loop_without_root_motion_is_timed_by_its_root_track() -> None:
 def test_the_refusals_say_what_to_do() -> None:
     other = replace(SK, names=tuple(f"x_{n}" for n in SK.names))
     walk = default_clips()["walk"]
-    with pytest.raises(RoleError, match=r"on a 17-joint skeleton \(x_hips, x_spine, x_chest, x_neck…\), not the "
-                                        r"puppet's 17 joints: retarget it \(cycle --retarget puppet, or clips add "
-                                        r"does it for BVH/glTF sources\)"):
+    with pytest.raises(
+        RoleError,
+        match=r"on a 17-joint skeleton \(x_hips, x_spine, x_chest, x_neck…\), not the "
+        r"puppet's 17 joints: retarget it \(cycle --retarget puppet, or clips add "
+        r"does it for BVH/glTF sources\)",
+    ):
         check_role(replace(walk, skeleton=other), "walk", SK)
     with pytest.raises(RoleError, match="is not one: extract a cycle with `puppetphone cycle`"):
         check_role(default_clips()["get_up"], "idle", SK)
@@ -142,10 +146,13 @@ def test_the_refusals_say_what_to_do() -> None:
 # --- the set -------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(("slot", "by", "message"), [
-    ("idle", "run", r"the idle \(3.00 m/s\) must be slower than the walk \(1.30 m/s\)"),
-    ("crouch_idle", "walk", r"the crouch_idle \(1.30 m/s\) must be slower than the crouch_walk \(0.70 m/s\)"),
-])
+@pytest.mark.parametrize(
+    ("slot", "by", "message"),
+    [
+        ("idle", "run", r"the idle \(3.00 m/s\) must be slower than the walk \(1.30 m/s\)"),
+        ("crouch_idle", "walk", r"the crouch_idle \(1.30 m/s\) must be slower than the crouch_walk \(0.70 m/s\)"),
+    ],
+)
 def test_every_pair_of_the_set_is_ordered(slot: str, by: str, message: str) -> None:
     clips = default_clips()
     clips[slot] = clips[by]
@@ -164,8 +171,11 @@ def test_a_one_shot_is_timed_from_its_first_to_its_last_frame() -> None:
         return replace(base, root=root)
 
     speed = 1.0 / base.duration
-    with pytest.raises(RoleError, match=rf"the idle \({speed:.2f} m/s\) must be slower than the walk "
-                                        rf"\({0.5 * speed:.2f} m/s\)"):
+    with pytest.raises(
+        RoleError,
+        match=rf"the idle \({speed:.2f} m/s\) must be slower than the walk "
+        rf"\({0.5 * speed:.2f} m/s\)",
+    ):
         check_set({"idle": going(1.0), "walk": going(0.5)})
 
 
@@ -228,8 +238,7 @@ def test_a_loop_with_turned_root_motion_is_conformed_to_travel_along_z() -> None
     walk = default_clips()["walk"]
     rm = walk.root_motion
     assert rm is not None
-    turned = replace(walk, root_motion=RootMotion(quat.rotate(_yaw(0.7), rm.translation), rm.heading + 0.7),
-                     markers={})
+    turned = replace(walk, root_motion=RootMotion(quat.rotate(_yaw(0.7), rm.translation), rm.heading + 0.7), markers={})
     out = conform(turned, "walk")
     assert out.root_motion is not None and np.allclose(out.root_motion.heading, 0.0)
     assert np.allclose(out.root_motion.translation[:, 0], 0.0)
@@ -252,7 +261,12 @@ def test_a_one_shot_keeps_its_direction_and_root_motion() -> None:
 def test_a_loop_a_little_off_sixty_frames_a_second_is_resampled() -> None:
     """67 frames over the walk's 1.1 s is 60.9 fps: still resampled to 60."""
     walk = default_clips()["walk"].baked_root_motion()
-    raw = replace(walk, fps=67 / walk.duration, root=np.concatenate([walk.root, walk.root[-1:]]),
-                  rotations=np.concatenate([walk.rotations, walk.rotations[-1:]]), markers={})
+    raw = replace(
+        walk,
+        fps=67 / walk.duration,
+        root=np.concatenate([walk.root, walk.root[-1:]]),
+        rotations=np.concatenate([walk.rotations, walk.rotations[-1:]]),
+        markers={},
+    )
     assert 60.5 < raw.fps < 61.0
     assert conform(raw, "walk").fps == 60.0

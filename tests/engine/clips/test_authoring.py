@@ -18,12 +18,26 @@ from engine.humanoid import humanoid_skeleton
 
 def test_mirrored_keys_repeat_the_half_cycle_with_flipped_signs() -> None:
     keys = mirrored(((0.0, (1.0, 2.0, 3.0)), (0.25, (4.0, 5.0, 6.0))), (-1.0, 1.0, -1.0))
-    assert keys == ((0.0, (1.0, 2.0, 3.0)), (0.25, (4.0, 5.0, 6.0)), (0.5, (-1.0, 2.0, -3.0)), (0.75, (-4.0, 5.0, -6.0)))
+    assert keys == (
+        (0.0, (1.0, 2.0, 3.0)),
+        (0.25, (4.0, 5.0, 6.0)),
+        (0.5, (-1.0, 2.0, -3.0)),
+        (0.75, (-4.0, 5.0, -6.0)),
+    )
 
 
 def test_foot_plan_rejects_impossible_timing() -> None:
-    good = dict(width=0.1, toe_out=0.0, front=0.3, strike_pitch=10.0, toeoff_pitch=30.0, flat_at=0.1,
-                heel_off=0.3, duty=0.6, swing=((0.5, 0.0, 0.1, 0.0),))
+    good = {
+        "width": 0.1,
+        "toe_out": 0.0,
+        "front": 0.3,
+        "strike_pitch": 10.0,
+        "toeoff_pitch": 30.0,
+        "flat_at": 0.1,
+        "heel_off": 0.3,
+        "duty": 0.6,
+        "swing": ((0.5, 0.0, 0.1, 0.0),),
+    }
     FootPlan(**good)
     with pytest.raises(ValueError, match="duty"):
         FootPlan(**{**good, "heel_off": 0.7})

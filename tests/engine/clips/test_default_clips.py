@@ -7,8 +7,8 @@ import pytest
 
 import engine.clips as clips_pkg
 from engine import quat
-from engine.fk import world_points
 from engine.clips import CLIP_NAMES, LOCOMOTION, default_clips, foot_contacts, foot_sliding, sole_points, world_poses
+from engine.fk import world_points
 
 CLIPS = default_clips()
 LOOPS = ("idle", "walk", "run", "crouch_idle", "crouch_walk")
@@ -146,7 +146,9 @@ def test_idle_breathes_and_shifts_weight() -> None:
     clip = CLIPS["idle"]
     pos, _ = world_poses(clip)
     assert 0.01 < np.ptp(clip.root[:, 0]) < 0.06  # weight shift side to side
-    chest = quat.angle_between(clip.rotations[:, clip.skeleton.index("chest")], clip.rotations[:1, clip.skeleton.index("chest")])
+    chest = quat.angle_between(
+        clip.rotations[:, clip.skeleton.index("chest")], clip.rotations[:1, clip.skeleton.index("chest")]
+    )
     assert np.degrees(chest.max()) > 0.5  # breathing
     assert np.ptp(pos[:, clip.skeleton.index("head"), 1]) < 0.03  # but no bouncing
 

@@ -45,7 +45,9 @@ def test_the_crowd_pass_locks_as_one_puppet_at_a_time_does():
         for k in range(3):
             assert np.allclose(roots[k], one[k].root, atol=1e-9)
             assert np.allclose(np.abs(np.sum(rots[k] * one[k].rotations, axis=-1)), 1.0, atol=1e-9)
-            assert np.allclose(batch[k].points, single[k].points) and np.array_equal(batch[k].planted, single[k].planted)
+            assert np.allclose(batch[k].points, single[k].points) and np.array_equal(
+                batch[k].planted, single[k].planted
+            )
         held.append(single[0].points[0].copy())
     # While the left foot is labelled down its lock stays where it landed although the body drifts.
     assert np.allclose(held[1], held[-1])

@@ -29,8 +29,13 @@ def _crowd(seed: int, n: int):  # type: ignore[no-untyped-def]
     return sk, rng, rots, roots, offsets
 
 
-@pytest.mark.parametrize("ground", [HeightfieldGround(np.random.default_rng(9).uniform(-0.1, 0.1, (12, 12)), 0.5, -3, -3),
-                                    PlaneGround(normal=(0.1, 1.0, -0.05))])
+@pytest.mark.parametrize(
+    "ground",
+    [
+        HeightfieldGround(np.random.default_rng(9).uniform(-0.1, 0.1, (12, 12)), 0.5, -3, -3),
+        PlaneGround(normal=(0.1, 1.0, -0.05)),
+    ],
+)
 def test_compiled_grounding_agrees_with_numpy_over_steps_with_locks(ground) -> None:  # type: ignore[no-untyped-def]
     sk, rng, rots, roots, offsets = _crowd(3, 25)
     weights = rng.uniform(0, 1, len(roots))
@@ -75,7 +80,9 @@ def test_compiled_grounding_plants_the_soles_and_rejects_bad_ground() -> None:
         sole = pos[:, f] + quat.rotate(wrot[:, f], np.array([0.0, -0.05, 0.075]))
         assert np.all(sole[:, 1] >= 0.1 - 1e-6)
     with jit.use(True), pytest.raises(ValueError, match="non-finite"):
-        ground_feet_batch(sk, roots.copy(), rots.copy(), lambda x, z: (np.full_like(x, np.nan), np.zeros(x.shape + (3,))))
+        ground_feet_batch(
+            sk, roots.copy(), rots.copy(), lambda x, z: (np.full_like(x, np.nan), np.zeros(x.shape + (3,)))
+        )
 
 
 def test_compiled_grounding_writes_back_into_strided_inputs() -> None:

@@ -86,6 +86,8 @@ def test_the_batched_grounding_agrees_with_one_puppet_at_a_time():
     shift = ground_feet_batch(sk, r, q, ground, offsets=offsets, weight=weights)
     for i in range(n):
         pose = Pose(roots[i].copy(), rots[i].copy())
-        assert ground_feet(sk, pose, ground, offsets=offsets[i], weight=weights[i]) == pytest.approx(shift[i], abs=1e-12)
+        assert ground_feet(sk, pose, ground, offsets=offsets[i], weight=weights[i]) == pytest.approx(
+            shift[i], abs=1e-12
+        )
         np.testing.assert_allclose(pose.root, r[i], atol=1e-12)
         np.testing.assert_allclose(pose.rotations, q[i], atol=1e-12)

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from puppetphone.bench.ik import TIP, chain_skeleton, chain_targets, pin_joints
 from engine import quat
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
 from engine.ik import Effector, IKRig, IKSettings, Pin, humanoid_rig, solve_ik
+from puppetphone.bench.ik import TIP, chain_skeleton, chain_targets, pin_joints
 
 
 def _world(sk, root, rot):
@@ -20,7 +20,7 @@ def _world(sk, root, rot):
 def test_reaches_reachable_targets_and_keeps_pins(pins):
     joints = 10
     sk = chain_skeleton(joints)
-    rig = IKRig.build(sk, limits={n: (-1.5, 1.5) for n in sk.names})
+    rig = IKRig.build(sk, limits=dict.fromkeys(sk.names, (-1.5, 1.5)))
     pj = pin_joints(joints, pins)
     eps = IKSettings().pin_epsilon
     for c0, target in chain_targets(rig, pj, 6, seed=pins):

@@ -42,8 +42,9 @@ def random_grid(sk: Skeleton, shape: tuple[int, ...], seed: int) -> tuple[Pose, 
 
 @pytest.mark.parametrize("limb", [LEG, ARM])
 @pytest.mark.parametrize("with_pole,with_end,weight", [(True, False, 1.0), (False, True, 1.0), (True, True, "grid")])
-def test_a_grid_of_puppets_solves_each_as_if_alone(limb: tuple[str, str, str], with_pole: bool, with_end: bool,
-                                                   weight: object) -> None:
+def test_a_grid_of_puppets_solves_each_as_if_alone(
+    limb: tuple[str, str, str], with_pole: bool, with_end: bool, weight: object
+) -> None:
     sk = humanoid_skeleton()
     shape = (2, 3)
     grid, offsets = random_grid(sk, shape, seed=5)
@@ -54,14 +55,22 @@ def test_a_grid_of_puppets_solves_each_as_if_alone(limb: tuple[str, str, str], w
     ends = quat.normalize(rng.normal(size=(*shape, 4))) if with_end else None
     w = rng.uniform(0.1, 0.9, shape) if weight == "grid" else np.ones(shape)
     solved = Pose(root=grid.root.copy(), rotations=grid.rotations.copy())
-    got = two_bone_ik(sk, solved, limb, targets, poles, end_rotation=ends, offsets=offsets,
-                      weight=w if weight == "grid" else 1.0)
+    got = two_bone_ik(
+        sk, solved, limb, targets, poles, end_rotation=ends, offsets=offsets, weight=w if weight == "grid" else 1.0
+    )
     assert got.shape == (*shape, 3)
     for i in np.ndindex(*shape):
         one = Pose(root=grid.root[i].copy(), rotations=grid.rotations[i].copy())
-        end = two_bone_ik(sk, one, limb, targets[i], None if poles is None else poles[i],
-                          end_rotation=None if ends is None else ends[i], offsets=offsets[i],
-                          weight=float(w[i]))
+        end = two_bone_ik(
+            sk,
+            one,
+            limb,
+            targets[i],
+            None if poles is None else poles[i],
+            end_rotation=None if ends is None else ends[i],
+            offsets=offsets[i],
+            weight=float(w[i]),
+        )
         np.testing.assert_allclose(quat.angle_between(one.rotations, solved.rotations[i]), 0.0, atol=1e-7)
         if weight == 1.0:
             np.testing.assert_allclose(got[i], end, atol=1e-9)
@@ -90,8 +99,9 @@ def test_every_puppet_reaches_its_target_or_stretches_towards_it() -> None:
     lo, hi = np.abs(lab - lbc), lab + lbc
     within = (np.linalg.norm(targets - a, axis=-1) > lo) & (np.linalg.norm(targets - a, axis=-1) < hi)
     np.testing.assert_allclose(end[within], targets[within], atol=1e-9)
-    np.testing.assert_allclose(dist[~within], np.clip(np.linalg.norm(targets - a, axis=-1), lo + 1e-6, hi - 1e-6)[~within],
-                               atol=1e-6)
+    np.testing.assert_allclose(
+        dist[~within], np.clip(np.linalg.norm(targets - a, axis=-1), lo + 1e-6, hi - 1e-6)[~within], atol=1e-6
+    )
     aim = (end - a) / dist[..., None]
     np.testing.assert_allclose(aim, direction, atol=1e-9)  # out of reach: straight towards it
     # the knee bends towards the pole's side of the a → target line

@@ -41,27 +41,86 @@ _BONES = {
     "r_lower_leg": ("r_upper_leg", (0.0, -0.42, 0.0)),
     "r_foot": ("r_lower_leg", (0.0, -0.40, 0.0)),
 }
-_TIPS = {"head": (0.0, 0.12, 0.0), "l_hand": (0.0, -0.08, 0.0), "r_hand": (0.0, -0.08, 0.0),
-         "l_foot": (0.0, -0.05, 0.14), "r_foot": (0.0, -0.05, 0.14)}
+_TIPS = {
+    "head": (0.0, 0.12, 0.0),
+    "l_hand": (0.0, -0.08, 0.0),
+    "r_hand": (0.0, -0.08, 0.0),
+    "l_foot": (0.0, -0.05, 0.14),
+    "r_foot": (0.0, -0.05, 0.14),
+}
 
-MIXAMO = {"hips": "Hips", "spine": "Spine", "chest": "Spine1", "neck": "Neck", "head": "Head",
-          **{f"{s}_{b}": f"{w}{n}" for s, w in (("l", "Left"), ("r", "Right"))
-             for b, n in (("upper_arm", "Arm"), ("lower_arm", "ForeArm"), ("hand", "Hand"),
-                          ("upper_leg", "UpLeg"), ("lower_leg", "Leg"), ("foot", "Foot"))}}
-BIOVISION = {"hips": "Hips", "spine": "Chest", "chest": "Chest2", "neck": "Neck", "head": "Head",
-             **{f"{s}_{b}": f"{w}{n}" for s, w in (("l", "Left"), ("r", "Right"))
-                for b, n in (("upper_arm", "Shoulder"), ("lower_arm", "Elbow"), ("hand", "Wrist"),
-                             ("upper_leg", "Hip"), ("lower_leg", "Knee"), ("foot", "Ankle"))}}
-LOWERCASE = {"hips": "hip", "spine": "abdomen", "chest": "chest", "neck": "neck", "head": "head",
-             **{f"{s}_{b}": f"{s}{n}" for s in ("l", "r")
-                for b, n in (("upper_arm", "shoulder"), ("lower_arm", "elbow"), ("hand", "wrist"),
-                             ("upper_leg", "hip"), ("lower_leg", "knee"), ("foot", "foot"))}}
+MIXAMO = {
+    "hips": "Hips",
+    "spine": "Spine",
+    "chest": "Spine1",
+    "neck": "Neck",
+    "head": "Head",
+    **{
+        f"{s}_{b}": f"{w}{n}"
+        for s, w in (("l", "Left"), ("r", "Right"))
+        for b, n in (
+            ("upper_arm", "Arm"),
+            ("lower_arm", "ForeArm"),
+            ("hand", "Hand"),
+            ("upper_leg", "UpLeg"),
+            ("lower_leg", "Leg"),
+            ("foot", "Foot"),
+        )
+    },
+}
+BIOVISION = {
+    "hips": "Hips",
+    "spine": "Chest",
+    "chest": "Chest2",
+    "neck": "Neck",
+    "head": "Head",
+    **{
+        f"{s}_{b}": f"{w}{n}"
+        for s, w in (("l", "Left"), ("r", "Right"))
+        for b, n in (
+            ("upper_arm", "Shoulder"),
+            ("lower_arm", "Elbow"),
+            ("hand", "Wrist"),
+            ("upper_leg", "Hip"),
+            ("lower_leg", "Knee"),
+            ("foot", "Ankle"),
+        )
+    },
+}
+LOWERCASE = {
+    "hips": "hip",
+    "spine": "abdomen",
+    "chest": "chest",
+    "neck": "neck",
+    "head": "head",
+    **{
+        f"{s}_{b}": f"{s}{n}"
+        for s in ("l", "r")
+        for b, n in (
+            ("upper_arm", "shoulder"),
+            ("lower_arm", "elbow"),
+            ("hand", "wrist"),
+            ("upper_leg", "hip"),
+            ("lower_leg", "knee"),
+            ("foot", "foot"),
+        )
+    },
+}
 ODD = {role: f"bone_{k:02d}" for k, role in enumerate(_BONES)}
 
 
-def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int = 120, fps: float = 30.0,
-              period: float = 1.0, stretch: float = 0.0, frames_header: int | None = None,
-              zero_end_site: bool = False, turn: float = 0.0, turn_period: float = 8.0) -> str:
+def human_bvh(
+    names: dict[str, str] = MIXAMO,
+    unit: float = 100.0,
+    frames: int = 120,
+    fps: float = 30.0,
+    period: float = 1.0,
+    stretch: float = 0.0,
+    frames_header: int | None = None,
+    zero_end_site: bool = False,
+    turn: float = 0.0,
+    turn_period: float = 8.0,
+) -> str:
     """BVH text of the walking figure.
 
     Args:
@@ -97,7 +156,9 @@ def human_bvh(names: dict[str, str] = MIXAMO, unit: float = 100.0, frames: int =
         tip = (0.0, 0.0, 0.0) if zero_end_site and role == "head" else _TIPS.get(role)
         if tip is not None and not kids.get(role):
             t = np.array(tip) * unit
-            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET {t[0]:.6f} {t[1]:.6f} {t[2]:.6f}", f"{pad}  }}"])
+            lines.extend(
+                [f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET {t[0]:.6f} {t[1]:.6f} {t[2]:.6f}", f"{pad}  }}"]
+            )
         lines.append(pad + "}")
 
     emit("hips", 0)
@@ -146,9 +207,13 @@ def blender_bvh(path: Path, clip: Clip) -> Path:
     translation, which repeats the OFFSET.
     """
     sk = clip.skeleton
-    zup = Clip(clip.name, replace(sk, offsets=quat.rotate(Y_TO_Z, sk.offsets), tips=quat.rotate(Y_TO_Z, sk.tips)),
-               clip.fps, quat.rotate(Y_TO_Z, clip.root),
-               quat.mul(quat.mul(Y_TO_Z, clip.rotations), quat.conjugate(Y_TO_Z)))
+    zup = Clip(
+        clip.name,
+        replace(sk, offsets=quat.rotate(Y_TO_Z, sk.offsets), tips=quat.rotate(Y_TO_Z, sk.tips)),
+        clip.fps,
+        quat.rotate(Y_TO_Z, clip.root),
+        quat.mul(quat.mul(Y_TO_Z, clip.rotations), quat.conjugate(Y_TO_Z)),
+    )
     bvh = clip_to_bvh(zup, order="XYZ", unit=1.0)
     loose = {"l_upper_leg", "r_upper_leg", "l_upper_arm", "r_upper_arm"}
     channels, columns, start = [], [], 0
@@ -163,14 +228,19 @@ def blender_bvh(path: Path, clip: Clip) -> Path:
         start += width
     data = np.round(np.concatenate(columns, axis=1), 6)
     ends = {j: np.round(e, 6) for j, e in bvh.end_sites.items()}
-    return write_bvh(path, replace(bvh, channels=tuple(channels), data=data, offsets=np.round(bvh.offsets, 6),
-                                   end_sites=ends))
+    return write_bvh(
+        path, replace(bvh, channels=tuple(channels), data=data, offsets=np.round(bvh.offsets, 6), end_sites=ends)
+    )
 
 
 # finger -> (knuckle offset from the wrist, three phalanx lengths), metres; the middle finger's tip is 0.19 m out
-_HAND = {"Thumb": ((0.025, 0.02, 0.0), (0.04, 0.032, 0.028)), "Index": ((0.02, 0.09, 0.0), (0.043, 0.026, 0.022)),
-         "Middle": ((0.0, 0.092, 0.0), (0.046, 0.028, 0.024)), "Ring": ((-0.018, 0.088, 0.0), (0.042, 0.027, 0.022)),
-         "Pinky": ((-0.034, 0.08, 0.0), (0.033, 0.02, 0.02))}
+_HAND = {
+    "Thumb": ((0.025, 0.02, 0.0), (0.04, 0.032, 0.028)),
+    "Index": ((0.02, 0.09, 0.0), (0.043, 0.026, 0.022)),
+    "Middle": ((0.0, 0.092, 0.0), (0.046, 0.028, 0.024)),
+    "Ring": ((-0.018, 0.088, 0.0), (0.042, 0.027, 0.022)),
+    "Pinky": ((-0.034, 0.08, 0.0), (0.033, 0.02, 0.02)),
+}
 
 
 def hand_bvh(unit: float = 100.0, frames: int = 90, fps: float = 30.0, period: float = 1.0) -> str:
@@ -179,15 +249,24 @@ def hand_bvh(unit: float = 100.0, frames: int = 90, fps: float = 30.0, period: f
     An adult's hand, 0.19 m from the wrist to the middle fingertip, in ``unit`` file units per
     metre; the fingers close and open every ``period`` seconds.
     """
-    lines = ["HIERARCHY", "ROOT RightHand", "{", "  OFFSET 0 0 0",
-             "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"]
+    lines = [
+        "HIERARCHY",
+        "ROOT RightHand",
+        "{",
+        "  OFFSET 0 0 0",
+        "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
+    ]
     for finger, (knuckle, bones) in _HAND.items():
         offsets = [knuckle, *((0.0, b, 0.0) for b in bones[:-1])]
         for k, off in enumerate(offsets):
             pad = "  " * (k + 1)
             o = np.array(off) * unit
-            lines += [f"{pad}JOINT RightHand{finger}{k + 1}", pad + "{", f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
-                      f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation"]
+            lines += [
+                f"{pad}JOINT RightHand{finger}{k + 1}",
+                pad + "{",
+                f"{pad}  OFFSET {o[0]:.6f} {o[1]:.6f} {o[2]:.6f}",
+                f"{pad}  CHANNELS 3 Zrotation Xrotation Yrotation",
+            ]
         pad = "  " * (len(offsets) + 1)
         lines += [f"{pad}End Site", pad + "{", f"{pad}  OFFSET 0 {bones[-1] * unit:.6f} 0", pad + "}"]
         lines += ["  " * k + "}" for k in range(len(offsets), 0, -1)]

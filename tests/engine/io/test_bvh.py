@@ -68,9 +68,10 @@ def test_to_clip_orders_positions_and_tips() -> None:
     sk = clip.skeleton
     np.testing.assert_allclose(clip.root[:, 2], [0.02, 0.03, 0.04])
     # the root's own order is YXZ: R = Ry(10) Rx(20) Rz(30)
-    expect = quat.mul(quat.mul(quat.from_axis_angle([0, 1, 0], np.radians(10)),
-                               quat.from_axis_angle([1, 0, 0], np.radians(20))),
-                      quat.from_axis_angle([0, 0, 1], np.radians(30)))
+    expect = quat.mul(
+        quat.mul(quat.from_axis_angle([0, 1, 0], np.radians(10)), quat.from_axis_angle([1, 0, 0], np.radians(20))),
+        quat.from_axis_angle([0, 0, 1], np.radians(30)),
+    )
     assert quat.angle_between(clip.rotations[0, 0], expect) < 1e-9
     # the leg's position channels (3,0,0) replace its OFFSET (3,0,0) instead of doubling it
     np.testing.assert_allclose(sk.offsets[2], [0.03, 0.0, 0.0])
@@ -96,9 +97,13 @@ def test_round_trip_every_file(mocap_dir: Path, tmp_path: Path) -> None:
 
 
 def test_readme_counts(mocap_dir: Path) -> None:
-    expect = {"cmu_16_15_walk_daz.bvh": (120, 472, 43, 132), "cmu_02_01_walk_ccbase.bvh": (60, 171, 101, 306),
-              "bandai1_walk_normal_001.bvh": (30, 195, 22, 132), "cmu_02_05_punch_ccbase.bvh": (60, 927, 100, 303),
-              "cmu_60_04_salsa_daz_scaled.bvh": (120, 1871, 43, 132)}
+    expect = {
+        "cmu_16_15_walk_daz.bvh": (120, 472, 43, 132),
+        "cmu_02_01_walk_ccbase.bvh": (60, 171, 101, 306),
+        "bandai1_walk_normal_001.bvh": (30, 195, 22, 132),
+        "cmu_02_05_punch_ccbase.bvh": (60, 927, 100, 303),
+        "cmu_60_04_salsa_daz_scaled.bvh": (120, 1871, 43, 132),
+    }
     for name, (fps, frames, joints, chans) in expect.items():
         m = read_bvh(mocap_dir / name)
         assert round(m.fps) == fps and m.num_frames == frames and m.num_joints == joints and m.data.shape[1] == chans
@@ -132,14 +137,19 @@ def test_additive_root_positions_keep_feet_on_floor(mocap_dir: Path) -> None:
 
 def test_units_are_detected(mocap_dir: Path) -> None:
     daz = read_bvh(mocap_dir / "cmu_16_15_walk_daz.bvh").to_clip()
-    for name, unit in (("cmu_16_15_walk_daz.bvh", 0.01), ("bandai1_walk_normal_001.bvh", 0.01),
-                       ("cmu_60_04_salsa_daz_scaled.bvh", None)):
+    for name, unit in (
+        ("cmu_16_15_walk_daz.bvh", 0.01),
+        ("bandai1_walk_normal_001.bvh", 0.01),
+        ("cmu_60_04_salsa_daz_scaled.bvh", None),
+    ):
         m = read_bvh(mocap_dir / name)
         auto = m.to_clip()
         raw = m.to_clip(scale=1.0)
         if unit is None:  # rescaled by its uploader to a 1.1 m figure in metres: no unit fits, scaled continuously
-            unit = float(np.linalg.norm(daz.skeleton.offsets[1:], axis=1).sum()
-                         / np.linalg.norm(raw.skeleton.offsets[1:], axis=1).sum())
+            unit = float(
+                np.linalg.norm(daz.skeleton.offsets[1:], axis=1).sum()
+                / np.linalg.norm(raw.skeleton.offsets[1:], axis=1).sum()
+            )
             np.testing.assert_allclose(auto.skeleton.offsets, raw.skeleton.offsets * unit, rtol=0.02)
             continue
         np.testing.assert_allclose(auto.skeleton.offsets, raw.skeleton.offsets * unit)
@@ -192,8 +202,10 @@ def test_clip_export_round_trip(mocap_dir: Path, tmp_path: Path) -> None:
         ("HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n", "unclosed braces"),
         ("hello\n", ":1: not a BVH file"),
         ("HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 1 Xrotation\n}\n", "no MOTION section"),
-        ("HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n1\nx\n",
-         ":11: frame 1 holds a non-number; 1 frames are complete"),
+        (
+            "HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 1 Xrotation\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n1\nx\n",
+            ":11: frame 1 holds a non-number; 1 frames are complete",
+        ),
     ],
 )
 def test_malformed_files_name_file_and_line(text: str, needle: str) -> None:
@@ -226,7 +238,13 @@ def test_write_is_atomic_and_refuses_bad_order(tmp_path: Path) -> None:
 
 
 def _chain_bvh(depth: int, offset: str = "0 1 0", frame: str = "0 0 0 0 0 0", frame_time: str = "0.0083333") -> str:
-    lines = ["HIERARCHY", "ROOT j0", "{", "  OFFSET 0 0 0", "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"]
+    lines = [
+        "HIERARCHY",
+        "ROOT j0",
+        "{",
+        "  OFFSET 0 0 0",
+        "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
+    ]
     for j in range(1, depth):
         lines += [f"JOINT j{j}", "{", f"  OFFSET {offset}", "  CHANNELS 0"]
     lines += ["}"] * depth
@@ -246,14 +264,17 @@ def test_a_hierarchy_deeper_than_the_python_stack_reads_and_writes(tmp_path):
         parse_bvh(_chain_bvh(MAX_JOINTS + 1))
 
 
-@pytest.mark.parametrize("kw,says", [
-    ({"offset": "0 nan 0"}, "OFFSET"),
-    ({"offset": "0 1e308 0"}, "OFFSET"),
-    ({"frame": "0 inf 0 0 0 0"}, "frame 0"),
-    ({"frame": "0 0 0 0 5e307 0"}, "frame 0"),
-    ({"frame_time": "inf"}, "frame time"),
-    ({"frame_time": "nan"}, "frame time"),
-])
+@pytest.mark.parametrize(
+    "kw,says",
+    [
+        ({"offset": "0 nan 0"}, "OFFSET"),
+        ({"offset": "0 1e308 0"}, "OFFSET"),
+        ({"frame": "0 inf 0 0 0 0"}, "frame 0"),
+        ({"frame": "0 0 0 0 5e307 0"}, "frame 0"),
+        ({"frame_time": "inf"}, "frame time"),
+        ({"frame_time": "nan"}, "frame time"),
+    ],
+)
 def test_nan_and_absurd_numbers_are_a_bvh_error(kw, says):
     with pytest.raises(BvhError, match=says):
         parse_bvh(_chain_bvh(3, **kw))

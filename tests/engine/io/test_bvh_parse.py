@@ -34,10 +34,12 @@ def one_joint(motion: str = "MOTION\nFrames: 2\nFrame Time: 0.25\n1 2 3\n4 5 6\n
 
 
 def test_a_small_file_reads_as_written() -> None:
-    text = ("\n\nhierarchy\nROOT Hips Bone\n{\n  OFFSET 1 2 3\n  CHANNELS 2 xposition ZROTATION\n  JOINT leg\n  {\n"
-            "    OFFSET 0 -4 0\n    CHANNELS 1 Xrotation\n    End Site\n    {\n      OFFSET 0 -5 0\n      OFFSET 9 9 9\n"
-            "    }\n  }\n  JOINT arm\n  {\n    OFFSET 7 0 0\n    CHANNELS 0\n  }\n}\nMOTION\n\n  frames :  2\n"
-            "Frame   Time: 0.5\n1 2 3\n\n4 5 6\n")
+    text = (
+        "\n\nhierarchy\nROOT Hips Bone\n{\n  OFFSET 1 2 3\n  CHANNELS 2 xposition ZROTATION\n  JOINT leg\n  {\n"
+        "    OFFSET 0 -4 0\n    CHANNELS 1 Xrotation\n    End Site\n    {\n      OFFSET 0 -5 0\n      OFFSET 9 9 9\n"
+        "    }\n  }\n  JOINT arm\n  {\n    OFFSET 7 0 0\n    CHANNELS 0\n  }\n}\nMOTION\n\n  frames :  2\n"
+        "Frame   Time: 0.5\n1 2 3\n\n4 5 6\n"
+    )
     m = parse_bvh(text, "s.bvh")
     assert m.names == ("Hips Bone", "leg", "arm") and m.parents.tolist() == [-1, 0, 0] and m.source == "s.bvh"
     np.testing.assert_array_equal(m.offsets, [[1, 2, 3], [0, -4, 0], [7, 0, 0]])
@@ -52,47 +54,54 @@ def test_a_small_file_reads_as_written() -> None:
     assert m.rotation_columns().tolist() == [False, True, True]
 
 
-@pytest.mark.parametrize("text,line,says", [
-    ("", 1, "not a BVH file (no HIERARCHY header)"),
-    ("\n\n", 1, "not a BVH file (no HIERARCHY header)"),
-    ("\nHIER\n", 2, "not a BVH file (no HIERARCHY header)"),
-    ("HIERARCHY\nJOINT a\n", 2, "unexpected JOINT here"),
-    ("HIERARCHY\nROOT a\n{\nROOT b\n", 4, "unexpected ROOT here"),
-    ("HIERARCHY\nROOT a\nJOINT b\n", 3, "unexpected JOINT here"),
-    ("HIERARCHY\nROOT\n", 2, "ROOT without a name"),
-    ("HIERARCHY\nROOT a\n{\nJOINT a\n", 4, "duplicate joint name 'a'"),
-    ("HIERARCHY\nROOT a\n{\nEnd Site\n{\nJOINT b\n", 6, "a joint inside an End Site"),
-    ("HIERARCHY\nEnd Site\n", 2, "End Site outside a joint"),
-    ("HIERARCHY\nROOT a\n{\nEnd Site\n{\nEnd Site\n", 6, "End Site outside a joint"),
-    ("HIERARCHY\nROOT a\n{\nJOINT b\nEnd Site\n", 5, "End Site outside a joint"),
-    ("HIERARCHY\n{\n", 2, "'{' without a ROOT, JOINT or End Site before it"),
-    ("HIERARCHY\n}\n", 2, "unbalanced '}'"),
-    ("HIERARCHY\nOFFSET 0 0 0\n", 2, "OFFSET needs 3 numbers inside a joint"),
-    ("HIERARCHY\nROOT a\n{\nOFFSET 0 0 0 0\n", 4, "OFFSET needs 3 numbers inside a joint"),
-    ("HIERARCHY\nROOT a\n{\nOFFSET 0 x 0\n", 4, "expected numbers, got '0 x 0'"),
-    ("HIERARCHY\nROOT a\n{\nOFFSET 0 -inf 0\n", 4, "OFFSET must be finite and within ±1e+07"),
-    ("HIERARCHY\nROOT a\n{\nOFFSET 0 -1.1e7 0\n", 4, "OFFSET must be finite and within ±1e+07"),
-    ("HIERARCHY\nCHANNELS 1 Xrotation\n", 2, "CHANNELS outside a joint"),
-    ("HIERARCHY\nROOT a\n{\nEnd Site\n{\nCHANNELS 1 Xrotation\n", 6, "CHANNELS outside a joint"),
-    ("HIERARCHY\nROOT a\n{\nCHANNELS\n", 4, "CHANNELS needs a count"),
-    ("HIERARCHY\nROOT a\n{\nCHANNELS x\n", 4, "CHANNELS needs a count"),
-    ("HIERARCHY\nROOT a\n{\nCHANNELS 1\n", 4, "CHANNELS says 1 but lists 0"),
-    ("HIERARCHY\nROOT a\n{\nCHANNELS 2 Xrotation xROTATION\n", 4, "bad channel list 'Xrotation xROTATION'"),
-    ("HIERARCHY\nROOT a\n{\nCHANNELS 1 Xrot\n", 4, "bad channel list 'Xrot'"),
-    ("HIERARCHY\nROOT a\n{\nWHATEVER 1\n", 4, "unexpected 'WHATEVER' in the hierarchy"),
-    ("HIERARCHY\nMOTION\n", 2, "no ROOT joint"),
-    ("HIERARCHY\n", 1, "no ROOT joint"),
-    ("HIERARCHY\nROOT a\n{\nMOTION\n", 4, "hierarchy ends with unclosed braces"),
-    ("HIERARCHY\nROOT a\n", 2, "hierarchy ends with unclosed braces"),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames 1\n", 6, "expected 'Frames:' and 'Frame Time:' after MOTION"),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1\nSpeed: 2\n", 7, "expected 'Frames:' and 'Frame Time:' after MOTION"),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1\n", 5, "MOTION without 'Frames:' and 'Frame Time:'"),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1.5\nFrame Time: 0.1\n", 7, "bad frame count or frame time"),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1\nFrame Time: fast\n", 7, "bad frame count or frame time"),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: -1\nFrame Time: 0.1\n", 7, FRAMES),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrame Time: 0\nFrames: 0\n", 7, FRAMES),
-    ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 0\nFrame Time: 10.001\n", 7, FRAMES),
-])
+@pytest.mark.parametrize(
+    "text,line,says",
+    [
+        ("", 1, "not a BVH file (no HIERARCHY header)"),
+        ("\n\n", 1, "not a BVH file (no HIERARCHY header)"),
+        ("\nHIER\n", 2, "not a BVH file (no HIERARCHY header)"),
+        ("HIERARCHY\nJOINT a\n", 2, "unexpected JOINT here"),
+        ("HIERARCHY\nROOT a\n{\nROOT b\n", 4, "unexpected ROOT here"),
+        ("HIERARCHY\nROOT a\nJOINT b\n", 3, "unexpected JOINT here"),
+        ("HIERARCHY\nROOT\n", 2, "ROOT without a name"),
+        ("HIERARCHY\nROOT a\n{\nJOINT a\n", 4, "duplicate joint name 'a'"),
+        ("HIERARCHY\nROOT a\n{\nEnd Site\n{\nJOINT b\n", 6, "a joint inside an End Site"),
+        ("HIERARCHY\nEnd Site\n", 2, "End Site outside a joint"),
+        ("HIERARCHY\nROOT a\n{\nEnd Site\n{\nEnd Site\n", 6, "End Site outside a joint"),
+        ("HIERARCHY\nROOT a\n{\nJOINT b\nEnd Site\n", 5, "End Site outside a joint"),
+        ("HIERARCHY\n{\n", 2, "'{' without a ROOT, JOINT or End Site before it"),
+        ("HIERARCHY\n}\n", 2, "unbalanced '}'"),
+        ("HIERARCHY\nOFFSET 0 0 0\n", 2, "OFFSET needs 3 numbers inside a joint"),
+        ("HIERARCHY\nROOT a\n{\nOFFSET 0 0 0 0\n", 4, "OFFSET needs 3 numbers inside a joint"),
+        ("HIERARCHY\nROOT a\n{\nOFFSET 0 x 0\n", 4, "expected numbers, got '0 x 0'"),
+        ("HIERARCHY\nROOT a\n{\nOFFSET 0 -inf 0\n", 4, "OFFSET must be finite and within ±1e+07"),
+        ("HIERARCHY\nROOT a\n{\nOFFSET 0 -1.1e7 0\n", 4, "OFFSET must be finite and within ±1e+07"),
+        ("HIERARCHY\nCHANNELS 1 Xrotation\n", 2, "CHANNELS outside a joint"),
+        ("HIERARCHY\nROOT a\n{\nEnd Site\n{\nCHANNELS 1 Xrotation\n", 6, "CHANNELS outside a joint"),
+        ("HIERARCHY\nROOT a\n{\nCHANNELS\n", 4, "CHANNELS needs a count"),
+        ("HIERARCHY\nROOT a\n{\nCHANNELS x\n", 4, "CHANNELS needs a count"),
+        ("HIERARCHY\nROOT a\n{\nCHANNELS 1\n", 4, "CHANNELS says 1 but lists 0"),
+        ("HIERARCHY\nROOT a\n{\nCHANNELS 2 Xrotation xROTATION\n", 4, "bad channel list 'Xrotation xROTATION'"),
+        ("HIERARCHY\nROOT a\n{\nCHANNELS 1 Xrot\n", 4, "bad channel list 'Xrot'"),
+        ("HIERARCHY\nROOT a\n{\nWHATEVER 1\n", 4, "unexpected 'WHATEVER' in the hierarchy"),
+        ("HIERARCHY\nMOTION\n", 2, "no ROOT joint"),
+        ("HIERARCHY\n", 1, "no ROOT joint"),
+        ("HIERARCHY\nROOT a\n{\nMOTION\n", 4, "hierarchy ends with unclosed braces"),
+        ("HIERARCHY\nROOT a\n", 2, "hierarchy ends with unclosed braces"),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames 1\n", 6, "expected 'Frames:' and 'Frame Time:' after MOTION"),
+        (
+            "HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1\nSpeed: 2\n",
+            7,
+            "expected 'Frames:' and 'Frame Time:' after MOTION",
+        ),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1\n", 5, "MOTION without 'Frames:' and 'Frame Time:'"),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1.5\nFrame Time: 0.1\n", 7, "bad frame count or frame time"),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 1\nFrame Time: fast\n", 7, "bad frame count or frame time"),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: -1\nFrame Time: 0.1\n", 7, FRAMES),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrame Time: 0\nFrames: 0\n", 7, FRAMES),
+        ("HIERARCHY\nROOT a\n{\n}\nMOTION\nFrames: 0\nFrame Time: 10.001\n", 7, FRAMES),
+    ],
+)
 def test_a_malformed_hierarchy_is_refused_naming_its_line(text: str, line: int, says: str) -> None:
     with pytest.raises(BvhError) as err:
         parse_bvh(text, "f.bvh")
@@ -105,11 +114,22 @@ def test_a_file_with_no_motion_names_only_the_file() -> None:
     assert str(err.value) == "f.bvh: no MOTION section"
 
 
-@pytest.mark.parametrize("rows,line,says", [
-    ("1 2 3\n4 5\n", 11, "frame 1 has 2 values, expected 3; only 1 of 2 frames are complete (truncated or malformed file)"),
-    ("1 2 3 4\n", 10, "frame 0 has 4 values, expected 3; only 0 of 2 frames are complete (truncated or malformed file)"),
-    ("1 2 3\n\n4 x 6\n", 12, "frame 1 holds a non-number; 1 frames are complete"),
-])
+@pytest.mark.parametrize(
+    "rows,line,says",
+    [
+        (
+            "1 2 3\n4 5\n",
+            11,
+            "frame 1 has 2 values, expected 3; only 1 of 2 frames are complete (truncated or malformed file)",
+        ),
+        (
+            "1 2 3 4\n",
+            10,
+            "frame 0 has 4 values, expected 3; only 0 of 2 frames are complete (truncated or malformed file)",
+        ),
+        ("1 2 3\n\n4 x 6\n", 12, "frame 1 holds a non-number; 1 frames are complete"),
+    ],
+)
 def test_a_bad_motion_row_is_named(rows: str, line: int, says: str) -> None:
     with pytest.raises(BvhError) as err:
         parse_bvh(one_joint("MOTION\nFrames: 2\nFrame Time: 0.25\n" + rows), "f.bvh")
@@ -179,14 +199,24 @@ def test_latin1_files_read(tmp_path: Path) -> None:
 
 def test_the_motion_object_checks_its_shapes() -> None:
     m = parse_bvh(one_joint())
-    for kw, says in [({"parents": np.array([-1, 0])}, "names, parents, offsets and channels disagree in length"),
-                     ({"offsets": np.zeros((1, 2))}, "names, parents, offsets and channels disagree in length"),
-                     ({"channels": ()}, "names, parents, offsets and channels disagree in length"),
-                     ({"data": np.zeros((2, 4))}, r"data must be \[F,3\], got \(2, 4\)"),
-                     ({"data": np.zeros(3)}, r"data must be \[F,3\], got \(3,\)"),
-                     ({"frame_time": 0.0}, "frame time must be positive, got 0.0")]:
-        args = {"names": m.names, "parents": m.parents, "offsets": m.offsets, "end_sites": m.end_sites,
-                "channels": m.channels, "frame_time": m.frame_time, "data": m.data, "source": "x.bvh"}
+    for kw, says in [
+        ({"parents": np.array([-1, 0])}, "names, parents, offsets and channels disagree in length"),
+        ({"offsets": np.zeros((1, 2))}, "names, parents, offsets and channels disagree in length"),
+        ({"channels": ()}, "names, parents, offsets and channels disagree in length"),
+        ({"data": np.zeros((2, 4))}, r"data must be \[F,3\], got \(2, 4\)"),
+        ({"data": np.zeros(3)}, r"data must be \[F,3\], got \(3,\)"),
+        ({"frame_time": 0.0}, "frame time must be positive, got 0.0"),
+    ]:
+        args = {
+            "names": m.names,
+            "parents": m.parents,
+            "offsets": m.offsets,
+            "end_sites": m.end_sites,
+            "channels": m.channels,
+            "frame_time": m.frame_time,
+            "data": m.data,
+            "source": "x.bvh",
+        }
         with pytest.raises(BvhError, match=f"^x.bvh: {says}"):
             BvhMotion(**{**args, **kw})  # type: ignore[arg-type,dict-item]  # the test swaps one field at a time
     with pytest.raises(BvhError, match="^BVH: frame time"):
@@ -205,15 +235,27 @@ def test_unwrapping_and_frame_selection() -> None:
 
 
 def test_format_writes_a_file_that_reads_back_identically() -> None:
-    text = one_joint(body="  JOINT b\n  {\n    OFFSET 0.1 0 -0\n    CHANNELS 0\n    End Site\n    {\n"
-                          "      OFFSET 1 2 3\n    }\n  }\n",
-                     motion="MOTION\nFrames: 1\nFrame Time: 0.0083333\n0.30000000000000004 2 -3.5\n")
+    text = one_joint(
+        body="  JOINT b\n  {\n    OFFSET 0.1 0 -0\n    CHANNELS 0\n    End Site\n    {\n"
+        "      OFFSET 1 2 3\n    }\n  }\n",
+        motion="MOTION\nFrames: 1\nFrame Time: 0.0083333\n0.30000000000000004 2 -3.5\n",
+    )
     m = parse_bvh(text)
     out = format_bvh(m)
-    assert out.splitlines()[:12] == ["HIERARCHY", "ROOT hips", "{", "  OFFSET 1 2 3",
-                                     "  CHANNELS 3 Xposition Yposition Zrotation", "  JOINT b", "  {",
-                                     "    OFFSET 0.1 0 -0", "    CHANNELS 0", "    End Site", "    {",
-                                     "      OFFSET 1 2 3"]
+    assert out.splitlines()[:12] == [
+        "HIERARCHY",
+        "ROOT hips",
+        "{",
+        "  OFFSET 1 2 3",
+        "  CHANNELS 3 Xposition Yposition Zrotation",
+        "  JOINT b",
+        "  {",
+        "    OFFSET 0.1 0 -0",
+        "    CHANNELS 0",
+        "    End Site",
+        "    {",
+        "      OFFSET 1 2 3",
+    ]
     assert out.endswith("MOTION\nFrames: 1\nFrame Time: 0.0083333\n0.30000000000000004 2 -3.5\n")
     back = parse_bvh(out)
     assert (back.names, back.channels, back.frame_time) == (m.names, m.channels, m.frame_time)
@@ -226,8 +268,12 @@ def test_format_refuses_two_roots_or_joints_out_of_order() -> None:
     two = BvhMotion(m.names, np.array([-1, -1]), m.offsets, {}, m.channels, 1.0, m.data, "t.bvh")
     with pytest.raises(BvhError, match="^t.bvh: need exactly one root joint, found 2"):
         format_bvh(two)
-    m3 = parse_bvh(one_joint(body="  JOINT b\n  {\n    OFFSET 0 0 0\n    CHANNELS 0\n  }\n"
-                                  "  JOINT c\n  {\n    OFFSET 0 0 0\n    CHANNELS 0\n  }\n"))
+    m3 = parse_bvh(
+        one_joint(
+            body="  JOINT b\n  {\n    OFFSET 0 0 0\n    CHANNELS 0\n  }\n"
+            "  JOINT c\n  {\n    OFFSET 0 0 0\n    CHANNELS 0\n  }\n"
+        )
+    )
     swapped = BvhMotion(m3.names, np.array([-1, 2, 0]), m3.offsets, {}, m3.channels, 1.0, m3.data)
     with pytest.raises(BvhError, match="^BVH: joints must be in depth-first file order"):
         format_bvh(swapped)
@@ -239,8 +285,11 @@ def test_to_clip_hands_every_option_to_the_converter() -> None:
     from engine.io.bvh_convert import bvh_to_clip
 
     m = parse_bvh(one_joint("MOTION\nFrames: 3\nFrame Time: 0.25\n1 2 30\n4 5 60\n7 8 90\n"), "f.bvh")
-    for kw in ({}, {"scale": 0.5, "skip_frames": 1, "name": "walk", "positions": "add"},
-               {"scale": 2.0, "positions": "replace"}):
+    for kw in (
+        {},
+        {"scale": 0.5, "skip_frames": 1, "name": "walk", "positions": "add"},
+        {"scale": 2.0, "positions": "replace"},
+    ):
         got, want = m.to_clip(**kw), bvh_to_clip(m, **kw)  # type: ignore[arg-type]  # options vary per case
         assert got.name == want.name and got.num_frames == want.num_frames
         np.testing.assert_array_equal(got.root, want.root)
@@ -284,8 +333,10 @@ def test_the_frame_count_warning_points_at_the_caller() -> None:
 
 def test_blank_lines_and_a_bare_joint_in_the_hierarchy() -> None:
     """Blank lines anywhere in the hierarchy are skipped; a joint with no OFFSET or CHANNELS has zeros and none."""
-    text = ("HIERARCHY\n\nROOT a\n\n{\n  OFFSET 1 2 3\n\n  CHANNELS 1 Xrotation\n  JOINT b\n  {\n  }\n\n}\n\n"
-            "MOTION\nFrames: 1\nFrame Time: 0.1\n5\n")
+    text = (
+        "HIERARCHY\n\nROOT a\n\n{\n  OFFSET 1 2 3\n\n  CHANNELS 1 Xrotation\n  JOINT b\n  {\n  }\n\n}\n\n"
+        "MOTION\nFrames: 1\nFrame Time: 0.1\n5\n"
+    )
     m = parse_bvh(text)
     assert m.names == ("a", "b") and m.channels == (("Xrotation",), ()) and m.data.tolist() == [[5.0]]
     np.testing.assert_array_equal(m.offsets, [[1, 2, 3], [0, 0, 0]])

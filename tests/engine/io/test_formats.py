@@ -65,20 +65,41 @@ def test_a_ppclip_refuses_options_meant_for_another_tools_file(tmp_path: Path) -
 
 def test_no_package_keeps_a_suffix_list_of_its_own() -> None:
     """A tuple or set of two or more motion suffixes written out outside the registry is a seventh list."""
-    listed = re.compile(r"""[(\[{]\s*["']\.(bvh|glb|gltf|ppclip|csv|npz|rec)["']\s*,\s*["']\.(bvh|glb|gltf|ppclip|csv|npz|rec)["']""")
+    listed = re.compile(
+        r"""[(\[{]\s*["']\.(bvh|glb|gltf|ppclip|csv|npz|rec)["']\s*,\s*["']\.(bvh|glb|gltf|ppclip|csv|npz|rec)["']"""
+    )
     found = []
     for package in PACKAGES:
         for path in sorted((ROOT / package).rglob("*.py")):
             if path == ROOT / "engine" / "io" / "formats.py":
                 continue
-            found += [f"{path.relative_to(ROOT)}:{n}" for n, line in enumerate(path.read_text().splitlines(), 1)
-                      if listed.search(line)]
+            found += [
+                f"{path.relative_to(ROOT)}:{n}"
+                for n, line in enumerate(path.read_text().splitlines(), 1)
+                if listed.search(line)
+            ]
     assert not found, found
 
 
 def test_a_command_refuses_an_unknown_suffix_with_the_registry_list(tmp_path: Path) -> None:
     take = tmp_path / "take.txt"
     take.write_text("not a motion file")
-    r = subprocess.run([sys.executable, "-m", "puppetphone", "clips", "--clips", str(tmp_path / "lib"), "add",
-                        str(take), "--role", "walk"], check=False, capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "clips",
+            "--clips",
+            str(tmp_path / "lib"),
+            "add",
+            str(take),
+            "--role",
+            "walk",
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 2 and ", ".join(SOURCE_SUFFIXES) in r.stderr

@@ -58,14 +58,19 @@ def test_fuzz_ppclip_bytes(campaign, mutations, fuzz_budget, tmp_path):
     c.check("ppclip bytes")
 
 
-json_leaf = st.one_of(st.none(), st.booleans(), st.integers(-2**70, 2**70), st.floats(allow_nan=True),
-                      st.text(max_size=6))
+json_leaf = st.one_of(
+    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True), st.text(max_size=6)
+)
 
 
-@given(st.sampled_from(["fps", "name", "loop", "markers", "joints", "version", "format"]),
-       st.recursive(json_leaf, lambda inner: st.one_of(st.lists(inner, max_size=3),
-                                                       st.dictionaries(st.text(max_size=4), inner, max_size=3)),
-                    max_leaves=8))
+@given(
+    st.sampled_from(["fps", "name", "loop", "markers", "joints", "version", "format"]),
+    st.recursive(
+        json_leaf,
+        lambda inner: st.one_of(st.lists(inner, max_size=3), st.dictionaries(st.text(max_size=4), inner, max_size=3)),
+        max_leaves=8,
+    ),
+)
 def test_fuzz_ppclip_headers_even_correctly_signed(tmp_path_factory, key, value):
     path = save_clip(_small_clip(), tmp_path_factory.mktemp("c") / "c.ppclip")
     with np.load(path) as data:
@@ -86,8 +91,9 @@ def _bvh_head(mocap_dir: Path, frames: int = 12) -> bytes:
     text = (mocap_dir / "cmu_16_15_walk_daz.bvh").read_text()
     head, _, motion = text.partition("MOTION")
     lines = motion.strip().splitlines()
-    return (head + "MOTION\nFrames: " + str(frames) + "\n" + lines[1] + "\n" + "\n".join(lines[2:2 + frames])
-            + "\n").encode()
+    return (
+        head + "MOTION\nFrames: " + str(frames) + "\n" + lines[1] + "\n" + "\n".join(lines[2 : 2 + frames]) + "\n"
+    ).encode()
 
 
 def _check_motion(text: bytes) -> None:

@@ -25,10 +25,18 @@ from tests.engine.io.synthetic_bvh import human_bvh
 
 pytestmark = pytest.mark.fuzz
 
-_json = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(), st.floats(), st.text(max_size=12),
-                               st.sampled_from(["hips", "l_foot", "head", "tail"])),
-                     lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=8), inner, max_size=5)),
-                     max_leaves=12)
+_json = st.recursive(
+    st.one_of(
+        st.none(),
+        st.booleans(),
+        st.integers(),
+        st.floats(),
+        st.text(max_size=12),
+        st.sampled_from(["hips", "l_foot", "head", "tail"]),
+    ),
+    lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=8), inner, max_size=5)),
+    max_leaves=12,
+)
 
 
 @settings(max_examples=150, deadline=None)

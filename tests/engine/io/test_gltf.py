@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from engine import quat
+from engine.clip import Clip
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
 from engine.io.bvh import read_bvh
 from engine.io.gltf import GltfChannel, GltfError, read_gltf
 from engine.io.gltf_clip import gltf_clip, gltf_skeleton, load_gltf_clips, sample_channel
 from engine.io.gltf_write import gltf_bytes, write_gltf
-from engine.clip import Clip
 
 # file → (skin joints, [(animation name or None, duration s, keys of the first channel)])
 README = {
@@ -78,7 +78,9 @@ def test_bind_matrices_match_rest_hierarchy(mocap_dir: Path) -> None:
         asset = read_gltf(mocap_dir / name)
         inv_mesh = np.linalg.inv(_world(asset, asset.names.index(mesh)))
         for k, j in enumerate(asset.skins[0].joints):
-            np.testing.assert_allclose(inv_mesh @ _world(asset, j) @ asset.skins[0].inverse_bind[k], np.eye(4), atol=2e-5)
+            np.testing.assert_allclose(
+                inv_mesh @ _world(asset, j) @ asset.skins[0].inverse_bind[k], np.eye(4), atol=2e-5
+            )
 
 
 def test_figures_stand_up_in_y(mocap_dir: Path) -> None:
@@ -106,8 +108,13 @@ def test_interpolation_modes() -> None:
     step = replace(lin, interpolation="STEP")
     np.testing.assert_allclose(sample_channel(step, np.array([0.5, 1.0]))[:, 0], [0.0, 2.0])
     # cubic: in-tangent, value, out-tangent per key; zero tangents give smoothstep
-    cub = GltfChannel(0, "translation", "CUBICSPLINE", times, np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0],
-                                                                        [0, 0, 0], [1, 0, 0], [0, 0, 0.0]]))
+    cub = GltfChannel(
+        0,
+        "translation",
+        "CUBICSPLINE",
+        times,
+        np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [1, 0, 0], [0, 0, 0.0]]),
+    )
     np.testing.assert_allclose(sample_channel(cub, np.array([0.5, 0.25]))[:, 0], [0.5, 0.15625])
     half = quat.from_axis_angle([0, 1, 0], np.pi / 2)
     rot = GltfChannel(0, "rotation", "LINEAR", times, np.stack([quat.identity(), half]))
@@ -188,17 +195,20 @@ def _doc(tmp_path: Path) -> tuple[Path, dict]:  # type: ignore[type-arg]
     return path, json.loads(path.read_text())
 
 
-@pytest.mark.parametrize("edit,says", [
-    (lambda d: d["nodes"][0].update(children=[0]), "cycle"),  # looped forever in gltf_clip
-    (lambda d: d["nodes"][1].update(children=[*d["nodes"][1].get("children", []), 0]), "cycle|shared"),
-    (lambda d: d["accessors"][0].update(count=10**10), "count"),
-    (lambda d: d["accessors"][0].update(count="many"), "count"),
-    (lambda d: d["nodes"][0].update(translation=[float("nan"), 0, 0]), "finite"),
-    (lambda d: d.update(nodes="abc"), "malformed"),
-    (lambda d: d["animations"][0].update(channels=[{"sampler": 0, "target": "node"}]), "malformed"),
-    (lambda d: d["animations"][0].setdefault("extras", {}).update(fps=1e12), "fps"),
-    (lambda d: d["animations"][0].setdefault("extras", {}).update(fps=float("nan")), "fps"),
-])
+@pytest.mark.parametrize(
+    "edit,says",
+    [
+        (lambda d: d["nodes"][0].update(children=[0]), "cycle"),  # looped forever in gltf_clip
+        (lambda d: d["nodes"][1].update(children=[*d["nodes"][1].get("children", []), 0]), "cycle|shared"),
+        (lambda d: d["accessors"][0].update(count=10**10), "count"),
+        (lambda d: d["accessors"][0].update(count="many"), "count"),
+        (lambda d: d["nodes"][0].update(translation=[float("nan"), 0, 0]), "finite"),
+        (lambda d: d.update(nodes="abc"), "malformed"),
+        (lambda d: d["animations"][0].update(channels=[{"sampler": 0, "target": "node"}]), "malformed"),
+        (lambda d: d["animations"][0].setdefault("extras", {}).update(fps=1e12), "fps"),
+        (lambda d: d["animations"][0].setdefault("extras", {}).update(fps=float("nan")), "fps"),
+    ],
+)
 def test_hostile_documents_are_gltf_errors(tmp_path: Path, edit, says) -> None:  # type: ignore[no-untyped-def]
     path, doc = _doc(tmp_path)
     edit(doc)
@@ -210,10 +220,13 @@ def test_hostile_documents_are_gltf_errors(tmp_path: Path, edit, says) -> None: 
 def test_key_times_far_apart_do_not_allocate_frames(tmp_path: Path) -> None:
     path, doc = _doc(tmp_path)
     times = np.array([0.0, 9e4], dtype="<f4").tobytes()
-    doc["buffers"].append({"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(times).decode()})
+    doc["buffers"].append(
+        {"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(times).decode()}
+    )
     doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": 8})
-    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2,
-                             "type": "SCALAR"})
+    doc["accessors"].append(
+        {"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2, "type": "SCALAR"}
+    )
     sampler = doc["animations"][0]["samplers"][0]
     n_out = doc["accessors"][sampler["output"]]["count"]
     doc["accessors"][sampler["output"]]["count"] = 2 if n_out >= 2 else n_out
@@ -226,10 +239,13 @@ def test_key_times_far_apart_do_not_allocate_frames(tmp_path: Path) -> None:
 def test_a_signalling_nan_in_a_buffer_is_a_gltf_error(tmp_path: Path) -> None:
     path, doc = _doc(tmp_path)
     snan = b"\x01\x00\xa0\x7f" * 2  # float32 signalling NaNs: widening them raised a RuntimeWarning
-    doc["buffers"].append({"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(snan).decode()})
+    doc["buffers"].append(
+        {"byteLength": 8, "uri": "data:application/octet-stream;base64," + base64.b64encode(snan).decode()}
+    )
     doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": 8})
-    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2,
-                             "type": "SCALAR"})
+    doc["accessors"].append(
+        {"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2, "type": "SCALAR"}
+    )
     doc["animations"][0]["samplers"][0]["input"] = len(doc["accessors"]) - 1
     path.write_text(json.dumps(doc))
     with pytest.raises(GltfError, match="NaN"):

@@ -71,11 +71,18 @@ def _written_gltfs(out: Path) -> list[Path]:
     src = out / "stretch.bvh"
     src.write_text(human_bvh(stretch=0.08, frames=150))
     clip = load_motion(src).clip
-    scales = 1.0 + 0.2 * np.sin(np.linspace(0, 2 * np.pi, clip.num_frames))[:, None] * (np.arange(clip.skeleton.num_joints) == 4)
+    scales = 1.0 + 0.2 * np.sin(np.linspace(0, 2 * np.pi, clip.num_frames))[:, None] * (
+        np.arange(clip.skeleton.num_joints) == 4
+    )
     files.append(write_gltf(out / "channels.glb", replace(clip, scales=scales)))
     for suffix in (".glb", ".gltf"):
-        r = subprocess.run([sys.executable, "-m", "puppetphone", "cycle", str(src), "-o", f"loop{suffix}"], cwd=out,
-                           capture_output=True, text=True, timeout=300)
+        r = subprocess.run(
+            [sys.executable, "-m", "puppetphone", "cycle", str(src), "-o", f"loop{suffix}"],
+            cwd=out,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert r.returncode == 0, r.stderr
         files.append(out / f"loop{suffix}")
     return files
@@ -84,8 +91,13 @@ def _written_gltfs(out: Path) -> list[Path]:
 def test_khronos_validator_reports_no_errors_or_warnings_on_our_gltf(tmp_path: Path) -> None:
     node, modules = _validator()
     files = _written_gltfs(tmp_path)
-    r = subprocess.run([node, str(_ROOT / "tools" / "gltf_validate.js"), *map(str, files)], capture_output=True,
-                       text=True, timeout=300, env={**os.environ, "NODE_PATH": str(modules)})
+    r = subprocess.run(
+        [node, str(_ROOT / "tools" / "gltf_validate.js"), *map(str, files)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "NODE_PATH": str(modules)},
+    )
     reports = [json.loads(line) for line in r.stdout.splitlines() if line.startswith("{")]
     assert len(reports) == len(files), r.stderr
     bad = [rep for rep in reports if rep["errors"] or rep["warnings"]]

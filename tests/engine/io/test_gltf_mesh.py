@@ -41,8 +41,11 @@ def _two_bone_doc() -> tuple[dict[str, Any], bytes]:
         ],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}, "indices": 3}]}],
         "skins": [{"joints": [1, 2], "inverseBindMatrices": 4}],
-        "nodes": [{"mesh": 0, "skin": 0}, {"children": [2]},
-                  {"translation": [0, 0.5, 0], "rotation": [0, 0, 0.3826834, 0.9238795]}],
+        "nodes": [
+            {"mesh": 0, "skin": 0},
+            {"children": [2]},
+            {"translation": [0, 0.5, 0], "rotation": [0, 0, 0.3826834, 0.9238795]},
+        ],
         "scenes": [{"nodes": [0, 1]}],
     }
     return doc, blob
@@ -71,8 +74,9 @@ def test_a_generated_skin_reads_and_skins_by_hand(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("name, unit", [("CesiumMan.glb", 100.0), ("two bones", 1.0)])
-def test_engine_poses_carry_onto_the_skin_whatever_the_unit_and_up(tmp_path: Path, mocap_dir: Path, name: str,
-                                                                    unit: float) -> None:
+def test_engine_poses_carry_onto_the_skin_whatever_the_unit_and_up(
+    tmp_path: Path, mocap_dir: Path, name: str, unit: float
+) -> None:
     if name == "two bones":  # joints in a line: the scale cannot be seen, the frame carries the move
         doc, blob = _two_bone_doc()
         path = _write(tmp_path, doc, blob)
@@ -112,19 +116,22 @@ def test_real_characters_load_with_their_textures(mocap_dir: Path) -> None:
     assert prim.texture is not None and prim.texture.shape[2] == 4 and prim.texture.std() > 10
     assert np.allclose(prim.weights.sum(axis=1), 1.0, atol=1e-6)
     assert prim.joints.max() < len(read_gltf(mocap_dir / "CesiumMan.glb").skins[0].joints)
-    assert 0.0 <= prim.uv.min() and prim.uv.max() <= 1.0
+    assert prim.uv.min() >= 0.0 and prim.uv.max() <= 1.0
 
 
-@pytest.mark.parametrize("break_it, message", [
-    (lambda d: d["skins"][0].update(joints=[1]), "JOINTS_0 names joints outside"),
-    (lambda d: d["meshes"][0]["primitives"][0]["attributes"].pop("WEIGHTS_0"), "no JOINTS_0/WEIGHTS_0"),
-    (lambda d: d["accessors"][3].update(count=5), "not whole triangles"),
-    (lambda d: d["nodes"][0].pop("skin"), "no mesh is skinned"),
-    (lambda d: d.pop("skins"), "has no skin"),
-    (lambda d: d["meshes"][0]["primitives"][0].update(material=4), "material 4 is not"),
-    (lambda d: d["accessors"][0].update(count=1 << 30), "count"),
-    (lambda d: d["meshes"][0]["primitives"][0]["attributes"].update(POSITION="x"), "malformed|missing"),
-])
+@pytest.mark.parametrize(
+    "break_it, message",
+    [
+        (lambda d: d["skins"][0].update(joints=[1]), "JOINTS_0 names joints outside"),
+        (lambda d: d["meshes"][0]["primitives"][0]["attributes"].pop("WEIGHTS_0"), "no JOINTS_0/WEIGHTS_0"),
+        (lambda d: d["accessors"][3].update(count=5), "not whole triangles"),
+        (lambda d: d["nodes"][0].pop("skin"), "no mesh is skinned"),
+        (lambda d: d.pop("skins"), "has no skin"),
+        (lambda d: d["meshes"][0]["primitives"][0].update(material=4), "material 4 is not"),
+        (lambda d: d["accessors"][0].update(count=1 << 30), "count"),
+        (lambda d: d["meshes"][0]["primitives"][0]["attributes"].update(POSITION="x"), "malformed|missing"),
+    ],
+)
 def test_broken_rules_are_one_line_errors(tmp_path: Path, break_it, message: str) -> None:
     doc, blob = _two_bone_doc()
     break_it(doc)
@@ -137,6 +144,6 @@ def test_zero_weights_are_refused(tmp_path: Path) -> None:
     doc, blob = _two_bone_doc()
     raw = bytearray(blob)
     start = doc["bufferViews"][2]["byteOffset"]
-    raw[start:start + 16] = np.zeros(4, dtype=np.float32).tobytes()
+    raw[start : start + 16] = np.zeros(4, dtype=np.float32).tobytes()
     with pytest.raises(GltfError, match="1 vertices have no skin weight"):
         read_skinned_meshes(_write(tmp_path, doc, bytes(raw)))

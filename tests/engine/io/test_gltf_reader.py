@@ -36,13 +36,24 @@ class Doc:
         self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(raw)})
         self.blob += raw
         count = int(np.asarray(values).shape[0])
-        self.doc["accessors"].append({"bufferView": len(self.doc["bufferViews"]) - 1, "componentType": ctype,
-                                      "count": count, "type": kind, **acc})
+        self.doc["accessors"].append(
+            {
+                "bufferView": len(self.doc["bufferViews"]) - 1,
+                "componentType": ctype,
+                "count": count,
+                "type": kind,
+                **acc,
+            }
+        )
         return len(self.doc["accessors"]) - 1
 
     def finish(self) -> dict[str, Any]:
-        self.doc["buffers"] = [{"uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(self.blob)).decode(),
-                                "byteLength": len(self.blob)}]
+        self.doc["buffers"] = [
+            {
+                "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(self.blob)).decode(),
+                "byteLength": len(self.blob),
+            }
+        ]
         return self.doc
 
     def write(self, path: Path) -> Path:
@@ -73,10 +84,17 @@ def arm(tmp_path: Path) -> Doc:
     d.doc["skins"] = [{"joints": [1, 2], "inverseBindMatrices": d.add(ibm, "MAT4"), "skeleton": 0}]
     times = d.add([[0.0], [0.5], [1.0]], "SCALAR")
     rots = d.add([[0, 0, 0, 1], [1, 0, 0, 0], [0, 1, 0, 0]], "VEC4")
-    d.doc["animations"] = [{"name": "wave", "extras": {"loop": True},
-                            "samplers": [{"input": times, "output": rots, "interpolation": "STEP"}],
-                            "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}},
-                                         {"sampler": 0, "target": {"extensions": {}}}]}]
+    d.doc["animations"] = [
+        {
+            "name": "wave",
+            "extras": {"loop": True},
+            "samplers": [{"input": times, "output": rots, "interpolation": "STEP"}],
+            "channels": [
+                {"sampler": 0, "target": {"node": 1, "path": "rotation"}},
+                {"sampler": 0, "target": {"extensions": {}}},
+            ],
+        }
+    ]
     return d
 
 
@@ -135,15 +153,24 @@ def test_glb_container_damage_is_named() -> None:
     good = glb({"asset": {"version": "2.0"}}, b"\x01\x02\x03\x04")
     doc, binary = parse_glb(good, "g")
     assert doc == {"asset": {"version": "2.0"}} and binary == b"\x01\x02\x03\x04"
-    cases = [(good[:19], "g: not a GLB file (bad magic)"),
-             (b"gltf" + good[4:], "g: not a GLB file (bad magic)"),
-             (good[:4] + struct.pack("<I", 1) + good[8:], "g: GLB version 1, only 2 is supported"),
-             (good[:8] + struct.pack("<I", len(good) + 1) + good[12:], f"g: truncated: header says {len(good) + 1} bytes, file has {len(good)}"),
-             (good[:12] + struct.pack("<I", 10_000) + good[16:], "g: truncated chunk at byte 12"),
-             (good[:8] + struct.pack("<I", 12) + good[12:], "g: no JSON chunk")]
+    cases = [
+        (good[:19], "g: not a GLB file (bad magic)"),
+        (b"gltf" + good[4:], "g: not a GLB file (bad magic)"),
+        (good[:4] + struct.pack("<I", 1) + good[8:], "g: GLB version 1, only 2 is supported"),
+        (
+            good[:8] + struct.pack("<I", len(good) + 1) + good[12:],
+            f"g: truncated: header says {len(good) + 1} bytes, file has {len(good)}",
+        ),
+        (good[:12] + struct.pack("<I", 10_000) + good[16:], "g: truncated chunk at byte 12"),
+        (good[:8] + struct.pack("<I", 12) + good[12:], "g: no JSON chunk"),
+    ]
     bad_json = b"{" + b" " * 3
-    cases.append((b"glTF" + struct.pack("<II", 2, 12 + 8 + 4) + struct.pack("<II", 4, 0x4E4F534A) + bad_json,
-                  "g: bad JSON chunk: JSONDecodeError"))
+    cases.append(
+        (
+            b"glTF" + struct.pack("<II", 2, 12 + 8 + 4) + struct.pack("<II", 4, 0x4E4F534A) + bad_json,
+            "g: bad JSON chunk: JSONDecodeError",
+        )
+    )
     for data, says in cases:
         with pytest.raises(GltfError) as err:
             parse_glb(data, "g")
@@ -186,8 +213,9 @@ def test_accessor_types_strides_offsets_and_normalisation() -> None:
     inter[:, 3:6] = [[7, 8, 9], [10, 11, 12]]
     blob = bytes(d.blob) + inter.tobytes()
     doc["bufferViews"].append({"buffer": 0, "byteOffset": len(d.blob), "byteLength": inter.nbytes, "byteStride": 28})
-    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2,
-                             "type": "VEC3", "byteOffset": 12})
+    doc["accessors"].append(
+        {"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 2, "type": "VEC3", "byteOffset": 12}
+    )
     np.testing.assert_array_equal(accessor(doc, [blob], 6), [[7, 8, 9], [10, 11, 12]])
     doc["accessors"][6]["byteOffset"] = 17  # 17 + 28 + 12 > 56 bytes
     with pytest.raises(GltfError, match="^s: accessor 6 reads past its bufferView$"):
@@ -204,8 +232,11 @@ def test_a_sparse_accessor_overrides_some_elements() -> None:
     idx = d.add([[2], [0]], "SCALAR", ctype=5123)
     vals = d.add([[9, 8], [7, 6]], "VEC2")
     doc = d.finish()
-    sparse = {"count": 2, "indices": {"bufferView": doc["accessors"][idx]["bufferView"], "componentType": 5123},
-              "values": {"bufferView": doc["accessors"][vals]["bufferView"]}}
+    sparse = {
+        "count": 2,
+        "indices": {"bufferView": doc["accessors"][idx]["bufferView"], "componentType": 5123},
+        "values": {"bufferView": doc["accessors"][vals]["bufferView"]},
+    }
     doc["accessors"][base]["sparse"] = sparse
     np.testing.assert_array_equal(accessor(doc, [bytes(d.blob)], base), [[7, 6], [2, 2], [9, 8]])
     doc["accessors"].append({"componentType": 5126, "count": 3, "type": "VEC2", "sparse": sparse})
@@ -219,22 +250,26 @@ def test_a_sparse_accessor_overrides_some_elements() -> None:
     blob = bytes(d.blob)
     bad_idx = d.add([[0], [3]], "SCALAR", ctype=5123)
     doc2 = d.finish()
-    doc2["accessors"][base]["sparse"] = dict(sparse, count=2, indices={"bufferView": doc2["accessors"][bad_idx]["bufferView"],
-                                                                        "componentType": 5123})
+    doc2["accessors"][base]["sparse"] = dict(
+        sparse, count=2, indices={"bufferView": doc2["accessors"][bad_idx]["bufferView"], "componentType": 5123}
+    )
     with pytest.raises(GltfError, match="^s: accessor 0 has sparse indices outside 0..2$"):
         accessor(doc2, [bytes(d.blob)], base, "s")
     assert blob  # the first buffer was used above
 
 
-@pytest.mark.parametrize("edit,says", [
-    (lambda a: a.pop("type"), "accessor 0 is missing or malformed"),
-    (lambda a: a.update(componentType=5130), "accessor 0 is missing or malformed"),
-    (lambda a: a.update(count=-1), f"accessor 0 count -1 is not 0..{MAX_ELEMENTS // 3}"),
-    (lambda a: a.update(count=True), f"accessor 0 count True is not 0..{MAX_ELEMENTS // 3}"),
-    (lambda a: a.update(count=MAX_ELEMENTS // 3 + 1), f"accessor 0 count {MAX_ELEMENTS // 3 + 1} is not"),
-    (lambda a: a.update(count=3), "accessor 0 reads past its bufferView"),
-    (lambda a: a.update(bufferView=5), "bufferView 5 or its buffer does not exist"),
-])
+@pytest.mark.parametrize(
+    "edit,says",
+    [
+        (lambda a: a.pop("type"), "accessor 0 is missing or malformed"),
+        (lambda a: a.update(componentType=5130), "accessor 0 is missing or malformed"),
+        (lambda a: a.update(count=-1), f"accessor 0 count -1 is not 0..{MAX_ELEMENTS // 3}"),
+        (lambda a: a.update(count=True), f"accessor 0 count True is not 0..{MAX_ELEMENTS // 3}"),
+        (lambda a: a.update(count=MAX_ELEMENTS // 3 + 1), f"accessor 0 count {MAX_ELEMENTS // 3 + 1} is not"),
+        (lambda a: a.update(count=3), "accessor 0 reads past its bufferView"),
+        (lambda a: a.update(bufferView=5), "bufferView 5 or its buffer does not exist"),
+    ],
+)
 def test_a_broken_accessor_is_named(edit: Any, says: str) -> None:
     d = Doc()
     d.add([[1, 2, 3], [4, 5, 6]], "VEC3")
@@ -269,28 +304,48 @@ def test_the_element_limit_is_inclusive() -> None:
     assert accessor(doc, [], 0).shape == (MAX_ELEMENTS, 1)
 
 
-@pytest.mark.parametrize("edit,says", [
-    (lambda d: d["nodes"][0].update(children=[3]), "node 0 has a bad or shared child 3"),
-    (lambda d: d["nodes"][0].update(children=[-1]), "node 0 has a bad or shared child -1"),
-    (lambda d: d["nodes"][2].update(children=[1]), "node 2 has a bad or shared child 1"),
-    (lambda d: d["nodes"][2].update(children=[0]), "the node hierarchy has a cycle"),
-    (lambda d: d["nodes"][1].update(translation=[0, float("nan"), 0]), "a node's translation, rotation or scale is not finite"),
-    (lambda d: d["nodes"][1].update(scale=[1, float("inf"), 1]), "a node's translation, rotation or scale is not finite"),
-    (lambda d: d["skins"][0].update(joints=[1, 3]), "skin 0 names a joint node that does not exist"),
-    (lambda d: d["skins"][0].update(joints=[-1]), "skin 0 names a joint node that does not exist"),
-    (lambda d: d["animations"][0]["channels"][0].update(sampler=4), "animation 0 channel names a missing sampler"),
-    (lambda d: d["animations"][0]["channels"][0].pop("sampler"), "animation 0 channel names a missing sampler"),
-    (lambda d: d["animations"][0]["samplers"][0].update(interpolation="SMOOTH"), "animation 0: unknown interpolation 'SMOOTH'"),
-    (lambda d: d["animations"][0]["samplers"][0].update(interpolation="CUBICSPLINE"), "animation 0: 3 keys but 3 values"),
-    (lambda d: d["animations"][0]["channels"][0]["target"].update(path="translation"),
-     "animation 0: translation keys have 4 numbers, not 3"),
-    (lambda d: d["animations"][0]["channels"][0]["target"].update(path="scale"), "animation 0: scale keys have 4 numbers, not 3"),
-    (lambda d: d["asset"].update(version="1.0"), "not a glTF 2.0 document (asset.version)"),
-    (lambda d: d.pop("asset"), "not a glTF 2.0 document (asset.version)"),
-    (lambda d: d["buffers"][0].update(byteLength=10_000), "buffer 0 holds"),
-    (lambda d: d["buffers"][0].pop("uri"), "buffer 0 has no uri and there is no GLB binary chunk"),
-    (lambda d: d["nodes"].append({"children": "x"}), "malformed document (TypeError"),
-])
+@pytest.mark.parametrize(
+    "edit,says",
+    [
+        (lambda d: d["nodes"][0].update(children=[3]), "node 0 has a bad or shared child 3"),
+        (lambda d: d["nodes"][0].update(children=[-1]), "node 0 has a bad or shared child -1"),
+        (lambda d: d["nodes"][2].update(children=[1]), "node 2 has a bad or shared child 1"),
+        (lambda d: d["nodes"][2].update(children=[0]), "the node hierarchy has a cycle"),
+        (
+            lambda d: d["nodes"][1].update(translation=[0, float("nan"), 0]),
+            "a node's translation, rotation or scale is not finite",
+        ),
+        (
+            lambda d: d["nodes"][1].update(scale=[1, float("inf"), 1]),
+            "a node's translation, rotation or scale is not finite",
+        ),
+        (lambda d: d["skins"][0].update(joints=[1, 3]), "skin 0 names a joint node that does not exist"),
+        (lambda d: d["skins"][0].update(joints=[-1]), "skin 0 names a joint node that does not exist"),
+        (lambda d: d["animations"][0]["channels"][0].update(sampler=4), "animation 0 channel names a missing sampler"),
+        (lambda d: d["animations"][0]["channels"][0].pop("sampler"), "animation 0 channel names a missing sampler"),
+        (
+            lambda d: d["animations"][0]["samplers"][0].update(interpolation="SMOOTH"),
+            "animation 0: unknown interpolation 'SMOOTH'",
+        ),
+        (
+            lambda d: d["animations"][0]["samplers"][0].update(interpolation="CUBICSPLINE"),
+            "animation 0: 3 keys but 3 values",
+        ),
+        (
+            lambda d: d["animations"][0]["channels"][0]["target"].update(path="translation"),
+            "animation 0: translation keys have 4 numbers, not 3",
+        ),
+        (
+            lambda d: d["animations"][0]["channels"][0]["target"].update(path="scale"),
+            "animation 0: scale keys have 4 numbers, not 3",
+        ),
+        (lambda d: d["asset"].update(version="1.0"), "not a glTF 2.0 document (asset.version)"),
+        (lambda d: d.pop("asset"), "not a glTF 2.0 document (asset.version)"),
+        (lambda d: d["buffers"][0].update(byteLength=10_000), "buffer 0 holds"),
+        (lambda d: d["buffers"][0].pop("uri"), "buffer 0 has no uri and there is no GLB binary chunk"),
+        (lambda d: d["nodes"].append({"children": "x"}), "malformed document (TypeError"),
+    ],
+)
 def test_a_broken_document_is_one_gltf_error(tmp_path: Path, edit: Any, says: str) -> None:
     doc = arm(tmp_path).finish()
     edit(doc)
@@ -301,8 +356,16 @@ def test_a_broken_document_is_one_gltf_error(tmp_path: Path, edit: Any, says: st
     assert str(err.value).startswith(f"{path}: {says}")
 
 
-@pytest.mark.parametrize("times,ok", [([0.0, 0.0, 1.0], True), ([0.0, 1.0, 0.5], False), ([-MAX_TIME, 0.0, MAX_TIME], True),
-                                      ([0.0, 1.0, MAX_TIME * 1.01], False), ([-MAX_TIME * 1.01, 0.0, 1.0], False)])
+@pytest.mark.parametrize(
+    "times,ok",
+    [
+        ([0.0, 0.0, 1.0], True),
+        ([0.0, 1.0, 0.5], False),
+        ([-MAX_TIME, 0.0, MAX_TIME], True),
+        ([0.0, 1.0, MAX_TIME * 1.01], False),
+        ([-MAX_TIME * 1.01, 0.0, 1.0], False),
+    ],
+)
 def test_key_times_must_not_decrease_and_stay_bounded(tmp_path: Path, times: list[float], ok: bool) -> None:
     d = arm(tmp_path)
     d.doc["animations"][0]["samplers"][0]["input"] = d.add([[t] for t in times], "SCALAR")
@@ -319,13 +382,20 @@ def test_cubic_and_weight_channels_keep_their_values(tmp_path: Path) -> None:
     t = d.add([[0.0], [1.0]], "SCALAR")
     cubic = d.add(np.arange(18, dtype=float).reshape(6, 3), "VEC3")
     weights = d.add([[0.5], [0.25], [1.0], [0.0]], "SCALAR")
-    d.doc["animations"][0]["samplers"] += [{"input": t, "output": cubic, "interpolation": "CUBICSPLINE"},
-                                           {"input": t, "output": weights}]
-    d.doc["animations"][0]["channels"] += [{"sampler": 1, "target": {"node": 2, "path": "translation"}},
-                                           {"sampler": 2, "target": {"node": 2, "path": "weights"}}]
+    d.doc["animations"][0]["samplers"] += [
+        {"input": t, "output": cubic, "interpolation": "CUBICSPLINE"},
+        {"input": t, "output": weights},
+    ]
+    d.doc["animations"][0]["channels"] += [
+        {"sampler": 1, "target": {"node": 2, "path": "translation"}},
+        {"sampler": 2, "target": {"node": 2, "path": "weights"}},
+    ]
     chans = read_gltf(d.write(tmp_path / "c.gltf")).animations[0].channels
-    assert [(c.node, c.path, c.interpolation) for c in chans] == [(1, "rotation", "STEP"), (2, "translation", "CUBICSPLINE"),
-                                                                   (2, "weights", "LINEAR")]
+    assert [(c.node, c.path, c.interpolation) for c in chans] == [
+        (1, "rotation", "STEP"),
+        (2, "translation", "CUBICSPLINE"),
+        (2, "weights", "LINEAR"),
+    ]
     assert chans[1].values.shape == (6, 3) and chans[2].values.shape == (4, 1)
 
 
@@ -356,12 +426,19 @@ def test_file_level_refusals(tmp_path: Path) -> None:
         read_gltf(path)
 
 
-@pytest.mark.parametrize("uri,says", [
-    ("../b.bin", "is not a file beside the glTF"), ("%2e%2e/b.bin", "is not a file beside the glTF"),
-    ("file:b.bin", "is not a file beside the glTF"), ("http://host/b.bin", "is not a file beside the glTF"),
-    ("sub\\b.bin", "is not a file beside the glTF"), ("", "is not a file beside the glTF"),
-    ("/b.bin", "is not a file beside the glTF"), ("link/b.bin", "leads out of the glTF's folder"),
-])
+@pytest.mark.parametrize(
+    "uri,says",
+    [
+        ("../b.bin", "is not a file beside the glTF"),
+        ("%2e%2e/b.bin", "is not a file beside the glTF"),
+        ("file:b.bin", "is not a file beside the glTF"),
+        ("http://host/b.bin", "is not a file beside the glTF"),
+        ("sub\\b.bin", "is not a file beside the glTF"),
+        ("", "is not a file beside the glTF"),
+        ("/b.bin", "is not a file beside the glTF"),
+        ("link/b.bin", "leads out of the glTF's folder"),
+    ],
+)
 def test_a_buffer_uri_must_name_a_file_beside_the_gltf(tmp_path: Path, uri: str, says: str) -> None:
     folder, outside = tmp_path / "model", tmp_path / "elsewhere"
     folder.mkdir()
@@ -376,7 +453,8 @@ def test_a_buffer_uri_must_name_a_file_beside_the_gltf(tmp_path: Path, uri: str,
     with pytest.raises(GltfError) as err:
         read_gltf(path)
     assert str(err.value) == f"{path}: buffer 0: uri {uri!r} {says}" + (
-        " (no absolute paths, schemes or ..)" if "beside" in says else "")
+        " (no absolute paths, schemes or ..)" if "beside" in says else ""
+    )
 
 
 def test_a_buffer_beside_the_gltf_or_in_a_subfolder_reads(tmp_path: Path) -> None:

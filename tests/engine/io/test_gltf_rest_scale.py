@@ -36,5 +36,9 @@ def test_a_rest_scale_on_an_inner_joint_lengthens_every_bone_below_it(tmp_path: 
     for j in range(sk.num_joints):
         factor = 2.0 if j in below else 1.0
         np.testing.assert_allclose(bs.offsets[j], factor * sk.offsets[j], atol=1e-6, err_msg=sk.names[j])
-        np.testing.assert_allclose(bs.tips[j], (2.0 if j in below | {sk.index("l_upper_arm")} else 1.0) * sk.tips[j],
-                                   atol=1e-6, err_msg=sk.names[j])
+        np.testing.assert_allclose(
+            bs.tips[j],
+            (2.0 if j in below | {sk.index("l_upper_arm")} else 1.0) * sk.tips[j],
+            atol=1e-6,
+            err_msg=sk.names[j],
+        )

@@ -18,13 +18,23 @@ from engine.io.motion_file import to_puppet
 from engine.skinning import node_world_matrices
 
 CESIUM = {
-    "hips": "Skeleton_torso_joint_1", "spine": "Skeleton_torso_joint_2", "chest": "torso_joint_3",
-    "neck": "Skeleton_neck_joint_1", "head": "Skeleton_neck_joint_2",
-    "l_upper_leg": "leg_joint_L_1", "l_lower_leg": "leg_joint_L_2", "l_foot": "leg_joint_L_3",
-    "r_upper_leg": "leg_joint_R_1", "r_lower_leg": "leg_joint_R_2", "r_foot": "leg_joint_R_3",
-    "l_upper_arm": "Skeleton_arm_joint_L__4_", "l_lower_arm": "Skeleton_arm_joint_L__3_",
-    "l_hand": "Skeleton_arm_joint_L__2_", "r_upper_arm": "Skeleton_arm_joint_R",
-    "r_lower_arm": "Skeleton_arm_joint_R__2_", "r_hand": "Skeleton_arm_joint_R__3_",
+    "hips": "Skeleton_torso_joint_1",
+    "spine": "Skeleton_torso_joint_2",
+    "chest": "torso_joint_3",
+    "neck": "Skeleton_neck_joint_1",
+    "head": "Skeleton_neck_joint_2",
+    "l_upper_leg": "leg_joint_L_1",
+    "l_lower_leg": "leg_joint_L_2",
+    "l_foot": "leg_joint_L_3",
+    "r_upper_leg": "leg_joint_R_1",
+    "r_lower_leg": "leg_joint_R_2",
+    "r_foot": "leg_joint_R_3",
+    "l_upper_arm": "Skeleton_arm_joint_L__4_",
+    "l_lower_arm": "Skeleton_arm_joint_L__3_",
+    "l_hand": "Skeleton_arm_joint_L__2_",
+    "r_upper_arm": "Skeleton_arm_joint_R",
+    "r_lower_arm": "Skeleton_arm_joint_R__2_",
+    "r_hand": "Skeleton_arm_joint_R__3_",
 }
 
 

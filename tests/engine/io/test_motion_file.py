@@ -34,11 +34,13 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, cwd=cwd,
-                          timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "puppetphone", *args], capture_output=True, text=True, cwd=cwd, timeout=300
+    )
 
 
 # -- wall 1: commands take glTF ------------------------------------------------------------------
+
 
 def test_cycle_extracts_the_walk_of_a_skinned_glb(mocap_dir: Path, tmp_path: Path) -> None:
     r = _cli("cycle", str(mocap_dir / "Fox.glb"), "--animation", "Walk", "-o", "fox.bvh", "--json", cwd=tmp_path)
@@ -72,6 +74,7 @@ def test_animation_is_refused_for_bvh(tmp_path: Path) -> None:
 
 
 # -- wall 2: translations of non-root joints -----------------------------------------------------
+
 
 def test_a_stretching_bone_keeps_its_translation_through_fk_bvh_and_gltf(tmp_path: Path) -> None:
     path = _write(tmp_path, "stretch.bvh", human_bvh(stretch=0.08))
@@ -109,6 +112,7 @@ def test_retargeting_drops_translations_with_a_warning(tmp_path: Path) -> None:
 
 # -- wall 3: Frames count off by one ---------------------------------------------------------------
 
+
 def test_a_frame_count_off_by_one_reads_the_complete_rows_with_a_warning(tmp_path: Path) -> None:
     for declared in (59, 61):
         with pytest.warns(BvhWarning, match=f"'Frames: {declared}' but the file holds 60 complete frames"):
@@ -128,6 +132,7 @@ def test_a_truncated_row_still_refuses() -> None:
 
 
 # -- wall 4: units --------------------------------------------------------------------------------
+
 
 def test_cmu_asf_units_are_judged_by_the_leg_not_as_inches(tmp_path: Path) -> None:
     cmu = 0.0254 / 0.45
@@ -169,8 +174,12 @@ def test_gltf_fps_comes_from_key_spacing(tmp_path: Path) -> None:
     bare = replace(anim, extras={})  # as another exporter writes it: no fps recorded
     assert key_rate(bare) == 25.0
     assert gltf_clip(replace(asset, animations=(bare,))).fps == 25.0
-    jitter = replace(bare, channels=tuple(replace(c, times=c.times + np.where(np.arange(len(c.times)) % 2, 0.013, 0.0))
-                                          for c in bare.channels))
+    jitter = replace(
+        bare,
+        channels=tuple(
+            replace(c, times=c.times + np.where(np.arange(len(c.times)) % 2, 0.013, 0.0)) for c in bare.channels
+        ),
+    )
     assert key_rate(jitter) is None and gltf_clip(replace(asset, animations=(jitter,))).fps == 30.0
 
 
@@ -185,6 +194,7 @@ def test_units_and_fps_are_printed_in_json(tmp_path: Path) -> None:
 
 
 # -- wall 5: names --------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize(("names", "family"), [(BIOVISION, "biovision"), (LOWERCASE, "lowercase")])
 def test_biovision_and_lowercase_skeletons_retarget(tmp_path: Path, names: dict[str, str], family: str) -> None:
@@ -203,14 +213,19 @@ def test_a_joint_map_file_maps_any_skeleton(tmp_path: Path) -> None:
     (tmp_path / "map.json").write_text(json.dumps({ODD[role]: role for role in ODD if role != "chest"}))
     puppet, used = to_puppet(clip, load_joint_map(tmp_path / "map.json"), "map.json")
     assert used == "map.json" and puppet.num_frames == clip.num_frames
-    for bad, needle in (("[1, 2]", "JSON object"), ('{"a": "tail"}', "unknown puppet joints"), ("{", "not a readable"),
-                        ('{"a": "hips", "b": "hips"}', "given twice")):
+    for bad, needle in (
+        ("[1, 2]", "JSON object"),
+        ('{"a": "tail"}', "unknown puppet joints"),
+        ("{", "not a readable"),
+        ('{"a": "hips", "b": "hips"}', "given twice"),
+    ):
         (tmp_path / "bad.json").write_text(bad)
         with pytest.raises(MotionFileError, match=needle):
             load_joint_map(tmp_path / "bad.json")
 
 
 # -- wall 6: loops that land in Blender -------------------------------------------------------------
+
 
 def test_looped_bvh_lands_at_the_nominal_rate_closed_with_end_sites(tmp_path: Path) -> None:
     path = _write(tmp_path, "w.bvh", human_bvh(fps=120.0, frames=500, period=1.1637, zero_end_site=True))
@@ -225,4 +240,6 @@ def test_looped_bvh_lands_at_the_nominal_rate_closed_with_end_sites(tmp_path: Pa
     assert head in out.end_sites and not np.any(out.end_sites[head])  # a zero End Site is kept
     r = _cli("cycle", str(path), "-o", "open.bvh", "--fps", "30", "--no-closing-frame", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    assert read_bvh(tmp_path / "open.bvh").fps == pytest.approx(30.0) and read_bvh(tmp_path / "open.bvh").num_frames == round(period * 30)
+    assert read_bvh(tmp_path / "open.bvh").fps == pytest.approx(30.0) and read_bvh(
+        tmp_path / "open.bvh"
+    ).num_frames == round(period * 30)

@@ -20,7 +20,10 @@ def test_io_imports_only_engine() -> None:
     # engine/ must not import input/, authoring/, games/ or puppetphone/ (DESIGN: which way imports go).
     for path in Path(engine.io.__file__).parent.glob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
-            mods = [a.name for a in node.names] if isinstance(node, ast.Import) else (
-                [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            mods = (
+                [a.name for a in node.names]
+                if isinstance(node, ast.Import)
+                else ([node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            )
             for mod in mods:
                 assert mod.split(".")[0] not in ("input", "authoring", "games", "puppetphone"), (path.name, mod)

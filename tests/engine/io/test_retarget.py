@@ -63,8 +63,13 @@ def test_bone_directions_copy_the_source(mocap_dir: Path) -> None:
         clip = retarget(src, PUPPET)
         s_pos, _ = forward_kinematics(src.skeleton, src.root, src.rotations)
         t_pos, _ = forward_kinematics(PUPPET, clip.root, clip.rotations)
-        for a, b in (("l_upper_arm", "l_lower_arm"), ("r_lower_arm", "r_hand"), ("l_upper_leg", "l_lower_leg"),
-                     ("r_lower_leg", "r_foot"), ("spine", "chest")):
+        for a, b in (
+            ("l_upper_arm", "l_lower_arm"),
+            ("r_lower_arm", "r_hand"),
+            ("l_upper_leg", "l_lower_leg"),
+            ("r_lower_leg", "r_foot"),
+            ("spine", "chest"),
+        ):
             sa, sb = src.skeleton.index(mapping[a]), src.skeleton.index(mapping[b])
             if src.skeleton.parents[sb] != sa:
                 continue  # joints skipped in between (iClone's Spine01) bend the source "bone"
@@ -97,16 +102,42 @@ def test_other_rigs_walk_on_the_floor(mocap_dir: Path) -> None:
 
 
 def test_guess_joint_map_picks_family(mocap_dir: Path) -> None:
-    expect = {"cmu_16_15_walk_daz.bvh": "cmu_daz", "bandai1_walk_normal_001.bvh": "bandai",
-              "cmu_02_05_punch_ccbase.bvh": "cc_base"}
+    expect = {
+        "cmu_16_15_walk_daz.bvh": "cmu_daz",
+        "bandai1_walk_normal_001.bvh": "bandai",
+        "cmu_02_05_punch_ccbase.bvh": "cc_base",
+    }
     for name, family in expect.items():
         got, mapping, _ = guess_joint_map(read_bvh(mocap_dir / name).names)
         assert got == family and len(mapping) == 17
-    mixamo = [f"mixamorig:{n}" for n in ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftArm", "LeftForeArm",
-                                         "LeftHand", "RightArm", "RightForeArm", "RightHand", "LeftUpLeg", "LeftLeg",
-                                         "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot")]
+    mixamo = [
+        f"mixamorig:{n}"
+        for n in (
+            "Hips",
+            "Spine",
+            "Spine1",
+            "Spine2",
+            "Neck",
+            "Head",
+            "LeftArm",
+            "LeftForeArm",
+            "LeftHand",
+            "RightArm",
+            "RightForeArm",
+            "RightHand",
+            "LeftUpLeg",
+            "LeftLeg",
+            "LeftFoot",
+            "LeftToeBase",
+            "RightUpLeg",
+            "RightLeg",
+            "RightFoot",
+        )
+    ]
     family, mapping, aims = guess_joint_map(mixamo)
-    assert family == "cmu_mixamo" and mapping["chest"] == "mixamorig:Spine2" and aims["l_foot"] == "mixamorig:LeftToeBase"
+    assert (
+        family == "cmu_mixamo" and mapping["chest"] == "mixamorig:Spine2" and aims["l_foot"] == "mixamorig:LeftToeBase"
+    )
     assert set(JOINT_MAPS["cmu_daz"]) == set(PUPPET.names)
     with pytest.raises(ValueError, match="no joint map fits"):
         guess_joint_map(["root", "a", "b"])

@@ -31,8 +31,23 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def _cycle_json(path: Path, *options: str, code: int = 0) -> tuple[dict, str]:
-    r = subprocess.run([sys.executable, "-m", "puppetphone", "cycle", str(path), "-o", str(path.with_suffix(".loop.bvh")),
-                        "--json", *options], check=False, capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "cycle",
+            str(path),
+            "-o",
+            str(path.with_suffix(".loop.bvh")),
+            "--json",
+            *options,
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == code, r.stderr
     return json.loads(r.stdout.strip().splitlines()[-1]).get("input", {}), r.stderr
 
@@ -87,8 +102,25 @@ def test_height_scales_to_a_stated_height_instead_of_a_unit(tmp_path: Path) -> N
     given, _ = _cycle_json(path, "--height", "1.55")
     assert given["units"] == "scaled" and given["height"] == pytest.approx(1.55, abs=1e-4)
     assert given["scaled_to"] == "a 1.55 m tall figure"
-    r = subprocess.run([sys.executable, "-m", "puppetphone", "cycle", str(path), "-o", str(tmp_path / "x.bvh"),
-                        "--height", "1.5", "--units", "cm"], check=False, capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "cycle",
+            str(path),
+            "-o",
+            str(tmp_path / "x.bvh"),
+            "--height",
+            "1.5",
+            "--units",
+            "cm",
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 2 and "give --units or --height, not both" in r.stderr
 
 
@@ -98,8 +130,24 @@ def test_a_library_run_says_how_it_sized_a_take_no_unit_fits(tmp_path: Path) -> 
     takes.mkdir()
     _write(takes, "hand.bvh", hand_bvh(unit=3.0))
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy"}
-    done = subprocess.run([sys.executable, "-m", "puppetphone", "cycles", str(takes), "-o", str(tmp_path / "lib"),
-                           "--jobs", "1", "--no-progress"], env=env, capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "cycles",
+            str(takes),
+            "-o",
+            str(tmp_path / "lib"),
+            "--jobs",
+            "1",
+            "--no-progress",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode in (0, 3), done.stderr
     notes = [line for line in done.stdout.splitlines() if line.startswith("note")]
     assert len(notes) == 1 and "hand.bvh" in notes[0] and "scaled to a 0.19 m hand" in notes[0], done.stdout

@@ -30,8 +30,9 @@ def test_a_blender_z_up_bvh_stands_up_exactly(tmp_path: Path) -> None:
     assert summary["up"] == "z" and summary["height"] == pytest.approx(motion.height, abs=1e-4)
     assert 1.4 < motion.height < 2.0
     # The rest pose stands up too (the editors and the unit judge look at it).
-    rest = forward_kinematics(motion.clip.skeleton, motion.clip.skeleton.offsets[0],
-                              quat.identity(motion.clip.skeleton.num_joints))[0]
+    rest = forward_kinematics(
+        motion.clip.skeleton, motion.clip.skeleton.offsets[0], quat.identity(motion.clip.skeleton.num_joints)
+    )[0]
     assert np.ptp(rest[:, 1]) > np.ptp(rest[:, 2])
 
 
@@ -48,8 +49,11 @@ def test_a_y_up_capture_keeps_its_axes_and_a_crawl_is_not_stood_up() -> None:
     assert judge_up(take).name == "y"
     # The same figure lying head first along its travel (a crawl in a Y-up file) keeps Y.
     flat = quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.float64(np.pi / 2))  # head towards +Z, the travel
-    crawl = replace(take, root=quat.rotate(flat, take.root - take.root[0]) * [1, 1, 0] + take.root * [0, 0, 1],
-                    rotations=np.concatenate([quat.mul(flat, take.rotations[:, :1]), take.rotations[:, 1:]], axis=1))
+    crawl = replace(
+        take,
+        root=quat.rotate(flat, take.root - take.root[0]) * [1, 1, 0] + take.root * [0, 0, 1],
+        rotations=np.concatenate([quat.mul(flat, take.rotations[:, :1]), take.rotations[:, 1:]], axis=1),
+    )
     assert judge_up(crawl).name == "y" and "travels" in judge_up(crawl).basis
 
 

@@ -83,16 +83,22 @@ def walk_clip(skeleton: Skeleton) -> Clip:
 @pytest.fixture(scope="session")
 def get_up_clips(skeleton: Skeleton) -> dict[str, Clip]:
     lib = {k: v for k, v in _library().items() if k.startswith("get_up")}
-    return lib or {"get_up_face_up": synthetic_get_up(skeleton, True),
-                   "get_up_face_down": synthetic_get_up(skeleton, False)}
+    return lib or {
+        "get_up_face_up": synthetic_get_up(skeleton, True),
+        "get_up_face_down": synthetic_get_up(skeleton, False),
+    }
 
 
 @pytest.fixture
 def make_app(skeleton: Skeleton) -> Callable[..., tuple[App, int]]:
     """An app with physics and one puppet ragdoll in the given pose and mode."""
 
-    def make(root: np.ndarray | None = None, rotations: np.ndarray | None = None,
-             mode: RagdollMode = RagdollMode.LIMP, seed: int = 0) -> tuple[App, int]:
+    def make(
+        root: np.ndarray | None = None,
+        rotations: np.ndarray | None = None,
+        mode: RagdollMode = RagdollMode.LIMP,
+        seed: int = 0,
+    ) -> tuple[App, int]:
         app = App(seed=seed, plugins=[install_physics])
         rd = Ragdoll(default_profile(skeleton))
         rd.set_mode(mode, immediate=True)

@@ -34,7 +34,9 @@ def _animate(app: App, e: int, clip: Clip, speed: float = 1.2) -> None:
 def test_active_mode_tracks_a_walk(make_app: Callable[..., tuple[App, int]], walk_clip: Clip) -> None:
     start = walk_clip.sample(0.0)
     lift = np.array([0.0, 0.3, 0.0])  # the walk is held just off the ground: we test the muscles
-    clip = Clip(walk_clip.name, walk_clip.skeleton, walk_clip.fps, walk_clip.root + lift, walk_clip.rotations, loop=True)
+    clip = Clip(
+        walk_clip.name, walk_clip.skeleton, walk_clip.fps, walk_clip.root + lift, walk_clip.rotations, loop=True
+    )
     app, e = make_app(start.root + lift, start.rotations, mode=RagdollMode.ACTIVE)
     _animate(app, e, clip)
     pw = app.world.resource(PhysicsWorld)
@@ -57,8 +59,9 @@ def test_active_mode_tracks_a_walk(make_app: Callable[..., tuple[App, int]], wal
 
 
 @pytest.mark.parametrize("simulated", [False, True])
-def test_animated_mode_passes_the_pose_through(make_app: Callable[..., tuple[App, int]], walk_clip: Clip,
-                                               simulated: bool) -> None:
+def test_animated_mode_passes_the_pose_through(
+    make_app: Callable[..., tuple[App, int]], walk_clip: Clip, simulated: bool
+) -> None:
     start = walk_clip.sample(0.0)
     app, e = make_app(start.root, start.rotations, mode=RagdollMode.ANIMATED)
     _animate(app, e, walk_clip)

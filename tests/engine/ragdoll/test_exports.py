@@ -7,10 +7,27 @@ import engine.ragdoll as ragdoll
 
 def test_public_surface() -> None:
     expected = {
-        "RagdollProfile", "default_profile", "build_mjcf", "PhysicsWorld", "Ragdoll", "RagdollMode", "Prop",
-        "SNOW_DENSITY", "blend_poses", "max_rotation_jump", "GetUpBlend", "LyingOrientation", "lying_orientation",
-        "lying_heading", "settled", "update_settle", "pick_get_up_clip", "physics_step", "install_physics",
-        "install", "spawn_snowball",
+        "RagdollProfile",
+        "default_profile",
+        "build_mjcf",
+        "PhysicsWorld",
+        "Ragdoll",
+        "RagdollMode",
+        "Prop",
+        "SNOW_DENSITY",
+        "blend_poses",
+        "max_rotation_jump",
+        "GetUpBlend",
+        "LyingOrientation",
+        "lying_orientation",
+        "lying_heading",
+        "settled",
+        "update_settle",
+        "pick_get_up_clip",
+        "physics_step",
+        "install_physics",
+        "install",
+        "spawn_snowball",
     }
     assert set(ragdoll.__all__) == expected
     for name in ragdoll.__all__:

@@ -66,12 +66,16 @@ def test_blend_never_pops(skeleton, get_up_clips: dict[str, Clip]) -> None:  # t
     # aligned with the body: same heading and place, ends in the clip's last (idle) frame
     assert lying_heading(frames[g.blend_frames].rotations[0]) == pytest.approx(lying_heading(start_rot[0]))
     np.testing.assert_allclose(frames[-1].rotations[1:], clip.rotations[-1, 1:], atol=1e-9)
-    np.testing.assert_allclose(frames[-1].root[[0, 2]] - start.root[[0, 2]],
-                               quat.rotate(g.heading(), clip.root[-1] - clip.root[0])[[0, 2]], atol=1e-9)
+    np.testing.assert_allclose(
+        frames[-1].root[[0, 2]] - start.root[[0, 2]],
+        quat.rotate(g.heading(), clip.root[-1] - clip.root[0])[[0, 2]],
+        atol=1e-9,
+    )
 
 
-def test_drop_settle_and_get_up(make_app: Callable[..., tuple[App, int]], get_up_clips: dict[str, Clip],
-                                idle_rotations: np.ndarray) -> None:
+def test_drop_settle_and_get_up(
+    make_app: Callable[..., tuple[App, int]], get_up_clips: dict[str, Clip], idle_rotations: np.ndarray
+) -> None:
     tilt = quat.identity(17)
     tilt[0] = quat.from_axis_angle(X, -0.35)
     app, e = make_app(np.array([0.0, 1.95, 0.0]), tilt)

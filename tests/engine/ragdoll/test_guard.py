@@ -26,8 +26,9 @@ def test_speeds_are_bounded_before_mujoco_sees_them(make_app: Callable[..., tupl
     assert app.world.get(ball, Transform).position[0] < 5.0 + MAX_LINEAR * app.world.dt + 1e-9
 
 
-def test_a_step_mujoco_cannot_take_is_undone_and_counted(make_app: Callable[..., tuple[App, int]],
-                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_step_mujoco_cannot_take_is_undone_and_counted(
+    make_app: Callable[..., tuple[App, int]], monkeypatch: pytest.MonkeyPatch
+) -> None:
     app, e = make_app(mode=RagdollMode.LIMP)
     app.run_steps(3)
     pw = app.world.resource(PhysicsWorld)
@@ -47,8 +48,9 @@ def test_a_step_mujoco_cannot_take_is_undone_and_counted(make_app: Callable[...,
     assert pw.recoveries == 1 and np.isfinite(pw.data.qpos).all()
 
 
-def test_a_mujoco_warning_is_caught_not_printed(make_app: Callable[..., tuple[App, int]],
-                                                capfd: pytest.CaptureFixture[str]) -> None:
+def test_a_mujoco_warning_is_caught_not_printed(
+    make_app: Callable[..., tuple[App, int]], capfd: pytest.CaptureFixture[str]
+) -> None:
     app, e = make_app(mode=RagdollMode.LIMP)
     app.step()
     pw = app.world.resource(PhysicsWorld)
@@ -66,7 +68,7 @@ def test_a_nan_target_never_reaches_mujoco(make_app: Callable[..., tuple[App, in
         app.run_steps(2)
         pw = app.world.resource(PhysicsWorld)
 
-        def poison(world) -> None:  # type: ignore[no-untyped-def]
+        def poison(world, e=e) -> None:  # type: ignore[no-untyped-def]
             world.get(e, LocalPose).rotations[3] = np.nan
 
         app.add_system("ik", poison)
@@ -76,8 +78,9 @@ def test_a_nan_target_never_reaches_mujoco(make_app: Callable[..., tuple[App, in
         assert pw.data is None or np.isfinite(pw.data.qpos).all()
 
 
-def test_two_puppets_on_one_spot_separate_without_exploding(make_app: Callable[..., tuple[App, int]],
-                                                            skeleton: Skeleton) -> None:
+def test_two_puppets_on_one_spot_separate_without_exploding(
+    make_app: Callable[..., tuple[App, int]], skeleton: Skeleton
+) -> None:
     app, a = make_app(mode=RagdollMode.LIMP)
     rd = Ragdoll(default_profile(skeleton))
     rd.set_mode(RagdollMode.LIMP, immediate=True)

@@ -52,8 +52,9 @@ def test_a_lone_animated_puppet_is_not_simulated(make_app: Callable[..., tuple[A
     assert abs(pw.root_velocity(e)[2] - 1.2) < 0.1  # its target's velocity
 
 
-def test_an_animated_puppet_still_shoves_a_ball_in_its_way(make_app: Callable[..., tuple[App, int]],
-                                                           walk_clip: Clip) -> None:
+def test_an_animated_puppet_still_shoves_a_ball_in_its_way(
+    make_app: Callable[..., tuple[App, int]], walk_clip: Clip
+) -> None:
     start = walk_clip.sample(0.0)
     app, e = make_app(start.root, start.rotations, mode=RagdollMode.ANIMATED)
     _walk_along_z(app, e, walk_clip, 1.2)

@@ -64,11 +64,10 @@ def test_a_parked_slot_stays_where_it_was_parked(skeleton: Skeleton) -> None:
         b0 = m.tree_bodyadr[t]
         j = np.nonzero(m.jnt_bodyid == b0)[0][0]
         q = m.jnt_qposadr[j]
-        np.testing.assert_array_equal(d.qpos[q:q + 7], before[q:q + 7])
+        np.testing.assert_array_equal(d.qpos[q : q + 7], before[q : q + 7])
 
 
-def test_the_pool_grows_once_when_more_fall_at_once(skeleton: Skeleton,
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_pool_grows_once_when_more_fall_at_once(skeleton: Skeleton, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(building_module, "INITIAL", 4)
     pw = _crowd(skeleton, 10)
     _drive(pw, skeleton, set())
@@ -121,8 +120,6 @@ def test_a_crowd_standing_steps_no_mujoco_at_all(skeleton: Skeleton) -> None:
     _drive(pw, skeleton, {2})
     pw.step()
     assert pw.data.time == pytest.approx(t + pw.dt)
-
-
 
 
 def test_a_ragdoll_that_falls_again_lands_on_the_ground(skeleton: Skeleton) -> None:

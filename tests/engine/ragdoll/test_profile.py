@@ -28,7 +28,7 @@ def test_configurable_radii_and_masses(skeleton: Skeleton) -> None:
     pr = default_profile(skeleton, masses=masses).with_radii(np.full(skeleton.num_joints, 0.03))
     np.testing.assert_allclose(pr.masses, masses)
     m = mujoco.MjModel.from_xml_string(build_mjcf([RagdollSpec(1, skeleton, pr, skeleton.offsets)], [], 1 / 480))
-    np.testing.assert_allclose(m.body_mass[1:1 + skeleton.num_joints], masses)
+    np.testing.assert_allclose(m.body_mass[1 : 1 + skeleton.num_joints], masses)
     assert np.allclose(m.geom_size[1:, 0], 0.03)
 
 
@@ -71,8 +71,9 @@ def test_self_collision_only_where_it_helps(skeleton: Skeleton) -> None:
 
 def test_two_ragdolls_collide_with_each_other(skeleton: Skeleton) -> None:
     pr = default_profile(skeleton)
-    xml = build_mjcf([RagdollSpec(1, skeleton, pr, skeleton.offsets), RagdollSpec(2, skeleton, pr, skeleton.offsets)],
-                     [], 1 / 480)
+    xml = build_mjcf(
+        [RagdollSpec(1, skeleton, pr, skeleton.offsets), RagdollSpec(2, skeleton, pr, skeleton.offsets)], [], 1 / 480
+    )
     m = mujoco.MjModel.from_xml_string(xml)
     pairs = {(int(a), int(b)) for a, b in zip(m.exclude_signature >> 16, m.exclude_signature & 0xFFFF)}
     hips1, hips2 = m.body("rd1_hips").id, m.body("rd2_hips").id
@@ -84,9 +85,13 @@ def test_any_skeleton_becomes_a_stable_ragdoll() -> None:
     from engine import quat
     from engine.ragdoll import PhysicsWorld
 
-    chain = Skeleton(("root", "a", "b", "c"), np.array([-1, 0, 1, 2]),
-                     np.array([[0, 1.5, 0], [0, 0.3, 0], [0.2, 0.2, 0], [0, 0.25, 0]]),
-                     np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0.15, 0]]), np.full(4, 0.06))
+    chain = Skeleton(
+        ("root", "a", "b", "c"),
+        np.array([-1, 0, 1, 2]),
+        np.array([[0, 1.5, 0], [0, 0.3, 0], [0.2, 0.2, 0], [0, 0.25, 0]]),
+        np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0.15, 0]]),
+        np.full(4, 0.06),
+    )
     pr = default_profile(chain, total_mass=5.0)
     assert pr.kinds == ("free", "ball", "ball", "ball") and pr.holdable == ("root",)
     pw = PhysicsWorld()

@@ -48,7 +48,7 @@ def test_let_go_in_mid_air_falls_settles_and_gets_up() -> None:
             getup_rot.append(w.get(e, LocalPose).rotations.copy())
             blend = w.get(e, GettingUp).blend or blend
         before = w.get(e, LocalPose).rotations.copy()
-        if 90 <= i and active == "Ragdoll":
+        if i >= 90 and active == "Ragdoll":
             lowest = min(lowest, float(pw.body_positions(e)[:, 1].min()))
         if trace[-1][1] != "GetUp" and len(trace) > 2 and trace[-2][1] == "GetUp":
             break

@@ -88,8 +88,10 @@ def test_rough_play_never_breaks_the_physics() -> None:
     install_puppets(app)
     w = app.world
     puppets = [spawn_puppet(w, (2.0 * i - 3.0, 0.0, 0.0), float(rng.uniform(-3, 3))) for i in range(4)]
-    balls = [spawn_snowball(w, [rng.uniform(-5, 5), 0.3, rng.uniform(-5, 5)], float(rng.uniform(0.12, 0.35)))
-             for _ in range(8)]
+    balls = [
+        spawn_snowball(w, [rng.uniform(-5, 5), 0.3, rng.uniform(-5, 5)], float(rng.uniform(0.12, 0.35)))
+        for _ in range(8)
+    ]
     since: dict[int, tuple[str, float]] = {}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PhysicsRecovery)

@@ -37,8 +37,9 @@ def test_only_the_solids_in_view_are_drawn_and_the_picture_is_the_same(monkeypat
     monkeypatch.setattr(Impostors, "draw", lambda self, rows, eye: (drawn.append(len(rows)), lit(self, rows, eye))[1])
     uploads = []
     upload = R.LodBatches.upload
-    monkeypatch.setattr(R.LodBatches, "upload",
-                        lambda self, rows, lv: (uploads.append(len(rows)), upload(self, rows, lv))[1])
+    monkeypatch.setattr(
+        R.LodBatches, "upload", lambda self, rows, lv: (uploads.append(len(rows)), upload(self, rows, lv))[1]
+    )
     images = []
     for cull in (True, False):
         if not cull:

@@ -59,7 +59,7 @@ def test_a_tree_has_the_pointed_silhouette_of_a_conifer(gl):
     widest = width.max()
     # Pointed: the top tenth of the tree is a narrow spire (round tiers, the old "green
     # snowman", were half as wide as the tree there).
-    spire = width[top: top + (bottom - top) // 10]
+    spire = width[top : top + (bottom - top) // 10]
     assert spire.max() < 0.2 * widest
     # Whorls: going down, the width grows, then steps back in where a tier's skirt ends
     # above the next tier (at least two such steps).
@@ -94,7 +94,7 @@ def test_a_rolled_ball_leaves_a_soft_continuous_groove(gl):
     # Across it (a column through the middle) the shade comes and goes over several pixels:
     # soft edges, no pixel-to-pixel jump of more than a third of the groove's depth.
     x0, y0 = px[20]
-    column = darker[max(y0 - 30, 0): y0 + 30, x0]
+    column = darker[max(y0 - 30, 0) : y0 + 30, x0]
     assert np.abs(np.diff(column)).max() < 0.35 * (column.max() - column.min())
     # Fresh snow beside the track is untouched.
     beside = np.round(cam.project(np.array([[0.0, 0.0, 1.2]]), W, H)).astype(int)[0]
@@ -122,6 +122,6 @@ def test_the_horizon_is_a_line_one_can_see(gl):
     horizon = int(np.round(cam.project(np.array([[0.0, 0.0, -1e4]]), W, H)[0, 1]))
     assert 10 < horizon < H - 10
     # Just above the far snow, the ridge's forest is a dark band between sky and snow.
-    band = rows[horizon - 12: horizon + 2].min()
+    band = rows[horizon - 12 : horizon + 2].min()
     assert rows[: horizon - 25].mean() - band > 40  # sky above is far brighter
-    assert rows[horizon + 20:].mean() - band > 40  # and so is the snow below
+    assert rows[horizon + 20 :].mean() - band > 40  # and so is the snow below

@@ -70,8 +70,11 @@ def test_props_by_shape():
     world = World()
     world.spawn(Transform(position=np.array([1.0, 0.3, 0.0]), scale=2.0), Shape.sphere(0.25))
     rot = quat.from_axis_angle([0, 0, 1], np.pi / 2)
-    world.spawn(Transform(position=np.array([0.0, 1.0, 0.0]), rotation=rot), Shape.capsule(0.1, 0.5),
-                Appearance(color=(0.0, 1.0, 0.0)))
+    world.spawn(
+        Transform(position=np.array([0.0, 1.0, 0.0]), rotation=rot),
+        Shape.capsule(0.1, 0.5),
+        Appearance(color=(0.0, 1.0, 0.0)),
+    )
     world.spawn(Transform(position=np.array([0.0, 0.5, 2.0])), Shape.box([0.2, 0.5, 0.3]))
     scene = scene_from_world(world, 1.0)
     sph = scene.spheres.data
@@ -101,7 +104,7 @@ def test_shape_and_appearance_validation():
     with pytest.raises(ValueError):
         Shape.sphere(-1.0)
     with pytest.raises(AttributeError):
-        Shape.box([1, 1, 1]).radius
+        Shape.box([1, 1, 1]).radius  # noqa: B018  # the access itself must raise
     with pytest.raises(ValueError):
         Appearance(color=(2.0, 0.0, 0.0))
     s = Shape.sphere(0.2)

@@ -4,8 +4,8 @@ import moderngl
 import numpy as np
 import pytest
 
-from puppetphone.bench.render import demo_scene
 from engine.render.headless import egl_available
+from puppetphone.bench.render import demo_scene
 
 _reason = egl_available()
 pytestmark = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
@@ -30,8 +30,9 @@ def test_draw_calls_do_not_grow_with_the_number_of_puppets(monkeypatch):
             scene.texts.clear()
             # Every limb at the same level of detail, so both scenes use the same meshes.
             viewer.camera = camera
-            viewer.renderer.quality = viewer.renderer.quality.__class__(**{**vars(viewer.renderer.quality),
-                                                                           "silhouette_px": 1e6})
+            viewer.renderer.quality = viewer.renderer.quality.__class__(
+                **{**vars(viewer.renderer.quality), "silhouette_px": 1e6}
+            )
             calls.append(0)
             viewer.draw(scene)
             counts[n] = calls[-1]

@@ -45,9 +45,9 @@ def _centre(gl, scene) -> np.ndarray:
 
 def test_a_placed_overlay_is_behind_nearer_things_and_in_front_of_farther_ones(gl) -> None:
     at = (0.0, 0.0, 0.0)
-    near = _centre(gl, _scene(2.0, at))      # the box is nearer the camera than the picture
-    far = _centre(gl, _scene(-2.0, at))      # the box is behind it
-    assert near[1] < 120 and near[0] > 120   # magenta box
+    near = _centre(gl, _scene(2.0, at))  # the box is nearer the camera than the picture
+    far = _centre(gl, _scene(-2.0, at))  # the box is behind it
+    assert near[1] < 120 and near[0] > 120  # magenta box
     assert abs(far[1] - GREEN[1]) < 30 and far[0] < 80  # the picture's green
 
 

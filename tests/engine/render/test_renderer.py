@@ -73,14 +73,14 @@ def test_sphere_shadow_darkens_the_ground(gl):
     dark = draw(gl, shadowed, cam)
     L = np.array(base.sun.direction) / np.linalg.norm(base.sun.direction)
     on_ground = centre - L * centre[1] / L[1]
-    (x, y), = np.round(cam.project([on_ground], W, H)).astype(int)
+    ((x, y),) = np.round(cam.project([on_ground], W, H)).astype(int)
     # the shadow spot is not covered by the sphere itself in this view
-    (sx, sy), = cam.project([centre], W, H)
+    ((sx, sy),) = cam.project([centre], W, H)
     assert np.hypot(x - sx, y - sy) > 25
     lum_lit, lum_dark = lit[y, x].sum(), dark[y, x].sum()
     assert lum_dark < 0.8 * lum_lit, (lum_lit, lum_dark)
     # Soft edge: half way out of the umbra is between shadow and light.
-    (ex, ey), = np.round(cam.project([on_ground + [0.0, 0.0, 0.6]], W, H)).astype(int)
+    ((ex, ey),) = np.round(cam.project([on_ground + [0.0, 0.0, 0.6]], W, H)).astype(int)
     assert dark[ey, ex].sum() > lum_dark
 
 
@@ -92,7 +92,7 @@ def test_shadows_can_be_switched_off(gl):
     with_shadow = draw(gl, s, cam)
     s.sun.shadows = False
     without = draw(gl, s, cam)
-    (x, y), = np.round(cam.project([[0.0, 0.0, 0.0]], W, H)).astype(int)
+    ((x, y),) = np.round(cam.project([[0.0, 0.0, 0.0]], W, H)).astype(int)
     assert with_shadow[y, x].sum() < without[y, x].sum() - 30
 
 
@@ -107,7 +107,8 @@ def test_text_overlay_appears_where_placed(gl):
     assert len(xs) > 50
     assert xs.min() >= 20 and ys.min() >= 200 and ys.max() < 200 + 30
     assert gl.renderer.text.texture("FPS 60  walk", 28, (1.0, 0.1, 0.1)) is gl.renderer.text.texture(
-        "FPS 60  walk", 28, (1.0, 0.1, 0.1))  # cached per string
+        "FPS 60  walk", 28, (1.0, 0.1, 0.1)
+    )  # cached per string
 
 
 def test_outline_rims_the_highlighted_capsule(gl):
@@ -168,8 +169,8 @@ def test_objects_receive_shadows_from_objects(gl):
     covered.sun.direction = table.sun.direction
     covered.add_box([0.0, 0.25, 0.0], [1.0, 0.25, 1.0], color=(0.8, 0.8, 0.8))
     covered.add_sphere([0.0, 1.6, 0.0], 0.3)
-    (x, y), = np.round(cam.project([[0.0, 0.5, 0.0]], W, H)).astype(int)
-    (sx, sy), = cam.project([[0.0, 1.6, 0.0]], W, H)
+    ((x, y),) = np.round(cam.project([[0.0, 0.5, 0.0]], W, H)).astype(int)
+    ((sx, sy),) = cam.project([[0.0, 1.6, 0.0]], W, H)
     assert np.hypot(x - sx, y - sy) > 20  # the spot under the sphere is visible
     assert draw(gl, covered, cam)[y, x].sum() < 0.85 * draw(gl, table, cam)[y, x].sum()
 
@@ -238,8 +239,8 @@ def test_a_thin_caster_shades_the_ground_steadily_even_when_the_shadow_mask_is_c
         scene.add_sphere([spread, 0.5, 0.0], 0.5)
         if x is not None:
             scene.add_capsule([x, 0.6, -0.3], [x, 0.6, 0.3], 0.04)
-        (px, py), = np.round(cam.project([[0.0 if x is None else x, 0.0, 0.2]], W, H)).astype(int)
-        return draw(gl, scene, cam)[py - 2:py + 3, px - 2:px + 3].sum(axis=2).mean()
+        ((px, py),) = np.round(cam.project([[0.0 if x is None else x, 0.0, 0.2]], W, H)).astype(int)
+        return draw(gl, scene, cam)[py - 2 : py + 3, px - 2 : px + 3].sum(axis=2).mean()
 
     for spread, least in ((10.0, 0.05), (1.0, 0.25)):
         plain = ground_under_forearm(spread, None)
@@ -262,7 +263,7 @@ def test_a_ball_does_not_shadow_its_own_sunlit_side(gl, distance):
         scene.add_sphere([0.0, 0.6, 0.0], 0.5)
         scene.add_sphere([-2.0, 0.3, 3.0], 0.3)  # a second caster widens the shadow map
         images.append(draw(gl, scene, cam))
-    (cx, cy), = np.round(cam.project([[0.0, 0.6, 0.0]], W, H)).astype(int)
+    ((cx, cy),) = np.round(cam.project([[0.0, 0.6, 0.0]], W, H)).astype(int)
     radius_px = 0.5 * H / (2 * np.tan(np.radians(cam.fov_y) / 2)) / distance
     yy, xx = np.mgrid[0:H, 0:W]
     inner = np.hypot(xx - cx, yy - cy) < 0.6 * radius_px

@@ -53,9 +53,13 @@ def _reference_skin(path: Path, time: float) -> list[np.ndarray]:
                 else:
                     s = v
         w, x, y, z = r
-        rot = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+        rot = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
         m = np.eye(4)
         m[:3, :3] = rot * s
         m[:3, 3] = t
@@ -72,7 +76,7 @@ def _reference_skin(path: Path, time: float) -> list[np.ndarray]:
         v = np.concatenate([prim.positions.astype(np.float64), np.ones((len(prim.positions), 1))], axis=1)
         acc = np.zeros((len(v), 4))
         for k in range(4):
-            acc += prim.weights[:, k:k + 1].astype(np.float64) * np.einsum("vij,vj->vi", mats[prim.joints[:, k]], v)
+            acc += prim.weights[:, k : k + 1].astype(np.float64) * np.einsum("vij,vj->vi", mats[prim.joints[:, k]], v)
         out.append(acc[:, :3])
     return out
 
@@ -122,7 +126,7 @@ def test_a_textured_character_shows_where_the_camera_projects_it(gl, mocap_dir: 
     colours = image[changed].reshape(-1, 3) // 16
     assert len(np.unique(colours, axis=0)) > 40
     # Nothing drawn far to the side of the figure.
-    assert not changed[:, : W // 8].any() and not changed[:, -W // 8:].any()
+    assert not changed[:, : W // 8].any() and not changed[:, -W // 8 :].any()
 
 
 def test_a_character_casts_its_shadow_on_the_ground(gl, mocap_dir: Path) -> None:

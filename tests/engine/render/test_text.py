@@ -15,8 +15,10 @@ from engine.render.text import MARGIN, PAD_X, PAD_Y, TextCache, layout_text
 from puppetphone.overlay import COLORS
 
 W, H = 320, 240
-LONG = ("mouse: press on the puppet (or a snowball) to grab it, drag to walk or run it, release to let go; "
-        "see https://example.invalid/a-very-long-address-without-any-spaces-in-it-at-all")
+LONG = (
+    "mouse: press on the puppet (or a snowball) to grab it, drag to walk or run it, release to let go; "
+    "see https://example.invalid/a-very-long-address-without-any-spaces-in-it-at-all"
+)
 _reason = egl_available()
 needs_gl = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
 
@@ -41,8 +43,13 @@ def test_wrap_keeps_every_piece_within_the_width_and_every_word():
 
 def test_layout_stacks_wraps_and_keeps_centred_lines_inside():
     cache = font_only()
-    lines = [TextLine("first", size=18), TextLine(LONG, size=18), TextLine("after", size=18),
-             TextLine("notice " * 20, size=40, anchor=(0.5, 0.3)), TextLine("corner", size=18, anchor=(1.0, 1.0))]
+    lines = [
+        TextLine("first", size=18),
+        TextLine(LONG, size=18),
+        TextLine("after", size=18),
+        TextLine("notice " * 20, size=40, anchor=(0.5, 0.3)),
+        TextLine("corner", size=18, anchor=(1.0, 1.0)),
+    ]
     placed = layout_text(lines, (W, H), cache)
     left = [p for p in placed if p.size == 18 and p.text != "corner"]
     assert left[0].text == "first" and left[-1].text == "after"
@@ -50,8 +57,8 @@ def test_layout_stacks_wraps_and_keeps_centred_lines_inside():
     assert [p.y for p in left] == sorted(p.y for p in left)  # stacked in order, wrapped pieces between
     for p in placed:
         w, h = cache.measure(p.text, p.size)
-        assert MARGIN <= p.x and p.x + w <= W - MARGIN, p
-        assert MARGIN <= p.y and p.y + h <= H - MARGIN, p
+        assert p.x >= MARGIN and p.x + w <= W - MARGIN, p
+        assert p.y >= MARGIN and p.y + h <= H - MARGIN, p
     big = [p for p in placed if p.size == 40]
     assert len(big) > 1 and all(abs(p.x + cache.measure(p.text, 40)[0] / 2 - W / 2) <= 1 for p in big)
     (corner,) = [p for p in placed if p.text == "corner"]
@@ -106,9 +113,9 @@ def glyph_masks(text, size):
     w, h = font_only().measure(text, size)
     core = np.zeros((h, w), bool)
     near = np.zeros((h, w), bool)
-    core[PAD_Y:PAD_Y + ink.shape[0], PAD_X:PAD_X + ink.shape[1]] = ink > 250
+    core[PAD_Y : PAD_Y + ink.shape[0], PAD_X : PAD_X + ink.shape[1]] = ink > 250
     any_ink = np.zeros((h, w), bool)
-    any_ink[PAD_Y:PAD_Y + ink.shape[0], PAD_X:PAD_X + ink.shape[1]] = ink > 0
+    any_ink[PAD_Y : PAD_Y + ink.shape[0], PAD_X : PAD_X + ink.shape[1]] = ink > 0
     for dy in range(-2, 3):
         for dx in range(-2, 3):
             near |= np.roll(np.roll(any_ink, dy, 0), dx, 1)

@@ -14,8 +14,12 @@ def test_parabola_passes_both_points_with_the_slope():
 
 
 def test_apex_of_a_true_parabola_is_exact_from_any_point():
-    true = lambda x: -2.0 * (x - 1.0) ** 2 + 1.5  # apex (1, 1.5), starts at (0, -0.5)
-    slope = lambda x: -4.0 * (x - 1.0)
+    def true(x):
+        return -2.0 * (x - 1.0) ** 2 + 1.5  # apex (1, 1.5), starts at (0, -0.5)
+
+    def slope(x):
+        return -4.0 * (x - 1.0)
+
     for xt in (0.2, 0.7, 1.4):
         p = fit_parabola(0.0, true(0.0), xt, true(xt), slope(xt))
         assert p.apex == pytest.approx((1.0, 1.5))

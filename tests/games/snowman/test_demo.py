@@ -65,8 +65,9 @@ def demo(tmp_path_factory: pytest.TempPathFactory) -> DemoRun:
     out, err = io.StringIO(), io.StringIO()
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         mp.setattr(App, "step", watched)
-        run.code = main(["replay", str(DEMO_PATH), "--verify", "--headless", "--size", "320x180",
-                         "--screenshot", str(shot)])
+        run.code = main(
+            ["replay", str(DEMO_PATH), "--verify", "--headless", "--size", "320x180", "--screenshot", str(shot)]
+        )
     run.out, run.err = out.getvalue(), err.getvalue()
     return run
 
@@ -104,9 +105,25 @@ def test_play_replay_demo_names_the_shipped_recording(tmp_path: Path) -> None:
     replay is checked above), in a fresh interpreter as a user types it."""
     shot = tmp_path / "first.png"
     done = subprocess.run(
-        [sys.executable, "-m", "puppetphone", "play", "snowman", "--source", "replay:demo", "--headless",
-         "--frames", "60", "--size", "160x90", "--screenshot", str(shot)],
-        capture_output=True, text=True, timeout=600,
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "play",
+            "snowman",
+            "--source",
+            "replay:demo",
+            "--headless",
+            "--frames",
+            "60",
+            "--size",
+            "160x90",
+            "--screenshot",
+            str(shot),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert done.returncode == 0, done.stderr[-2000:]
     assert "ran 60 steps of snowman" in done.stdout, done.stdout

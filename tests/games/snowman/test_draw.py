@@ -50,7 +50,9 @@ def test_a_snowman_is_drawn_on_its_joints(shape):
     coal = rows_with_color(spheres, (0.08, 0.08, 0.09))
     assert len(coal) == 2 + (3 if shape.middle else 0) + 2 and not np.any(coal[:, 10])
     # The carrot points the way the snowman faces (+x after a quarter turn about y).
-    (nose,) = [r for r in rows_with_color(capsules, (0.95, 0.45, 0.1)) if np.linalg.norm(r[0:3] - pos[sk.index("head")]) < 1.0]
+    (nose,) = [
+        r for r in rows_with_color(capsules, (0.95, 0.45, 0.1)) if np.linalg.norm(r[0:3] - pos[sk.index("head")]) < 1.0
+    ]
     assert nose[3] - nose[0] > 0.5 * shape.head
     # Twig arms end beyond the hands; legs start at the thighs.
     twigs = rows_with_color(capsules, (0.35, 0.22, 0.12))

@@ -58,8 +58,9 @@ def _same(a: dict, b: dict) -> None:
     assert a["stats"] == b["stats"] and a["snow"] == b["snow"]
     assert [(x["radius"], x["on"]) for x in a["balls"]] == [(x["radius"], x["on"]) for x in b["balls"]]
     assert np.allclose([x["position"] for x in a["balls"]], [x["position"] for x in b["balls"]], atol=1e-9)
-    assert [(s["number"], s["bottom"], s["middle"], s["head"]) for s in a["snowmen"]] == \
-        [(s["number"], s["bottom"], s["middle"], s["head"]) for s in b["snowmen"]]
+    assert [(s["number"], s["bottom"], s["middle"], s["head"]) for s in a["snowmen"]] == [
+        (s["number"], s["bottom"], s["middle"], s["head"]) for s in b["snowmen"]
+    ]
     assert np.allclose([s["position"] for s in a["snowmen"]], [s["position"] for s in b["snowmen"]], atol=1e-9)
 
 
@@ -118,7 +119,9 @@ def test_keys_save_reset_and_restore(tmp_path: Path, field_file: Path) -> None:
         hub.command("explode")
 
 
-def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file(tmp_path: Path, field_file: Path) -> None:
+def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file(
+    tmp_path: Path, field_file: Path
+) -> None:
     field_file.write_text(json.dumps(snapshot(_built_field().world)))
     hub = InputHub()
     setup = load_game("snowman").prepare({"field": ""})
@@ -137,7 +140,11 @@ def test_a_recorded_session_restoring_the_field_on_disk_replays_without_the_file
     assert rec.header.setup["field"] is not None
     replayed = load_game("snowman").replay_setup(rec.header.setup)
     seen = []
-    result = verify(lambda h: make_app("snowman", 3, h, replayed), rec, on_step=lambda a, i: seen.append(len(a.world.query(Snowball))))
+    result = verify(
+        lambda h: make_app("snowman", 3, h, replayed),
+        rec,
+        on_step=lambda a, i: seen.append(len(a.world.query(Snowball))),
+    )
     assert result.ok, result.message()
     assert seen[-1] == 3 and 0 in seen and not field_file.exists()  # restored, reset, restored; nothing written
 
@@ -161,8 +168,12 @@ def test_each_command_tells_the_player_on_screen_without_touching_the_hash() -> 
     app = make_app("snowman", 3, hub)
     app.run_steps(3)
     assert app.world.try_resource(Notice) is None
-    for kind, text in [(RESTORE, "nothing saved to restore (F5 saves the field)"), (SAVE, "field saved"),
-                       (RESTORE, "field restored"), (RESET, "new field")]:
+    for kind, text in [
+        (RESTORE, "nothing saved to restore (F5 saves the field)"),
+        (SAVE, "field saved"),
+        (RESTORE, "field restored"),
+        (RESET, "new field"),
+    ]:
         hub.command(kind)
         app.step()
         notice = app.world.resource(Notice)
@@ -185,18 +196,21 @@ def _zlib_bomb(snap: dict) -> None:
     snap["snow"]["zlib_f8"] = base64.b64encode(zlib.compress(bytes(64 << 20), 9)).decode()
 
 
-@pytest.mark.parametrize("edit,says", [
-    (lambda s: s["snowmen"][0].pop("heading"), "snowman heading"),  # used to raise after the field was cleared
-    (lambda s: s["snowmen"][0].update(heading=float("nan")), "snowman heading"),
-    (lambda s: s["puppets"][0].update(heading=float("inf")), "puppet heading"),
-    (lambda s: s["balls"][0].pop("snow"), "ball snow"),
-    (lambda s: s["balls"][0].update(position=[1e308, 0.0, 0.0]), "within"),
-    (lambda s: s["balls"][0].update(on=0), "ring"),
-    (lambda s: s["balls"].extend([dict(s["balls"][0], on=None)] * 1000), "at most"),
-    (lambda s: s["snowmen"][0].update(number=True), "number"),
-    (lambda s: s.update(stats=[]), "stats"),
-    (_zlib_bomb, "snow grid"),
-])
+@pytest.mark.parametrize(
+    "edit,says",
+    [
+        (lambda s: s["snowmen"][0].pop("heading"), "snowman heading"),  # used to raise after the field was cleared
+        (lambda s: s["snowmen"][0].update(heading=float("nan")), "snowman heading"),
+        (lambda s: s["puppets"][0].update(heading=float("inf")), "puppet heading"),
+        (lambda s: s["balls"][0].pop("snow"), "ball snow"),
+        (lambda s: s["balls"][0].update(position=[1e308, 0.0, 0.0]), "within"),
+        (lambda s: s["balls"][0].update(on=0), "ring"),
+        (lambda s: s["balls"].extend([dict(s["balls"][0], on=None)] * 1000), "at most"),
+        (lambda s: s["snowmen"][0].update(number=True), "number"),
+        (lambda s: s.update(stats=[]), "stats"),
+        (_zlib_bomb, "snow grid"),
+    ],
+)
 def test_a_bad_field_is_refused_whole_before_anything_changes(edit, says) -> None:  # type: ignore[no-untyped-def]
     app = _built_field()
     before = snapshot(app.world)
@@ -216,7 +230,8 @@ def test_a_deeply_nested_save_file_is_set_aside(field_file: Path, capsys: pytest
 
 
 def test_a_bad_file_is_set_aside_beside_an_existing_bad_without_replacing_it(
-        field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    field_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     snap = _edited(start_snapshot(), lambda s: s["puppets"][0].update(heading=float("nan")))
     field_file.write_text(json.dumps(snap))
     blocker = Path(str(field_file) + ".bad")
@@ -229,11 +244,14 @@ def test_a_bad_file_is_set_aside_beside_an_existing_bad_without_replacing_it(
     app.run_steps(3)
 
 
-@pytest.mark.parametrize("make", [
-    lambda p: (p.mkdir(), (p / "notes.txt").write_text("mine")),  # a user's folder
-    lambda p: p.write_text("my shopping list\n"),  # a user's text file
-    lambda p: p.write_text("[" * 100_000),  # not JSON a field ever was
-])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda p: (p.mkdir(), (p / "notes.txt").write_text("mine")),  # a user's folder
+        lambda p: p.write_text("my shopping list\n"),  # a user's text file
+        lambda p: p.write_text("[" * 100_000),  # not JSON a field ever was
+    ],
+)
 def test_a_field_path_holding_something_else_is_refused_and_left_untouched(field_file: Path, make) -> None:  # type: ignore[no-untyped-def]
     from games.base import GameOptionError
 
@@ -257,7 +275,9 @@ def test_a_pipe_as_field_is_refused_and_never_renamed(tmp_path: Path) -> None:
     assert stat.S_ISFIFO(pipe.lstat().st_mode) and not Path(f"{pipe}.bad").exists()
 
 
-def test_a_failed_f5_says_so_keeps_playing_and_keeps_the_field(field_file: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_failed_f5_says_so_keeps_playing_and_keeps_the_field(
+    field_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     from games.common import Notice
 
     hub = InputHub()
@@ -284,8 +304,9 @@ def test_a_replay_whose_header_carries_a_bad_field_plays_on(tmp_path: Path) -> N
     hub = InputHub()
     app = make_app("snowman", 3, hub)
     rec_path = tmp_path / "s.rec"
-    recorder = Recorder(rec_path, RecordingHeader(game="snowman", seed=3, dt=app.world.dt,
-                                                  setup={"field": bad})).attach(app)
+    recorder = Recorder(
+        rec_path, RecordingHeader(game="snowman", seed=3, dt=app.world.dt, setup={"field": bad})
+    ).attach(app)
     hub.command(RESTORE)
     app.run_steps(5)
     recorder.close()

@@ -30,7 +30,7 @@ def _set_foot(sk, wp, name, x, height):
 def test_a_foot_coming_down_leaves_one_print_under_it_pointing_along_the_toes():
     world, sk, wp = _walker()
     r = float(sk.radii[sk.index("l_foot")])
-    for step, (x, up) in enumerate([(0.0, False), (0.2, True), (0.4, False), (0.4, False), (0.6, True), (0.8, False)]):
+    for _step, (x, up) in enumerate([(0.0, False), (0.2, True), (0.4, False), (0.4, False), (0.6, True), (0.8, False)]):
         _set_foot(sk, wp, "l_foot", x, (3.0 if up else 1.0) * r)
         _set_foot(sk, wp, "r_foot", 0.0, 5.0 * r)  # the other foot stays in the air
         leave_footprints(world)

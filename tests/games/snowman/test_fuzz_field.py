@@ -55,21 +55,41 @@ def test_fuzz_field_files(app, campaign, mutations, fuzz_budget, tmp_path):
     assert restored > 0, "no accepted field could be restored: the campaign checked only refusals"
 
 
-numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10, 10**6), st.booleans(),
-                    st.none(), st.text(max_size=3))
+numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-10, 10**6),
+    st.booleans(),
+    st.none(),
+    st.text(max_size=3),
+)
 vec = st.one_of(st.lists(st.floats(-50, 50), min_size=3, max_size=3), st.lists(numbers, max_size=4), numbers)
-ball = st.fixed_dictionaries({"position": vec, "radius": st.one_of(st.floats(0.05, 1.0), numbers),
-                              "snow": st.one_of(st.floats(0, 10), numbers),
-                              "on": st.one_of(st.none(), st.integers(-1, 5), numbers)})
-snowman = st.fixed_dictionaries({"number": st.one_of(st.integers(0, 9), numbers), "bottom": st.one_of(st.just(0.4), numbers),
-                                 "middle": st.one_of(st.just(0.3), st.none(), numbers),
-                                 "head": st.one_of(st.just(0.2), numbers), "position": vec,
-                                 "heading": st.one_of(st.floats(-7, 7), numbers)})
+ball = st.fixed_dictionaries(
+    {
+        "position": vec,
+        "radius": st.one_of(st.floats(0.05, 1.0), numbers),
+        "snow": st.one_of(st.floats(0, 10), numbers),
+        "on": st.one_of(st.none(), st.integers(-1, 5), numbers),
+    }
+)
+snowman = st.fixed_dictionaries(
+    {
+        "number": st.one_of(st.integers(0, 9), numbers),
+        "bottom": st.one_of(st.just(0.4), numbers),
+        "middle": st.one_of(st.just(0.3), st.none(), numbers),
+        "head": st.one_of(st.just(0.2), numbers),
+        "position": vec,
+        "heading": st.one_of(st.floats(-7, 7), numbers),
+    }
+)
 puppet = st.fixed_dictionaries({"position": vec, "heading": st.one_of(st.floats(-7, 7), numbers)})
 
 
-@given(st.lists(ball, max_size=5), st.lists(snowman, max_size=2), st.lists(puppet, min_size=0, max_size=2),
-       st.one_of(st.just({"built": 0, "balls_started": 0}), st.dictionaries(st.text(max_size=12), numbers)))
+@given(
+    st.lists(ball, max_size=5),
+    st.lists(snowman, max_size=2),
+    st.lists(puppet, min_size=0, max_size=2),
+    st.one_of(st.just({"built": 0, "balls_started": 0}), st.dictionaries(st.text(max_size=12), numbers)),
+)
 def test_fuzz_structured_fields_restore_whole_or_not_at_all(app, tmp_path_factory, balls, snowmen, puppets, stats):
     snap = {**start_snapshot(), "balls": balls, "snowmen": snowmen, "puppets": puppets, "stats": stats}
     path = Path(tmp_path_factory.mktemp("f")) / "field.json"

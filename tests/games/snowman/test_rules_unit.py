@@ -76,8 +76,9 @@ def test_a_smaller_ball_resting_on_a_bigger_one_packs_on_centred() -> None:
     assert w.get(small, Stacked).on == big
 
 
-@pytest.mark.parametrize("upper,rise,stacks", [(0.4, 0.0, False), (0.41, 0.0, False), (0.25, 0.49, True),
-                                               (0.25, 0.5, False)])
+@pytest.mark.parametrize(
+    "upper,rise,stacks", [(0.4, 0.0, False), (0.41, 0.0, False), (0.25, 0.49, True), (0.25, 0.5, False)]
+)
 def test_only_a_smaller_ball_not_bouncing_up_packs_on(upper: float, rise: float, stacks: bool) -> None:
     w = world()
     rules.spawn_ball(w, np.zeros(3), 0.4)
@@ -440,7 +441,7 @@ def test_a_stack_that_stands_still_long_enough_comes_alive(capsys: pytest.Captur
     rules.assemble_snowmen(w)
     assert not any(w.alive(e) for e in ids) and w.resource(SnowmanStats).built == 1
     assert w.resource(StackWatch).frames == {}
-    (e, man, body), = w.query(Snowman, PuppetBody)
+    ((e, man, body),) = w.query(Snowman, PuppetBody)
     assert (man.shape.bottom, man.shape.middle, man.shape.head) == (0.5, 0.35, 0.2) and man.number == 1
     assert body.heading == pytest.approx(float(np.arctan2(-3.0, -4.0)))  # it faces the middle of the field
     assert w.get(e, Grabbable).radius == pytest.approx(0.6)
@@ -460,7 +461,7 @@ def test_a_two_ball_snowman_needs_a_head_sized_top() -> None:
         rules.assemble_snowmen(w)
     assert all(w.alive(e) for e in headless) and not any(w.alive(e) for e in fine)
     assert w.resource(StackWatch).headless == 1
-    (_, man), = w.query(Snowman)
+    ((_, man),) = w.query(Snowman)
     assert man.shape.middle is None and (man.shape.bottom, man.shape.head) == (0.5, 0.3)
 
 
@@ -469,7 +470,7 @@ def test_a_snowman_near_the_middle_faces_forward() -> None:
     stack(w, [0.5, 0.3], x=0.3, z=0.3)
     for _ in range(rules.STILL_FRAMES):
         rules.assemble_snowmen(w)
-    (_, body), = w.query(PuppetBody)
+    ((_, body),) = w.query(PuppetBody)
     assert body.heading == 0.0
 
 
@@ -567,5 +568,5 @@ def test_a_snowman_a_metre_from_the_middle_faces_it() -> None:
     stack(w, [0.5, 0.3], x=0.6, z=0.8)
     for _ in range(rules.STILL_FRAMES):
         rules.assemble_snowmen(w)
-    (_, body), = w.query(PuppetBody)
+    ((_, body),) = w.query(PuppetBody)
     assert body.heading == pytest.approx(float(np.arctan2(-0.6, -0.8)))

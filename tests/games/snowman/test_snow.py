@@ -16,7 +16,10 @@ def test_segment_area_limits():
 def test_ball_grows_by_volume_and_slower_when_big():
     r1 = grow_radius(0.1, 1.0, 0.04)
     assert r1 > 0.1
-    v = lambda r: 4 / 3 * np.pi * r**3
+
+    def v(r):
+        return 4 / 3 * np.pi * r**3
+
     assert v(r1) - v(0.1) == pytest.approx(segment_area(0.1, 0.04) * 1.0)
     # The same metre adds less radius to a big ball.
     assert grow_radius(0.5, 1.0, 0.04) - 0.5 < r1 - 0.1

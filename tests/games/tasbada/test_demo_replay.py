@@ -12,8 +12,9 @@ from input.replay import verify
 DEMO = Path(__file__).resolve().parents[3] / "games" / "tasbada" / "demo.rec"
 
 
-def test_demo_replays_every_stage_in_order_with_matching_hashes(tmp_path: Path,
-                                                                 capsys: pytest.CaptureFixture[str]) -> None:
+def test_demo_replays_every_stage_in_order_with_matching_hashes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     from puppetphone.games import make_app
 
     rec = read_recording(DEMO)
@@ -47,14 +48,32 @@ def test_a_headless_replay_screenshot_shows_the_living_props_and_exits_cleanly(t
     if egl_available() is not None:
         pytest.skip(f"no EGL: {egl_available()}")
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path / "data")}
-    done = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(DEMO), "--headless", "--frames", "701",
-                           "--screenshot", "s.png", "--screenshot-at", "700"], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "replay",
+            str(DEMO),
+            "--headless",
+            "--frames",
+            "701",
+            "--screenshot",
+            "s.png",
+            "--screenshot-at",
+            "700",
+        ],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stderr
     shot = np.asarray(Image.open(tmp_path / "s.png").convert("RGB"), dtype=np.int32)
     h, w = shot.shape[:2]
-    jug = shot[int(0.5 * h): int(0.85 * h), int(0.45 * w): int(0.7 * w)]
+    jug = shot[int(0.5 * h) : int(0.85 * h), int(0.45 * w) : int(0.7 * w)]
     pupils_and_mouth = (jug < 70).all(axis=2)  # the photo's orange jug has no near-black pixel; the living one a face
     assert pupils_and_mouth.sum() > 300, f"no living jug: {pupils_and_mouth.sum()} face pixels"
-    banner = shot[int(0.9 * h): int(0.96 * h), int(0.1 * w): int(0.8 * w)]
+    banner = shot[int(0.9 * h) : int(0.96 * h), int(0.1 * w) : int(0.8 * w)]
     assert banner.mean() > 85, "the 'waking up the things you marked' banner darkens the floor"

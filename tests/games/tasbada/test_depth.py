@@ -81,8 +81,8 @@ def test_the_pot_hides_what_stands_behind_it_and_not_what_stands_in_front(mixed)
     assert plain[0] > 150 and plain[2] < 110  # the orange pot
     front = _render(app, viewer, _on_ray(viewer, px, z_pot + 1.2))[y, x]
     behind = _render(app, viewer, _on_ray(viewer, px, z_pot - 1.5))[y, x]
-    assert _magenta(front), front                      # nearer than the pot: the box shows
-    assert not _magenta(behind), behind                # farther: hidden by the pot's matte
+    assert _magenta(front), front  # nearer than the pot: the box shows
+    assert not _magenta(behind), behind  # farther: hidden by the pot's matte
     assert np.abs(behind - plain).max() < 40
 
 
@@ -112,12 +112,12 @@ def test_a_held_avatar_shows_on_the_floor_where_it_is_led_and_each_cage_its_foot
     from games.tasbada.objects import Creature
 
     app, viewer = mixed
-    (e, body, tr), = app.world.query(PuppetBody, Transform)
+    ((e, body, tr),) = app.world.query(PuppetBody, Transform)
     cue = np.array(CUE_COLOR) * 255
 
     def cue_pixels_near(point: np.ndarray, img: np.ndarray, r: int = 14) -> int:
         x, y = viewer.camera.project(point[None], W, H)[0].astype(int)
-        patch = img[max(y - r, 0): y + r, max(x - r, 0): x + r]
+        patch = img[max(y - r, 0) : y + r, max(x - r, 0) : x + r]
         return int((np.abs(patch - cue).max(axis=2) < 40).sum())
 
     goal = np.array([tr.position[0] + 0.25, 0.0, tr.position[2] + 1.2])  # led toward the camera

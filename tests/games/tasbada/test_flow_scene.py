@@ -45,9 +45,9 @@ def test_author_flow_opens_tasbada() -> None:
 
 
 def test_a_saved_tasbada_flow_file_reopens_on_the_forest(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from authoring.flow_tool import flow_setup
     from authoring.flowcurves.session import FlowSession
     from authoring.flowcurves.storage import save_flow
-    from authoring.flow_tool import flow_setup
     from puppetphone.flow_scenes import SCENES
 
     session = FlowSession(flow_scene((640, 360)), securves=[])

@@ -18,8 +18,12 @@ from puppetphone.session import build_activity
 @pytest.mark.parametrize("size", [(1280, 720), (960, 540), (640, 360)])
 def test_the_help_in_stage_two_ends_above_the_pose_pickers_title(size: tuple[int, int]) -> None:
     hub = InputHub([MouseSource()])
-    session = build_activity("tasbada", 0, hub, setup={"pose_note": "pose: off (tasbada pose=off); drag the "
-                                                                      "avatar's hands and feet to pose it"})
+    session = build_activity(
+        "tasbada",
+        0,
+        hub,
+        setup={"pose_note": "pose: off (tasbada pose=off); drag the avatar's hands and feet to pose it"},
+    )
     world = session.simulation.app.world
     q = world.resource(Quest)
     q.stage = PROPS_ALIVE
@@ -31,8 +35,9 @@ def test_the_help_in_stage_two_ends_above_the_pose_pickers_title(size: tuple[int
     cache = TextCache(None)
     placed = layout_text(scene.texts, size, cache)
     bottom = max(p.y + cache.measure(p.text, p.size)[1] for p in placed if p.x < picker.PANEL[2] * size[0])
-    assert bottom < picker.PANEL[1] * size[1], f"the help reaches {bottom:.0f} px, the picker starts at " \
-                                               f"{picker.PANEL[1] * size[1]:.0f} px"
+    assert bottom < picker.PANEL[1] * size[1], (
+        f"the help reaches {bottom:.0f} px, the picker starts at {picker.PANEL[1] * size[1]:.0f} px"
+    )
 
 
 def test_the_menu_shows_no_help_over_its_title() -> None:
@@ -40,5 +45,7 @@ def test_the_menu_shows_no_help_over_its_title() -> None:
     session = build_activity("tasbada", 0, hub, setup={})
     session.simulation.app.world.resource(Quest).stage = MENU
     scene = RenderScene()
-    draw_overlay(scene, session.simulation.app.world, session.simulation.game, hub, 60.0, False, session.simulation.overlay)
+    draw_overlay(
+        scene, session.simulation.app.world, session.simulation.game, hub, 60.0, False, session.simulation.overlay
+    )
     assert not any(t.text in CONTROLS or "hides this help" in t.text for t in scene.texts)

@@ -15,13 +15,36 @@ def _play(*sets: str, tmp: Path) -> subprocess.CompletedProcess[str]:
     for name in ("TASBADA_SAVE", "TASBADA_PHOTO", "TASBADA_SELFIE"):
         env.pop(name, None)
     args = [a for s in sets for a in ("--set", s)]
-    return subprocess.run([sys.executable, "-m", "puppetphone", "play", "tasbada", "--headless", "--frames", "5",
-                           "--set", "webcam=off", *args], cwd=tmp, env=env, capture_output=True, text=True, timeout=600)
+    return subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "play",
+            "tasbada",
+            "--headless",
+            "--frames",
+            "5",
+            "--set",
+            "webcam=off",
+            *args,
+        ],
+        cwd=tmp,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
 
 
-@pytest.mark.parametrize(("option", "says"), [("light=north", "tasbada light must be a number of degrees, not 'north'"),
-                                               ("light=nan", "tasbada light must be a finite number"),
-                                               ("pose=maybe", "tasbada pose must be auto or off, not 'maybe'")])
+@pytest.mark.parametrize(
+    ("option", "says"),
+    [
+        ("light=north", "tasbada light must be a number of degrees, not 'north'"),
+        ("light=nan", "tasbada light must be a finite number"),
+        ("pose=maybe", "tasbada pose must be auto or off, not 'maybe'"),
+    ],
+)
 def test_a_bad_option_is_one_clear_line(option: str, says: str, tmp_path: Path) -> None:
     done = _play(option, tmp=tmp_path)
     assert done.returncode != 0

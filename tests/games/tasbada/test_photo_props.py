@@ -35,19 +35,19 @@ def test_grabcut_matte_keeps_the_jug_drops_the_box_and_feathers_the_edge() -> No
     photo = _room()
     m = matte(photo, BOX)
     alpha = m.full((W, H))
-    assert alpha[105, 140] > 0.99 and alpha[72, 140] > 0.5       # body and top of the jug
-    assert alpha[62, 102] < 0.01 and alpha[144, 178] < 0.01      # the box's corners: no rectangle
+    assert alpha[105, 140] > 0.99 and alpha[72, 140] > 0.5  # body and top of the jug
+    assert alpha[62, 102] < 0.01 and alpha[144, 178] < 0.01  # the box's corners: no rectangle
     rim = alpha[105, 105:125]
-    assert ((rim > 0.05) & (rim < 0.95)).any()                  # a soft edge, not a hard cut
+    assert ((rim > 0.05) & (rim < 0.95)).any()  # a soft edge, not a hard cut
     assert abs(m.base[1] - 140) <= 2 and abs(m.base[0] - 140) <= 3
-    assert np.array_equal(matte(photo, BOX).alpha, m.alpha)      # reseeded: the same matte every time
+    assert np.array_equal(matte(photo, BOX).alpha, m.alpha)  # reseeded: the same matte every time
 
 
 def test_the_hole_is_painted_with_the_room_around_it() -> None:
     photo = _room()
     filled = inpaint_hole(photo, matte(photo, BOX).full((W, H)))
-    assert np.abs(filled[110, 140].astype(int) - WOOD).max() < 30   # floor where the jug's body was
-    assert np.abs(filled[74, 140].astype(int) - WALL).max() < 40    # wall where its top was
+    assert np.abs(filled[110, 140].astype(int) - WOOD).max() < 30  # floor where the jug's body was
+    assert np.abs(filled[74, 140].astype(int) - WALL).max() < 40  # wall where its top was
 
 
 def test_the_shadow_is_found_on_the_side_it_falls_and_lit_out() -> None:
@@ -55,10 +55,10 @@ def test_the_shadow_is_found_on_the_side_it_falls_and_lit_out() -> None:
     m = matte(photo, BOX)
     s = find_shadow(photo, m, FLOOR)
     assert s.found and s.mask is not None
-    assert s.light[0] > 0.05                      # it falls to the right: light from the left
+    assert s.light[0] > 0.05  # it falls to the right: light from the left
     assert 0.2 < s.strength < 0.6
     left = find_shadow(_room(shadow_dx=-30), m, FLOOR)
-    assert left.found and left.light[0] < -0.05   # and to the left when it does
+    assert left.found and left.light[0] < -0.05  # and to the left when it does
     clean = remove_shadows(photo, [s])
     shadowed = (175, 140)
     assert photo[shadowed[1], shadowed[0]].astype(int).sum() < np.sum(WOOD) - 60
@@ -84,8 +84,8 @@ def test_the_recast_shadow_slides_away_and_fades_as_the_prop_rises() -> None:
         ys, xs = np.mgrid[0 : img.shape[0], 0 : img.shape[1]]
         return float((xs * img).sum() / img.sum()) + origin[0]
 
-    assert centroid(up, (x1, y1)) > centroid(down, (x0, y0)) + 8   # along the light, further away
-    assert up.max() < down.max() <= 0.4 + 1e-6                      # and fainter
+    assert centroid(up, (x1, y1)) > centroid(down, (x0, y0)) + 8  # along the light, further away
+    assert up.max() < down.max() <= 0.4 + 1e-6  # and fainter
 
 
 def test_the_surface_squashes_leans_and_opens_a_mouth_with_its_base_on_the_floor() -> None:
@@ -99,14 +99,14 @@ def test_the_surface_squashes_leans_and_opens_a_mouth_with_its_base_on_the_floor
 
     t0, b0, rest, _ = top_and_bottom(Deform())
     t1, b1, _, _ = top_and_bottom(Deform(sx=1.15, sy=0.8))
-    assert abs(b1 - b0) <= 1 and t1 > t0 + 8                       # squashed about its base
+    assert abs(b1 - b0) <= 1 and t1 > t0 + 8  # squashed about its base
     assert np.abs(rest[..., :3][rest[..., 3] > 250].astype(int).mean(axis=0) - JUG).max() < 25  # photo texture
     top, _, leaned, (lx, ly) = top_and_bottom(Deform(lean=0.3))
     r0 = int(top) - ly
     cols_top = np.nonzero(leaned[r0 : r0 + 8, :, 3].max(axis=0) > 128)[0] + lx
-    assert cols_top.mean() > 140 + 8                                # the top moved right
+    assert cols_top.mean() > 140 + 8  # the top moved right
     _, _, talking, _ = top_and_bottom(Deform(mouth=1.0))
     dark = (talking[..., 3] > 128) & (talking[..., :3].astype(int).sum(axis=2) < 150)
-    assert dark.sum() > 10                                          # a dark mouth opened in the surface
+    assert dark.sum() > 10  # a dark mouth opened in the surface
     closed = rest[..., :3].astype(int).sum(axis=2) < 150
-    assert not (closed & (rest[..., 3] > 128)).any()                # none while it is closed
+    assert not (closed & (rest[..., 3] > 128)).any()  # none while it is closed

@@ -59,8 +59,14 @@ def _hands(rotations: np.ndarray) -> dict[str, np.ndarray]:
 
 def test_arms_out_in_the_picture_lift_the_avatars_arms_out() -> None:
     # A person (facing the camera) with the right arm straight out sideways and the left hand on the hip.
-    points = {"l_shoulder": [0.6, 0.3], "r_shoulder": [0.4, 0.3], "r_elbow": [0.26, 0.3], "r_wrist": [0.12, 0.3],
-              "l_elbow": [0.7, 0.42], "l_wrist": [0.62, 0.52]}
+    points = {
+        "l_shoulder": [0.6, 0.3],
+        "r_shoulder": [0.4, 0.3],
+        "r_elbow": [0.26, 0.3],
+        "r_wrist": [0.12, 0.3],
+        "l_elbow": [0.7, 0.42],
+        "l_wrist": [0.62, 0.52],
+    }
     rot, posed = pose.lift(points, aspect=1.0)
     sk = humanoid_skeleton()
     assert posed[sk.names.index("r_upper_arm")] and posed[sk.names.index("r_lower_arm")]
@@ -68,8 +74,8 @@ def test_arms_out_in_the_picture_lift_the_avatars_arms_out() -> None:
     rest = _hands(np.tile([1.0, 0.0, 0.0, 0.0], (sk.num_joints, 1)))
     now = _hands(rot)
     shoulder_y = 0.95 + 0.1 + 0.18 + 0.17
-    assert now["r_hand"][0] < rest["r_hand"][0] - 0.3      # the avatar's right hand (its −X) went out
-    assert abs(now["r_hand"][1] - shoulder_y) < 0.12        # to shoulder height
+    assert now["r_hand"][0] < rest["r_hand"][0] - 0.3  # the avatar's right hand (its −X) went out
+    assert abs(now["r_hand"][1] - shoulder_y) < 0.12  # to shoulder height
     assert now["l_lower_arm"][0] > rest["l_lower_arm"][0] + 0.05  # the left elbow out a little
 
 
@@ -81,10 +87,20 @@ def test_the_pose_is_held_then_eased_into_the_idle() -> None:
     assert np.all(np.diff([weight(t) for t in ts]) <= 1e-12)  # never comes back
 
 
-@given(st.one_of(st.none(), st.integers(), st.text(max_size=5),
-                 st.dictionaries(st.sampled_from([*pose.KEYPOINTS, "x"]),
-                                 st.one_of(st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=3),
-                                           st.text(max_size=3), st.none()), max_size=6)))
+@given(
+    st.one_of(
+        st.none(),
+        st.integers(),
+        st.text(max_size=5),
+        st.dictionaries(
+            st.sampled_from([*pose.KEYPOINTS, "x"]),
+            st.one_of(
+                st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=3), st.text(max_size=3), st.none()
+            ),
+            max_size=6,
+        ),
+    )
+)
 @settings(max_examples=150, deadline=None)
 def test_fuzzed_keypoints_in_a_setup_are_taken_whole_or_refused(raw: object) -> None:
     got = pose.validate(raw)

@@ -44,19 +44,59 @@ def test_an_endless_device_is_refused_before_reading() -> None:
     assert isinstance(_load_within(Path("/dev/zero")), SaveError)
 
 
-@pytest.mark.parametrize("text,says", [
-    ('{"format": "tasbada-progress", "marks": ' + "[" * 100_000 + "]" * 100_000 + "}", "nested too deeply"),
-    (json.dumps({"format": "tasbada-progress", "version": 1, "reached": ["real"], "ground_v": 1e308, "marks": []}),
-     "floor line"),
-    (json.dumps({"format": "tasbada-progress", "version": 1, "reached": ["real"], "ground_v": 0.5,
-                 "marks": [{"kind": "lasso", "points": [[0.1, 0.2]] * 5000}]}), "at most"),
-    (json.dumps({"format": "tasbada-progress", "version": 1, "reached": "real", "ground_v": 0.5, "marks": []}),
-     "reached"),
-    (json.dumps({"format": "tasbada-progress", "version": 1, "reached": [], "ground_v": 0.5,
-                 "marks": [{"kind": "box", "points": [[0.1, "x"], [0.2, 0.3]]}]}), "two numbers"),
-    (json.dumps({"format": "tasbada-progress", "version": 1, "reached": [], "ground_v": 0.5, "marks": [],
-                 "photo": ["a"]}), "text"),
-])
+@pytest.mark.parametrize(
+    "text,says",
+    [
+        ('{"format": "tasbada-progress", "marks": ' + "[" * 100_000 + "]" * 100_000 + "}", "nested too deeply"),
+        (
+            json.dumps(
+                {"format": "tasbada-progress", "version": 1, "reached": ["real"], "ground_v": 1e308, "marks": []}
+            ),
+            "floor line",
+        ),
+        (
+            json.dumps(
+                {
+                    "format": "tasbada-progress",
+                    "version": 1,
+                    "reached": ["real"],
+                    "ground_v": 0.5,
+                    "marks": [{"kind": "lasso", "points": [[0.1, 0.2]] * 5000}],
+                }
+            ),
+            "at most",
+        ),
+        (
+            json.dumps({"format": "tasbada-progress", "version": 1, "reached": "real", "ground_v": 0.5, "marks": []}),
+            "reached",
+        ),
+        (
+            json.dumps(
+                {
+                    "format": "tasbada-progress",
+                    "version": 1,
+                    "reached": [],
+                    "ground_v": 0.5,
+                    "marks": [{"kind": "box", "points": [[0.1, "x"], [0.2, 0.3]]}],
+                }
+            ),
+            "two numbers",
+        ),
+        (
+            json.dumps(
+                {
+                    "format": "tasbada-progress",
+                    "version": 1,
+                    "reached": [],
+                    "ground_v": 0.5,
+                    "marks": [],
+                    "photo": ["a"],
+                }
+            ),
+            "text",
+        ),
+    ],
+)
 def test_a_damaged_save_is_one_save_error(tmp_path: Path, text: str, says: str) -> None:
     path = tmp_path / "save.json"
     path.write_text(text)
@@ -73,10 +113,13 @@ def test_an_oversized_save_is_refused_without_reading_it(tmp_path: Path) -> None
         load_progress(path)
 
 
-@pytest.mark.parametrize("make", [
-    lambda p: (p.mkdir(), (p / "holiday.jpg").write_bytes(b"\xff\xd8")),
-    lambda p: p.write_text("my diary"),
-])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda p: (p.mkdir(), (p / "holiday.jpg").write_bytes(b"\xff\xd8")),
+        lambda p: p.write_text("my diary"),
+    ],
+)
 def test_a_save_path_that_is_not_our_save_is_refused_and_untouched(tmp_path: Path, make) -> None:  # type: ignore[no-untyped-def]
     target = tmp_path / "save.json"
     make(target)

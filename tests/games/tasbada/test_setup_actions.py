@@ -42,7 +42,7 @@ def test_a_box_started_on_the_floor_line_is_a_box_and_the_knob_moves_the_line(dr
     d = driver({"pose_note": "test"})
     q: Quest = d.world.resource(Quest)
     v0 = q.ground_v
-    d.move(_px(0.5, v0), 8)            # on the line, away from the knob
+    d.move(_px(0.5, v0), 8)  # on the line, away from the knob
     d.press()
     d.move(_px(0.62, 0.8), 10)
     d.release()
@@ -54,11 +54,11 @@ def test_a_box_started_on_the_floor_line_is_a_box_and_the_knob_moves_the_line(dr
     assert q.ground_v == pytest.approx(0.65, abs=0.01) and len(q.marks) == 1
     undo = next(b for b in REAL_BUTTONS if b.action == "undo").rect
     d.click(_px((undo[0] + undo[2]) / 2, (undo[1] + undo[3]) / 2), 8)
-    assert q.ground_v == v0 and len(q.marks) == 1       # the line's move is taken back first
+    assert q.ground_v == v0 and len(q.marks) == 1  # the line's move is taken back first
     d.click(_px((undo[0] + undo[2]) / 2, (undo[1] + undo[3]) / 2), 4)
-    assert q.marks == [] and q.ground_v == v0           # then the mark
+    assert q.marks == [] and q.ground_v == v0  # then the mark
     d.click(_px((undo[0] + undo[2]) / 2, (undo[1] + undo[3]) / 2), 4)
-    assert q.marks == [] and q.ground_v == v0           # nothing left: nothing happens
+    assert q.marks == [] and q.ground_v == v0  # nothing left: nothing happens
 
 
 def test_with_no_pose_found_the_picker_poses_the_avatar(driver) -> None:
@@ -78,7 +78,7 @@ def test_with_no_pose_found_the_picker_poses_the_avatar(driver) -> None:
     d.press()
     d.move(_px(start[0] - 0.06, start[1] - 0.25), 8)
     d.release()
-    assert q.line == line                                # the press posed, it did not skip the narration
+    assert q.line == line  # the press posed, it did not skip the narration
     moved = to_panel(q.pose["r_wrist"])
     assert moved[1] < start[1] - 0.2
     restart_from(d.world, q, MIXED)

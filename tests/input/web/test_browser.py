@@ -21,16 +21,40 @@ import pytest
 
 from puppetphone.bench.chromium import Chromium, find_chromium
 
-pytestmark = pytest.mark.skipif(find_chromium() is None,
-                                reason="no chromium executable: apt-get install chromium (.ci/run installs it)")
+pytestmark = pytest.mark.skipif(
+    find_chromium() is None, reason="no chromium executable: apt-get install chromium (.ci/run installs it)"
+)
 
 
 def start_play(tmp_path: Path, frames: int, *extra: str, game: str = "sandbox") -> tuple[subprocess.Popen[str], str]:
     """``puppetphone play GAME --source web`` on a free port; the process and its controller link."""
-    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy", "XDG_DATA_HOME": str(tmp_path / "data")}
-    proc = subprocess.Popen([sys.executable, "-m", "puppetphone", "play", game, "--source", "web", "--web-port", "0", "--headless",
-                             "--frames", str(frames), *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=env)
+    env = {
+        **os.environ,
+        "SDL_VIDEODRIVER": "dummy",
+        "SDL_AUDIODRIVER": "dummy",
+        "XDG_DATA_HOME": str(tmp_path / "data"),
+    }
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "puppetphone",
+            "play",
+            game,
+            "--source",
+            "web",
+            "--web-port",
+            "0",
+            "--headless",
+            "--frames",
+            str(frames),
+            *extra,
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     assert proc.stderr is not None
     end = time.monotonic() + 60
     while time.monotonic() < end:
@@ -119,10 +143,27 @@ def test_chromium_grabs_and_moves_the_puppet_and_the_session_replays(tmp_path):
     shots = {}
     for view in ("phone", "orbit"):
         shots[view] = tmp_path / f"{view}.png"
-        replay = subprocess.run([sys.executable, "-m", "puppetphone", "replay", str(rec), "--verify", "--headless", "--view", view,
-                                 "--screenshot", str(shots[view]), "--screenshot-at", str(held[len(held) // 2])],
-                                capture_output=True, text=True, timeout=120,
-                                env={**os.environ, "SDL_VIDEODRIVER": "dummy"})
+        replay = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "puppetphone",
+                "replay",
+                str(rec),
+                "--verify",
+                "--headless",
+                "--view",
+                view,
+                "--screenshot",
+                str(shots[view]),
+                "--screenshot-at",
+                str(held[len(held) // 2]),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env={**os.environ, "SDL_VIDEODRIVER": "dummy"},
+        )
         assert replay.returncode == 0, replay.stderr
         assert "state hashes match" in replay.stdout
     from PIL import Image

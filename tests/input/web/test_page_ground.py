@@ -21,14 +21,15 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from puppetphone.bench.chromium import Chromium, find_chromium
 from engine.render.scene import GroundMarks, RenderScene
 from input.web.cert import load_or_create
 from input.web.scene_stream import CameraPose, quantise
 from input.web.server import WebSource
+from puppetphone.bench.chromium import Chromium, find_chromium
 
-pytestmark = pytest.mark.skipif(find_chromium() is None,
-                                reason="no chromium executable: apt-get install chromium (.ci/run installs it)")
+pytestmark = pytest.mark.skipif(
+    find_chromium() is None, reason="no chromium executable: apt-get install chromium (.ci/run installs it)"
+)
 
 W, H = 390, 844
 HEIGHT = 6.0
@@ -43,7 +44,7 @@ def scene() -> RenderScene:
     s.add_sphere(BALL, RADIUS, color=(0.85, 0.45, 0.3))
     amount = np.zeros((80, 80), dtype=np.float32)  # 10 cm cells from (-4, -4)
     x0, z0, x1, z1 = TRACK
-    amount[int((z0 + 4) / 0.1):int((z1 + 4) / 0.1), int((x0 + 4) / 0.1):int((x1 + 4) / 0.1)] = 1.0
+    amount[int((z0 + 4) / 0.1) : int((z1 + 4) / 0.1), int((x0 + 4) / 0.1) : int((x1 + 4) / 0.1)] = 1.0
     s.marks = GroundMarks(amount, -4.0, -4.0, 0.1)
     return s
 
@@ -55,7 +56,7 @@ def to_screen(x: float, z: float) -> tuple[int, int]:
 
 
 def patch(img: np.ndarray, x: int, y: int, r: int = 10) -> np.ndarray:
-    return img[y - r:y + r, x - r:x + r].reshape(-1, 3).mean(axis=0)
+    return img[y - r : y + r, x - r : x + r].reshape(-1, 3).mean(axis=0)
 
 
 def test_the_ball_casts_its_shadow_along_the_sun_and_the_track_shows_in_the_snow(tmp_path):
@@ -79,8 +80,10 @@ def test_the_ball_casts_its_shadow_along_the_sun_and_the_track_shows_in_the_snow
             with Chromium() as browser:
                 browser.open(src.url(), W, H)
                 browser.wait_for("ppView.drawn > 5", timeout=60)
-                browser.evaluate("document.getElementById('start').hidden = true;"
-                                 "document.querySelectorAll('header, main, footer').forEach((e) => { e.style.visibility = 'hidden'; })")
+                browser.evaluate(
+                    "document.getElementById('start').hidden = true;"
+                    "document.querySelectorAll('header, main, footer').forEach((e) => { e.style.visibility = 'hidden'; })"
+                )
                 time.sleep(0.5)
                 browser.screenshot(tmp_path / "ground.png")
         finally:

@@ -21,8 +21,9 @@ from PIL import Image
 from puppetphone.bench.chromium import Chromium, find_chromium
 from tests.input.web.test_browser import calibrate, start_play
 
-pytestmark = pytest.mark.skipif(find_chromium() is None,
-                                reason="no chromium executable: apt-get install chromium (.ci/run installs it)")
+pytestmark = pytest.mark.skipif(
+    find_chromium() is None, reason="no chromium executable: apt-get install chromium (.ci/run installs it)"
+)
 
 W, H = 390, 844
 HIDE_CONTROLS = "document.querySelectorAll('header, main, footer').forEach((e) => { e.style.visibility = 'hidden'; })"
@@ -60,8 +61,9 @@ def wait_steps(browser: Chromium, steps: int) -> None:
 
 def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_desktop(tmp_path):
     desk = tmp_path / "desktop.png"
-    play, url = start_play(tmp_path, 480, "--view", "phone", "--size", f"{W}x{H}", "--screenshot", str(desk),
-                           game="snowman")
+    play, url = start_play(
+        tmp_path, 480, "--view", "phone", "--size", f"{W}x{H}", "--screenshot", str(desk), game="snowman"
+    )
     try:
         with Chromium() as browser:
             browser.enable_sensors()
@@ -70,8 +72,10 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
             # Ask for AR: headless Chromium has no immersive-ar, the page says so and is a magic window.
             browser.evaluate("document.getElementById('xr').hidden = false")
             browser.click("xr")
-            mode = browser.wait_for("document.getElementById('mode').textContent.includes('AR refused') && "
-                                    "document.getElementById('mode').textContent")
+            mode = browser.wait_for(
+                "document.getElementById('mode').textContent.includes('AR refused') && "
+                "document.getElementById('mode').textContent"
+            )
             assert "magic window" in mode
             calibrate(browser)
             browser.orientation(0.0, -10.0, 0.0)  # at the puppet, a little down
@@ -86,7 +90,9 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
             assert play.returncode == 0, err
             time.sleep(0.3)
             last = bare_shot(browser, tmp_path / "last.png")
-            stats = browser.evaluate("({frames: ppView.frames, bytes: ppView.bytes, step: ppView.step, where: ppView.where})")
+            stats = browser.evaluate(
+                "({frames: ppView.frames, bytes: ppView.bytes, step: ppView.step, where: ppView.where})"
+            )
     finally:
         if play.poll() is None:
             play.kill()
@@ -95,7 +101,7 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
     # The puppet stands on snow under a sky.
     seen = puppet_mask(ahead)
     assert seen.sum() > 3000, f"{seen.sum()} puppet pixels on the page"
-    assert snow(ahead[H * 3 // 4:]).mean() > 0.6, "the lower quarter of the page is not snowy ground"
+    assert snow(ahead[H * 3 // 4 :]).mean() > 0.6, "the lower quarter of the page is not snowy ground"
     assert sky(ahead[: H // 5]).mean() > 0.5, "the top of the page is not sky"
     # Turning the phone turned the view: the puppet left the middle of the picture.
     ys, xs = np.nonzero(seen)
@@ -104,7 +110,7 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
         assert abs(np.nonzero(moved)[1].mean() - xs.mean()) > W / 4, "the puppet stayed where it was after a 45° turn"
     assert np.abs(turned - ahead).mean() > 8.0
     # Desktop and page, same step, same pose: below the desktop's text lines the pictures agree.
-    d, p = rgb(desk)[H // 2:], last[H // 2:]
+    d, p = rgb(desk)[H // 2 :], last[H // 2 :]
     dm, pm = puppet_mask(d), puppet_mask(p)
     assert pm.sum() > 500 and dm.sum() > 500, (pm.sum(), dm.sum())
     assert 0.6 < pm.sum() / dm.sum() < 1.6, f"puppet areas: page {pm.sum()}, desktop {dm.sum()}"

@@ -24,8 +24,10 @@ PLACEMENT = Path(input.web.__file__).parent / "page" / "placement.js"
 
 
 def run_page_maths(body: str) -> dict:
-    script = (f"const {{ placeField, fieldToLocalMatrix, localToField }} = require({json.dumps(str(PLACEMENT))});\n"
-              f"console.log(JSON.stringify((() => {{ {body} }})()));")
+    script = (
+        f"const {{ placeField, fieldToLocalMatrix, localToField }} = require({json.dumps(str(PLACEMENT))});\n"
+        f"console.log(JSON.stringify((() => {{ {body} }})()));"
+    )
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stderr
     return json.loads(res.stdout)

@@ -59,8 +59,9 @@ def test_xr_pose_is_a_camera_pose_with_position():
 
 
 def test_sample_fields_carry_buttons_crouch_and_motion():
-    msg = parse_message(json.dumps({**READING, "jump": True, "cal": True, "crouch": 0.5, "acc": [0, 0, 9.8],
-                                    "rot": [90.0, 0.0, 0.0]}))
+    msg = parse_message(
+        json.dumps({**READING, "jump": True, "cal": True, "crouch": 0.5, "acc": [0, 0, 9.8], "rot": [90.0, 0.0, 0.0]})
+    )
     assert isinstance(msg, ControllerMessage)
     sample = PoseSample(**to_sample_fields(msg, "web:1", 12.5))
     assert sample.flick and sample.calibrate and sample.touch and sample.mode == "device"
@@ -73,43 +74,63 @@ def test_ping():
     assert parse_message('{"ping": 12.5}') == Ping(12.5)
 
 
-@pytest.mark.parametrize(("text", "reason"), [
-    (b"\x00\x01", "binary message"),
-    ("x" * (MAX_MESSAGE_BYTES + 1), "message too long"),
-    ("{not json", "not JSON"),
-    ("[1, 2]", "not a JSON object"),
-    (json.dumps({**READING, "evil": 1}), "unknown field 'evil'"),
-    (json.dumps({**READING, "seq": -1}), "seq must be a whole number"),
-    (json.dumps({**READING, "seq": True}), "seq must be a whole number"),
-    (json.dumps({**READING, "kind": "teleport"}), "kind must be one of orientation, xr"),
-    (json.dumps({**READING, "o": [0, 0]}), "o must be a list of 3 numbers"),
-    (json.dumps({**READING, "o": [0, "1", 0]}), "o must be a number"),
-    ('{"seq": 1, "t": 0, "kind": "orientation", "o": [0, NaN, 0]}', "o is out of range"),
-    (json.dumps({**READING, "o": [0, 1e300, 0]}), "o is out of range"),
-    (json.dumps({**READING, "touch": 1}), "touch must be true or false"),
-    (json.dumps({**READING, "crouch": 2}), "crouch is out of range"),
-    (json.dumps({**READING, "crouch": -0.1}), "crouch is out of range"),
-    (json.dumps({"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0, 2], "p": [0, 0, 0]}), "q is out of range"),
-    (json.dumps({"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0.5, 0.5], "p": [0, 0, 0]}), "q is not a unit quaternion"),
-    (json.dumps({"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0, 1], "p": [0, 0, 5000]}), "p is out of range"),
-    ("[" * 5000 + "]" * 5000, "message too long"),
-])
+@pytest.mark.parametrize(
+    ("text", "reason"),
+    [
+        (b"\x00\x01", "binary message"),
+        ("x" * (MAX_MESSAGE_BYTES + 1), "message too long"),
+        ("{not json", "not JSON"),
+        ("[1, 2]", "not a JSON object"),
+        (json.dumps({**READING, "evil": 1}), "unknown field 'evil'"),
+        (json.dumps({**READING, "seq": -1}), "seq must be a whole number"),
+        (json.dumps({**READING, "seq": True}), "seq must be a whole number"),
+        (json.dumps({**READING, "kind": "teleport"}), "kind must be one of orientation, xr"),
+        (json.dumps({**READING, "o": [0, 0]}), "o must be a list of 3 numbers"),
+        (json.dumps({**READING, "o": [0, "1", 0]}), "o must be a number"),
+        ('{"seq": 1, "t": 0, "kind": "orientation", "o": [0, NaN, 0]}', "o is out of range"),
+        (json.dumps({**READING, "o": [0, 1e300, 0]}), "o is out of range"),
+        (json.dumps({**READING, "touch": 1}), "touch must be true or false"),
+        (json.dumps({**READING, "crouch": 2}), "crouch is out of range"),
+        (json.dumps({**READING, "crouch": -0.1}), "crouch is out of range"),
+        (json.dumps({"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0, 2], "p": [0, 0, 0]}), "q is out of range"),
+        (
+            json.dumps({"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0.5, 0.5], "p": [0, 0, 0]}),
+            "q is not a unit quaternion",
+        ),
+        (json.dumps({"seq": 1, "t": 0, "kind": "xr", "q": [0, 0, 0, 1], "p": [0, 0, 5000]}), "p is out of range"),
+        ("[" * 5000 + "]" * 5000, "message too long"),
+    ],
+)
 def test_bad_messages_are_one_line_errors(text, reason):
     with pytest.raises(WebMessageError) as err:
         parse_message(text)
     assert str(err.value) == reason
 
 
-json_values = st.recursive(st.one_of(st.none(), st.booleans(), st.integers(-2**60, 2**60),
-                                     st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=6)),
-                           lambda inner: st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=6), inner,
-                                                                                         max_size=4), max_leaves=12)
+json_values = st.recursive(
+    st.one_of(
+        st.none(),
+        st.booleans(),
+        st.integers(-(2**60), 2**60),
+        st.floats(allow_nan=True, allow_infinity=True),
+        st.text(max_size=6),
+    ),
+    lambda inner: st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=6), inner, max_size=4),
+    max_leaves=12,
+)
 keys = st.sampled_from(["seq", "t", "kind", "o", "q", "p", "acc", "rot", "touch", "jump", "cal", "crouch", "ping"])
 
 
 @pytest.mark.fuzz
-@given(st.dictionaries(keys, st.one_of(json_values, st.sampled_from(["orientation", "xr"]),
-                                       st.lists(st.floats(-400, 400), min_size=3, max_size=4)), max_size=12))
+@given(
+    st.dictionaries(
+        keys,
+        st.one_of(
+            json_values, st.sampled_from(["orientation", "xr"]), st.lists(st.floats(-400, 400), min_size=3, max_size=4)
+        ),
+        max_size=12,
+    )
+)
 def test_fuzz_messages_give_valid_samples_or_one_error(fields):
     try:
         text = json.dumps(fields)

@@ -34,30 +34,36 @@ def test_a_message_of_exactly_the_limit_is_read() -> None:
     assert isinstance(msg, ControllerMessage) and msg.seq == 3 and msg.t == 1.7e12
 
 
-@pytest.mark.parametrize(("fields", "ok", "bad", "reason"), [
-    (READING, {"o": [360.0, -360.0, 0.0]}, {"o": [360.5, 0.0, 0.0]}, "o is out of range"),
-    (XR, {"p": [1000.0, 0.0, -1000.0]}, {"p": [0.0, 1000.5, 0.0]}, "p is out of range"),
-    (READING, {"acc": [2000.0, 0.0, 0.0]}, {"acc": [0.0, 0.0, 2000.5]}, "acc is out of range"),
-    (READING, {"rot": [11000.0, 0.0, 0.0]}, {"rot": [0.0, 11000.5, 0.0]}, "rot is out of range"),
-    (READING, {"seq": 0}, {"seq": 2**53}, "seq must be a whole number"),
-    (READING, {"seq": 2**53 - 1}, {"seq": -1}, "seq must be a whole number"),
-])
+@pytest.mark.parametrize(
+    ("fields", "ok", "bad", "reason"),
+    [
+        (READING, {"o": [360.0, -360.0, 0.0]}, {"o": [360.5, 0.0, 0.0]}, "o is out of range"),
+        (XR, {"p": [1000.0, 0.0, -1000.0]}, {"p": [0.0, 1000.5, 0.0]}, "p is out of range"),
+        (READING, {"acc": [2000.0, 0.0, 0.0]}, {"acc": [0.0, 0.0, 2000.5]}, "acc is out of range"),
+        (READING, {"rot": [11000.0, 0.0, 0.0]}, {"rot": [0.0, 11000.5, 0.0]}, "rot is out of range"),
+        (READING, {"seq": 0}, {"seq": 2**53}, "seq must be a whole number"),
+        (READING, {"seq": 2**53 - 1}, {"seq": -1}, "seq must be a whole number"),
+    ],
+)
 def test_each_limit_is_inclusive(fields: dict, ok: dict, bad: dict, reason: str) -> None:
     assert isinstance(parse_message(json.dumps({**fields, **ok})), ControllerMessage)
     assert _reason({**fields, **bad}) == reason
 
 
-@pytest.mark.parametrize(("fields", "reason"), [
-    ({"ping": "now"}, "ping must be a number"),
-    ({**READING, "t": "now"}, "t must be a number"),
-    ({k: v for k, v in READING.items() if k != "t"}, "t must be a number"),
-    ({**READING, "acc": [0, "x", 0]}, "acc must be a number"),
-    ({**READING, "acc": [0, 0]}, "acc must be a list of 3 numbers"),
-    ({**READING, "rot": [0, None, 0]}, "rot must be a number"),
-    ({**READING, "jump": "yes"}, "jump must be true or false"),
-    ({**READING, "cal": 0}, "cal must be true or false"),
-    ({**READING, "a" * 30: 1}, "unknown field 'aaaaaaaaaaaaaaaaaaaa'"),  # cut to 20 characters
-])
+@pytest.mark.parametrize(
+    ("fields", "reason"),
+    [
+        ({"ping": "now"}, "ping must be a number"),
+        ({**READING, "t": "now"}, "t must be a number"),
+        ({k: v for k, v in READING.items() if k != "t"}, "t must be a number"),
+        ({**READING, "acc": [0, "x", 0]}, "acc must be a number"),
+        ({**READING, "acc": [0, 0]}, "acc must be a list of 3 numbers"),
+        ({**READING, "rot": [0, None, 0]}, "rot must be a number"),
+        ({**READING, "jump": "yes"}, "jump must be true or false"),
+        ({**READING, "cal": 0}, "cal must be true or false"),
+        ({**READING, "a" * 30: 1}, "unknown field 'aaaaaaaaaaaaaaaaaaaa'"),  # cut to 20 characters
+    ],
+)
 def test_each_error_names_its_field(fields: dict, reason: str) -> None:
     assert _reason(fields) == reason
 

@@ -21,8 +21,11 @@ def test_all_names_exist():
 def test_web_imports_only_engine_input_and_libraries():
     for path in ROOT.glob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
-            names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
-                [node.module] if isinstance(node, ast.ImportFrom) and node.module else [])
+            names = (
+                [a.name for a in node.names]
+                if isinstance(node, ast.Import)
+                else ([node.module] if isinstance(node, ast.ImportFrom) and node.module else [])
+            )
             for n in names:
                 assert n.split(".")[0] not in ("games", "authoring", "puppetphone"), f"{path.name}: {n}"
 

@@ -29,7 +29,7 @@ def tracked(scene: RenderScene, rolled: list[tuple[int, int, int, int]]) -> Rend
     and two footprints."""
     amount = np.zeros((240, 240), dtype=np.float32)
     for r0, c0, h, w in rolled:
-        amount[r0:r0 + h, c0:c0 + w] = np.linspace(0.2, 1.0, w)
+        amount[r0 : r0 + h, c0 : c0 + w] = np.linspace(0.2, 1.0, w)
     scene.marks = GroundMarks(amount, -12.0, -12.0, 0.1)
     scene.add_prints(np.array([[0.5, 1.0], [0.8, 1.3]]), np.array([0.0, 1.2]), strength=np.array([1.0, 0.4]))
     return scene
@@ -130,7 +130,7 @@ def test_the_glb_is_a_gltf_with_a_ground_mesh_and_the_rows_the_first_frame_build
     extras, back = read_scene_glb(glb)
     assert same(back, state) and back.step == 7
     assert extras["ground"]["color"] == list(scene.ground.color)
-    doc = json.loads(glb[20:20 + int.from_bytes(glb[12:16], "little")])
+    doc = json.loads(glb[20 : 20 + int.from_bytes(glb[12:16], "little")])
     assert doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] == 0
     nxt = quantise(scene_with(12, 0.01, 5), 8, 0.0, CAM)
     assert same(decode_frame(back, encode_frame(back, nxt)), nxt)
@@ -140,8 +140,12 @@ def test_the_glb_is_a_gltf_with_a_ground_mesh_and_the_rows_the_first_frame_build
 def test_the_pages_reader_decodes_the_engines_frames_to_the_same_rows(tmp_path):
     scene = tracked(scene_with(15), [(10, 10, 3, 3)])
     first = quantise(scene, 1, 0.0, CAM)
-    states = [quantise(tracked(scene_with(15, 0.02 * i, 8), [(10, 10, 3, 3 + i)]), 1 + i, 0.0, CAM) for i in range(1, 4)]
-    states.append(quantise(tracked(scene_with(3, 2.0, 3), [(10, 10, 3, 6), (200, 3, 1, 1)]), 9, 0.0, CAM))  # int16, fewer rows
+    states = [
+        quantise(tracked(scene_with(15, 0.02 * i, 8), [(10, 10, 3, 3 + i)]), 1 + i, 0.0, CAM) for i in range(1, 4)
+    ]
+    states.append(
+        quantise(tracked(scene_with(3, 2.0, 3), [(10, 10, 3, 6), (200, 3, 1, 1)]), 9, 0.0, CAM)
+    )  # int16, fewer rows
     blobs = [scene_glb(first, scene)]
     prev = first
     for s in states:
@@ -192,7 +196,9 @@ console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
     a0, a1 = first.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
     assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
     assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
-    assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), "a late frame must hold, not run on"
+    assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), (
+        "a late frame must hold, not run on"
+    )
 
 
 @needs_node

@@ -60,8 +60,10 @@ def test_the_websocket_needs_the_exact_token(source):
     with connect(f"wss://127.0.0.1:{source.port}/ws?t={source.token}", ssl=_tls(), open_timeout=10) as ws:
         assert "hello" in ws.recv(timeout=10)
     for wrong in _wrong_tokens(source.token):
-        with pytest.raises(InvalidStatus), connect(f"wss://127.0.0.1:{source.port}/ws?t={wrong}", ssl=_tls(),
-                                                   open_timeout=10):
+        with (
+            pytest.raises(InvalidStatus),
+            connect(f"wss://127.0.0.1:{source.port}/ws?t={wrong}", ssl=_tls(), open_timeout=10),
+        ):
             pass
 
 

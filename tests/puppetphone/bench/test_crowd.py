@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from puppetphone.bench.crowd import crowd_app, timed_steps
 from engine.app import STAGES
+from puppetphone.bench.crowd import crowd_app, timed_steps
 
 
 def test_timed_steps_cover_every_stage_and_the_old_path_runs() -> None:

@@ -7,11 +7,11 @@ import sys
 import numpy as np
 import pytest
 
-from puppetphone.bench.crowd_scale import AFTER, fall_run
-from puppetphone.bench.startup import child_cpu_s
 from engine import quat
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
+from puppetphone.bench.crowd_scale import AFTER, fall_run
+from puppetphone.bench.startup import child_cpu_s
 
 
 def test_the_fall_run_times_the_fall_and_raw_mujoco_on_the_same_model() -> None:

@@ -20,8 +20,8 @@ def test_the_mesh_figures_meet_their_goals() -> None:
 
 
 def test_the_fig_3_7_script_is_one_operation_that_bends_the_tree() -> None:
-    from authoring.flowcurves.session import FlowSession
     from authoring.flow_tool import FlowTool
+    from authoring.flowcurves.session import FlowSession
 
     scene, securves = mesh_tree_problem()
     activity = FlowTool(FlowSession(scene, securves=securves), None)

@@ -57,8 +57,10 @@ def test_a_valid_flick_jumps_and_lands_from_any_speed(device, speed):
 @pytest.mark.parametrize("pixels", [80.0, 250.0])
 def test_an_ordinary_hands_mouse_flick_jumps(pixels):
     """Up and back within about 0.15 s, 80 to 250 px: a jump, landed."""
+
     def flick(t, g):  # type: ignore[no-untyped-def]
         return g, pixels * min(t / 0.06, 1.0) - pixels * min(max(t - 0.06, 0.0) / 0.08, 1.0)
+
     result = jump(1.0, "mouse", gesture=flick)
     assert result.landed, (result.reason, sorted(set(result.states)))
 
@@ -79,9 +81,11 @@ def test_a_running_jump_lands_running_and_the_arc_poses_it():
 def _ride(lift, side=lambda t: 0.0, halt=False):  # type: ignore[no-untyped-def]
     """A phone gesture riding the stick: ``lift(t)`` m up, ``side(t)`` m sideways, on top of the
     1 m/s walk (or, with ``halt``, the hand stops where it flicked)."""
+
     def gesture(t, ground):  # type: ignore[no-untyped-def]
         here = ground - np.array([0.6, -0.8]) * t if halt else ground
         return here + np.array([0.8, 0.6]) * side(t), lift(t)
+
     return gesture
 
 
@@ -93,7 +97,9 @@ PHONE_INVALID = {
     "rose again after starting to fall": _ride(lambda t: _arc(t) if t < 0.55 else _arc(0.55) + 2.0 * (t - 0.55)),
     "turned in the air": _ride(_arc, side=lambda t: 0.0 if t < 0.3 else 3.0 * (t - 0.3)),
     "stopped in the air": _ride(lambda t: 0.8 * np.sin(0.5 * np.pi * min(t / 0.4, 1.0)), halt=True),
-    "pulled down hard": _ride(lambda t: 0.8 * np.sin(0.5 * np.pi * min(t / 0.4, 1.0)) - (10.0 * (t - 0.45) if t > 0.45 else 0.0)),
+    "pulled down hard": _ride(
+        lambda t: 0.8 * np.sin(0.5 * np.pi * min(t / 0.4, 1.0)) - (10.0 * (t - 0.45) if t > 0.45 else 0.0)
+    ),
 }
 
 
@@ -109,7 +115,10 @@ def _mouse_flick(t: float) -> float:
 
 MOUSE_INVALID = {
     # a second flick in mid-air: a hop off nothing
-    "rose again after starting to fall": lambda t, g: (g, _mouse_flick(t) + (_mouse_flick(t - 0.4) if t > 0.4 else 0.0)),
+    "rose again after starting to fall": lambda t, g: (
+        g,
+        _mouse_flick(t) + (_mouse_flick(t - 0.4) if t > 0.4 else 0.0),
+    ),
     # the hand drags 1.2 m sideways in 0.3 s while the puppet flies
     "turned in the air": lambda t, g: (g + np.array([0.8, 0.6]) * min(max(t - 0.25, 0.0) * 4.0, 1.2), _mouse_flick(t)),
 }

@@ -46,6 +46,7 @@ def test_auto_level_is_where_the_governor_settles_from_the_frames_cpu_time() -> 
             end = time.process_time() + seconds
             while time.process_time() < end:
                 pass
+
         return frame
 
     slow, quick = Levels(), Levels()

@@ -24,8 +24,9 @@ def test_each_count_has_its_mannequin_baseline(mocap_dir: Path, monkeypatch: pyt
         assert "mannequins" in (f.baseline or "")
 
 
-def test_without_the_character_file_it_says_so_and_gives_nothing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_without_the_character_file_it_says_so_and_gives_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     import puppetphone.bench.render_skinned as bench
 
     monkeypatch.setenv("PUPPETPHONE_DATA", str(tmp_path))

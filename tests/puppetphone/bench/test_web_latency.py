@@ -8,8 +8,9 @@ import pytest
 from puppetphone.bench.chromium import find_chromium
 from puppetphone.bench.web_latency import measure
 
-pytestmark = pytest.mark.skipif(find_chromium() is None,
-                                reason="no chromium executable: apt-get install chromium (.ci/run installs it)")
+pytestmark = pytest.mark.skipif(
+    find_chromium() is None, reason="no chromium executable: apt-get install chromium (.ci/run installs it)"
+)
 
 STEP = 1 / 60
 

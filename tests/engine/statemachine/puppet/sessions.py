@@ -27,7 +27,6 @@ from engine.components import Grabbable, Stick, Transform
 from engine.ecs import Entity
 from engine.statemachine import Brain
 from games.sandbox import GAME
-from puppetphone.games import make_app as games_make_app
 from input.hub import InputHub
 from input.motionstick import StickConfig
 from input.mouse import MouseSource
@@ -35,6 +34,7 @@ from input.mousebot import MouseBot
 from input.recording import Recorder, RecordingHeader
 from input.sample import PoseSample
 from input.source import PoseSource
+from puppetphone.games import make_app as games_make_app
 
 __all__ = ["SEED", "SESSIONS", "Session", "make_app", "record", "puppet_of", "PhoneBot", "DATA_DIR"]
 
@@ -80,8 +80,16 @@ class PhoneBot:
 
     def _push(self, touch: bool | None = None, calibrate: bool = False) -> None:
         w = self.app.world
-        self.phone.push(PoseSample(time=w.frame * w.dt, source="phone", orientation=self.orientation,
-                                   position=self.position.copy(), touch=touch, calibrate=calibrate))
+        self.phone.push(
+            PoseSample(
+                time=w.frame * w.dt,
+                source="phone",
+                orientation=self.orientation,
+                position=self.position.copy(),
+                touch=touch,
+                calibrate=calibrate,
+            )
+        )
 
     def step(self, n: int = 1) -> None:
         """Hold the phone where it is for ``n`` steps (one sample each)."""
@@ -144,8 +152,8 @@ def _walk_run(app: App, bot: MouseBot) -> None:
     bot.wait(0.3)
     bot.press_on(p)
     bot.wait(0.3)
-    bot.drag_path([P([0.0, 0, 1.2])], 0.8)   # walk
-    bot.drag_path([P([0.0, 0, 5.2])], 2.6)   # run
+    bot.drag_path([P([0.0, 0, 1.2])], 0.8)  # walk
+    bot.drag_path([P([0.0, 0, 5.2])], 2.6)  # run
     bot.wait(0.8)
     bot.release()
     bot.wait(0.2)
@@ -197,6 +205,7 @@ def _phone_jump(rise: Callable[[float], np.ndarray], seconds: float, after: floa
         bot.step(15)
         bot.move(rise, seconds)
         bot.step(int(after / app.world.dt))
+
     return script
 
 
@@ -225,7 +234,7 @@ def _held_in_air(app: App, bot: MouseBot) -> None:
     p = puppet_of(app)
     bot.wait(0.3)
     bot.press_on(p)
-    _wheel(bot, 6)          # lift well above standing height
+    _wheel(bot, 6)  # lift well above standing height
     bot.wait(0.8)
     bot.drag_path([bot.tip() + P([0.4, 0, 0.3])], 1.0)  # swing it a little
     bot.release()
@@ -238,14 +247,14 @@ def _pick_up_carry(app: App, bot: MouseBot) -> None:
     bot.press_on(p)
     bot.drag_path([P([0.0, 0, 0.45])], 0.6)
     _wheel(bot, -3)
-    bot.wait(1.6)   # crouched and still over the ball: pick up
+    bot.wait(1.6)  # crouched and still over the ball: pick up
     _wheel(bot, 3)
     bot.wait(0.3)
-    bot.drag_path([P([0.0, 0, 2.2])], 0.9)   # carry it
+    bot.drag_path([P([0.0, 0, 2.2])], 0.9)  # carry it
     bot.wait(0.6)
-    _wheel(bot, -3)                           # and put it down
+    _wheel(bot, -3)  # and put it down
     bot.wait(0.45)
-    bot.release()                             # and leave it there
+    bot.release()  # and leave it there
     bot.wait(0.3)
 
 
@@ -255,7 +264,7 @@ def _roll_snowball(app: App, bot: MouseBot) -> None:
     bot.press_on(p)
     _wheel(bot, -3)
     bot.wait(0.4)
-    bot.drag_path([P([0.0, 0, 2.4])], 0.7)   # crouch-walk into the big ball and push it
+    bot.drag_path([P([0.0, 0, 2.4])], 0.7)  # crouch-walk into the big ball and push it
     _wheel(bot, 3)
     bot.wait(0.5)
 
@@ -267,8 +276,8 @@ def _flick_while_rolling(app: App, bot: MouseBot) -> None:
     bot.press_on(p)
     _wheel(bot, -3)
     bot.wait(0.4)
-    bot.drag_path([P([0.0, 0, 2.0])], 0.7)   # crouch-walk into the big ball: rolling it
-    for _ in range(4):                        # 160 px up in four steps, and held up there
+    bot.drag_path([P([0.0, 0, 2.0])], 0.7)  # crouch-walk into the big ball: rolling it
+    for _ in range(4):  # 160 px up in four steps, and held up there
         bot.move_to_pixel((bot.pos[0], bot.pos[1] - 40.0), (1, 0, 0))
         bot.step()
     bot.wait(1.0)
@@ -305,23 +314,50 @@ class Session:
         return DATA_DIR / f"puppet_{self.name}.rec"
 
 
-SESSIONS: dict[str, Session] = {s.name: s for s in [
-    Session("walk_run", "empty", "mouse", _walk_run, "drag slowly then fast: walk then run, speed follows the stick"),
-    Session("crouch_walk", "empty", "mouse", _crouch_walk, "wheel down, drag: crouch walk; wheel up: stand"),
-    Session("jump_valid", "empty", "mouse", _valid_jump, "flick while walking: anticipation, arc, landing crouch"),
-    Session("jump_rise_again", "empty", "phone", _phone_jump(_rise_again, 1.0, 0.4),
-            "phone lifted, lowered, lifted again: invalid"),
-    Session("jump_turn", "empty", "mouse", _turn_in_air, "flick then drag sideways in the air: invalid"),
-    Session("jump_stop", "empty", "phone", _phone_jump(_stop_in_air, 0.8, 0.4),
-            "phone lifted and held still in the air: invalid"),
-    Session("held_in_air", "empty", "mouse", _held_in_air, "wheel up: held in the air, released, settles, gets up"),
-    Session("pick_up_carry", "small_ball", "mouse", _pick_up_carry, "crouch still over a small ball, stand, carry it"),
-    Session("roll_snowball", "big_ball", "mouse", _roll_snowball, "crouch-walk into a big ball: roll it"),
-    Session("flick_while_rolling", "big_ball", "mouse", _flick_while_rolling,
-            "player repro: flick up while rolling a ball; nothing is thrown out of the field"),
-    Session("deep_crouch_walk", "empty", "mouse", _deep_crouch_walk,
-            "player repro: five wheel-down clicks then a crouch-walk; no ragdoll"),
-]}
+SESSIONS: dict[str, Session] = {
+    s.name: s
+    for s in [
+        Session(
+            "walk_run", "empty", "mouse", _walk_run, "drag slowly then fast: walk then run, speed follows the stick"
+        ),
+        Session("crouch_walk", "empty", "mouse", _crouch_walk, "wheel down, drag: crouch walk; wheel up: stand"),
+        Session("jump_valid", "empty", "mouse", _valid_jump, "flick while walking: anticipation, arc, landing crouch"),
+        Session(
+            "jump_rise_again",
+            "empty",
+            "phone",
+            _phone_jump(_rise_again, 1.0, 0.4),
+            "phone lifted, lowered, lifted again: invalid",
+        ),
+        Session("jump_turn", "empty", "mouse", _turn_in_air, "flick then drag sideways in the air: invalid"),
+        Session(
+            "jump_stop",
+            "empty",
+            "phone",
+            _phone_jump(_stop_in_air, 0.8, 0.4),
+            "phone lifted and held still in the air: invalid",
+        ),
+        Session("held_in_air", "empty", "mouse", _held_in_air, "wheel up: held in the air, released, settles, gets up"),
+        Session(
+            "pick_up_carry", "small_ball", "mouse", _pick_up_carry, "crouch still over a small ball, stand, carry it"
+        ),
+        Session("roll_snowball", "big_ball", "mouse", _roll_snowball, "crouch-walk into a big ball: roll it"),
+        Session(
+            "flick_while_rolling",
+            "big_ball",
+            "mouse",
+            _flick_while_rolling,
+            "player repro: flick up while rolling a ball; nothing is thrown out of the field",
+        ),
+        Session(
+            "deep_crouch_walk",
+            "empty",
+            "mouse",
+            _deep_crouch_walk,
+            "player repro: five wheel-down clicks then a crouch-walk; no ragdoll",
+        ),
+    ]
+}
 
 
 def record(session: Session, path: Path | None = None) -> App:
@@ -330,8 +366,14 @@ def record(session: Session, path: Path | None = None) -> App:
     src: PoseSource = MouseSource() if session.source == "mouse" else ScriptedPhone()
     hub = InputHub([src])
     app = make_app(session.scene, hub)
-    header = RecordingHeader(game="sandbox", seed=SEED, dt=app.world.dt, sources=[session.source],
-                             setup={"scene": session.scene}, extra={"session": session.name})
+    header = RecordingHeader(
+        game="sandbox",
+        seed=SEED,
+        dt=app.world.dt,
+        sources=[session.source],
+        setup={"scene": session.scene},
+        extra={"session": session.name},
+    )
     with Recorder(path, header).attach(app):
         if session.source == "mouse":
             session.script(app, MouseBot(app, src, GAME.camera()))  # type: ignore[arg-type]

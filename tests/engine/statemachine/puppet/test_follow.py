@@ -129,14 +129,22 @@ def test_the_drag_reach_grows_with_the_puppets_speed_not_the_sticks() -> None:
 _AT = np.array([1.0, 0.9, 2.0])  # where the puppet stands (its hips): not the origin
 
 
-def _puppet(heading: float = 0.0, walk: np.ndarray | None = None, ahead: np.ndarray | None = None,
-            lead: np.ndarray | None = None, held: bool = True) -> tuple[World, int, PuppetBody, _Player]:
+def _puppet(
+    heading: float = 0.0,
+    walk: np.ndarray | None = None,
+    ahead: np.ndarray | None = None,
+    lead: np.ndarray | None = None,
+    held: bool = True,
+) -> tuple[World, int, PuppetBody, _Player]:
     """A puppet at ``_AT`` whose stick is ``ahead`` of it (world offset), moving at ``lead``."""
     world = World(dt=DT)
-    body = PuppetBody(held_by=7 if held else None, heading=heading,
-                      target=_AT + (np.zeros(3) if ahead is None else ahead),
-                      lead=np.zeros(3) if lead is None else lead,
-                      walk_velocity=np.zeros(3) if walk is None else walk)
+    body = PuppetBody(
+        held_by=7 if held else None,
+        heading=heading,
+        target=_AT + (np.zeros(3) if ahead is None else ahead),
+        lead=np.zeros(3) if lead is None else lead,
+        walk_velocity=np.zeros(3) if walk is None else walk,
+    )
     entity = world.spawn(Transform(position=np.array(_AT)), body)
     return world, entity, body, _Player()
 
@@ -185,8 +193,9 @@ def test_turning_at_the_same_speed_is_not_braking() -> None:
 def test_the_lead_band_is_passed_on() -> None:
     """Crouched (a 6 cm lead band), a stick 3 cm ahead gives half its velocity."""
     world, e, body, player = _puppet(ahead=_v(0.0, 0.03), lead=_v(0.0, 1.0))
-    v, _ = spring_step(np.zeros(3), np.zeros(3), wanted_velocity(_v(0.0, 0.03), _v(0.0, 1.0), T, 0.06),
-                       T.follow_omega, DT)
+    v, _ = spring_step(
+        np.zeros(3), np.zeros(3), wanted_velocity(_v(0.0, 0.03), _v(0.0, 1.0), T, 0.06), T.follow_omega, DT
+    )
     follow_velocity(world, e, body, player, lead_band=0.06)
     assert body.walk_velocity == pytest.approx(v)
 
@@ -232,8 +241,9 @@ def test_the_turn_takes_the_short_way_across_the_back() -> None:
     """Facing 175°, led toward -175°: it turns 10° through 180°, not 350° the long way, and its heading
     stays in [-π, π)."""
     d = np.radians(-175.0)
-    world, e, body, player = _puppet(heading=np.radians(175.0), walk=2.0 * _v(np.sin(d), np.cos(d)),
-                                     ahead=5.0 * _v(np.sin(d), np.cos(d)))
+    world, e, body, player = _puppet(
+        heading=np.radians(175.0), walk=2.0 * _v(np.sin(d), np.cos(d)), ahead=5.0 * _v(np.sin(d), np.cos(d))
+    )
     before = body.heading
     for _ in range(3):
         follow_velocity(world, e, body, player)

@@ -31,11 +31,16 @@ T = PuppetTuning()
 _AT = np.array([1.0, 0.9, 2.0])
 
 
-def _puppet(tuning: PuppetTuning = T, held: bool = True, height: float = 0.95,
-            ahead: np.ndarray | None = None) -> tuple[World, int, PuppetBody, LocomotionPlayer, IKRequest, Brain]:
+def _puppet(
+    tuning: PuppetTuning = T, held: bool = True, height: float = 0.95, ahead: np.ndarray | None = None
+) -> tuple[World, int, PuppetBody, LocomotionPlayer, IKRequest, Brain]:
     world = World()
-    body = PuppetBody(tuning=tuning, held_by=5 if held else None, target_height=height,
-                      target=_AT + (np.zeros(3) if ahead is None else ahead))
+    body = PuppetBody(
+        tuning=tuning,
+        held_by=5 if held else None,
+        target_height=height,
+        target=_AT + (np.zeros(3) if ahead is None else ahead),
+    )
     player, ik = LocomotionPlayer(), IKRequest()
     ik.grounding, ik.sphere_centre, ik.sphere_radius = False, np.array([0.0, 1.0, 0.0]), 0.3
     brain = Brain(machine=None)  # type: ignore[arg-type]
@@ -57,7 +62,10 @@ def test_the_spring_controller_follows_with_the_foot_locks_on(followers: list) -
     ik.foot_lock.enabled = False
     follow_stick(world, e, body, player)
     follow_stick(world, e, body, player, speed_scale=0.5, lead_band=0.06)
-    assert followers == [("spring", (world, e, body, player, 1.0, 0.02)), ("spring", (world, e, body, player, 0.5, 0.06))]
+    assert followers == [
+        ("spring", (world, e, body, player, 1.0, 0.02)),
+        ("spring", (world, e, body, player, 0.5, 0.06)),
+    ]
     assert ik.foot_lock.enabled is True
 
 
@@ -101,12 +109,15 @@ def test_a_lifted_puppet_leaves_the_ground_states_even_at_its_stick() -> None:
     assert not locomotion_fits(world, e, None)  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize(("held", "height", "asked"), [
-    (False, 0.3, None),  # released: stand tall, whatever the stick's last height
-    (True, T.crouch_exit, None),  # at the exit height: standing
-    (True, T.crouch_exit - 0.01, T.crouch_exit - 0.01),  # a slight dip
-    (True, T.crouch_enter - 0.2, T.crouch_enter),  # never lower than the crouch's entry in Locomotion
-])
+@pytest.mark.parametrize(
+    ("held", "height", "asked"),
+    [
+        (False, 0.3, None),  # released: stand tall, whatever the stick's last height
+        (True, T.crouch_exit, None),  # at the exit height: standing
+        (True, T.crouch_exit - 0.01, T.crouch_exit - 0.01),  # a slight dip
+        (True, T.crouch_enter - 0.2, T.crouch_enter),  # never lower than the crouch's entry in Locomotion
+    ],
+)
 def test_locomotion_stands_tall_or_dips_with_the_stick(held: bool, height: float, asked: float | None) -> None:
     world, e, _body, player, ik, brain = _puppet(held=held, height=height)
     hand = world.get(e, Handling)

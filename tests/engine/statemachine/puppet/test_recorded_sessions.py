@@ -28,11 +28,10 @@ from engine.ragdoll.components import Prop, Ragdoll
 from engine.statemachine import Brain
 from engine.statemachine.puppet import Jumping, PuppetBody
 from engine.statemachine.puppet.words import describe_puppet
-from games.sandbox import GAME
+from games.sandbox import BIG_BALL, GAME
 from input.hub import InputHub
 from input.mouse import MouseSource
 from input.mousebot import MouseBot
-from games.sandbox import BIG_BALL
 from input.recording import read_recording
 from input.replay import verify
 
@@ -149,8 +148,11 @@ def test_walk_then_run_speed_follows_the_stick() -> None:
 # -- (2) crouch walk ------------------------------------------------------------------
 def test_crouch_walk_lowers_the_hips_and_walks() -> None:
     w = replay("crouch_walk")
-    assert transitions(w) == [("-", "Locomotion", "start"), ("Locomotion", "Crouch", "lowered"),
-                              ("Crouch", "Locomotion", "raised")]
+    assert transitions(w) == [
+        ("-", "Locomotion", "start"),
+        ("Locomotion", "Crouch", "lowered"),
+        ("Crouch", "Locomotion", "raised"),
+    ]
     state, hips = w.state, w.arr("hips")
     crouch = np.array([s == "Crouch" for s in state])
     assert hips[:15].min() > 0.9  # standing before the wheel turns
@@ -169,8 +171,12 @@ def test_crouch_walk_lowers_the_hips_and_walks() -> None:
 # -- (3) a valid jump -----------------------------------------------------------------
 def test_valid_jump_anticipates_reaches_its_apex_and_lands() -> None:
     w = replay("jump_valid")
-    assert transitions(w) == [("-", "Locomotion", "start"), ("Locomotion", "Jump", "flick"),
-                              ("Jump", "Land", "landed"), ("Land", "Locomotion", "absorbed")]
+    assert transitions(w) == [
+        ("-", "Locomotion", "start"),
+        ("Locomotion", "Jump", "flick"),
+        ("Jump", "Land", "landed"),
+        ("Land", "Locomotion", "absorbed"),
+    ]
     flick = w.first("flick", True)
     jump = w.first("state", "Jump")
     take_off = w.first("phase", "air")
@@ -198,15 +204,21 @@ def test_valid_jump_anticipates_reaches_its_apex_and_lands() -> None:
 
 
 # -- (4-6) invalid jumps --------------------------------------------------------------
-@pytest.mark.parametrize("name, reason", [
-    ("jump_rise_again", "rose again after starting to fall"),
-    ("jump_turn", "turned in the air"),
-    ("jump_stop", "stopped in the air"),
-])
+@pytest.mark.parametrize(
+    "name, reason",
+    [
+        ("jump_rise_again", "rose again after starting to fall"),
+        ("jump_turn", "turned in the air"),
+        ("jump_stop", "stopped in the air"),
+    ],
+)
 def test_invalid_jump_ends_in_ragdoll(name: str, reason: str) -> None:
     w = replay(name)
-    assert transitions(w) == [("-", "Locomotion", "start"), ("Locomotion", "Jump", "flick"),
-                              ("Jump", "Ragdoll", "jump_invalid")]
+    assert transitions(w) == [
+        ("-", "Locomotion", "start"),
+        ("Locomotion", "Jump", "flick"),
+        ("Jump", "Ragdoll", "jump_invalid"),
+    ]
     assert w.jump.invalid is not None and w.jump.invalid.value == reason
     take_off = w.first("phase", "air")
     fell = w.first("state", "Ragdoll")
@@ -221,16 +233,20 @@ def test_phone_jumps_ride_the_stick_and_the_mouse_jump_is_ballistic() -> None:
         take_off = w.first("phase", "air")
         fell = w.first("state", "Ragdoll")
         # Riding the phone: the hips are where the stick holds them.
-        th = w.arr("target_height")[take_off + 1:fell]
-        hips = w.arr("pos")[take_off + 1:fell, 1] + STAND
+        th = w.arr("target_height")[take_off + 1 : fell]
+        hips = w.arr("pos")[take_off + 1 : fell, 1] + STAND
         assert np.allclose(hips, th, atol=1e-9)
 
 
 # -- (7) held in the air --------------------------------------------------------------
 def test_held_in_the_air_falls_settles_and_gets_up() -> None:
     w = replay("held_in_air")
-    assert transitions(w) == [("-", "Locomotion", "start"), ("Locomotion", "Ragdoll", "no state fits"),
-                              ("Ragdoll", "GetUp", "settled"), ("GetUp", "Locomotion", "standing")]
+    assert transitions(w) == [
+        ("-", "Locomotion", "start"),
+        ("Locomotion", "Ragdoll", "no state fits"),
+        ("Ragdoll", "GetUp", "settled"),
+        ("GetUp", "Locomotion", "standing"),
+    ]
     fell = w.first("state", "Ragdoll")
     assert w.held[fell] and w.target_height[fell] > STAND + 0.25
     released = fell + w.held[fell:].index(False)
@@ -254,11 +270,11 @@ def test_pick_up_carry_and_put_down() -> None:
     ball = w.arr("ball")
     pick, carry, put = w.first("state", "PickUp"), w.first("state", "Carry"), w.first("state", "PutDown")
     assert ball[:pick, 1] == pytest.approx(0.14, abs=0.01)  # resting on the ground
-    assert float(ground_speed(w)[pick - 10:pick].mean()) < 0.2  # still when it reached
-    carried = ball[carry + 30:put]
+    assert float(ground_speed(w)[pick - 10 : pick].mean()) < 0.2  # still when it reached
+    carried = ball[carry + 30 : put]
     assert carried[:, 1].min() > 0.9  # in front of the chest
     pos = w.arr("pos")
-    gap = np.linalg.norm((carried - pos[carry + 30:put])[:, [0, 2]], axis=1)
+    gap = np.linalg.norm((carried - pos[carry + 30 : put])[:, [0, 2]], axis=1)
     assert gap == pytest.approx(0.22 + 0.14, abs=0.02)  # kept in front of the puppet
     assert np.linalg.norm((ball[put] - ball[carry])[[0, 2]]) > 1.0  # carried along
     assert ball[-1][1] == pytest.approx(0.14, abs=0.02)  # set down on the ground
@@ -268,8 +284,12 @@ def test_pick_up_carry_and_put_down() -> None:
 # -- (9) roll a snowball --------------------------------------------------------------
 def test_crouch_walking_into_a_big_ball_rolls_it() -> None:
     w = replay("roll_snowball")
-    assert transitions(w) == [("-", "Locomotion", "start"), ("Locomotion", "Crouch", "lowered"),
-                              ("Crouch", "RollSnowball", "pushes a ball"), ("RollSnowball", "Locomotion", "stood up")]
+    assert transitions(w) == [
+        ("-", "Locomotion", "start"),
+        ("Locomotion", "Crouch", "lowered"),
+        ("Crouch", "RollSnowball", "pushes a ball"),
+        ("RollSnowball", "Locomotion", "stood up"),
+    ]
     ball, rot = w.arr("ball"), w.arr("ball_rot")
     start = w.first("state", "RollSnowball")
     stop = start + w.state[start:].index("Locomotion")
@@ -279,12 +299,12 @@ def test_crouch_walking_into_a_big_ball_rolls_it() -> None:
     assert np.allclose(ball[start:stop, 1], 0.3, atol=1e-9)  # on the ground
     # Rolling without slipping: each step turns it by distance / radius.
     step = np.linalg.norm(np.diff(ball[start:stop, :], axis=0)[:, [0, 2]], axis=1)
-    dots = np.abs(np.einsum("ij,ij->i", rot[start:stop - 1], rot[start + 1:stop]))
+    dots = np.abs(np.einsum("ij,ij->i", rot[start : stop - 1], rot[start + 1 : stop]))
     turned = 2 * np.arccos(np.clip(dots, -1.0, 1.0))
     assert np.allclose(turned, step / 0.3, atol=1e-4)
     # Pushed ahead of the puppet, crouched.
     pos = w.arr("pos")
-    assert np.all(ball[start + 1:stop, 2] > pos[start + 1:stop, 2] + 0.3)
+    assert np.all(ball[start + 1 : stop, 2] > pos[start + 1 : stop, 2] + 0.3)
     hips = w.arr("hips")
     assert float(np.median(hips[start:stop])) < 0.75
 
@@ -301,14 +321,17 @@ def in_order(words: list[str], expected: list[str]) -> bool:
     return all(any(w == e for w in it) for e in expected)
 
 
-@pytest.mark.parametrize("name,expected", [
-    ("walk_run", ["standing", "walking", "running"]),
-    ("crouch_walk", ["crouching", "crouch-walking"]),
-    ("roll_snowball", ["rolling a snowball"]),
-    ("pick_up_carry", ["picking up a ball", "carrying a ball"]),
-    ("jump_valid", ["getting ready to jump", "in the air", "landing"]),
-    ("held_in_air", ["hanging from the stick", "fell over", "getting up", "standing"]),
-])
+@pytest.mark.parametrize(
+    "name,expected",
+    [
+        ("walk_run", ["standing", "walking", "running"]),
+        ("crouch_walk", ["crouching", "crouch-walking"]),
+        ("roll_snowball", ["rolling a snowball"]),
+        ("pick_up_carry", ["picking up a ball", "carrying a ball"]),
+        ("jump_valid", ["getting ready to jump", "in the air", "landing"]),
+        ("held_in_air", ["hanging from the stick", "fell over", "getting up", "standing"]),
+    ],
+)
 def test_sessions_read_in_a_players_words(name: str, expected: list[str]) -> None:
     words = words_along(name)
     assert in_order(words, expected), words
@@ -338,7 +361,7 @@ def test_the_reason_of_a_fall_goes_once_the_puppet_is_up() -> None:
         seen.append(describe_puppet(app.world, p, brain))
     words = [w for w, _ in groupby(seen)]
     assert in_order(words, ["getting up", "standing"]), words
-    assert not any("invalid" in w for w in words[words.index("getting up"):]), words
+    assert not any("invalid" in w for w in words[words.index("getting up") :]), words
     assert words[-1] == "standing"
 
 

@@ -53,7 +53,9 @@ def test_a_registered_state_is_entered_run_and_left() -> None:
         steps += 1
     assert steps == pytest.approx(wave.WAVE_TIME / world.dt, abs=1)
     assert [(t.source, t.target, t.reason) for t in brain.trace[-2:]] == [
-        (PuppetState.LOCOMOTION, wave.WAVE, wave.WAVE_EVENT), (wave.WAVE, PuppetState.LOCOMOTION, "waved")]
+        (PuppetState.LOCOMOTION, wave.WAVE, wave.WAVE_EVENT),
+        (wave.WAVE, PuppetState.LOCOMOTION, "waved"),
+    ]
 
 
 def _one_by_one(world: World) -> None:
