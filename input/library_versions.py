@@ -26,6 +26,8 @@ NUMERIC_LIBRARIES = (
     "cma",
     "opencv-python-headless",
     "pillow",
+    "numba",  # the crowd's compiled kernels round their sums their own way
+    "llvmlite",
 )
 _MAX_NAME = 64
 

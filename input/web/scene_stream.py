@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.errors import FormatError
 from engine.render.scene import RenderScene
 
 __all__ = [
@@ -75,7 +76,7 @@ _RECT = struct.Struct("<HHHH")
 _COUNT = struct.Struct("<I")
 
 
-class FrameError(ValueError):
+class FrameError(FormatError):
     """Bytes that are not a scene frame of this version."""
 
 

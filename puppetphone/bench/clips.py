@@ -32,7 +32,7 @@ SWEEP = (0.6, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.5)
 
 def cmu_walk():  # type: ignore[no-untyped-def]
     """The CMU 16_15 walk as the library's walk (``None`` without the data)."""
-    root = Path(os.environ.get("PUPPETPHONE_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+    root = Path(os.environ.get("PUPPETPHONE_DATA", Path(__file__).resolve().parents[3] / "shared" / "data"))
     path = root / "mocap" / "cmu_16_15_walk_daz.bvh"
     if not path.is_file():
         return None

@@ -68,7 +68,7 @@ def _mocap_walk() -> float | None:
 
     from authoring.cycles.formats import load_performance
 
-    root = Path(os.environ.get("PUPPETPHONE_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+    root = Path(os.environ.get("PUPPETPHONE_DATA", Path(__file__).resolve().parents[3] / "shared" / "data"))
     path = root / "mocap" / "cmu_16_15_walk_daz.bvh"
     if not path.is_file():
         return None

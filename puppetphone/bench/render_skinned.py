@@ -29,7 +29,7 @@ WIDTH, HEIGHT = 1280, 720
 
 def character_file() -> Path | None:
     """CesiumMan.glb in ``$PUPPETPHONE_DATA/mocap`` or ``shared/data/mocap`` beside the project, if there."""
-    here = Path(__file__).resolve().parent.parent
+    here = Path(__file__).resolve().parents[2]  # the checkout: puppetphone/bench/ is two levels down
     roots = [Path(os.environ["PUPPETPHONE_DATA"])] if os.environ.get("PUPPETPHONE_DATA") else []
     roots.append(here.parent / "shared" / "data")
     return next((r / "mocap" / "CesiumMan.glb" for r in roots if (r / "mocap" / "CesiumMan.glb").is_file()), None)

@@ -47,13 +47,16 @@ def _with_header(path: Path, edit) -> None:  # type: ignore[no-untyped-def]
     path.write_bytes(MAGIC + struct.pack("<II", len(raw), zlib.crc32(raw)) + raw + data[start + n :])
 
 
+GATE_TOOLS = ("mypy", "ruff")  # pinned so the type and lint gate flags the same things everywhere
+
+
 def test_the_list_is_exactly_what_constraints_pins() -> None:
     pinned = [
         line.split("==")[0].strip().lower()
         for line in (ROOT / "constraints.txt").read_text().splitlines()
         if "==" in line and not line.lstrip().startswith("#")
     ]
-    assert sorted(NUMERIC_LIBRARIES) == sorted(pinned)
+    assert sorted(NUMERIC_LIBRARIES) == sorted(p for p in pinned if p not in GATE_TOOLS)
 
 
 def test_one_line_names_what_differs() -> None:
@@ -109,7 +112,10 @@ def test_a_recording_from_before_the_versions_reads_and_verifies_with_no_note(re
     assert "all 10 state hashes match" in done.stdout
 
 
-@pytest.mark.parametrize("bad", [[], {"mujoco": 4}, {"": "1"}, {"mujoco": "x" * 65}, {f"l{i}": "1" for i in range(41)}])
+@pytest.mark.parametrize(
+    "bad",
+    [[], {"mujoco": 4}, {"": "1"}, {"mujoco": "x" * 65}, {f"l{i}": "1" for i in range(4 * len(NUMERIC_LIBRARIES) + 1)}],
+)
 def test_a_bad_versions_field_is_one_line(recording: Path, bad: object) -> None:
     _with_header(recording, lambda head: head.update(libraries=bad))
     with pytest.raises(RecordingError, match="libraries must"):

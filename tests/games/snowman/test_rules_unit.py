@@ -17,7 +17,7 @@ from engine.ecs import World
 from engine.ragdoll.components import Prop
 from engine.statemachine import Brain
 from engine.statemachine.machine import State, StateMachine
-from engine.statemachine.puppet import PuppetBody, PuppetMachine
+from engine.statemachine.puppet import Handling, PuppetBody, PuppetMachine
 from games.snowman import rules
 from games.snowman.components import Snowball, Snowman, SnowmanStats, Stacked, StackWatch
 from games.snowman.snow import SnowField
@@ -32,9 +32,9 @@ def world(field: SnowField | None = None) -> World:
     return w
 
 
-def brain(active: str, **memory: object) -> Brain:
+def brain(active: str) -> Brain:
     machine = StateMachine("m", [State(active), State("Other")], [], default=active)
-    return Brain(machine=machine, active=active, memory=dict(memory))
+    return Brain(machine=machine, active=active)
 
 
 def on_top(w: World, lower: int, radius: float) -> int:
@@ -109,12 +109,12 @@ def test_a_held_ball_neither_packs_on_nor_takes_one() -> None:
     w.get(stick, Stick).grabbed = big  # the bottom ball in the hand: nothing packs onto it
     rules.stick_stacked_balls(w)
     assert not w.has(small, Stacked)
-    carrier = w.spawn(PuppetBody())
+    carrier = w.spawn(PuppetBody(), Handling())
     w.get(stick, Stick).grabbed = None
-    w.get(carrier, PuppetBody).object = big  # carried by a puppet: the same
+    w.get(carrier, Handling).object = big  # carried by a puppet: the same
     rules.stick_stacked_balls(w)
     assert not w.has(small, Stacked)
-    w.get(carrier, PuppetBody).object = None
+    w.get(carrier, Handling).object = None
     rules.stick_stacked_balls(w)
     assert w.get(small, Stacked).on == big
 
@@ -282,11 +282,11 @@ def test_every_puppet_putting_down_is_aimed() -> None:
     bottom = rules.spawn_ball(w, np.zeros(3), 0.5)
     middle = on_top(w, bottom, 0.35)
     rules.stick_stacked_balls(w)
-    w.spawn(PuppetBody(), brain("Walk", putdown_on=bottom))
+    w.spawn(PuppetBody(), Handling(onto=bottom), brain("Walk"))
     held = rules.spawn_ball(w, np.array([3.0, 0.0, 0.0]), 0.2)
-    puppet = w.spawn(PuppetBody(object=held), brain("PutDown", putdown_on=bottom))
+    puppet = w.spawn(PuppetBody(), Handling(object=held, onto=bottom), brain("PutDown"))
     rules.aim_putdown_on_stacks(w)
-    assert w.get(puppet, Brain).memory["putdown_on"] == middle
+    assert w.get(puppet, Handling).onto == middle
 
 
 def test_putting_a_ball_down_on_a_stack_aims_at_its_top() -> None:
@@ -295,13 +295,13 @@ def test_putting_a_ball_down_on_a_stack_aims_at_its_top() -> None:
     middle = on_top(w, bottom, 0.35)
     rules.stick_stacked_balls(w)
     held = rules.spawn_ball(w, np.array([3.0, 0.0, 0.0]), 0.2)
-    puppet = w.spawn(PuppetBody(object=held), brain("PutDown", putdown_on=bottom))
+    puppet = w.spawn(PuppetBody(), Handling(object=held, onto=bottom), brain("PutDown"))
     rules.aim_putdown_on_stacks(w)
-    assert w.get(puppet, Brain).memory["putdown_on"] == middle
-    w.get(puppet, Brain).memory["putdown_on"] = bottom
+    assert w.get(puppet, Handling).onto == middle
+    w.get(puppet, Handling).onto = bottom
     w.get(held, Prop).radius = 0.35  # not smaller than the top: aim stays at the base
     rules.aim_putdown_on_stacks(w)
-    assert w.get(puppet, Brain).memory["putdown_on"] == bottom
+    assert w.get(puppet, Handling).onto == bottom
 
 
 @pytest.mark.parametrize("case", ["other state", "no stack", "nothing held", "held gone"])
@@ -313,12 +313,12 @@ def test_putdown_aim_is_left_alone_outside_putting_down_on_a_stack(case: str) ->
     held = rules.spawn_ball(w, np.array([3.0, 0.0, 0.0]), 0.2)
     loose = rules.spawn_ball(w, np.array([-3.0, 0.0, 0.0]), 0.5)
     aim = loose if case == "no stack" else bottom
-    body = PuppetBody(object=None if case == "nothing held" else held)
-    puppet = w.spawn(body, brain("Walk" if case == "other state" else "PutDown", putdown_on=aim))
+    hand = Handling(object=None if case == "nothing held" else held, onto=aim)
+    puppet = w.spawn(PuppetBody(), hand, brain("Walk" if case == "other state" else "PutDown"))
     if case == "held gone":
         w.despawn(held)
     rules.aim_putdown_on_stacks(w)
-    assert w.get(puppet, Brain).memory["putdown_on"] == aim
+    assert w.get(puppet, Handling).onto == aim
 
 
 def test_climbing_a_stack_stops_below_the_held_ball() -> None:
@@ -329,9 +329,9 @@ def test_climbing_a_stack_stops_below_the_held_ball() -> None:
     rules.stick_stacked_balls(w)
     held = on_top(w, middle, 0.2)
     w.add(held, Stacked(on=middle))
-    puppet = w.spawn(PuppetBody(object=held), brain("PutDown", putdown_on=bottom))
+    puppet = w.spawn(PuppetBody(), Handling(object=held, onto=bottom), brain("PutDown"))
     rules.aim_putdown_on_stacks(w)
-    assert w.get(puppet, Brain).memory["putdown_on"] == middle
+    assert w.get(puppet, Handling).onto == middle
 
 
 def crouch_walker(w: World) -> int:

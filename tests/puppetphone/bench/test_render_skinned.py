@@ -30,6 +30,6 @@ def test_without_the_character_file_it_says_so_and_gives_nothing(
     import puppetphone.bench.render_skinned as bench
 
     monkeypatch.setenv("PUPPETPHONE_DATA", str(tmp_path))
-    monkeypatch.setattr(bench, "_character_file", lambda: None)
+    monkeypatch.setattr(bench, "character_file", lambda: None)
     assert bench.run() == []
     assert "CesiumMan.glb not found" in capsys.readouterr().err
