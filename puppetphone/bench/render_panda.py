@@ -25,8 +25,8 @@ __all__ = ["measure"]
 
 def measure(actors: int = 100, frames: int = 5, repeats: int = 3) -> tuple[float, int]:
     """``(process CPU seconds per frame, triangles per frame)`` of ``actors`` walking pandas."""
-    from direct.actor.Actor import Actor  # type: ignore[import-untyped]  # Panda3D ships no type stubs
-    from direct.showbase.ShowBase import ShowBase  # type: ignore[import-untyped]  # (same)
+    from direct.actor.Actor import Actor
+    from direct.showbase.ShowBase import ShowBase
     from panda3d.core import loadPrcFileData
 
     loadPrcFileData(
