@@ -18,10 +18,17 @@ __all__ = ["set_contact_bits"]
 
 
 def set_contact_bits(m: mujoco.MjModel, geoms: NDArray[np.int64], contype: ArrayLike, conaffinity: ArrayLike) -> None:
-    """Give ``geoms`` these bits (scalars or one per geom) and recompute their bodies' aggregates."""
+    """Give ``geoms`` these bits (scalars or one per geom) and recompute the aggregates of the bodies
+    whose geoms changed. Called every physics step, where usually nothing changes: then it only compares."""
     geoms = np.asarray(geoms, dtype=np.int64)
-    m.geom_contype[geoms] = contype
-    m.geom_conaffinity[geoms] = conaffinity
+    new_type = np.broadcast_to(np.asarray(contype, dtype=m.geom_contype.dtype), geoms.shape)
+    new_affinity = np.broadcast_to(np.asarray(conaffinity, dtype=m.geom_conaffinity.dtype), geoms.shape)
+    changed = (m.geom_contype[geoms] != new_type) | (m.geom_conaffinity[geoms] != new_affinity)
+    if not changed.any():
+        return
+    geoms = geoms[changed]
+    m.geom_contype[geoms] = new_type[changed]
+    m.geom_conaffinity[geoms] = new_affinity[changed]
     bodies = np.unique(m.geom_bodyid[geoms])
     of_bodies = np.nonzero(np.isin(m.geom_bodyid, bodies))[0]  # every geom of those bodies, not only these
     owner = m.geom_bodyid[of_bodies]
