@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import importlib.metadata
+import importlib.util
 import os
+import pickle
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -139,8 +144,49 @@ settings.register_profile(
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
+def _kernel_caches_fresh() -> bool:
+    """Whether numba's index file of every kernel module is newer than its source and was written by
+    the numba installed here (an index starts with the pickled version that wrote it)."""
+    version = importlib.metadata.version("numba")
+    kernels = [p for p in (_ROOT / "engine").rglob("*.py") if "njit\n" in p.read_text(encoding="utf-8")]
+    for source in kernels:
+        indexes = list((source.parent / "__pycache__").glob(f"{source.stem}.*.nbi"))
+        if not indexes or min(i.stat().st_mtime for i in indexes) < source.stat().st_mtime:
+            return False
+        for index in indexes:
+            try:
+                with index.open("rb") as f:
+                    if pickle.load(f) != version:  # our own cache files, written by numba
+                        return False
+            except (OSError, EOFError, pickle.UnpicklingError):
+                return False
+    return True
+
+
+def _compile_kernels_once(config: pytest.Config) -> None:
+    """Compile the numba kernels into their on-disk cache before any worker starts.
+
+    A clean checkout has no cache: without this, every xdist worker and every command a test
+    starts as a subprocess compiles the same kernels (about 15 s of CPU each) until one of them
+    has written the cache. Two short runs of the real command line reach every kernel the games
+    use (the crowd path with several puppets, the snowman path); the workers then load them.
+    """
+    if hasattr(config, "workerinput") or os.environ.get("PUPPETPHONE_NUMPY"):
+        return
+    if importlib.util.find_spec("numba") is None or _kernel_caches_fresh():
+        return
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
+    for args in (["sandbox", "--puppets", "4", "--frames", "30"], ["snowman", "--frames", "2"]):
+        cmd = [sys.executable, "-m", "puppetphone", "play", *args, "--headless"]
+        done = subprocess.run(cmd, env=env, cwd=_ROOT, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            raise pytest.UsageError(f"compiling the kernels failed: {' '.join(cmd)}\n{done.stderr}")
+
+
 def pytest_configure(config: pytest.Config) -> None:
-    """``pytest -m fuzz``: the fuzz tests only, each a long campaign (50,000 cases, a fresh seed)."""
+    """Kernels compiled once; ``pytest -m fuzz``: the fuzz tests only, each a long campaign
+    (50,000 cases, a fresh seed)."""
+    _compile_kernels_once(config)
     if "fuzz" in (config.option.markexpr or "") and "not fuzz" not in config.option.markexpr:
         settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "fuzz"))
         os.environ.setdefault("FUZZ_CASES", "50000")

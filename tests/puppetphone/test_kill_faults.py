@@ -3,7 +3,8 @@
 Each test runs the product's own save path in a child process that saves over and over,
 each time something different (``clips add`` of two walks in turn through the command's own
 ``main``, F5 in a live snowman game, Ctrl+S in a live ``author edit`` session after an edit,
-a ``cycles`` batch), kills it with SIGKILL at a few seeded random moments, and checks that
+a ``cycles`` batch), kills it with SIGKILL at a few seeded points (after a counted number of
+saves, some way into the next), and checks that
 what was saved before the kill is still there and opens: the library loads its walk (one
 of the two), the field loads, the edited clip opens with its session file, the index reads
 and every clip file it names has its recorded SHA-256. A handful of kill points each keeps
@@ -33,8 +34,25 @@ def _kill_points(n: int = KILLS, seed: int = 30, longest: float = 0.6) -> list[f
     return [float(x) for x in np.random.default_rng(seed).uniform(0.0, longest, n)]
 
 
-def _kill_after(argv: list[str], delay: float, env: dict[str, str] | None = None) -> None:
-    """Start a saver, wait for its first save ("go"), let it run ``delay`` s more, SIGKILL it."""
+SavePoint = tuple[int, float]
+
+
+def _save_points(n: int = KILLS, seed: int = 30) -> list[SavePoint]:
+    """Where to kill a saver: after how many more saves, then how far into the next one.
+
+    Counted saves, not seconds, keep the kills apart on a loaded machine: the saves counted differ
+    between kill points (1, 2, … in a seeded order), so the file on disk at each kill differs too;
+    the seconds only place the kill inside the save under way (a save takes a few ms to ~0.1 s).
+    """
+    rng = np.random.default_rng(seed)
+    counts = rng.permutation(np.arange(1, n + 1)) if n <= 8 else rng.integers(1, 9, n)
+    return [(int(c), float(d)) for c, d in zip(counts, rng.uniform(0.0, 0.1, n), strict=True)]
+
+
+def _kill_after(argv: list[str], point: SavePoint, env: dict[str, str] | None = None) -> None:
+    """Start a saver, wait for its first save ("go") and ``point[0]`` more ("s" each), then ``point[1]``
+    seconds into the next save, SIGKILL it."""
+    saves, delay = point
     with subprocess.Popen(
         [sys.executable, "-c", *argv],
         stdout=subprocess.PIPE,
@@ -42,11 +60,18 @@ def _kill_after(argv: list[str], delay: float, env: dict[str, str] | None = None
         env={**os.environ, "SDL_VIDEODRIVER": "dummy", **(env or {})},
     ) as proc:
         assert proc.stdout is not None and proc.stderr is not None
-        for line in proc.stdout:  # the command's own lines, then "go"
+        lines = iter(proc.stdout)
+        for line in lines:  # the command's own lines, then "go"
             if line == b"go\n":
                 break
         else:
             pytest.fail(f"the saver ended before its first save: {proc.stderr.read().decode()[-2000:]}")
+        counted = 0
+        while counted < saves:  # a save's own lines (``clips add`` prints what it added), then "s"
+            line = next(lines, None)
+            if line is None:
+                pytest.fail(f"the saver stopped saving: {proc.stderr.read().decode()[-2000:]}")
+            counted += line == b"s\n"
         time.sleep(delay)
         proc.send_signal(signal.SIGKILL)
         proc.wait(30)
@@ -60,16 +85,18 @@ assert main(["clips", "add", a, "--role", "walk", "--clips", library]) == 0
 print("go", flush=True)
 for i in range(10**6):
     assert main(["clips", "add", (b, a)[i % 2], "--role", "walk", "--clips", library]) == 0
+    print("s", flush=True)
 """
 
 
-def _campaign(n: int | None = None) -> list[float]:
-    """The kill points: :data:`KILLS` in every run, ``FUZZ_CASES`` under ``-m fuzz``."""
+def _campaign() -> tuple[list[SavePoint], list[float]]:
+    """The kill points (for the savers, for the batch): :data:`KILLS` in every run, ``FUZZ_CASES``
+    under ``-m fuzz``."""
     cases, seed = fuzz_cases(KILLS)
-    return _kill_points(n or cases, 30 + seed)
+    return _save_points(cases, 30 + seed), _kill_points(cases, 30 + seed)
 
 
-def _clips_add(tmp_path: Path, points: list[float]) -> None:
+def _clips_add(tmp_path: Path, points: list[SavePoint]) -> None:
     from engine.clipfile import save_clip
     from engine.cliplib.library import ClipLibrary, clip_digest
     from engine.clips import default_clips
@@ -80,8 +107,8 @@ def _clips_add(tmp_path: Path, points: list[float]) -> None:
     save_clip(walk.resampled(55.0), b)
     library = tmp_path / "lib"
     added: set[str] = set()
-    for delay in points:
-        _kill_after([CLIPS_ADD, str(library), str(a), str(b)], delay)
+    for point in points:
+        _kill_after([CLIPS_ADD, str(library), str(a), str(b)], point)
         lib = ClipLibrary(library)
         added.add(clip_digest(lib.load()["walk"]))  # it loads: the old walk or the new one, never none
         assert lib.entries()["walk"].sha256 == clip_digest(lib.load()["walk"])
@@ -97,7 +124,7 @@ def _clips_add(tmp_path: Path, points: list[float]) -> None:
 
 
 def test_kill_9_during_clips_add_leaves_a_library_that_loads(tmp_path: Path) -> None:
-    _clips_add(tmp_path, _kill_points())
+    _clips_add(tmp_path, _save_points())
 
 
 SNOWMAN_F5 = """
@@ -117,17 +144,18 @@ for i in range(10**6):
     app.world.resource(SnowField).roll(np.array([x, 0.2, 0.0]), np.array([x + 0.05, 0.2, 0.0]), 0.2)
     hub.command(SAVE)
     app.step()
+    print("s", flush=True)
 """
 
 
-def _snowman_f5(tmp_path: Path, points: list[float]) -> None:
+def _snowman_f5(tmp_path: Path, points: list[SavePoint]) -> None:
     from games.snowman.field_save import load_field
     from puppetphone.games import load_game
 
     field = tmp_path / "field.json"
     seen: set[str] = set()
-    for delay in points:
-        _kill_after([SNOWMAN_F5, str(field)], delay)
+    for point in points:
+        _kill_after([SNOWMAN_F5, str(field)], point)
         assert load_field(field) is not None  # whole: the field before the kill or after it
         seen.add(hashlib.sha256(field.read_bytes()).hexdigest())
         assert load_game("snowman").prepare({"field": str(field)})["field"] is not None
@@ -136,7 +164,7 @@ def _snowman_f5(tmp_path: Path, points: list[float]) -> None:
 
 
 def test_kill_9_during_snowman_f5_leaves_the_field_that_loads(tmp_path: Path) -> None:
-    _snowman_f5(tmp_path, _kill_points())
+    _snowman_f5(tmp_path, _save_points())
 
 
 AUTHOR_SAVE = """
@@ -157,17 +185,18 @@ for i in range(10**6):
     session = act.simulation.edit.session  # what a drag of a control point does on release, a little each time
     session.move_control_point(act.simulation.edit.item, i % 4, np.array([0.0, 0.004 * (-1) ** i, 0.0]))
     ctrl_s()
+    print("s", flush=True)
 """
 
 
-def _author_edit(tmp_path: Path, points: list[float]) -> None:
+def _author_edit(tmp_path: Path, points: list[SavePoint]) -> None:
     from authoring.mocurves import load_session
     from engine.cliplib.library import clip_digest
 
     out = tmp_path / "walk_edited.ppclip"
     seen: set[str] = set()
-    for delay in points:
-        _kill_after([AUTHOR_SAVE, str(out)], delay)
+    for point in points:
+        _kill_after([AUTHOR_SAVE, str(out)], point)
         session = load_session(out)  # the clip and its session file open together
         seen.add(clip_digest(session.clip))
     assert len(seen) > 1  # the kills did land between different saves
@@ -183,7 +212,7 @@ def _author_edit(tmp_path: Path, points: list[float]) -> None:
 
 
 def test_kill_9_during_author_edit_save_leaves_a_clip_that_opens(tmp_path: Path) -> None:
-    _author_edit(tmp_path, _kill_points())
+    _author_edit(tmp_path, _save_points())
 
 
 def _done_takes(lib: Path) -> set[str]:
@@ -253,15 +282,15 @@ def test_kill_9_during_a_cycles_batch_keeps_every_take_done_before(tmp_path: Pat
 @pytest.mark.parametrize("save", ["clips add", "snowman F5", "author edit", "cycles"])
 def test_fuzz_kill_9_campaign(tmp_path: Path, save: str) -> None:
     """The long campaign: ``FUZZ_CASES`` kill points for each save."""
-    points = _campaign()
+    saves, delays = _campaign()
     if save == "clips add":
-        _clips_add(tmp_path, points)
+        _clips_add(tmp_path, saves)
     elif save == "snowman F5":
-        _snowman_f5(tmp_path, points)
+        _snowman_f5(tmp_path, saves)
     elif save == "author edit":
-        _author_edit(tmp_path, points)
+        _author_edit(tmp_path, saves)
     else:
-        _cycles(tmp_path, points, count=max(8, 3 * len(points)))
+        _cycles(tmp_path, delays, count=max(8, 3 * len(delays)))
 
 
 def test_kill_9_during_record_leaves_every_frame_before_it_replaying(tmp_path: Path) -> None:
