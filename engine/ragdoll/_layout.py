@@ -10,6 +10,7 @@ targets of ten ragdolls is then a handful of numpy calls, not ten Python loops.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -203,7 +204,7 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
     idx = np.asarray(slots, dtype=np.int64)
     sizes = np.diff(pool.starts)[idx]
     starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    fields: dict[str, object] = {n: getattr(pool, n)[idx] for n in _PER_RAGDOLL}
+    fields: dict[str, NDArray[Any]] = {n: getattr(pool, n)[idx] for n in _PER_RAGDOLL}  # int and float arrays
     for owner, names in _GROUPS.items():
         own = getattr(pool, owner)
         lo, hi = np.searchsorted(own, idx, "left"), np.searchsorted(own, idx, "right")
@@ -221,4 +222,4 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
         hold_eq=[pool.hold_eq[i] for i in slots],
         hold_joint=[pool.hold_joint[i] for i in slots],
         **fields,
-    )  # type: ignore[arg-type]
+    )

@@ -8,6 +8,8 @@ command instead of MuJoCo's state.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
@@ -32,6 +34,15 @@ class Readback:
     layout: Layout | None
     _ke: _F | None
     _read: tuple[_F, _F] | None
+
+    if TYPE_CHECKING:  # what the mixin reads of PhysicsWorld, the class it mixes into
+
+        @property
+        def dt(self) -> float: ...
+
+        def ensure_built(self) -> None: ...
+
+        def _slot(self, key: int) -> RagdollSlot: ...
 
     def _readback(self) -> tuple[_F, _F]:
         """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll (cached per step)."""
