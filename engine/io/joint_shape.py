@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64
 from engine.fk import forward_kinematics
 from engine.io.joint_maps import guess_joint_map
 
@@ -31,8 +32,6 @@ if TYPE_CHECKING:
     from engine.clip import Clip
 
 __all__ = ["guess_roles_by_shape", "guess_clip_joint_map"]
-
-F64 = NDArray[np.float64]
 
 
 def _children(parents: NDArray[np.int64]) -> list[list[int]]:

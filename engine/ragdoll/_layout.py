@@ -16,12 +16,11 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, rd_name
 
 __all__ = ["Layout", "bone_axes", "build_layout"]
-
-I = NDArray[np.int64]
-F = NDArray[np.float64]
 
 
 @dataclass

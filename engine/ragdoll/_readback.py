@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as _F
 from engine.fk import forward_kinematics
 from engine.pose import Pose
 from engine.ragdoll._control import read_poses
@@ -22,8 +22,6 @@ from engine.ragdoll._layout import Layout
 from engine.ragdoll._slots import RagdollSlot
 
 __all__ = ["Readback"]
-
-_F = NDArray[np.float64]
 
 
 class Readback:

@@ -27,9 +27,10 @@ import warnings
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
+from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.pose import Pose
 from engine.ragdoll._building import Building
@@ -47,7 +48,6 @@ from engine.skeleton import Skeleton
 __all__ = ["PhysicsWorld"]
 
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
-_F = NDArray[np.float64]
 
 
 class PhysicsWorld(Readback, Building):
