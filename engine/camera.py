@@ -21,13 +21,13 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
+from engine.arrays import F64 as F
 
 __all__ = ["Camera", "OrbitCamera", "PhoneCamera", "look_at", "perspective"]
 
-F = NDArray[np.float64]
 _UP = np.array([0.0, 1.0, 0.0])
 
 

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.clip import Clip, RootMotion
 from engine.skeleton import Skeleton
 
@@ -36,8 +37,6 @@ __all__ = [
     "bezier_basis",
     "bezier_basis_slope",
 ]
-
-F = NDArray[np.float64]
 
 
 def bezier_basis(lam: ArrayLike) -> tuple[F, F, F, F]:

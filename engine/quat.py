@@ -10,7 +10,9 @@ loops are never on the hot path.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from engine.arrays import F64 as F
 
 __all__ = [
     "IDENTITY",
@@ -37,7 +39,6 @@ __all__ = [
     "to_xyzw",
 ]
 
-F = NDArray[np.float64]
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 
 

@@ -20,11 +20,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from engine.arrays import F64 as F
 
 __all__ = ["RootCurve", "closed_basis"]
-
-F = NDArray[np.float64]
 
 
 def closed_basis(n: int, k: int) -> F:

@@ -187,12 +187,15 @@ class _BaseKeys:
         if event.type == pygame.QUIT or (event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE):
             runner.stop()
             return True
-        if event.type == pygame.KEYDOWN and event.key == pygame.K_p:
-            runner.clock.resume() if runner.clock.paused else runner.clock.pause()
-            return True
-        if event.type == pygame.KEYDOWN and event.key == pygame.K_PERIOD and runner.clock.paused:
-            runner.clock.request_step()
-            return True
+        if event.type == pygame.KEYDOWN and event.key in (pygame.K_p, pygame.K_PERIOD):
+            clock = runner.clock
+            assert clock is not None  # window events come only inside run(), which sets the clock first
+            if event.key == pygame.K_p:
+                clock.resume() if clock.paused else clock.pause()
+                return True
+            if clock.paused:
+                clock.request_step()
+                return True
         if event.type == pygame.KEYDOWN and event.key == pygame.K_g:
             runner.cycle_quality()
             return True

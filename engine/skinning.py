@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64
 from engine.io.gltf import GltfAnimation, GltfAsset
 from engine.io.gltf_clip import sample_channel
 from engine.io.gltf_mesh import SkinnedMeshes
@@ -32,8 +33,6 @@ __all__ = [
     "bind_from_engine",
     "SkinBinding",
 ]
-
-F64 = NDArray[np.float64]
 
 
 def trs_matrices(t: F64, r: F64, s: F64) -> F64:

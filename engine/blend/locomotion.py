@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -246,7 +247,7 @@ def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members
             res = Resolution(points[j], feasible[j], bool(inside[j]), float(rates[j]))
             library.memo[(key, *missed[j])] = res
             out[i] = res
-    return out  # type: ignore[return-value]
+    return cast(list[Resolution], out)  # every None was a miss, and every miss is filled above
 
 
 def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F, dt: float) -> tuple[F, F, F, F, F, F | None]:

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TypedDict, Unpack
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -145,6 +146,17 @@ class Resolution:
     rate: float
 
 
+class _TableOptions(TypedDict, total=False):
+    """The tuning fields of :class:`LookupTable`, as keywords of :meth:`LookupTable.measure`."""
+
+    power: float
+    neighbours: int
+    rate_property: int | None
+    max_rate: float
+    keep_cost: float
+    gradients: bool
+
+
 @dataclass(frozen=True)
 class LookupTable:
     """Measured probes of a blend space and the IDW inverse map ``u → p``.
@@ -217,11 +229,11 @@ class LookupTable:
         density: int | Sequence[int],
         measure_fn: Callable[[F], F],
         properties: Sequence[str],
-        **kw: object,
+        **kw: Unpack[_TableOptions],
     ) -> LookupTable:
         """Build a table by measuring ``measure_fn(probes [P,N]) -> [P,M]`` over a probe grid."""
         probes, shape = probe_grid(dims, density)
-        return cls(probes, np.asarray(measure_fn(probes)), tuple(properties), shape, **kw)  # type: ignore[arg-type]
+        return cls(probes, np.asarray(measure_fn(probes)), tuple(properties), shape, **kw)
 
     def _scaled(self, u: ArrayLike) -> F:
         x = np.asarray(u, dtype=np.float64)

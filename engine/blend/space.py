@@ -28,13 +28,15 @@ so the division is always safe.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TypedDict, Unpack
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
+from engine.arrays import I64
 from engine.blend.pose_blend import blend_quaternions, blend_vectors
 from engine.blend.sync import DEFAULT_SYNC_MARKERS, SyncGroup
 from engine.clip import Clip
@@ -45,7 +47,7 @@ __all__ = ["BlendSpace", "gradient_band_weights"]
 F = NDArray[np.float64]
 
 
-def _blend_channels(pose: Pose, clips: list[Clip], pairs: list[tuple[F, F, F]], w: F) -> None:
+def _blend_channels(pose: Pose, clips: list[Clip], pairs: list[tuple[I64, I64, F]], w: F) -> None:
     """Blend the clips' translation and scale channels into ``pose`` (only when some clip has one).
 
     A clip without a channel contributes its skeleton's offsets (or scale 1), so a stretching
@@ -76,6 +78,13 @@ def gradient_band_weights(points: ArrayLike, p: ArrayLike) -> F:
     h = np.where(np.eye(k, dtype=bool), np.inf, h)
     hi = np.clip(h.min(axis=-1), 0.0, 1.0)
     return hi / hi.sum(axis=-1, keepdims=True)
+
+
+class _SpaceOptions(TypedDict, total=False):
+    """The optional fields of :class:`BlendSpace`, as keywords of :meth:`BlendSpace.from_named`."""
+
+    markers: tuple[str, ...]
+    method: str
 
 
 @dataclass(frozen=True)
@@ -116,7 +125,11 @@ class BlendSpace:
 
     @classmethod
     def from_named(
-        cls, clips: dict[str, Clip], placement: dict[str, Sequence[float]], axes: Sequence[str], **kw: object
+        cls,
+        clips: Mapping[str, Clip],
+        placement: Mapping[str, Sequence[float]],
+        axes: Sequence[str],
+        **kw: Unpack[_SpaceOptions],
     ) -> BlendSpace:
         """Build from ``{clip name: point}``; a name without a clip is a clear error."""
         missing = [n for n in placement if n not in clips]
@@ -124,7 +137,7 @@ class BlendSpace:
             raise KeyError(f"blend space needs clips {missing}; available: {sorted(clips)}")
         names = list(placement)
         points = np.array([placement[n] for n in names], dtype=np.float64)
-        return cls(tuple(clips[n] for n in names), points, tuple(axes), **kw)  # type: ignore[arg-type]
+        return cls(tuple(clips[n] for n in names), points, tuple(axes), **kw)
 
     @property
     def names(self) -> tuple[str, ...]:

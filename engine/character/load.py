@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64
 from engine.character.rig import CharacterRig, RigError, build_rig
 from engine.fk import forward_kinematics
 from engine.humanoid import JOINTS
@@ -34,7 +35,6 @@ from engine.skinning import SkinBinding, blend_skin, node_world_matrices, rigid_
 
 __all__ = ["Character", "CharacterError", "character_from_bytes", "read_character", "MAX_CHARACTER"]
 
-F64 = NDArray[np.float64]
 MAX_CHARACTER = 8 << 20
 """Bytes of a character file a recording carries (CesiumMan is 0.5 MB; its header's limit is 16 MB)."""
 

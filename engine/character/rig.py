@@ -21,16 +21,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64
 from engine.fk import forward_kinematics
 from engine.humanoid import JOINTS, humanoid_skeleton
 from engine.skeleton import Skeleton
 
 __all__ = ["CharacterRig", "build_rig", "LIMB_BONES", "RigError"]
 
-F64 = NDArray[np.float64]
 
 #: Joints whose bone (towards their child) keeps the puppet's rest direction.
 LIMB_BONES = (

@@ -21,14 +21,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from engine.arrays import F64 as F
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded, read_npz
 
 __all__ = ["MeasureCache", "default_cache_dir", "code_fingerprint"]
 
-F = NDArray[np.float64]
 _ENGINE = Path(__file__).resolve().parents[1]
 _MEASURING = (
     "blend/measure.py",

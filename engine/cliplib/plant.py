@@ -19,13 +19,13 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64 as F
 from engine.clip import Clip
 from engine.clips._legik import solve_leg
 from engine.clips.contacts import foot_contacts, sole_points, world_poses
 
 __all__ = ["plant_feet", "LEGS"]
 
-F = NDArray[np.float64]
 LEGS = (("l_upper_leg", "l_lower_leg", "l_foot"), ("r_upper_leg", "r_lower_leg", "r_foot"))
 
 

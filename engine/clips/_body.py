@@ -15,16 +15,15 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.clip import Clip
 from engine.clips._legik import LegSolution, solve_leg
 from engine.skeleton import Skeleton
 
 __all__ = ["BodyIntent", "assemble", "upper_body_rotations", "foot_rotation", "pelvis_rotation", "SIDES"]
 
-F = NDArray[np.float64]
 SIDES = ("l", "r")
 _X = np.array([1.0, 0.0, 0.0])
 _Y = np.array([0.0, 1.0, 0.0])

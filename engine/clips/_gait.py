@@ -17,10 +17,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.clip import Clip
 from engine.clips import _keys
 from engine.clips._body import BodyIntent, assemble, foot_rotation, pelvis_rotation
@@ -31,7 +31,6 @@ from engine.skeleton import Skeleton
 
 __all__ = ["FootPlan", "GaitSpec", "build_gait", "ANKLE_HEIGHT", "mirrored", "column_intent"]
 
-F = NDArray[np.float64]
 ANKLE_HEIGHT = 0.06
 """Ankle height of a flat foot: the rest pose's, where the sole (heel and toe tip) is 1 cm up."""
 

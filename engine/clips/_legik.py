@@ -12,13 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 
 __all__ = ["LegSolution", "solve_leg"]
-
-F = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

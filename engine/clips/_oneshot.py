@@ -15,8 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import NDArray
 
+from engine.arrays import F64 as F
 from engine.clip import Clip
 from engine.clips import _keys
 from engine.clips._body import BodyIntent, assemble, upper_body_rotations
@@ -26,7 +26,6 @@ from engine.skeleton import Skeleton
 
 __all__ = ["PoseKey", "key_from_intent", "build_one_shot", "hands_above_floor"]
 
-F = NDArray[np.float64]
 V3 = tuple[float, float, float]
 
 

@@ -10,15 +10,13 @@ less than what each frame needs, so no ankle target is left out of reach.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.skeleton import Skeleton
 
 __all__ = ["lower_to_reach", "smooth_envelope"]
-
-F = NDArray[np.float64]
 
 
 def lower_to_reach(

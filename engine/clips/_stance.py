@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from engine.arrays import F64 as F
 from engine.clip import Clip
 from engine.clips import _keys
 from engine.clips._body import BodyIntent, assemble, pelvis_rotation
@@ -22,8 +22,6 @@ from engine.clips._reach import lower_to_reach
 from engine.skeleton import Skeleton
 
 __all__ = ["StanceSpec", "stance_intent", "build_stance"]
-
-F = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -12,12 +12,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.clip import Clip
 from engine.fk import forward_kinematics
 
 __all__ = ["HEEL_OFFSET", "FOOT_JOINTS", "world_poses", "sole_points", "foot_contacts", "foot_sliding"]
 
-F = NDArray[np.float64]
 
 HEEL_OFFSET = np.array([0.0, -0.05, -0.05])
 """Back of the heel in the foot joint's frame: level with the toe tip, 5 cm behind the ankle."""

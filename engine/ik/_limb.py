@@ -20,6 +20,7 @@ from engine.ik._scalar import (
     Q,
     V,
     add,
+    as_q,
     between,
     chain_fk,
     cross,
@@ -131,5 +132,5 @@ def solve_limb(
     new_qb = qmul(root_turn, qmul(rb, qb))
     new_qc = qmul(new_qb, qmul(qconj(qb), qc)) if end_rotation is None else end_rotation
     for j, q in ((ia, qmul(qconj(qpa), new_qa)), (ib, qmul(qconj(new_qa), new_qb)), (ic, qmul(qconj(new_qb), new_qc))):
-        rot[j] = qnormalize(q) if weight >= 1.0 else slerp(tuple(rot[j]), q, weight)
+        rot[j] = qnormalize(q) if weight >= 1.0 else slerp(as_q(rot[j]), q, weight)
     return c

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from functools import lru_cache
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,6 +43,7 @@ __all__ = [
     "from_frames",
     "path_of",
     "chain_fk",
+    "as_q",
 ]
 
 V = tuple[float, float, float]
@@ -194,6 +196,12 @@ def from_frames(world: tuple[V, V], local: tuple[V, V]) -> Q:
     return (-q[0], -q[1], -q[2], -q[3]) if q[0] < 0.0 else q
 
 
+def as_q(row: Sequence[float]) -> Q:
+    """A pose's rotation row (a list from ``ndarray.tolist()``) as a quaternion tuple."""
+    w, x, y, z = row
+    return (w, x, y, z)
+
+
 @lru_cache(maxsize=256)
 def _path(parents: bytes, joint: int) -> tuple[int, ...]:
     par = np.frombuffer(parents, dtype=np.int64)
@@ -218,10 +226,11 @@ def chain_fk(
     """
     path = path_of(parents, joint)
     pos: dict[int, V] = {0: root}
-    wr: dict[int, Q] = {0: tuple(rot[0])}
+    wr: dict[int, Q] = {0: as_q(rot[0])}
     p = 0
     for j in path[1:]:
-        pos[j] = add(pos[p], qrot(wr[p], off[j]))
-        wr[j] = qmul(wr[p], rot[j])
+        # The rows are read by unpacking only, so a list row serves as well as a tuple (no copy per joint).
+        pos[j] = add(pos[p], qrot(wr[p], cast(V, off[j])))
+        wr[j] = qmul(wr[p], cast(Q, rot[j]))
         p = j
     return pos, wr

@@ -150,12 +150,14 @@ def _apply_locks(
 ) -> None:
     """Hold planted toes where they landed: ``targets`` and ``new_rot`` changed in place, the locks advanced."""
     groups: dict[tuple[float, ...], list[int]] = {}
+    held: dict[int, FootLock] = {}
     for p, lock in enumerate(locks):
         if lock is not None and lock.contacts is not None and lock.enabled:
             _fit_lock(lock, toes[p])
             groups.setdefault(lock.settings(), []).append(p)
+            held[p] = lock
     for members in groups.values():  # puppets whose locks share settings: one array pass
-        _lock_group(np.array(members), [locks[p] for p in members], targets, new_rot, toes, floor, tips, dt)
+        _lock_group(np.array(members), [held[p] for p in members], targets, new_rot, toes, floor, tips, dt)
 
 
 def _fit_lock(lock: FootLock, toes: F) -> None:
@@ -271,7 +273,7 @@ def ground_feet(
     weight: float = 1.0,
     lock: FootLock | None = None,
     dt: float = 0.0,
-) -> F:
+) -> np.float64:
     """Plant one puppet's feet on ``ground`` in place; returns the pelvis height change applied.
 
     Args:
@@ -295,7 +297,9 @@ def ground_feet(
     ankle, qfoot, sole, hips = [], [], [], []
     for (u, _, f), leg in zip(idx, legs, strict=True):
         wp, wr = chain_fk(par, root, rot, off, f)
-        ankle.append(wp[f]), qfoot.append(wr[f]), hips.append(wp[u])
+        ankle.append(wp[f])
+        qfoot.append(wr[f])
+        hips.append(wp[u])
         sole.append(add(wp[f], qrot(wr[f], leg.sole)))
     clip_height = [s[1] for s in sole]  # authored on flat ground at y = 0
     height, normal = ground(np.array([s[0] for s in sole]), np.array([s[2] for s in sole]))
@@ -399,7 +403,9 @@ def ground_feet_batch(
     ankle, qfoot, hip = [], [], []
     for u, _, f in idx:
         wp, wr = path_fk(skeleton, roots, rotations, f, off)
-        ankle.append(wp[f]), qfoot.append(wr[f]), hip.append(wp[u])
+        ankle.append(wp[f])
+        qfoot.append(wr[f])
+        hip.append(wp[u])
     ankles, qfeet = np.stack(ankle, axis=1), np.stack(qfoot, axis=1)  # [P,L,3], [P,L,4]
     sole = ankles + quat.rotate(qfeet, soles)
     clip_height = sole[..., 1]  # authored on flat ground at y = 0

@@ -95,7 +95,8 @@ def _contacts(
 
 
 def _vec3(v: ArrayLike) -> V:
-    return tuple(np.asarray(v, dtype=np.float64).reshape(3).tolist())
+    x, y, z = np.asarray(v, dtype=np.float64).reshape(3).tolist()
+    return (x, y, z)
 
 
 def sphere_contacts(
@@ -143,9 +144,9 @@ def hands_on_sphere(
 
     def targets() -> tuple[list[V], list[Q], list[V], V]:
         """Wrist targets, hand rotations, shoulders and the body's forward, from the current pose."""
-        shoulders = [chain_fk(par, root, rot, off, u)[0] for u, _, _ in ids]
-        chest = shoulders[0][int(par[ids[0][0]])]
-        shoulders = [wp[u] for wp, (u, _, _) in zip(shoulders, ids, strict=True)]
+        arm_fk = [chain_fk(par, root, rot, off, u)[0] for u, _, _ in ids]
+        chest = arm_fk[0][int(par[ids[0][0]])]
+        shoulders = [wp[u] for wp, (u, _, _) in zip(arm_fk, ids, strict=True)]
         left, fwd = qrot(rot[0], (1.0, 0.0, 0.0)), qrot(rot[0], (0.0, 0.0, 1.0))
         contacts, normals = _contacts(cen, radius, chest, left, spread, elevation)
         wrists, hand_rot = [], []

@@ -97,8 +97,12 @@ class IKRig:
         dof_joint, dof_slot, dof_trans, lo, hi, st = [], [], [], [], [], []
         if root_translation:
             for s in range(3):
-                dof_joint.append(0), dof_slot.append(s), dof_trans.append(True)
-                lo.append(-translation_limit), hi.append(translation_limit), st.append(1.0)
+                dof_joint.append(0)
+                dof_slot.append(s)
+                dof_trans.append(True)
+                lo.append(-translation_limit)
+                hi.append(translation_limit)
+                st.append(1.0)
         for j in range(n):
             k = int(kinds[j])
             if k == FIXED:
@@ -113,8 +117,12 @@ class IKRig:
             if np.any(js < 0):
                 raise ValueError(f"joint {name!r}: stiffness must be non-negative")
             for s in range(k):
-                dof_joint.append(j), dof_slot.append(s), dof_trans.append(False)
-                lo.append(jl[s]), hi.append(ju[s]), st.append(js[s])
+                dof_joint.append(j)
+                dof_slot.append(s)
+                dof_trans.append(False)
+                lo.append(jl[s])
+                hi.append(ju[s])
+                st.append(js[s])
         anc = np.zeros((n, n), dtype=bool)
         for j in range(n):
             anc[j, j] = True

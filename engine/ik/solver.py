@@ -132,7 +132,7 @@ class _Problem:
         self.pin_rot_frames = np.array([j for p, j in zip(kept, kept_idx, strict=True) if p.orientation], np.int64)
 
 
-def _points(wpos: F, wmat: F, frames: F, local: F) -> F:
+def _points(wpos: F, wmat: F, frames: NDArray[np.int64], local: F) -> F:
     return wpos[frames] + np.einsum("nij,nj->ni", wmat[frames], local)
 
 

@@ -134,7 +134,7 @@ def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]
             locks=[req.foot_lock for _, _, req in group],
             dt=world.dt,
         )
-        finite = np.isfinite(roots).all(axis=1) & np.isfinite(rots).all(axis=(1, 2))
+        finite = np.asarray(np.isfinite(roots).all(axis=1) & np.isfinite(rots).all(axis=(1, 2)))
         for i, (puppet, local, req) in enumerate(group):
             done.add(id(req))
             req.pelvis_shift = float(shift[i])

@@ -114,7 +114,9 @@ def two_bone_ik(
     rot = pose.rotations
     one = rot.ndim == 2 and target.shape == (3,) and np.ndim(weight) == 0 and (offsets is None or np.ndim(offsets) == 2)
     if one and _single(pole, 3) and _single(end_rotation, 4):
-        return _two_bone_one(skeleton, pose, (ia, ib, ic), target, pole, end_rotation, offsets, float(weight))
+        return _two_bone_one(
+            skeleton, pose, (ia, ib, ic), target, pole, end_rotation, offsets, float(np.asarray(weight))
+        )
     wpos, wrot = path_fk(skeleton, pose.root, rot, ic, offsets)
     a, b, c = wpos[ia], wpos[ib], wpos[ic]
     qa, qb, qc = wrot[ia], wrot[ib], wrot[ic]

@@ -11,10 +11,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64
 
 __all__ = ["fold_root"]
-
-F64 = NDArray[np.float64]
 
 
 def fold_root(

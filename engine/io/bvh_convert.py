@@ -182,8 +182,8 @@ def clip_to_bvh(clip: Clip, order: str = "ZXY", unit: float = 100.0) -> BvhMotio
     for k, j in enumerate(perm):
         if k == 0:
             columns.append(clip.root * unit)
-        elif moving[j]:
-            columns.append(trans[:, j] * unit)  # type: ignore[index]  # moving[j] only where trans exists
+        elif trans is not None and moving[j]:  # moving[j] only where trans exists
+            columns.append(trans[:, j] * unit)
         columns.append(angles[:, k])
     data = np.concatenate(columns, axis=1)
     leaves = {j for j in range(sk.num_joints) if not sk.children(j)}

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64
 from engine.clip import Clip
 from engine.io._tracks import fold_root
 from engine.io.gltf import GltfAnimation, GltfAsset, GltfChannel, GltfError, read_gltf
@@ -31,8 +32,6 @@ DEFAULT_FPS = 30.0
 
 MAX_FPS = 1000.0
 MAX_SAMPLES = 4_000_000  # frames x nodes: an hour at 60 fps of an 18-node skeleton
-
-F64 = NDArray[np.float64]
 
 
 def sample_channel(channel: GltfChannel, t: NDArray[np.float64]) -> F64:

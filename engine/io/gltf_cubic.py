@@ -25,16 +25,15 @@ import os
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.atomic import atomic_write_bytes
 from engine.io.formats import FORMATS
 from engine.keyframes import BezierCurves, KeyframedClip
 
 __all__ = ["write_gltf_cubic", "read_gltf_cubic"]
 
-F = NDArray[np.float64]
 _H = 1e-6  # step of the central differences through exp/log (their error is ~1e-12 here)
 
 

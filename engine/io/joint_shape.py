@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64
 from engine.fk import forward_kinematics
 from engine.io.joint_maps import guess_joint_map
 
@@ -31,8 +32,6 @@ if TYPE_CHECKING:
     from engine.clip import Clip
 
 __all__ = ["guess_roles_by_shape", "guess_clip_joint_map"]
-
-F64 = NDArray[np.float64]
 
 
 def _children(parents: NDArray[np.int64]) -> list[list[int]]:
@@ -121,9 +120,10 @@ def _roles(
     if other is None or h[other] > 0.25 * height:  # a foot in a stride's swing rises, a tail hangs higher
         raise ValueError("no two legs stand on the ground and meet at hips: not a standing humanoid")
     hips = _meet(parents, first, other)
-    legs = [_limb(_chain(parents, hips, leaf), pos) for leaf in (first, other)]
-    if legs[0] is None or legs[1] is None:
+    leg0, leg1 = (_limb(_chain(parents, hips, leaf), pos) for leaf in (first, other))
+    if leg0 is None or leg1 is None:
         raise ValueError("a leg has fewer than three joints below the hips (upper leg, lower leg, foot)")
+    legs = [leg0, leg1]
     leg_roots = {_chain(parents, hips, leaf)[0] for leaf in (first, other)}
     on_ground = [j for j in by_height[2:] if h[j] < 0.15 * height and not leg_roots & set(_path_up(parents, j))]
     if on_ground:

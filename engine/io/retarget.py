@@ -24,9 +24,9 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64
 from engine.clip import Clip, RootMotion
 from engine.fk import forward_kinematics
 from engine.io.joint_shape import guess_clip_joint_map
@@ -41,7 +41,6 @@ class RetargetWarning(UserWarning):
     """Retargeting dropped motion the puppet cannot play (translation or scale channels)."""
 
 
-F64 = NDArray[np.float64]
 _AXES = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0], [0, 0, -1]], dtype=np.float64)
 
 

@@ -22,11 +22,12 @@ from enum import Enum
 
 import daqp
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from engine.arrays import F64 as F
 
 __all__ = ["DenseQP", "QPResult", "QPStatus"]
 
-F = NDArray[np.float64]
 
 _INF = 1e30  # DAQP's "no bound"
 

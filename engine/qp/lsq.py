@@ -18,13 +18,11 @@ rows this is ~7× faster than the dense form (``puppetphone bench qp``).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine.qp.dense import DenseQP, QPResult
 
 __all__ = ["LeastSquaresQP"]
-
-F = NDArray[np.float64]
 
 
 class LeastSquaresQP:

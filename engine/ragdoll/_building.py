@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64 as _F
 from engine.ragdoll._carry import restore, snapshot
 from engine.ragdoll._guard import velocity_limits
 from engine.ragdoll._layout import Layout, build_layout, select
@@ -23,8 +24,6 @@ from engine.ragdoll._slots import PropSlot, RagdollSlot
 from engine.ragdoll.mjcf import build_mjcf, prop_name
 
 __all__ = ["Building"]
-
-_F = NDArray[np.float64]
 
 
 class Building:

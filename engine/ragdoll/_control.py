@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as _F
 from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
@@ -27,7 +28,6 @@ _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
 _PIN_DAMPING = 100.0  # and damping (1/s): critically damped
 _MAX_LEAD = 0.5  # s: cap on the velocity lead at tiny weights
 _HOLD_REACH = 0.5  # m: farthest the hold spring's anchor is from the held body (a stick flicked into the sky)
-_F = NDArray[np.float64]
 
 
 @dataclass

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64 as _F
 from engine.ragdoll.profile import RagdollProfile, bone_segments
 from engine.skeleton import Skeleton
 
@@ -34,8 +35,6 @@ LEAVE = 1.0  # m of clearance over which it leaves again
 LOOKAHEAD = 0.25  # s of a prop's travel added to its sphere
 OVERLAP = 0.35  # m between two roots under which a simulated ragdoll passes through ragdolls (a ghost)
 APART = 0.8  # m over which a ghost collides with ragdolls again
-
-_F = NDArray[np.float64]
 
 
 def reach(skeleton: Skeleton, profile: RagdollProfile, offsets: _F) -> float:

@@ -10,17 +10,17 @@ targets of ten ragdolls is then a handful of numpy calls, not ten Python loops.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
 from engine.ragdoll.mjcf import RagdollFragment, RagdollSpec, rd_name
 
 __all__ = ["Layout", "bone_axes", "build_layout"]
-
-I = NDArray[np.int64]
-F = NDArray[np.float64]
 
 
 @dataclass
@@ -203,7 +203,7 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
     idx = np.asarray(slots, dtype=np.int64)
     sizes = np.diff(pool.starts)[idx]
     starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    fields: dict[str, object] = {n: getattr(pool, n)[idx] for n in _PER_RAGDOLL}
+    fields: dict[str, NDArray[Any]] = {n: getattr(pool, n)[idx] for n in _PER_RAGDOLL}  # int and float arrays
     for owner, names in _GROUPS.items():
         own = getattr(pool, owner)
         lo, hi = np.searchsorted(own, idx, "left"), np.searchsorted(own, idx, "right")
@@ -221,4 +221,4 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
         hold_eq=[pool.hold_eq[i] for i in slots],
         hold_joint=[pool.hold_joint[i] for i in slots],
         **fields,
-    )  # type: ignore[arg-type]
+    )

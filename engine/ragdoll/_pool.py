@@ -112,14 +112,12 @@ class RagdollPool:
         for _ in range(want - have):
             i = len(self.slots)
             new = rd_name(i, "")
+            body, contact, equality, actuator = (
+                tuple(line.replace(old, new) for line in lines)
+                for lines in (tpl.body, tpl.contact, tpl.equality, tpl.actuator)
+            )
             frag = RagdollFragment(
-                dataclasses.replace(tpl.spec, key=i),
-                *(
-                    tuple(line.replace(old, new) for line in lines)
-                    for lines in (tpl.body, tpl.contact, tpl.equality, tpl.actuator)
-                ),
-                tpl.kp,
-                tpl.kv,
+                dataclasses.replace(tpl.spec, key=i), body, contact, equality, actuator, tpl.kp, tpl.kv
             )
             self.slots.append(PoolSlot(kind, frag))
         return True

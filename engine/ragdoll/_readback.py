@@ -8,11 +8,13 @@ command instead of MuJoCo's state.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as _F
 from engine.fk import forward_kinematics
 from engine.pose import Pose
 from engine.ragdoll._control import read_poses
@@ -20,8 +22,6 @@ from engine.ragdoll._layout import Layout
 from engine.ragdoll._slots import RagdollSlot
 
 __all__ = ["Readback"]
-
-_F = NDArray[np.float64]
 
 
 class Readback:
@@ -32,6 +32,15 @@ class Readback:
     layout: Layout | None
     _ke: _F | None
     _read: tuple[_F, _F] | None
+
+    if TYPE_CHECKING:  # what the mixin reads of PhysicsWorld, the class it mixes into
+
+        @property
+        def dt(self) -> float: ...
+
+        def ensure_built(self) -> None: ...
+
+        def _slot(self, key: int) -> RagdollSlot: ...
 
     def _readback(self) -> tuple[_F, _F]:
         """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll (cached per step)."""

@@ -4,15 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-from numpy.typing import NDArray
-
+from engine.arrays import F64 as _F
 from engine.ragdoll._control import Command
 from engine.ragdoll.mjcf import PropSpec, RagdollSpec
 
 __all__ = ["RagdollSlot", "PropSlot"]
-
-_F = NDArray[np.float64]
 
 
 @dataclass

@@ -27,9 +27,11 @@ import warnings
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
+from engine.arrays import F64 as _F
+from engine.arrays import I64
 from engine.pose import Pose
 from engine.ragdoll._building import Building
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
@@ -46,7 +48,6 @@ from engine.skeleton import Skeleton
 __all__ = ["PhysicsWorld"]
 
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
-_F = NDArray[np.float64]
 
 
 class PhysicsWorld(Readback, Building):
@@ -239,7 +240,7 @@ class PhysicsWorld(Readback, Building):
         q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
         if q.shape != (sum(sizes), 4):
             raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes}")
-        ends = np.cumsum(sizes)
+        ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
         ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
         q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
         for slot, good, root, rot in zip(slots, ok, r, np.split(q, ends[:-1]), strict=True):

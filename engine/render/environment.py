@@ -19,7 +19,7 @@ from engine.render import env_meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render import shaders_ground as G
-from engine.render.gpu import Instances, mesh_buffers, set_uniform
+from engine.render.gpu import Instances, Releasable, mesh_buffers, set_uniform
 from engine.render.scene import PRINT_STRIDE, GroundMarks, RenderScene
 
 __all__ = ["Environment", "marks_rect", "soften_marks"]
@@ -210,7 +210,13 @@ class Environment:
 
     def release(self) -> None:
         """Free the GPU objects."""
-        for obj in (*self._vaos.values(), *self._buffers, *self._programs.values(), self._prints.buf):
+        objects: tuple[Releasable, ...] = (
+            *self._vaos.values(),
+            *self._buffers,
+            *self._programs.values(),
+            self._prints.buf,
+        )
+        for obj in objects:
             obj.release()
         if self._marks_tex is not None:
             self._marks_tex.release()

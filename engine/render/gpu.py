@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Protocol
 
 import moderngl
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Instances", "LodBatches", "set_uniform", "mesh_buffers"]
+__all__ = ["Instances", "LodBatches", "Releasable", "set_uniform", "mesh_buffers"]
+
+
+class Releasable(Protocol):
+    """A GPU object freed by ``release()`` (buffers, programs, textures, framebuffers, arrays share no base class)."""
+
+    def release(self) -> None: ...
 
 
 class Instances:
@@ -36,7 +42,7 @@ def set_uniform(prog: moderngl.Program, name: str, value: Any) -> None:
     since GL reads them column-major.
     """
     u = prog.get(name, None)  # not ``name in prog``: Program has no __contains__, that scans its members
-    if u is None:
+    if not isinstance(u, moderngl.Uniform):  # optimised away, or an attribute or varying: nothing to set
         return
     if isinstance(value, np.ndarray) and value.shape == (4, 4):
         u.write(np.ascontiguousarray(value.T, dtype=np.float32).tobytes())

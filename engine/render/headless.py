@@ -18,10 +18,18 @@ from engine.render.offscreen import OffscreenBuffers
 __all__ = ["HeadlessTarget", "egl_available"]
 
 
+def _egl_context() -> moderngl.Context:
+    """A standalone GL 3.3 context on EGL (the one place that names the backend)."""
+    return moderngl.create_standalone_context(
+        backend="egl",  # type: ignore[arg-type]  # moderngl's stubs type each **settings value as a dict; backend is a str
+        require=330,
+    )
+
+
 def egl_available() -> str | None:
     """``None`` if an EGL GL 3.3 context can be created here, else the reason it cannot."""
     try:
-        ctx = moderngl.create_standalone_context(backend="egl", require=330)
+        ctx = _egl_context()
     except Exception as exc:  # any failure means "no headless GL here"; the message says why
         return f"{type(exc).__name__}: {exc}"
     ctx.release()
@@ -34,7 +42,7 @@ class HeadlessTarget:
     def __init__(
         self, width: int, height: int, *, samples: int | None = None, ctx: moderngl.Context | None = None
     ) -> None:
-        self.ctx = ctx if ctx is not None else moderngl.create_standalone_context(backend="egl", require=330)
+        self.ctx = ctx if ctx is not None else _egl_context()
         self._own_ctx = ctx is None
         self.buffers = OffscreenBuffers(self.ctx, width, height, samples)
 

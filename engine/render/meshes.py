@@ -82,7 +82,8 @@ def sphere_mesh(segments: int = 20, rings: int = 6) -> tuple[NDArray[np.float32]
 
 def box_mesh() -> tuple[NDArray[np.float32], NDArray[np.int32]]:
     """A unit cube ``[-1,1]^3``: vertices ``[24,6]`` (position, face normal) and ``[12,3]`` triangles."""
-    verts, tris = [], []
+    verts: list[NDArray[np.float64]] = []
+    tris: list[tuple[int, int, int]] = []
     for axis in range(3):
         for sign in (-1.0, 1.0):
             n = np.zeros(3)

@@ -45,7 +45,7 @@ from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.env_meshes import cone_mesh
 from engine.render.environment import Environment
-from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
+from engine.render.gpu import Instances, LodBatches, Releasable, mesh_buffers, set_uniform
 from engine.render.impostors import Impostors
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
@@ -468,8 +468,8 @@ class Renderer:
     ) -> None:
         w, h = size
         sun = scene.sun
-        L = np.asarray(sun.direction, dtype=np.float64)
-        L = tuple(float(x) for x in L / np.linalg.norm(L))
+        direction = np.asarray(sun.direction, dtype=np.float64)
+        L = tuple(float(x) for x in direction / np.linalg.norm(direction))
         tan_half = math.tan(math.radians(camera.fov_y) / 2.0)
         eye = tuple(float(x) for x in camera.eye)
         # World size of one shadow-map texel: the light frustum is 2/|row 0 of P@V| wide.
@@ -590,7 +590,8 @@ class Renderer:
             v.release()
         for i in (*self._inst.values(), *self._outline_inst.values()):
             i.buf.release()
-        for obj in (*self._buffers, *self._programs.values(), self._blank, self._noise):
+        objects: tuple[Releasable, ...] = (*self._buffers, *self._programs.values(), self._blank, self._noise)
+        for obj in objects:
             obj.release()
         if self._background is not None:
             self._background.release()

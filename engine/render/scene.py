@@ -431,7 +431,10 @@ class RenderScene:
         img = np.asarray(image)
         if img.ndim != 3 or img.shape[2] != 4 or img.dtype != np.uint8 or min(img.shape[:2]) < 1:
             raise ValueError(f"overlay must be uint8 [H,W,4], got {img.dtype} {img.shape}")
-        at = None if depth_at is None else tuple(float(x) for x in np.asarray(depth_at, dtype=np.float64).reshape(3))
+        at = None
+        if depth_at is not None:
+            a0, a1, a2 = (float(x) for x in np.asarray(depth_at, dtype=np.float64).reshape(3))
+            at = (a0, a1, a2)
         r0, r1, r2, r3 = (float(x) for x in rect)
         r = (r0, r1, r2, r3)
         if not (r[0] < r[2] and r[1] < r[3]):

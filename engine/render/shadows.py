@@ -24,7 +24,7 @@ from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.env_meshes import cone_mesh
-from engine.render.gpu import Instances, LodBatches, mesh_buffers, set_uniform
+from engine.render.gpu import Instances, LodBatches, Releasable, mesh_buffers, set_uniform
 from engine.render.lod import LEVELS, LIMITS, choose_levels_orthographic, level_meshes
 from engine.render.scene import CAPSULE_STRIDE, RenderScene
 
@@ -224,5 +224,13 @@ class Shadows:
         self._mask_vao.release()
         if self._cone_vao is not None:
             self._cone_vao.release()
-        for obj in (*self._buffers, *self._programs.values(), self._depth_fbo, self.depth, self._mask_fbo, self.mask):
+        objects: tuple[Releasable, ...] = (
+            *self._buffers,
+            *self._programs.values(),
+            self._depth_fbo,
+            self.depth,
+            self._mask_fbo,
+            self.mask,
+        )
+        for obj in objects:
             obj.release()

@@ -134,7 +134,7 @@ class SkinnedDraw:
     def __init__(self, ctx: moderngl.Context, lit: moderngl.Program, flat: moderngl.Program) -> None:
         self.ctx = ctx
         self.lit, self.flat = lit, flat
-        self.feedback = ctx.program(vertex_shader=S.HEADER + SKIN_VS, varyings=["v_pos"])
+        self.feedback = ctx.program(vertex_shader=S.HEADER + SKIN_VS, varyings=("v_pos",))
         self.depth = ctx.program(vertex_shader=S.HEADER + SKIN_VS, fragment_shader=S.HEADER + S.DEPTH_FS)
         self._meshes: dict[int, tuple[SkinnedMeshes, list[_PrimitiveGPU]]] = {}
         self._joints: moderngl.Texture | None = None

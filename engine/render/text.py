@@ -76,7 +76,7 @@ class TextCache:
         self._pgfont = pygame.font
         self.ctx = ctx
         self.capacity = capacity
-        self._fonts: dict[int, object] = {}
+        self._fonts: dict[int, pygame.font.Font] = {}
         self._tex: OrderedDict[tuple[str, int, tuple[int, int, int]], moderngl.Texture] = OrderedDict()
         self._wrapped: OrderedDict[tuple[str, int, int], list[str]] = OrderedDict()
 
