@@ -19,7 +19,7 @@ import numpy as np
 
 from authoring.bindings import orbit_camera
 from authoring.operations import Key, Operation, Orbit, Resize, Zoom, encode
-from authoring.session import Ending, Opened, ToolKind, ToolSimulation
+from authoring.session import Ending, KeyUse, Opened, ToolKind, ToolSimulation
 from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.hub import InputHub
@@ -87,7 +87,7 @@ class CurvesTool(ToolSimulation):
         """The scene's orbit camera."""
         return self.scene.camera
 
-    def on_key(self, key: Key, hub: InputHub) -> str:  # type: ignore[override]  # the KeyUse literal
+    def on_key(self, key: Key, hub: InputHub) -> KeyUse:
         """Every key is the scene's (P pins, . steps a frame) but Ctrl+P, the runner's pause."""
         return "pass" if key.name == "p" and key.ctrl else "queue"
 

@@ -313,7 +313,8 @@ def reopen_edit(setup: object) -> EditTool:
     checked = _check_setup(setup)
     session = _reopen(checked)
     size = checked.get("size", [1280, 720])
-    edit = EditScene(session, (int(size[0]), int(size[1])), character=_character(checked, session.clip.skeleton))  # type: ignore[index]  # checked: two ints
+    assert isinstance(size, list)  # checked: two whole numbers
+    edit = EditScene(session, (int(size[0]), int(size[1])), character=_character(checked, session.clip.skeleton))
     return EditTool(edit, session, None)
 
 
