@@ -28,15 +28,15 @@ if TYPE_CHECKING:
 
     from authoring.record_scene import RecordScene
 
-    F = NDArray[np.float64]
-
 __all__ = ["RECORD_GAME", "TOOL", "RecordTool", "open_record", "record_digest", "reopen_record"]
 
 #: The name a take's recording gives as its game.
 RECORD_GAME = "author-record"
 
 
-def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre: F, rest: F) -> F:
+def _scripted(
+    step: int, fps: float, rng_phase: list[float], drive: str, centre: NDArray[np.float64], rest: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """The scripted performer: loops of 1.2 s ± 15 % with a tremor, as a value for the scene."""
     import numpy as np
 
