@@ -16,7 +16,7 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-UNEXPLAINED_BUDGET = 78  # lower it as ignores get their reason or their fix; never raise it
+UNEXPLAINED_BUDGET = 4  # lower it as ignores get their reason or their fix; never raise it
 RUNTIME = ("engine", "input", "authoring", "games", "puppetphone")
 IGNORE = re.compile(r"#\s*type:\s*ignore(?P<codes>\[[^\]]*\])?(?P<rest>.*)$")
 
