@@ -10,11 +10,16 @@ the static IK (at a key).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
 from engine.skeleton import Skeleton
+
+if TYPE_CHECKING:
+    from authoring.keyframe_curves.session import CurveSession
 
 __all__ = ["bone_axis", "HANDLE_LENGTH", "ORIENT_RGB", "turn_towards", "orientation_sticks"]
 
@@ -37,7 +42,7 @@ def turn_towards(world_rotation: F, axis_local: F, direction: F) -> F:
     return quat.normalize(quat.mul(quat.between(now, direction), world_rotation))
 
 
-def orientation_sticks(session, times: F, joint: int) -> tuple[F, F, F]:  # type: ignore[no-untyped-def]
+def orientation_sticks(session: CurveSession, times: F, joint: int) -> tuple[F, F, F]:
     """``(base [T,3], tip [T,3], world rotation [T,4])`` of ``joint``'s handle at ``times``."""
     from authoring.keyframe_curves.jacobian import _fk
 

@@ -34,6 +34,7 @@ names, and the tests do the same.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,6 +49,7 @@ from engine import quat
 from engine.character.load import Character
 from engine.character.view import character_instance
 from engine.fk import forward_kinematics
+from engine.keyframes import KeyframedClip
 from engine.render.extract import puppet_capsules
 from engine.render.scene import RenderScene
 
@@ -130,7 +132,7 @@ class CurvesScene:
         n = clip.num_frames
         return clip.curves.times[0] + np.arange(n) / clip.fps
 
-    def trajectory(self, clip=None) -> F:  # type: ignore[no-untyped-def]
+    def trajectory(self, clip: KeyframedClip | None = None) -> F:
         """``[F,3]`` the selected joint's position at every frame."""
         s = self.session
         j = s.clip.skeleton.index(self.joint)
@@ -160,8 +162,8 @@ class CurvesScene:
         col = np.tile(np.array([0.2, 0.2, 0.25]), (len(traj), 1))
         sizes = np.full(len(traj), 6.0)
         for h in s.holds:
-            held = s.solver.points((np.arange(h.first, h.last + 1) % clip.num_frames) / clip.fps,
-                                   clip.skeleton.index(h.joint), np.zeros(3))  # fmt: skip
+            joint = clip.skeleton.index(h.joint) if isinstance(h.joint, str) else int(h.joint)  # as the solver reads it
+            held = s.solver.points((np.arange(h.first, h.last + 1) % clip.num_frames) / clip.fps, joint, np.zeros(3))
             scene.add_points(held, 9.0, PURPLE if h.contact else RED, pixels=True)
         keys = self._key_frames()
         col[keys] = ORANGE
@@ -277,9 +279,8 @@ class CurvesScene:
                             self.trajectory()[self.frame][None]])  # fmt: skip
         if np.nanmin(np.linalg.norm(self.camera.project(others, *self.size) - np.asarray(p), axis=1)) < d_grip:
             return False
-        self.gesture = _Gesture(
-            "orient", self.frame, tip[0], p, key=-1 if self.key_index() is None else int(self.key_index())
-        )
+        key = self.key_index()
+        self.gesture = _Gesture("orient", self.frame, tip[0], p, key=-1 if key is None else key)
         self._turn_from = (rot[0], self.trajectory()[self.frame])
         return True
 
@@ -321,14 +322,14 @@ class CurvesScene:
                 "" if res.reached else f"out of reach: closest pose kept (residual {res.residual * 1e3:.0f} mm)"
             )
             return
-        res = self.session.drag(self.joint, self.frame_times()[g.frame], position=target, commit=False)
+        out = self.session.drag(self.joint, self.frame_times()[g.frame], position=target, commit=False)
         self.message = (
             ""
-            if res.reached
+            if out.reached
             else (
-                f"out of reach: closest kept (residual {res.closest_error * 1e3:.0f} mm)"
+                f"out of reach: closest kept (residual {out.closest_error * 1e3:.0f} mm)"
                 if self.session.preview is not None
-                else f"out of reach (miss {res.error * 1e3:.0f} mm): a pin would slip"
+                else f"out of reach (miss {out.error * 1e3:.0f} mm): a pin would slip"
             )
         )
 
@@ -428,7 +429,7 @@ class CurvesScene:
             first, last = (0, n - 1) if shift else (max(0, self.frame - HOLD_HALF), min(n - 1, self.frame + HOLD_HALF))
             s.toggle_hold(self.joint, first, last, contact=name == "c")
 
-    def _key_edit(self, edit) -> None:  # type: ignore[no-untyped-def]
+    def _key_edit(self, edit: Callable[[], object]) -> None:
         try:
             edit()
             self.message = ""

@@ -13,17 +13,21 @@ import hashlib
 import tempfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from authoring.bindings import orbit_camera
 from authoring.operations import Key, Operation, Orbit, Resize, Zoom, encode
-from authoring.session import Ending, Opened, ToolKind, ToolSimulation
+from authoring.session import Ending, KeyUse, Opened, ToolKind, ToolSimulation
 from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.hub import InputHub
 from input.sample import InputFrame
+
+if TYPE_CHECKING:
+    from authoring.curves_scene import CurvesScene
+    from authoring.keyframe_curves.session import CurveSession
 
 __all__ = ["CURVES_GAME", "SCRIPTS", "TOOL", "CurvesTool", "curves_digest", "open_curves", "reopen_curves"]
 
@@ -32,7 +36,7 @@ CURVES_GAME = "author-curves"
 SCRIPTS = ("drag", "walk")
 
 
-def _drag_script(scene) -> Iterator[list[list[object]]]:  # type: ignore[no-untyped-def]
+def _drag_script(scene: CurvesScene) -> Iterator[list[list[object]]]:
     """Pin both feet over the whole clip, then drag the left hand's trajectory at frame 15 up and forward."""
     from authoring.keypose_script import goto_frame
 
@@ -51,7 +55,7 @@ def _drag_script(scene) -> Iterator[list[list[object]]]:  # type: ignore[no-unty
     yield [["release", round(x - 35.0, 2), round(y - 40.0, 2)]]
 
 
-def curves_digest(activity) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+def curves_digest(activity: CurvesTool) -> tuple[str, dict[str, bytes]]:
     """The session's state in parts: the curves, the holds, the viewport."""
     from engine.hashing import combine_parts
 
@@ -83,7 +87,7 @@ class CurvesTool(ToolSimulation):
         """The scene's orbit camera."""
         return self.scene.camera
 
-    def on_key(self, key: Key, hub: InputHub) -> str:  # type: ignore[override]  # the KeyUse literal
+    def on_key(self, key: Key, hub: InputHub) -> KeyUse:
         """Every key is the scene's (P pins, . steps a frame) but Ctrl+P, the runner's pause."""
         return "pass" if key.name == "p" and key.ctrl else "queue"
 
@@ -208,7 +212,7 @@ def _setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str, objec
     return setup
 
 
-def _reopen(setup: object):  # type: ignore[no-untyped-def]
+def _reopen(setup: object) -> tuple[CurveSession, tuple[int, int], str]:
     """The recorded session, from the recording alone (a path in it is never opened); one-line ``ValueError``."""
     from authoring.keyframe_curves.session import REST, CurveSession, keys_path
     from engine.clips import default_clips

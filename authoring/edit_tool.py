@@ -14,7 +14,7 @@ import sys
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,6 +25,12 @@ from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.sample import InputFrame
 
+if TYPE_CHECKING:
+    from authoring.edit_scene import EditScene
+    from authoring.mocurves import EditSession
+    from engine.skeleton import Skeleton
+    from engine.skinning import SkinBinding
+
 __all__ = ["EDIT_GAME", "TOOL", "EditTool", "edit_digest", "open_edit", "reopen_edit"]
 
 #: The name an edit session's recording gives as its game.
@@ -32,7 +38,7 @@ EDIT_GAME = "author-edit"
 MAX_CHARACTER = 8 << 20  # bytes of a GLB a recording carries (its header holds at most 16 MB)
 
 
-def _motion_setup(path: Path, size: tuple[int, int], options: dict[str, object] | None) -> dict[str, object]:
+def _motion_setup(path: Path, size: tuple[int, int], options: Mapping[str, Any] | None) -> dict[str, object]:
     """A motion file opened as its loop, as the setup a recording keeps: the loop's ``.ppclip`` bytes.
 
     The live session is built from these same bytes (:func:`_reopen`), so a replay opens
@@ -40,7 +46,7 @@ def _motion_setup(path: Path, size: tuple[int, int], options: dict[str, object] 
     from authoring.motion_loop import open_loop
     from engine.clipfile import save_clip
 
-    clip, note = open_loop(path, **(options or {}))  # type: ignore[arg-type]
+    clip, note = open_loop(path, **(options or {}))
     print(note, file=sys.stderr)
     with tempfile.TemporaryDirectory() as tmp:
         data = save_clip(clip, Path(tmp) / "clip.ppclip").read_bytes()
@@ -78,7 +84,7 @@ def _character_setup(path: Path) -> str:
     return base64.b64encode(path.read_bytes()).decode()
 
 
-def _character(setup: dict[str, object], skeleton):  # type: ignore[no-untyped-def]
+def _character(setup: dict[str, object], skeleton: Skeleton) -> SkinBinding | None:
     """The skinned character of the set-up bound to the loop's skeleton, or None (said in one line)."""
     from engine.io.gltf import GltfError, read_gltf
     from engine.io.gltf_mesh import read_skinned_meshes
@@ -98,7 +104,7 @@ def _character(setup: dict[str, object], skeleton):  # type: ignore[no-untyped-d
             return None
 
 
-def _open(spec: str, options: dict[str, object] | None = None):  # type: ignore[no-untyped-def]
+def _open(spec: str, options: Mapping[str, Any] | None = None) -> tuple[EditSession, Path]:
     from authoring.mocurves import EditSession, load_session
     from engine.clips import default_clips
     from engine.io.motion_file import MOTION_SUFFIXES
@@ -168,7 +174,7 @@ def _check_setup(setup: object) -> dict[str, object]:
     return setup
 
 
-def _reopen(setup: dict[str, object]):  # type: ignore[no-untyped-def]
+def _reopen(setup: dict[str, object]) -> EditSession:
     """The recorded session's clip, from the recording alone (never from a path it names)."""
     from authoring.mocurves import load_session
     from authoring.mocurves.storage import side_path
@@ -184,7 +190,7 @@ def _reopen(setup: dict[str, object]):  # type: ignore[no-untyped-def]
         return load_session(path)
 
 
-def edit_digest(edit) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+def edit_digest(edit: EditScene) -> tuple[str, dict[str, bytes]]:
     """The edit scene's state in parts: the clip, the scale tracks, the viewport."""
     from engine.hashing import combine_parts
 
@@ -307,7 +313,8 @@ def reopen_edit(setup: object) -> EditTool:
     checked = _check_setup(setup)
     session = _reopen(checked)
     size = checked.get("size", [1280, 720])
-    edit = EditScene(session, (int(size[0]), int(size[1])), character=_character(checked, session.clip.skeleton))  # type: ignore[index]  # checked: two ints
+    assert isinstance(size, list)  # checked: two whole numbers
+    edit = EditScene(session, (int(size[0]), int(size[1])), character=_character(checked, session.clip.skeleton))
     return EditTool(edit, session, None)
 
 

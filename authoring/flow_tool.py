@@ -16,10 +16,10 @@ import hashlib
 import math
 import tempfile
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -27,7 +27,14 @@ from authoring.bindings import orbit_camera
 from authoring.operations import Key, Move, Operation, Orbit, Press, Release, Zoom
 from authoring.session import Ending, Opened, Script, ToolKind, ToolSimulation
 from engine.camera import Camera
+from engine.render.scene import RenderScene
 from input.sample import InputFrame
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.background import BackgroundSession
+    from authoring.flowcurves.scene import FlowScene
+    from authoring.flowcurves.securves import SECurve
+    from authoring.flowcurves.session import FlowSession
 
 __all__ = [
     "FLOW_GAME",
@@ -47,11 +54,13 @@ FLOW_GAME = "author-flow"
 
 SCRIPTS = ("row", "centre", "demo")
 #: The scenes the tool can open, by name: each builds its scene for a window size.
-Scenes = Mapping[str, Callable[[tuple[int, int]], Any]]
+Scenes = Mapping[str, Callable[[tuple[int, int]], "FlowScene"]]
+#: The SEcurve search's progress: ``(group done, groups, group name)``.
+Progress = Callable[[int, int, str], None]
 _CENTRE_GRAB = 18.0  # pixels: a press this close to the centre-point drags it
 
 
-def flow_setup(spec: str, size: tuple[int, int], scenes: Scenes):  # type: ignore[no-untyped-def]
+def flow_setup(spec: str, size: tuple[int, int], scenes: Scenes) -> tuple[FlowScene, Path, list[dict[str, Any]]]:
     """``(scene, default output, edits to re-apply)`` of a named scene or a saved flow file (quick: no SEcurves yet).
 
     ``scenes`` are the scenes a game offers by name (the launcher wires them: a tool never imports a game)."""
@@ -72,7 +81,12 @@ def flow_setup(spec: str, size: tuple[int, int], scenes: Scenes):  # type: ignor
     return scenes[spec](size), Path(f"{spec}.flow.json"), []
 
 
-def build_session(scene, edits, progress=None, securves=None):  # type: ignore[no-untyped-def]
+def build_session(
+    scene: FlowScene,
+    edits: Iterable[Mapping[str, Any]],
+    progress: Progress | None = None,
+    securves: list[SECurve] | None = None,
+) -> FlowSession:
     """The session of ``scene`` (its SEcurves found, unless given: the slow part) with ``edits`` re-applied."""
     from authoring.flowcurves.session import FlowSession
 
@@ -82,7 +96,9 @@ def build_session(scene, edits, progress=None, securves=None):  # type: ignore[n
     return session
 
 
-def open_flow(spec: str, size: tuple[int, int], scenes: Scenes, progress=None):  # type: ignore[no-untyped-def]
+def open_flow(
+    spec: str, size: tuple[int, int], scenes: Scenes, progress: Progress | None = None
+) -> tuple[FlowSession, Path]:
     """A session of a named scene or of a saved flow file (its edits re-applied), and its default output."""
     scene, out, edits = flow_setup(spec, size, scenes)
     return build_session(scene, edits, progress), out
@@ -116,7 +132,7 @@ def script_events(name: str) -> dict[int, list[tuple]]:
     return ops
 
 
-def flow_digest(activity) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+def flow_digest(activity: FlowTool) -> tuple[str, dict[str, bytes]]:
     """The session's state in parts: the edits, the bent scenery, the editor's own state (never a timing)."""
     from engine.hashing import combine_parts
 
@@ -186,7 +202,7 @@ class FlowTool(ToolSimulation):
         centres = [e for e in self.session.edits if e.kind == "centre"]
         return centres[-1].points[0] if centres else None
 
-    def _timed(self, fn, *args) -> None:  # type: ignore[no-untyped-def]
+    def _timed(self, fn: Callable[..., object], *args: object) -> None:
         t0 = time.perf_counter()
         try:
             fn(*args)
@@ -262,8 +278,9 @@ class FlowTool(ToolSimulation):
             self.message = save_or_say(lambda path: save_flow(self.session, path), self.output)
 
     def _take_built(self) -> None:
+        assert self.building is not None  # (called only while a build runs)
         try:
-            self.session = self.building.result()  # type: ignore[union-attr]
+            self.session = self.building.result()
         except Exception as exc:  # noqa: BLE001 - the build's error, said once
             self.message = f"cannot find the SEcurves: {exc}"
 
@@ -299,7 +316,7 @@ class FlowTool(ToolSimulation):
             f"factorisation), {len(r.vertices)} objects moved"
         )
 
-    def draw(self, scene, alpha: float, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
+    def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
         from authoring.flowcurves.view import draw_objects, draw_session
 
         if self.session is None:  # the rest scene while its SEcurves are found, never a black window
@@ -329,6 +346,7 @@ def open_live(options: Mapping[str, Any], size: tuple[int, int], scenes: Scenes)
     (``progress`` is told each group), a window builds them on a thread while it shows the rest scene."""
     spec = str(options.get("flow_scene", "snowman"))
     scene, default_out, edits = flow_setup(spec, size, scenes)
+    session: FlowSession | BackgroundSession
     if options.get("headless"):
         session = build_session(scene, edits, options.get("progress"))
     else:

@@ -11,10 +11,15 @@ into root motion, so the loop plays in place like the built-in cycles.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from engine.clip import Clip
+
+if TYPE_CHECKING:
+    from authoring.cycles.take_range import Bound
+    from engine.io.motion_file import MotionFile
 
 __all__ = ["open_loop"]
 
@@ -27,8 +32,8 @@ def open_loop(
     up: str | None = None,
     height: float | None = None,
     retarget: bool = False,
-    start: object = None,
-    end: object = None,
+    start: Bound | None = None,
+    end: Bound | None = None,
     items: list[str] | None = None,
 ) -> tuple[Clip, str]:
     """The loop of a motion file and a one-line note of how it was made.
@@ -74,9 +79,9 @@ def open_loop(
 
 
 def _loop_of_part(
-    motion,
-    start: object,
-    end: object,  # type: ignore[no-untyped-def]
+    motion: MotionFile,
+    start: Bound | None,
+    end: Bound | None,
     items: list[str] | None,
 ) -> tuple[Clip, str]:
     """The loop extracted from the part ``[start, end)`` of a take (the refusal names the part that loops)."""
@@ -85,7 +90,7 @@ def _loop_of_part(
     from authoring.cycles.take_range import refusal_hint, select
 
     whole = performance_from_motion(motion, items)
-    perf, offset = select(whole, start, end)  # type: ignore[arg-type]
+    perf, offset = select(whole, start, end)
     try:
         result = extract_cycle(perf.trajectory, np.random.default_rng(0))
     except CycleError as exc:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import astuple, dataclass
+from typing import TypeGuard
 
 __all__ = ["OPERATIONS", "Key", "Move", "Operation", "Orbit", "Press", "Release", "Resize", "Zoom", "decode", "encode"]
 
@@ -105,6 +106,11 @@ def _number(v: object, what: str) -> float:
     return float(v)
 
 
+def _whole(v: object) -> TypeGuard[int]:
+    """Whether ``v`` is a whole number (a JSON ``true`` is not one)."""
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
 def _flag(v: object, what: str) -> bool:
     if not isinstance(v, bool):
         raise ValueError(f"{what} is not true or false: {v!r}")
@@ -135,9 +141,9 @@ def decode(raw: Raw | list[object]) -> Operation:
             return Zoom(factor)
         if name == "key" and len(args) in (2, 3) and isinstance(args[0], str):
             return Key(args[0], _flag(args[1], where), _flag(args[2], where) if len(args) == 3 else False)
-        if name == "size" and len(args) == 2 and all(isinstance(v, int) and not isinstance(v, bool) for v in args):
-            w, h = int(args[0]), int(args[1])  # type: ignore[call-overload]  # checked int above
-            if 0 < w <= 16384 and 0 < h <= 16384:
+        if name == "size" and len(args) == 2:
+            w, h = args
+            if _whole(w) and _whole(h) and 0 < w <= 16384 and 0 < h <= 16384:
                 return Resize(w, h)
     except ValueError as exc:
         raise ValueError(str(exc)) from None

@@ -452,7 +452,7 @@ class RecordScene:
             scene.add_text(self.message, size=16)
 
 
-def _drivable(skeleton: Skeleton, item: str, drive: str) -> tuple[int, object]:
+def _drivable(skeleton: Skeleton, item: str, drive: str) -> tuple[int, tuple[int, int, int] | None]:
     """``item``'s joint index and IK chain, or ``ValueError`` when ``drive`` cannot move it."""
     if item not in skeleton.names:
         raise ValueError(f"no joint {item!r}; the character has {', '.join(skeleton.names)}")

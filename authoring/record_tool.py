@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from authoring.bindings import orbit_camera
 from authoring.operations import Key, Move, Operation, Orbit, Press, Release, Resize, Zoom
@@ -22,13 +22,21 @@ from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.sample import InputFrame
 
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+
+    from authoring.record_scene import RecordScene
+
 __all__ = ["RECORD_GAME", "TOOL", "RecordTool", "open_record", "record_digest", "reopen_record"]
 
 #: The name a take's recording gives as its game.
 RECORD_GAME = "author-record"
 
 
-def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre, rest):  # type: ignore[no-untyped-def]
+def _scripted(
+    step: int, fps: float, rng_phase: list[float], drive: str, centre: NDArray[np.float64], rest: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """The scripted performer: loops of 1.2 s ± 15 % with a tremor, as a value for the scene."""
     import numpy as np
 
@@ -50,7 +58,7 @@ def _scripted(step: int, fps: float, rng_phase: list[float], drive: str, centre,
     return np.concatenate([position, q]) if drive == "pose" else q
 
 
-def record_digest(scene) -> tuple[str, dict[str, bytes]]:  # type: ignore[no-untyped-def]
+def record_digest(scene: RecordScene) -> tuple[str, dict[str, bytes]]:
     """The record scene's state in parts: the stacked clip, the candidate loop, the take, the rest."""
     import hashlib
 
@@ -223,8 +231,8 @@ def open_record(options: Mapping[str, Any], size: tuple[int, int]) -> Opened:
     output = options.get("output")
     tool = RecordTool(
         _record_scene(setup),
-        script=setup["script"],
-        output=Path(output) if output else None,  # type: ignore[arg-type]  # checked choice
+        script=_script_of(setup),
+        output=Path(output) if output else None,
         size=size,
     )
     return Opened(tool, setup, conclude=tool.conclude)
@@ -234,11 +242,14 @@ def reopen_record(setup: object) -> RecordTool:
     """The recorded take, rebuilt from its set-up alone (saving nothing)."""
     checked = _check_record_setup(setup)
     size = checked.get("size", [1280, 720])
-    return RecordTool(
-        _record_scene(checked),
-        script=checked.get("script"),  # type: ignore[arg-type]  # checked choice
-        size=(int(size[0]), int(size[1])),
-    )  # type: ignore[index]  # checked: two ints
+    assert isinstance(size, list)  # checked: two whole numbers
+    return RecordTool(_record_scene(checked), script=_script_of(checked), size=(int(size[0]), int(size[1])))
+
+
+def _script_of(setup: Mapping[str, object]) -> str | None:
+    """The set-up's scripted performer: ``"loops"`` or ``None`` (a command-line choice, or checked when reopened)."""
+    script = setup.get("script")
+    return script if isinstance(script, str) else None
 
 
 def _record_setup(options: Mapping[str, Any], size: tuple[int, int]) -> dict[str, object]:

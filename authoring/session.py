@@ -30,7 +30,7 @@ from engine.camera import Camera
 from engine.render.scene import RenderScene
 from input.hub import InputHub
 from input.recording import Recorder, Recording, RecordingHeader
-from input.replay import HashCheck
+from input.replay import HashCheck, ReplaySource
 from input.sample import InputFrame
 
 __all__ = [
@@ -244,7 +244,7 @@ class Session:
         if self.simulation.ended():
             return True
         replay = self.hub.replay
-        return replay is not None and self.frame > replay.last_frame  # type: ignore[attr-defined]  # ReplaySource's
+        return isinstance(replay, ReplaySource) and self.frame > replay.last_frame  # (the hub's only frame source)
 
     def draw(self, scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
         """The simulation's drawing."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,6 +14,9 @@ from engine.render.components import Appearance
 from engine.render.extract import scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
+
+if TYPE_CHECKING:
+    from engine.character.load import Character
 
 __all__ = [
     "draw_world",
@@ -70,10 +74,10 @@ class PlayerCharacter:
     SIM_STATE = False
 
     value: object
-    character: object
+    character: Character
 
 
-def player_character(world: World):  # type: ignore[no-untyped-def]  # -> engine.character.load.Character | None
+def player_character(world: World) -> Character | None:
     """The player's character of the game's set-up, or ``None`` for the mannequin.
 
     Raises:

@@ -29,6 +29,7 @@ from engine import quat
 from engine.blend.locomotion import LocomotionPlayer
 from engine.clips.contacts import FOOT_JOINTS, HEEL_OFFSET
 from engine.components import Puppet, Transform, WorldPose
+from engine.skeleton import Skeleton
 from engine.statemachine import Brain
 from input.source import PoseSource
 
@@ -126,7 +127,7 @@ def record_stick_walk(
     return Path(path)
 
 
-def _soles(sk, wp: WorldPose) -> np.ndarray:  # type: ignore[no-untyped-def]
+def _soles(sk: Skeleton, wp: WorldPose) -> np.ndarray:
     """``[2, 2, 3]`` heel and toe-tip world points of both feet."""
     out = np.empty((2, 2, 3))
     for s, name in enumerate(FOOT_JOINTS):

@@ -21,7 +21,11 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from engine.cliplib.authored import AuthoredClips
+    from engine.cliplib.library import ClipLibrary
 
 __all__ = ["configure", "run", "library_setup", "authored_resource"]
 
@@ -56,7 +60,7 @@ def configure(parser: argparse.ArgumentParser) -> None:
     parser.epilog = "exit codes: 0 done; 2 an unreadable file or library, or a clip refused for its role (with why)"
 
 
-def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-def]
+def _add(library: ClipLibrary, args: argparse.Namespace) -> int:
     from engine.cliplib.roles import RoleError, check_role, conform, normalise_role
     from engine.cliplib.source import read_source, to_puppet
     from engine.clips import default_clips
@@ -88,7 +92,7 @@ def _add(library, args: argparse.Namespace) -> int:  # type: ignore[no-untyped-d
     return 0
 
 
-def _list(library) -> int:  # type: ignore[no-untyped-def]
+def _list(library: ClipLibrary) -> int:
     clips = library.load()
     entries = library.entries()
     if not clips:
@@ -164,7 +168,7 @@ def library_setup(folder: Path | None, replay: bool) -> dict[str, Any] | None:
     return encode(clips)
 
 
-def authored_resource(value: Any):  # type: ignore[no-untyped-def]
+def authored_resource(value: Any) -> AuthoredClips:
     """The :class:`~engine.cliplib.authored.AuthoredClips` of a set-up's ``"clips"`` (checked, see ``decode``)."""
     from engine.cliplib.authored import AuthoredClips
     from engine.cliplib.cache import default_cache_dir

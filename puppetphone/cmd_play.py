@@ -10,6 +10,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from authoring.session import Session
+    from engine.runner import RunOptions, RunResult
+    from input.hub import InputHub
 
 __all__ = ["configure", "run", "run_activity"]
 
@@ -97,7 +103,7 @@ def resolve_source(source: str, game: str) -> str:
     return source
 
 
-def announce_web(hub) -> None:  # type: ignore[no-untyped-def]
+def announce_web(hub: InputHub) -> None:
     """Print a web controller's link, fingerprint and QR code, and publish it for ``devices``."""
     from input.web.server import WebSource
 
@@ -115,17 +121,20 @@ def announce_web(hub) -> None:  # type: ignore[no-untyped-def]
             atexit.register(unpublish)
 
 
-def run_activity(activity, options) -> tuple[int, object]:  # type: ignore[no-untyped-def]
+def run_activity(activity: Session, options: RunOptions) -> tuple[int, RunResult | None]:
     """Run a game's session through the runner; ``(exit code, run result)``."""
     from engine.render.window import NoDisplayError
     from engine.runner import Runner
+    from puppetphone.session import GameSimulation
 
-    runner = Runner(options, clock=activity.simulation.app.clock)
+    game = activity.simulation
+    assert isinstance(game, GameSimulation)  # build_activity's sessions run a game
+    runner = Runner(options, clock=game.app.clock)
     runner.push_handlers(activity)
-    activity.simulation.fps = lambda: runner.fps
+    game.fps = lambda: runner.fps
     activity.hub.start()
     try:
-        result = runner.run(activity)  # (a Session: its camera is read-only, the runner only reads it)
+        result = runner.run(activity)  # type: ignore[arg-type]  # Session.camera is read-only: the runner only reads it
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2, None
@@ -204,7 +213,10 @@ def run(args: argparse.Namespace) -> int:
     announce_web(hub)
     seed, setup = args.seed, None
     if hub.replay is not None:
-        recording = hub.replay.recording  # type: ignore[attr-defined]
+        from input.replay import ReplaySource
+
+        assert isinstance(hub.replay, ReplaySource)  # make_hub's only frame source
+        recording = hub.replay.recording
         if recording.header.game != args.game:
             hub.close()
             print(f"the recording is of {recording.header.game!r}, not {args.game!r}", file=sys.stderr)
@@ -246,5 +258,5 @@ def run(args: argparse.Namespace) -> int:
         return 2
     code, result = run_activity(activity, run_options(args, f"PuppetPhone — {args.game}", pace=hub.live))
     if result is not None:
-        print(f"ran {result.steps} steps of {args.game}")  # type: ignore[attr-defined]
+        print(f"ran {result.steps} steps of {args.game}")
     return code

@@ -19,6 +19,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from input.recording import Recording
+    from input.replay import HashCheck
+    from puppetphone.registry import Entry
 
 __all__ = ["configure", "run"]
 
@@ -100,10 +106,11 @@ def run(args: argparse.Namespace) -> int:
     code, result = run_activity(activity, run_options(args, f"PuppetPhone — replay of {args.file}"))
     if code:
         return code
-    return _verdict(activity.check, result.steps, rec, args, cut_short)  # type: ignore[attr-defined]
+    assert result is not None and activity.check is not None  # exit code 0: it ran, verifying ``rec``
+    return _verdict(activity.check, result.steps, rec, args, cut_short)
 
 
-def _replay_tool(entry, rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
+def _replay_tool(entry: Entry, rec: Recording, args: argparse.Namespace, cut_short: bool) -> int:
     """A tool's session: reopened from the recording by its registered tool, fed the recorded input."""
     from authoring.session import tool_session
     from engine.render.window import NoDisplayError
@@ -132,10 +139,11 @@ def _replay_tool(entry, rec, args: argparse.Namespace, cut_short: bool) -> int: 
         session.close()
     if result.screenshot is not None:
         print(f"screenshot: {result.screenshot}")
+    assert session.check is not None  # tool_session checks every step against ``rec``
     return _verdict(session.check, result.steps, rec, args, cut_short)
 
 
-def _verdict(check, steps: int, rec, args: argparse.Namespace, cut_short: bool) -> int:  # type: ignore[no-untyped-def]
+def _verdict(check: HashCheck, steps: int, rec: Recording, args: argparse.Namespace, cut_short: bool) -> int:
     """Print how the replay went; the exit code."""
     if not check.ok:
         print(check.message())

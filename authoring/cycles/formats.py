@@ -438,7 +438,8 @@ def save_loop(
 
         clip = loop_clip(result, perf)
         travel, turn = loop_travel(result, perf)
-        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)  # type: ignore[union-attr]  # skeletal: has a clip
+        assert perf.clip is not None  # a skeletal performance keeps its clip
+        clip, travel = loop_at_rate(clip, fps or nominal_rate(perf.clip.fps), travel, turn)
         if fmt.name != "bvh":
             return write_gltf(path, clip)
         return write_bvh(path, clip_to_bvh(closed(clip, travel, turn) if closing_frame is not False else clip))

@@ -8,6 +8,7 @@ authoring never imports a game: the launcher hands the data over.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
@@ -19,13 +20,19 @@ from engine.camera import Camera
 __all__ = ["objects_from_data", "scene_from_data", "mesh_from_data", "mesh_data"]
 
 
+def _rgb(color: Iterable[float]) -> tuple[float, float, float]:
+    """A colour's three channels as floats (the flow file's parser and the games' scenes give three)."""
+    r, g, b = (float(c) for c in color)
+    return r, g, b
+
+
 def mesh_from_data(m: dict[str, Any]) -> TriMesh:
     """A triangle mesh from its plain description."""
     colors = m.get("face_colors")
     return TriMesh(
         np.array(m["vertices"], dtype=np.float64),
         np.array(m["faces"], dtype=np.int64),
-        tuple(float(c) for c in m.get("color", (0.6, 0.6, 0.6))),  # type: ignore[arg-type]
+        _rgb(m.get("color", (0.6, 0.6, 0.6))),
         None if colors is None else np.array(colors, dtype=np.float64),
     )
 
@@ -53,8 +60,8 @@ def objects_from_data(objects: list[dict[str, Any]]) -> list[FlowObject]:
                     np.array(p["a"], dtype=np.float64),
                     np.array(p["b"], dtype=np.float64),
                     float(p["radius"]),
-                    tuple(float(c) for c in p["color"]),
-                )  # type: ignore[arg-type]
+                    _rgb(p["color"]),
+                )
                 for p in o.get("primitives", [])
             ],
             mesh_from_data(o["mesh"]) if o.get("mesh") is not None else None,

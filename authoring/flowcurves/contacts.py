@@ -54,7 +54,7 @@ def _closest_between(p: Primitive, q: Primitive) -> tuple[F, F]:
     b = d1 @ d2
     den = a * e - b * b
     s = np.clip((b * f - c * e) / den, 0, 1) if den > 1e-12 else 0.0
-    t = (b * s + f) / e
+    t: F | float = (b * s + f) / e
     if t < 0:
         t, s = 0.0, np.clip(-c / a, 0, 1)
     elif t > 1:

@@ -154,4 +154,4 @@ def fit_stroke(
     lhs = np.vstack([a, c])
     rhs = np.vstack([f * math.sqrt(w_fit / len(f)), np.zeros((j, 2))])
     q = np.linalg.lstsq(lhs, rhs, rcond=None)[0]
-    return Hermite(q)
+    return Hermite(np.asarray(q, dtype=np.float64))  # (lstsq's stubs say floating; it is float64 here)

@@ -47,7 +47,7 @@ def _skinned(mesh: TriMesh) -> SkinnedMeshes:
     prims = []
     for c in np.unique(colors, axis=0):
         faces = mesh.faces[(colors == c).all(axis=1)]
-        linear = tuple(float(x) for x in np.asarray(c) ** 2.2) + (1.0,)
+        r, g, b = (float(x) for x in np.asarray(c) ** 2.2)
         prims.append(
             SkinnedPrimitive(
                 positions,
@@ -56,10 +56,10 @@ def _skinned(mesh: TriMesh) -> SkinnedMeshes:
                 joints,
                 weights,
                 np.ascontiguousarray(faces.ravel(), dtype=np.uint32),
-                linear,
+                (r, g, b, 1.0),
                 None,
             )
-        )  # type: ignore[arg-type]  # a 4-tuple built from an array
+        )
     return SkinnedMeshes(0, tuple(prims), ())
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -151,6 +152,10 @@ class _Bend:
         n = self.n
         return np.concatenate([gq[..., 1:n, :], gq[..., n + 1 :, :]], axis=-2).reshape(*gq.shape[:-2], -1)
 
+    @overload
+    def batch(self, free: F, gradient: Literal[False] = False) -> F: ...
+    @overload
+    def batch(self, free: F, gradient: Literal[True]) -> tuple[F, F]: ...
     def batch(self, free: F, gradient: bool = False) -> F | tuple[F, F]:
         """Energies ``[b, k]`` of the candidates ``[b, k, 4n−4]`` (and their gradients, shaped as ``free``)."""
         q = self.assemble(free)
@@ -214,7 +219,7 @@ def bend_curve(curve: Hermite, centre: ArrayLike, start: Hermite | None = None, 
 
 
 #: Step lengths tried at once by :func:`rebend` (a line search as one vectorised evaluation).
-_STEPS = 2.0 ** -np.arange(-2, 24)
+_STEPS: F = np.asarray(2.0 ** -np.arange(-2, 24), dtype=np.float64)  # (the stubs type the power as floating)
 
 
 def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iterations: int = 12) -> list[Hermite]:
@@ -228,7 +233,7 @@ def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iter
     editor's scripted drag on the snowman field: the same curves as a cold build to 0.003 px,
     most of them after 3 steps).
     """
-    out: list[Hermite | None] = [None] * len(curves)
+    out: dict[int, Hermite] = {}
     groups: dict[int, list[int]] = {}
     for i, c in enumerate(curves):
         groups.setdefault(c.n, []).append(i)
@@ -254,7 +259,7 @@ def rebend(curves: list[Hermite], centre: ArrayLike, starts: list[Hermite], iter
         q = energy.assemble(x[:, None])[:, 0]
         for row, i in enumerate(members):
             out[i] = Hermite(q[row])
-    return out  # type: ignore[return-value]
+    return [out[i] for i in range(len(curves))]  # every curve is in one group
 
 
 def _reverse(curve: Hermite) -> Hermite:

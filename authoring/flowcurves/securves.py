@@ -13,6 +13,7 @@ not, and its curves then take those spines (a round rock has no direction and no
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -73,7 +74,9 @@ def _curve_distance(a: F, b: F) -> float:
     return float(np.sqrt(((a[:, None, :] - b[None]) ** 2).sum(axis=-1)).min())
 
 
-def compute_securves(scene: FlowScene, rasters: list[Raster], progress=None) -> list[SECurve]:  # type: ignore[no-untyped-def]
+def compute_securves(
+    scene: FlowScene, rasters: list[Raster], progress: Callable[[int, int, str], None] | None = None
+) -> list[SECurve]:
     """The scene's SEcurves, one per group plus group contours, in group order (repeatable)."""
     out: list[SECurve] = []
     spines: list[tuple[F, list[int]]] = []

@@ -24,11 +24,14 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from engine.atomic import atomic_write_bytes
 from engine.errors import FormatError
 from engine.npz_safe import read_bounded
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.session import FlowSession
 
 __all__ = [
     "FlowFileError",
@@ -211,10 +214,13 @@ def load_flow(path: Path) -> dict[str, Any]:
     return parse_flow(doc)
 
 
-def flow_document(session) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+def flow_document(session: FlowSession) -> dict[str, Any]:
     """A session's edits and deformed objects as a flow document."""
-    cam = session.scene.camera
     from authoring.flowcurves.adapters import mesh_data
+    from engine.camera import OrbitCamera
+
+    cam = session.scene.camera
+    assert isinstance(cam, OrbitCamera)  # a flow file keeps an orbit view (its scenes are seen through one)
 
     objects = [
         {
@@ -249,7 +255,7 @@ def flow_document(session) -> dict[str, Any]:  # type: ignore[no-untyped-def]
     }
 
 
-def save_flow(session, path: Path) -> None:  # type: ignore[no-untyped-def]
+def save_flow(session: FlowSession, path: Path) -> None:
     """Write the session atomically (checked by the same parser a reader uses)."""
     doc = parse_flow(flow_document(session))
     atomic_write_bytes(Path(path), json.dumps(doc, separators=(",", ":")).encode("utf-8"))

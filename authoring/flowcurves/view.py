@@ -9,12 +9,18 @@ keeps a GPU copy per mesh object it is given, so the rest meshes are given, once
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
 from authoring.flowcurves.meshdraw import MeshDrawer
 from authoring.flowcurves.scene import FlowObject, FlowScene, pixel_rays
 from engine.render.scene import RenderScene
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.session import FlowSession
 
 __all__ = ["draw_objects", "draw_screen_polyline", "draw_session", "SECURVE_COLOR", "FLOW_COLOR"]
 
@@ -57,7 +63,12 @@ def draw_screen_polyline(
     scene.add_polyline(pts, color=color, width=width, closed=closed)
 
 
-def draw_session(scene: RenderScene, session, show_securves: bool = True, pending=None) -> None:  # type: ignore[no-untyped-def]
+def draw_session(
+    scene: RenderScene,
+    session: FlowSession,
+    show_securves: bool = True,
+    pending: Sequence[tuple[float, float]] | None = None,
+) -> None:
     """The deformed scene, its SEcurves (blue), flow curves (purple), centre-point and a stroke in progress."""
     from authoring.flowcurves.session import dense
 

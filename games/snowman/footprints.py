@@ -42,18 +42,17 @@ class Footprints:
     fade_start: float = 40.0
     """Seconds a print stays sharp before it starts to fill with snow."""
     fade_time: float = 30.0
-    xz: NDArray[np.float64] = field(default=None)
-    heading: NDArray[np.float64] = field(default=None)
-    frame: NDArray[np.int64] = field(default=None)
+    xz: NDArray[np.float64] = field(init=False)  # the ring buffer, ``capacity`` long (made by __post_init__)
+    heading: NDArray[np.float64] = field(init=False)
+    frame: NDArray[np.int64] = field(init=False)
     count: int = 0
     down: dict[tuple[int, int], bool] = field(default_factory=dict)
     last: dict[tuple[int, int], NDArray[np.float64]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.xz is None:
-            self.xz = np.zeros((self.capacity, 2))
-            self.heading = np.zeros(self.capacity)
-            self.frame = np.full(self.capacity, -1, dtype=np.int64)
+        self.xz = np.zeros((self.capacity, 2))
+        self.heading = np.zeros(self.capacity)
+        self.frame = np.full(self.capacity, -1, dtype=np.int64)
 
     def stamp(self, xz: NDArray[np.float64], heading: float, frame: int) -> None:
         """Add a print (over the oldest once full)."""

@@ -46,14 +46,13 @@ class SnowField:
     size: float = 24.0
     cell: float = 0.1
     initial_depth: float = 0.04
-    depth: NDArray[np.float64] = field(default=None)  # type: ignore[arg-type]  # made in __post_init__
+    depth: NDArray[np.float64] = field(init=False)  # ``initial_depth`` everywhere, made by __post_init__
 
     SIM_STATE = True
 
     def __post_init__(self) -> None:
         n = int(round(self.size / self.cell))
-        if self.depth is None:
-            self.depth = np.full((n, n), self.initial_depth)
+        self.depth = np.full((n, n), self.initial_depth)
 
     def _cells(self, center: NDArray[np.float64], half_width: float) -> tuple[slice, slice]:
         n = self.depth.shape[0]

@@ -15,10 +15,14 @@ flow editor never imports the game. Laid out by a seeded generator: the same eve
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.scene import FlowScene
+    from engine.camera import OrbitCamera
 
 __all__ = ["SCENE", "crystal_tree", "flow_camera", "flow_objects", "island"]
 
@@ -119,14 +123,14 @@ def flow_objects() -> list[dict[str, Any]]:
     return out
 
 
-def flow_camera():  # type: ignore[no-untyped-def]
+def flow_camera() -> OrbitCamera:
     """The view the forest is bent from: level with the islands' undersides, the whole forest in frame."""
     from engine.camera import OrbitCamera
 
-    return OrbitCamera(target=[0.0, 1.9, -2.0], yaw=0.0, pitch=0.05, distance=8.5)
+    return OrbitCamera(target=np.array([0.0, 1.9, -2.0]), yaw=0.0, pitch=0.05, distance=8.5)
 
 
-def flow_scene(size: tuple[int, int] = (1280, 720)):  # type: ignore[no-untyped-def]
+def flow_scene(size: tuple[int, int] = (1280, 720)) -> FlowScene:
     """The forest as a :class:`~authoring.flowcurves.scene.FlowScene` (the editor's and the bench's)."""
     from authoring.flowcurves.adapters import scene_from_data
 

@@ -13,9 +13,13 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from engine.atomic import atomic_write_bytes
 from input.web.cert import data_folder
+
+if TYPE_CHECKING:
+    from input.web.server import WebSource
 
 __all__ = ["WebLink", "web_link", "publish", "unpublish", "running_session"]
 
@@ -41,15 +45,15 @@ class WebLink:
         return out
 
 
-def web_link(source: object) -> WebLink:
+def web_link(source: WebSource) -> WebLink:
     """The link of a running :class:`input.web.server.WebSource`."""
     from input.pairing import lan_addresses
 
-    host: str = source.host  # type: ignore[attr-defined]
+    host = source.host
     addresses = lan_addresses() or ["127.0.0.1"] if host in ("0.0.0.0", "") else [host]
-    urls = [source.url(a) for a in addresses]  # type: ignore[attr-defined]
+    urls = [source.url(a) for a in addresses]
     loopback = all(a.startswith(_LOOPBACK) for a in addresses)
-    return WebLink(urls, source.certificate.fingerprint, loopback)  # type: ignore[attr-defined]
+    return WebLink(urls, source.certificate.fingerprint, loopback)
 
 
 def _session_file(folder: Path | None) -> Path:

@@ -32,12 +32,9 @@ __all__ = ["PhoneViewport", "camera_pose"]
 
 def camera_pose(camera: Camera) -> CameraPose:
     """A camera's eye, orientation (camera → world) and vertical field of view."""
-    q = quat.from_matrix(camera.rotation)
-    return CameraPose(
-        tuple(float(v) for v in camera.eye),
-        tuple(float(v) for v in q),  # type: ignore[arg-type]
-        float(camera.fov_y),
-    )
+    x, y, z = (float(v) for v in camera.eye)
+    w, qx, qy, qz = (float(v) for v in quat.from_matrix(camera.rotation))
+    return CameraPose((x, y, z), (w, qx, qy, qz), float(camera.fov_y))
 
 
 class PhoneViewport:

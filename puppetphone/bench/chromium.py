@@ -191,7 +191,10 @@ class Chromium:
         from input.web.protocol import orientation_to_quat
 
         w, x, y, z = (float(v) for v in orientation_to_quat(alpha, beta, gamma))
-        params = {"type": "relative-orientation", "reading": {"quaternion": {"x": x, "y": y, "z": z, "w": w}}}
+        params: dict[str, Any] = {
+            "type": "relative-orientation",
+            "reading": {"quaternion": {"x": x, "y": y, "z": z, "w": w}},
+        }
         if wait:
             self.call("Emulation.setSensorOverrideReadings", **params)
         else:

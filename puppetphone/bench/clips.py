@@ -19,10 +19,15 @@ import os
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from puppetphone.bench.figures import Figure
+
+if TYPE_CHECKING:
+    from engine.clip import Clip
+    from puppetphone.clip_walk import WalkFigures
 
 __all__ = ["run", "cmu_walk", "SWEEP"]
 
@@ -30,7 +35,7 @@ BENCH = "clips"
 SWEEP = (0.6, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.5)
 
 
-def cmu_walk():  # type: ignore[no-untyped-def]
+def cmu_walk() -> Clip | None:
     """The CMU 16_15 walk as the library's walk (``None`` without the data)."""
     root = Path(os.environ.get("PUPPETPHONE_DATA", Path(__file__).resolve().parents[3] / "shared" / "data"))
     path = root / "mocap" / "cmu_16_15_walk_daz.bvh"
@@ -61,7 +66,7 @@ def _start_times(clips: dict) -> tuple[float, float]:
     return float(np.median(warm)), cold
 
 
-def _walk(speed: float, clips: dict | None):
+def _walk(speed: float, clips: dict | None) -> WalkFigures:
     from puppetphone.clip_walk import record_stick_walk, walk_figures
 
     with tempfile.TemporaryDirectory() as d:

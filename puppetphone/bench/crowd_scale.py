@@ -22,6 +22,8 @@ import time
 import mujoco
 import numpy as np
 
+from engine.app import App
+from engine.ecs import Entity
 from engine.ragdoll import PhysicsWorld, Ragdoll, RagdollMode
 from puppetphone.bench.crowd import BUDGET_MS, crowd_app, timed_steps
 from puppetphone.bench.figures import Figure
@@ -35,7 +37,7 @@ FALLERS = 10
 _BENCH = "crowd-scale"
 
 
-def _ragdolls(app):  # type: ignore[no-untyped-def]
+def _ragdolls(app: App) -> list[Entity]:
     return [e for e, _ in app.world.query(Ragdoll)]
 
 

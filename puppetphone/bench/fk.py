@@ -6,16 +6,18 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from engine import jit, quat
 from engine.fk import forward_kinematics
 from engine.humanoid import humanoid_skeleton
+from engine.skeleton import Skeleton
 from puppetphone.bench.figures import Figure, median_time
 
 __all__ = ["run", "per_joint_fk"]
 
 
-def per_joint_fk(skeleton, root, rotations):  # type: ignore[no-untyped-def]
+def per_joint_fk(skeleton: Skeleton, root: ArrayLike, rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reference FK written the obvious way: one puppet, one joint at a time."""
     n = skeleton.num_joints
     pos = np.zeros((n, 3))

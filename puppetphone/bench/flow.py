@@ -38,12 +38,14 @@ and their 81 contacts are in the system; the repeats move the targets a little (
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 
 from authoring.flow_tool import FlowTool
 from authoring.flowcurves.deform import ITERATIONS, SceneDeformer
 from authoring.flowcurves.principal import principal_curve
+from authoring.flowcurves.scene import FlowScene
 from authoring.flowcurves.securves import SECurve
 from games.snowman.bent_scenery import flow_scene
 from puppetphone.bench.figures import Figure, median_time
@@ -72,7 +74,7 @@ THESIS_EDITS: dict[str, list[list[Op]]] = {
 }
 
 
-def field_problem():  # type: ignore[no-untyped-def]
+def field_problem() -> tuple[FlowScene, SceneDeformer, list[SECurve], Callable[[int], list[np.ndarray]]]:
     """The field's deformer, one SEcurve per group (principal curves) and a bend for each."""
     scene = flow_scene()
     deformer = SceneDeformer(scene)
@@ -113,20 +115,15 @@ def run() -> list[Figure]:
     dense = median_time(lambda: system.solve(hard, soft[0], ITERATIONS, dense=True), repeats=3, min_time=0.0) * 1e3
     cpu = _cpu_median(lambda: system.solve(hard, soft[next(steps) % 8], ITERATIONS))
     deformer._cache = None
-    factor = (
-        median_time(
-            lambda: (
-                setattr(deformer, "_cache", None),
-                deformer._system(
-                    list(offsets),
-                    [(o, seg.c[owners == o]) for seg, owners, _ in taken[0] for o in sorted(set(owners.tolist()))],
-                ),
-            ),
-            repeats=5,
-            min_time=0.0,
+
+    def factorise() -> None:
+        deformer._cache = None
+        deformer._system(
+            list(offsets),
+            [(o, seg.c[owners == o]) for seg, owners, _ in taken[0] for o in sorted(set(owners.tolist()))],
         )
-        * 1e3
-    )
+
+    factor = median_time(factorise, repeats=5, min_time=0.0) * 1e3
     return [
         Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system", dense),
         Figure("flow", "flow_solve_cpu_ms_40_objects", cpu, "ms", "its wall time (shared cores)", solve),
@@ -136,7 +133,7 @@ def run() -> list[Figure]:
     ]
 
 
-def _cpu_median(fn, repeats: int = 15) -> float:  # type: ignore[no-untyped-def]
+def _cpu_median(fn: Callable[[], object], repeats: int = 15) -> float:
     """Median process CPU milliseconds per call: what the solve costs when the cores are shared."""
     fn()
     times = []
@@ -147,7 +144,7 @@ def _cpu_median(fn, repeats: int = 15) -> float:  # type: ignore[no-untyped-def]
     return float(np.median(times)) * 1e3
 
 
-def _scripted_edits(scene) -> list[Figure]:  # type: ignore[no-untyped-def]
+def _scripted_edits(scene: FlowScene) -> list[Figure]:
     """Operations and update times of the editor's scripted row and centre-point edits."""
     from authoring.flowcurves.securves import compute_securves
     from authoring.flowcurves.session import FlowSession

@@ -15,10 +15,14 @@ an update.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
 from authoring.flowcurves.network import FlowNetwork
+from authoring.flowcurves.scene import FlowScene
+from authoring.flowcurves.securves import SECurve
 from authoring.flowcurves.session import FlowSession
 from puppetphone.bench.figures import Figure
 
@@ -28,19 +32,19 @@ __all__ = ["DRAG", "drag_figures"]
 DRAG = [(640.0 + 4.0 * k, 120.0 + 1.0 * k) for k in range(0, 31, 3)]
 
 
-def _timed(fn) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+def _timed(fn: Callable[[], object]) -> tuple[float, float]:
     """Wall and process-CPU milliseconds of one call."""
     w0, c0 = time.perf_counter(), time.process_time()
     fn()
     return (time.perf_counter() - w0) * 1e3, (time.process_time() - c0) * 1e3
 
 
-def drag_figures(scene, securves) -> list[Figure]:  # type: ignore[no-untyped-def]
+def drag_figures(scene: FlowScene, securves: list[SECurve] | None) -> list[Figure]:
     """Warm drag updates against cold rebuilds at the same points (whole update, and network alone)."""
     session = FlowSession(scene, securves=securves)
     session.add("centre", [DRAG[0]])
     path = DRAG[1:] + DRAG[-2::-1]
-    warm = [_timed(lambda p=p: session.move_centre(p)) for p in path]
+    warm = [_timed(partial(session.move_centre, p)) for p in path]
     edit = session.edits[-1]
     cold = []
     for p in path:
@@ -49,8 +53,8 @@ def drag_figures(scene, securves) -> list[Figure]:  # type: ignore[no-untyped-de
     spines = [s.points for s in session.spines()]
     width = scene.size[0]
     network = FlowNetwork.build(spines, DRAG[0], width)
-    net_warm = [_timed(lambda p=p: network.move(p, warm=True)) for p in path]
-    net_cold = [_timed(lambda p=p: FlowNetwork.build(spines, p, width)) for p in path]
+    net_warm = [_timed(partial(network.move, p, warm=True)) for p in path]
+    net_cold = [_timed(partial(FlowNetwork.build, spines, p, width)) for p in path]
     warm_ms, cold_ms = np.median(warm, axis=0), np.median(cold, axis=0)  # [wall, cpu]
     return [
         Figure(

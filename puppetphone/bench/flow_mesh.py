@@ -20,10 +20,17 @@ further right as it rises (:func:`lean_stroke`). After the solve:
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
 from puppetphone.bench.figures import Figure
+
+if TYPE_CHECKING:
+    from authoring.flowcurves.scene import FlowObject, FlowScene
+    from authoring.flowcurves.securves import SECurve
+    from authoring.flowcurves.session import FlowSession
 
 __all__ = ["HARD_WEIGHT", "bend", "lean_stroke", "mesh_tree_problem", "run"]
 
@@ -33,7 +40,7 @@ F = NDArray[np.float64]
 HARD_WEIGHT = 1e5
 
 
-def mesh_tree_problem(size: tuple[int, int] = (640, 480)):  # type: ignore[no-untyped-def]
+def mesh_tree_problem(size: tuple[int, int] = (640, 480)) -> tuple[FlowScene, list[SECurve]]:
     """``(scene, securves)``: one crystal tree (a mesh) seen from the side, and its principal curve."""
     from authoring.flowcurves.adapters import scene_from_data
     from authoring.flowcurves.principal import principal_curve
@@ -56,7 +63,7 @@ def lean_stroke(spine: F, gap: float = 14.0, lean: float = 0.0012) -> F:
     return np.c_[spine[:, 0].max() + gap + lean * (y.max() - y) ** 2, y]
 
 
-def bend(weight: float | None = None, lean: float = 0.0012):  # type: ignore[no-untyped-def]
+def bend(weight: float | None = None, lean: float = 0.0012) -> tuple[FlowScene, FlowSession]:
     """The tree bent along :func:`lean_stroke`: ``(scene, session)`` (``weight``: the shape weight, default ``W_SHAPE``)."""
     from authoring.flowcurves import arap
     from authoring.flowcurves.session import FlowSession
@@ -70,7 +77,7 @@ def bend(weight: float | None = None, lean: float = 0.0012):  # type: ignore[no-
     return scene, session
 
 
-def contact_error_px(scene, bent) -> float:  # type: ignore[no-untyped-def]
+def contact_error_px(scene: FlowScene, bent: list[FlowObject]) -> float:
     """The largest screen move of a ground vertex of any mesh (rest ``scene`` against ``bent`` objects)."""
     from authoring.flowcurves.contacts import GROUND_TOLERANCE
 
@@ -85,7 +92,7 @@ def contact_error_px(scene, bent) -> float:  # type: ignore[no-untyped-def]
     return worst
 
 
-def shape_residuals(session) -> F:  # type: ignore[no-untyped-def]
+def shape_residuals(session: FlowSession) -> F:
     """Distances (px) of every constrained SEcurve sample from its target on the flow curve."""
     from authoring.flowcurves.session import dense
 
@@ -103,6 +110,7 @@ def run() -> list[Figure]:
 
     scene, session = bend()
     rest, moved = scene.objects[0].mesh, session.objects[0].mesh
+    assert rest is not None and moved is not None  # the crystal tree is one mesh
     up = np.array([0.0, 1.0, 0.0])
     tilt = max(
         base_tilt_deg(o.mesh.vertices, b.mesh.vertices, up)

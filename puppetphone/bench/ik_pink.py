@@ -13,6 +13,7 @@ position constraint (pink's ``constraints``), as our pins are within ε. Steps o
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
@@ -35,7 +36,7 @@ def available() -> str | None:
     return None
 
 
-def _model(joints: int, link: float, tip: np.ndarray, limit: float):  # type: ignore[no-untyped-def]
+def _model(joints: int, link: float, tip: np.ndarray, limit: float) -> Any:  # a pinocchio Model (untyped)
     import pinocchio as pin
 
     model = pin.Model()
@@ -74,7 +75,9 @@ def pink_chain(
     model = _model(joints, link, tip, limit)
     data = model.createData()
     limits = [ConfigurationLimit(model)]  # built once, like our rig
-    times, errors, drifts = [], [], []
+    times: list[float] = []
+    errors: list[float] = []
+    drifts: list[float] = []
     for c0, target in cases:
         rot = quat.exp(c0.reshape(joints, 3))
         q0 = np.clip(quat.to_euler("xyz", rot).reshape(-1), -limit + 1e-6, limit - 1e-6)
@@ -98,9 +101,9 @@ def pink_chain(
                                   safety_break=False)  # fmt: skip
                 conf.integrate_inplace(v, 1.0)
             best = min(best, time.perf_counter() - t0)
-        errors.append(np.linalg.norm(conf.get_transform_frame_to_world("tip").translation - target))
+        errors.append(float(np.linalg.norm(conf.get_transform_frame_to_world("tip").translation - target)))
         drift = [np.linalg.norm(conf.get_transform_frame_to_world(f"f{j}").translation - h.transform_target_to_world.translation)
                  for j, h in zip(pins, holds, strict=True)]  # fmt: skip
-        drifts.append(max(drift, default=0.0))
+        drifts.append(float(max(drift, default=0.0)))
         times.append(best)
     return float(np.median(times)) * 1e3, float(np.median(errors)) * 1e3, float(np.median(drifts)) * 1e3

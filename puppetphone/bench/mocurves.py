@@ -10,7 +10,9 @@ default walk (projection, λ fit, re-integration and the leg IK of both feet).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 from scipy.optimize import minimize
@@ -47,16 +49,25 @@ def slsqp_timewarp(n: int, constraints: dict[int, float]) -> np.ndarray:
     return np.asarray(minimize(f, times, method="SLSQP", constraints=[cons], options={"maxiter": 500}).x)
 
 
+def _cold_solve(n: int) -> None:
+    """A fresh workspace's first solve (``timewarp_ms_N``)."""
+    TimeWarp(n, 1.0).solve(_drag(n))
+
+
+def _warm_solve(n: int, warp: TimeWarp, steps: Iterator[int]) -> None:
+    """The drag's next move re-solved by a warm workspace (``timewarp_warm_ms_N``)."""
+    warp.solve(_drag(n, next(steps) % 20))
+
+
 def run() -> list[Figure]:
     """Time-warp cold/warm solve times per size and the contact solve time."""
     figures = []
     slsqp_ms = median_time(lambda: slsqp_timewarp(120, _drag(120)), repeats=3, min_time=0.0) * 1e3
     for n in SIZES:
-        cold = median_time(lambda n=n: TimeWarp(n, 1.0).solve(_drag(n)), repeats=9) * 1e3
+        cold = median_time(partial(_cold_solve, n), repeats=9) * 1e3
         warp = TimeWarp(n, 1.0)
         warp.solve(_drag(n))
-        steps = iter(range(1, 10**9))
-        warm = median_time(lambda n=n, warp=warp, steps=steps: warp.solve(_drag(n, next(steps) % 20)), repeats=9) * 1e3
+        warm = median_time(partial(_warm_solve, n, warp, iter(range(1, 10**9))), repeats=9) * 1e3
         base, base_value = ("scipy SLSQP, same QP", slsqp_ms) if n == 120 else ("goal at 120 keypoints", GOAL_MS)
         figures.append(Figure("mocurves", f"timewarp_ms_{n}", cold, "ms", base, base_value))
         figures.append(Figure("mocurves", f"timewarp_warm_ms_{n}", warm, "ms", "cold solve", cold))

@@ -69,18 +69,18 @@ def run() -> list[Figure]:
                     Figure(BENCH, f"character_{key}_fell", float(ch.fell), "", "mannequin", float(new.fell)),
                 ]
     for device in ("phone", "mouse"):
-        new = [jump(v, device, "spring") for v in JUMP_SPEEDS]
-        old = [jump(v, device, "legacy") for v in JUMP_SPEEDS]
-        apex = [r.apex_error for r in new if r.apex_error is not None]
-        delay = [r.takeoff_delay for r in new if r.takeoff_delay is not None]
+        new_jumps = [jump(v, device, "spring") for v in JUMP_SPEEDS]
+        old_jumps = [jump(v, device, "legacy") for v in JUMP_SPEEDS]
+        apex = [r.apex_error for r in new_jumps if r.apex_error is not None]
+        delay = [r.takeoff_delay for r in new_jumps if r.takeoff_delay is not None]
         figs += [
             Figure(
                 BENCH,
                 f"{device}_jump_landed_pct",
-                100.0 * np.mean([r.landed for r in new]),
+                100.0 * float(np.mean([r.landed for r in new_jumps])),
                 "%",
                 "legacy controller",
-                100.0 * np.mean([r.landed for r in old]),
+                100.0 * float(np.mean([r.landed for r in old_jumps])),
             ),
             Figure(BENCH, f"{device}_jump_apex_error", float(np.max(apex)) if apex else float("nan"), "m"),
             Figure(BENCH, f"{device}_jump_takeoff_s", float(np.median(delay)) if delay else float("nan"), "s"),

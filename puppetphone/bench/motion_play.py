@@ -204,15 +204,16 @@ class _Driver:
         a frame), queue it for the next frame, which handles the queue at once as the game does."""
         assert isinstance(self.source, MouseSource)
         if self.burst == 1:
-            self.source.handle_event(pygame.event.Event(kind, **attrs), self.camera, self.size, now=t)
+            self.source.handle_event(pygame.event.Event(kind, attrs), self.camera, self.size, now=t)
         else:
-            self._pending.append(pygame.event.Event(kind, **attrs))
+            self._pending.append(pygame.event.Event(kind, attrs))
 
     def _advance(self) -> None:
         """One simulation step (after the frame's events, when a frame starts) and its record."""
         if self.burst > 1 and self._steps % self.burst == 0:
             for event in self._pending:
-                self.source.handle_event(event, self.camera, self.size, now=self.time)  # type: ignore[attr-defined]
+                assert isinstance(self.source, MouseSource)  # only the mouse queues events
+                self.source.handle_event(event, self.camera, self.size, now=self.time)
             self._pending.clear()
         self._steps += 1
         self.app.step()
@@ -229,6 +230,7 @@ class _Driver:
         dt = self.world.dt
         n = int(round(RATE * dt))
         for k in range(1, n + 1) if hand is not None else ():
+            assert hand is not None  # the loop runs only with a hand
             ground, self.lift = hand(self.clock + dt * k / n)
             t = self.time + dt * k / n
             if self.device == "phone":

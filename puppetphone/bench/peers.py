@@ -19,6 +19,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -123,10 +124,10 @@ def run() -> list[Figure]:
             Figure(
                 _BENCH,
                 name,
-                cpu_time(lambda u=u: table.query(u)) * 1e6,
+                cpu_time(partial(table.query, u)) * 1e6,
                 "us",
                 "SciPy cKDTree query + textbook IDW",
-                cpu_time(lambda u=u: textbook(u)) * 1e6,
+                cpu_time(partial(textbook, u)) * 1e6,
             )
         )
     return figures

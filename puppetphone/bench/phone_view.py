@@ -26,12 +26,19 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from puppetphone.bench.figures import Figure
+
+if TYPE_CHECKING:
+    from engine.app import App
+    from engine.ecs import World
+    from engine.render.scene import RenderScene
 
 __all__ = ["PageLatency", "client_latency", "page_latency", "run", "stream_bytes"]
 
@@ -39,7 +46,7 @@ STEP_MS = 1000.0 / 60.0
 PHONE = (390, 844)
 
 
-def _stream_cost(app, draw, steps: int) -> tuple[float, float, int]:  # type: ignore[no-untyped-def]
+def _stream_cost(app: App, draw: Callable[[World, RenderScene, float], None], steps: int) -> tuple[float, float, int]:
     """Mean coded and raw float32 bytes per step over ``steps`` steps, and the puppets seen."""
     from engine.components import Puppet
     from engine.render.scene import RenderScene

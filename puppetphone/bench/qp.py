@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
+from unittest import mock
 
 import numpy as np
 
@@ -49,13 +50,10 @@ def _ik_problems() -> list[Problem]:
     sk = chain_skeleton(56)
     rig = IKRig.build(sk, limits=dict.fromkeys(sk.names, (-LIMIT, LIMIT)))
     pj = pin_joints(56, 3)
-    ikqp.StepQP.solve = spy  # type: ignore[method-assign]
-    try:
+    with mock.patch.object(ikqp.StepQP, "solve", spy):
         for c0, target in chain_targets(rig, pj, 20, seed=1683):
             root, rot = rig.to_pose(c0, quat.identity(56), np.zeros(3))
             solve_ik(rig, root, rot, [Effector(55, target, point=TIP)], [Pin(j) for j in pj])
-    finally:
-        ikqp.StepQP.solve = orig  # type: ignore[method-assign]
     return rec
 
 
@@ -80,10 +78,11 @@ def _warp_problems() -> list[Problem]:
     return out
 
 
-def _daqp(probs: list[Problem]) -> list[np.ndarray]:
+def _daqp(probs: list[Problem]) -> list[np.ndarray | None]:
     from engine.qp import DenseQP
 
-    out, cur, qp = [], None, None
+    out: list[np.ndarray | None] = []
+    cur, qp = None, None
     for key, h, f, a, blo, bhi, lo, hi in probs:
         if key != cur:
             qp, cur = DenseQP(len(f), a.shape[0]), key
@@ -95,7 +94,9 @@ def _daqp(probs: list[Problem]) -> list[np.ndarray]:
 def _proxsuite(probs: list[Problem]) -> list[np.ndarray]:
     import proxsuite
 
-    out, cur, qp = [], None, None
+    out: list[np.ndarray] = []
+    cur = None
+    qp: Any = None  # the solver's workspace (an untyped library)
     for key, h, f, a, blo, bhi, lo, hi in probs:
         n, m = len(f), a.shape[0]
         big = 1e20
@@ -125,7 +126,9 @@ def _proxsuite(probs: list[Problem]) -> list[np.ndarray]:
 def _piqp(probs: list[Problem]) -> list[np.ndarray]:
     import piqp
 
-    out, cur, s = [], None, None
+    out: list[np.ndarray] = []
+    cur = None
+    s: Any = None  # the solver's workspace (an untyped library)
     for key, h, f, a, blo, bhi, lo, hi in probs:
         if key != cur:
             s, cur = piqp.DenseSolver(), key
@@ -142,7 +145,9 @@ def _osqp(probs: list[Problem]) -> list[np.ndarray]:
     import osqp
     import scipy.sparse as sp
 
-    out, cur, s = [], None, None
+    out: list[np.ndarray] = []
+    cur = None
+    s: Any = None  # the solver's workspace (an untyped library)
     for key, h, f, a, blo, bhi, lo, hi in probs:
         n = len(f)
         am = sp.csc_matrix(np.vstack([a, np.eye(n)]))
@@ -157,10 +162,10 @@ def _osqp(probs: list[Problem]) -> list[np.ndarray]:
     return out
 
 
-def _time(fn: Callable[[list[Problem]], list[np.ndarray]], probs: list[Problem],
-          passes: int = 5) -> tuple[float, list[np.ndarray]]:  # fmt: skip
+def _time(fn: Callable[[list[Problem]], Sequence[np.ndarray | None]], probs: list[Problem],
+          passes: int = 5) -> tuple[float, Sequence[np.ndarray | None]]:  # fmt: skip
     ts = []
-    xs: list[np.ndarray] = []
+    xs: Sequence[np.ndarray | None] = []
     for _ in range(passes):
         t0 = time.perf_counter()
         xs = fn(probs)
@@ -200,17 +205,16 @@ def _lifted() -> Figure:
         raw.append((id(self),) + tuple(np.copy(a) if isinstance(a, np.ndarray) else a for a in args))
         return orig(self, *args)
 
-    ikqp.StepQP.solve = spy  # type: ignore[method-assign]
-    try:
+    with mock.patch.object(ikqp.StepQP, "solve", spy):
         dense = _ik_problems()
-    finally:
-        ikqp.StepQP.solve = orig  # type: ignore[method-assign]
 
-    def lifted(_: list[Problem]) -> list[np.ndarray]:
-        out, cur, qp = [], None, None
+    def lifted(_: list[Problem]) -> list[np.ndarray | None]:
+        out: list[np.ndarray | None] = []
+        cur, qp = None, None
         for key, w, diag, js, ds, jr, blo, bhi, lo, hi in raw:
             if key != cur:
                 qp, cur = LeastSquaresQP(len(diag), len(ds), jr.shape[0]), key
+            assert qp is not None
             out.append(qp.solve(diag, js, ds, w, lo, hi, jr, blo, bhi).x)
         return out
 

@@ -35,10 +35,17 @@ cores are free (``fps_unloaded_1280x720``).
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from puppetphone.bench.figures import Figure, median_time
+
+if TYPE_CHECKING:
+    from engine.camera import Camera, OrbitCamera
+    from engine.render import RenderScene
+    from engine.render.renderer import Renderer
 
 __all__ = ["run", "demo_scene", "unloaded_frame_time", "cpu_frame_time", "quality_figures"]
 
@@ -57,7 +64,7 @@ COLORS = (
 )
 
 
-def demo_scene(puppets: int = 7, snowballs: int = 20, seed: int = 1):  # type: ignore[no-untyped-def]
+def demo_scene(puppets: int = 7, snowballs: int = 20, seed: int = 1) -> tuple[RenderScene, OrbitCamera]:
     """The benchmark scene and a camera that frames it."""
     from engine import quat
     from engine.camera import OrbitCamera
@@ -110,7 +117,7 @@ def _thread_cpu() -> dict[str, float]:
     return out
 
 
-def unloaded_frame_time(frame, frames: int = 40) -> float | None:  # type: ignore[no-untyped-def]
+def unloaded_frame_time(frame: Callable[[], object], frames: int = 40) -> float | None:
     """Seconds per frame if the cores were free: main thread + busiest other thread CPU."""
     before = _thread_cpu()
     for _ in range(frames):
@@ -133,7 +140,7 @@ void main() { f_color = vec4(0.8, 0.85, 0.9, 1.0); }
 """
 
 
-def cpu_frame_time(frame, frames: int = 6, repeats: int = 3) -> float:  # type: ignore[no-untyped-def]
+def cpu_frame_time(frame: Callable[[], object], frames: int = 6, repeats: int = 3) -> float:
     """Median over ``repeats`` of the process CPU seconds per frame of ``frame`` (after two warm-up frames).
 
     Process CPU time counts the main thread and every rasteriser thread, so it does not
@@ -174,7 +181,7 @@ def panda3d_peer() -> tuple[float, int] | str:
     return float(lines[-2]), int(lines[-1])
 
 
-def auto_level(renderer, frame, frames: int = 40) -> str:  # type: ignore[no-untyped-def]
+def auto_level(renderer: Renderer, frame: Callable[[], object], frames: int = 40) -> str:
     """The level :class:`~engine.render.quality.QualityGovernor` settles on from ``frame``'s CPU times."""
     import time
 
@@ -209,7 +216,7 @@ def quality_figures() -> list[Figure]:
     empty.ground.grid = False  # the snowman field's ground (no grid lines)
     crowd, crowd_camera = demo_scene(puppets=BIG_CROWD)
 
-    def draw(s: RenderScene, cam) -> None:  # type: ignore[no-untyped-def]
+    def draw(s: RenderScene, cam: Camera) -> None:
         renderer.render(s, cam, target.begin())
         target.end()
         target.ctx.finish()

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import sys
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -90,8 +91,8 @@ def run() -> list[Figure]:
                 target.end()
                 target.ctx.finish()
 
-            t_skin = cpu_frame_time(lambda s=skinned: frame(s), frames=3 if n == 100 else 6)
-            t_mann = cpu_frame_time(lambda s=mannequins: frame(s), frames=3 if n == 100 else 6)
+            t_skin = cpu_frame_time(partial(frame, skinned), frames=3 if n == 100 else 6)
+            t_mann = cpu_frame_time(partial(frame, mannequins), frames=3 if n == 100 else 6)
             figures.append(
                 Figure(
                     "render",

@@ -15,10 +15,14 @@ drives its ragdoll every step — only the stick-following is skipped.
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from puppetphone.bench.figures import Figure, median_time
+
+if TYPE_CHECKING:
+    from engine.app import App
 
 __all__ = ["run", "loaded_app", "SNOWMEN", "SNOWBALLS"]
 
@@ -27,7 +31,7 @@ SNOWBALLS = 20
 WIDTH, HEIGHT = 1280, 720
 
 
-def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1):  # type: ignore[no-untyped-def]
+def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1) -> App:
     """The snowman game with its puppet, ``snowmen`` snowmen and ``snowballs`` balls (0, 0 and
     no puppet: the empty field), stepped for one second so every model is built."""
     from engine.ragdoll.components import Prop
@@ -70,7 +74,7 @@ def loaded_app(snowmen: int = SNOWMEN, snowballs: int = SNOWBALLS, seed: int = 1
     return app
 
 
-def _step_time(app, steps: int = 300) -> float:  # type: ignore[no-untyped-def]
+def _step_time(app: App, steps: int = 300) -> float:
     """Median seconds of ``steps`` consecutive steps, each timed alone.
 
     The scene moves on as it is stepped (balls roll and slow down), so every run times
@@ -84,7 +88,7 @@ def _step_time(app, steps: int = 300) -> float:  # type: ignore[no-untyped-def]
     return float(np.median(times))
 
 
-def _render_fps(app) -> tuple[float, float | None]:  # type: ignore[no-untyped-def]
+def _render_fps(app: App) -> tuple[float, float | None]:
     """Median frames per second of the game's full frame (world, scenery, snow, overlay) at
     1280x720, and the rate the same frames would run at with the cores free (see
     :mod:`puppetphone.bench.render`; ``None`` without ``/proc``)."""

@@ -20,8 +20,16 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from engine.app import App
+    from engine.components import Stick as _Stick
+    from engine.pacing import RealTimePacer
+    from input.sample import InputFrame as _InputFrame
+    from input.web.server import WebSource
 
 __all__ = ["measure"]
 
@@ -75,7 +83,15 @@ def measure(steps: int = 300, dt: float = 1.0 / 60.0, warmup: int = 60, wake: bo
     return np.array(latencies)
 
 
-def _run(app, src, steps, warmup, pacer, InputFrame, Stick) -> list[float]:  # type: ignore[no-untyped-def]
+def _run(
+    app: App,
+    src: WebSource,
+    steps: int,
+    warmup: int,
+    pacer: RealTimePacer,
+    InputFrame: type[_InputFrame],  # the classes, imported lazily by the caller
+    Stick: type[_Stick],
+) -> list[float]:
     out = []
     for k in range(warmup + steps):
         pacer.wait()

@@ -203,3 +203,19 @@ def test_render_shows_keys_on_the_timeline_and_joint_handles_at_a_key(viewer):
     grip, _ = _grip_px(scene)  # the teal orientation grip at the current frame's stick
     x, y = int(round(grip[0])), int(round(grip[1]))
     assert _near(img2[y - 5 : y + 6, x - 5 : x + 6], (26, 191, 178), tol=50).sum() >= 20
+
+
+def test_a_hold_naming_its_joint_by_index_draws_as_one_naming_it():
+    """``Hold.joint`` is a name or an index (the solver reads both); the scene looked an index up as a
+    name and drawing raised ``KeyError``. Broken by reverting the scene to ``skeleton.index(h.joint)``."""
+    from authoring.keyframe_curves.solver import Hold
+    from engine.render.scene import RenderScene
+
+    rest = CurveSession.from_spec("rest")
+    drawn = []
+    for joint in ("r_foot", rest.clip.skeleton.index("r_foot")):
+        scene = RenderScene()
+        CurvesScene(CurveSession(rest.clip, holds=(Hold(joint, 0, 10),)), (640, 480), "l_hand").draw(scene)
+        drawn.append(scene.points.data.copy())
+    assert len(drawn[0]) > 0
+    np.testing.assert_array_equal(drawn[0], drawn[1])
