@@ -56,12 +56,12 @@ def groove_shade(soft: NDArray[np.uint8], sun_dir: NDArray[np.float64]) -> NDArr
     """
     m = soft.astype(np.float32) / 255.0
     p = np.pad(m, 1, mode="edge")
-    gx = p[1:-1, 2:] - p[1:-1, :-2]
-    gz = p[2:, 1:-1] - p[:-2, 1:-1]
-    n = np.stack([gx * GROOVE, np.ones_like(m), gz * GROOVE], axis=-1)
-    n /= np.linalg.norm(n, axis=-1, keepdims=True)
-    sun = np.asarray(sun_dir, dtype=np.float32)
-    light = np.clip(np.maximum(n @ sun, 0.0) / max(float(sun[1]), 0.2), 0.72, 1.12)
+    gx = (p[1:-1, 2:] - p[1:-1, :-2]) * GROOVE
+    gz = (p[2:, 1:-1] - p[:-2, 1:-1]) * GROOVE
+    sx, sy, sz = (float(v) for v in sun_dir)
+    # n = (gx, 1, gz) / |(gx, 1, gz)|, dotted with the sun (elementwise: no [N, N, 3] temporaries)
+    ndl = (gx * sx + sy + gz * sz) / np.sqrt(1.0 + gx * gx + gz * gz)
+    light = np.clip(np.maximum(ndl, 0.0) / max(sy, 0.2), 0.72, 1.12)
 
     def smoothstep(e0: float, e1: float, x: NDArray[np.float32]) -> NDArray[np.float32]:
         t = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
@@ -70,7 +70,7 @@ def groove_shade(soft: NDArray[np.uint8], sun_dir: NDArray[np.float64]) -> NDArr
     tint = 1.0 + (_FLOOR_TINT - 1.0) * smoothstep(0.0, 1.0, m)[..., None]
     k = tint * (1.0 + (light - 1.0) * smoothstep(0.0, 0.4, m))[..., None]
     out = np.empty((*m.shape, 4), dtype=np.uint8)
-    out[..., :3] = np.clip(0.5 * k * 255.0 + 0.5, 0, 255)
+    out[..., :3] = np.minimum(k * 127.5 + 0.5, 255.0).astype(np.uint8)  # k > 0: no lower clip
     out[..., 3] = soft
     return out
 
