@@ -223,17 +223,17 @@ class Environment:
         rect = marks_rect(marks)
         if rect is None:
             return
-        soft = soften_marks(marks.amount)
-        key = soft.tobytes() + np.asarray(sun_dir, dtype=np.float64).tobytes()
-        nz, nx = soft.shape
+        # The texture is made again only when the track or the sun changed (the key is the raw grid).
+        key = np.ascontiguousarray(marks.amount).tobytes() + np.asarray(sun_dir, dtype=np.float64).tobytes()
+        nz, nx = marks.amount.shape
         if self._marks_tex is None or self._marks_tex.size != (nx, nz):
             if self._marks_tex is not None:
                 self._marks_tex.release()
-            self._marks_tex = self.ctx.texture((nx, nz), 4, groove_shade(soft, sun_dir).tobytes())
+            self._marks_tex = self.ctx.texture((nx, nz), 4, groove_shade(soften_marks(marks.amount), sun_dir).tobytes())
             self._marks_tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
             self._marks_tex.repeat_x = self._marks_tex.repeat_y = False
         elif key != self._marks_src:
-            self._marks_tex.write(groove_shade(soft, sun_dir).tobytes())
+            self._marks_tex.write(groove_shade(soften_marks(marks.amount), sun_dir).tobytes())
         self._marks_src = key
         self._marks_tex.use(location=5)
         # The decal's rectangle in the texture's uv (texel centres at (i + 0.5) / n).
