@@ -9,7 +9,7 @@ Passes, in order (each kind of primitive is one instanced draw call):
    culling in a flat colour: only a rim around the silhouette stays visible.
 3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
    and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`),
-   or ray-cast on their bounding boxes where the level says so (:mod:`engine.render.impostors`),
+   or ray-cast on a quad over their outline where the level says so (:mod:`engine.render.impostors`),
    and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
    and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
