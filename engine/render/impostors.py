@@ -1,16 +1,21 @@
-"""Capsules and spheres as ray-cast impostors: eight vertices per solid instead of dozens.
+"""Capsules and spheres as ray-cast impostors: four vertices per solid instead of dozens.
 
 A crowd on a software rasteriser (llvmpipe) is bound by its vertex stage, which runs
 on the main thread: 100 puppets are 2,100 capsules, and even at their coarsest level of
 detail their meshes cost more than all the pixels they cover (measured: the crowd's
-frame at 5 % of the pixels cost 80 % of the full frame). An impostor draws each solid's
-bounding box instead (8 vertices, 12 triangles) and finds the surface per pixel: the
-ray from the eye through the pixel meets the capsule (a cylinder and two end spheres)
+frame at 5 % of the pixels cost 80 % of the full frame). An impostor draws one quad
+facing the eye (or the sun) over each solid's outline and finds the surface per pixel:
+the ray from the eye through the pixel meets the capsule (a cylinder and two end spheres)
 exactly, so the outline is round at any size and the depth written is the surface's.
 
-Only the box's back faces are drawn (front-face culling): they cover the box's whole
-outline even with the eye inside the box, and every pixel runs the ray test once. The
-same program draws the sun's shadow map, with the light's parallel rays.
+The quad lies across the view in front of the whole solid, as wide as the solid is seen
+across the view: seen from the eye every point of the solid is then behind the quad and
+inside its outline (a central projection onto a nearer plane only shrinks it). It covers
+about 1.3 times the outline of a sphere where the bounding box's back faces covered 2.2
+times, with two triangles instead of six (the box, measured in the crowd's frame: the
+triangles cost more than the pixels). When the eye is within the solid's depth or the quad
+would cross the near plane, the quad covers the whole view at the near plane instead.
+The same program draws the sun's shadow map, with the light's parallel rays.
 """
 
 from __future__ import annotations
@@ -24,30 +29,23 @@ from engine.render.gpu import Instances, mesh_buffers, set_uniform
 from engine.render.scene import CAPSULE_STRIDE
 from engine.render.shadows import CAPSULE_FMT
 
-__all__ = ["IMPOSTOR_VS", "IMPOSTOR_FS", "IMPOSTOR_DEPTH_FS", "box_corners", "Impostors"]
+__all__ = ["IMPOSTOR_VS", "IMPOSTOR_FS", "IMPOSTOR_DEPTH_FS", "quad_corners", "Impostors"]
 
 
-def box_corners() -> tuple[NDArray[np.float32], NDArray[np.int32]]:
-    """The cube ``[-1, 1]³``: eight corners and twelve triangles, counter-clockwise seen from outside."""
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float32)
-    tris = []
-    for axis in range(3):
-        for sign in (-1.0, 1.0):
-            face = [i for i in range(8) if corners[i, axis] == sign]  # four corners, in index order
-            a, b, c, d = face  # index order makes a, b, c, d a 2x2 grid: a-b-d-c round the face
-            for tri in ((a, b, d), (a, d, c)):
-                p = corners[list(tri)]
-                normal = np.cross(p[1] - p[0], p[2] - p[0])
-                tris.append(tri if normal[axis] * sign > 0 else tri[::-1])
-    return corners, np.array(tris, dtype=np.int32)
+def quad_corners() -> tuple[NDArray[np.float32], NDArray[np.int32]]:
+    """The square ``[-1, 1]²``: four corners and two triangles (drawn without face culling)."""
+    corners = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
+    return corners, np.array([[0, 1, 2], [2, 1, 3]], dtype=np.int32)
 
 
-# The box around a capsule: its axis frame, the radius on both sides and beyond both ends.
+# The quad over a capsule's outline, across the view and in front of the whole capsule.
 IMPOSTOR_VS = """
 uniform mat4 u_view_proj;
+uniform mat4 u_inv_view_proj;
+uniform vec4 u_view;            // xyz: the eye (w = 1), or the direction the light looks (w = 0)
 uniform vec3 u_cam;
 uniform float u_fog_density;
-in vec3 in_corner;              // -1..1
+in vec2 in_corner;              // -1..1
 in vec3 i_a;
 in vec3 i_b;
 in float i_r;
@@ -60,21 +58,40 @@ flat out float v_r;
 flat out vec3 v_color;
 flat out float v_fog;
 void main() {
-    vec3 axis = i_b - i_a;
-    float len = length(axis);
-    vec3 y = len > 1e-6 ? axis / len : vec3(0.0, 1.0, 0.0);
-    vec3 helper = abs(y.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    vec3 x = normalize(cross(helper, y));
-    vec3 z = cross(x, y);
-    float r = i_r * 1.01;       // a hair larger: the box's faces never clip the surface
-    v_pos = i_a + x * (in_corner.x * r) + z * (in_corner.z * r) + y * mix(-r, len + r, in_corner.y * 0.5 + 0.5);
+    vec3 c = 0.5 * (i_a + i_b);
+    vec3 h = 0.5 * (i_b - i_a);
+    float r = i_r * 1.01;       // a hair larger: the quad's edges never clip the outline
+    bool persp = u_view.w > 0.5;
+    vec3 d = persp ? c - u_view.xyz : u_view.xyz;
+    float dist = length(d);
+    d = dist > 1e-9 ? d / dist : vec3(0.0, 0.0, -1.0);
+    float ahead = abs(dot(h, d)) + r;           // how far the capsule reaches towards the eye
+    vec3 across = h - d * dot(h, d);            // the half axis as seen across the view
+    float half_len = length(across);
+    vec3 helper = abs(d.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 u = half_len > 1e-6 * r ? across / half_len : normalize(cross(d, helper));
+    vec3 side = cross(d, u);
+    vec3 centre = persp ? u_view.xyz + d * (dist - ahead) : c - d * ahead;
+    vec4 C = u_view_proj * vec4(centre, 1.0);
+    vec4 U = u_view_proj * vec4(u * (half_len + r), 0.0);
+    vec4 V = u_view_proj * vec4(side * r, 0.0);
+    // Clip z + w is linear over the quad: its least value over the corners says whether any
+    // corner is behind the near plane (same answer for the instance's four vertices).
+    bool near = persp && (dist - ahead <= 0.0 || C.z + C.w - abs(U.z + U.w) - abs(V.z + V.w) <= 0.0);
+    if (near) {
+        vec4 p = u_inv_view_proj * vec4(in_corner, -1.0, 1.0);
+        v_pos = p.xyz / p.w;
+        gl_Position = vec4(in_corner, 0.0, 1.0);
+    } else {
+        v_pos = centre + u * (in_corner.x * (half_len + r)) + side * (in_corner.y * r);
+        gl_Position = C + U * in_corner.x + V * in_corner.y;
+    }
     v_a = i_a;
     v_b = i_b;
     v_r = i_r;
     v_color = i_color;
-    float fog = length(0.5 * (i_a + i_b) - u_cam) * u_fog_density;
+    float fog = length(c - u_cam) * u_fog_density;
     v_fog = fog / (1.0 + fog);
-    gl_Position = u_view_proj * vec4(v_pos, 1.0);
 }
 """
 
@@ -82,7 +99,7 @@ void main() {
 # between the ends) and the two end spheres' entries; a miss discards the pixel.
 _HIT = """
 uniform mat4 u_view_proj;
-uniform vec4 u_view;            // xyz: the eye (w = 1), or the direction the light looks (w = 0)
+uniform vec4 u_view;
 in vec3 v_pos;
 flat in vec3 v_a;
 flat in vec3 v_b;
@@ -158,12 +175,12 @@ class Impostors:
         h, lit = S.HEADER, S.HEADER + S.LIGHTING
         self.lit = ctx.program(vertex_shader=h + IMPOSTOR_VS, fragment_shader=lit + IMPOSTOR_FS)
         self.depth = ctx.program(vertex_shader=h + IMPOSTOR_VS, fragment_shader=h + IMPOSTOR_DEPTH_FS)
-        self._vbo, self._ibo = mesh_buffers(ctx, box_corners())
+        self._vbo, self._ibo = mesh_buffers(ctx, quad_corners())
         self._inst = Instances(ctx, 4 * CAPSULE_STRIDE)
         self._shadow_inst = Instances(ctx, 4 * CAPSULE_STRIDE)
         self._vaos = {
             name: ctx.vertex_array(
-                prog, [(self._vbo, "3f", "in_corner"), (inst.buf, *CAPSULE_FMT)], self._ibo, 4, skip_errors=True
+                prog, [(self._vbo, "2f", "in_corner"), (inst.buf, *CAPSULE_FMT)], self._ibo, 4, skip_errors=True
             )
             for name, prog, inst in (("lit", self.lit, self._inst), ("depth", self.depth, self._shadow_inst))
         }
@@ -171,14 +188,14 @@ class Impostors:
     def draw(self, rows: NDArray[np.float32], eye: NDArray[np.float64]) -> None:
         """Lit solids seen from ``eye`` (the frame's uniforms are already set on :attr:`lit`).
 
-        Culling is set here (front faces) and restored to back-face culling.
+        Face culling is off for the quads and on again afterwards.
         """
         if not self._inst.upload(rows):
             return
         set_uniform(self.lit, "u_view", (float(eye[0]), float(eye[1]), float(eye[2]), 1.0))
-        self.ctx.cull_face = "front"
+        self.ctx.disable(moderngl.CULL_FACE)
         self._vaos["lit"].render(moderngl.TRIANGLES, instances=self._inst.count)
-        self.ctx.cull_face = "back"
+        self.ctx.enable(moderngl.CULL_FACE)
 
     def draw_depth(self, rows: NDArray[np.float32], light_vp: NDArray[np.float64], look: NDArray[np.float64]) -> None:
         """The solids into the bound shadow map; ``look``: the unit direction the light's rays travel."""
@@ -186,12 +203,8 @@ class Impostors:
             return
         set_uniform(self.depth, "u_view_proj", light_vp)
         set_uniform(self.depth, "u_view", (float(look[0]), float(look[1]), float(look[2]), 0.0))
-        self.ctx.enable(moderngl.CULL_FACE)
-        self.ctx.front_face = "ccw"
-        self.ctx.cull_face = "front"
-        self._vaos["depth"].render(moderngl.TRIANGLES, instances=self._shadow_inst.count)
-        self.ctx.cull_face = "back"
         self.ctx.disable(moderngl.CULL_FACE)
+        self._vaos["depth"].render(moderngl.TRIANGLES, instances=self._shadow_inst.count)
 
     def release(self) -> None:
         """Free the GPU objects."""

@@ -8,7 +8,7 @@ work (map and mask sizes) and how coarse a round solid may be drawn (silhouette 
 ``high`` adds the per-pixel snow detail near the camera; ``low`` lets only the solids
 nearest the camera cast shadows (600 of them: a crowd's near rows), bounding the shadow
 work whatever the crowd's size, and draws capsules and spheres as ray-cast impostors
-(8 vertices each: a crowd is vertex-bound on a software rasteriser).
+(a quad of 4 vertices each: a crowd is vertex-bound on a software rasteriser).
 
 ``auto`` is :class:`QualityGovernor`: it starts at ``medium``, steps down as soon as the
 median of the last frames misses the 30 fps budget, and steps up only when a level's
@@ -44,7 +44,7 @@ class Quality:
     """Capsules and spheres drawn into the shadow map, nearest the camera first (``None``: all).
     A crowd is vertex-bound on a software rasteriser, and the shadow map draws it a second time."""
     impostors: bool = False
-    """Capsules and spheres ray-cast on their bounding boxes (:mod:`engine.render.impostors`), not meshed."""
+    """Capsules and spheres ray-cast on a quad over their outline (:mod:`engine.render.impostors`), not meshed."""
 
 
 QUALITIES = {

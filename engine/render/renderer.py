@@ -9,7 +9,7 @@ Passes, in order (each kind of primitive is one instanced draw call):
    culling in a flat colour: only a rim around the silhouette stays visible.
 3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
    and spheres with the coarsest mesh their size on screen allows (:mod:`engine.render.lod`),
-   or ray-cast on their bounding boxes where the level says so (:mod:`engine.render.impostors`),
+   or ray-cast on a quad over their outline where the level says so (:mod:`engine.render.impostors`),
    and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
    and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
@@ -135,6 +135,13 @@ def _shadow_key(
     return h.digest()
 
 
+def _same_value(a: Any, b: Any) -> bool:
+    """Whether two uniform values are equal (numbers, tuples or numpy matrices)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and np.array_equal(a, b)
+    return bool(a == b)
+
+
 def _linear(c: Any) -> tuple[float, float, float]:
     a = np.clip(np.asarray(c, dtype=np.float64), 0.0, None) ** 2  # the shaders' gamma 2.0
     return float(a[0]), float(a[1]), float(a[2])
@@ -238,6 +245,8 @@ class Renderer:
         """When true, each pass waits for the GPU and its time lands in :attr:`timings` (slow; benches only)."""
         self.timings: dict[str, float] = {}
         self._mark_t = 0.0
+        self._common: dict[str, Any] = {}
+        """The frame uniforms every program holds (:meth:`_set_frame_uniforms` writes only changes)."""
         self._shadow_key: bytes | None = None
         """What the shadow map and mask now hold (:func:`_shadow_key`); ``None``: nothing reusable."""
         self.reuse_shadows = False
@@ -359,7 +368,9 @@ class Renderer:
         target.use()
         target.viewport = (0, 0, w, h)
         target.clear(*scene.horizon_color, 1.0, depth=1.0)
+        self._mark("clear")
         self._set_frame_uniforms(scene, camera, vp, light_vp, (w, h))
+        self._mark("uniforms")
         self.shadows.depth.use(location=1)
         self._background_texture(scene).use(location=2)
         self._noise.use(location=3)
@@ -373,11 +384,14 @@ class Renderer:
         if any(c.outline for c in scene.skinned):
             self.skinned.draw_outline(scene.skinned)
         ctx.cull_face = "back"
+        self._mark("outline")
         for batches in self._lod.values():
             batches.render()
+        self._mark("lod")
         if impostors:
             solids = np.concatenate([rows["capsules"][seen["capsules"]], rows["spheres"][seen["spheres"]]])
             self.impostors.draw(_nearest_first(solids, eye), eye)
+        self._mark("impostors")
         for kind in ("boxes", "cones"):
             if counts[kind]:
                 self._vaos[kind].render(moderngl.TRIANGLES, instances=counts[kind])
@@ -438,7 +452,9 @@ class Renderer:
                     "u_shadow_strength": 0.9 if rect is not None else 0.0,
                 },
             )
+        self._mark("ground")
         self.env.draw_sky(scene, photo, float(g.height))
+        self._mark("sky")
         if photo:
             ctx.depth_func = "<="
             self._vaos["sky_photo"].render(moderngl.TRIANGLES, vertices=3)
@@ -509,10 +525,16 @@ class Renderer:
             "u_inv_view_proj": np.linalg.inv(vp),
             "u_inflate_px": 0.0,
         }
+        # Only what changed since the last frame is written: a still camera and sun change nothing,
+        # and each write is a Python call per program (25 names x 16 programs cost 1.3 ms a frame).
+        # What a pass sets over these (the text's viewport, the outline's inflation) it sets every frame.
+        last = self._common
+        changed = [k for k, v in common.items() if k not in last or not _same_value(last[k], v)]
         for prog in (*self._programs.values(), self.impostors.lit):
-            for name, value in common.items():
-                set_uniform(prog, name, value)
-        self.env.set_common(common)
+            for name in changed:
+                set_uniform(prog, name, common[name])
+        self.env.set_common(common, changed)
+        self._common = common
         outline = tuple(float(c) for c in scene.outline_color)
         for name in ("capsule_flat", "box_flat", "skinned_flat"):
             set_uniform(self._programs[name], "u_color", outline)

@@ -125,3 +125,22 @@ def test_the_horizon_is_a_line_one_can_see(gl):
     band = rows[horizon - 12 : horizon + 2].min()
     assert rows[: horizon - 25].mean() - band > 40  # sky above is far brighter
     assert rows[horizon + 20 :].mean() - band > 40  # and so is the snow below
+
+
+@pytest.mark.parametrize("towards", [1.0, -1.0])
+def test_the_groove_wall_facing_the_sun_is_the_brighter_one(gl, towards):
+    """The track's walls are shaded by how they face the sun (``groove_shade``): with the sun low
+    over +z the wall on the -z side, which faces +z, is lit and the other is in shade, and the
+    other way round. (Broken once: with the slope's sign flipped in ``groove_shade`` this fails.)"""
+    cam = OrbitCamera(target=np.array([0.0, 0.0, 0.0]), yaw=0.0, pitch=1.45, distance=3.0)
+    scene = _track_scene()
+    scene.sun.direction = (0.0, 0.45, 0.9 * towards)
+    scene.sun.shadows = False
+    img = luminance(draw(gl, scene, cam))
+    # Sample across the groove (half-width 0.3 m) at x = 0: the wall around |z| = 0.25.
+    zs = np.linspace(-0.45, 0.45, 19)
+    px = np.round(cam.project(np.c_[np.zeros_like(zs), np.zeros_like(zs), zs], W, H)).astype(int)
+    profile = img[px[:, 1], px[:, 0]]
+    minus_side, plus_side = profile[:9].max(), profile[10:].max()
+    lit, shaded = (minus_side, plus_side) if towards > 0 else (plus_side, minus_side)
+    assert lit > shaded + 4

@@ -1,9 +1,13 @@
 """Ray-cast impostors (quality ``low``): round outlines at any size, and their share of the shadow map.
 
 Broken once to see each test fail: with ``Quality.impostors`` off at ``low`` the sphere is
-the coarsest mesh (a 10-gon's area, 93.5 % of the disc) and the first test fails; with the
+the coarsest mesh (a 10-gon's area, 93.5 % of the disc) and the disc test fails; with the
 impostors' shadow-map draw removed (``Impostors.draw_depth`` returning at once) the ground
-under the sphere stays lit and the second fails.
+under the sphere stays lit and the shadow test fails. With the quad through the capsule's
+centre instead of in front of it (``centre`` = ``c`` in ``IMPOSTOR_VS``) the near end of a
+capsule seen end-on is cut to a square and the end-on test fails; without the whole-view
+quad near the eye (``near`` always false) a capsule reaching past the camera loses the part
+beyond the near plane and the close-up test fails.
 """
 
 import math
@@ -14,31 +18,31 @@ import pytest
 from engine.camera import OrbitCamera
 from engine.render import RenderScene
 from engine.render.headless import egl_available
-from engine.render.impostors import box_corners
+from engine.render.impostors import quad_corners
 from engine.render.quality import QUALITIES
 
 _reason = egl_available()
 needs_gl = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
 
 
-def test_the_box_is_closed_and_every_face_looks_outwards():
-    corners, tris = box_corners()
-    assert len(tris) == 12
+def test_the_quad_is_two_triangles_over_the_unit_square():
+    corners, tris = quad_corners()
+    assert corners.shape == (4, 2) and set(map(tuple, corners)) == {(-1, -1), (1, -1), (-1, 1), (1, 1)}
     p = corners[tris]
-    normals = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    centres = p.mean(axis=1)
-    assert np.all(np.einsum("ij,ij->i", normals, centres) > 0)  # outward: counter-clockwise from outside
-    edges = {tuple(sorted(e)) for t in tris for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
-    assert len(edges) == 18  # 12 cube edges + 6 face diagonals: closed, each edge shared by two triangles
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    assert area.sum() == pytest.approx(4.0)  # the two triangles tile the square
 
 
-def _render(scene: RenderScene, camera: OrbitCamera, size: tuple[int, int] = (320, 240)) -> np.ndarray:
+def _render(
+    scene: RenderScene, camera: OrbitCamera, size: tuple[int, int] = (320, 240), quality: str = "low"
+) -> np.ndarray:
     from engine.render import Viewer, make_target
 
     viewer = Viewer(make_target(True, *size, samples=0))
     try:
         with viewer.target.ctx:
-            viewer.renderer.set_quality(QUALITIES["low"])
+            viewer.renderer.set_quality(QUALITIES[quality])
         viewer.camera = camera
         viewer.draw(scene)
         return viewer.read_pixels().astype(np.int32)
@@ -78,3 +82,43 @@ def test_at_low_impostors_cast_their_shadow_on_the_ground():
     # Ground beside the sphere's outline, towards the camera-facing lower edge, where the shadow disc shows.
     diff = (bright - shadowed).sum(axis=2)
     assert np.count_nonzero(diff > 30) > 200
+
+
+def _red_mask(img: np.ndarray) -> np.ndarray:
+    return (img[..., 0] - img[..., 2]) > 40
+
+
+def _dark_scene() -> RenderScene:
+    scene = RenderScene()
+    scene.ground.visible = False
+    scene.sun.shadows = False
+    scene.sky_color = scene.horizon_color = (0.0, 0.0, 0.0)
+    return scene
+
+
+@needs_gl
+def test_at_low_a_capsule_seen_end_on_shows_its_near_end_as_a_full_disc():
+    scene = _dark_scene()
+    radius, distance = 0.4, 5.0
+    # The axis points at the eye: the near end sphere (at distance - 0.6) hides the rest.
+    scene.add_capsules(np.array([[0.0, 2.0, -0.6]]), np.array([[0.0, 2.0, 0.6]]), radius, color=(1.0, 0.2, 0.2))
+    camera = OrbitCamera(target=np.array([0.0, 2.0, 0.0]), pitch=0.0, yaw=0.0, distance=distance)
+    img = _render(scene, camera, (640, 480))
+    area = float(np.count_nonzero(_red_mask(img)))
+    near = distance - 0.6
+    px_per_tan = 240 / math.tan(math.radians(camera.fov_y) / 2.0)
+    r_px = px_per_tan * math.tan(math.asin(radius / near))
+    assert area == pytest.approx(math.pi * r_px**2, rel=0.03)
+
+
+@needs_gl
+def test_at_low_a_capsule_reaching_past_the_camera_is_drawn_as_the_mesh_draws_it():
+    scene = _dark_scene()
+    # A long bar beside the eye, from far ahead to behind the camera (it crosses the near plane).
+    scene.add_capsules(np.array([[0.35, 1.8, -8.0]]), np.array([[0.35, 1.8, 8.0]]), 0.15, color=(1.0, 0.2, 0.2))
+    camera = OrbitCamera(target=np.array([0.0, 2.0, 0.0]), pitch=0.0, yaw=0.0, distance=3.0)
+    impostor = _red_mask(_render(scene, camera, quality="low"))
+    mesh = _red_mask(_render(scene, camera, quality="high"))
+    assert mesh.sum() > 2000  # the bar crosses much of the view
+    overlap = np.count_nonzero(impostor & mesh) / np.count_nonzero(impostor | mesh)
+    assert overlap > 0.95

@@ -269,3 +269,26 @@ def test_a_ball_does_not_shadow_its_own_sunlit_side(gl, distance):
     inner = np.hypot(xx - cx, yy - cy) < 0.6 * radius_px
     diff = np.abs(images[0] - images[1]).sum(axis=2)[inner]
     assert inner.sum() > 20 and diff.max() <= 6, (distance, diff.max())
+
+
+def test_a_frame_after_the_camera_and_sun_moved_matches_a_fresh_renderers(gl):
+    """The frame uniforms are written only when they change: a renderer that drew another view
+    and sun first must still draw exactly what a new renderer draws. (Broken once: with no
+    frame uniform ever written again after the first frame, the second view kept the first
+    camera and this failed.)"""
+    from engine.render import Viewer, make_target
+
+    scene, _, _ = puppet_scene()
+    scene.add_spheres([[0.6, 0.3, 0.3]], 0.3)
+    first = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), yaw=0.0, pitch=0.2, distance=4.0)
+    second = OrbitCamera(target=np.array([0.2, 0.8, 0.0]), yaw=1.1, pitch=0.5, distance=3.0)
+    draw(gl, scene, first)
+    scene.sun.direction = (-0.4, 0.8, 0.3)
+    again = draw(gl, scene, second)
+    fresh = Viewer(make_target(True, W, H, samples=0))
+    try:
+        new = draw(fresh, scene, second)
+    finally:
+        fresh.close()
+    assert np.abs(again - new).max() <= 2
+    assert np.abs(again - draw(gl, scene, first)).mean() > 5  # the two views do differ
