@@ -48,6 +48,7 @@ def scene_with(n_capsules: int, shift: float = 0.0, moved: int | None = None) ->
     s.add_box([2.0, 0.5, 0.0], [0.2, 0.5, 0.3], rotation=(0.92388, 0.0, 0.38268, 0.0))
     s.add_line([0.0, 1.0, 0.0], [0.5, 0.2, 0.0], color=(1.0, 0.55, 0.15))
     s.add_points(np.array([[0.5, 0.2, 0.0]]), size=0.05)
+    s.add_cones(np.array([[-5.0, 0.9, -4.5], [-5.0, 1.8, -4.5]]), np.array([[-5.0, 2.6, -4.5], [-5.0, 3.3, -4.5]]), 0.9)
     return s
 
 
@@ -111,6 +112,43 @@ def test_quantisation_keeps_millimetres_and_clamps_what_is_far_away():
     rows = quantise(s, 0, 0.0, CAM).rows["capsules"][0]
     assert rows[:3].tolist() == [0, 1234, -7000]
     assert rows[4] == 32767  # 40 m is past the int16 range of millimetres: clamped, never wrapped
+
+
+def test_the_trees_go_once_and_then_cost_three_bytes_a_frame():
+    """Conifer tiers are rows of their own kind: in the GLB, then unchanged (a row count and a mode byte).
+    (A codec that left the cones out fails ``same``; one that resent them fails the size.)"""
+    base = quantise(scene_with(3), 1, 0.0, CAM)
+    assert base.rows["cones"].shape == (2, 11) and base.rows["cones"][1, 4] == 3300
+    glb_state = read_scene_glb(scene_glb(base, scene_with(3)))[1]
+    assert same(glb_state, base)
+    moved = quantise(scene_with(3, 0.02, 3), 2, 0.0, CAM)
+    frame = encode_frame(base, moved)
+    assert same(decode_frame(glb_state, frame), moved)
+
+    def treeless(st: SceneState) -> SceneState:
+        return SceneState(st.step, 0.0, CAM, {**st.rows, "cones": st.rows["cones"][:0]})
+
+    assert len(frame) == len(encode_frame(treeless(base), treeless(moved))), "unchanged cones cost more than 3 bytes"
+
+
+@pytest.mark.fuzz
+def test_fuzz_byte_mutations_of_a_scene_frame(campaign, mutations, fuzz_budget):
+    """Mutated frames (all kinds, cones and tracks included) decode to rows of the right shape or raise one
+    FrameError; nothing else escapes the boundary. (A reader that reshapes a frame of changed rows with no
+    changed column raised numpy's ValueError here.)"""
+    from input.web.scene_stream import SCALES
+
+    cases, seed = fuzz_budget(2000)
+    c = campaign(FrameError)
+    base = quantise(tracked(scene_with(6), [(100, 100, 4, 6)]), 1, 0.0, CAM)
+    moved = quantise(tracked(scene_with(6, 0.05, 4), [(100, 100, 4, 6), (5, 5, 2, 2), (230, 230, 2, 2)]), 2, 0.0, CAM)
+    for good in (encode_frame(base, moved), encode_frame(SceneState.empty(), base)):
+        for data in mutations(good, cases // 2, seed):
+            state = c.run(decode_frame, base, data)
+            if state is not None:
+                for kind, scales in SCALES.items():
+                    assert state.rows[kind].ndim == 2 and state.rows[kind].shape[1] == len(scales)
+    c.check("scene frames")
 
 
 @pytest.mark.parametrize("cut", ["short", "magic", "trailing"])
@@ -221,48 +259,102 @@ console.log(JSON.stringify(Array.from(m.cells)));
     assert np.abs(page - desktop).max() <= 1
 
 
-@needs_node
-def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
-    """``stream_worker.js`` under node with a fake WebSocket and drawer port: every frame is acknowledged to the
-    engine as soon as it is decoded; the drawer gets at most two frames it has not taken, then, once it
-    takes one, the newest frame (not the next in a queue), and the tracks only when they changed.
-    (A worker that posts every frame fails the count; one that keeps a queue fails the newest step.)"""
+def worker_frames(tmp_path: Path) -> tuple[RenderScene, list[bytes]]:
+    """A GLB and six frames of a scene whose tracks change at steps 6 and 7, written to ``tmp_path/<i>.bin``."""
     scene = tracked(scene_with(4), [(10, 10, 3, 3)])
     states = [quantise(scene, 1, 0.0, CAM)]
     for i in range(2, 8):
-        strips = [(10, 10, 3, 3)] + ([(50, 50, 2, 2)] if i >= 6 else [])
+        strips = [(10, 10, 3, 3)] + ([(50, 50, 2, 2)] if i >= 6 else []) + ([(60, 70, 1, 4)] if i >= 7 else [])
         states.append(quantise(tracked(scene_with(4, 0.01 * i, 2), strips), i, 0.0, CAM))
     blobs = [scene_glb(states[0], scene)] + [encode_frame(a, b) for a, b in zip(states, states[1:], strict=False)]
     for i, blob in enumerate(blobs):
         (tmp_path / f"{i}.bin").write_bytes(blob)
+    return scene, blobs
+
+
+def run_worker(tmp_path: Path, body: str) -> dict:
+    """``view_worker.js`` under node with a fake WebSocket, animation frames run by hand and, when ``body``
+    sends it a canvas, a fake renderer that logs what it is given; ``body`` prints the JSON returned."""
     script = f"""
 const fs = require("fs"), page = {json.dumps(str(PAGE))};
 globalThis.importScripts = (...names) => {{ for (const n of names) Object.assign(globalThis, require(page + "/" + n)); }};
-const toMain = [], sent = [], drawn = [];
+const toMain = [], sent = [], drawn = [], frames = [];
 globalThis.postMessage = (m) => toMain.push(m);
 globalThis.onmessage = null;
+globalThis.requestAnimationFrame = (f) => frames.push(f);
+const tick = () => frames.splice(0).forEach((f) => f(0));
 class FakeSocket {{ constructor(url) {{ this.url = url; this.readyState = 1; FakeSocket.last = this; }} send(x) {{ sent.push(JSON.parse(x)); }} }}
 FakeSocket.OPEN = 1;
 globalThis.WebSocket = FakeSocket;
-require(page + "/stream_worker.js");
+require(page + "/view_worker.js");
+globalThis.PageRenderer = class {{ constructor(c) {{ this.canvas = c; }}
+  draw(f) {{ drawn.push({{ step: f.step, dirty: f.marksDirty, caps: f.rows.capsules.length, cones: f.rows.cones.length }}); }} }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const port = {{ postMessage: (m) => drawn.push({{ step: m.frame.step, extras: !!m.frame.extras, marks: m.frame.marks === undefined ? "same" : "grid" }}) }};
+const arrive = (i) => FakeSocket.last.onmessage({{ data: buf(i) }});
 onmessage({{ data: {{ connect: "wss://x/ws" }} }});
-onmessage({{ data: {{ drawer: port }} }});
-for (let i = 0; i < {len(blobs)}; i++) FakeSocket.last.onmessage({{ data: buf(i) }});
-const before = drawn.length;
-port.onmessage({{ data: {{ got: 1 }} }});
-const after = drawn.length;
-port.onmessage({{ data: {{ got: 2 }} }});
-console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length }}));
+{body}
 """
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stderr
-    out = json.loads(res.stdout)
+    return json.loads(res.stdout)
+
+
+@needs_node
+def test_the_view_worker_draws_each_frame_at_its_next_animation_frame_and_hands_it_to_no_one(tmp_path):
+    """With the canvas, the worker that reads the socket draws: a frame is acknowledged at once and drawn at
+    the next animation frame, never posted to another thread; the drawer is told only the tracks' cells that
+    changed since it last drew (a rectangle, not the grid). (Posting frames to the main thread while drawing
+    fails ``posted``; handing the drawer the whole grid each time fails the dirty rectangles.)"""
+    _, blobs = worker_frames(tmp_path)
+    out = run_worker(
+        tmp_path,
+        """
+onmessage({ data: { canvas: {width: 1, height: 1}, size: [390, 844] } });
+tick();
+arrive(0); tick(); arrive(1); tick(); tick();
+for (let i = 2; i < 7; i++) arrive(i);
+tick();
+console.log(JSON.stringify({ acks: sent.map((m) => m.ack), drawn, posted: toMain.filter((m) => m.frame).length }));
+""",
+    )
+    assert out["acks"] == list(range(1, 8))
+    assert out["posted"] == 0, "a frame went to another thread while this one draws"
+    steps = [d["step"] for d in out["drawn"]]
+    assert steps == [1, 2, 2, 7], f"drawn steps {steps}: each animation frame draws the newest"
+    first, second, again, newest = out["drawn"]
+    assert first["dirty"] is None, "a new grid is the renderer's to upload whole"
+    assert second["dirty"] is None and again["dirty"] is None, "the tracks did not change at step 2"
+    # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4): one rectangle round both, drawn once.
+    assert newest["dirty"] == [50, 50, 61, 74]
+    assert newest["caps"] == 4 * 11 and newest["cones"] == 2 * 11
+
+
+@needs_node
+def test_where_the_worker_cannot_draw_it_hands_the_main_thread_the_newest_frame_never_a_queue(tmp_path):
+    """Without a canvas (AR, no OffscreenCanvas) frames go to the main thread: every frame is acknowledged to
+    the engine as soon as it is decoded; the main thread gets at most two frames it has not taken, then,
+    once it takes one, the newest frame (not the next in a queue), and the tracks only when they changed,
+    with the cells changed since the tracks it got. (A worker that posts every frame fails the count; one
+    that keeps a queue fails the newest step.)"""
+    _, blobs = worker_frames(tmp_path)
+    out = run_worker(
+        tmp_path,
+        f"""
+const got = () => toMain.filter((m) => m.frame).map((m) => ({{ step: m.frame.step, extras: !!m.frame.extras,
+  marks: m.frame.marks === undefined ? "same" : "grid", dirty: m.frame.marksDirty }}));
+for (let i = 0; i < {len(blobs)}; i++) arrive(i);
+const before = got().length;
+onmessage({{ data: {{ got: 1 }} }});
+const after = got().length;
+onmessage({{ data: {{ got: 2 }} }});
+console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn: got(), end: got().length }}));
+""",
+    )
     assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
     assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
     assert out["after"] == 3 and out["end"] == 3
     first, second, newest = out["drawn"]
-    assert first == {"step": 1, "extras": True, "marks": "grid"}
-    assert second == {"step": 2, "extras": False, "marks": "same"}
-    assert newest == {"step": 7, "extras": False, "marks": "grid"}, "after a take: the newest frame, tracks changed"
+    assert first["step"] == 1 and first["extras"] and first["marks"] == "grid"
+    assert second == {"step": 2, "extras": False, "marks": "same", "dirty": None}
+    assert newest["step"] == 7 and not newest["extras"] and newest["marks"] == "grid"
+    assert newest["dirty"] == [50, 50, 61, 74], "the cells changed since the main thread's tracks"
