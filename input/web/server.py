@@ -28,10 +28,9 @@ delta-coded against what *that* page last got (:mod:`input.web.scene_stream`). A
 connection never queues: it holds only the newest state, and sends while fewer than
 :data:`FRAMES_IN_FLIGHT` frames wait for the page's ``{"ack": step}``, so a slow phone
 (or Wi-Fi) gets fewer frames, each the latest, rather than a growing backlog. The page
-reads the socket in a worker of its own (``page/view_worker.js``, which also draws) and
-acknowledges a frame as soon as it is decoded there, so the acknowledgements pace the
-network and the phone; a phone that draws slowly holds off the next frame by its
-drawing time at most.
+reads the socket in a worker of its own (``page/stream_worker.js``) and acknowledges a
+frame as soon as it is decoded there, so the acknowledgements pace the network and the
+phone, not the page's drawing.
 
 :attr:`WebSource.page_times` remembers, for the latest readings, the page's clock at
 the sensor event, keyed by the sample's receive time: the latency bench reads it.
@@ -71,7 +70,8 @@ PAGE_FILES = {
     "/index.html": ("index.html", "text/html; charset=utf-8"),
     "/app.js": ("app.js", _JS),
     "/stream.js": ("stream.js", _JS),
-    "/view_worker.js": ("view_worker.js", _JS),
+    "/stream_worker.js": ("stream_worker.js", _JS),
+    "/render_worker.js": ("render_worker.js", _JS),
     "/render.js": ("render.js", _JS),
     "/placement.js": ("placement.js", _JS),
     "/style.css": ("style.css", "text/css; charset=utf-8"),

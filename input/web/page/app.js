@@ -1,6 +1,6 @@
 // PuppetPhone web controller: the phone's browser becomes the MotionStick, and the viewport.
 // Streams one JSON reading per sensor event over a WebSocket (format: input/web/protocol.py) and draws
-// the scene the engine streams back (view_worker.js, stream.js, render.js): the
+// the scene the engine streams back (stream_worker.js, render_worker.js, stream.js, render.js): the
 // phone is the camera, the stick hangs from it. Modes: WebXR immersive-ar (the field placed on the floor by a hit test, the camera image
 // behind it), else a "magic window" (device orientation turns the view over a plain sky).
 // Plain scripts, no build step; served by the engine over HTTPS (sensors need a secure context).
@@ -15,30 +15,31 @@ const state = {
   o: [0, 0, 0], acc: null, rot: null, kind: "orientation", q: null, p: null,
   sensor: "none", lastSent: 0, taken: false, rtt: null, xrNote: "", placement: null,
 };
-// Threads: the view worker (view_worker.js) holds the WebSocket, decodes, and draws the magic window into
-// the page's canvas, transferred to it. This thread handles the sensors and the controls, and draws only
-// in AR (the XR session is here) or where the worker cannot draw: then the worker sends its frames here.
-const worker = new Worker("view_worker.js");
-worker.onerror = (e) => { $("status").textContent = "view: " + e.message; };
+// Threads: the stream worker (stream_worker.js) holds the WebSocket and decodes; the render worker
+// (render_worker.js) draws the magic window into the page's canvas, transferred to it. This thread
+// handles the sensors and the controls, and draws only in AR (the XR session is here) or where a
+// worker cannot draw: then the stream worker sends its frames here.
+const worker = new Worker("stream_worker.js");
+worker.onerror = (e) => { $("status").textContent = "stream: " + e.message; };
 const stream = new SceneStream(), counter = new FrameCounter();
-let renderer = null, drawsHere = false;
+let renderer = null, drawsHere = false, painter = null;
 // What the bench and the tests read: frames drawn, the step on screen, frames per second, who draws;
-// report() gives the logs (per step: published, reached the worker, decoded, available to the drawer;
-// and when each step was first drawn), all in ms since the epoch; holdResolution(r) keeps the drawing at
-// r of the device's pixels (null: adapt to the frame rate again).
+// report() gives the logs (per step: published, reached the stream worker, decoded, available to the
+// drawer; and when each step was first drawn), all in ms since the epoch.
 const reportWaiters = [];
-window.ppView = { drawn: 0, step: -1, fps: 0, resolution: 1, frames: 0, bytes: 0, where: "view worker",
+// holdResolution(r) keeps the drawing at r of the device's pixels (null: adapt to the frame rate again).
+window.ppView = { drawn: 0, step: -1, fps: 0, resolution: 1, frames: 0, bytes: 0, where: "render worker",
   report: () => (drawsHere || state.kind === "xr"
     ? Promise.resolve({ log: stream.log, drawLog: counter.drawLog, frames: stream.frames, bytes: stream.bytes })
-    : new Promise((resolve) => { reportWaiters.push(resolve); worker.postMessage({ report: true }); })),
-  holdResolution: (r) => { counter.hold(r); worker.postMessage({ resolution: r }); } };
+    : new Promise((resolve) => { reportWaiters.push(resolve); painter.postMessage({ report: true }); })),
+  holdResolution: (r) => { counter.hold(r); if (painter) painter.postMessage({ resolution: r }); } };
 
 function canvasSize() {
   const canvas = $("view"), px = Math.min(devicePixelRatio, 2);
   return [Math.max(1, Math.round(canvas.clientWidth * px)), Math.max(1, Math.round(canvas.clientHeight * px))];
 }
 
-// Draw on this thread from now on (on a fresh canvas if the old one went to the worker).
+// Draw on this thread from now on (on a fresh canvas if the old one went to the render worker).
 function drawHere(reason) {
   let canvas = $("view");
   if (canvas.dataset.transferred) {
@@ -48,17 +49,29 @@ function drawHere(reason) {
     canvas = fresh;
   }
   drawsHere = true; window.ppView.where = "main thread";
+  worker.postMessage({ drawer: null });
   try { renderer = new PageRenderer(canvas, { xrCompatible: true }); } catch (err) { $("fps").textContent = "view: " + err.message; }
   if (reason) $("status").textContent = "view: " + reason;
+}
+
+function onPainter(e) {
+  const m = e.data;
+  if (m.status) { Object.assign(window.ppView, m.status); showFps(m.status); }
+  else if (m.report) reportWaiters.splice(0).forEach((resolve) => resolve(m.report));
+  else if (m.cannotDraw !== undefined) drawHere(m.cannotDraw);
 }
 
 {
   const canvas = $("view");
   if (typeof canvas.transferControlToOffscreen === "function") {
-    const off = canvas.transferControlToOffscreen();
+    const off = canvas.transferControlToOffscreen(), link = new MessageChannel();
     canvas.dataset.transferred = "1";
-    worker.postMessage({ canvas: off, size: canvasSize() }, [off]);
-    window.addEventListener("resize", () => worker.postMessage({ size: canvasSize() }));
+    painter = new Worker("render_worker.js");
+    painter.onmessage = onPainter;
+    painter.onerror = (e) => { $("status").textContent = "view: " + e.message; };
+    painter.postMessage({ canvas: off, size: canvasSize(), port: link.port2 }, [off, link.port2]);
+    worker.postMessage({ drawer: link.port1 }, [link.port1]);
+    window.addEventListener("resize", () => painter.postMessage({ size: canvasSize() }));
   } else {
     drawHere("");
   }
@@ -93,14 +106,11 @@ function sendReading(t) {
   state.cal = false;
 }
 
-// The WebSocket lives in the view worker (view_worker.js): readings and pings go out through it,
+// The WebSocket lives in the stream worker (stream_worker.js): readings and pings go out through it,
 // the engine's JSON comes back here, and scene frames come here only when this thread draws.
 worker.onmessage = (e) => {
   const m = e.data;
-  if (m.status) { Object.assign(window.ppView, m.status); showFps(m.status); }
-  else if (m.report) reportWaiters.splice(0).forEach((resolve) => resolve(m.report));
-  else if (m.cannotDraw !== undefined) drawHere(m.cannotDraw);
-  else if (m.frame) {
+  if (m.frame) {
     stream.accept(m.frame, performance.now());
     worker.postMessage({ got: m.frame.step });
   } else if (m.text !== undefined) {
@@ -219,7 +229,7 @@ async function startXR() {
     optionalFeatures: ["hit-test", "dom-overlay"], domOverlay: { root: document.body } });
   // The XR session draws on this thread: the worker forwards its frames here meanwhile.
   if (!renderer) renderer = new PageRenderer(document.createElement("canvas"), { xrCompatible: true });
-  if (!drawsHere) worker.postMessage({ pause: true });
+  if (painter && !drawsHere) { painter.postMessage({ pause: true }); worker.postMessage({ drawer: null }); }
   const gl = renderer.gl;
   await gl.makeXRCompatible();
   session.updateRenderState({ baseLayer: new XRWebGLLayer(session, gl) });
@@ -256,7 +266,7 @@ async function startXR() {
   };
   session.addEventListener("end", () => {
     state.kind = "orientation"; state.sensor = "orientation"; state.placement = null; document.body.classList.remove("ar");
-    if (!drawsHere) { worker.postMessage({ pause: false }); stream.reset(); }
+    if (painter && !drawsHere) { const link = new MessageChannel(); painter.postMessage({ pause: false, port: link.port2 }, [link.port2]); worker.postMessage({ drawer: link.port1 }, [link.port1]); }
     setMode(); requestAnimationFrame(drawFrame);
   });
   session.requestAnimationFrame(frame);

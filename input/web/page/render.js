@@ -5,12 +5,29 @@
 // image shows behind the scene.
 "use strict";
 
+// Lighting per vertex (Gouraud), finished to display colour there: the software rasteriser a phone-sized
+// canvas is judged on (SwiftShader) pays per pixel, and the pixel stage is then one copy. Gamma 2 (squares
+// and a square root) rather than 2.2.
+const LIT = `
+uniform vec3 sunDir; uniform vec3 sunColor; uniform float ambient; uniform vec3 eye;
+uniform vec3 sky; uniform vec3 outlineColor;
+vec3 lit(vec3 n, vec3 p, vec3 base, float outline) {
+  n = normalize(n);
+  float diff = max(dot(n, sunDir), 0.0);
+  vec3 hemi = mix(vec3(0.52, 0.54, 0.58), sky * sky, 0.5 + 0.5 * n.y);
+  vec3 c = base * (sunColor * diff * 0.55 + hemi * ambient * 1.1);
+  float rim = 1.0 - abs(dot(n, normalize(eye - p)));
+  c = mix(c, outlineColor * outlineColor, clamp(outline, 0.0, 1.0) * rim * rim * rim);
+  return sqrt(c / (1.0 + c * 0.15));
+}`;
+
 const CAPSULE_VS = `#version 300 es
 layout(location=0) in vec4 dirEnd;
 layout(location=1) in vec3 a; layout(location=2) in vec3 b; layout(location=3) in float r;
 layout(location=4) in vec3 col; layout(location=5) in float outline;
 uniform mat4 viewProj;
-out vec3 vN; out vec3 vP; out vec3 vC; out float vO;
+out vec3 vColor;
+${LIT}
 void main() {
   vec3 ax = b - a; float len = length(ax);
   vec3 w = len > 1e-6 ? ax / len : vec3(0.0, 1.0, 0.0);
@@ -18,7 +35,7 @@ void main() {
   vec3 u = normalize(cross(t, w)); vec3 v = cross(w, u);
   vec3 n = u * dirEnd.x + w * dirEnd.y + v * dirEnd.z;
   vec3 p = mix(a, b, dirEnd.w) + r * n;
-  vN = n; vP = p; vC = col * col; vO = outline;
+  vColor = lit(n, p, col * col, outline);
   gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
@@ -27,11 +44,12 @@ layout(location=0) in vec3 corner; layout(location=6) in vec3 normal;
 layout(location=1) in vec3 c; layout(location=2) in vec3 h; layout(location=3) in vec4 q;
 layout(location=4) in vec3 col; layout(location=5) in float outline;
 uniform mat4 viewProj;
-out vec3 vN; out vec3 vP; out vec3 vC; out float vO;
+out vec3 vColor;
+${LIT}
 vec3 rot(vec4 q, vec3 v) { vec3 u = q.yzw; return v + 2.0 * cross(u, cross(u, v) + q.x * v); }
 void main() {
   vec3 p = c + rot(q, corner * h);
-  vN = rot(q, normal); vP = p; vC = col * col; vO = outline;
+  vColor = lit(rot(q, normal), p, col * col, outline);
   gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
@@ -42,7 +60,8 @@ layout(location=0) in vec4 vert;  // cos, sin round the axis; height fraction; 1
 layout(location=1) in vec3 a; layout(location=2) in vec3 b; layout(location=3) in float r;
 layout(location=4) in vec3 col; layout(location=5) in float snowy;
 uniform mat4 viewProj;
-out vec3 vN; out vec3 vP; out vec3 vC; out float vO;
+out vec3 vColor;
+${LIT}
 void main() {
   vec3 axis = b - a; float h = max(length(axis), 1e-6); vec3 y = axis / h;
   vec3 helper = abs(y.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
@@ -50,12 +69,12 @@ void main() {
   float t = vert.z, seed = dot(a, vec3(12.9, 0.0, 78.2)), angle = atan(vert.y, vert.x);
   float spike = vert.w < 0.5 && t < 0.01 ? 0.5 + 0.5 * cos(angle * 9.0 + seed) : 0.0;
   vec3 radial = x * vert.x + z * vert.y;
-  vP = a + axis * t + radial * (r * (1.0 - t) * (1.0 + 0.12 * spike)) - y * (0.10 * h * spike);
-  vN = vert.w > 0.5 ? -y : normalize(radial * h + y * r);
+  vec3 p = a + axis * t + radial * (r * (1.0 - t) * (1.0 + 0.12 * spike)) - y * (0.10 * h * spike);
+  vec3 n = vert.w > 0.5 ? -y : normalize(radial * h + y * r);
   float snow = snowy * smoothstep(0.2, 0.5, t + 0.22 * sin(angle * 5.0 + seed) + 0.15 * spike);
   vec3 c = mix(col, vec3(0.93, 0.95, 0.99), snow);
-  vC = c * c; vO = 0.0;
-  gl_Position = viewProj * vec4(vP, 1.0);
+  vColor = lit(n, p, c * c, 0.0);
+  gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
 // The falling snow (engine/render/snowfall.py): each flake placed from its start and phase by the time of
@@ -82,57 +101,48 @@ void main() {
   frag = vec4(mix(color, horizon, vFade * vFade), 1.0);
 }`;
 
-const LIT_FS = `#version 300 es
-precision highp float;
-in vec3 vN; in vec3 vP; in vec3 vC; in float vO;
-uniform vec3 sunDir; uniform vec3 sunColor; uniform float ambient; uniform vec3 eye;
-uniform vec3 sky; uniform vec3 horizon; uniform vec3 outlineColor;
-out vec4 frag;
-// Gamma 2 (squares and a square root) rather than 2.2: software GL on a phone-sized canvas is fill-bound.
-void main() {
-  vec3 n = normalize(vN);
-  float diff = max(dot(n, sunDir), 0.0);
-  vec3 hemi = mix(vec3(0.52, 0.54, 0.58), sky * sky, 0.5 + 0.5 * n.y);
-  vec3 c = vC * (sunColor * diff * 0.55 + hemi * ambient * 1.1);
-  float rim = 1.0 - abs(dot(n, normalize(eye - vP)));
-  c = mix(c, outlineColor * outlineColor, clamp(vO, 0.0, 1.0) * rim * rim * rim);
-  frag = vec4(sqrt(c / (1.0 + c * 0.15)), 1.0);
-}`;
+const FLAT_FS = `#version 300 es
+precision mediump float;
+in vec3 vColor; out vec4 frag;
+void main() { frag = vec4(vColor, 1.0); }`;
 
+// The ground as a grid of 2 m cells: its colour, the fade to the horizon and where it falls in the shadow
+// mask are worked out per vertex; a pixel reads the mask once (its border is kept clear, so no test) and,
+// only where the game draws grid lines, works out the lines.
 const GROUND_VS = `#version 300 es
-layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; out vec3 vP;
-void main() { vP = vec3(xz.x, height, xz.y); gl_Position = viewProj * vec4(vP, 1.0); }`;
+layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; uniform vec3 eye; uniform vec4 shadowRect;
+out vec3 vP; out float vFade; out vec2 vMask;
+void main() {
+  vP = vec3(xz.x, height, xz.y);
+  vFade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
+  vMask = (vP.xz - shadowRect.xy) / shadowRect.zw;
+  gl_Position = viewProj * vec4(vP, 1.0);
+}`;
 
 const GROUND_FS = `#version 300 es
 precision highp float;
-in vec3 vP; uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
-uniform vec3 eye; uniform vec3 horizon; uniform float alpha;
-uniform sampler2D shadowMask; uniform vec4 shadowRect; uniform vec3 shadowTint;
+in vec3 vP; in float vFade; in vec2 vMask;
+uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
+uniform vec3 horizon; uniform float alpha; uniform sampler2D shadowMask; uniform vec3 shadowTint;
 out vec4 frag;
 void main() {
-  float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
   vec3 c = color;
   if (gridStrength > 0.0) {  // a field of snow has none: the software rasteriser skips the derivatives
     vec2 g = abs(fract(vP.xz / spacing + 0.5) - 0.5) / fwidth(vP.xz / spacing);
-    c = mix(color, gridColor, (1.0 - min(min(g.x, g.y), 1.0)) * gridStrength * (1.0 - fade));
+    c = mix(color, gridColor, (1.0 - min(min(g.x, g.y), 1.0)) * gridStrength * (1.0 - vFade));
   }
-  vec2 muv = (vP.xz - shadowRect.xy) / shadowRect.zw;
-  if (all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) c *= mix(vec3(1.0), shadowTint, texture(shadowMask, muv).r);
-  c = mix(c, horizon, fade * fade);
-  frag = vec4(c, alpha);
+  c *= mix(vec3(1.0), shadowTint, texture(shadowMask, vMask).r);
+  frag = vec4(mix(c, horizon, vFade * vFade), alpha);
 }`;
 
+// The sky's gradient per vertex of a screen-covering grid (behind everything: depth 1).
 const SKY_VS = `#version 300 es
-const vec2 P[3] = vec2[3](vec2(-1.0, -1.0), vec2(3.0, -1.0), vec2(-1.0, 3.0));
-out vec2 ndc; void main() { ndc = P[gl_VertexID]; gl_Position = vec4(ndc, 1.0, 1.0); }`;
-
-const SKY_FS = `#version 300 es
-precision highp float;
-in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
-out vec4 frag;
+layout(location=0) in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
+out vec3 vColor;
 void main() {
   vec3 d = normalize(basis * vec3(ndc * tanHalf, -1.0));
-  frag = vec4(mix(horizon, sky, pow(clamp(d.y, 0.0, 1.0), 0.45)), 1.0);
+  vColor = mix(horizon, sky, pow(clamp(d.y, 0.0, 1.0), 0.45));
+  gl_Position = vec4(ndc, 1.0, 1.0);
 }`;
 
 // Blob shadows: each round thing (capsule, sphere; a box as its footprint's circle) cast along the sun
@@ -275,6 +285,17 @@ function coneMesh(segments = 16, rings = 4) {
   return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
 }
 
+// An n × n grid of quads over [x0, x1] × [y0, y1]: vertices (x, y) and triangles.
+function gridMesh(n, x0, x1, y0, y1) {
+  const v = [], idx = [];
+  for (let j = 0; j <= n; j++) for (let i = 0; i <= n; i++) v.push(x0 + ((x1 - x0) * i) / n, y0 + ((y1 - y0) * j) / n);
+  for (let j = 0; j < n; j++) for (let i = 0; i < n; i++) {
+    const k = j * (n + 1) + i;
+    idx.push(k, k + 1, k + n + 1, k + 1, k + n + 2, k + n + 1);
+  }
+  return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
+}
+
 function boxMesh() {
   const v = [];
   const faces = [[0, 1], [0, -1], [1, 1], [1, -1], [2, 1], [2, -1]];
@@ -348,10 +369,10 @@ class PageRenderer {
     const gl = canvas.getContext("webgl2", { antialias: false, alpha: false, desynchronized: true, xrCompatible: !!options.xrCompatible });
     if (!gl) throw new Error("WebGL2 is not available");
     this.gl = gl; this.canvas = canvas;
-    this.capsule = compile(gl, CAPSULE_VS, LIT_FS);
-    this.box = compile(gl, BOX_VS, LIT_FS);
+    this.capsule = compile(gl, CAPSULE_VS, FLAT_FS);
+    this.box = compile(gl, BOX_VS, FLAT_FS);
     this.ground = compile(gl, GROUND_VS, GROUND_FS);
-    this.sky = compile(gl, SKY_VS, SKY_FS);
+    this.sky = compile(gl, SKY_VS, FLAT_FS);
     const mesh = capsuleMesh();
     this.capVao = gl.createVertexArray(); gl.bindVertexArray(this.capVao);
     this.buffer(mesh.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 16, 0);
@@ -364,9 +385,15 @@ class PageRenderer {
     gl.enableVertexAttribArray(6); gl.vertexAttribPointer(6, 3, gl.FLOAT, false, 24, 12);
     this.boxInst = this.instances([3, 3, 4, 3, 1]);
     this.groundVao = gl.createVertexArray(); gl.bindVertexArray(this.groundVao);
-    this.groundBuf = this.buffer(new Float32Array(8));
-    gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
-    this.skyVao = gl.createVertexArray();
+    const ground = gridMesh(40, -40, 40, -40, 40);
+    this.buffer(ground.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    const gb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, ground.indices, gl.STATIC_DRAW);
+    this.groundCount = ground.indices.length;
+    this.skyVao = gl.createVertexArray(); gl.bindVertexArray(this.skyVao);
+    const sky = gridMesh(24, -1, 1, -1, 1);
+    this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    const sb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, sb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sky.indices, gl.STATIC_DRAW);
+    this.skyCount = sky.indices.length;
     this.blob = compile(gl, BLOB_VS, BLOB_FS);
     this.marksProg = compile(gl, DECAL_VS, MARKS_FS);
     this.printProg = compile(gl, PRINT_VS, PRINT_FS);
@@ -385,7 +412,7 @@ class PageRenderer {
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.shadowTex, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    this.cone = compile(gl, CONE_VS, LIT_FS);
+    this.cone = compile(gl, CONE_VS, FLAT_FS);
     const cone = coneMesh();
     this.coneVao = gl.createVertexArray(); gl.bindVertexArray(this.coneVao);
     this.buffer(cone.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 16, 0);
@@ -446,7 +473,7 @@ class PageRenderer {
     const size = Math.min(Math.max(x1 - x0, z1 - z0), 48), cx = Math.min(Math.max((x0 + x1) / 2, -60), 60), cz = Math.min(Math.max((z0 + z1) / 2, -60), 60);
     const rect = [cx - size / 2, cz - size / 2, size, size];
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
-    gl.viewport(0, 0, SHADOW_SIZE, SHADOW_SIZE);
+    gl.viewport(1, 1, SHADOW_SIZE - 2, SHADOW_SIZE - 2);  // a clear border: the ground reads it outside the rect
     gl.disable(gl.DEPTH_TEST);
     gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT);
     gl.enable(gl.BLEND); gl.blendEquation(gl.MAX);
@@ -458,7 +485,8 @@ class PageRenderer {
     gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, n);
     gl.blendEquation(gl.FUNC_ADD); gl.disable(gl.BLEND);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    return rect;
+    const grow = 1 / (SHADOW_SIZE - 2);  // the whole mask, border included, as the ground reads it
+    return [rect[0] - rect[2] * grow, rect[1] - rect[3] * grow, rect[2] * (1 + 2 * grow), rect[3] * (1 + 2 * grow)];
   }
 
   // The tracks' texture and the rectangle of marked cells. A new grid is softened and uploaded whole; the
@@ -625,20 +653,18 @@ class PageRenderer {
   backdrop(frame, look, viewProj, eye, basis) {
     const gl = this.gl;
     {
-      const g = look.ground, half = 40;
+      const g = look.ground;
       gl.useProgram(this.ground.prog);
       gl.bindVertexArray(this.groundVao);
-      gl.bindBuffer(gl.ARRAY_BUFFER, this.groundBuf);
-      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-half, -half, half, -half, -half, half, half, half]), gl.DYNAMIC_DRAW);
       const u = this.ground.u;
       gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g.height);
       gl.uniform3fv(u.color, g.color); gl.uniform3fv(u.gridColor, g.grid_color);
       gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0); gl.uniform1f(u.spacing, g.grid_spacing);
       gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform1f(u.alpha, 1);
       gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, this.shadowTex); gl.uniform1i(u.shadowMask, 0);
-      gl.uniform4fv(u.shadowRect, this.shadowRect || [0, 0, 0, 0]);
+      gl.uniform4fv(u.shadowRect, this.shadowRect || [1e6, 1e6, 1, 1]);  // none: the mask's clear border
       gl.uniform3fv(u.shadowTint, shadowTint(look));
-      gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
+      gl.drawElements(gl.TRIANGLES, this.groundCount, gl.UNSIGNED_SHORT, 0);
     }
     this.drawDecals(frame, look, viewProj, eye);
     const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
@@ -647,7 +673,7 @@ class PageRenderer {
     gl.uniform2f(this.sky.u.tanHalf, t * aspect, t);
     gl.uniform3fv(this.sky.u.sky, look.sky); gl.uniform3fv(this.sky.u.horizon, look.horizon);
     gl.depthFunc(gl.LEQUAL); gl.depthMask(false);
-    gl.bindVertexArray(this.skyVao); gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.bindVertexArray(this.skyVao); gl.drawElements(gl.TRIANGLES, this.skyCount, gl.UNSIGNED_SHORT, 0);
     gl.depthFunc(gl.LESS);
     if (look.snowfall) this.drawSnowfall(frame, look, viewProj, eye);
     gl.depthMask(true);

@@ -1,9 +1,10 @@
 // PuppetPhone scene stream: the GLB a page gets once, then delta-coded frames (input/web/scene_stream.py).
-// The reader mirrors scene_stream.decode_frame. StreamDecoder and SceneStream run in the view worker
-// (view_worker.js), which reads the socket and draws; SceneStream keeps the newest two decoded frames and
-// interpolates one frame behind the newest, so a late frame never stalls the picture (the last holds).
-// Nothing that did not change is copied: a kind a frame leaves alone keeps its arrays (the drawer sees
-// the same object and uploads nothing), and the tracks come with the rectangle of cells that changed.
+// The reader mirrors scene_stream.decode_frame. StreamDecoder runs in the stream worker (stream_worker.js),
+// which holds the socket; Forwarder makes each frame a message for the thread that draws (render_worker.js,
+// or the main thread in AR), and SceneStream, there, keeps the newest two frames and interpolates one frame
+// behind the newest, so a late frame never stalls the picture (the last holds). Nothing that did not change
+// is copied: a kind a frame leaves alone keeps its array (the drawer sees the same object and uploads
+// nothing), and the tracks go as the block of cells that changed.
 "use strict";
 
 const KINDS = ["capsules", "spheres", "boxes", "lines", "points", "prints", "cones"];
@@ -206,6 +207,37 @@ class StreamDecoder {
   }
 }
 
+// Each frame as a message for a drawer on another thread: only the kinds whose rows changed since the frame
+// that drawer last got (the rest it keeps), and of the tracks, the block of cells changed since (the whole
+// grid when it is new to the drawer). ``note`` every decoded frame, sent or not: its changed cells count.
+class Forwarder {
+  constructor() { this.reset(); }
+
+  // The drawer holds nothing (new drawer, new scene): the next message carries everything.
+  reset() { this.sent = {}; this.marks = null; this.dirty = null; this.whole = true; }
+
+  note(frame) { if (frame.extras) this.whole = true; else this.dirty = unionRect(this.dirty, frame.marksDirty); }
+
+  message(frame, extras) {
+    const rows = {};
+    for (const kind of KINDS) {
+      if (this.whole || frame.rows[kind] !== this.sent[kind]) rows[kind] = this.sent[kind] = frame.rows[kind];
+    }
+    const m = frame.marks;
+    let marks;  // undefined: as before
+    if (this.whole || m !== this.marks) marks = m ? { nx: m.nx, nz: m.nz, x0: m.x0, z0: m.z0, cell: m.cell, cells: m.cells.slice() } : null;
+    else if (m && this.dirty) {
+      const [r0, c0, r1, c1] = this.dirty, w = c1 - c0, block = new Uint8Array((r1 - r0) * w);
+      for (let r = r0; r < r1; r++) block.set(m.cells.subarray(r * m.nx + c0, r * m.nx + c1), (r - r0) * w);
+      marks = { nx: m.nx, nz: m.nz, x0: m.x0, z0: m.z0, cell: m.cell, patch: { rect: this.dirty, cells: block } };
+    }
+    const out = { extras: this.whole ? extras : null, step: frame.step, published: frame.published, camera: frame.camera, rows, marks,
+      arrived: frame.arrived, decoded: frame.decoded, received: frame.received, bytes: frame.bytes };
+    this.marks = m; this.dirty = null; this.whole = false;
+    return out;
+  }
+}
+
 function sameGrid(a, b) { return !!a && !!b && a.nx === b.nx && a.nz === b.nz && a.x0 === b.x0 && a.z0 === b.z0 && a.cell === b.cell; }
 
 // The drawing thread's half: the newest two frames, blended by arrival time at each drawing, and the
@@ -221,16 +253,21 @@ class SceneStream {
     if (frame.extras) { this.extras = frame.extras; this.prev = null; this.cur = null; }
     if (!this.extras) return;
     const interval = this.cur ? Math.min(Math.max(now - this.cur.arrived, 1000 / 60), 100) : 1000 / 60;
+    // Kinds a forwarded frame leaves out are as in the frame before (the same arrays).
+    const rows = frame.extras || !this.cur ? frame.rows : { ...this.cur.rows, ...frame.rows };
     this.prev = this.cur;
-    this.cur = { rows: frame.rows, camera: frame.camera, arrived: now, interval, step: frame.step };
+    this.cur = { rows, camera: frame.camera, arrived: now, interval, step: frame.step };
     this.frames = frame.received; this.bytes = frame.bytes;
-    // The tracks: undefined, as before; null, none; the same grid, its changed cells; else a new grid.
-    if (frame.marks !== undefined) {
-      if (frame.marks && sameGrid(this.marks, frame.marks) && !frame.extras) {
-        this.marks.cells = frame.marks.cells;
-        this.marksDirty = unionRect(this.marksDirty, frame.marksDirty);
-      } else { this.marks = frame.marks; this.marksDirty = null; }
-    }
+    // The tracks: undefined, as before; null, none; a patch of changed cells (forwarded) or the grid held
+    // here with cells changed in place (decoded here): those cells; else a new grid.
+    const m = frame.marks;
+    if (m === undefined) { /* as before */ } else if (m && m.patch && sameGrid(this.marks, m) && !frame.extras) {
+      const [r0, c0, r1, c1] = m.patch.rect, w = c1 - c0;
+      for (let r = r0; r < r1; r++) this.marks.cells.set(m.patch.cells.subarray((r - r0) * w, (r - r0 + 1) * w), r * m.nx + c0);
+      this.marksDirty = unionRect(this.marksDirty, m.patch.rect);
+    } else if (m && m === this.marks && !frame.extras) this.marksDirty = unionRect(this.marksDirty, frame.marksDirty);
+    else if (m && m.patch) { /* a patch for a grid this thread does not hold: wait for the whole grid */ }
+    else { this.marks = m; this.marksDirty = null; }
     // [step, published, reached the socket's thread, decoded, available to the drawer]: ms since the epoch.
     if (frame.published) this.log.push([frame.step, frame.published, frame.arrived, frame.decoded, performance.timeOrigin + now]);
     if (this.log.length > 4000) this.log.shift();
@@ -267,4 +304,4 @@ class SceneStream {
   }
 }
 
-if (typeof module !== "undefined") module.exports = { SceneStream, StreamDecoder, decodeFrame, decodeMarks, softenMarks, softenInto, unionRect, readSceneGlb, toFloat, KINDS };
+if (typeof module !== "undefined") module.exports = { SceneStream, StreamDecoder, Forwarder, decodeFrame, decodeMarks, softenMarks, softenInto, unionRect, readSceneGlb, toFloat, KINDS };

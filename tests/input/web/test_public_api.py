@@ -35,10 +35,10 @@ def test_the_page_ships_with_the_package():
     html = page.joinpath("index.html").read_text()
     for name in ("app.js", "stream.js", "render.js", "placement.js", "style.css"):
         assert name in html and page.joinpath(name).is_file()
-    # The worker is loaded by the scripts, not the HTML; the server serves every file of the page.
+    # The workers are loaded by the scripts, not the HTML; the server serves every file of the page.
     from input.web.server import PAGE_FILES
 
     served = {name for name, _ in PAGE_FILES.values()}
-    for name in ("view_worker.js",):
+    for name in ("stream_worker.js", "render_worker.js"):
         assert page.joinpath(name).is_file() and name in served
     assert served == {p.name for p in page.iterdir() if p.suffix in (".html", ".js", ".css")}

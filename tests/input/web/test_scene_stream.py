@@ -273,25 +273,28 @@ def worker_frames(tmp_path: Path) -> tuple[RenderScene, list[bytes]]:
 
 
 def run_worker(tmp_path: Path, body: str) -> dict:
-    """``view_worker.js`` under node with a fake WebSocket, animation frames run by hand and, when ``body``
-    sends it a canvas, a fake renderer that logs what it is given; ``body`` prints the JSON returned."""
+    """``stream_worker.js`` under node with a fake WebSocket and a drawer port that logs what it gets (and
+    feeds it to a SceneStream, as the render worker does); ``body`` prints the JSON returned."""
     script = f"""
 const fs = require("fs"), page = {json.dumps(str(PAGE))};
 globalThis.importScripts = (...names) => {{ for (const n of names) Object.assign(globalThis, require(page + "/" + n)); }};
-const toMain = [], sent = [], drawn = [], frames = [];
+globalThis.performance = {{ timeOrigin: 0, now: () => 0 }};
+const toMain = [], sent = [], drawn = [];
 globalThis.postMessage = (m) => toMain.push(m);
 globalThis.onmessage = null;
-globalThis.requestAnimationFrame = (f) => frames.push(f);
-const tick = () => frames.splice(0).forEach((f) => f(0));
 class FakeSocket {{ constructor(url) {{ this.url = url; this.readyState = 1; FakeSocket.last = this; }} send(x) {{ sent.push(JSON.parse(x)); }} }}
 FakeSocket.OPEN = 1;
 globalThis.WebSocket = FakeSocket;
-require(page + "/view_worker.js");
-globalThis.PageRenderer = class {{ constructor(c) {{ this.canvas = c; }}
-  draw(f) {{ drawn.push({{ step: f.step, dirty: f.marksDirty, caps: f.rows.capsules.length, cones: f.rows.cones.length }}); }} }};
+require(page + "/stream_worker.js");
+const {{ SceneStream, StreamDecoder, KINDS }} = require(page + "/stream.js");
+const shown = new SceneStream(), truth = new StreamDecoder();
+const port = {{ postMessage: (m) => {{ const f = m.frame; shown.accept(structuredClone(f), 0);
+  drawn.push({{ step: f.step, extras: !!f.extras, kinds: Object.keys(f.rows), marks: f.marks === undefined ? "same" : f.marks === null ? "none" : f.marks.patch ? "patch" : "grid",
+    rect: f.marks && f.marks.patch ? f.marks.patch.rect : null }}); }} }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const arrive = (i) => FakeSocket.last.onmessage({{ data: buf(i) }});
+const arrive = (i) => {{ truth.receive(buf(i)); FakeSocket.last.onmessage({{ data: buf(i) }}); }};
 onmessage({{ data: {{ connect: "wss://x/ws" }} }});
+onmessage({{ data: {{ drawer: port }} }});
 {body}
 """
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
@@ -300,61 +303,36 @@ onmessage({{ data: {{ connect: "wss://x/ws" }} }});
 
 
 @needs_node
-def test_the_view_worker_draws_each_frame_at_its_next_animation_frame_and_hands_it_to_no_one(tmp_path):
-    """With the canvas, the worker that reads the socket draws: a frame is acknowledged at once and drawn at
-    the next animation frame, never posted to another thread; the drawer is told only the tracks' cells that
-    changed since it last drew (a rectangle, not the grid). (Posting frames to the main thread while drawing
-    fails ``posted``; handing the drawer the whole grid each time fails the dirty rectangles.)"""
-    _, blobs = worker_frames(tmp_path)
-    out = run_worker(
-        tmp_path,
-        """
-onmessage({ data: { canvas: {width: 1, height: 1}, size: [390, 844] } });
-tick();
-arrive(0); tick(); arrive(1); tick(); tick();
-for (let i = 2; i < 7; i++) arrive(i);
-tick();
-console.log(JSON.stringify({ acks: sent.map((m) => m.ack), drawn, posted: toMain.filter((m) => m.frame).length }));
-""",
-    )
-    assert out["acks"] == list(range(1, 8))
-    assert out["posted"] == 0, "a frame went to another thread while this one draws"
-    steps = [d["step"] for d in out["drawn"]]
-    assert steps == [1, 2, 2, 7], f"drawn steps {steps}: each animation frame draws the newest"
-    first, second, again, newest = out["drawn"]
-    assert first["dirty"] is None, "a new grid is the renderer's to upload whole"
-    assert second["dirty"] is None and again["dirty"] is None, "the tracks did not change at step 2"
-    # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4): one rectangle round both, drawn once.
-    assert newest["dirty"] == [50, 50, 61, 74]
-    assert newest["caps"] == 4 * 11 and newest["cones"] == 2 * 11
-
-
-@needs_node
-def test_where_the_worker_cannot_draw_it_hands_the_main_thread_the_newest_frame_never_a_queue(tmp_path):
-    """Without a canvas (AR, no OffscreenCanvas) frames go to the main thread: every frame is acknowledged to
-    the engine as soon as it is decoded; the main thread gets at most two frames it has not taken, then,
-    once it takes one, the newest frame (not the next in a queue), and the tracks only when they changed,
-    with the cells changed since the tracks it got. (A worker that posts every frame fails the count; one
-    that keeps a queue fails the newest step.)"""
+def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
+    """Every frame is acknowledged to the engine as soon as it is decoded; the drawer gets at most two frames
+    it has not taken, then, once it takes one, the newest frame (not the next in a queue). Each message
+    carries only the kinds that changed since the drawer's last one (the trees once) and, of the tracks, the
+    block of cells changed since (the whole grid first); the drawer's picture is then the decoder's, cell for
+    cell. (A worker that posts every frame fails the count; one that keeps a queue fails the newest step;
+    one that forgets the cells of frames it held back fails the agreement.)"""
     _, blobs = worker_frames(tmp_path)
     out = run_worker(
         tmp_path,
         f"""
-const got = () => toMain.filter((m) => m.frame).map((m) => ({{ step: m.frame.step, extras: !!m.frame.extras,
-  marks: m.frame.marks === undefined ? "same" : "grid", dirty: m.frame.marksDirty }}));
 for (let i = 0; i < {len(blobs)}; i++) arrive(i);
-const before = got().length;
-onmessage({{ data: {{ got: 1 }} }});
-const after = got().length;
-onmessage({{ data: {{ got: 2 }} }});
-console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn: got(), end: got().length }}));
+const before = drawn.length;
+port.onmessage({{ data: {{ got: 1 }} }});
+const after = drawn.length;
+port.onmessage({{ data: {{ got: 2 }} }});
+const rows = KINDS.every((k) => Array.from(shown.cur.rows[k]).join() === Array.from(truth.state.rows[k]).map((v, i) =>
+  v / truth.scales[k][i % truth.scales[k].length]).map((v) => Math.fround(v)).join());
+const cells = Array.from(shown.marks.cells).join() === Array.from(truth.state.marks.cells).join();
+console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length, rows, cells }}));
 """,
     )
     assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
     assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
     assert out["after"] == 3 and out["end"] == 3
     first, second, newest = out["drawn"]
-    assert first["step"] == 1 and first["extras"] and first["marks"] == "grid"
-    assert second == {"step": 2, "extras": False, "marks": "same", "dirty": None}
-    assert newest["step"] == 7 and not newest["extras"] and newest["marks"] == "grid"
-    assert newest["dirty"] == [50, 50, 61, 74], "the cells changed since the main thread's tracks"
+    assert first["step"] == 1 and first["extras"] and first["marks"] == "grid" and "cones" in first["kinds"]
+    assert second["step"] == 2 and not second["extras"] and second["marks"] == "same"
+    assert "cones" not in second["kinds"] and "capsules" in second["kinds"], second["kinds"]
+    assert newest["step"] == 7 and newest["marks"] == "patch"
+    # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4); step 6 was held back and replaced by 7.
+    assert newest["rect"] == [50, 50, 61, 74]
+    assert out["rows"] and out["cells"], "the drawer's picture is not the decoder's"
