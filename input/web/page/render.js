@@ -335,6 +335,32 @@ function mul4(a, b) {
   return m;
 }
 
+// The six planes (a, b, c, d: inside where a·x + b·y + c·z + d ≥ 0, normalised) of a view-projection's frustum.
+function frustumPlanes(m) {
+  const row = (i) => [m[i], m[4 + i], m[8 + i], m[12 + i]], w = row(3), planes = [];
+  for (const i of [0, 1, 2]) for (const s of [1, -1]) {
+    const r = row(i), p = [0, 1, 2, 3].map((k) => w[k] + s * r[k]), n = Math.hypot(p[0], p[1], p[2]) || 1;
+    planes.push(p.map((v) => v / n));
+  }
+  return planes;
+}
+
+// The rows of ``rows`` (``stride`` floats: end a, end b, radius first) whose bounding sphere meets the
+// frustum: the software rasteriser shades every vertex of every instance, on screen or not, and a phone
+// looks at a few of the field's trees and puppets at a time. ``grow`` widens a row's radius (a cone's skirt).
+function cull(rows, stride, planes, grow = 1) {
+  const n = rows.length / stride, keep = [];
+  for (let i = 0; i < n; i++) {
+    const o = i * stride, cx = (rows[o] + rows[o + 3]) / 2, cy = (rows[o + 1] + rows[o + 4]) / 2, cz = (rows[o + 2] + rows[o + 5]) / 2;
+    const rad = Math.hypot(rows[o + 3] - rows[o], rows[o + 4] - rows[o + 1], rows[o + 5] - rows[o + 2]) / 2 + grow * rows[o + 6];
+    if (planes.every((p) => p[0] * cx + p[1] * cy + p[2] * cz + p[3] >= -rad)) keep.push(i);
+  }
+  if (keep.length === n) return rows;
+  const out = new Float32Array(keep.length * stride);
+  keep.forEach((i, k) => out.set(rows.subarray(i * stride, (i + 1) * stride), k * stride));
+  return out;
+}
+
 // What a full shadow leaves of the snow's colour, per channel: the sun's share of its light goes, the blue
 // sky's stays (as the desktop's ground shadow; colours squared and rooted for gamma 2).
 function shadowTint(look) {
@@ -616,16 +642,17 @@ class PageRenderer {
       proj = perspective(cam.fov, w / h, 0.05, 200); view = viewMatrix(cam.p, cam.q); eye = cam.p;
       basis = quatToMat3(cam.q);
     }
-    const viewProj = mul4(proj, view);
+    const viewProj = mul4(proj, view), planes = frustumPlanes(viewProj);
     gl.enable(gl.DEPTH_TEST); gl.disable(gl.CULL_FACE);
     if (!xr || xr.first) { gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT); }
-    if (round.length) {
+    const shown = cull(round, 11, planes);
+    if (shown.length) {
       gl.useProgram(this.capsule.prog);
       gl.uniformMatrix4fv(this.capsule.u.viewProj, false, viewProj);
       this.lighting(this.capsule, look, eye);
       gl.bindVertexArray(this.capVao);
-      this.upload(this.capInst, round);
-      gl.drawElementsInstanced(gl.TRIANGLES, this.capCount, gl.UNSIGNED_SHORT, 0, round.length / 11);
+      this.upload(this.capInst, shown);
+      gl.drawElementsInstanced(gl.TRIANGLES, this.capCount, gl.UNSIGNED_SHORT, 0, shown.length / 11);
     }
     const boxes = frame.rows.boxes;
     if (boxes.length) {
@@ -636,7 +663,7 @@ class PageRenderer {
       this.upload(this.boxInst, boxes);
       gl.drawArraysInstanced(gl.TRIANGLES, 0, 36, boxes.length / 14);
     }
-    const cones = frame.rows.cones || new Float32Array(0);
+    const cones = cull(frame.rows.cones || new Float32Array(0), 11, planes, 1.3);
     if (cones.length) {
       gl.useProgram(this.cone.prog);
       gl.uniformMatrix4fv(this.cone.u.viewProj, false, viewProj);
@@ -721,4 +748,4 @@ class FrameCounter {
 }
 const MIN_RESOLUTION = 0.5;
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows };
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };

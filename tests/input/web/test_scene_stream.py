@@ -131,6 +131,39 @@ def test_the_trees_go_once_and_then_cost_three_bytes_a_frame():
     assert len(frame) == len(encode_frame(treeless(base), treeless(moved))), "unchanged cones cost more than 3 bytes"
 
 
+def test_the_falling_snow_goes_once_in_the_glb_as_the_flakes_and_the_rule_that_moves_them():
+    """The snowman's snowfall rides in the GLB (a VEC4 accessor of start and phase per flake, and the
+    rule's constants), and the page's rule (render.js FLAKE_VS) applied to what the GLB carries puts each
+    flake where the desktop draws it at that step. (A GLB without the flakes, or with the wrong speed or
+    sway, fails.)"""
+    from games.snowman.scenery import SNOWFALL
+
+    state = quantise(scene_with(3), 600, 0.0, CAM)
+    glb = scene_glb(state, scene_with(3), SNOWFALL, 1 / 60)
+    extras, _ = read_scene_glb(glb)
+    f = extras["snowfall"]
+    doc = json.loads(glb[20 : 20 + int.from_bytes(glb[12:16], "little")])
+    view = doc["bufferViews"][doc["accessors"][f["accessor"]]["bufferView"]]
+    blob = glb[20 + int.from_bytes(glb[12:16], "little") + 8 :]
+    flakes = np.frombuffer(blob, "<f4", 4 * f["count"], view["byteOffset"]).reshape(-1, 4).astype(np.float64)
+    assert f["count"] == 900 and f["step_seconds"] == pytest.approx(1 / 60)
+    time = 600 * f["step_seconds"]
+    # The page's rule, with the clock's terms reduced as render.js does (fall mod height, phases mod 2π).
+    fall, turn = (f["speed"] * time) % f["height"], 2 * np.pi
+    a, b = (f["sway_rates"][0] * time) % turn, (f["sway_rates"][1] * time) % turn
+    page = np.column_stack(
+        [
+            flakes[:, 0] + f["sway"] * np.sin(a + flakes[:, 3]),
+            (flakes[:, 1] - fall) % f["height"],
+            flakes[:, 2] + f["sway"] * np.cos(b + flakes[:, 3]),
+        ]
+    )
+    desktop = RenderScene()
+    SNOWFALL.draw(desktop, time)
+    assert np.abs(page - desktop.points.data[:, :3]).max() < 1e-3
+    assert read_scene_glb(scene_glb(state, scene_with(3)))[0]["snowfall"] is None
+
+
 @pytest.mark.fuzz
 def test_fuzz_byte_mutations_of_a_scene_frame(campaign, mutations, fuzz_budget):
     """Mutated frames (all kinds, cones and tracks included) decode to rows of the right shape or raise one
