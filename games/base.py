@@ -26,6 +26,7 @@ from engine.app import App
 from engine.camera import OrbitCamera
 from engine.ecs import World
 from engine.render.scene import RenderScene
+from engine.render.snowfall import Snowfall
 
 __all__ = ["Game", "GameSetup", "GameOptionError", "describe_options", "parse_settings"]
 
@@ -102,6 +103,8 @@ class Game:
             drawing without what would cost too much on the wire (snowman: the 900 falling
             flakes move every step; the tracks are cells in grid order, so a new one shifts
             every row after it).
+        snowfall: the falling snow ``draw`` adds, described once so a phone can move the flakes
+            itself (``draw_state`` leaves them out); ``None``: no falling snow.
         camera: the starting camera.
         status: overlay lines (counters, stage) read from the world.
         controls: the start screen's help lines; a line that starts with a source kind and a
@@ -132,4 +135,5 @@ class Game:
     prepare: Callable[[dict[str, str]], dict[str, Any]] = _options_as_setup
     replay_setup: Callable[[dict[str, Any]], dict[str, Any]] = dict
     draw_state: Callable[[World, RenderScene, float], None] | None = None
+    snowfall: Snowfall | None = None
     close: Callable[[World], None] = _nothing_to_close

@@ -181,4 +181,6 @@ def _stream_to_phones(session: Session, simulation: GameSimulation) -> None:
     for source in session.hub.sources:
         if isinstance(source, WebSource):
             draw = simulation.game.draw_state or simulation.game.draw
-            simulation.app.on_step_end.append(PhoneViewport(source, draw, lambda: simulation.orbit))
+            simulation.app.on_step_end.append(
+                PhoneViewport(source, draw, lambda: simulation.orbit, simulation.game.snowfall)
+            )

@@ -124,7 +124,8 @@ def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[i
 
 def draw_snowman_state(world: World, scene: RenderScene, alpha: float) -> None:
     """Puppets, snowballs, snowmen, sticks, trees and the tracks and footprints in the snow: what the phone is
-    streamed (everything but the falling snow, which each side draws from its own clock)."""
+    streamed every step (everything but the falling snow, which the phone gets once as
+    :data:`~games.snowman.scenery.SNOWFALL` and moves by the step it shows)."""
     from engine.components import Stick
 
     draw_world(world, scene, alpha)

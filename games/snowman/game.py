@@ -33,7 +33,7 @@ from games.snowman.rules import (
     start_snowballs,
     stick_stacked_balls,
 )
-from games.snowman.scenery import build_scenery
+from games.snowman.scenery import SNOWFALL, build_scenery
 from games.snowman.snow import SnowField
 
 __all__ = ["GAME", "install", "CONTROLS"]
@@ -125,4 +125,5 @@ GAME = Game(
     prepare=prepare_game,
     replay_setup=replay_game,
     draw_state=draw_snowman_state,
+    snowfall=SNOWFALL,
 )

@@ -15,17 +15,21 @@ from engine.components import Obstacle, Transform
 from engine.ecs import World
 from engine.render.components import Appearance, Shape
 from engine.render.scene import RenderScene
+from engine.render.snowfall import Snowfall
 
 if TYPE_CHECKING:
     from games.snowman.bent_scenery import BentScenery
 
-__all__ = ["build_scenery", "draw_snowfall", "draw_trees", "conifer_tiers", "TREES", "ROCKS"]
+__all__ = ["build_scenery", "draw_snowfall", "SNOWFALL", "draw_trees", "conifer_tiers", "TREES", "ROCKS"]
 
 TREES = ((-5.0, -4.5, 1.0), (6.0, -5.5, 1.2), (-7.5, 3.0, 0.9), (7.0, 4.5, 1.1), (-2.5, -8.0, 1.3), (3.5, 8.0, 1.0))
 ROCKS = ((3.2, -2.4, 0.45), (-3.8, 2.6, 0.35), (1.0, 5.5, 0.4))
 
-_FLAKES = np.random.default_rng(20171105).uniform([-12, 0, -12], [12, 9, 12], size=(900, 3))
-_DRIFT = np.random.default_rng(7).uniform(0, 2 * np.pi, size=900)
+#: The field's falling snow (drawn by the desktop, described to the phone once).
+SNOWFALL = Snowfall(
+    np.random.default_rng(20171105).uniform([-12, 0, -12], [12, 9, 12], size=(900, 3)),
+    np.random.default_rng(7).uniform(0, 2 * np.pi, size=900),
+)
 
 
 def build_scenery(world: World) -> None:
@@ -100,8 +104,4 @@ def draw_trees(scene: RenderScene, bent: BentScenery | None = None) -> None:
 
 def draw_snowfall(scene: RenderScene, time: float) -> None:
     """Flakes drifting down; they wrap around the top when they reach the ground."""
-    p = _FLAKES.copy()
-    p[:, 1] = (p[:, 1] - 0.6 * time) % 9.0
-    p[:, 0] += 0.25 * np.sin(0.7 * time + _DRIFT)
-    p[:, 2] += 0.25 * np.cos(0.5 * time + _DRIFT)
-    scene.add_points(p, size=0.035, color=(1.0, 1.0, 1.0))
+    SNOWFALL.draw(scene, time)

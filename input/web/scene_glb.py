@@ -6,7 +6,10 @@ with its snow colour as material), and the primitives of the step the phone join
 at ride in ``SHORT`` accessors, one per kind, quantised as
 :mod:`input.web.scene_stream` does (the first delta frame builds on exactly these
 rows). Scene extras carry what the page lights and clears with: sun, sky, horizon,
-the column scales and the frame version.
+the column scales and the frame version; and the falling snow, if the game has one
+(:class:`~engine.render.snowfall.Snowfall`: the flakes' start positions and phases in
+a ``FLOAT VEC4`` accessor and the rule that moves them, which the page applies to the
+step it shows, ``step_seconds`` each).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import numpy as np
 
 from engine.io.gltf_write import container_bytes
 from engine.render.scene import RenderScene
+from engine.render.snowfall import Snowfall
 from input.web.scene_stream import FRAME_VERSION, KINDS, SCALES, MarksGrid, SceneState
 
 __all__ = ["scene_glb", "read_scene_glb", "FIELD_HALF_SIZE"]
@@ -35,8 +39,9 @@ def _ground_mesh(half: float, height: float) -> tuple[bytes, bytes]:
     return pos.tobytes(), idx.tobytes()
 
 
-def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
-    """The GLB a phone starts from: ground mesh, ``state``'s rows, lighting in the scene's extras."""
+def scene_glb(state: SceneState, scene: RenderScene, snowfall: Snowfall | None = None, dt: float = 1 / 60) -> bytes:
+    """The GLB a phone starts from: ground mesh, ``state``'s rows, lighting and ``snowfall`` (moved by
+    ``dt`` seconds a step) in the scene's extras."""
     chunks: list[bytes] = []
     views: list[dict] = []
     accessors: list[dict] = []
@@ -82,6 +87,20 @@ def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
             "z0": m.z0,
             "cell": m.cell,
         }
+    flakes = None
+    if snowfall is not None:
+        raw = np.column_stack([snowfall.start, snowfall.phase]).astype("<f4")
+        flakes = {
+            "accessor": add(raw.tobytes(), 5126, len(raw), "VEC4"),
+            "count": len(raw),
+            "speed": snowfall.speed,
+            "height": snowfall.height,
+            "sway": snowfall.sway,
+            "sway_rates": list(snowfall.sway_rates),
+            "size": snowfall.size,
+            "color": list(snowfall.color),
+            "step_seconds": dt,
+        }
     blob = b"".join(chunks)
     cam = state.camera
     doc = {
@@ -97,6 +116,7 @@ def scene_glb(state: SceneState, scene: RenderScene) -> bytes:
                         "step": state.step,
                         "rows": rows,
                         "marks": marks,
+                        "snowfall": flakes,
                         "ground": asdict(g),
                         "sun": asdict(scene.sun),
                         "sky": list(scene.sky_color),

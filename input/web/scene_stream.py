@@ -2,7 +2,8 @@
 
 The page draws what the desktop draws: the primitives a game's drawing puts in a
 :class:`~engine.render.scene.RenderScene` (puppet bones as capsules, snowballs and
-snowmen as spheres, props as boxes, the stick as a line and a point). Sending these
+snowmen as spheres, props as boxes, the stick as a line and a point, conifer tiers as
+cones; footprints). Sending these
 rather than joint transforms keeps one drawing per game: the page needs no copy of
 each game's rules for snowmen, sticks or height cues, and the phone's picture is the
 desktop's picture.
@@ -54,9 +55,10 @@ __all__ = [
     "decode_frame",
     "FrameError",
     "FRAME_VERSION",
+    "MAX_MARKS_CELLS",
 ]
 
-FRAME_VERSION = 2
+FRAME_VERSION = 3
 _MM, _C, _Q = 1000.0, 255.0, 32767.0
 #: Per kind, the scale of each column of the scene's rows (value × scale, rounded, is sent).
 SCALES: dict[str, tuple[float, ...]] = {
@@ -66,8 +68,11 @@ SCALES: dict[str, tuple[float, ...]] = {
     "lines": (_MM,) * 6 + (_C,) * 3 + (10.0,),  # p0, p1, colour, width (1/10 px)
     "points": (_MM,) * 4 + (_C,) * 3 + (1.0,),  # position, size, colour, size-in-pixels flag
     "prints": (_MM,) * 2 + (_Q,) * 2 + (_MM,) * 2 + (_C,),  # footprint: x z, heading cos sin, half sizes, strength
+    "cones": (_MM,) * 7 + (_C,) * 4,  # base[3] apex[3] radius colour[3] snow (conifer tiers; static: 3 B a frame)
 }
 KINDS = tuple(SCALES)
+#: The most cells a tracks grid may have (the snowman's is 240 × 240): a reader allocates no more.
+MAX_MARKS_CELLS = 1 << 20
 _HEADER = struct.Struct("<2sBBId3f4ff")
 _KIND = struct.Struct("<HB")
 _COLUMNS = struct.Struct("<H")
@@ -155,6 +160,8 @@ def _encode_marks(base: MarksGrid | None, marks: MarksGrid | None) -> bytes:
     else:
         changed = np.ones(marks.cells.shape, dtype=bool)
     nz, nx = marks.cells.shape
+    if nx * nz > MAX_MARKS_CELLS:
+        raise ValueError(f"a tracks grid of {nx} × {nz} cells does not fit in a frame")
     head = _GRID.pack(nx, nz, marks.x0, marks.z0, marks.cell)
     rows, cols = np.nonzero(changed.any(axis=1))[0], np.nonzero(changed.any(axis=0))[0]
     r0, r1, c0, c1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
@@ -187,6 +194,10 @@ def _decode_marks(base: MarksGrid | None, data: bytes, at: int) -> tuple[MarksGr
     need(_GRID.size)
     nx, nz, x0, z0, cell = _GRID.unpack_from(data, at)
     at += _GRID.size
+    if nx * nz > MAX_MARKS_CELLS:
+        raise FrameError(f"tracks grid of {nx} × {nz} cells (at most {MAX_MARKS_CELLS})")
+    if not (np.isfinite([x0, z0]).all() and 0.0 < cell < 1e3):
+        raise FrameError(f"tracks grid at ({x0}, {z0}) with cells of {cell} m")
     cells = np.zeros((nz, nx), dtype=np.uint8)
     if base is not None and base.cells.shape == (nz, nx) and (base.x0, base.z0, base.cell) == (x0, z0, cell):
         cells[:] = base.cells
@@ -272,7 +283,11 @@ def decode_frame(base: SceneState, data: bytes) -> SceneState:
             mask_len = (n + 7) // 8
             if at + _COLUMNS.size + mask_len > len(data):
                 raise FrameError(f"frame ends inside its {kind}")
+            if mode not in (1, 2):
+                raise FrameError(f"unknown mode {mode} for the {kind}")
             (bits,) = _COLUMNS.unpack_from(data, at)
+            if bits == 0 or bits >> len(scales):
+                raise FrameError(f"changed-column bits {bits:#06x} for {len(scales)} columns of {kind}")
             columns = np.array([(bits >> c) & 1 for c in range(len(scales))], dtype=bool)
             at += _COLUMNS.size
             changed = np.unpackbits(np.frombuffer(data, np.uint8, mask_len, at), count=n, bitorder="little").astype(

@@ -53,6 +53,7 @@ from urllib.parse import parse_qs, urlsplit
 from websockets.exceptions import ConnectionClosed
 from websockets.frames import CloseCode
 
+from engine.render.snowfall import Snowfall
 from input.source import PoseSource
 from input.web.cert import WebCertificate, load_or_create
 from input.web.protocol import Ack, ControllerMessage, PageClock, Ping, WebMessageError, parse_message, to_sample_fields
@@ -153,7 +154,7 @@ class WebSource(PoseSource):
         self._clocks: dict[str, PageClock] = {}  # per controller: its page's event times on our clock
         self.refused = 0
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._latest: tuple[SceneState, Any] | None = None
+        self._latest: tuple[SceneState, Any, Snowfall | None, float] | None = None
         self._wakes: set[asyncio.Event] = set()
         self.frames_sent = 0
         self.frame_bytes = 0
@@ -163,10 +164,11 @@ class WebSource(PoseSource):
         """Pages connected to watch the scene (each controller's page is one)."""
         return len(self._wakes)
 
-    def publish(self, state: SceneState, look: Any) -> None:
+    def publish(self, state: SceneState, look: Any, snowfall: Snowfall | None = None, dt: float = 1 / 60) -> None:
         """Hand the pages the newest scene (engine thread); ``look`` is the scene whose ground,
-        sun and sky the GLB carries. Older states not yet sent are simply replaced."""
-        self._latest = (state, look)
+        sun and sky the GLB carries, with ``snowfall`` (moved by the page: step × ``dt`` seconds).
+        Older states not yet sent are simply replaced."""
+        self._latest = (state, look, snowfall, dt)
         loop = self._loop
         if loop is not None and self._wakes:
             try:
@@ -303,8 +305,8 @@ class WebSource(PoseSource):
             latest = self._latest
             if latest is None or (base is not None and latest[0].step == base.step):
                 continue
-            state, look = latest
-            data = scene_glb(state, look) if base is None else encode_frame(base, state)
+            state, look, snowfall, dt = latest
+            data = scene_glb(state, look, snowfall, dt) if base is None else encode_frame(base, state)
             try:
                 await ws.send(data)
             except ConnectionClosed:

@@ -27,10 +27,12 @@ let renderer = null, drawsHere = false, painter = null;
 // report() gives the logs (per step: published, reached the stream worker, decoded, available to the
 // drawer; and when each step was first drawn), all in ms since the epoch.
 const reportWaiters = [];
+// holdResolution(r) keeps the drawing at r of the device's pixels (null: adapt to the frame rate again).
 window.ppView = { drawn: 0, step: -1, fps: 0, resolution: 1, frames: 0, bytes: 0, where: "render worker",
   report: () => (drawsHere || state.kind === "xr"
     ? Promise.resolve({ log: stream.log, drawLog: counter.drawLog, frames: stream.frames, bytes: stream.bytes })
-    : new Promise((resolve) => { reportWaiters.push(resolve); painter.postMessage({ report: true }); })) };
+    : new Promise((resolve) => { reportWaiters.push(resolve); painter.postMessage({ report: true }); })),
+  holdResolution: (r) => { counter.hold(r); if (painter) painter.postMessage({ resolution: r }); } };
 
 function canvasSize() {
   const canvas = $("view"), px = Math.min(devicePixelRatio, 2);

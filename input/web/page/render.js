@@ -5,12 +5,29 @@
 // image shows behind the scene.
 "use strict";
 
+// Lighting per vertex (Gouraud), finished to display colour there: the software rasteriser a phone-sized
+// canvas is judged on (SwiftShader) pays per pixel, and the pixel stage is then one copy. Gamma 2 (squares
+// and a square root) rather than 2.2.
+const LIT = `
+uniform vec3 sunDir; uniform vec3 sunColor; uniform float ambient; uniform vec3 eye;
+uniform vec3 sky; uniform vec3 outlineColor;
+vec3 lit(vec3 n, vec3 p, vec3 base, float outline) {
+  n = normalize(n);
+  float diff = max(dot(n, sunDir), 0.0);
+  vec3 hemi = mix(vec3(0.52, 0.54, 0.58), sky * sky, 0.5 + 0.5 * n.y);
+  vec3 c = base * (sunColor * diff * 0.55 + hemi * ambient * 1.1);
+  float rim = 1.0 - abs(dot(n, normalize(eye - p)));
+  c = mix(c, outlineColor * outlineColor, clamp(outline, 0.0, 1.0) * rim * rim * rim);
+  return sqrt(c / (1.0 + c * 0.15));
+}`;
+
 const CAPSULE_VS = `#version 300 es
 layout(location=0) in vec4 dirEnd;
 layout(location=1) in vec3 a; layout(location=2) in vec3 b; layout(location=3) in float r;
 layout(location=4) in vec3 col; layout(location=5) in float outline;
 uniform mat4 viewProj;
-out vec3 vN; out vec3 vP; out vec3 vC; out float vO;
+out vec3 vColor;
+${LIT}
 void main() {
   vec3 ax = b - a; float len = length(ax);
   vec3 w = len > 1e-6 ? ax / len : vec3(0.0, 1.0, 0.0);
@@ -18,7 +35,7 @@ void main() {
   vec3 u = normalize(cross(t, w)); vec3 v = cross(w, u);
   vec3 n = u * dirEnd.x + w * dirEnd.y + v * dirEnd.z;
   vec3 p = mix(a, b, dirEnd.w) + r * n;
-  vN = n; vP = p; vC = col * col; vO = outline;
+  vColor = lit(n, p, col * col, outline);
   gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
@@ -27,63 +44,105 @@ layout(location=0) in vec3 corner; layout(location=6) in vec3 normal;
 layout(location=1) in vec3 c; layout(location=2) in vec3 h; layout(location=3) in vec4 q;
 layout(location=4) in vec3 col; layout(location=5) in float outline;
 uniform mat4 viewProj;
-out vec3 vN; out vec3 vP; out vec3 vC; out float vO;
+out vec3 vColor;
+${LIT}
 vec3 rot(vec4 q, vec3 v) { vec3 u = q.yzw; return v + 2.0 * cross(u, cross(u, v) + q.x * v); }
 void main() {
   vec3 p = c + rot(q, corner * h);
-  vN = rot(q, normal); vP = p; vC = col * col; vO = outline;
+  vColor = lit(rot(q, normal), p, col * col, outline);
   gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
-const LIT_FS = `#version 300 es
-precision highp float;
-in vec3 vN; in vec3 vP; in vec3 vC; in float vO;
-uniform vec3 sunDir; uniform vec3 sunColor; uniform float ambient; uniform vec3 eye;
-uniform vec3 sky; uniform vec3 horizon; uniform vec3 outlineColor;
-out vec4 frag;
-// Gamma 2 (squares and a square root) rather than 2.2: software GL on a phone-sized canvas is fill-bound.
+// Conifer tiers (engine/render/shaders.py CONE_VS): base centre a, apex b, base radius r; ``outline`` carries
+// the snow on the tier, which whitens its upper side in a ragged band; the skirt's every other spoke hangs lower.
+const CONE_VS = `#version 300 es
+layout(location=0) in vec4 vert;  // cos, sin round the axis; height fraction; 1 on the base disc
+layout(location=1) in vec3 a; layout(location=2) in vec3 b; layout(location=3) in float r;
+layout(location=4) in vec3 col; layout(location=5) in float snowy;
+uniform mat4 viewProj;
+out vec3 vColor;
+${LIT}
 void main() {
-  vec3 n = normalize(vN);
-  float diff = max(dot(n, sunDir), 0.0);
-  vec3 hemi = mix(vec3(0.52, 0.54, 0.58), sky * sky, 0.5 + 0.5 * n.y);
-  vec3 c = vC * (sunColor * diff * 0.55 + hemi * ambient * 1.1);
-  float rim = 1.0 - abs(dot(n, normalize(eye - vP)));
-  c = mix(c, outlineColor * outlineColor, clamp(vO, 0.0, 1.0) * rim * rim * rim);
-  frag = vec4(sqrt(c / (1.0 + c * 0.15)), 1.0);
+  vec3 axis = b - a; float h = max(length(axis), 1e-6); vec3 y = axis / h;
+  vec3 helper = abs(y.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+  vec3 x = normalize(cross(helper, y)); vec3 z = cross(x, y);
+  float t = vert.z, seed = dot(a, vec3(12.9, 0.0, 78.2)), angle = atan(vert.y, vert.x);
+  float spike = vert.w < 0.5 && t < 0.01 ? 0.5 + 0.5 * cos(angle * 9.0 + seed) : 0.0;
+  vec3 radial = x * vert.x + z * vert.y;
+  vec3 p = a + axis * t + radial * (r * (1.0 - t) * (1.0 + 0.12 * spike)) - y * (0.10 * h * spike);
+  vec3 n = vert.w > 0.5 ? -y : normalize(radial * h + y * r);
+  float snow = snowy * smoothstep(0.2, 0.5, t + 0.22 * sin(angle * 5.0 + seed) + 0.15 * spike);
+  vec3 c = mix(col, vec3(0.93, 0.95, 0.99), snow);
+  vColor = lit(n, p, c * c, 0.0);
+  gl_Position = viewProj * vec4(p, 1.0);
 }`;
 
+// The falling snow (engine/render/snowfall.py): each flake placed from its start and phase by the time of
+// the step shown (``fall``, ``swayA``, ``swayB``: the clock's terms, reduced on the CPU in double precision).
+const FLAKE_VS = `#version 300 es
+layout(location=0) in vec4 flake;
+uniform mat4 viewProj; uniform float fall; uniform float height; uniform float sway; uniform vec2 phase;
+uniform float size; uniform float focal; uniform vec3 eye;
+out float vFade;
+void main() {
+  vec3 p = vec3(flake.x + sway * sin(phase.x + flake.w), mod(flake.y - fall, height), flake.z + sway * cos(phase.y + flake.w));
+  gl_Position = viewProj * vec4(p, 1.0);
+  gl_PointSize = clamp(size * focal / max(gl_Position.w, 0.05), 1.0, 24.0);
+  vFade = clamp(length(p - eye) / 35.0, 0.0, 1.0);
+}`;
+
+const FLAKE_FS = `#version 300 es
+precision mediump float;
+in float vFade; uniform vec3 color; uniform vec3 horizon;
+out vec4 frag;
+void main() {
+  vec2 d = gl_PointCoord - 0.5;
+  if (dot(d, d) > 0.25) discard;
+  frag = vec4(mix(color, horizon, vFade * vFade), 1.0);
+}`;
+
+const FLAT_FS = `#version 300 es
+precision mediump float;
+in vec3 vColor; out vec4 frag;
+void main() { frag = vec4(vColor, 1.0); }`;
+
+// The ground as a grid of 2 m cells: its colour, the fade to the horizon and where it falls in the shadow
+// mask are worked out per vertex; a pixel reads the mask once (its border is kept clear, so no test) and,
+// only where the game draws grid lines, works out the lines.
 const GROUND_VS = `#version 300 es
-layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; out vec3 vP;
-void main() { vP = vec3(xz.x, height, xz.y); gl_Position = viewProj * vec4(vP, 1.0); }`;
+layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; uniform vec3 eye; uniform vec4 shadowRect;
+out vec3 vP; out float vFade; out vec2 vMask;
+void main() {
+  vP = vec3(xz.x, height, xz.y);
+  vFade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
+  vMask = (vP.xz - shadowRect.xy) / shadowRect.zw;
+  gl_Position = viewProj * vec4(vP, 1.0);
+}`;
 
 const GROUND_FS = `#version 300 es
 precision highp float;
-in vec3 vP; uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
-uniform vec3 eye; uniform vec3 horizon; uniform float alpha;
-uniform sampler2D shadowMask; uniform vec4 shadowRect; uniform vec3 shadowTint;
+in vec3 vP; in float vFade; in vec2 vMask;
+uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
+uniform vec3 horizon; uniform float alpha; uniform sampler2D shadowMask; uniform vec3 shadowTint;
 out vec4 frag;
 void main() {
-  vec2 g = abs(fract(vP.xz / spacing + 0.5) - 0.5) / fwidth(vP.xz / spacing);
-  float line = 1.0 - min(min(g.x, g.y), 1.0);
-  float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
-  vec3 c = mix(color, gridColor, line * gridStrength * (1.0 - fade));
-  vec2 muv = (vP.xz - shadowRect.xy) / shadowRect.zw;
-  if (all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) c *= mix(vec3(1.0), shadowTint, texture(shadowMask, muv).r);
-  c = mix(c, horizon, fade * fade);
-  frag = vec4(c, alpha);
+  vec3 c = color;
+  if (gridStrength > 0.0) {  // a field of snow has none: the software rasteriser skips the derivatives
+    vec2 g = abs(fract(vP.xz / spacing + 0.5) - 0.5) / fwidth(vP.xz / spacing);
+    c = mix(color, gridColor, (1.0 - min(min(g.x, g.y), 1.0)) * gridStrength * (1.0 - vFade));
+  }
+  c *= mix(vec3(1.0), shadowTint, texture(shadowMask, vMask).r);
+  frag = vec4(mix(c, horizon, vFade * vFade), alpha);
 }`;
 
+// The sky's gradient per vertex of a screen-covering grid (behind everything: depth 1).
 const SKY_VS = `#version 300 es
-const vec2 P[3] = vec2[3](vec2(-1.0, -1.0), vec2(3.0, -1.0), vec2(-1.0, 3.0));
-out vec2 ndc; void main() { ndc = P[gl_VertexID]; gl_Position = vec4(ndc, 1.0, 1.0); }`;
-
-const SKY_FS = `#version 300 es
-precision highp float;
-in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
-out vec4 frag;
+layout(location=0) in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
+out vec3 vColor;
 void main() {
   vec3 d = normalize(basis * vec3(ndc * tanHalf, -1.0));
-  frag = vec4(mix(horizon, sky, pow(clamp(d.y, 0.0, 1.0), 0.45)), 1.0);
+  vColor = mix(horizon, sky, pow(clamp(d.y, 0.0, 1.0), 0.45));
+  gl_Position = vec4(ndc, 1.0, 1.0);
 }`;
 
 // Blob shadows: each round thing (capsule, sphere; a box as its footprint's circle) cast along the sun
@@ -209,6 +268,34 @@ function capsuleMesh(seg = 10, rings = 3) {
   return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
 }
 
+// A unit cone (engine/render/env_meshes.py cone_mesh): side rings from base to apex, and the base disc.
+function coneMesh(segments = 16, rings = 4) {
+  const v = [], idx = [];
+  for (let i = 0; i <= rings; i++) for (let k = 0; k < segments; k++) {
+    const a = (2 * Math.PI * k) / segments; v.push(Math.cos(a), Math.sin(a), i / rings, 0);
+  }
+  for (let i = 0; i < rings; i++) for (let k = 0; k < segments; k++) {
+    const p = i * segments + k, q = i * segments + ((k + 1) % segments);
+    idx.push(p, q, p + segments, q, q + segments, p + segments);
+  }
+  const centre = v.length / 4;
+  v.push(0, 0, 0, 1);
+  for (let k = 0; k < segments; k++) { const a = (2 * Math.PI * k) / segments; v.push(Math.cos(a), Math.sin(a), 0, 1); }
+  for (let k = 0; k < segments; k++) idx.push(centre, centre + 1 + k, centre + 1 + ((k + 1) % segments));
+  return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
+}
+
+// An n × n grid of quads over [x0, x1] × [y0, y1]: vertices (x, y) and triangles.
+function gridMesh(n, x0, x1, y0, y1) {
+  const v = [], idx = [];
+  for (let j = 0; j <= n; j++) for (let i = 0; i <= n; i++) v.push(x0 + ((x1 - x0) * i) / n, y0 + ((y1 - y0) * j) / n);
+  for (let j = 0; j < n; j++) for (let i = 0; i < n; i++) {
+    const k = j * (n + 1) + i;
+    idx.push(k, k + 1, k + n + 1, k + 1, k + n + 2, k + n + 1);
+  }
+  return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
+}
+
 function boxMesh() {
   const v = [];
   const faces = [[0, 1], [0, -1], [1, 1], [1, -1], [2, 1], [2, -1]];
@@ -248,6 +335,32 @@ function mul4(a, b) {
   return m;
 }
 
+// The six planes (a, b, c, d: inside where a·x + b·y + c·z + d ≥ 0, normalised) of a view-projection's frustum.
+function frustumPlanes(m) {
+  const row = (i) => [m[i], m[4 + i], m[8 + i], m[12 + i]], w = row(3), planes = [];
+  for (const i of [0, 1, 2]) for (const s of [1, -1]) {
+    const r = row(i), p = [0, 1, 2, 3].map((k) => w[k] + s * r[k]), n = Math.hypot(p[0], p[1], p[2]) || 1;
+    planes.push(p.map((v) => v / n));
+  }
+  return planes;
+}
+
+// The rows of ``rows`` (``stride`` floats: end a, end b, radius first) whose bounding sphere meets the
+// frustum: the software rasteriser shades every vertex of every instance, on screen or not, and a phone
+// looks at a few of the field's trees and puppets at a time. ``grow`` widens a row's radius (a cone's skirt).
+function cull(rows, stride, planes, grow = 1) {
+  const n = rows.length / stride, keep = [];
+  for (let i = 0; i < n; i++) {
+    const o = i * stride, cx = (rows[o] + rows[o + 3]) / 2, cy = (rows[o + 1] + rows[o + 4]) / 2, cz = (rows[o + 2] + rows[o + 5]) / 2;
+    const rad = Math.hypot(rows[o + 3] - rows[o], rows[o + 4] - rows[o + 1], rows[o + 5] - rows[o + 2]) / 2 + grow * rows[o + 6];
+    if (planes.every((p) => p[0] * cx + p[1] * cy + p[2] * cz + p[3] >= -rad)) keep.push(i);
+  }
+  if (keep.length === n) return rows;
+  const out = new Float32Array(keep.length * stride);
+  keep.forEach((i, k) => out.set(rows.subarray(i * stride, (i + 1) * stride), k * stride));
+  return out;
+}
+
 // What a full shadow leaves of the snow's colour, per channel: the sun's share of its light goes, the blue
 // sky's stays (as the desktop's ground shadow; colours squared and rooted for gamma 2).
 function shadowTint(look) {
@@ -282,10 +395,10 @@ class PageRenderer {
     const gl = canvas.getContext("webgl2", { antialias: false, alpha: false, desynchronized: true, xrCompatible: !!options.xrCompatible });
     if (!gl) throw new Error("WebGL2 is not available");
     this.gl = gl; this.canvas = canvas;
-    this.capsule = compile(gl, CAPSULE_VS, LIT_FS);
-    this.box = compile(gl, BOX_VS, LIT_FS);
+    this.capsule = compile(gl, CAPSULE_VS, FLAT_FS);
+    this.box = compile(gl, BOX_VS, FLAT_FS);
     this.ground = compile(gl, GROUND_VS, GROUND_FS);
-    this.sky = compile(gl, SKY_VS, SKY_FS);
+    this.sky = compile(gl, SKY_VS, FLAT_FS);
     const mesh = capsuleMesh();
     this.capVao = gl.createVertexArray(); gl.bindVertexArray(this.capVao);
     this.buffer(mesh.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 16, 0);
@@ -298,9 +411,15 @@ class PageRenderer {
     gl.enableVertexAttribArray(6); gl.vertexAttribPointer(6, 3, gl.FLOAT, false, 24, 12);
     this.boxInst = this.instances([3, 3, 4, 3, 1]);
     this.groundVao = gl.createVertexArray(); gl.bindVertexArray(this.groundVao);
-    this.groundBuf = this.buffer(new Float32Array(8));
-    gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
-    this.skyVao = gl.createVertexArray();
+    const ground = gridMesh(40, -40, 40, -40, 40);
+    this.buffer(ground.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    const gb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, ground.indices, gl.STATIC_DRAW);
+    this.groundCount = ground.indices.length;
+    this.skyVao = gl.createVertexArray(); gl.bindVertexArray(this.skyVao);
+    const sky = gridMesh(24, -1, 1, -1, 1);
+    this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    const sb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, sb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sky.indices, gl.STATIC_DRAW);
+    this.skyCount = sky.indices.length;
     this.blob = compile(gl, BLOB_VS, BLOB_FS);
     this.marksProg = compile(gl, DECAL_VS, MARKS_FS);
     this.printProg = compile(gl, PRINT_VS, PRINT_FS);
@@ -319,8 +438,37 @@ class PageRenderer {
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.shadowTex, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    this.shadowRect = null;
-    this.marksTex = null; this.marksVersion = -1; this.marksRect = null;
+    this.cone = compile(gl, CONE_VS, FLAT_FS);
+    const cone = coneMesh();
+    this.coneVao = gl.createVertexArray(); gl.bindVertexArray(this.coneVao);
+    this.buffer(cone.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 16, 0);
+    const cb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, cb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, cone.indices, gl.STATIC_DRAW);
+    this.coneCount = cone.indices.length;
+    this.coneInst = this.instances([3, 3, 1, 3, 1]);
+    this.flake = compile(gl, FLAKE_VS, FLAKE_FS);
+    this.flakeVao = gl.createVertexArray(); gl.bindVertexArray(this.flakeVao);
+    this.flakeBuf = this.buffer(new Float32Array(4)); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 16, 0);
+    this.flakes = null;
+    gl.bindVertexArray(null);
+    this.shadowRect = null; this.shadowCasters = null;
+    this.marksTex = null; this.marksSrc = null; this.marksSoft = null; this.marksRect = null;
+    this.uploaded = new Map(); this.round = { key: [], rows: new Float32Array(0) };
+  }
+
+  // ``data`` into the array buffer ``buf``, unless it is the very array uploaded there last (unchanged rows).
+  upload(buf, data) {
+    const gl = this.gl;
+    gl.bindBuffer(gl.ARRAY_BUFFER, buf);
+    if (this.uploaded.get(buf) === data) return;
+    this.uploaded.set(buf, data);
+    gl.bufferData(gl.ARRAY_BUFFER, data, gl.DYNAMIC_DRAW);
+  }
+
+  // The round rows of ``rows`` (roundRows), rebuilt only when one of the kinds they come from changed.
+  roundOf(rows) {
+    const key = [rows.capsules, rows.spheres, rows.lines, rows.points], c = this.round;
+    if (!key.every((a, i) => a === c.key[i])) { c.key = key; c.rows = roundRows(rows); }
+    return c.rows;
   }
 
   // A one-channel texture, linearly filtered, clamped at its edges.
@@ -351,7 +499,7 @@ class PageRenderer {
     const size = Math.min(Math.max(x1 - x0, z1 - z0), 48), cx = Math.min(Math.max((x0 + x1) / 2, -60), 60), cz = Math.min(Math.max((z0 + z1) / 2, -60), 60);
     const rect = [cx - size / 2, cz - size / 2, size, size];
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
-    gl.viewport(0, 0, SHADOW_SIZE, SHADOW_SIZE);
+    gl.viewport(1, 1, SHADOW_SIZE - 2, SHADOW_SIZE - 2);  // a clear border: the ground reads it outside the rect
     gl.disable(gl.DEPTH_TEST);
     gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT);
     gl.enable(gl.BLEND); gl.blendEquation(gl.MAX);
@@ -359,28 +507,43 @@ class PageRenderer {
     const u = this.blob.u;
     gl.uniform3f(u.sunDir, sx, sy, sz); gl.uniform1f(u.height, g); gl.uniform4fv(u.rect, rect);
     gl.bindVertexArray(this.blobVao);
-    gl.bindBuffer(gl.ARRAY_BUFFER, this.blobInst); gl.bufferData(gl.ARRAY_BUFFER, round, gl.DYNAMIC_DRAW);
+    this.upload(this.blobInst, round);
     gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, n);
     gl.blendEquation(gl.FUNC_ADD); gl.disable(gl.BLEND);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    return rect;
+    const grow = 1 / (SHADOW_SIZE - 2);  // the whole mask, border included, as the ground reads it
+    return [rect[0] - rect[2] * grow, rect[1] - rect[3] * grow, rect[2] * (1 + 2 * grow), rect[3] * (1 + 2 * grow)];
   }
 
-  // The tracks' texture, uploaded when the stream brought a new grid, and the rectangle of marked cells.
-  updateMarks(marks, version) {
-    if (version === this.marksVersion) return;
-    this.marksVersion = version;
+  // The tracks' texture and the rectangle of marked cells. A new grid is softened and uploaded whole; the
+  // same grid with ``dirty`` cells ([row0, col0, row1, col1)) has only those and their neighbours softened
+  // again and re-uploaded (a ball rolling changes a few cells a step, not the 240 × 240 grid).
+  updateMarks(marks, dirty) {
     const gl = this.gl;
-    if (this.marksTex) gl.deleteTexture(this.marksTex);
-    this.marksTex = null; this.marksRect = null;
-    if (!marks) return;
-    let r0 = marks.nz, r1 = -1, c0 = marks.nx, c1 = -1;
-    for (let r = 0; r < marks.nz; r++) {
-      const row = marks.cells.subarray(r * marks.nx, (r + 1) * marks.nx);
-      for (let c = 0; c < marks.nx; c++) if (row[c] > 5) { if (r < r0) r0 = r; if (r > r1) r1 = r; if (c < c0) c0 = c; if (c > c1) c1 = c; }
+    if (marks !== this.marksSrc) {
+      if (this.marksTex) gl.deleteTexture(this.marksTex);
+      this.marksTex = null; this.marksRect = null; this.marksSrc = marks; this.marksSoft = null; this.marksBox = null;
+      if (!marks) return;
+      this.marksSoft = new Uint8Array(marks.nx * marks.nz);
+      dirty = softenInto(marks.cells, this.marksSoft, marks.nx, marks.nz, [0, 0, marks.nz, marks.nx]);
+      this.marksTex = this.texture(marks.nx, marks.nz, this.marksSoft);
+    } else if (marks && dirty) {
+      dirty = softenInto(marks.cells, this.marksSoft, marks.nx, marks.nz, dirty);
+      const [r0, c0, r1, c1] = dirty;
+      gl.bindTexture(gl.TEXTURE_2D, this.marksTex);
+      gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1); gl.pixelStorei(gl.UNPACK_ROW_LENGTH, marks.nx);
+      gl.pixelStorei(gl.UNPACK_SKIP_ROWS, r0); gl.pixelStorei(gl.UNPACK_SKIP_PIXELS, c0);
+      gl.texSubImage2D(gl.TEXTURE_2D, 0, c0, r0, c1 - c0, r1 - r0, gl.RED, gl.UNSIGNED_BYTE, this.marksSoft);
+      gl.pixelStorei(gl.UNPACK_ROW_LENGTH, 0); gl.pixelStorei(gl.UNPACK_SKIP_ROWS, 0); gl.pixelStorei(gl.UNPACK_SKIP_PIXELS, 0);
+    } else return;
+    // The marked cells' bounds grow by what the changed cells hold (a filled cell keeps them: drawn, discarded).
+    let [r0, c0, r1, c1] = this.marksBox || [marks.nz, marks.nx, -1, -1];
+    const cells = marks.cells;
+    for (let r = dirty[0]; r < dirty[2]; r++) for (let c = dirty[1]; c < dirty[3]; c++) {
+      if (cells[r * marks.nx + c] > 5) { if (r < r0) r0 = r; if (r > r1) r1 = r; if (c < c0) c0 = c; if (c > c1) c1 = c; }
     }
     if (r1 < 0) return;
-    this.marksTex = this.texture(marks.nx, marks.nz, marks.cells);
+    this.marksBox = [r0, c0, r1, c1];
     const cell = marks.cell;
     this.marksRect = { marks, rect: [marks.x0 + (c0 - 1) * cell, marks.z0 + (r0 - 1) * cell, (c1 - c0 + 3) * cell, (r1 - r0 + 3) * cell] };
   }
@@ -410,7 +573,7 @@ class PageRenderer {
       gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g);
       gl.uniform3f(u.sunDir, d[0] / len, d[1] / len, d[2] / len); gl.uniform3fv(u.eye, eye);
       gl.bindVertexArray(this.printVao);
-      gl.bindBuffer(gl.ARRAY_BUFFER, this.printInst); gl.bufferData(gl.ARRAY_BUFFER, prints, gl.DYNAMIC_DRAW);
+      this.upload(this.printInst, prints);
       gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, prints.length / 7);
     }
     gl.disable(gl.POLYGON_OFFSET_FILL); gl.disable(gl.BLEND);
@@ -450,19 +613,24 @@ class PageRenderer {
   draw(frame, look, xr = null) {
     const gl = this.gl;
     let proj, view, eye, basis;
-    const round = roundRows(frame.rows);
+    const round = this.roundOf(frame.rows);
     if (!xr) {
-      // Boxes cast as the circle round their footprint.
-      const boxes = frame.rows.boxes, nb = boxes.length / 14, casters = new Float32Array(round.length + 11 * nb);
-      casters.set(round);
-      for (let i = 0, at = round.length; i < nb; i++, at += 11) {
-        const o = i * 14;
-        casters.set(boxes.subarray(o, o + 3), at); casters.set(boxes.subarray(o, o + 3), at + 3);
-        casters[at + 1] = casters[at + 4] = boxes[o + 1] - boxes[o + 4] + Math.hypot(boxes[o + 3], boxes[o + 5]);
-        casters[at + 6] = Math.hypot(boxes[o + 3], boxes[o + 5]);
+      // The blob shadows again only when something round or a box moved. Boxes cast as the circle round
+      // their footprint.
+      const boxes = frame.rows.boxes;
+      if (this.shadowCasters === null || this.shadowCasters[0] !== round || this.shadowCasters[1] !== boxes) {
+        const nb = boxes.length / 14, casters = new Float32Array(round.length + 11 * nb);
+        casters.set(round);
+        for (let i = 0, at = round.length; i < nb; i++, at += 11) {
+          const o = i * 14;
+          casters.set(boxes.subarray(o, o + 3), at); casters.set(boxes.subarray(o, o + 3), at + 3);
+          casters[at + 1] = casters[at + 4] = boxes[o + 1] - boxes[o + 4] + Math.hypot(boxes[o + 3], boxes[o + 5]);
+          casters[at + 6] = Math.hypot(boxes[o + 3], boxes[o + 5]);
+        }
+        this.shadowCasters = [round, boxes];
+        this.shadowRect = this.drawShadows(casters, look);
       }
-      this.shadowRect = this.drawShadows(casters, look);
-      this.updateMarks(frame.marks, frame.marksVersion);
+      this.updateMarks(frame.marks, frame.marksDirty);
     }
     if (xr) {
       ({ proj, view, eye } = xr);
@@ -474,16 +642,17 @@ class PageRenderer {
       proj = perspective(cam.fov, w / h, 0.05, 200); view = viewMatrix(cam.p, cam.q); eye = cam.p;
       basis = quatToMat3(cam.q);
     }
-    const viewProj = mul4(proj, view);
+    const viewProj = mul4(proj, view), planes = frustumPlanes(viewProj);
     gl.enable(gl.DEPTH_TEST); gl.disable(gl.CULL_FACE);
     if (!xr || xr.first) { gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT); }
-    if (round.length) {
+    const shown = cull(round, 11, planes);
+    if (shown.length) {
       gl.useProgram(this.capsule.prog);
       gl.uniformMatrix4fv(this.capsule.u.viewProj, false, viewProj);
       this.lighting(this.capsule, look, eye);
       gl.bindVertexArray(this.capVao);
-      gl.bindBuffer(gl.ARRAY_BUFFER, this.capInst); gl.bufferData(gl.ARRAY_BUFFER, round, gl.DYNAMIC_DRAW);
-      gl.drawElementsInstanced(gl.TRIANGLES, this.capCount, gl.UNSIGNED_SHORT, 0, round.length / 11);
+      this.upload(this.capInst, shown);
+      gl.drawElementsInstanced(gl.TRIANGLES, this.capCount, gl.UNSIGNED_SHORT, 0, shown.length / 11);
     }
     const boxes = frame.rows.boxes;
     if (boxes.length) {
@@ -491,8 +660,17 @@ class PageRenderer {
       gl.uniformMatrix4fv(this.box.u.viewProj, false, viewProj);
       this.lighting(this.box, look, eye);
       gl.bindVertexArray(this.boxVao);
-      gl.bindBuffer(gl.ARRAY_BUFFER, this.boxInst); gl.bufferData(gl.ARRAY_BUFFER, boxes, gl.DYNAMIC_DRAW);
+      this.upload(this.boxInst, boxes);
       gl.drawArraysInstanced(gl.TRIANGLES, 0, 36, boxes.length / 14);
+    }
+    const cones = cull(frame.rows.cones || new Float32Array(0), 11, planes, 1.3);
+    if (cones.length) {
+      gl.useProgram(this.cone.prog);
+      gl.uniformMatrix4fv(this.cone.u.viewProj, false, viewProj);
+      this.lighting(this.cone, look, eye);
+      gl.bindVertexArray(this.coneVao);
+      this.upload(this.coneInst, cones);
+      gl.drawElementsInstanced(gl.TRIANGLES, this.coneCount, gl.UNSIGNED_SHORT, 0, cones.length / 11);
     }
     if (!xr) this.backdrop(frame, look, viewProj, eye, basis);
     gl.bindVertexArray(null);
@@ -502,20 +680,18 @@ class PageRenderer {
   backdrop(frame, look, viewProj, eye, basis) {
     const gl = this.gl;
     {
-      const g = look.ground, half = 40;
+      const g = look.ground;
       gl.useProgram(this.ground.prog);
       gl.bindVertexArray(this.groundVao);
-      gl.bindBuffer(gl.ARRAY_BUFFER, this.groundBuf);
-      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-half, -half, half, -half, -half, half, half, half]), gl.DYNAMIC_DRAW);
       const u = this.ground.u;
       gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g.height);
       gl.uniform3fv(u.color, g.color); gl.uniform3fv(u.gridColor, g.grid_color);
       gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0); gl.uniform1f(u.spacing, g.grid_spacing);
       gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform1f(u.alpha, 1);
       gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, this.shadowTex); gl.uniform1i(u.shadowMask, 0);
-      gl.uniform4fv(u.shadowRect, this.shadowRect || [0, 0, 0, 0]);
+      gl.uniform4fv(u.shadowRect, this.shadowRect || [1e6, 1e6, 1, 1]);  // none: the mask's clear border
       gl.uniform3fv(u.shadowTint, shadowTint(look));
-      gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
+      gl.drawElements(gl.TRIANGLES, this.groundCount, gl.UNSIGNED_SHORT, 0);
     }
     this.drawDecals(frame, look, viewProj, eye);
     const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
@@ -524,17 +700,38 @@ class PageRenderer {
     gl.uniform2f(this.sky.u.tanHalf, t * aspect, t);
     gl.uniform3fv(this.sky.u.sky, look.sky); gl.uniform3fv(this.sky.u.horizon, look.horizon);
     gl.depthFunc(gl.LEQUAL); gl.depthMask(false);
-    gl.bindVertexArray(this.skyVao); gl.drawArrays(gl.TRIANGLES, 0, 3);
-    gl.depthMask(true); gl.depthFunc(gl.LESS);
+    gl.bindVertexArray(this.skyVao); gl.drawElements(gl.TRIANGLES, this.skyCount, gl.UNSIGNED_SHORT, 0);
+    gl.depthFunc(gl.LESS);
+    if (look.snowfall) this.drawSnowfall(frame, look, viewProj, eye);
+    gl.depthMask(true);
+  }
+
+  // The falling snow over everything drawn (hidden by what is in front: depth test, no depth writes), at the
+  // time of the step shown; the flakes go to the GPU once per scene.
+  drawSnowfall(frame, look, viewProj, eye) {
+    const gl = this.gl, f = look.snowfall, u = this.flake.u;
+    if (this.flakes !== f.flakes) { this.flakes = f.flakes; this.upload(this.flakeBuf, f.flakes); }
+    const time = frame.time * f.step_seconds, turn = 2 * Math.PI;
+    gl.useProgram(this.flake.prog);
+    gl.uniformMatrix4fv(u.viewProj, false, viewProj);
+    gl.uniform1f(u.fall, (f.speed * time) % f.height); gl.uniform1f(u.height, f.height); gl.uniform1f(u.sway, f.sway);
+    gl.uniform2f(u.phase, (f.sway_rates[0] * time) % turn, (f.sway_rates[1] * time) % turn);
+    gl.uniform1f(u.size, f.size); gl.uniform1f(u.focal, this.canvas.height / 2 / Math.tan((frame.camera.fov * Math.PI) / 360));
+    gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.color, f.color); gl.uniform3fv(u.horizon, look.horizon);
+    gl.bindVertexArray(this.flakeVao);
+    gl.drawArrays(gl.POINTS, 0, f.count);
   }
 }
 
 // Frames drawn, the step on screen and when each step was first drawn, frames per second, and the
 // resolution scale: a phone (or a software renderer) that cannot keep 40 fps draws fewer pixels,
-// stretched, rather than fewer frames. Used by whichever thread draws (the stream worker, or the main
+// stretched, rather than fewer frames. Used by whichever thread draws (the view worker, or the main
 // thread in AR and where a worker cannot draw).
 class FrameCounter {
-  constructor() { this.drawn = 0; this.step = -1; this.fps = 0; this.resolution = 1; this.drawLog = []; this.ticks = 0; this.since = null; }
+  constructor() { this.drawn = 0; this.step = -1; this.fps = 0; this.resolution = 1; this.held = null; this.drawLog = []; this.ticks = 0; this.since = null; }
+
+  // Keep the resolution at ``r`` (the bench measures the full resolution's frame rate); null: adapt again.
+  hold(r) { this.held = r; if (r !== null) this.resolution = r; this.ticks = 0; this.since = null; }
 
   // One frame drawn at ``now`` (ms, performance.now()) showing ``step``; true when ``fps`` was renewed.
   count(step, now) {
@@ -543,6 +740,7 @@ class FrameCounter {
     if (this.since === null) this.since = now;
     if (now - this.since < 1000) return false;
     this.fps = (1000 * this.ticks) / (now - this.since); this.ticks = 0; this.since = now;
+    if (this.held !== null) return true;
     if (this.fps < 40 && this.resolution > MIN_RESOLUTION) this.resolution = Math.max(MIN_RESOLUTION, this.resolution * 0.85);
     else if (this.fps > 55 && this.resolution < 1) this.resolution = Math.min(1, this.resolution / 0.85);
     return true;
@@ -550,4 +748,4 @@ class FrameCounter {
 }
 const MIN_RESOLUTION = 0.5;
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows };
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };

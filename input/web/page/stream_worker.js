@@ -1,12 +1,14 @@
 // PuppetPhone stream worker: the page's WebSocket, on a thread that does nothing else.
 //
-// Why: on the main thread a scene frame waited behind everything else there (software WebGL, layout,
-// sensor events) before it was even read: 68-76 ms from the engine's step to the page at p99. Here a
-// frame is stamped the moment it arrives, decoded, acknowledged to the engine at once (the engine's
-// back-pressure sees the network and this thread), and passed on as float rows in transferred buffers
-// to whoever draws: the render worker (render_worker.js, through a MessagePort) or, in AR and where
-// a worker cannot draw, the main thread. At most IN_FLIGHT frames wait there for the drawer; a newer
-// one replaces the one held back, so a busy drawer gets the newest frame, never a growing queue.
+// Why its own thread: a frame is stamped the moment it arrives, decoded, acknowledged to the engine at once
+// (the engine's back-pressure sees the network and this thread, not the drawing), and the phone's readings
+// go out at once. Tried: one worker that also drew (no hand-off). Under load its socket waited for each
+// drawing: the acknowledgements came late, so the engine sent a frame every third or fourth step instead of
+// every step, and the readings that turn the view waited behind the drawing too (bench phone-view and the
+// page-view test, reported with issue 33). So frames go on, as messages that carry only what changed
+// (stream.js Forwarder), to whoever draws: the render worker (render_worker.js, through a MessagePort) or,
+// in AR and where a worker cannot draw, the main thread. At most IN_FLIGHT frames wait there for the
+// drawer; a newer one replaces the one held back, so a busy drawer gets the newest frame, never a queue.
 //
 // From the main thread: {connect: url}, {send: text} (a reading, a ping), {drawer: port | null} (where
 // frames go; null: the main thread), {got: step} (the main thread took a frame). To it: {open}, {close},
@@ -15,25 +17,23 @@
 importScripts("stream.js");
 
 const IN_FLIGHT = 2;
-const NOT_SENT = {};
-let ws = null, decoder = null, inFlight = 0, held = null, drawer = null, resend = false, sentMarks = NOT_SENT;
+let ws = null, decoder = null, inFlight = 0, held = null, drawer = null;
+const forward = new Forwarder();
 const clock = () => performance.timeOrigin + performance.now();
 
 function took() { inFlight = Math.max(0, inFlight - 1); flush(); }
 
 function flush() {
   if (!held || inFlight >= IN_FLIGHT) return;
-  const frame = held;
+  const frame = forward.message(held, decoder.extras);
   held = null;
   inFlight += 1;
-  // The tracks' grid goes only when it changed since the last frame the drawer got, softened (a copy).
-  if (frame.marks === sentMarks) frame.marks = undefined; else { sentMarks = frame.marks; frame.marks = softenMarks(frame.marks); }
-  const buffers = Object.values(frame.rows).map((a) => a.buffer);
-  if (drawer) drawer.postMessage({ frame }, buffers); else postMessage({ frame }, buffers);
+  // Copied, not transferred: the decoder keeps the arrays of the kinds that do not change.
+  if (drawer) drawer.postMessage({ frame }); else postMessage({ frame });
 }
 
 function open(url) {
-  decoder = new StreamDecoder(); inFlight = 0; held = null; sentMarks = NOT_SENT;
+  decoder = new StreamDecoder(); inFlight = 0; held = null; forward.reset();
   const sock = new WebSocket(url);
   sock.binaryType = "arraybuffer";
   ws = sock;
@@ -46,9 +46,7 @@ function open(url) {
     try { frame = decoder.receive(ev.data); } catch (err) { postMessage({ error: err.message }); return; }
     sock.send(JSON.stringify({ ack: frame.step }));
     frame.arrived = arrived; frame.decoded = clock();
-    // A frame held back is replaced: keep the scene it carried, and give a new drawer the scene.
-    if ((held && held.extras) || resend) frame.extras = frame.extras || decoder.extras;
-    resend = false;
+    forward.note(frame);
     held = frame;
     flush();
   };
@@ -62,6 +60,6 @@ onmessage = (e) => {
   else if (m.drawer !== undefined) {
     drawer = m.drawer;
     if (drawer) drawer.onmessage = (ev) => { if (ev.data.got !== undefined) took(); };
-    inFlight = 0; held = null; resend = true; sentMarks = NOT_SENT;
+    inFlight = 0; held = null; forward.reset();  // a new drawer holds nothing: the next frame carries all
   }
 };

@@ -4,7 +4,8 @@
 desktop renders the phone's view too, at the phone's size); Chromium (software WebGL2)
 opens the link with its token, asks for AR and is refused (the page says it falls back
 to the magic window), calibrates, and draws the stream. Pixel statistics of the page's
-canvas (the controls hidden) show the puppet standing on snow under a sky; turning the
+canvas (the controls hidden) show the puppet standing on snow under a sky with snow
+falling, and a conifer once the phone turns to it; turning the
 emulated phone turns the view; and the page's last frame agrees with the desktop's
 screenshot of the same step from the same pose.
 """
@@ -45,6 +46,16 @@ def snow(img: np.ndarray) -> np.ndarray:
 
 def sky(img: np.ndarray) -> np.ndarray:
     return (img[..., 2] > img[..., 0] + 25) & (img[..., 2] > 150)
+
+
+def conifer(img: np.ndarray) -> np.ndarray:
+    """The trees' dark green tiers (streamed as cones): green above red, darker than snow and sky."""
+    return (img[..., 1] > img[..., 0] + 15) & (img.max(axis=2) < 140)
+
+
+def flakes(img: np.ndarray) -> np.ndarray:
+    """Falling snow against the blue sky: pixels near white in all three channels."""
+    return img.min(axis=2) > 235
 
 
 def bare_shot(browser: Chromium, path: Path) -> np.ndarray:
@@ -103,6 +114,10 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
     assert seen.sum() > 3000, f"{seen.sum()} puppet pixels on the page"
     assert snow(ahead[H * 3 // 4 :]).mean() > 0.6, "the lower quarter of the page is not snowy ground"
     assert sky(ahead[: H // 5]).mean() > 0.5, "the top of the page is not sky"
+    # It snows (flakes in the sky above the puppet), and the turned view looks at a conifer's snowy tiers:
+    # without the snowfall in the scene GLB the sky is all blue; without the cones only a trunk stands there.
+    assert flakes(ahead[: H // 5]).sum() > 30, f"{flakes(ahead[: H // 5]).sum()} flake pixels in the sky"
+    assert conifer(turned).sum() > 5000, f"{conifer(turned).sum()} tree pixels after turning to the tree"
     # Turning the phone turned the view: the puppet left the middle of the picture.
     ys, xs = np.nonzero(seen)
     moved = puppet_mask(turned)

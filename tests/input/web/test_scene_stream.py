@@ -48,6 +48,7 @@ def scene_with(n_capsules: int, shift: float = 0.0, moved: int | None = None) ->
     s.add_box([2.0, 0.5, 0.0], [0.2, 0.5, 0.3], rotation=(0.92388, 0.0, 0.38268, 0.0))
     s.add_line([0.0, 1.0, 0.0], [0.5, 0.2, 0.0], color=(1.0, 0.55, 0.15))
     s.add_points(np.array([[0.5, 0.2, 0.0]]), size=0.05)
+    s.add_cones(np.array([[-5.0, 0.9, -4.5], [-5.0, 1.8, -4.5]]), np.array([[-5.0, 2.6, -4.5], [-5.0, 3.3, -4.5]]), 0.9)
     return s
 
 
@@ -111,6 +112,76 @@ def test_quantisation_keeps_millimetres_and_clamps_what_is_far_away():
     rows = quantise(s, 0, 0.0, CAM).rows["capsules"][0]
     assert rows[:3].tolist() == [0, 1234, -7000]
     assert rows[4] == 32767  # 40 m is past the int16 range of millimetres: clamped, never wrapped
+
+
+def test_the_trees_go_once_and_then_cost_three_bytes_a_frame():
+    """Conifer tiers are rows of their own kind: in the GLB, then unchanged (a row count and a mode byte).
+    (A codec that left the cones out fails ``same``; one that resent them fails the size.)"""
+    base = quantise(scene_with(3), 1, 0.0, CAM)
+    assert base.rows["cones"].shape == (2, 11) and base.rows["cones"][1, 4] == 3300
+    glb_state = read_scene_glb(scene_glb(base, scene_with(3)))[1]
+    assert same(glb_state, base)
+    moved = quantise(scene_with(3, 0.02, 3), 2, 0.0, CAM)
+    frame = encode_frame(base, moved)
+    assert same(decode_frame(glb_state, frame), moved)
+
+    def treeless(st: SceneState) -> SceneState:
+        return SceneState(st.step, 0.0, CAM, {**st.rows, "cones": st.rows["cones"][:0]})
+
+    assert len(frame) == len(encode_frame(treeless(base), treeless(moved))), "unchanged cones cost more than 3 bytes"
+
+
+def test_the_falling_snow_goes_once_in_the_glb_as_the_flakes_and_the_rule_that_moves_them():
+    """The snowman's snowfall rides in the GLB (a VEC4 accessor of start and phase per flake, and the
+    rule's constants), and the page's rule (render.js FLAKE_VS) applied to what the GLB carries puts each
+    flake where the desktop draws it at that step. (A GLB without the flakes, or with the wrong speed or
+    sway, fails.)"""
+    from games.snowman.scenery import SNOWFALL
+
+    state = quantise(scene_with(3), 600, 0.0, CAM)
+    glb = scene_glb(state, scene_with(3), SNOWFALL, 1 / 60)
+    extras, _ = read_scene_glb(glb)
+    f = extras["snowfall"]
+    doc = json.loads(glb[20 : 20 + int.from_bytes(glb[12:16], "little")])
+    view = doc["bufferViews"][doc["accessors"][f["accessor"]]["bufferView"]]
+    blob = glb[20 + int.from_bytes(glb[12:16], "little") + 8 :]
+    flakes = np.frombuffer(blob, "<f4", 4 * f["count"], view["byteOffset"]).reshape(-1, 4).astype(np.float64)
+    assert f["count"] == 900 and f["step_seconds"] == pytest.approx(1 / 60)
+    time = 600 * f["step_seconds"]
+    # The page's rule, with the clock's terms reduced as render.js does (fall mod height, phases mod 2π).
+    fall, turn = (f["speed"] * time) % f["height"], 2 * np.pi
+    a, b = (f["sway_rates"][0] * time) % turn, (f["sway_rates"][1] * time) % turn
+    page = np.column_stack(
+        [
+            flakes[:, 0] + f["sway"] * np.sin(a + flakes[:, 3]),
+            (flakes[:, 1] - fall) % f["height"],
+            flakes[:, 2] + f["sway"] * np.cos(b + flakes[:, 3]),
+        ]
+    )
+    desktop = RenderScene()
+    SNOWFALL.draw(desktop, time)
+    assert np.abs(page - desktop.points.data[:, :3]).max() < 1e-3
+    assert read_scene_glb(scene_glb(state, scene_with(3)))[0]["snowfall"] is None
+
+
+@pytest.mark.fuzz
+def test_fuzz_byte_mutations_of_a_scene_frame(campaign, mutations, fuzz_budget):
+    """Mutated frames (all kinds, cones and tracks included) decode to rows of the right shape or raise one
+    FrameError; nothing else escapes the boundary. (A reader that reshapes a frame of changed rows with no
+    changed column raised numpy's ValueError here.)"""
+    from input.web.scene_stream import SCALES
+
+    cases, seed = fuzz_budget(2000)
+    c = campaign(FrameError)
+    base = quantise(tracked(scene_with(6), [(100, 100, 4, 6)]), 1, 0.0, CAM)
+    moved = quantise(tracked(scene_with(6, 0.05, 4), [(100, 100, 4, 6), (5, 5, 2, 2), (230, 230, 2, 2)]), 2, 0.0, CAM)
+    for good in (encode_frame(base, moved), encode_frame(SceneState.empty(), base)):
+        for data in mutations(good, cases // 2, seed):
+            state = c.run(decode_frame, base, data)
+            if state is not None:
+                for kind, scales in SCALES.items():
+                    assert state.rows[kind].ndim == 2 and state.rows[kind].shape[1] == len(scales)
+    c.check("scene frames")
 
 
 @pytest.mark.parametrize("cut", ["short", "magic", "trailing"])
@@ -221,23 +292,26 @@ console.log(JSON.stringify(Array.from(m.cells)));
     assert np.abs(page - desktop).max() <= 1
 
 
-@needs_node
-def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
-    """``stream_worker.js`` under node with a fake WebSocket and drawer port: every frame is acknowledged to the
-    engine as soon as it is decoded; the drawer gets at most two frames it has not taken, then, once it
-    takes one, the newest frame (not the next in a queue), and the tracks only when they changed.
-    (A worker that posts every frame fails the count; one that keeps a queue fails the newest step.)"""
+def worker_frames(tmp_path: Path) -> tuple[RenderScene, list[bytes]]:
+    """A GLB and six frames of a scene whose tracks change at steps 6 and 7, written to ``tmp_path/<i>.bin``."""
     scene = tracked(scene_with(4), [(10, 10, 3, 3)])
     states = [quantise(scene, 1, 0.0, CAM)]
     for i in range(2, 8):
-        strips = [(10, 10, 3, 3)] + ([(50, 50, 2, 2)] if i >= 6 else [])
+        strips = [(10, 10, 3, 3)] + ([(50, 50, 2, 2)] if i >= 6 else []) + ([(60, 70, 1, 4)] if i >= 7 else [])
         states.append(quantise(tracked(scene_with(4, 0.01 * i, 2), strips), i, 0.0, CAM))
     blobs = [scene_glb(states[0], scene)] + [encode_frame(a, b) for a, b in zip(states, states[1:], strict=False)]
     for i, blob in enumerate(blobs):
         (tmp_path / f"{i}.bin").write_bytes(blob)
+    return scene, blobs
+
+
+def run_worker(tmp_path: Path, body: str) -> dict:
+    """``stream_worker.js`` under node with a fake WebSocket and a drawer port that logs what it gets (and
+    feeds it to a SceneStream, as the render worker does); ``body`` prints the JSON returned."""
     script = f"""
 const fs = require("fs"), page = {json.dumps(str(PAGE))};
 globalThis.importScripts = (...names) => {{ for (const n of names) Object.assign(globalThis, require(page + "/" + n)); }};
+globalThis.performance = {{ timeOrigin: 0, now: () => 0 }};
 const toMain = [], sent = [], drawn = [];
 globalThis.postMessage = (m) => toMain.push(m);
 globalThis.onmessage = null;
@@ -245,24 +319,53 @@ class FakeSocket {{ constructor(url) {{ this.url = url; this.readyState = 1; Fak
 FakeSocket.OPEN = 1;
 globalThis.WebSocket = FakeSocket;
 require(page + "/stream_worker.js");
+const {{ SceneStream, StreamDecoder, KINDS }} = require(page + "/stream.js");
+const shown = new SceneStream(), truth = new StreamDecoder();
+const port = {{ postMessage: (m) => {{ const f = m.frame; shown.accept(structuredClone(f), 0);
+  drawn.push({{ step: f.step, extras: !!f.extras, kinds: Object.keys(f.rows), marks: f.marks === undefined ? "same" : f.marks === null ? "none" : f.marks.patch ? "patch" : "grid",
+    rect: f.marks && f.marks.patch ? f.marks.patch.rect : null }}); }} }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const port = {{ postMessage: (m) => drawn.push({{ step: m.frame.step, extras: !!m.frame.extras, marks: m.frame.marks === undefined ? "same" : "grid" }}) }};
+const arrive = (i) => {{ truth.receive(buf(i)); FakeSocket.last.onmessage({{ data: buf(i) }}); }};
 onmessage({{ data: {{ connect: "wss://x/ws" }} }});
 onmessage({{ data: {{ drawer: port }} }});
-for (let i = 0; i < {len(blobs)}; i++) FakeSocket.last.onmessage({{ data: buf(i) }});
+{body}
+"""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    return json.loads(res.stdout)
+
+
+@needs_node
+def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
+    """Every frame is acknowledged to the engine as soon as it is decoded; the drawer gets at most two frames
+    it has not taken, then, once it takes one, the newest frame (not the next in a queue). Each message
+    carries only the kinds that changed since the drawer's last one (the trees once) and, of the tracks, the
+    block of cells changed since (the whole grid first); the drawer's picture is then the decoder's, cell for
+    cell. (A worker that posts every frame fails the count; one that keeps a queue fails the newest step;
+    one that forgets the cells of frames it held back fails the agreement.)"""
+    _, blobs = worker_frames(tmp_path)
+    out = run_worker(
+        tmp_path,
+        f"""
+for (let i = 0; i < {len(blobs)}; i++) arrive(i);
 const before = drawn.length;
 port.onmessage({{ data: {{ got: 1 }} }});
 const after = drawn.length;
 port.onmessage({{ data: {{ got: 2 }} }});
-console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length }}));
-"""
-    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
-    assert res.returncode == 0, res.stderr
-    out = json.loads(res.stdout)
+const rows = KINDS.every((k) => Array.from(shown.cur.rows[k]).join() === Array.from(truth.state.rows[k]).map((v, i) =>
+  v / truth.scales[k][i % truth.scales[k].length]).map((v) => Math.fround(v)).join());
+const cells = Array.from(shown.marks.cells).join() === Array.from(truth.state.marks.cells).join();
+console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length, rows, cells }}));
+""",
+    )
     assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
     assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
     assert out["after"] == 3 and out["end"] == 3
     first, second, newest = out["drawn"]
-    assert first == {"step": 1, "extras": True, "marks": "grid"}
-    assert second == {"step": 2, "extras": False, "marks": "same"}
-    assert newest == {"step": 7, "extras": False, "marks": "grid"}, "after a take: the newest frame, tracks changed"
+    assert first["step"] == 1 and first["extras"] and first["marks"] == "grid" and "cones" in first["kinds"]
+    assert second["step"] == 2 and not second["extras"] and second["marks"] == "same"
+    assert "cones" not in second["kinds"] and "capsules" in second["kinds"], second["kinds"]
+    assert newest["step"] == 7 and newest["marks"] == "patch"
+    # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4); step 6 was held back and replaced by 7.
+    assert newest["rect"] == [50, 50, 61, 74]
+    assert out["rows"] and out["cells"], "the drawer's picture is not the decoder's"
