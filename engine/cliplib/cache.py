@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded, read_npz
 
-__all__ = ["MeasureCache", "cache_root", "code_fingerprint", "default_cache_dir", "read_checked", "write_checked"]
+__all__ = ["FILE_FORMAT", "MeasureCache", "cache_root", "code_fingerprint", "default_cache_dir", "read_checked", "write_checked"]
 
 F = NDArray[np.float64]
 _ENGINE = Path(__file__).resolve().parents[1]
@@ -58,6 +58,8 @@ def default_cache_dir() -> Path:
 
 
 _SHA = "sha256"  # the member of a cache file that holds its checksum
+#: Part of every key: a build that lays files out otherwise never reads (nor fights over) these.
+FILE_FORMAT = "puppetphone-cache/2"
 
 
 def _entry_digest(key: str, arrays: dict[str, NDArray[Any]]) -> bytes:
@@ -114,7 +116,7 @@ class MeasureCache:
 
     def __init__(self, folder: str | Path, key: str) -> None:
         self.folder = Path(folder)
-        self.key = hashlib.sha256((key + code_fingerprint()).encode()).hexdigest()[:32]
+        self.key = hashlib.sha256((FILE_FORMAT + key + code_fingerprint()).encode()).hexdigest()[:32]
         self.hits = 0
         self.misses = 0
 
