@@ -31,7 +31,15 @@ from numpy.typing import NDArray
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded, read_npz
 
-__all__ = ["FILE_FORMAT", "MeasureCache", "cache_root", "code_fingerprint", "default_cache_dir", "read_checked", "write_checked"]
+__all__ = [
+    "FILE_FORMAT",
+    "MeasureCache",
+    "cache_root",
+    "code_fingerprint",
+    "default_cache_dir",
+    "read_checked",
+    "write_checked",
+]
 
 F = NDArray[np.float64]
 _ENGINE = Path(__file__).resolve().parents[1]

@@ -156,9 +156,7 @@ def decode(arrays: Mapping[str, NDArray[Any]]) -> dict[str, Clip]:
     return out
 
 
-def cached_clips(
-    build: Callable[[], Mapping[str, Clip]], folder: Path | None = None
-) -> tuple[dict[str, Clip], bool]:
+def cached_clips(build: Callable[[], Mapping[str, Clip]], folder: Path | None = None) -> tuple[dict[str, Clip], bool]:
     """The clips ``build`` makes, read from ``folder`` (default :func:`default_folder`) when a start
     built them before; otherwise built and stored. Returns them and whether they came from the cache."""
     path = (folder or default_folder()) / f"{build_key()}.npz"
