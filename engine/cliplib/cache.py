@@ -98,7 +98,8 @@ def write_checked(path: Path, key: str, arrays: dict[str, NDArray[Any]]) -> bool
     if _SHA in arrays:
         raise ValueError(f"{_SHA!r} is the checksum's member; name the array otherwise")
     buf = io.BytesIO()
-    np.savez(buf, **arrays, **{_SHA: np.frombuffer(_entry_digest(key, arrays), dtype=np.uint8)})
+    members: dict[str, Any] = {**arrays, _SHA: np.frombuffer(_entry_digest(key, arrays), dtype=np.uint8)}
+    np.savez(buf, **members)  # (typed Any: numpy's stub reads ** as its keyword options)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(path, buf.getvalue())
