@@ -105,20 +105,19 @@ def resolve_source(source: str, game: str) -> str:
 
 def announce_web(hub: InputHub) -> None:
     """Print a web controller's link, fingerprint and QR code, and publish it for ``devices``."""
-    from input.web.server import WebSource
+    from puppetphone.web_pairing import web_sources
 
-    for source in hub.sources:
-        if isinstance(source, WebSource):
-            import atexit
+    for source in web_sources(hub):
+        import atexit
 
-            from input.pairing import qr_ascii
-            from input.web.pairing import publish, unpublish, web_link
+        from input.pairing import qr_ascii
+        from input.web.pairing import publish, unpublish, web_link
 
-            link = web_link(source)
-            print("\n".join(link.lines()), file=sys.stderr)
-            print(qr_ascii(link.urls[0]), file=sys.stderr)
-            publish(link)
-            atexit.register(unpublish)
+        link = web_link(source)
+        print("\n".join(link.lines()), file=sys.stderr)
+        print(qr_ascii(link.urls[0]), file=sys.stderr)
+        publish(link)
+        atexit.register(unpublish)
 
 
 def run_activity(activity: Session, options: RunOptions) -> tuple[int, RunResult | None]:

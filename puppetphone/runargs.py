@@ -16,7 +16,7 @@ from puppetphone.argtypes import MAX_WINDOW, int_range, output_file, window_size
 if TYPE_CHECKING:  # the engine's modules load numpy and GL: imported when a session starts, not to parse
     from engine.runner import RunOptions
 
-__all__ = ["HUD_DUMP_ENV", "add_run_arguments", "image_path", "quality_name", "run_options", "steps"]
+__all__ = ["HUD_DUMP_ENV", "QUALITY_NAMES", "add_run_arguments", "image_path", "quality_name", "run_options", "steps"]
 
 #: Steps: zero or more.
 steps = int_range(0)
@@ -34,14 +34,18 @@ def image_path(text: str) -> Path:
     return path
 
 
-def quality_name(text: str) -> str:
-    """A ``--quality`` value, refused before the session starts when it is none of the levels."""
-    from engine.render.quality import parse_quality
+#: ``engine.render.quality.QUALITY_NAMES``, spelled here so that parsing (the default ``auto`` too)
+#: does not import the renderer (a second of imports; a test checks the two agree).
+QUALITY_NAMES = ("low", "medium", "high", "auto")
 
-    try:
-        return parse_quality(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+
+def quality_name(text: str) -> str:
+    """A ``--quality`` value, refused before the session starts when it is none of the levels
+    (as :func:`engine.render.quality.parse_quality` does)."""
+    name = text.strip().lower()
+    if name not in QUALITY_NAMES:
+        raise argparse.ArgumentTypeError(f"quality must be one of {', '.join(QUALITY_NAMES)}, not {text!r}")
+    return name
 
 
 def add_run_arguments(parser: argparse.ArgumentParser, *, screenshot_at: bool = False) -> None:

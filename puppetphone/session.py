@@ -175,12 +175,12 @@ def build_activity(
 
 def _stream_to_phones(session: Session, simulation: GameSimulation) -> None:
     """With a web source, every step's scene goes to the connected pages too (output only)."""
-    from input.web.server import WebSource
-    from input.web.viewport import PhoneViewport
+    from puppetphone.web_pairing import web_sources
 
-    for source in session.hub.sources:
-        if isinstance(source, WebSource):
-            draw = simulation.game.draw_state or simulation.game.draw
-            simulation.app.on_step_end.append(
-                PhoneViewport(source, draw, lambda: simulation.orbit, simulation.game.snowfall)
-            )
+    for source in web_sources(session.hub):
+        from input.web.viewport import PhoneViewport
+
+        draw = simulation.game.draw_state or simulation.game.draw
+        simulation.app.on_step_end.append(
+            PhoneViewport(source, draw, lambda: simulation.orbit, simulation.game.snowfall)
+        )

@@ -1,4 +1,4 @@
-"""The lookup table's measurement, cached on disk by the clips' content hash.
+"""Derived data cached on disk by a content hash: the lookup table's measurement, the built-in clips.
 
 Measuring the puppet's table plays 961 blends for a cycle each (about half a second,
 more with long mocap cycles); a set of authored clips is measured once and the result
@@ -10,6 +10,10 @@ since a replay must measure exactly what the recorded session measured. Each fil
 carries the SHA-256 of its key, probes and values; a cache file that is unreadable, does
 not match its probes or its checksum (damaged, or edited by hand) is ignored and
 rewritten (it is a cache: losing it costs half a second, never a wrong answer).
+
+:func:`read_checked` / :func:`write_checked` are that file discipline on their own (a
+SHA-256 over the key and every array, an atomic write, any failure a miss): the built-in
+clips (:mod:`engine.clips.stored`) are kept with them too.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ import io
 import os
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -26,7 +31,15 @@ from engine.arrays import F64 as F
 from engine.atomic import atomic_write_bytes
 from engine.npz_safe import read_bounded, read_npz
 
-__all__ = ["MeasureCache", "default_cache_dir", "code_fingerprint"]
+__all__ = [
+    "FILE_FORMAT",
+    "MeasureCache",
+    "cache_root",
+    "code_fingerprint",
+    "default_cache_dir",
+    "read_checked",
+    "write_checked",
+]
 
 _ENGINE = Path(__file__).resolve().parents[1]
 _MEASURING = (
@@ -40,10 +53,58 @@ _MEASURING = (
 )
 
 
+def cache_root() -> Path:
+    """``$XDG_CACHE_HOME/puppetphone`` (``~/.cache/puppetphone`` when unset or empty)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "puppetphone"
+
+
 def default_cache_dir() -> Path:
     """``$XDG_CACHE_HOME/puppetphone/lookup`` (``~/.cache/puppetphone/lookup`` when unset)."""
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "puppetphone" / "lookup"
+    return cache_root() / "lookup"
+
+
+_SHA = "sha256"  # the member of a cache file that holds its checksum
+#: Part of every key: a build that lays files out otherwise never reads (nor fights over) these.
+FILE_FORMAT = "puppetphone-cache/2"
+
+
+def _entry_digest(key: str, arrays: dict[str, NDArray[Any]]) -> bytes:
+    """A cache file's checksum: its key, then every array's name, dtype, shape and bytes, by name."""
+    h = hashlib.sha256(key.encode())
+    for name in sorted(arrays):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(f"\0{name}\0{a.dtype.str}\0{a.shape}\0".encode() + a.tobytes())
+    return h.digest()
+
+
+def read_checked(path: Path, key: str, limit: int = 64 << 20) -> dict[str, NDArray[Any]] | None:
+    """The arrays :func:`write_checked` stored at ``path`` under ``key``; ``None`` (a miss) when the
+    file is missing, unreadable, larger than ``limit``, damaged, or was written under another key."""
+    try:
+        arrays = read_npz(read_bounded(path, limit))
+    except (OSError, ValueError):  # NpzError is a ValueError
+        return None
+    digest = arrays.pop(_SHA, None)
+    if digest is None or digest.dtype != np.uint8 or digest.tobytes() != _entry_digest(key, arrays):
+        return None
+    return arrays
+
+
+def write_checked(path: Path, key: str, arrays: dict[str, NDArray[Any]]) -> bool:
+    """Store ``arrays`` at ``path`` atomically with their checksum under ``key``; ``False`` when it
+    could not be written (a read-only or full cache folder only costs the next start the rebuild)."""
+    if _SHA in arrays:
+        raise ValueError(f"{_SHA!r} is the checksum's member; name the array otherwise")
+    buf = io.BytesIO()
+    members: dict[str, Any] = {**arrays, _SHA: np.frombuffer(_entry_digest(key, arrays), dtype=np.uint8)}
+    np.savez(buf, **members)  # (typed Any: numpy's stub reads ** as its keyword options)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_bytes(path, buf.getvalue())
+    except OSError:
+        return False
+    return True
 
 
 def code_fingerprint() -> str:
@@ -63,7 +124,7 @@ class MeasureCache:
 
     def __init__(self, folder: str | Path, key: str) -> None:
         self.folder = Path(folder)
-        self.key = hashlib.sha256((key + code_fingerprint()).encode()).hexdigest()[:32]
+        self.key = hashlib.sha256((FILE_FORMAT + key + code_fingerprint()).encode()).hexdigest()[:32]
         self.hits = 0
         self.misses = 0
 
@@ -72,26 +133,15 @@ class MeasureCache:
         return self.folder / f"{self.key}.npz"
 
     def _read(self, probes: F) -> F | None:
-        try:
-            arrays = read_npz(read_bounded(self.path, 64 << 20))
-        except (OSError, ValueError):
+        arrays = read_checked(self.path, self.key)
+        if arrays is None:
             return None
         got, values = arrays.get("probes"), arrays.get("values")
         if got is None or values is None or got.shape != probes.shape or not np.array_equal(got, probes):
             return None
         if values.dtype != np.float64 or values.shape[0] != len(probes) or not np.isfinite(values).all():
             return None
-        digest = arrays.get("sha256")
-        if digest is None or digest.dtype != np.uint8 or digest.tobytes() != self._digest(got, values):
-            return None
         return values
-
-    def _digest(self, probes: F, values: F) -> bytes:
-        """What a file's checksum must be: its key, probes and values, byte for byte."""
-        h = hashlib.sha256(self.key.encode())
-        for a in (probes, values):
-            h.update(str(a.shape).encode() + np.ascontiguousarray(a, dtype=np.float64).tobytes())
-        return h.digest()
 
     def __call__(self, probes: F, measure: Callable[[F], F]) -> F:
         cached = self._read(probes)
@@ -100,16 +150,5 @@ class MeasureCache:
             return cached
         self.misses += 1
         values = np.asarray(measure(probes), dtype=np.float64)
-        buf = io.BytesIO()
-        np.savez(
-            buf,
-            probes=probes,
-            values=values,
-            sha256=np.frombuffer(self._digest(np.asarray(probes, dtype=np.float64), values), dtype=np.uint8),
-        )
-        try:
-            self.folder.mkdir(parents=True, exist_ok=True)
-            atomic_write_bytes(self.path, buf.getvalue())
-        except OSError:
-            pass  # a read-only or full cache folder only costs the next start its half second
+        write_checked(self.path, self.key, {"probes": np.asarray(probes, dtype=np.float64), "values": values})
         return values

@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from PIL import Image
 
 from engine.io.gltf import _MALFORMED, GltfError, _document, _view, accessor
 
@@ -87,6 +86,8 @@ def _texture(
     if "bufferView" not in image:
         return None  # an image beside the file: drawn in its base colour factor instead (said as ignored)
     raw, _ = _view(doc, buffers, image["bufferView"], source)
+    from PIL import Image  # here: a puppet without textures (every start of the built-in one) never loads Pillow
+
     try:
         with Image.open(io.BytesIO(raw)) as img:
             w, h = img.size

@@ -80,11 +80,11 @@ def scenery_objects() -> list[dict[str, Any]]:
 
 def prepare_flow(path: str) -> list[dict[str, Any]] | None:
     """The deformed objects of a flow file for the snowman field (``GameOptionError`` if unusable)."""
+    if not path:
+        return None  # before the imports: the flow tools (and SciPy's optimiser) cost every plain start 0.3 s
     from authoring.flowcurves.storage import FlowFileError, load_flow
     from games.base import GameOptionError
 
-    if not path:
-        return None
     try:
         doc = load_flow(Path(path).expanduser())
     except FlowFileError as exc:

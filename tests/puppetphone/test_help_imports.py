@@ -48,3 +48,8 @@ def test_parse_time_constants_agree_with_their_owners():
 
     assert (factory.DEFAULT_PORT, factory.DEFAULT_WEB_PORT) == (DEFAULT_PORT, DEFAULT_WEB_PORT)
     assert set(UNIT_NAMES) == set(UNITS) and set(UP_AXES) == set(AXES)
+    from engine.render.quality import QUALITY_NAMES, parse_quality
+    from puppetphone import runargs
+
+    assert runargs.QUALITY_NAMES == QUALITY_NAMES
+    assert [runargs.quality_name(t) for t in (" Low", "AUTO")] == [parse_quality(t) for t in (" Low", "AUTO")]
