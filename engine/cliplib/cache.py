@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from engine.arrays import F64 as F
 from engine.atomic import atomic_write_bytes
