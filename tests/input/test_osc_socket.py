@@ -32,6 +32,7 @@ from input.osc import STEP_BUDGET, OscSource
 from input.sample import CONNECT, DISCONNECT, PoseSample
 
 Message = Callable[..., bytes]
+Clients = Callable[[], socket.socket]
 LOOPBACK = "127.0.0.1"
 PHONE = f"osc:{LOOPBACK}"
 WAIT = 5.0  # seconds: the bound on a script that never runs out (a failure), never reached when passing
@@ -72,6 +73,9 @@ class ScriptedClock:
         self.sleeps.append(seconds)
 
 
+Run = Callable[[OscSource, list[Any]], tuple[OscSource, ScriptedClock]]
+
+
 @pytest.fixture
 def pose(osc: tuple[Message, Message]) -> bytes:
     return osc[0]("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
@@ -94,14 +98,15 @@ def clients() -> Iterator[Callable[[], socket.socket]]:
 
 
 @pytest.fixture
-def run(monkeypatch: pytest.MonkeyPatch) -> Iterator[Callable[..., tuple[OscSource, ScriptedClock]]]:
+def run(monkeypatch: pytest.MonkeyPatch) -> Iterator[Run]:
     """``run(src, times)``: start ``src``'s thread on a scripted clock; return once the script has run out."""
     started: list[OscSource] = []
 
     def go(src: OscSource, times: list[Any]) -> tuple[OscSource, ScriptedClock]:
         clock = ScriptedClock(src, times)
         monkeypatch.setattr(osc, "time", clock)
-        started.append(src.start())  # type: ignore[arg-type]  # start() returns the source itself
+        src.start()
+        started.append(src)
         assert clock.done.wait(WAIT), "the socket thread did not read what was sent"
         assert src._thread is not None
         src._thread.join(WAIT)
@@ -117,7 +122,7 @@ def samples(items: list[PoseSample | tuple[str, str]]) -> list[PoseSample]:
     return [i for i in items if isinstance(i, PoseSample)]
 
 
-def test_a_datagram_is_read_stamped_and_named_after_the_phones_address(run, clients, pose: bytes) -> None:  # type: ignore[no-untyped-def]
+def test_a_datagram_is_read_stamped_and_named_after_the_phones_address(run: Run, clients: Clients, pose: bytes) -> None:
     src = OscSource(host=LOOPBACK, port=0, admit_after=2)
     phone = clients()
     for _ in range(2):
@@ -130,7 +135,7 @@ def test_a_datagram_is_read_stamped_and_named_after_the_phones_address(run, clie
     assert src.status().drop_reasons == {"sender pending": 1}
 
 
-def test_another_port_of_the_phone_spends_a_budget_of_its_own(run, clients, pose: bytes) -> None:  # type: ignore[no-untyped-def]
+def test_another_port_of_the_phone_spends_a_budget_of_its_own(run: Run, clients: Clients, pose: bytes) -> None:
     """The phone is admitted from one port; a flood from a second port of the same address is cut at
     its own step budget, and the phone's next datagram still goes through."""
     src = OscSource(host=LOOPBACK, port=0, admit_after=1)
@@ -147,7 +152,7 @@ def test_another_port_of_the_phone_spends_a_budget_of_its_own(run, clients, pose
     assert status.last_error == f"over budget: {PHONE}:other"
 
 
-def test_a_quiet_phone_is_released_while_another_host_keeps_sending(run, clients, pose: bytes) -> None:  # type: ignore[no-untyped-def]
+def test_a_quiet_phone_is_released_while_another_host_keeps_sending(run: Run, clients: Clients, pose: bytes) -> None:
     """Expiry runs after every datagram, not only when the socket is quiet: a host that never stops
     sending cannot keep a silent phone's slot taken."""
     src = OscSource(host=LOOPBACK, port=0, admit_after=1, timeout=1.0)
@@ -159,7 +164,7 @@ def test_a_quiet_phone_is_released_while_another_host_keeps_sending(run, clients
     assert not src.status().connected
 
 
-def test_a_quiet_socket_still_expires_the_phone_and_keeps_reading(run, clients, pose: bytes) -> None:  # type: ignore[no-untyped-def]
+def test_a_quiet_socket_still_expires_the_phone_and_keeps_reading(run: Run, clients: Clients, pose: bytes) -> None:
     """Nothing arrives for a while (the read times out): the silent phone is released then, and the
     thread goes on reading: the phone back on a new UDP port (an app restarted) takes the free slot."""
     src = OscSource(host=LOOPBACK, port=0, admit_after=1, timeout=1.0)
@@ -196,7 +201,9 @@ class FailingOnce:
         self.sock.close()
 
 
-def test_a_socket_error_is_reported_and_the_thread_goes_on_after_a_pause(run, clients, pose: bytes) -> None:  # type: ignore[no-untyped-def]
+def test_a_socket_error_is_reported_and_the_thread_goes_on_after_a_pause(
+    run: Run, clients: Clients, pose: bytes
+) -> None:
     src = OscSource(host=LOOPBACK, port=0, admit_after=1)
     src._sock = FailingOnce(src._sock)  # type: ignore[assignment]  # the real socket behind one failure
     clients().sendto(pose, (LOOPBACK, src.port))
@@ -240,7 +247,9 @@ def test_a_taken_port_is_a_one_line_error_and_leaks_no_socket() -> None:
         holder.close()
 
 
-def test_a_burst_is_held_by_the_receive_buffer_until_the_thread_reads_it(run, clients, pose: bytes) -> None:  # type: ignore[no-untyped-def]
+def test_a_burst_is_held_by_the_receive_buffer_until_the_thread_reads_it(
+    run: Run, clients: Clients, pose: bytes
+) -> None:
     """1000 small datagrams sent at once (a Wi-Fi bunch, or a stall of the thread) all reach the gate:
     the default receive buffer (about 208 KB here) holds only 256 of them."""
     n = 1000
