@@ -181,6 +181,15 @@ def test_long_addresses_are_cut_in_the_detail(dec, osc) -> None:  # type: ignore
     assert [(r, len(d)) for r, d in dec.drops] == [("unknown address", 100), ("address pattern", 100)]
 
 
+def test_a_long_parse_error_is_cut_in_the_detail(dec) -> None:  # type: ignore[no-untyped-def]
+    """python-osc quotes a bad type-tag string whole in its error; the detail keeps 200 characters.
+    Broken by: the cut made 201 (mutmut ``decode__mutmut_10``)."""
+    tag = b"x" * 400  # a type-tag string must start with ","
+    dec.decode(b"/a\x00\x00" + tag + b"\x00" * 4, "a", 0.0)
+    reason, detail = dec.drops[0]
+    assert reason == "malformed packet" and len(detail) == 200 and detail.startswith("ParseError: ")
+
+
 def test_a_pattern_or_an_unknown_address_does_not_cost_the_rest_of_the_bundle(dec, osc) -> None:  # type: ignore[no-untyped-def]
     _, bundle = osc
     s = dec.decode(

@@ -11,6 +11,7 @@ import pytest
 from input.web.protocol import (
     CROUCH_DEPTH,
     MAX_MESSAGE_BYTES,
+    Ack,
     ControllerMessage,
     PageClock,
     WebMessageError,
@@ -102,3 +103,26 @@ def test_the_page_clock_maps_page_times_by_the_least_delayed_reading() -> None:
     assert clock.offset == pytest.approx(3611.0)
     assert clock.stamp(-3.6e6 + 100.0, 11.1) == pytest.approx(11.1)
     assert clock.stamp(-3.6e6 + 200.0, 12.8) == pytest.approx(12.8)  # 1.6 s late: restarted
+
+
+@pytest.mark.parametrize("step", [0, 1, 2**32 - 1])
+def test_an_ack_carries_its_step(step: int) -> None:
+    """The page's back-pressure message (fourth mutation round: no selected test parsed one)."""
+    assert parse_message(json.dumps({"ack": step})) == Ack(step)
+
+
+@pytest.mark.parametrize("step", [-1, 2**32, True, 1.5, "3", None])
+def test_an_ack_that_is_not_a_step_number_is_refused(step: object) -> None:
+    assert _reason({"ack": step}) == "ack must be a step number"
+
+
+def test_an_ack_among_other_fields_is_not_an_ack() -> None:
+    assert _reason({**READING, "ack": 3}) == "unknown field 'ack'"
+
+
+def test_the_page_clock_keeps_a_reading_exactly_one_second_late() -> None:
+    """The restart is for a page clock *more* than a second ahead (binary-exact times)."""
+    clock = PageClock()
+    assert clock.stamp(0.0, 10.0) == 10.0  # offset 10 s
+    assert clock.stamp(1000.0, 12.0) == 11.0  # a second late: stamped at its page time, offset kept
+    assert clock.offset == 10.0
