@@ -34,7 +34,16 @@ __all__ = ["BUILD_SOURCES", "build_key", "cached_clips", "default_folder", "deco
 
 _ENGINE = Path(__file__).resolve().parents[1]
 #: The engine modules the build imports besides ``engine/clips/*.py`` (all of which are hashed).
-BUILD_SOURCES: tuple[str, ...] = ("clip.py", "fk.py", "humanoid.py", "jit.py", "pose.py", "quat.py", "skeleton.py")
+BUILD_SOURCES: tuple[str, ...] = (
+    "arrays.py",
+    "clip.py",
+    "fk.py",
+    "humanoid.py",
+    "jit.py",
+    "pose.py",
+    "quat.py",
+    "skeleton.py",
+)
 _FORMAT = "puppetphone-builtin-clips/1"
 _OPTIONAL = ("translations", "scales")
 
