@@ -45,6 +45,7 @@ import secrets
 import socket
 import time
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import resources
 from typing import Any
@@ -105,6 +106,8 @@ class WebSource(PoseSource):
         silent_after: seconds without a message after which a controller's puppet is freed.
         certificate: the TLS certificate (default: the user's, made on first use).
         token: the session token (default: a new random one).
+        clock: the seconds the rate limit and the page clocks are measured in (monotonic time;
+            a test gives a clock it moves itself).
 
     Raises:
         ValueError: ``max_controllers`` below 1 or a port outside 0..65535.
@@ -121,6 +124,7 @@ class WebSource(PoseSource):
         token: str | None = None,
         capacity: int = 256,
         silent_after: float = 2.0,
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         if max_controllers < 1:
             raise ValueError(f"max_controllers must be at least 1, not {max_controllers}")
@@ -133,6 +137,7 @@ class WebSource(PoseSource):
         self.max_controllers = max_controllers
         self.max_rate = max_rate
         self.silent_after = silent_after
+        self.clock = clock
         self.certificate = certificate or load_or_create(lan_addresses())
         # Made here, not in the server thread: a certificate that cannot serve is an error at
         # start (one line), never a dead thread while the game runs on without input.
@@ -255,7 +260,7 @@ class WebSource(PoseSource):
         controller = f"web:{slot}"
         self._slots[slot] = ws
         self.connected(controller)
-        bucket = [self.max_rate, time.monotonic()]
+        bucket = [self.max_rate, self.clock()]
         acked = _Acks()
         wake = asyncio.Event()
         sender = None
@@ -271,7 +276,7 @@ class WebSource(PoseSource):
                     self._release(slot, controller)
                     await ws.close(4002, "silent for too long")
                     return
-                reply = self._handle(message, controller, bucket, time.monotonic())
+                reply = self._handle(message, controller, bucket, self.clock())
                 if isinstance(reply, Ack):
                     acked.step = max(acked.step, reply.step)
                     acked.arrived.set()

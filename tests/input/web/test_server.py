@@ -109,31 +109,49 @@ def test_one_controller_per_puppet_and_readings_reach_the_hub(source):
         assert json.loads(again.recv(timeout=5)) == {"hello": "web:1"}
 
 
-def test_malformed_and_flooding_messages_are_counted_and_dropped(source):
-    with _ws(source) as phone:
-        phone.recv(timeout=5)
-        phone.send(b"\x00binary")
-        phone.send("{oops")
-        phone.send(json.dumps({**READING, "o": [0, float("inf"), 0]}).replace("Infinity", "1e999"))
-        for i in range(400):  # far past the 100/s bucket
-            phone.send(json.dumps({**READING, "seq": i}))
-        _wait(lambda: source.status().packets + source.status().drop_reasons.get("rate limit", 0) == 400)
-        time.sleep(0.1)  # every reading is handled; the bucket refills a little: the ping is read
-        phone.send(json.dumps({"ping": 1.0}))
-        phone.recv(timeout=5)  # the connection is alive and answers
-    status = source.status()
-    assert status.drop_reasons["malformed message"] == 3
-    assert status.drop_reasons["rate limit"] >= 250
-    queued = [s for s in source.drain() if isinstance(s, PoseSample)]
-    assert 90 <= len(queued) <= 150
-    with _ws(source) as phone:  # a huge message ends that connection, and only that
-        phone.recv(timeout=5)
-        phone.send("x" * 100_000)
-        with pytest.raises(ConnectionClosed):
+class _HandClock:
+    """Seconds that pass only when the test says so: the rate limit is counted, not timed."""
+
+    def __init__(self) -> None:
+        self.now = 1000.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_malformed_and_flooding_messages_are_counted_and_dropped(certificate):
+    """Broken on purpose: the bucket never spent (``bucket[0] = tokens``) lets all 400 through; a
+    bucket that does not refill with time keeps the ping out."""
+    clock = _HandClock()
+    source = WebSource(port=0, certificate=certificate, max_rate=100.0, clock=clock).start()
+    try:
+        with _ws(source) as phone:
             phone.recv(timeout=5)
-    _wait(lambda: source.status().drop_reasons.get("message too big") == 1)
-    with _ws(source) as phone:
-        assert json.loads(phone.recv(timeout=5)) == {"hello": "web:1"}
+            phone.send(b"\x00binary")
+            phone.send("{oops")
+            phone.send(json.dumps({**READING, "o": [0, float("inf"), 0]}).replace("Infinity", "1e999"))
+            for i in range(400):  # far past the 100/s bucket, all within the same instant
+                phone.send(json.dumps({**READING, "seq": i}))
+            _wait(lambda: source.status().packets + source.status().drop_reasons.get("rate limit", 0) == 400)
+            clock.now += 0.1  # the bucket refills by 10: the ping is read
+            phone.send(json.dumps({"ping": 1.0}))
+            phone.recv(timeout=5)  # the connection is alive and answers
+        status = source.status()
+        assert status.drop_reasons["malformed message"] == 3
+        # a full bucket of 100: 3 spent by the malformed messages, 97 readings, the rest dropped
+        assert status.drop_reasons["rate limit"] == 303
+        queued = [s for s in source.drain() if isinstance(s, PoseSample)]
+        assert len(queued) == 97
+        with _ws(source) as phone:  # a huge message ends that connection, and only that
+            phone.recv(timeout=5)
+            phone.send("x" * 100_000)
+            with pytest.raises(ConnectionClosed):
+                phone.recv(timeout=5)
+        _wait(lambda: source.status().drop_reasons.get("message too big") == 1)
+        with _ws(source) as phone:
+            assert json.loads(phone.recv(timeout=5)) == {"hello": "web:1"}
+    finally:
+        source.stop()
 
 
 def test_the_link_names_lan_addresses_when_bound_to_all(certificate):
