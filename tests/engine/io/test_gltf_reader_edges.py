@@ -9,6 +9,7 @@ folder (``PUPPETPHONE_DATA``) and checks its rest transforms against its own JSO
 from __future__ import annotations
 
 import json
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +17,8 @@ import numpy as np
 import pytest
 
 from engine import quat
-from engine.io.gltf import GltfAnimation, GltfChannel, GltfError, accessor, read_gltf
+from engine.io import gltf
+from engine.io.gltf import GltfAnimation, GltfChannel, GltfError, accessor, parse_glb, read_gltf
 from tests.engine.io.test_gltf_reader import Doc, arm, glb
 
 
@@ -234,3 +236,110 @@ def test_a_real_model_reads_its_rest_transforms_and_skin(mocap_dir: Path) -> Non
     glb_asset = read_gltf(mocap_dir / "RiggedSimple.glb")
     np.testing.assert_array_equal(glb_asset.rotation, a.rotation)
     np.testing.assert_array_equal(glb_asset.skins[0].inverse_bind, skin.inverse_bind)
+
+
+def test_glb_header_edges() -> None:
+    """The smallest GLB (20 bytes: header and an empty JSON chunk), unsigned sizes, a chunk ending the file.
+
+    Mutants: ``<= 20`` or ``< 21`` for the size check (the 20-byte file called "bad magic"); the header
+    read as signed ``<ii`` (a length of 2³²−1 reported as −1 and not refused as truncated); the chunk
+    loop stopping one byte early (``pos + 9`` or ``<``: an empty BIN chunk at the very end lost).
+    """
+    empty_json = b"glTF" + struct.pack("<II", 2, 20) + struct.pack("<II", 0, 0x4E4F534A)
+    with pytest.raises(GltfError, match="^g: bad JSON chunk: JSONDecodeError$"):
+        parse_glb(empty_json, "g")
+    with pytest.raises(GltfError, match="^<glb>: not a GLB file \\(bad magic\\)$"):
+        parse_glb(empty_json[:19])
+    huge = empty_json[:8] + struct.pack("<I", 0xFFFFFFFF) + empty_json[12:]
+    with pytest.raises(GltfError, match="^g: truncated: header says 4294967295 bytes, file has 20$"):
+        parse_glb(huge, "g")
+    odd = empty_json[:4] + struct.pack("<I", 0xFFFFFFFE) + empty_json[8:]
+    with pytest.raises(GltfError, match="^g: GLB version 4294967294, only 2 is supported$"):
+        parse_glb(odd, "g")
+    doc, binary = parse_glb(glb({"a": 1}, b""))
+    assert doc == {"a": 1} and binary == b""  # a BIN chunk of size 0 whose header ends the file
+
+
+def _column_major(m: np.ndarray) -> list[float]:
+    return [float(v) for v in m.T.reshape(-1)]
+
+
+def test_a_matrix_decomposes_into_column_scales_and_a_proper_rotation(tmp_path: Path) -> None:
+    """Rotation times scale gives the matrix back, for rotated, shrunk, mirrored, collapsed and projective inputs.
+
+    Mutants: scale from the rows (``axis=1``) or with the bottom row (``mat[:4]``); the ``s > 1e-12``
+    guard made ``s > 1.000000000001`` (a 0.5 scale left in the rotation); the mirror test ``det <= 0`` or
+    ``det < 1`` (a collapsed axis mirrored); the mirrored column not negated in the rotation.
+    """
+    rz = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90° about z
+    cases = [
+        (rz @ np.diag([2.0, 3.0, 4.0]), [2.0, 3.0, 4.0]),
+        (rz @ np.diag([0.5, 0.25, 1.0]), [0.5, 0.25, 1.0]),
+        (rz @ np.diag([-2.0, 3.0, 4.0]), [-2.0, 3.0, 4.0]),
+        (rz @ np.diag([2.0, 0.0, 3.0]), [2.0, 0.0, 3.0]),
+    ]
+    d = Doc()
+    for m3, _ in cases:
+        m = np.eye(4)
+        m[:3, :3], m[:3, 3] = m3, [1.0, 2.0, 3.0]
+        d.doc["nodes"].append({"matrix": _column_major(m)})
+    projective = np.eye(4)
+    projective[3, :3] = [5.0, 6.0, 7.0]  # not a TRS matrix: only the upper 3×4 is read
+    d.doc["nodes"].append({"matrix": _column_major(projective)})
+    a = read_gltf(d.write(tmp_path / "m.gltf"))
+    for i, (m3, scale) in enumerate(cases):
+        np.testing.assert_allclose(a.scale[i], scale, atol=1e-12)
+        r = quat.to_matrix(a.rotation[i])
+        np.testing.assert_allclose(np.linalg.det(r), 1.0, atol=1e-9)
+        if scale[1] != 0.0:
+            np.testing.assert_allclose(r @ np.diag(a.scale[i]), m3, atol=1e-9)
+        np.testing.assert_allclose(a.translation[i], [1, 2, 3])
+    np.testing.assert_allclose(a.scale[4], [1, 1, 1])
+    np.testing.assert_allclose(a.rotation[4], [1, 0, 0, 0], atol=1e-12)
+
+
+def test_the_node_limit_is_inclusive_and_named(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Mutants: ``n >= MAX_NODES`` (a document at the limit refused); the message dropped."""
+    monkeypatch.setattr(gltf, "MAX_NODES", 3)
+    d = Doc()
+    d.doc["nodes"] = [{}, {}, {}]
+    path = d.write(tmp_path / "n.gltf")
+    assert read_gltf(path).num_nodes == 3
+    d.doc["nodes"].append({})
+    path = d.write(tmp_path / "n.gltf")
+    with pytest.raises(GltfError, match=f"^{path}: 4 nodes; the limit is 3$"):
+        read_gltf(path)
+
+
+def test_long_uris_are_cut_to_60_characters_in_messages(tmp_path: Path) -> None:
+    """Mutants: the cut at 61 characters, in both URI refusals."""
+    d = arm(tmp_path)
+    doc = d.finish()
+    path = tmp_path / "u.gltf"
+    long = "../" + "x" * 100 + ".bin"
+    doc["buffers"][0]["uri"] = long
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError) as err:
+        read_gltf(path)
+    assert f"uri {long[:60]!r} is not a file beside" in str(err.value)
+    (tmp_path / "l").mkdir()
+    name = "y" * 80
+    (tmp_path / "l" / name).symlink_to(tmp_path.parent)
+    doc["buffers"][0]["uri"] = f"l/{name}/b.bin"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError) as err:
+        read_gltf(path)
+    assert str(err.value) == f"{path}: buffer 0: uri {('l/' + name)[:60]!r} leads out of the glTF's folder"
+
+
+def test_a_symlink_loop_is_refused_as_leading_out(tmp_path: Path) -> None:
+    """A path that cannot be resolved (a link to itself) counts as outside; mutant: ``inside = True`` there."""
+    d = arm(tmp_path)
+    doc = d.finish()
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    doc["buffers"][0]["uri"] = "loop/b.bin"
+    path = tmp_path / "s.gltf"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(GltfError) as err:
+        read_gltf(path)
+    assert str(err.value) == f"{path}: buffer 0: uri 'loop/b.bin' leads out of the glTF's folder"
