@@ -343,3 +343,27 @@ def test_a_symlink_loop_is_refused_as_leading_out(tmp_path: Path) -> None:
     with pytest.raises(GltfError) as err:
         read_gltf(path)
     assert str(err.value) == f"{path}: buffer 0: uri 'loop/b.bin' leads out of the glTF's folder"
+
+
+def test_optional_parts_may_be_missing(tmp_path: Path) -> None:
+    """A skin without ``joints``, an animation without ``channels``, a channel without ``target`` read as empty.
+
+    Mutants: the defaults ``[]`` / ``{}`` made ``None`` or dropped (a TypeError, reported as malformed).
+    """
+    d = arm(tmp_path)
+    d.doc["skins"].append({"name": "bare"})
+    d.doc["animations"].append({"name": "still", "samplers": []})
+    d.doc["animations"][0]["channels"].append({"sampler": 0})
+    a = read_gltf(d.write(tmp_path / "o.gltf"))
+    assert a.skins[1].joints == () and a.skins[1].inverse_bind.shape == (0, 4, 4)
+    assert a.animations[1].name == "still" and a.animations[1].channels == ()
+    assert len(a.animations[0].channels) == 1
+
+
+def test_a_broken_inverse_bind_accessor_names_the_file(tmp_path: Path) -> None:
+    """Mutant: the skin's accessor read without the file's name (``<gltf>: accessor …``)."""
+    d = arm(tmp_path)
+    d.doc["skins"][0]["inverseBindMatrices"] = 99
+    path = d.write(tmp_path / "i.gltf")
+    with pytest.raises(GltfError, match=f"^{path}: accessor 99 is missing or malformed$"):
+        read_gltf(path)
