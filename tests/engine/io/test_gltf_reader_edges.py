@@ -367,3 +367,22 @@ def test_a_broken_inverse_bind_accessor_names_the_file(tmp_path: Path) -> None:
     path = d.write(tmp_path / "i.gltf")
     with pytest.raises(GltfError, match=f"^{path}: accessor 99 is missing or malformed$"):
         read_gltf(path)
+
+
+@pytest.mark.parametrize("part", ["input", "output"])
+def test_a_broken_sampler_accessor_names_the_file(tmp_path: Path, part: str) -> None:
+    """Mutants: a sampler's key times or values read without the file's name."""
+    d = arm(tmp_path)
+    d.doc["animations"][0]["samplers"][0][part] = 42
+    path = d.write(tmp_path / "s.gltf")
+    with pytest.raises(GltfError, match=f"^{path}: accessor 42 is missing or malformed$"):
+        read_gltf(path)
+
+
+def test_rotation_keys_must_have_four_numbers(tmp_path: Path) -> None:
+    """Mutant: ``rotation`` dropped from the width table (three numbers then fail deep in the conversion)."""
+    d = arm(tmp_path)
+    d.doc["animations"][0]["samplers"][0]["output"] = d.add([[0, 0, 0], [1, 0, 0], [0, 1, 0]], "VEC3")
+    path = d.write(tmp_path / "q.gltf")
+    with pytest.raises(GltfError, match=f"^{path}: animation 0: rotation keys have 3 numbers, not 4$"):
+        read_gltf(path)
