@@ -386,3 +386,18 @@ def test_rotation_keys_must_have_four_numbers(tmp_path: Path) -> None:
     path = d.write(tmp_path / "q.gltf")
     with pytest.raises(GltfError, match=f"^{path}: animation 0: rotation keys have 3 numbers, not 4$"):
         read_gltf(path)
+
+
+def test_a_plain_data_uri_may_hold_commas(tmp_path: Path) -> None:
+    """Only the first comma ends a data URI's header; mutant ``rpartition`` cuts the payload at the last one."""
+    doc = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": "data:application/octet-stream,,A%2C,", "byteLength": 4}],
+        "bufferViews": [{"buffer": 0, "byteLength": 4}],
+        "accessors": [{"bufferView": 0, "componentType": 5121, "count": 4, "type": "SCALAR"}],
+        "nodes": [{"name": "n"}],
+        "skins": [{"joints": [0]}],
+    }
+    path = tmp_path / "c.gltf"
+    path.write_text(json.dumps(doc))
+    assert read_gltf(path).names == ("n",)  # the payload ",A%2C," is 4 bytes, as byteLength says
