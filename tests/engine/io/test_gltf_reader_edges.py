@@ -176,7 +176,7 @@ def test_a_glb_with_broken_json_or_a_version_1_document(tmp_path: Path) -> None:
     with pytest.raises(GltfError, match=r"not a glTF 2\.0 document"):
         read_gltf(tmp_path / "v.glb")
     (tmp_path / "t.glb").write_bytes(glb({"asset": {"version": "2.0"}}, None)[:30])
-    with pytest.raises(GltfError, match="truncated: header says"):
+    with pytest.raises(GltfError, match=f"^{tmp_path / 't.glb'}: truncated: header says"):  # names the file
         read_gltf(tmp_path / "t.glb")
     (tmp_path / "j.gltf").write_text("{not json")
     with pytest.raises(GltfError, match=r"neither GLB nor glTF JSON: JSONDecodeError$"):
@@ -401,3 +401,11 @@ def test_a_plain_data_uri_may_hold_commas(tmp_path: Path) -> None:
     path = tmp_path / "c.gltf"
     path.write_text(json.dumps(doc))
     assert read_gltf(path).names == ("n",)  # the payload ",A%2C," is 4 bytes, as byteLength says
+
+
+def test_an_empty_buffer_without_byte_length_reads(tmp_path: Path) -> None:
+    """``byteLength`` defaults to 0; mutant: the default made 1 (an empty buffer refused)."""
+    doc = {"asset": {"version": "2.0"}, "buffers": [{"uri": "data:application/octet-stream;base64,"}]}
+    path = tmp_path / "e.gltf"
+    path.write_text(json.dumps(doc))
+    assert read_gltf(path).num_nodes == 0
