@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import struct
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,7 @@ import pytest
 
 from engine import quat
 from engine.io import gltf
-from engine.io.gltf import GltfAnimation, GltfChannel, GltfError, accessor, parse_glb, read_gltf
+from engine.io.gltf import MAX_ELEMENTS, GltfAnimation, GltfChannel, GltfError, accessor, parse_glb, read_gltf
 from tests.engine.io.test_gltf_reader import Doc, arm, glb
 
 
@@ -409,3 +410,40 @@ def test_an_empty_buffer_without_byte_length_reads(tmp_path: Path) -> None:
     path = tmp_path / "e.gltf"
     path.write_text(json.dumps(doc))
     assert read_gltf(path).num_nodes == 0
+
+
+def test_accessor_messages_exactly() -> None:
+    """Mutants: the default source name, the count's repr cut at 21, ``/`` for ``//`` in the limit, sparse count 1."""
+    d = Doc()
+    d.add([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], "VEC3")
+    doc = d.finish()
+    blob = [bytes(d.blob)]
+    with pytest.raises(GltfError, match=r"^<gltf>: accessor 7 is missing or malformed$"):
+        accessor(doc, blob, 7)
+    doc["accessors"][0]["count"] = "c" * 40
+    with pytest.raises(GltfError) as err:
+        accessor(doc, blob, 0, "s")
+    assert str(err.value) == f"s: accessor 0 count {repr('c' * 40)[:20]} is not 0..{MAX_ELEMENTS // 3}"
+    doc["accessors"][0]["count"] = 2
+    one = d.add([[1]], "SCALAR", ctype=5123)
+    val = d.add([[9.0, 9.0, 9.0]], "VEC3")
+    doc = d.finish()
+    doc["accessors"][0]["sparse"] = {
+        "count": 1,
+        "indices": {"bufferView": doc["accessors"][one]["bufferView"], "componentType": 5123},
+        "values": {"bufferView": doc["accessors"][val]["bufferView"]},
+    }
+    np.testing.assert_array_equal(accessor(doc, [bytes(d.blob)], 0), [[1, 2, 3], [9, 9, 9]])
+
+
+def test_a_signalling_nan_is_refused_without_a_warning() -> None:
+    """Widening a float32 signalling NaN warns in numpy; mutant ``errstate(invalid=None)`` lets that warning out."""
+    d = Doc()
+    d.add([[1.0]], "SCALAR")
+    doc = d.finish()
+    snan = bytearray(d.blob)
+    snan[0:4] = struct.pack("<I", 0x7F800001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(GltfError, match="^s: accessor 0 holds NaN, infinite or absurd values$"):
+            accessor(doc, [bytes(snan)], 0, "s")
