@@ -447,3 +447,34 @@ def test_a_signalling_nan_is_refused_without_a_warning() -> None:
         warnings.simplefilter("error")
         with pytest.raises(GltfError, match="^s: accessor 0 holds NaN, infinite or absurd values$"):
             accessor(doc, [bytes(snan)], 0, "s")
+
+
+def test_a_sparse_accessor_may_replace_every_element_and_its_parts_are_checked() -> None:
+    """Mutants: ``n < count`` (a full replacement refused); the sparse views' errors without the source name;
+    ``errstate(invalid=None)`` around the sparse values (a signalling NaN warning escapes)."""
+    d = Doc()
+    base = d.add([[1.0], [2.0]], "SCALAR")
+    idx = d.add([[1], [0]], "SCALAR", ctype=5123)
+    vals = d.add([[5.0], [6.0]], "SCALAR")
+    doc = d.finish()
+    sparse: dict[str, Any] = {
+        "count": 2,
+        "indices": {"bufferView": doc["accessors"][idx]["bufferView"], "componentType": 5123},
+        "values": {"bufferView": doc["accessors"][vals]["bufferView"]},
+    }
+    doc["accessors"][base]["sparse"] = sparse
+    blob = bytes(d.blob)
+    np.testing.assert_array_equal(accessor(doc, [blob], base)[:, 0], [6.0, 5.0])
+    for part in ("indices", "values"):
+        broken = {**sparse, part: {**sparse[part], "bufferView": 9}}
+        doc["accessors"][base]["sparse"] = broken
+        with pytest.raises(GltfError, match="^s: bufferView 9 or its buffer does not exist$"):
+            accessor(doc, [blob], base, "s")
+    doc["accessors"][base]["sparse"] = sparse
+    snan = bytearray(blob)
+    start = doc["bufferViews"][doc["accessors"][vals]["bufferView"]]["byteOffset"]
+    snan[start : start + 4] = struct.pack("<I", 0x7F800001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(GltfError, match="^s: accessor 0 holds NaN, infinite or absurd values$"):
+            accessor(doc, [bytes(snan)], base, "s")
