@@ -49,3 +49,16 @@ def test_one_pose_takes_the_float_path(
     )
     assert len(calls) == (1 if float_path else 0)
     assert np.isfinite(got).all()
+
+
+def test_a_broken_chain_or_a_non_finite_target_is_named() -> None:
+    """Mutants: ``and`` for ``or`` (a chain with only its second link broken accepted); the names or the
+    message text changed."""
+    sk = humanoid_skeleton()
+    pose = Pose.rest(sk)
+    with pytest.raises(ValueError, match="^l_upper_leg → l_lower_leg → l_hand is not a parent chain$"):
+        two_bone.two_bone_ik(sk, pose, ("l_upper_leg", "l_lower_leg", "l_hand"), np.zeros(3))
+    with pytest.raises(ValueError, match="^l_upper_arm → l_lower_leg → l_foot is not a parent chain$"):
+        two_bone.two_bone_ik(sk, pose, ("l_upper_arm", "l_lower_leg", "l_foot"), np.zeros(3))
+    with pytest.raises(ValueError, match="^two_bone_ik target must be finite$"):
+        two_bone.two_bone_ik(sk, pose, LEG, [0.0, np.nan, 0.0])
