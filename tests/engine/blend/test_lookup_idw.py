@@ -44,11 +44,10 @@ def idw_by_hand(probes: F, scaled: F, x: F, k: int, power: float, slopes: F | No
     return np.clip(num / den, 0.0, 1.0)
 
 
-def table_1d(**kw: object) -> LookupTable:
+def table_1d(power: float = 7.0, neighbours: int = 16) -> LookupTable:
     """Four probes on one axis measuring a non-linear property (0, 1, 2.5, 4 m/s)."""
-    return LookupTable(
-        np.array([[0.0], [1 / 3], [2 / 3], [1.0]]), np.array([[0.0], [1.0], [2.5], [4.0]]), ("speed",), **kw
-    )  # type: ignore[arg-type]  # kw holds LookupTable's own keywords
+    probes = np.array([[0.0], [1 / 3], [2 / 3], [1.0]])
+    return LookupTable(probes, np.array([[0.0], [1.0], [2.5], [4.0]]), ("speed",), power=power, neighbours=neighbours)
 
 
 def test_range_scaling_of_the_properties() -> None:
@@ -170,8 +169,8 @@ def test_bad_tables_and_requests_name_what_is_wrong() -> None:
 def test_probe_grid_orders_points_c_style_and_refuses_thin_grids() -> None:
     pts, shape = probe_grid(2, (2, 3))
     assert shape == (2, 3)
-    np.testing.assert_allclose(pts, [[0, 0], [0, 0.5], [0, 1], [1, 0], [1, 0.5], [1, 1]])
-    assert probe_grid(3, np.int64(2))[1] == (2, 2, 2)
+    np.testing.assert_allclose(pts, np.array([[0, 0], [0, 0.5], [0, 1], [1, 0], [1, 0.5], [1, 1]]))
+    assert probe_grid(3, np.int64(2))[1] == (2, 2, 2)  # type: ignore[arg-type]  # numpy integers are accepted at run time
     for dims, density in ((2, (2,)), (2, (2, 1)), (1, 1)):
         with pytest.raises(ValueError, match=f"on each of the {dims} axes"):
             probe_grid(dims, density)
@@ -199,11 +198,11 @@ def test_linear_mapping_maps_its_two_points_and_clamps() -> None:
         LinearMapping(2.0, 2.0, 0.0, 1.0)
 
 
-def square_table(**kw: object) -> LookupTable:
+def square_table(rate_property: int | None = 0) -> LookupTable:
     """A 2-D grid measuring speed = 2·p₀ (0..2 m/s) and height = 0.5 + 0.4·p₁: feasible set [0,2]×[0.5,0.9]."""
     probes, shape = probe_grid(2, 5)
     values = np.stack([2.0 * probes[:, 0], 0.5 + 0.4 * probes[:, 1]], axis=-1)
-    return LookupTable(probes, values, ("speed", "height"), shape, **kw)  # type: ignore[arg-type]  # kw holds LookupTable's own keywords
+    return LookupTable(probes, values, ("speed", "height"), shape, rate_property=rate_property)
 
 
 def test_projection_prefers_changing_the_speed_within_the_rate_limit() -> None:
