@@ -364,7 +364,8 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
             faded[i] = weight
     _contacts(world, members, players, votes, faded)
     # Heading, travel and the world root for the whole group at once.
-    rotation = np.array([tr.rotation for tr in transforms])
+    rotation_column = cols.get(Transform, "rotation")
+    rotation = rotation_column.read(transforms).copy()
     yaw = _yaw(rotation)
     hq = quat.from_axis_angle(_UP, yaw)
     step = quat.rotate(hq, travel)
@@ -377,8 +378,7 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
     headings = quat.normalize(quat.mul(turn_q, rotation))
     world_roots = positions + offsets
     position_column.write(transforms, positions)
-    for tr, heading in zip(transforms, headings, strict=True):
-        tr.rotation = heading
+    rotation_column.write(transforms, headings)
     pose_store = world.components(LocalPose)
     poses = [pose_store.get(m[0]) for m in members]
     if None in poses:  # a puppet's first pose
