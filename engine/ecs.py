@@ -17,7 +17,8 @@ for a stage boundary. The whole core stays small and typed, in esper's spirit.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
+from types import MappingProxyType
 from typing import Any, TypeVar, overload
 
 import numpy as np
@@ -114,6 +115,11 @@ class World:
     def try_get(self, entity: Entity, ctype: type[T]) -> T | None:
         """The component or ``None``."""
         return self._components.get(ctype, {}).get(entity)
+
+    def components(self, ctype: type[T]) -> Mapping[Entity, T]:
+        """Every component of that type by entity: a live, read-only view, for a system that looks up
+        one optional component per row of a batch (``.get(e)``) without a call per lookup."""
+        return MappingProxyType(self._components.setdefault(ctype, {}))
 
     def has(self, entity: Entity, ctype: type) -> bool:
         """Whether the entity has a component of that type."""

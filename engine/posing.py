@@ -8,9 +8,8 @@ The previous world pose is kept for render interpolation.
 
 from __future__ import annotations
 
-import numpy as np
-
 from engine.app import App
+from engine.columns import columns
 from engine.components import LocalPose, Puppet, WorldPose
 from engine.ecs import World
 from engine.fk import forward_kinematics
@@ -23,19 +22,29 @@ def fk_system(world: World) -> None:
     groups: dict[bytes, list[tuple[int, Puppet, LocalPose]]] = {}
     for e, puppet, local in world.query(Puppet, LocalPose):
         groups.setdefault(puppet.skeleton.parents.tobytes(), []).append((e, puppet, local))
-    for members in groups.values():
+    cols = columns(world)
+    world_poses = world.components(WorldPose)
+    for key, members in groups.items():
         skeleton = members[0][1].skeleton
-        roots = np.array([m[2].root for m in members], dtype=np.float64)
-        rots = np.array([m[2].rotations for m in members], dtype=np.float64)
-        offsets = np.array([m[1].joint_offsets() for m in members], dtype=np.float64)
+        joints = skeleton.num_joints
+        locals_ = [m[2] for m in members]
+        roots = cols.get(LocalPose, "root", joints).read(locals_)
+        rots = cols.get(LocalPose, "rotations", joints).read(locals_)
+        offsets = cols.stacked(("offsets", key))([m[1].joint_offsets() for m in members])
         pos, rot = forward_kinematics(skeleton, roots, rots, offsets)
-        for k, (e, _, _) in enumerate(members):
-            wp = world.try_get(e, WorldPose)
-            if wp is None:
-                world.add(e, WorldPose(pos[k], rot[k], pos[k].copy(), rot[k].copy()))
-            else:
-                wp.prev_positions, wp.prev_rotations = wp.positions, wp.rotations
-                wp.positions, wp.rotations = pos[k], rot[k]
+        poses = [world_poses.get(e) for e, _, _ in members]
+        if None in poses:  # a puppet's first pose
+            for k, (e, _, _) in enumerate(members):
+                if poses[k] is None:
+                    world.add(e, WorldPose(pos[k], rot[k], pos[k].copy(), rot[k].copy()))
+            poses = [world_poses[e] for e, _, _ in members]
+        # The previous step is kept for render interpolation: copied into its own columns, as
+        # this step's values are written over the last step's in place.
+        for field in ("positions", "rotations"):
+            now = cols.get(WorldPose, field, joints)
+            cols.get(WorldPose, f"prev_{field}", joints).write(poses, now.read(poses))
+        cols.get(WorldPose, "positions", joints).write(poses, pos)
+        cols.get(WorldPose, "rotations", joints).write(poses, rot)
 
 
 def install_fk(app: App) -> None:

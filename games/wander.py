@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from engine.app import App
 from engine.blend.locomotion import LocomotionPlayer
+from engine.columns import columns
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
@@ -40,19 +41,23 @@ class Wanderer:
 
 def wander_system(world: World) -> None:
     """Steer every free wanderer toward its goal; pick a new goal when one is reached."""
+    jumps, ragdolls = world.components(Jumping), world.components(Ragdoll)
+    placed, locomotion = world.components(Transform), world.components(LocomotionPlayer)
     rows = [
         (w, body, tr, player)
         for e, w, body in world.query(Wanderer, PuppetBody)
         if body.held_by is None
-        and ((jump := world.try_get(e, Jumping)) is None or jump.air == 0.0)
-        and (rd := world.try_get(e, Ragdoll)) is not None
+        and ((jump := jumps.get(e)) is None or jump.air == 0.0)
+        and (rd := ragdolls.get(e)) is not None
         and rd.mode is RagdollMode.ANIMATED
-        and (tr := world.try_get(e, Transform)) is not None
-        and (player := world.try_get(e, LocomotionPlayer)) is not None
+        and (tr := placed.get(e)) is not None
+        and (player := locomotion.get(e)) is not None
     ]
     if not rows:
         return
-    pos = np.array([r[2].position for r in rows])
+    cols = columns(world)
+    transforms = [r[2] for r in rows]
+    pos = cols.get(Transform, "position").read(transforms)
     goal = np.array([r[0].goal for r in rows])
     err = goal - pos
     dist = np.hypot(err[:, 0], err[:, 2])
@@ -61,19 +66,20 @@ def wander_system(world: World) -> None:
     step = _TURN_RATE * world.dt
     heading = (heading + np.clip(turn, -step, step) + np.pi) % (2 * np.pi) - np.pi
     facing = np.maximum(np.cos(turn), 0.0)
-    rotation = yaw_rotation(heading)
-    for i, (w, body, tr, player) in enumerate(rows):
-        body.heading = float(heading[i])
-        tr.rotation = rotation[i]
-        player.speed = float(w.speed * facing[i])
-        if dist[i] < _REACHED:
-            w.goal = np.array(
-                [
-                    *world.rng.uniform(-w.field_half, w.field_half, 1),
-                    0.0,
-                    *world.rng.uniform(-w.field_half, w.field_half, 1),
-                ]
-            )
+    cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
+    speeds = (np.array([r[0].speed for r in rows]) * facing).tolist()
+    for (_w, body, _tr, player), h, v in zip(rows, heading.tolist(), speeds, strict=True):
+        body.heading = h
+        player.speed = v
+    for i in np.flatnonzero(dist < _REACHED).tolist():
+        w = rows[i][0]
+        w.goal = np.array(
+            [
+                *world.rng.uniform(-w.field_half, w.field_half, 1),
+                0.0,
+                *world.rng.uniform(-w.field_half, w.field_half, 1),
+            ]
+        )
 
 
 def install_wander(app: App) -> None:

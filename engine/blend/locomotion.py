@@ -43,8 +43,10 @@ from engine.blend.pose_blend import crossfade, fade_weight
 from engine.blend.space import BlendSpace
 from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
+from engine.columns import columns
 from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import World
+from engine.ik.foot_lock import FootLock
 from engine.ik.system import IKRequest
 from engine.pose import Pose
 
@@ -303,29 +305,31 @@ def animate(world: World) -> None:
 
 
 def _animate_group(world: World, library: BlendLibrary, key: str, members: list[_Row], dt: float) -> None:
-    """One locomotion set's puppets: array passes, and per-puppet Python only to read and write
-    components and for a puppet playing an override clip."""
+    """One locomotion set's puppets: array passes, and per-puppet Python only for scalar fields and
+    for a puppet playing an override clip. The array fields (blend point, feasible request, position,
+    local pose, foot-contact votes) are written through the world's :mod:`engine.columns`."""
     loco = library[key]
     space = loco.space
+    cols = columns(world)
     players = [m[3] for m in members]
+    transforms = [m[1] for m in members]
     alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
     resolved = _resolve_group(library, key, loco, members)
     target = np.array([res.point for res in resolved])
-    previous = [player.point for player in players]
-    if any(p is None for p in previous):
-        previous = [res.point if p is None else p for p, res in zip(previous, resolved, strict=True)]
+    point_column = cols.get(LocomotionPlayer, "point", key)
+    if any(player.point is None for player in players):
+        previous = [res.point if p.point is None else p.point for p, res in zip(players, resolved, strict=True)]
         eased = np.array(previous)
         fresh = np.array([player.point is None for player in players])
         points = np.where(fresh[:, None], target, eased + alpha * (target - eased))
     else:
-        eased = np.array(previous)
+        eased = point_column.read(players)
         points = eased + alpha * (target - eased)
     scale = np.array([player.scale for player in players])
     rates = np.array([res.rate for res in resolved])
     feasible = np.array([res.feasible for res in resolved]) * scale[:, None]
-    for i, (player, res) in enumerate(zip(players, resolved, strict=True)):
-        player.finished = None
-        player.point, player.feasible, player.inside, player.rate = points[i], feasible[i], res.inside, res.rate
+    point_column.write(players, points)
+    cols.get(LocomotionPlayer, "feasible", key).write(players, feasible)
     phase = np.array([player.phase for player in players])
     tracks = library.tracks(key)
     packed = _kernel.packed(space, tracks) if jit.enabled() else None
@@ -341,24 +345,28 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
     roots = blended * scale[:, None]
     travel = travel * scale[:, None]
     keep_turn = np.ones(len(members))
+    faded = np.zeros(len(members))  # the override clip's weight, where one plays
     wrapped = (new_phase % 1.0).tolist()
-    for i, (e, _tr, _pup, player) in enumerate(members):
-        player.phase = wrapped[i]
-        clip, weight = None, 0.0
-        if player.override is not None:  # the unusual puppet: a one-shot or a held pose over its blend
-            clip, weight, clip_travel = _override(player, loco, dt)
-            if clip is not None:
-                over = clip.sample(player.override_time)
-                local = crossfade(Pose(roots[i], rots[i]), Pose(over.root * scale[i], over.rotations), weight)
-                roots[i], rots[i] = local.root, local.rotations
-                travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
-                keep_turn[i] = 1.0 - weight
-        ik = world.try_get(e, IKRequest)
-        if ik is not None:
-            ik.foot_lock.contacts = None if votes is None else votes[i] * (1.0 - (weight if clip is not None else 0.0))
-            ik.foot_lock.settle = player.speed < _SETTLE_SPEED
+    overrides = []
+    for player, res, ph in zip(players, resolved, wrapped, strict=True):
+        player.finished, player.inside, player.rate, player.phase = None, res.inside, res.rate, ph
+        if player.override is not None:
+            overrides.append(player)
+    for i, player in enumerate(players) if overrides else ():
+        if player.override is None:  # the unusual puppet: a one-shot or a held pose over its blend
+            continue
+        clip, weight, clip_travel = _override(player, loco, dt)
+        if clip is not None:
+            over = clip.sample(player.override_time)
+            local = crossfade(Pose(roots[i], rots[i]), Pose(over.root * scale[i], over.rotations), weight)
+            roots[i], rots[i] = local.root, local.rotations
+            travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
+            keep_turn[i] = 1.0 - weight
+            faded[i] = weight
+    _contacts(world, members, players, votes, faded)
     # Heading, travel and the world root for the whole group at once.
-    rotation = np.array([m[1].rotation for m in members])
+    rotation_column = cols.get(Transform, "rotation")
+    rotation = rotation_column.read(transforms).copy()
     yaw = _yaw(rotation)
     hq = quat.from_axis_angle(_UP, yaw)
     step = quat.rotate(hq, travel)
@@ -366,16 +374,46 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
     hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
     rots[:, 0] = quat.mul(hq_new, rots[:, 0])
     offsets = quat.rotate(hq_new, roots)
-    positions = np.array([m[1].position for m in members]) + step
+    position_column = cols.get(Transform, "position")
+    positions = position_column.read(transforms) + step
     headings = quat.normalize(quat.mul(turn_q, rotation))
     world_roots = positions + offsets
-    for i, (e, tr, _pup, _player) in enumerate(members):
-        tr.position, tr.rotation, root = positions[i], headings[i], world_roots[i]
-        existing = world.try_get(e, LocalPose)
-        if existing is None:
-            world.queue_add(e, LocalPose(root, rots[i]))
-        else:
-            existing.root, existing.rotations = root, rots[i]
+    position_column.write(transforms, positions)
+    rotation_column.write(transforms, headings)
+    pose_store = world.components(LocalPose)
+    poses = [pose_store.get(m[0]) for m in members]
+    if None in poses:  # a puppet's first pose
+        for i, (e, *_rest) in enumerate(members):
+            if poses[i] is None:
+                world.queue_add(e, LocalPose(world_roots[i], rots[i]))
+        return
+    joints = rots.shape[1]
+    cols.get(LocalPose, "root", joints).write(poses, world_roots)
+    cols.get(LocalPose, "rotations", joints).write(poses, rots)
+
+
+def _contacts(world: World, members: list[_Row], players: list[LocomotionPlayer], votes: F | None, faded: F) -> None:
+    """The blend's foot-contact votes (less an override clip's weight) and the settle flag to each
+    puppet's foot lock, so the leg IK holds planted feet where they landed."""
+    requests = world.components(IKRequest)
+    locks = []
+    settle = []
+    for (e, *_rest), player in zip(members, players, strict=True):
+        req = requests.get(e)
+        if req is not None:
+            locks.append(req.foot_lock)
+            settle.append(player.speed < _SETTLE_SPEED)
+    for lock, flag in zip(locks, settle, strict=True):
+        lock.settle = flag
+    if votes is None:
+        for lock in locks:
+            lock.contacts = None
+        return
+    contacts = votes * (1.0 - faded)[:, None]
+    if len(locks) < len(members):
+        has = np.array([requests.get(e) is not None for e, *_rest in members])
+        contacts = contacts[has]
+    columns(world).get(FootLock, "contacts", contacts.shape[1]).write(locks, contacts)
 
 
 def install_blend(app: App) -> None:

@@ -19,11 +19,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import jit, quat
+from engine.columns import Columns
 from engine.ik import _ground_kernel as _kernel
 from engine.ik._limb import solve_limb
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
@@ -146,7 +148,14 @@ def _lock_and_lift(
 
 
 def _apply_locks(
-    locks: Sequence[FootLock | None], targets: F, new_rot: F, toes: F, floor: F, tips: F, dt: float
+    locks: Sequence[FootLock | None],
+    targets: F,
+    new_rot: F,
+    toes: F,
+    floor: F,
+    tips: F,
+    dt: float,
+    cols: Columns | None = None,
 ) -> None:
     """Hold planted toes where they landed: ``targets`` and ``new_rot`` changed in place, the locks advanced."""
     groups: dict[tuple[float, ...], list[int]] = {}
@@ -157,7 +166,7 @@ def _apply_locks(
             groups.setdefault(lock.settings(), []).append(p)
             held[p] = lock
     for members in groups.values():  # puppets whose locks share settings: one array pass
-        _lock_group(np.array(members), [held[p] for p in members], targets, new_rot, toes, floor, tips, dt)
+        _lock_group(np.array(members), [held[p] for p in members], targets, new_rot, toes, floor, tips, dt, cols)
 
 
 def _fit_lock(lock: FootLock, toes: F) -> None:
@@ -171,11 +180,19 @@ def _fit_lock(lock: FootLock, toes: F) -> None:
 
 
 def _lock_group(
-    idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, toes: F, floor: F, tips: F, dt: float
+    idx: NDArray[np.int64],
+    group: list[FootLock],
+    targets: F,
+    new_rot: F,
+    toes: F,
+    floor: F,
+    tips: F,
+    dt: float,
+    cols: Columns | None = None,
 ) -> None:
     """Lock the feet of puppets ``idx`` (their ``group`` of locks, one setting) in place, as arrays ``[G, L]``."""
     if jit.enabled():
-        _lock_group_compiled(idx, group, targets, new_rot, floor, tips, dt)
+        _lock_group_compiled(idx, group, targets, new_rot, floor, tips, dt, cols)
         return
     weights = np.stack([g.weights for g in group])
     # A planted foot keeps the heading it landed with while the body turns above it
@@ -210,22 +227,21 @@ def _lock_group(
 
 
 def _lock_group_compiled(
-    idx: NDArray[np.int64], group: list[FootLock], targets: F, new_rot: F, floor: F, tips: F, dt: float
+    idx: NDArray[np.int64],
+    group: list[FootLock],
+    targets: F,
+    new_rot: F,
+    floor: F,
+    tips: F,
+    dt: float,
+    cols: Columns | None = None,
 ) -> None:
-    """:func:`_lock_group` on the compiled kernel: the locks' state gathered into ``[G, L]`` arrays, one pass,
-    each lock given its rows back."""
+    """:func:`_lock_group` on the compiled kernel: the locks' state as ``[G, L]`` arrays, one pass.
+
+    With ``cols`` the state stays in columns the locks view (:mod:`engine.columns`), which the
+    kernel updates in place; without, it is gathered from the locks and each given its rows back."""
     legs = tips.shape[0]
-    try:
-        contacts = np.array([g.contacts for g in group], dtype=np.float64)
-    except ValueError:  # ragged: some puppet's vote is one number for every leg
-        contacts = np.zeros(0)
-    if contacts.shape != (len(group), legs):
-        contacts = np.stack([np.broadcast_to(np.asarray(g.contacts, dtype=np.float64), (legs,)) for g in group])
-    points, weights = np.array([g.points for g in group]), np.array([g.weights for g in group])
-    planted = np.array([g.planted for g in group], dtype=bool)
-    stepping = np.array([g.stepping for g in group], dtype=bool)
-    yaw, animated = np.array([g.yaw for g in group]), np.array([g.animated for g in group])
-    settle = np.array([g.settle for g in group], dtype=bool)
+    state = _lock_state(group, legs, cols)
     _kernel.lock_group(
         np.asarray(idx, dtype=np.int64),
         targets,
@@ -234,18 +250,51 @@ def _lock_group_compiled(
         np.ascontiguousarray(tips, dtype=np.float64),
         dt,
         np.array(group[0].settings()),
-        points,
-        weights,
-        planted,
-        stepping,
-        yaw,
-        animated,
-        contacts,
-        settle,
+        state["points"],
+        state["weights"],
+        state["planted"],
+        state["stepping"],
+        state["yaw"],
+        state["animated"],
+        _lock_contacts(group, legs, cols),
+        np.array([g.settle for g in group], dtype=bool),
     )
+    if cols is not None:
+        for name in _LOCK_STATE:
+            cols.get(FootLock, name, legs, _LOCK_TYPES.get(name, np.float64)).write(group, state[name])
+        return
     for k, g in enumerate(group):
-        g.points, g.weights, g.planted, g.stepping = points[k], weights[k], planted[k], stepping[k]
-        g.yaw, g.animated = yaw[k], animated[k]
+        g.points, g.weights, g.planted, g.stepping = (state[n][k] for n in ("points", "weights", "planted", "stepping"))
+        g.yaw, g.animated = state["yaw"][k], state["animated"][k]
+
+
+#: The lock state the compiled kernel advances in place, in its argument order, and the non-float fields.
+_LOCK_STATE = ("points", "weights", "planted", "stepping", "yaw", "animated")
+_LOCK_TYPES: dict[str, type] = {"planted": np.bool_, "stepping": np.bool_}
+
+
+def _lock_state(group: list[FootLock], legs: int, cols: Columns | None) -> dict[str, NDArray[Any]]:
+    """The locks' state fields as writable C-contiguous ``[G, L…]`` arrays (the columns themselves, given ``cols``)."""
+    if cols is None:
+        return {
+            name: np.array([getattr(g, name) for g in group], dtype=_LOCK_TYPES.get(name, np.float64))
+            for name in _LOCK_STATE
+        }
+    return {name: cols.get(FootLock, name, legs, _LOCK_TYPES.get(name, np.float64)).read(group) for name in _LOCK_STATE}
+
+
+def _lock_contacts(group: list[FootLock], legs: int, cols: Columns | None) -> F:
+    """The locks' contact votes ``[G, L]`` (a vote given as one number holds for every leg)."""
+    try:
+        if cols is not None:
+            contacts = cols.get(FootLock, "contacts", legs).read(group)
+        else:
+            contacts = np.array([g.contacts for g in group], dtype=np.float64)
+    except ValueError:  # ragged: some puppet's vote is one number for every leg
+        contacts = np.zeros(0)
+    if contacts.shape != (len(group), legs):
+        contacts = np.stack([np.broadcast_to(np.asarray(g.contacts, dtype=np.float64), (legs,)) for g in group])
+    return contacts
 
 
 def _reach_shift(hips: F, targets: F, lengths: F, shift: F, max_pelvis_shift: float) -> F:
@@ -358,6 +407,7 @@ def ground_feet_batch(
     weight: ArrayLike = 1.0,
     locks: Sequence[FootLock | None] | None = None,
     dt: float = 0.0,
+    lock_columns: Columns | None = None,
 ) -> F:
     """:func:`ground_feet` for ``P`` puppets of one skeleton at once, in place.
 
@@ -372,6 +422,8 @@ def ground_feet_batch(
         offsets: ``[J,3]`` or ``[P,J,3]`` bone offsets.
         weight: ``[P]`` (or one) 0..1 blend of the whole effect.
         locks: per puppet, its :class:`~engine.ik.foot_lock.FootLock` (or ``None``), advanced by ``dt``.
+        lock_columns: where the compiled path keeps the locks' state as columns
+            (:mod:`engine.columns`: no gather and scatter per step); without it, gathered.
 
     Returns:
         ``[P]`` pelvis height changes applied.
@@ -398,6 +450,7 @@ def ground_feet_batch(
             w,
             locks,
             dt,
+            lock_columns,
         )
     soles = np.array([leg.sole for leg in legs])
     ankle, qfoot, hip = [], [], []
@@ -454,6 +507,7 @@ def _ground_compiled(
     w: F,
     locks: Sequence[FootLock | None] | None,
     dt: float,
+    lock_columns: Columns | None = None,
 ) -> F:
     """:func:`ground_feet_batch` on the compiled kernels (:mod:`engine.ik._ground_kernel`); the locks in numpy."""
     p, n = rotations.shape[0], len(legs)
@@ -490,7 +544,8 @@ def _ground_compiled(
         floor,
     )
     if locks is not None:
-        _apply_locks(locks, targets, new_rot, targets + quat.rotate(new_rot, tips), floor, tips, dt)
+        toes = targets + quat.rotate(new_rot, tips)
+        _apply_locks(locks, targets, new_rot, toes, floor, tips, dt, lock_columns)
     shift = np.empty(p)
     _kernel.legs_solve(
         skeleton.parents,

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.columns import columns
 from engine.components import LocalPose, Puppet
 from engine.ecs import World
 from engine.humanoid import JOINTS
@@ -116,14 +117,21 @@ def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]
     ground = world.try_resource(IKGround)
     query = ground.query if ground is not None else PlaneGround()
     done: set[int] = set()
+    cols = columns(world)
     for group in groups.values():
         if len(group) < cache.batch_from:
             continue
         sk = cache.same_as(group[0][0].skeleton)
-        roots = np.array([local.root for _, local, _ in group], dtype=np.float64)
-        rots = np.array([local.rotations for _, local, _ in group], dtype=np.float64)
-        offsets = np.array([p.joint_offsets() for p, _, _ in group])
-        weights = np.array([req.grounding_weight for _, _, req in group])
+        poses = [local for _, local, _ in group]
+        requests = [req for _, _, req in group]
+        # The local poses are read and written through their columns (engine.columns): no gather, no
+        # scatter. The solve works on copies, so a row that comes out non-finite keeps its animated pose.
+        root_column = cols.get(LocalPose, "root", sk.num_joints)
+        rotation_column = cols.get(LocalPose, "rotations", sk.num_joints)
+        given_roots, given_rots = root_column.read(poses), rotation_column.read(poses)
+        roots, rots = given_roots.copy(), given_rots.copy()
+        offsets = cols.stacked(("ik-offsets", id(sk)))([p.joint_offsets() for p, _, _ in group])
+        weights = np.array([req.grounding_weight for req in requests])
         shift = ground_feet_batch(
             sk,
             roots,
@@ -131,19 +139,23 @@ def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]
             query,
             offsets=offsets,
             weight=weights,
-            locks=[req.foot_lock for _, _, req in group],
+            locks=[req.foot_lock for req in requests],
             dt=world.dt,
+            lock_columns=cols,
         )
+        done.update(map(id, requests))
+        for req, value in zip(requests, shift.tolist(), strict=True):
+            req.pelvis_shift = value
         finite = np.asarray(np.isfinite(roots).all(axis=1) & np.isfinite(rots).all(axis=(1, 2)))
-        for i, (puppet, local, req) in enumerate(group):
-            done.add(id(req))
-            req.pelvis_shift = float(shift[i])
-            pose = Pose(roots[i], rots[i])
+        for i, (puppet, _, req) in enumerate(group):
             if req.sphere_centre is not None and req.sphere_radius > 0.0:
+                pose = Pose(roots[i], rots[i])
                 hands_on_sphere(puppet.skeleton, pose, req.sphere_centre, req.sphere_radius, offsets=puppet.offsets)
                 finite[i] = pose.is_finite()
-            if finite[i]:
-                local.root, local.rotations = pose.root, pose.rotations
+        if not finite.all():  # a bad target must not poison the puppet: keep the animated pose
+            roots[~finite], rots[~finite] = given_roots[~finite], given_rots[~finite]
+        root_column.write(poses, roots)
+        rotation_column.write(poses, rots)
     return done
 
 

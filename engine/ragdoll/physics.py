@@ -222,12 +222,14 @@ class PhysicsWorld(Readback, Building):
         c.muscle, c.pin = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
         c.support = float(np.clip(gravity_support, 0, 1))
 
-    def drive_animated(self, keys: list[int], roots: list[_F], rotations: list[_F]) -> list[int]:
+    def drive_animated(self, keys: list[int], roots: list[_F] | _F, rotations: list[_F] | _F) -> list[int]:
         """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
         in one pass: a crowd of animated puppets is most of the physics stage's Python work).
 
-        A target with NaN or infinite values is not taken: that ragdoll keeps its previous
-        command (see :meth:`target`), so a bad pose never reaches MuJoCo.
+        ``roots`` is ``[P, 3]`` (or a list of ``[3]``); ``rotations`` a list of ``[J, 4]`` per ragdoll,
+        or ``[P, J, 4]`` when all have ``J`` joints. A target with NaN or infinite values is not
+        taken: that ragdoll keeps its previous command (see :meth:`target`), so a bad pose never
+        reaches MuJoCo.
 
         Returns:
             The keys whose targets were refused.
@@ -237,13 +239,18 @@ class PhysicsWorld(Readback, Building):
         slots = [self._slot(k) for k in keys]
         sizes = [s.spec.skeleton.num_joints for s in slots]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
-        q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
+        stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
+        if stacked:
+            q = np.asarray(rotations, dtype=np.float64).reshape(-1, 4)
+        else:
+            q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
         if q.shape != (sum(sizes), 4):
             raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes}")
         ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
         ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
         q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
-        for slot, good, root, rot in zip(slots, ok, r, np.split(q, ends[:-1]), strict=True):
+        per_ragdoll = list(q.reshape(len(keys), -1, 4)) if stacked else np.split(q, ends[:-1])
+        for slot, good, root, rot in zip(slots, ok.tolist(), r, per_ragdoll, strict=True):
             c = slot.cmd
             if good:
                 c.root, c.rot = root, rot

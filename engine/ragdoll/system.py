@@ -17,10 +17,11 @@ Ragdolls and props that appear in the same step are added in one rebuild.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.app import App
+from engine.columns import columns
 from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import Entity, World
 from engine.pose import Pose
@@ -67,9 +68,7 @@ def physics_step(world: World) -> None:
     rows = world.query(Ragdoll, Puppet, LocalPose)
     animated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is RagdollMode.ANIMATED]
     simulated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is not RagdollMode.ANIMATED]
-    refused = pw.drive_animated(
-        [e for e, _, _ in animated], [p.root for _, _, p in animated], [p.rotations for _, _, p in animated]
-    )
+    refused = pw.drive_animated([e for e, _, _ in animated], *_animated_targets(world, rows, animated))
     targets: dict[Entity, Pose] = {}
     for e, rd, pose in simulated:
         rd.ramp(world.dt)
@@ -85,7 +84,8 @@ def physics_step(world: World) -> None:
         pose = world.get(e, LocalPose)
         pose.root, pose.rotations = pw.target(e).root, pw.target(e).rotations
     for _, rd, _ in animated:
-        rd.ramp(world.dt)
+        if rd.muscle_weight != rd.muscle_target or rd.pin_weight != rd.pin_target or rd.blend_weight != rd.blend_target:
+            rd.ramp(world.dt)  # (at its targets a ragdoll's ramp changes nothing)
         # not simulated: the body is its animation (no energy of its own, nothing to settle)
         rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
     for e, rd, _, _ in rows:
@@ -104,6 +104,21 @@ def physics_step(world: World) -> None:
         if not prop.carried:
             pos, rot, vel = pw.prop_state(e)
             tr.position, tr.rotation, prop.velocity = pos, rot, vel
+
+
+def _animated_targets(
+    world: World,
+    rows: list[tuple[Entity, Ragdoll, Puppet, LocalPose]],
+    animated: list[tuple[Entity, Ragdoll, LocalPose]],
+) -> tuple[NDArray[np.float64] | list[NDArray[np.float64]], NDArray[np.float64] | list[NDArray[np.float64]]]:
+    """The animated ragdolls' targets: their local poses' roots ``[P, 3]`` and rotations ``[P, J, 4]``
+    read from the pose columns (:mod:`engine.columns`) when all have ``J`` joints, else as lists."""
+    joints = {puppet.skeleton.num_joints for _, rd, puppet, _ in rows if rd.mode is RagdollMode.ANIMATED}
+    poses = [pose for _, _, pose in animated]
+    if len(joints) != 1:
+        return [p.root for p in poses], [p.rotations for p in poses]
+    cols, count = columns(world), joints.pop()
+    return cols.get(LocalPose, "root", count).read(poses), cols.get(LocalPose, "rotations", count).read(poses)
 
 
 def install_physics(app: App, timestep: float | None = None, substeps: int = 8) -> None:

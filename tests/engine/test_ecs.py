@@ -108,3 +108,15 @@ def test_component_types_are_the_ones_in_use_by_name():
     assert w.component_types() == [Pos, Vel]
     w.remove(e, Pos)
     assert w.component_types() == [Vel]
+
+
+def test_components_is_a_live_read_only_view_of_one_type() -> None:
+    """``World.components`` sees adds and removals and cannot be written through."""
+    world = World()
+    seen = world.components(int)
+    e = world.spawn(5)
+    assert seen.get(e) == 5 and len(seen) == 1
+    world.remove(e, int)
+    assert seen.get(e) is None
+    with pytest.raises(TypeError):
+        seen[e] = 3  # type: ignore[index]  # the view is read-only: this is what is tested

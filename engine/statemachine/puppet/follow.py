@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.blend.locomotion import LocomotionPlayer
+from engine.columns import Columns
 from engine.components import Transform
 from engine.ecs import Entity, World
 from engine.statemachine.puppet.body import PuppetBody, PuppetTuning
@@ -133,19 +134,31 @@ def _face(
 
 
 def follow_released(
-    dt: float, bodies: list[PuppetBody], transforms: list[Transform], players: list[LocomotionPlayer]
+    dt: float,
+    bodies: list[PuppetBody],
+    transforms: list[Transform],
+    players: list[LocomotionPlayer],
+    cols: Columns | None = None,
 ) -> None:
     """:func:`follow_velocity` (``speed_scale`` 1) for puppets no stick holds, over arrays.
 
     Unheld, the spring pulls the request to rest; the spring step, the speed and the
     facing rotation are computed for all at once with the very operations of the
     single-puppet path (elementwise, so the numbers are the same), and only a puppet
-    still moving fast enough to turn is turned one by one."""
+    still moving fast enough to turn is turned one by one. With ``cols`` the bodies'
+    spring state and the rotations of the puppets that stand are kept in columns
+    (:mod:`engine.columns`), not gathered and scattered."""
     n = len(bodies)
     if n == 0:
         return
-    value = np.array([b.walk_velocity for b in bodies], dtype=np.float64).reshape(n, 3)
-    rate = np.array([b.walk_rate for b in bodies], dtype=np.float64).reshape(n, 3)
+    if cols is None:
+        value = np.array([b.walk_velocity for b in bodies], dtype=np.float64).reshape(n, 3)
+        rate = np.array([b.walk_rate for b in bodies], dtype=np.float64).reshape(n, 3)
+        recent = np.array([b.recent for b in bodies], dtype=np.float64).reshape(n, -1, 3)
+    else:
+        value = cols.get(PuppetBody, "walk_velocity").read(bodies)
+        rate = cols.get(PuppetBody, "walk_rate").read(bodies)
+        recent = cols.get(PuppetBody, "recent").read(bodies)
     goal = np.zeros((n, 3))
     # The single path brakes when |goal| = 0 < |v|, i.e. when v·v > 0 (a sum of squares is
     # positive exactly when one of them is).
@@ -155,12 +168,23 @@ def follow_released(
     speed = np.hypot(value[:, 0], value[:, 2])
     heading = np.array([b.heading for b in bodies])
     rotation = yaw_rotation(heading)
-    recent = np.array([b.recent for b in bodies], dtype=np.float64).reshape(n, -1, 3)
     recent = np.concatenate([recent[:, 1:], value[:, None]], axis=1)
-    for i, (body, tr, player) in enumerate(zip(bodies, transforms, players, strict=True)):
-        body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
-        if speed[i] > 1e-3:
-            _face(tr, body, player, float(speed[i]), dt, 1.0)
-        else:
-            tr.rotation = rotation[i]
-            player.speed = float(speed[i])
+    if cols is None:
+        for i, body in enumerate(bodies):
+            body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
+    else:
+        cols.get(PuppetBody, "walk_velocity").write(bodies, value)
+        cols.get(PuppetBody, "walk_rate").write(bodies, rate)
+        cols.get(PuppetBody, "recent").write(bodies, recent)
+    speeds = speed.tolist()
+    still = [i for i, v in enumerate(speeds) if not v > 1e-3]
+    for i, v in enumerate(speeds):
+        if v > 1e-3:
+            _face(transforms[i], bodies[i], players[i], v, dt, 1.0)
+    for i in still:
+        players[i].speed = speeds[i]
+    if cols is None or len(still) < n // 2:
+        for i in still:
+            transforms[i].rotation = rotation[i]
+    else:
+        cols.get(Transform, "rotation").write([transforms[i] for i in still], rotation[still])

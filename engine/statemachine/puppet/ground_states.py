@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
+from engine.columns import columns as engine_columns
 from engine.components import Transform
 from engine.ecs import Entity, World
 from engine.ik.system import IKRequest
@@ -138,19 +139,21 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
         else:
             update_locomotion(world, columns.entities[i], world.get(columns.entities[i], Brain))
     transforms, players = [], []
+    handling, locomotion = world.components(Handling), world.components(LocomotionPlayer)
+    requests, placed = world.components(IKRequest), world.components(Transform)
     for i in fast:
         e = columns.entities[i]
-        world.get(e, Handling).left = None  # standing
-        player = world.get(e, LocomotionPlayer)
+        handling[e].left = None  # standing
+        player = locomotion[e]
         player.height = None
-        ik = world.try_get(e, IKRequest)
+        ik = requests.get(e)
         if ik is not None:
             ik.foot_lock.enabled = True
             ik.grounding = True
             ik.sphere_centre, ik.sphere_radius = None, 0.0
-        transforms.append(world.get(e, Transform))
+        transforms.append(placed[e])
         players.append(player)
-    follow_released(world.dt, [columns.bodies[i] for i in fast], transforms, players)
+    follow_released(world.dt, [columns.bodies[i] for i in fast], transforms, players, engine_columns(world))
 
 
 _LOCOMOTION: PuppetStateDef = PuppetStateDef(

@@ -1,0 +1,189 @@
+"""Columns: one array field of many components kept as the rows of one array the components view.
+
+A crowd's hot per-puppet arrays (local poses, world poses, foot locks) are written by one
+system and read by the next every step. Gathering them from a hundred component objects
+(``np.array([c.rotations for c in comps])``) and scattering the results back
+(``for k, c in enumerate(comps): c.rotations = out[k]``) is Python work per puppet that
+costs more than the compiled kernels in between. A :class:`Column` keeps the field of a
+fixed list of components (a batch, in a fixed row order) as one ``[N, ...]`` array and
+sets each component's field to a *view* of its row, once. From then on:
+
+- :meth:`Column.write` copies a batch's new values into the array in place: every
+  component sees its row, and no component is touched.
+- :meth:`Column.read` hands out the array itself: no gather.
+
+The components stay plain objects that any code may read and assign as before. A
+component whose field was replaced by other code (``pose.rotations = other``, a state's
+override) no longer views its row; both methods notice it by identity and take the
+new value in (``read``) or re-link the row (``write``), so a puppet in an unusual state
+costs a little Python and the crowd none. What changes for other code: a field that views a
+column is overwritten in place by the next write, so a reference kept across steps must be
+a copy (``np.array(c.rotations)``), as with any array that a system updates in place.
+
+A column of a batch whose members change (a puppet spawned or removed, a group that
+splits) is rebuilt from the components' current values: correct whatever happened, and
+only as costly as the gather it replaces.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from operator import attrgetter
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from engine.ecs import World
+
+__all__ = ["Column", "Columns", "Stacked", "columns"]
+
+
+class Column:
+    """Field ``attr`` of a batch of components, as rows of one array they view.
+
+    Args:
+        attr: the field's name on each component.
+        dtype: the array's type (a field of another type is converted when taken in).
+    """
+
+    __slots__ = ("attr", "dtype", "_get", "_ids", "_owners", "_row", "base", "_views")
+
+    def __init__(self, attr: str, dtype: type = np.float64) -> None:
+        self.attr = attr
+        self.dtype = dtype
+        self._get = attrgetter(attr)
+        self._ids: list[int] = []
+        self._owners: list[Any] = []
+        self._row: dict[int, int] = {}
+        self.base: NDArray[Any] | None = None
+        self._views: list[NDArray[Any]] = []
+
+    def _rows(self, owners: Sequence[Any]) -> slice | list[int] | None:
+        """Where ``owners`` are in the column: all of it in order (``slice(None)``), some of its rows,
+        or ``None`` when one is not in it (or the rows are no views of the array: a copied world)."""
+        if self.base is None or (self._views and self._views[0].base is not self.base):
+            return None
+        ids = list(map(id, owners))
+        if ids == self._ids:
+            return _ALL
+        row = self._row
+        try:
+            return [row[k] for k in ids]
+        except KeyError:
+            return None
+
+    def _sync(self, rows: slice | list[int], take_in: bool) -> bool:
+        """Point the fields replaced by other code at their rows again, first copying their values in
+        if ``take_in``; ``False`` (and nothing re-linked after it) if such a value has another shape."""
+        index = range(len(self._owners)) if rows is _ALL else rows
+        assert isinstance(index, range | list)
+        owners, views = self._owners, self._views
+        for i in index:
+            now = self._get(owners[i])
+            if now is views[i]:
+                continue
+            if take_in:
+                value: NDArray[Any] = np.asarray(now, dtype=self.dtype)
+                if value.shape != views[i].shape:
+                    return False
+                views[i][...] = value
+            setattr(owners[i], self.attr, views[i])
+        return True
+
+    def _link(self, owners: Sequence[Any], base: NDArray[Any]) -> NDArray[Any]:
+        """Make ``base`` the column of ``owners`` and point every component's field at its row."""
+        if base.ndim < 2:
+            raise ValueError(f"a column holds array fields, one row each: {self.attr} has shape {base.shape[1:]}")
+        self.base, self._owners, self._ids = base, list(owners), list(map(id, owners))
+        self._row = {k: i for i, k in enumerate(self._ids)}
+        self._views = list(base)
+        for owner, view in zip(owners, self._views, strict=True):
+            setattr(owner, self.attr, view)
+        return base
+
+    def read(self, owners: Sequence[Any]) -> NDArray[Any]:
+        """The field of every component of ``owners`` as one array ``[N, ...]``.
+
+        For the column's whole batch it is the column itself (no copy): changing it in place
+        changes the components' fields. For part of the batch it is a copy of their rows.
+        A field replaced since the last call is taken in first; components not in the
+        column (or a replaced field of another shape) build it anew from their fields.
+        """
+        rows = self._rows(owners)
+        if rows is None or not self._sync(rows, take_in=True):
+            return self._link(owners, np.array([self._get(o) for o in owners], dtype=self.dtype))
+        assert self.base is not None
+        return self.base if rows is _ALL else self.base[rows]
+
+    def write(self, owners: Sequence[Any], values: ArrayLike) -> None:
+        """Set the field of every component of ``owners`` to its row of ``values`` ``[N, ...]`` (copied)."""
+        values = np.asarray(values, dtype=self.dtype)
+        rows = self._rows(owners)
+        if rows is _ALL and values is self.base:  # changed in place: what read handed out
+            return
+        if rows is None or self.base is None or self.base.shape[1:] != values.shape[1:] or len(values) != len(owners):
+            self._link(owners, values.copy())
+            return
+        self._sync(rows, take_in=False)
+        self.base[rows] = values
+
+
+_ALL = slice(None)
+
+
+class Columns:
+    """Resource: the columns of a world, by (component type, field, batch key). Not simulation state:
+    the values live in the components (the columns are how they are stored), so it is never hashed."""
+
+    SIM_STATE = False
+
+    def __init__(self) -> None:
+        self._columns: dict[tuple[type, str, object], Column] = {}
+        self._stacks: dict[object, Stacked] = {}
+
+    def get(self, ctype: type, attr: str, key: object = None, dtype: type = np.float64) -> Column:
+        """The column of field ``attr`` of ``ctype`` for the batch named ``key`` (made on first use)."""
+        column = self._columns.get((ctype, attr, key))
+        if column is None:
+            column = self._columns[(ctype, attr, key)] = Column(attr, dtype)
+        return column
+
+    def stacked(self, key: object) -> Stacked:
+        """The :class:`Stacked` cache named ``key`` (made on first use)."""
+        stack = self._stacks.get(key)
+        if stack is None:
+            stack = self._stacks[key] = Stacked()
+        return stack
+
+
+def columns(world: World) -> Columns:
+    """The world's :class:`Columns` resource (inserted on first use)."""
+    found = world.try_resource(Columns)
+    if found is None:
+        found = Columns()
+        world.insert_resource(found)
+    return found
+
+
+class Stacked:
+    """The stack ``[N, ...]`` of a batch's arrays that do not change in place (a skeleton's offsets).
+
+    Rebuilt only when one of the arrays is another object than last time (it keeps them, so
+    an id is never reused while cached). The result is shared: read it, never change it.
+    """
+
+    __slots__ = ("_arrays", "_ids", "_stack")
+
+    def __init__(self) -> None:
+        self._arrays: list[Any] = []
+        self._ids: list[int] = []
+        self._stack: NDArray[np.float64] | None = None
+
+    def __call__(self, arrays: Sequence[Any]) -> NDArray[np.float64]:
+        """The stack of ``arrays`` (float64)."""
+        ids = list(map(id, arrays))
+        if self._stack is None or ids != self._ids:
+            self._arrays, self._ids = list(arrays), ids
+            self._stack = np.array(arrays, dtype=np.float64)
+        return self._stack

@@ -1,0 +1,124 @@
+"""Columns: a batch's array field stored as rows of one array the components view.
+
+What must hold for the systems that use them: the components always show the values
+written (in place, with no scatter), a read hands out the column itself with no gather, a
+field that other code replaced is taken in (read) or overwritten (write) and its row
+re-linked, and a batch that changes membership or shape is rebuilt from the fields.
+Broken once to check the tests can fail: with ``_sync`` not copying a replaced value in
+(``views[i][...] = value`` removed), ``test_a_replaced_field_is_taken_in_and_relinked``
+fails (the column keeps the old row).
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from engine.columns import Column, Columns, Stacked, columns
+from engine.ecs import World
+
+
+@dataclass
+class _Pose:
+    root: np.ndarray
+
+
+def _poses(n: int) -> list[_Pose]:
+    return [_Pose(np.full(3, float(i))) for i in range(n)]
+
+
+def test_write_makes_fields_views_and_read_is_the_column() -> None:
+    poses = _poses(4)
+    col = Column("root")
+    values = np.arange(12.0).reshape(4, 3)
+    col.write(poses, values)
+    for i, p in enumerate(poses):
+        assert np.array_equal(p.root, values[i])
+    col.write(poses, values + 1.0)  # in place: the same view objects see the new rows
+    assert all(np.array_equal(p.root, values[i] + 1.0) for i, p in enumerate(poses))
+    column = col.read(poses)
+    assert column is col.base
+    column[2] = -5.0  # the column itself: a change in place reaches the component
+    assert np.array_equal(poses[2].root, [-5.0, -5.0, -5.0])
+
+
+def test_read_of_fresh_components_gathers_them() -> None:
+    poses = _poses(3)
+    col = Column("root")
+    assert np.array_equal(col.read(poses), [[0.0] * 3, [1.0] * 3, [2.0] * 3])
+    assert poses[1].root.base is col.base
+
+
+def test_a_replaced_field_is_taken_in_and_relinked() -> None:
+    poses = _poses(3)
+    col = Column("root")
+    col.read(poses)
+    poses[1].root = np.array([7.0, 8.0, 9.0])  # other code replaces the field
+    assert np.array_equal(col.read(poses)[1], [7.0, 8.0, 9.0])
+    assert poses[1].root.base is col.base
+    poses[0].root = np.array([1.0, 1.0, 1.0])
+    col.write(poses, np.zeros((3, 3)))  # a write overwrites it and links the row again
+    assert np.array_equal(poses[0].root, [0.0, 0.0, 0.0])
+    assert poses[0].root.base is col.base
+
+
+def test_part_of_the_batch_is_read_as_a_copy_and_written_in_its_rows() -> None:
+    poses = _poses(4)
+    col = Column("root")
+    col.read(poses)
+    part = [poses[3], poses[1]]
+    rows = col.read(part)
+    assert np.array_equal(rows, [[3.0] * 3, [1.0] * 3]) and rows.base is not col.base
+    col.write(part, np.array([[30.0] * 3, [10.0] * 3]))
+    assert [float(p.root[0]) for p in poses] == [0.0, 10.0, 2.0, 30.0]
+    assert col.read(poses) is col.base  # the whole batch is still the column
+
+
+def test_a_new_member_or_shape_rebuilds_the_column() -> None:
+    poses = _poses(2)
+    col = Column("root")
+    first = col.read(poses)
+    more = [*poses, _Pose(np.full(3, 5.0))]
+    assert np.array_equal(col.read(more)[:, 0], [0.0, 1.0, 5.0]) and col.base is not first
+    for p in more:
+        p.root = np.zeros(4)  # fields of another shape
+    assert col.read(more).shape == (3, 4)
+    assert more[2].root.base is col.base
+
+
+def test_ragged_fields_raise_and_scalars_are_refused() -> None:
+    col = Column("root")
+    with pytest.raises(ValueError):
+        col.read([_Pose(np.zeros(3)), _Pose(np.zeros(2))])
+    with pytest.raises(ValueError, match="array fields"):
+        col.write(_poses(2), np.zeros(2))
+
+
+def test_a_copied_batch_is_not_taken_for_the_column() -> None:
+    poses = _poses(3)
+    col = Column("root")
+    col.write(poses, np.ones((3, 3)))
+    poses2, col2 = copy.deepcopy((poses, col))  # a copied world: fields are copies, no views
+    col2.write(poses2, np.full((3, 3), 4.0))
+    assert all(np.array_equal(p.root, [4.0] * 3) for p in poses2)
+    assert all(np.array_equal(p.root, [1.0] * 3) for p in poses)
+
+
+def test_stacked_is_rebuilt_only_for_other_arrays() -> None:
+    a, b = np.zeros((2, 3)), np.ones((2, 3))
+    stack = Stacked()
+    first = stack([a, b])
+    assert stack([a, b]) is first
+    c = np.full((2, 3), 2.0)
+    assert np.array_equal(stack([a, c])[1], c)
+
+
+def test_the_world_resource_is_made_once_and_never_hashed() -> None:
+    world = World()
+    cols = columns(world)
+    assert columns(world) is cols and cols.get(_Pose, "root", 3) is cols.get(_Pose, "root", 3)
+    assert cols.get(_Pose, "root", 3) is not cols.get(_Pose, "root", 4)
+    assert Columns.SIM_STATE is False
