@@ -13,7 +13,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
 from engine.skeleton import Skeleton
@@ -23,7 +22,8 @@ if TYPE_CHECKING:
 
 __all__ = ["bone_axis", "HANDLE_LENGTH", "ORIENT_RGB", "turn_towards", "orientation_sticks"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 HANDLE_LENGTH = 0.08  # metres
 ORIENT_RGB = (0.1, 0.75, 0.7)
 

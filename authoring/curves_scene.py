@@ -55,7 +55,8 @@ from engine.render.scene import RenderScene
 
 __all__ = ["CurvesScene"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 ORANGE = (0.95, 0.55, 0.1)
 RED = (0.9, 0.1, 0.1)
 PURPLE = (0.6, 0.15, 0.85)

@@ -9,14 +9,13 @@ over the puppet.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from authoring.curves_timeline import Timeline
 from engine.camera import OrbitCamera
 
 __all__ = ["panel_layout", "framing_camera"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def panel_layout(size: tuple[int, int]) -> tuple[int, int]:

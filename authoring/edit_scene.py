@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from authoring.mocurves import LAYERS, EditSession, RetimeDrag, item_chain, plane_from_stroke
 from authoring.mocurves.curves import MoCurve
@@ -38,7 +37,8 @@ from engine.skinning import SkinBinding
 
 __all__ = ["EditScene", "MODES", "speed_lines"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 MODES = ("points", "arrows", "timing", "contact")
 CURVE = (0.95, 0.55, 0.1)
 FAINT = (0.55, 0.6, 0.7)

@@ -36,7 +36,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from authoring.cycles import CycleError, CycleResult, Item, Trajectory, extract_cycle
 from authoring.joint_pick import joint_at
@@ -56,7 +55,8 @@ from engine.skeleton import Skeleton
 
 __all__ = ["DRIVES", "PERFORM", "READY_HINT", "RecordScene", "drag_rotation", "mouse_point"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 DRIVES = ("translation", "rotation", "pose", "scale")
 _WIDTH = {"translation": 3, "rotation": 4, "pose": 7, "scale": 1}  # numbers in one performed value
 PERFORMANCE = (0.95, 0.55, 0.1)  # orange: what was performed

@@ -8,13 +8,12 @@ same thing, to the pixel, in both.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine.camera import Camera
 
 __all__ = ["PICK_PX", "point_on_view_plane", "pick_point"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 PICK_PX = 14.0  # how close (pixels) the pointer must be to a drawn point to take it
 

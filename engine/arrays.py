@@ -16,7 +16,7 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["F64", "F32", "I64", "I32", "U8", "Bool"]
+__all__ = ["F64", "F32", "I64", "I32", "Intp", "U8", "Bool"]
 
 F64: TypeAlias = NDArray[np.float64]
 """Positions, rotations, weights: the simulation's numbers."""
@@ -24,6 +24,8 @@ F32: TypeAlias = NDArray[np.float32]
 """What the GPU reads (vertex and instance data)."""
 I64: TypeAlias = NDArray[np.int64]
 """Indices: joints, frames, parents."""
+Intp: TypeAlias = NDArray[np.intp]
+"""Row numbers as numpy hands them out (``nonzero``, ``argsort``, ``flatnonzero``)."""
 I32: TypeAlias = NDArray[np.int32]
 """Triangle indices as GL reads them."""
 U8: TypeAlias = NDArray[np.uint8]

@@ -12,11 +12,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 __all__ = ["OneEuro", "smoothing_factor"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def smoothing_factor(dt: float, cutoff: F | float) -> F | float:

@@ -25,7 +25,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
 from input.hid_reports import (
@@ -48,7 +47,8 @@ from input.source import PoseSource
 
 __all__ = ["SpaceMouseIntegrator", "ImuIntegrator", "HidSource", "enumerate_supported"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _RAW_TO_ENGINE = np.array([[-1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, -1.0, 0.0]])
 
 

@@ -22,7 +22,6 @@ import struct
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine.errors import FormatError
 
@@ -47,7 +46,8 @@ __all__ = [
     "known_device",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 AXIS_SCALE = 350.0
 
 # (vid, pid) -> name; rotation in report 2 unless listed in SPACEMOUSE_COMBINED.

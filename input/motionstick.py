@@ -33,7 +33,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
 from engine.components import Grabbable, Obstacle, Stick, Transform
@@ -44,7 +43,8 @@ from input.stick_geometry import pick, shorten
 
 __all__ = ["StickState", "StickConfig", "motionstick_system", "spawn_stick"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _Z = np.array([0.0, 0.0, 1.0])
 
 

@@ -39,9 +39,6 @@ from input.source import PoseSource
 
 __all__ = ["MouseSource", "RayCamera"]
 
-F = NDArray[np.float64]
-
-# pygame event type ids (pygame.locals), copied so this module needs no display.
 MOUSEMOTION, MOUSEBUTTONDOWN, MOUSEBUTTONUP, MOUSEWHEEL = 1024, 1025, 1026, 1027
 
 

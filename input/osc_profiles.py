@@ -33,7 +33,6 @@ from typing import Any
 
 import numpy as np
 import pythonosc
-from numpy.typing import NDArray
 from pythonosc import osc_packet
 from pythonosc.dispatcher import Dispatcher
 
@@ -43,7 +42,8 @@ from input.sample import PoseSample
 
 __all__ = ["OscDecoder", "SenderState", "G"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 G = 9.80665
 UNIT_TOLERANCE = 0.05  # phones send float32 quaternions; beyond this the packet is wrong
 # No phone app sends a number this large (metres, rad/s, m/s², g); a bigger one is an attack or

@@ -20,7 +20,7 @@ in every case: tap-to-calibrate fixes it in the MotionStick.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
 
@@ -36,7 +36,7 @@ __all__ = [
     "reorder_quat",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 WORLD_Z_UP_TO_ENGINE: F = quat.from_axis_angle([1.0, 0.0, 0.0], -np.pi / 2)
 STICK_TO_DEVICE: F = quat.from_axis_angle([0.0, 1.0, 1.0], np.pi)

@@ -23,7 +23,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+
+from engine.arrays import F64 as F
 
 __all__ = [
     "PoseSample",
@@ -55,8 +56,6 @@ COMMANDS: tuple[str, ...] = (RESET, SAVE, RESTORE)
 TOOL = "tool"
 # Recordings store the index: new kinds go at the end.
 EVENT_KINDS: tuple[str, ...] = (CONNECT, DISCONNECT, TOUCH_DOWN, TOUCH_UP, *COMMANDS, TOOL)
-
-F = NDArray[np.float64]
 
 
 def encode_tool(operation: tuple[str | int | float | bool, ...]) -> str:

@@ -6,11 +6,10 @@ Kept apart from the system so the maths can be tested on plain arrays.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 __all__ = ["pick", "shorten"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def pick(origin: F, direction: F, centers: F, radii: F, max_distance: float = 50.0) -> tuple[int, float] | None:

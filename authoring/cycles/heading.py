@@ -19,13 +19,13 @@ come back as the closing frame's offset (:func:`engine.io.loop_export.closed`).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
 
 __all__ = ["normalise", "restore", "yaw"]
 
-F64 = NDArray[np.float64]
+from engine.arrays import F64
+
 _UP = np.array([0.0, 1.0, 0.0])
 
 

@@ -34,7 +34,7 @@ from authoring.cycles.trajectory import Trajectory, TrajectoryError
 
 __all__ = ["Segment", "SegmentSettings", "best_segment", "cut", "find_segments", "looping_segments"]
 
-F64 = NDArray[np.float64]
+from engine.arrays import F64
 
 
 @dataclass(frozen=True)

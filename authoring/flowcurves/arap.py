@@ -28,15 +28,13 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
 from scipy.sparse.linalg import splu
 
 __all__ = ["ArapSystem", "arap_energy", "laplacian", "W_SHAPE", "EPS"]
 
-F = NDArray[np.float64]
-I = NDArray[np.int64]
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
 
-#: Weight of the shape constraints against the edge terms (one edge of a 15 px triangle ≈ 1).
 W_SHAPE = 50.0
 #: Pull to the rest pose that keeps unconstrained islands in place (see the module docstring).
 EPS = 1e-6

@@ -17,15 +17,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from authoring.flowcurves.scene import FlowScene, Primitive
 
 __all__ = ["Contact", "find_contacts", "mesh_feet", "GROUND_TOLERANCE", "MESH_FEET"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: A primitive whose lowest point is this close above the ground (metres) still rests on it.
 GROUND_TOLERANCE = 0.02
 #: At most this many of a mesh's ground vertices become fixed points (spread evenly along screen x).
 MESH_FEET = 12

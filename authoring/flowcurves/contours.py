@@ -27,13 +27,13 @@ import warnings
 from types import ModuleType
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from authoring.flowcurves.hermite import Hermite
 
 __all__ = ["abstract_contour", "contour_energy", "outside_count", "thinness", "W_A", "W_O", "W_C", "THIN"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 W_A, W_O, W_C = 100.0, 1e5, 5.0
 CONTROL_POINTS = 6

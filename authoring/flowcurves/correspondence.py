@@ -32,7 +32,7 @@ from authoring.flowcurves.hermite import resample_polyline, tangents
 
 __all__ = ["Segment", "correspond", "D_M", "THETA_M", "W1", "W2", "S_MIN", "SPACING"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 D_M, THETA_M = 100.0, 2.0 * math.pi / 3.0
 W1, W2, S_MIN = 1.0, 1e5, 150.0

@@ -43,9 +43,8 @@ from authoring.flowcurves.tilt import MAX_BASE_TILT_DEG, base_tilt_deg
 
 __all__ = ["SceneDeformer", "Solve", "ITERATIONS", "REACH_STEPS"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: Local/global iterations per solve (from the rest pose; see tests for the energy they reach).
 ITERATIONS = 8
 #: Bisection steps for the part of the way a stroke is followed when a base would tilt too far
 #: (2⁻⁸ of the way: under a pixel for strokes that move objects less than 256 px).

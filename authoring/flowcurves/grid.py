@@ -18,17 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
 
 from authoring.flowcurves.scene import FlowObject, Raster, pixel_rays
 from engine.camera import Camera
 
 __all__ = ["Grid", "build_grid", "Embedding", "GRID_SPACING", "lift"]
 
-F = NDArray[np.float64]
-I = NDArray[np.int64]
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
 
-#: Grid resolution in pixels (§3.5.1: "15 pixels in our examples").
 GRID_SPACING = 15.0
 
 

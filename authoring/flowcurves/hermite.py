@@ -19,9 +19,8 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["Hermite", "basis", "fit_stroke", "control_count", "resample_polyline", "polyline_length", "tangents"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: Eq. 3.6 weights (the thesis gives none): samples are averaged (w1 = 1 over their mean) and the
 #: curvature integral is taken over arc length in pixels (∫κ² dσ, so long strokes are not smoothed
 #: more than short ones). w2 = 100 px³: a bend of radius 200 px over 600 px costs ~1.5 px², kept;
 #: a 3 px wiggle every 40 px costs ~170 px² against ~5 px² of fit, smoothed away.

@@ -25,10 +25,9 @@ from engine.camera import Camera
 
 __all__ = ["MAX_MESH_TRIANGLES", "MAX_MESH_VERTICES", "MeshError", "TriMesh", "rasterize_mesh", "read_glb_mesh"]
 
-F = NDArray[np.float64]
-I = NDArray[np.int64]
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
 
-#: Vertices of one flow mesh: each is drawn as its own skinning joint (:mod:`.meshdraw`), and the
 #: renderer's joint texture is one row per joint (GL's smallest guaranteed texture side is 16384).
 MAX_MESH_VERTICES = 8192
 MAX_MESH_TRIANGLES = 4 * MAX_MESH_VERTICES

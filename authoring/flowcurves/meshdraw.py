@@ -21,7 +21,7 @@ from engine.render.scene import SkinnedInstance
 
 __all__ = ["MeshDrawer", "vertex_normals"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def vertex_normals(vertices: F, faces: NDArray[np.int64]) -> F:

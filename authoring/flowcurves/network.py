@@ -28,16 +28,15 @@ from dataclasses import dataclass
 from typing import Literal, overload
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 
 from authoring.flowcurves.hermite import Hermite, basis, fit_stroke, resample_polyline, tangents
 
 __all__ = ["average_curves", "bend_curve", "rebend", "FlowNetwork", "tip_angle", "D_MAX", "THETA_MAX"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: d_Max is the user's grouping radius (the editor's ``[``/``]``); 60 px groups only close curves.
 D_MAX, THETA_MAX = 60.0, math.pi / 3.0
 W1, W2, W3 = 500.0, 0.5, 7.0
 #: The length term's ``|L − l0|`` is taken as ``√((L − l0)² + ε²) − ε``: within 0.5 energy units of it

@@ -17,13 +17,11 @@ the number of control points (we use 4).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from authoring.flowcurves.hermite import Hermite, basis
 
 __all__ = ["principal_curve", "W1", "W2", "CONTROL_POINTS"]
-
-F = NDArray[np.float64]
 
 W1, W2 = 1.0, 1000.0
 CONTROL_POINTS = 4

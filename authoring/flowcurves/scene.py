@@ -21,7 +21,7 @@ from engine.camera import Camera
 
 __all__ = ["Primitive", "FlowObject", "FlowScene", "Raster", "rasterize", "pixel_rays", "project"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 @dataclass

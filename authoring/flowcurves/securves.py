@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from authoring.flowcurves.contours import THIN, abstract_contour, thinness
 from authoring.flowcurves.principal import principal_curve
@@ -25,9 +25,8 @@ from authoring.flowcurves.scene import FlowScene, Raster
 
 __all__ = ["SECurve", "compute_securves", "GROUP_DISTANCE"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: Principal curves of different groups closer than this (pixels) are joined by a group contour.
 GROUP_DISTANCE = 40.0
 #: A footprint this many times longer than wide has a direction worth a spine (a rock has none).
 ELONGATED = 1.4

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from authoring.flowcurves.deform import SceneDeformer, Solve
 from authoring.flowcurves.hermite import Hermite, fit_stroke, polyline_length
@@ -25,7 +25,7 @@ from authoring.flowcurves.securves import SECurve, compute_securves
 
 __all__ = ["FlowSession", "Edit", "dense"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def dense(curve: Hermite, spacing: float = 2.0) -> F:

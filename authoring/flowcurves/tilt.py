@@ -12,13 +12,11 @@ base further (the largest such part, by bisection).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 __all__ = ["BASE_FRACTION", "MAX_BASE_TILT_DEG", "base_tilt_deg"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: The largest rotation of a planted object's base (degrees) a stroke may cause.
 MAX_BASE_TILT_DEG = 25.0
 #: The base is this lowest fraction of the object's height.
 BASE_FRACTION = 1.0 / 3.0

@@ -23,7 +23,7 @@ from engine.ik.rig import IKRig
 
 __all__ = ["batch_points"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def _fk(rig: IKRig, c: F) -> tuple[F, F]:

@@ -40,9 +40,8 @@ __all__ = [
     "MIN_KEY_GAP_FRAMES",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: Keys stay at least this many frames apart (a segment needs room for its in-betweens).
 MIN_KEY_GAP_FRAMES = 2
 
 

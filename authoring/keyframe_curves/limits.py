@@ -14,13 +14,13 @@ For a channel ``c_i`` limited to ``[u_i, v_i]`` and the segment ``[t_k, t_{k+1}]
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine.keyframes import BezierCurves
 
 __all__ = ["segment_bounds", "retime_segment"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def segment_bounds(

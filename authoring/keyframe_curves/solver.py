@@ -51,7 +51,7 @@ from engine.qp import LeastSquaresQP
 
 __all__ = ["Drag", "Hold", "CurveSettings", "CurveEdit", "TangentSolver", "curve_rig"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,8 @@ from engine.fk import forward_kinematics
 
 __all__ = ["ContactPlane", "ContactResult", "plane_from_stroke", "contact_runs", "solve_contacts"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _UP = np.array([0.0, 1.0, 0.0])
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
 from engine.clip import Clip
@@ -30,7 +30,7 @@ from engine.skeleton import Skeleton
 
 __all__ = ["MoCurve", "mocurves", "item_chain", "layer_joints", "LAYERS", "ARROW_AXES"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 LAYERS = ("item", "limb", "all")
 """Layer choices for time warps: the item's own joint, the limb it ends (the IK chain), every joint."""

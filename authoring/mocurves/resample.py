@@ -22,7 +22,7 @@ from engine.clip import Clip, RootMotion
 
 __all__ = ["periodic_cubic", "periodic_slerp", "retime_clip"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def periodic_cubic(values: ArrayLike, period: float, times: ArrayLike) -> F:

@@ -24,7 +24,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from authoring.mocurves import spatial
 from authoring.mocurves.contact import ContactPlane, ContactResult, solve_contacts
@@ -36,7 +36,7 @@ from engine.root_curve import RootCurve
 
 __all__ = ["EditSession", "EditState", "RetimeDrag"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 @dataclass(frozen=True)

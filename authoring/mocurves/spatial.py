@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from authoring.mocurves.curves import item_chain
 from engine import quat
@@ -37,7 +37,7 @@ __all__ = [
     "set_positions",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def gaussian_weights(n: int, i: int, tau: int, sigma: float) -> F:

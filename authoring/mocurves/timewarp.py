@@ -28,13 +28,12 @@ from collections.abc import Mapping
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
 
 from engine.qp import DenseQP
 
 __all__ = ["TimeWarp", "TimeWarpError", "W_STRONG", "W_SOFT"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 W_STRONG = 1.0e4
 """w1 = w2: constraints and period act as strong constraints."""

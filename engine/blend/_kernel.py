@@ -25,8 +25,8 @@ from engine.jit import njit, qnormalize, qslerp
 
 __all__ = ["Packed", "packed", "play"]
 
-F = NDArray[np.float64]
-I = NDArray[np.int64]  # an index array, as F is a float one
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
 
 
 @dataclass(frozen=True)

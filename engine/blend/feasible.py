@@ -23,8 +23,8 @@ from scipy.spatial import cKDTree
 
 __all__ = ["FeasibleSet", "kuhn_simplices", "border_facets", "closest_point_on_simplices"]
 
-F = NDArray[np.float64]
-Ix = NDArray[np.int64]
+from engine.arrays import F64 as F
+from engine.arrays import I64 as Ix
 
 
 def kuhn_simplices(shape: tuple[int, ...]) -> Ix:

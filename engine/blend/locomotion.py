@@ -52,7 +52,8 @@ from engine.pose import Pose
 
 __all__ = ["LocomotionSet", "BlendLibrary", "LocomotionPlayer", "animate", "install_blend"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _UP = np.array([0.0, 1.0, 0.0])
 _SETTLE_SPEED = 0.05  # m/s: asked for less, a puppet is coming to stand (its feet shuffle into place)
 

@@ -43,7 +43,8 @@ from engine.blend.feasible import FeasibleSet
 
 __all__ = ["LookupTable", "Resolution", "probe_grid", "LinearMapping"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _NO_SLOPES = np.zeros((0, 0, 0))  # what the compiled IDW gets for a table without probe slopes
 
 

@@ -32,7 +32,8 @@ __all__ = [
     "LOCOMOTION_PROPERTIES",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 LOCOMOTION_PROPERTIES: tuple[str, ...] = ("speed", "height")
 _UP = np.array([0.0, 1.0, 0.0])
 

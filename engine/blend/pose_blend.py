@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
 from engine.pose import Pose
@@ -34,7 +34,7 @@ __all__ = [
     "fade_weight",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def _check_weights(weights: ArrayLike, k: int) -> F:

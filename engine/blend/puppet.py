@@ -15,10 +15,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from functools import lru_cache
 
-import numpy as np
-from numpy.typing import NDArray
-
 from engine.app import App
+from engine.arrays import F64 as F
 from engine.blend.locomotion import BlendLibrary, LocomotionSet, install_blend
 from engine.blend.lookup import LinearMapping, LookupTable
 from engine.blend.measure import LOCOMOTION_PROPERTIES, measure_locomotion
@@ -26,8 +24,6 @@ from engine.blend.space import BlendSpace
 from engine.clip import Clip
 from engine.cliplib.cache import MeasureCache, default_cache_dir
 from engine.cliplib.library import set_digest
-
-F = NDArray[np.float64]
 
 __all__ = [
     "PUPPET_AXES",

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from typing import TypedDict, Unpack
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
 from engine.arrays import I64
@@ -44,7 +44,7 @@ from engine.pose import Pose
 
 __all__ = ["BlendSpace", "gradient_band_weights"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def _blend_channels(pose: Pose, clips: list[Clip], pairs: list[tuple[I64, I64, F]], w: F) -> None:

@@ -26,13 +26,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine.clip import Clip
 
 __all__ = ["SyncGroup", "DEFAULT_SYNC_MARKERS"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 DEFAULT_SYNC_MARKERS: tuple[str, ...] = ("left_down", "right_down")
 
 

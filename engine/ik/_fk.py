@@ -21,9 +21,8 @@ from engine.skeleton import Skeleton
 
 __all__ = ["fk_matrices"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-# Keyed by the parent array's bytes, not ``id(skeleton)``: a freed skeleton's id is reused
 # by the next one allocated, which then silently got another hierarchy's table.
 _JUMPS: dict[bytes, list[NDArray[np.int64]]] = {}
 

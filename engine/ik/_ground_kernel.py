@@ -27,8 +27,9 @@ from engine.jit import njit, qaxis_angle, qbetween, qconj, qmul, qnormalize, qro
 
 __all__ = ["legs_fk", "legs_solve", "legs_targets", "lock_group"]
 
-F = NDArray[np.float64]
-I = NDArray[np.int64]  # an index array, as F is a float one
+from engine.arrays import F64 as F
+from engine.arrays import I64 as I
+
 _EPS = 1e-9
 
 

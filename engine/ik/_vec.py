@@ -9,14 +9,14 @@ forward-kinematics walk along one root-to-joint path, which is all a limb solver
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
 from engine.skeleton import Skeleton
 
 __all__ = ["cross", "rotate", "path_fk"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def cross(a: ArrayLike, b: ArrayLike) -> F:

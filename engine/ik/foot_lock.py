@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 __all__ = ["FootLock", "lock_feet", "floor_lift", "smoothstep"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 @dataclass

@@ -44,7 +44,8 @@ __all__ = [
     "ground_feet_batch",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 GroundQuery = Callable[[F, F], tuple[F, F]]
 _UP = (0.0, 1.0, 0.0)
 _STILL = 0.1  # m/s: an animated toe slower than this has found its standing place

@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine.ik._limb import solve_limb
 from engine.ik._scalar import (
@@ -45,7 +45,8 @@ from engine.skeleton import Skeleton
 
 __all__ = ["Arm", "HUMANOID_ARMS", "sphere_contacts", "hands_on_sphere"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _UP: V = (0.0, 1.0, 0.0)
 
 

@@ -22,7 +22,7 @@ from engine.ik.rig import BALL, IKRig
 
 __all__ = ["right_jacobian", "ball_axis_columns", "dof_axes", "point_jacobian", "orientation_jacobian"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 def _skew(v: F) -> F:

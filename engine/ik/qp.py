@@ -16,14 +16,11 @@ iterations per step at 168 coordinates, and occasionally hit its 10,000 cap.)
 
 from __future__ import annotations
 
-import numpy as np
-from numpy.typing import NDArray
-
 from engine.qp import LeastSquaresQP
 
 __all__ = ["StepQP"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 class StepQP:

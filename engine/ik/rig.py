@@ -23,13 +23,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.skeleton import Skeleton
 
 __all__ = ["IKRig", "FIXED", "HINGE", "BALL", "humanoid_rig"]
 
 FIXED, HINGE, BALL = 0, 1, 3
-
-F = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from engine.ik.rig import IKRig
 
 __all__ = ["Effector", "Pin", "IKSettings", "IKResult", "solve_ik"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 @dataclass(frozen=True)

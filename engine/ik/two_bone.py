@@ -23,7 +23,7 @@ batched code below to rounding.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from engine import quat
 from engine.ik._limb import solve_limb
@@ -33,7 +33,8 @@ from engine.skeleton import Skeleton
 
 __all__ = ["two_bone_ik"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _EPS = 1e-9
 
 

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import I64 as _Idx
 from engine.components import Puppet, Transform, WorldPose
 from engine.ecs import World
 from engine.render.components import Appearance, Shape
@@ -32,9 +33,6 @@ __all__ = ["scene_from_world", "puppet_capsules"]
 
 _DEFAULT_PUPPET = Appearance()
 _DEFAULT_PROP = Appearance(color=(0.95, 0.96, 0.98))
-
-
-_Idx = NDArray[np.int64]
 
 
 @lru_cache(maxsize=64)

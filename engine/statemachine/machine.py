@@ -39,6 +39,7 @@ from typing import Any, Generic, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.arrays import Intp as Rows
 from engine.ecs import Entity, World
 
 __all__ = [
@@ -58,7 +59,7 @@ ANY = "*"
 C = TypeVar("C")
 Callback = Callable[[World, Entity, "Brain"], None]
 Guard = Callable[[World, Entity, "Brain"], bool]
-Rows = NDArray[np.intp]
+
 BatchGuard = Callable[[World, C, Rows], NDArray[np.bool_]]
 """``(world, columns, rows) -> mask``: the array form of a guard over the entities ``rows`` of the columns."""
 BatchUpdate = Callable[[World, C, Rows], None]

@@ -18,7 +18,6 @@ import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 if TYPE_CHECKING:
     from authoring.flowcurves.scene import FlowScene
@@ -26,7 +25,7 @@ if TYPE_CHECKING:
 
 __all__ = ["SCENE", "crystal_tree", "flow_camera", "flow_objects", "island"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 SCENE = "tasbada"
 TRUNK_COLOR = (0.45, 0.35, 0.6)

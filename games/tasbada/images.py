@@ -16,9 +16,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 from PIL import Image
 
+from engine.arrays import U8
 from engine.errors import FormatError
 
 __all__ = ["PHOTO_SIZE", "PhotoError", "load_image", "fit_photo", "clothes_color", "TORSO"]
@@ -26,8 +26,6 @@ __all__ = ["PHOTO_SIZE", "PhotoError", "load_image", "fit_photo", "clothes_color
 PHOTO_SIZE = (960, 540)
 TORSO = (0.3, 0.62, 0.7, 0.98)
 """The torso region of a selfie, ``(u0, v0, u1, v1)``: centred, the lower third of the frame."""
-
-U8 = NDArray[np.uint8]
 
 
 class PhotoError(FormatError):

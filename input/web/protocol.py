@@ -38,9 +38,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
+from engine.arrays import F64 as F
 from engine.errors import FormatError
 from input.phone_frames import arkit_to_stick, phone_to_stick
 
@@ -65,8 +65,6 @@ CROUCH_DEPTH = 0.45
 KINDS = ("orientation", "xr")
 _KEYS = {"seq", "t", "kind", "o", "q", "p", "acc", "rot", "touch", "jump", "cal", "crouch"}
 _DEG = math.pi / 180.0
-
-F = NDArray[np.float64]
 
 
 class WebMessageError(FormatError):

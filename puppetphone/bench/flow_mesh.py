@@ -23,7 +23,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
 from puppetphone.bench.figures import Figure
 
@@ -34,9 +33,8 @@ if TYPE_CHECKING:
 
 __all__ = ["HARD_WEIGHT", "bend", "lean_stroke", "mesh_tree_problem", "run"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
-#: A shape weight at which the constraints are met as exactly as the grid allows (see the module doc).
 HARD_WEIGHT = 1e5
 
 

@@ -31,7 +31,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pygame
-from numpy.typing import NDArray
 
 from engine import quat
 from engine.app import App
@@ -62,7 +61,8 @@ __all__ = [
     "CONTROLLERS",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 DEVICES = ("phone", "mouse")
 CONTROLLERS = ("spring", "legacy")
 RATE = 120.0  # device samples per second (a 125 Hz mouse, a 100-120 Hz phone)

@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine.ecs import Entity
 from engine.pose import Pose
@@ -35,7 +34,7 @@ __all__ = [
     "PUPPET_COMPONENTS",
 ]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
 
 
 @dataclass(frozen=True)

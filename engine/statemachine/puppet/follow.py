@@ -26,7 +26,6 @@ pass, with the same numbers. Time is ``world.dt``.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import Columns
@@ -37,7 +36,8 @@ from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
 
 __all__ = ["spring_step", "wanted_velocity", "follow_velocity", "follow_released", "drag_reach"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _TURN_FROM = 0.1  # m/s: a request slower than this turns nothing; twice this turns at the full rate
 
 

@@ -14,7 +14,6 @@ holders from one pass over the sticks, and only the held puppets one by one.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import quat
 from engine.components import Stick, Transform
@@ -25,7 +24,8 @@ from engine.statemachine.puppet.spec import PuppetColumns
 
 __all__ = ["holder", "wanted_anchor", "sense", "heading_vector", "prop_in_front", "yaw_rotation", "sense_all"]
 
-F = NDArray[np.float64]
+from engine.arrays import F64 as F
+
 _UP = np.array([0.0, 1.0, 0.0])
 
 
