@@ -66,7 +66,11 @@ class Activity(Protocol):
     """What the runner runs: fixed steps of ``dt`` and a drawing of the current state."""
 
     dt: float
-    camera: Camera
+
+    @property
+    def camera(self) -> Camera:
+        """The camera the window shows (the runner only reads it: a game's may be a property)."""
+        ...
 
     def step(self) -> None:
         """Advance one fixed step."""

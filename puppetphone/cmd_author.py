@@ -276,7 +276,7 @@ def run(args: argparse.Namespace) -> int:
     _announce(hub)
     runner.push_handlers(session)
     try:
-        result = runner.run(session)  # type: ignore[arg-type]  # Session.camera is read-only: the runner only reads it
+        result = runner.run(session)
         if result.screenshot is not None:
             print(f"screenshot: {result.screenshot}")
         ending = opened.conclude()

@@ -133,7 +133,7 @@ def run_activity(activity: Session, options: RunOptions) -> tuple[int, RunResult
     game.fps = lambda: runner.fps
     activity.hub.start()
     try:
-        result = runner.run(activity)  # type: ignore[arg-type]  # Session.camera is read-only: the runner only reads it
+        result = runner.run(activity)
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2, None

@@ -127,7 +127,7 @@ def _replay_tool(entry: Entry, rec: Recording, args: argparse.Namespace, cut_sho
         return 2
     runner = Runner(run_options(args, f"PuppetPhone — replay of {args.file}"))
     try:
-        result = runner.run(session)  # type: ignore[arg-type]  # Session.camera is read-only: the runner only reads it
+        result = runner.run(session)
     except NoDisplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
