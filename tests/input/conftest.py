@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -12,6 +12,7 @@ from pythonosc.osc_message_builder import OscMessageBuilder
 from engine.app import App
 from engine.components import Grabbable, Obstacle, Transform
 from input.hub import InputHub
+from input.osc import OscSource
 from input.plugin import install_input
 
 
@@ -60,3 +61,24 @@ def bundle(*messages: tuple) -> bytes:
 @pytest.fixture
 def osc() -> tuple[Callable[..., bytes], Callable[..., bytes]]:
     return message, bundle
+
+
+@pytest.fixture
+def source() -> Iterator[Callable[..., OscSource]]:
+    """Makes OSC sources on 127.0.0.1 and a free port (keyword overrides per test), stopped after the test."""
+    made: list[OscSource] = []
+
+    def make(**kw: object) -> OscSource:
+        src = OscSource(host="127.0.0.1", port=0, **kw)  # type: ignore[arg-type]  # keyword overrides per test
+        made.append(src)
+        return src
+
+    yield make
+    for s in made:
+        s.stop()
+
+
+@pytest.fixture
+def pose(osc: tuple[Callable[..., bytes], Callable[..., bytes]]) -> bytes:
+    """One identity orientation message, as a phone sends it."""
+    return osc[0]("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)

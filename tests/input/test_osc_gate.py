@@ -8,7 +8,7 @@ at twice the rate fails ``test_the_rate_limit_is_a_token_bucket_refilled_at_max_
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 
 import pytest
 
@@ -27,25 +27,6 @@ from input.sample import CONNECT, DISCONNECT, PoseSample
 
 Message = Callable[..., bytes]
 PHONE, OTHER = "osc:10.0.0.1", "osc:10.0.0.2"
-
-
-@pytest.fixture
-def source() -> Iterator[Callable[..., OscSource]]:
-    made: list[OscSource] = []
-
-    def make(**kw: object) -> OscSource:
-        src = OscSource(host="127.0.0.1", port=0, **kw)  # type: ignore[arg-type]  # keyword overrides per test
-        made.append(src)
-        return src
-
-    yield make
-    for s in made:
-        s.stop()
-
-
-@pytest.fixture
-def pose(osc: tuple[Message, Message]) -> bytes:
-    return osc[0]("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
 
 
 def nested(depth: int, inner: bytes) -> bytes:

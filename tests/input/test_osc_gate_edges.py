@@ -7,10 +7,9 @@ survivors (docs/mutation.md), each test names the mutants that broke it.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 
 import numpy as np
-import pytest
 
 from engine import quat
 from input.osc import ADMIT_AFTER, MAX_BUNDLE_DEPTH, MAX_DATAGRAM, MAX_MESSAGES, OscSource, bundle_shape
@@ -20,25 +19,6 @@ from input.sample import CONNECT, DISCONNECT, PoseSample
 Message = Callable[..., bytes]
 PHONE, OTHER = "osc:10.0.0.1", "osc:10.0.0.2"
 _BUNDLE_HEAD = b"#bundle\x00" + b"\x00" * 8
-
-
-@pytest.fixture
-def source() -> Iterator[Callable[..., OscSource]]:
-    made: list[OscSource] = []
-
-    def make(**kw: object) -> OscSource:
-        src = OscSource(port=0, **kw)  # type: ignore[arg-type]  # keyword overrides per test
-        made.append(src)
-        return src
-
-    yield make
-    for s in made:
-        s.stop()
-
-
-@pytest.fixture
-def pose(osc: tuple[Message, Message]) -> bytes:
-    return osc[0]("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
 
 
 def flat(elements: list[bytes]) -> bytes:

@@ -6,34 +6,13 @@ Written against the mutation run's survivors (docs/mutation.md); each test names
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-
-import pytest
+from collections.abc import Callable
 
 from input.osc import MAX_CANDIDATES, STEP_BUDGET, OscSource
 from input.sample import CONNECT, DISCONNECT, PoseSample
 
 Message = Callable[..., bytes]
 PHONE, OTHER = "osc:10.0.0.1", "osc:10.0.0.2"
-
-
-@pytest.fixture
-def source() -> Iterator[Callable[..., OscSource]]:
-    made: list[OscSource] = []
-
-    def make(**kw: object) -> OscSource:
-        src = OscSource(host="127.0.0.1", port=0, **kw)  # type: ignore[arg-type]  # keyword overrides per test
-        made.append(src)
-        return src
-
-    yield make
-    for s in made:
-        s.stop()
-
-
-@pytest.fixture
-def pose(osc: tuple[Message, Message]) -> bytes:
-    return osc[0]("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
 
 
 def times(items: list[PoseSample | tuple[str, str]]) -> list[float | tuple[str, str]]:

@@ -77,11 +77,6 @@ Run = Callable[[OscSource, list[Any]], tuple[OscSource, ScriptedClock]]
 
 
 @pytest.fixture
-def pose(osc: tuple[Message, Message]) -> bytes:
-    return osc[0]("/puppetphone/orientation", 1.0, 0.0, 0.0, 0.0)
-
-
-@pytest.fixture
 def clients() -> Iterator[Callable[[], socket.socket]]:
     """Client sockets, each on its own ephemeral port (a phone app, or a second one)."""
     made: list[socket.socket] = []
