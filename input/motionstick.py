@@ -15,7 +15,8 @@ step, for every controller entity (``Stick`` + :class:`StickState`):
    position for 6-DoF phones). "Point at the screen and tap" calibrates: the first
    tap of an uncalibrated device, or a sample with ``calibrate``, makes the current
    pointing direction the scene's forward;
-3. ray-pick the grabbable the stick points at (``focus``: the renderer outlines it);
+3. ray-pick the grabbable the stick points at (``focus``: the renderer outlines it): its
+   grab sphere or, for a posed puppet, any bone it is drawn with (:mod:`input.stick_pick`);
 4. touch down grabs the focus, keeping the stick's length and the grabbed thing's
    rotation relative to the tip; touch up releases;
 5. shorten the stick where the tip would go below the ground or into an
@@ -39,7 +40,8 @@ from engine.components import Grabbable, Obstacle, Stick, Transform
 from engine.ecs import Entity, World
 from input.filters import OneEuro
 from input.sample import DISCONNECT, TOUCH_DOWN, TOUCH_UP, InputFrame, PoseSample
-from input.stick_geometry import pick, shorten
+from input.stick_geometry import shorten
+from input.stick_pick import stick_target
 
 __all__ = ["StickState", "StickConfig", "motionstick_system", "spawn_stick"]
 
@@ -198,13 +200,8 @@ def motionstick_system(world: World) -> None:
         if stick.grabbed is not None and not world.alive(stick.grabbed):
             _release(stick)
         # Ray pick: what would be grabbed now (the renderer outlines it).
-        others = [(g, gr.radius, gr.anchor(tr)) for g, gr, tr in grabbables if g != stick.grabbed]
-        hit = None
-        if others:
-            centers = np.array([c for _, _, c in others])
-            radii = np.array([r for _, r, _ in others])
-            hit = pick(stick.pivot, stick.direction, centers, radii, cfg.max_pick)
-        stick.focus = others[hit[0]][0] if hit is not None else None
+        hit = stick_target(world, grabbables, stick.pivot, stick.direction, cfg.max_pick, skip=stick.grabbed)
+        stick.focus = hit[0] if hit is not None else None
         for kind, src in frame.events:
             if src != st.source:
                 continue
