@@ -12,8 +12,9 @@ Passes, in order (each kind of primitive is one instanced draw call):
    or ray-cast on a quad over their outline where the level says so (:mod:`engine.render.impostors`),
    and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
-   and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
-   ground over the rectangles they cover: soft shadow, snow track, footprints.
+   and the sun, shaded per vertex (the last three not drawn when the ground fills the view),
+   then the decals laid on the ground over the rectangles they cover: soft shadow, snow track,
+   footprints.
 5. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
 6. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
    depth (a real prop in front of or behind 3-D objects) or over everything (an interface).
