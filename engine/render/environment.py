@@ -23,7 +23,7 @@ from engine.render import shaders_ground as G
 from engine.render.gpu import Instances, Releasable, mesh_buffers, set_uniform
 from engine.render.scene import PRINT_STRIDE, GroundMarks, RenderScene
 
-__all__ = ["Environment", "GROOVE", "groove_shade", "marks_rect", "soften_marks"]
+__all__ = ["Environment", "GROOVE", "ground_fills_view", "groove_shade", "marks_rect", "soften_marks"]
 
 _PRINT_FMT = ("2f 2f 2f 1f/i", "i_xz", "i_dir", "i_half", "i_strength")
 RIDGE_RADIUS = 130.0
@@ -85,6 +85,29 @@ def marks_rect(marks: GroundMarks, threshold: float = 0.02) -> tuple[float, floa
     x0, x1 = marks.x0 + (cols[0] - 1) * c, marks.x0 + (cols[-1] + 2) * c
     z0, z1 = marks.z0 + (rows[0] - 1) * c, marks.z0 + (rows[-1] + 2) * c
     return float(x0), float(z0), float(x1 - x0), float(z1 - z0)
+
+
+def ground_fills_view(
+    inv_view_proj: NDArray[np.float64], eye: NDArray[np.float64], height: float, reach: float
+) -> bool:
+    """Whether every pixel's ray meets the ground (the plane ``y = height``) less than ``reach`` metres
+    away across it: then the ground mesh hides the whole sky, ridge and sun, and they need not be drawn.
+
+    A camera looking down at a field (the snowman game's) sees no sky, yet drawing the dome,
+    the ridge and the sun set up and binned their ~2,000 triangles before the depth test threw
+    every pixel away. Checking the view's four corner rays suffices: without roll the
+    highest rays are at the top corners, and the ground seen is the convex quadrilateral
+    between the corner rays' hits, inside the circle of ``reach`` when they are.
+    """
+    drop = float(eye[1]) - height
+    if drop <= 0.0:
+        return False
+    far = np.array([[x, y, 1.0, 1.0] for x in (-1.0, 1.0) for y in (-1.0, 1.0)]) @ np.asarray(inv_view_proj).T
+    rays = far[:, :3] / far[:, 3:4] - np.asarray(eye, dtype=np.float64)
+    if not np.all(rays[:, 1] < 0.0):
+        return False
+    across = drop / -rays[:, 1] * np.hypot(rays[:, 0], rays[:, 2])
+    return bool(np.all(across < reach))
 
 
 class Environment:

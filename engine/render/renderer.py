@@ -12,8 +12,9 @@ Passes, in order (each kind of primitive is one instanced draw call):
    or ray-cast on a quad over their outline where the level says so (:mod:`engine.render.impostors`),
    and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
-   and the sun, shaded per vertex (about the cost of a clear), then the decals laid on the
-   ground over the rectangles they cover: soft shadow, snow track, footprints.
+   and the sun, shaded per vertex (the last three not drawn when the ground fills the view),
+   then the decals laid on the ground over the rectangles they cover: soft shadow, snow track,
+   footprints.
 5. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
 6. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
    depth (a real prop in front of or behind 3-D objects) or over everything (an interface).
@@ -44,7 +45,7 @@ from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.env_meshes import cone_mesh
-from engine.render.environment import Environment
+from engine.render.environment import RIDGE_RADIUS, Environment, ground_fills_view
 from engine.render.gpu import Instances, LodBatches, Releasable, mesh_buffers, set_uniform
 from engine.render.impostors import Impostors
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
@@ -348,8 +349,9 @@ class Renderer:
         for k, inst in self._outline_inst.items():
             d = getattr(scene, k).data
             outlined[k] = inst.upload(d[d[:, -1] > 0.5])
-        light_vp = light_matrix(scene) if scene.sun.shadows else None
-        rect = ground_rect(scene) if light_vp is not None else None
+        bounds = scene.bounds() if scene.sun.shadows else None
+        light_vp = light_matrix(scene, bounds) if bounds is not None else None
+        rect = ground_rect(scene, bounds=bounds) if light_vp is not None else None
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
             casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
@@ -431,6 +433,7 @@ class Renderer:
         # With per-pixel snow detail the ground reads its shadow mask itself (one more fetch in a
         # pass it pays anyway); otherwise the shadow is a decal over the casters' rectangle only.
         detail = self.quality.ground_detail and g.snow > 0
+        extent = min(camera.far * 0.9, 150.0)  # of the ground mesh around the eye
         self.shadows.mask.use(location=4)
         if g.visible:
             self.env.draw_ground(
@@ -439,7 +442,7 @@ class Renderer:
                 photo,
                 {
                     "u_center": (float(eye[0]), 0.0, float(eye[2])),
-                    "u_extent": min(camera.far * 0.9, 150.0),
+                    "u_extent": extent,
                     "u_height": float(g.height),
                     "u_ground_lin": _linear(g.color),
                     "u_snow": float(g.snow),
@@ -453,7 +456,11 @@ class Renderer:
                 },
             )
         self._mark("ground")
-        self.env.draw_sky(scene, photo, float(g.height))
+        # The ground's extent, and the ridge's distance, with a margin for the mesh's straight edges.
+        reach = 0.9 * min(extent, RIDGE_RADIUS)
+        hidden = g.visible and not photo and ground_fills_view(self._common["u_inv_view_proj"], eye, g.height, reach)
+        if not hidden:
+            self.env.draw_sky(scene, photo, float(g.height))
         self._mark("sky")
         if photo:
             ctx.depth_func = "<="

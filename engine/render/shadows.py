@@ -60,13 +60,18 @@ def _on_ground(points: NDArray[np.float64], L: NDArray[np.float64], height: floa
     return points - drop[:, None] * L
 
 
-def light_matrix(scene: RenderScene) -> NDArray[np.float64] | None:
-    """The sun's orthographic view-projection around every caster, ``None`` without casters.
+Bounds = tuple[NDArray[np.float64], NDArray[np.float64]] | None
+"""``scene.bounds()``: passed in by a caller that needs it twice (it walks every caster row)."""
+
+
+def light_matrix(scene: RenderScene, bounds: Bounds = None) -> NDArray[np.float64] | None:
+    """The sun's orthographic view-projection around every caster (``bounds``: ``scene.bounds()``
+    if given), ``None`` without casters.
 
     The sides hug the casters' bounding sphere; the depth range runs from the nearest
     caster to where their shadows land on the ground, tight for depth precision.
     """
-    b = scene.bounds()
+    b = scene.bounds() if bounds is None else bounds
     if b is None:
         return None
     lo, hi = b
@@ -82,9 +87,12 @@ def light_matrix(scene: RenderScene) -> NDArray[np.float64] | None:
     return _ortho(radius, near, far) @ view
 
 
-def ground_rect(scene: RenderScene, margin: float = 0.5) -> tuple[float, float, float, float] | None:
-    """``(x0, z0, width, depth)`` on the ground covering every caster's planar shadow."""
-    b = scene.bounds()
+def ground_rect(
+    scene: RenderScene, margin: float = 0.5, bounds: Bounds = None
+) -> tuple[float, float, float, float] | None:
+    """``(x0, z0, width, depth)`` on the ground covering every caster's planar shadow (``bounds`` as for
+    :func:`light_matrix`)."""
+    b = scene.bounds() if bounds is None else bounds
     if b is None:
         return None
     g = _on_ground(_corners(*b), _sun(scene), scene.ground.height)

@@ -33,71 +33,89 @@ _SNOW = (0.97, 0.98, 1.0)
 
 _LEG = ("upper_leg", "lower_leg", "foot")
 _ARM = ("upper_arm", "lower_arm", "hand")
-# Capsule rows per snowman, in the order _snowman_rows fills them: two legs (thigh,
+# Capsule rows per snowman, in the order _snowmen_rows fills them: two legs (thigh,
 # shin, foot), two twig arms (three segments each), the nose.
 _CAPSULE_COLORS = np.array([_SNOW] * 6 + [_TWIG] * 6 + [_CARROT])
 _EYES = np.array([[0.35, 0.25, 0.88], [-0.35, 0.25, 0.88]])
 _NOSE = np.array([[0.0, 0.0, 0.9], [0.0, -0.05, 1.6]])
 _BUTTONS = np.array([[0.0, 0.45 * k, 0.95] for k in (-0.6, 0.0, 0.6)])
+# The 16 joints gathered per snowman, in this order (columns of P and R in _snowmen_rows).
+_LEGS, _ARMS = slice(0, 6), slice(6, 12)
+_FEET, _HANDS, _HIPS, _CHEST, _HEAD = [2, 5], [8, 11], 12, 14, 15
+# Which gathered joint turns each local offset: foot and hand tips, the spine's "up", eyes, nose, buttons.
+_TURN = [*_FEET, *_HANDS, _HIPS, _HEAD, _HEAD, _HEAD, _HEAD, _CHEST, _CHEST, _CHEST]
+# Sphere slots per snowman: bottom, middle, head, two eyes, three buttons; the first three are balls.
+_BALL_SLOT = np.array([True, True, True, False, False, False, False, False])
+_MIDDLE_SLOT = np.array([False, True, False, False, False, True, True, True])
 
 
-def _joint_indices(sk: Skeleton) -> dict[str, list[int]]:
-    """The joints a snowman is drawn from, looked up once per rig."""
+def _joint_indices(sk: Skeleton) -> list[int]:
+    """The 16 joints a snowman is drawn from (legs, arms, then hips, spine, chest, head)."""
     j = sk.index
-    return {
-        "legs": [j(f"{side}_{bone}") for side in "lr" for bone in _LEG],
-        "arms": [j(f"{side}_{bone}") for side in "lr" for bone in _ARM],
-        "body": [j("hips"), j("spine"), j("chest"), j("head")],
-    }
+    legs = [j(f"{side}_{bone}") for side in "lr" for bone in _LEG]
+    arms = [j(f"{side}_{bone}") for side in "lr" for bone in _ARM]
+    return [*legs, *arms, j("hips"), j("spine"), j("chest"), j("head")]
 
 
-def _snowman_rows(
-    snowman: Snowman, sk: Skeleton, pos: np.ndarray, rot: np.ndarray, joints: dict[str, list[int]]
+def _interpolated(poses: list[WorldPose], alpha: float) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """:meth:`WorldPose.interpolated` of every pose in one pass (the same numbers: both are elementwise)."""
+    counts = np.cumsum([len(wp.positions) for wp in poses])[:-1]
+    prev_p = np.concatenate([wp.prev_positions for wp in poses])
+    pos = prev_p + alpha * (np.concatenate([wp.positions for wp in poses]) - prev_p)
+    rot = quat.nlerp(
+        np.concatenate([wp.prev_rotations for wp in poses]), np.concatenate([wp.rotations for wp in poses]), alpha
+    )
+    return np.split(pos, counts), np.split(rot, counts)
+
+
+def _snowmen_rows(
+    shapes: list[Snowman], skeletons: list[Skeleton], poses: list[np.ndarray], rotations: list[np.ndarray]
 ) -> tuple[np.ndarray, ...]:
-    """One snowman's capsules (a, b, radius) and spheres (centre, radius, is-a-ball)."""
-    shape = snowman.shape
-    hips_i, spine_i, chest_i, head_i = joints["body"]
-    legs, arms = joints["legs"], joints["arms"]
-    hips, chest, head = pos[hips_i], pos[chest_i], pos[head_i]
-    rh = shape.head
-    spine_len = float(np.linalg.norm(sk.offsets[spine_i]) + np.linalg.norm(sk.offsets[chest_i]))
-    feet, hands = [legs[2], legs[5]], [arms[2], arms[5]]
+    """Every snowman's capsules ``(a, b, radius)`` ``[S, 13, ...]`` and sphere slots ``(centre, radius, used)``
+    ``[S, 8, ...]`` (slots of the middle ball and its buttons unused on a two-ball snowman), all at once.
+
+    The per-snowman part is only gathering (joints, tips, radii); the geometry runs as
+    array operations over all snowmen, since a snowman is ~20 primitives and computing
+    them one snowman at a time cost a third of a millisecond each.
+    """
+    n = len(shapes)
+    idx = [_joint_indices(sk) for sk in skeletons]
+    P = np.stack([p[i] for p, i in zip(poses, idx, strict=True)])
+    R = np.stack([r[i] for r, i in zip(rotations, idx, strict=True)])
+    rh = np.array([sm.shape.head for sm in shapes])
+    bottom = np.array([sm.shape.bottom for sm in shapes])
+    has_middle = np.array([sm.shape.middle is not None for sm in shapes])
+    middle = np.array([sm.shape.middle or 0.0 for sm in shapes])
+    t_middle = np.array([middle_ball_parameter(sm.shape) for sm in shapes])
+    rigs = list(zip(skeletons, idx, strict=True))
+    tips = np.stack([sk.tips[[i[k] for k in (*_FEET, *_HANDS)]] for sk, i in rigs])
+    spine_len = np.array([np.linalg.norm(sk.offsets[i[13]]) + np.linalg.norm(sk.offsets[i[14]]) for sk, i in rigs])
+    leg_r = np.stack([sk.radii[i[_LEGS]] for sk, i in rigs])
+    arm_r = np.array([sk.radii[i[6]] for sk, i in rigs])
     # Every offset that turns with a bone, rotated in one call: foot and hand tips, the
     # spine's "up" (Eq. 6.4's p_up), eyes and nose on the head, buttons on the chest.
-    local = np.vstack(
-        [
-            sk.tips[feet],
-            sk.tips[hands],
-            [[0.0, spine_len, 0.0]],
-            _EYES * rh,
-            _NOSE * rh,
-            _BUTTONS * (shape.middle or 0.0),
-        ]
+    up = np.zeros((n, 1, 3))
+    up[:, 0, 1] = spine_len
+    local = np.concatenate(
+        [tips, up, _EYES * rh[:, None, None], _NOSE * rh[:, None, None], _BUTTONS * middle[:, None, None]], axis=1
     )
-    turn = rot[feet + hands + [hips_i] + [head_i] * 4 + [chest_i] * 3]
-    moved = quat.rotate(turn, local)
-    foot_tips, hand_tips, up = pos[feet] + moved[0:2], pos[hands] + moved[2:4], hips + moved[4]
-    eyes, nose = head + moved[5:7], head + moved[7:9]
-    leg_a = np.vstack([pos[legs[0:3]], pos[legs[3:6]]])
-    leg_b = np.vstack([pos[legs[1:3]], foot_tips[0:1], pos[legs[4:6]], foot_tips[1:2]])
-    arm_pts = [np.vstack([pos[arms[k : k + 3]], hand_tips[k // 3]]) for k in (0, 3)]
-    cap_a = np.vstack([leg_a, arm_pts[0][:-1], arm_pts[1][:-1], nose[0:1]])
-    cap_b = np.vstack([leg_b, arm_pts[0][1:], arm_pts[1][1:], nose[1:2]])
-    cap_r = np.concatenate([sk.radii[legs], np.full(6, sk.radii[arms[0]]), [0.07 * rh]])
-    centres, radii = [hips], [shape.bottom]
-    if shape.middle is not None:
-        centres.append(bezier_spine(hips, chest, up, middle_ball_parameter(shape)))
-        radii.append(shape.middle)
-    centres.append(head)
-    radii.append(rh)
-    n_balls = len(centres)
-    centres += list(eyes)
-    radii += [0.1 * rh] * 2
-    if shape.middle is not None:
-        centres += list(centres[1] + moved[9:12])
-        radii += [0.08 * shape.middle] * 3
-    is_ball = np.arange(len(radii)) < n_balls
-    return cap_a, cap_b, cap_r, np.array(centres), np.array(radii), is_ball
+    moved = quat.rotate(R[:, _TURN], local)
+    foot_tips, hand_tips = P[:, _FEET] + moved[:, 0:2], P[:, _HANDS] + moved[:, 2:4]
+    hips, chest, head = P[:, _HIPS], P[:, _CHEST], P[:, _HEAD]
+    nose = head[:, None] + moved[:, 7:9]
+    legs, arms = P[:, _LEGS], P[:, _ARMS]
+    cap_a = np.concatenate([legs, arms, nose[:, 0:1]], axis=1)
+    ends = [legs[:, 1:3], foot_tips[:, 0:1], legs[:, 4:6], foot_tips[:, 1:2]]
+    ends += [arms[:, 1:3], hand_tips[:, 0:1], arms[:, 4:6], hand_tips[:, 1:2], nose[:, 1:2]]
+    cap_b = np.concatenate(ends, axis=1)
+    cap_r = np.concatenate([leg_r, np.repeat(arm_r[:, None], 6, axis=1), 0.07 * rh[:, None]], axis=1)
+    mid = bezier_spine(hips, chest, hips + moved[:, 4], t_middle)[:, None]
+    centres = np.concatenate(
+        [hips[:, None], mid, head[:, None], head[:, None] + moved[:, 5:7], mid + moved[:, 9:12]], 1
+    )
+    radii = np.stack([bottom, middle, rh, 0.1 * rh, 0.1 * rh, *(3 * [0.08 * middle])], axis=1)
+    used = ~_MIDDLE_SLOT | has_middle[:, None]
+    return cap_a, cap_b, cap_r, centres, radii, used
 
 
 def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[int]) -> None:
@@ -106,20 +124,20 @@ def draw_snowmen(world: World, scene: RenderScene, alpha: float, outlined: set[i
     Gathering the rows first matters: a snowman is ~20 primitives, and adding them one
     call at a time cost more than a millisecond a frame with six snowmen on the field.
     """
-    caps: list[tuple[np.ndarray, ...]] = []
-    spheres: list[tuple[np.ndarray, ...]] = []
-    for e, snowman, puppet, wp in world.query(Snowman, Puppet, WorldPose):
-        sk = puppet.skeleton
-        pos, rot = wp.interpolated(alpha)
-        cap_a, cap_b, cap_r, centres, radii, is_ball = _snowman_rows(snowman, sk, pos, rot, _joint_indices(sk))
-        caps.append((cap_a, cap_b, cap_r, _CAPSULE_COLORS))
-        colors = np.where(is_ball[:, None], _SNOW, _COAL)
-        spheres.append((centres, radii, colors, is_ball & (e in outlined)))
-    if caps:
-        a, b, r, col = (np.concatenate(x) for x in zip(*caps))
-        scene.add_capsules(a, b, r, color=col)
-        c, r, col, out = (np.concatenate(x) for x in zip(*spheres))
-        scene.add_spheres(c, r, color=col, outline=out)
+    found = [(e, snowman, puppet.skeleton, wp) for e, snowman, puppet, wp in world.query(Snowman, Puppet, WorldPose)]
+    if not found:
+        return
+    entities, shapes, skeletons, poses = (list(x) for x in zip(*found, strict=True))
+    pos, rot = _interpolated(poses, alpha)
+    cap_a, cap_b, cap_r, centres, radii, used = _snowmen_rows(shapes, skeletons, pos, rot)
+    n = len(found)
+    colors = np.tile(_CAPSULE_COLORS, (n, 1))
+    scene.add_capsules(cap_a.reshape(-1, 3), cap_b.reshape(-1, 3), cap_r.reshape(-1), color=colors)
+    is_ball = np.broadcast_to(_BALL_SLOT, used.shape)
+    lit = is_ball & np.array([e in outlined for e in entities])[:, None]
+    scene.add_spheres(
+        centres[used], radii[used], color=np.where(is_ball[used][:, None], _SNOW, _COAL), outline=lit[used]
+    )
 
 
 def draw_snowman_state(world: World, scene: RenderScene, alpha: float) -> None:

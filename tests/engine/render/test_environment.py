@@ -144,3 +144,41 @@ def test_the_groove_wall_facing_the_sun_is_the_brighter_one(gl, towards):
     minus_side, plus_side = profile[:9].max(), profile[10:].max()
     lit, shaded = (minus_side, plus_side) if towards > 0 else (plus_side, minus_side)
     assert lit > shaded + 4
+
+
+def test_the_ground_fills_the_view_only_when_every_corner_ray_lands_within_reach():
+    """Looking down at the field the sky is skipped; raise the camera's pitch towards the horizon, turn it
+    away from the field's centre, or bring the reach in, and it is not. (Checking only the view's centre
+    ray, not its corners, fails the tilted case.)"""
+    from engine.render.environment import ground_fills_view
+
+    def fills(camera, reach=117.0, height=0.0):
+        inv = np.linalg.inv(camera.view_projection(W / H))
+        return ground_fills_view(inv, camera.eye, height, reach)
+
+    down = OrbitCamera(target=np.array([0.0, 0.0, 0.0]), yaw=0.3, pitch=0.6, distance=9.0)
+    assert fills(down)
+    assert not fills(down, reach=5.0)  # the far corners land beyond 5 m
+    assert not fills(down, height=down.eye[1] + 1.0)  # the eye under the plane sees no ground below it
+    # The centre ray still lands close by, but the top corners reach the horizon.
+    assert not fills(OrbitCamera(target=np.array([0.0, 0.0, 0.0]), yaw=0.3, pitch=0.2, distance=9.0))
+    assert not fills(OrbitCamera(target=np.array([0.0, 1.0, 0.0]), yaw=0.3, pitch=0.05, distance=9.0))
+
+
+@pytest.mark.parametrize("pitch", [0.6, 0.05])
+def test_skipping_the_hidden_sky_changes_no_pixel(gl, pitch, monkeypatch):
+    """The frame with the sky skipped where the ground hides it is the frame with the sky drawn, looking
+    down (skipped) and at the horizon (drawn: its top is the sky's deeper blue, not the pale colour
+    the frame is cleared to). (Skipping the sky in every frame fails the horizon case.)"""
+    import engine.render.renderer as renderer_module
+
+    scene = field()
+    draw_trees(scene)
+    camera = OrbitCamera(target=np.array([0.0, 1.0, 0.0]), yaw=0.3, pitch=pitch, distance=9.0)
+    skipped = draw(gl, scene, camera)
+    monkeypatch.setattr(renderer_module, "ground_fills_view", lambda *a: False)
+    drawn = draw(gl, scene, camera)
+    assert np.array_equal(skipped, drawn)
+    sky = drawn[: H // 8]
+    if pitch < 0.1:
+        assert sky[..., 0].mean() < 175, "the horizon view should show the sky at the top"  # cleared: ~192

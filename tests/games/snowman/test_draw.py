@@ -61,6 +61,41 @@ def test_a_snowman_is_drawn_on_its_joints(shape):
     assert any(np.allclose(r[0:3], pos[sk.index("r_upper_leg")]) for r in capsules)
 
 
+def test_snowmen_drawn_together_get_the_rows_each_gets_alone():
+    """The snowmen's rows are computed as arrays over all of them at once; each snowman's rows (in its
+    place, outline included) must be the ones it gets when it is the only one, whatever the others'
+    shapes and poses. (Taking the first snowman's middle radius for all of them fails this.)"""
+    rng = np.random.default_rng(4)
+    shapes = [SnowmanShape(0.5, 0.35, 0.22), SnowmanShape(0.4, None, 0.2), SnowmanShape(0.3, 0.2, 0.12)]
+    poses = []
+    for k, shape in enumerate(shapes):
+        sk = snowman_skeleton(shape)
+        rot = quat.exp(rng.normal(scale=0.3, size=(sk.num_joints, 3)))
+        pos, rot = forward_kinematics(sk, sk.offsets[0] + np.array([1.5 * k, 0.0, -k]), rot)
+        prev, prev_rot = forward_kinematics(
+            sk, sk.offsets[0] + np.array([1.5 * k, 0.1, -k]), quat.identity(sk.num_joints)
+        )
+        poses.append((shape, sk, WorldPose(pos, rot, prev, prev_rot)))
+
+    def draw(which, outlined):
+        world = World()
+        ents = [world.spawn(Snowman(shape), Puppet(sk), wp) for shape, sk, wp in which]
+        world.flush()
+        scene = RenderScene()
+        draw_snowmen(world, scene, 0.4, {ents[i] for i in outlined})
+        order = [ents.index(e) for e, _ in world.query(Snowman)]
+        return scene.capsules.data, scene.spheres.data, order
+
+    caps, spheres, order = draw(poses, {2})
+    at_c = at_s = 0
+    for k in order:
+        alone_c, alone_s, _ = draw([poses[k]], {0} if k == 2 else set())
+        assert np.array_equal(caps[at_c : at_c + len(alone_c)], alone_c)
+        assert np.array_equal(spheres[at_s : at_s + len(alone_s)], alone_s)
+        at_c, at_s = at_c + len(alone_c), at_s + len(alone_s)
+    assert (at_c, at_s) == (len(caps), len(spheres)) == (39, 20)
+
+
 def test_trees_are_a_trunk_and_three_overlapping_cone_tiers_each():
     scene = RenderScene()
     draw_trees(scene)
