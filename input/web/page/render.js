@@ -108,28 +108,29 @@ precision mediump float;
 in vec3 vColor; out vec4 frag;
 void main() { frag = vec4(vColor, 1.0); }`;
 
-// The ground as a grid of 2 m cells. A field of snow (no grid lines) is coloured per vertex, faded to the
-// horizon there, and its pixels are a copy: the software rasteriser a phone-sized canvas is judged on pays
-// per pixel, and the ground is half the screen. Where a game draws grid lines, a pixel works them out
-// (GRID_FS). The blob shadows, tracks and footprints go on afterwards, each over what it covers.
+// The ground as a disc of rings round the eye (groundDisc), out to where it has long faded into the horizon.
+// A field of snow (no grid lines) is coloured per vertex, faded to the horizon there, and its pixels are a
+// copy. Few, large triangles: the software rasteriser a phone-sized canvas is judged on (SwiftShader) pays
+// per triangle as well as per pixel (a grid of 2 m cells, 3200 triangles, cost more than half the screen's
+// pixels). Where a game draws grid lines, a pixel works them out (GRID_FS). The blob shadows, tracks and
+// footprints go on afterwards, each over what it covers.
 const GROUND_VS = `#version 300 es
-layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; uniform vec3 eye;
+layout(location=0) in vec2 around; uniform mat4 viewProj; uniform float height; uniform vec3 eye;
 uniform vec3 color; uniform vec3 horizon;
 out vec3 vColor;
 void main() {
-  vec3 p = vec3(xz.x, height, xz.y);
-  float fade = clamp(length(p.xz - eye.xz) / 35.0, 0.0, 1.0);
+  float fade = clamp(length(around) / 35.0, 0.0, 1.0);
   vColor = mix(color, horizon, fade * fade);
-  gl_Position = viewProj * vec4(p, 1.0);
+  gl_Position = viewProj * vec4(eye.x + around.x, height, eye.z + around.y, 1.0);
 }`;
 
 const GRID_VS = `#version 300 es
-layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; uniform vec3 eye;
+layout(location=0) in vec2 around; uniform mat4 viewProj; uniform float height; uniform vec3 eye;
 out vec2 vXZ; out float vFade;
 void main() {
-  vXZ = xz;
-  vFade = clamp(length(xz - eye.xz) / 35.0, 0.0, 1.0);
-  gl_Position = viewProj * vec4(xz.x, height, xz.y, 1.0);
+  vXZ = eye.xz + around;
+  vFade = clamp(length(around) / 35.0, 0.0, 1.0);
+  gl_Position = viewProj * vec4(vXZ.x, height, vXZ.y, 1.0);
 }`;
 
 // The ground's colour at ``xz`` with the grid lines (the same in GRID_FS and SHADOW_FS, so a shade is never
@@ -149,7 +150,8 @@ out vec4 frag;
 ${GROUND_COLOUR}
 void main() { frag = vec4(mix(groundColour(vXZ, vFade), horizon, vFade * vFade), 1.0); }`;
 
-// The sky's gradient per vertex of a screen-covering grid (behind everything: depth 1).
+// The sky's gradient per vertex of a screen-covering grid of SKY_CELLS² cells (behind everything: depth 1).
+const SKY_CELLS = 24;  // the gradient steepens at the horizon: coarser cells show a step there
 const SKY_VS = `#version 300 es
 layout(location=0) in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
 out vec3 vColor;
@@ -298,6 +300,23 @@ function coneMesh(segments = 16, rings = 4) {
   v.push(0, 0, 0, 1);
   for (let k = 0; k < segments; k++) { const a = (2 * Math.PI * k) / segments; v.push(Math.cos(a), Math.sin(a), 0, 1); }
   for (let k = 0; k < segments; k++) idx.push(centre, centre + 1 + k, centre + 1 + ((k + 1) % segments));
+  return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
+}
+
+// The ground round the eye: rings at ``radii`` (metres; the first 0, the centre), ``segments`` round, as
+// offsets (x, z) from the eye, and triangles. Rings every 5 m while the ground fades (the fade's square,
+// interpolated linearly along 5 m, is off by under a thousandth), then one ring far out.
+function groundDisc(radii = [0, 5, 10, 15, 20, 25, 30, 35, 60], segments = 24) {
+  const v = [0, 0], idx = [];
+  for (let i = 1; i < radii.length; i++) for (let k = 0; k < segments; k++) {
+    const a = (2 * Math.PI * k) / segments;
+    v.push(radii[i] * Math.cos(a), radii[i] * Math.sin(a));
+  }
+  const at = (ring, k) => (ring === 0 ? 0 : 1 + (ring - 1) * segments + (k % segments));
+  for (let i = 0; i < radii.length - 1; i++) for (let k = 0; k < segments; k++) {
+    if (i === 0) { idx.push(0, at(1, k), at(1, k + 1)); continue; }
+    idx.push(at(i, k), at(i + 1, k), at(i + 1, k + 1), at(i, k), at(i + 1, k + 1), at(i, k + 1));
+  }
   return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
 }
 
@@ -454,12 +473,12 @@ class PageRenderer {
     gl.enableVertexAttribArray(6); gl.vertexAttribPointer(6, 3, gl.FLOAT, false, 24, 12);
     this.boxInst = this.instances([3, 3, 4, 3, 1]);
     this.groundVao = gl.createVertexArray(); gl.bindVertexArray(this.groundVao);
-    const ground = gridMesh(40, -40, 40, -40, 40);
+    const ground = groundDisc();
     this.buffer(ground.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     const gb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, ground.indices, gl.STATIC_DRAW);
     this.groundCount = ground.indices.length;
     this.skyVao = gl.createVertexArray(); gl.bindVertexArray(this.skyVao);
-    const sky = gridMesh(24, -1, 1, -1, 1);
+    const sky = gridMesh(SKY_CELLS, -1, 1, -1, 1);
     this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     const sb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, sb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sky.indices, gl.STATIC_DRAW);
     this.skyCount = sky.indices.length;
