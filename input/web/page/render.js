@@ -304,9 +304,11 @@ function coneMesh(segments = 16, rings = 4) {
 }
 
 // The ground round the eye: rings at ``radii`` (metres; the first 0, the centre), ``segments`` round, as
-// offsets (x, z) from the eye, and triangles. Rings every 5 m while the ground fades (the fade's square,
-// interpolated linearly along 5 m, is off by under a thousandth), then one ring far out.
-function groundDisc(radii = [0, 5, 10, 15, 20, 25, 30, 35, 60], segments = 24) {
+// offsets (x, z) from the eye, and triangles. Small rings under the eye: a triangle from right below the
+// camera out to 5 m, clipped at the near plane, got its depth wrong in SwiftShader (the ground hid the
+// puppet's legs); then rings every 5 m while the ground fades (the fade's square, interpolated linearly
+// along 5 m, is off by under a thousandth), and one far out.
+function groundDisc(radii = [0, 0.5, 1.5, 3, 5, 10, 15, 20, 25, 30, 35, 60], segments = 24) {
   const v = [0, 0], idx = [];
   for (let i = 1; i < radii.length; i++) for (let k = 0; k < segments; k++) {
     const a = (2 * Math.PI * k) / segments;
