@@ -803,4 +803,4 @@ class FrameCounter {
 }
 const MIN_RESOLUTION = 0.5;
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, shadeMarks, MARKS_ONE, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, shadeMarks, MARKS_ONE, groundDisc, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
