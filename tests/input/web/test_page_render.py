@@ -13,6 +13,7 @@ import math
 import shutil
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -46,13 +47,14 @@ console.log(JSON.stringify({{ kept: Array.from(kept.filter((_, i) => i % 11 === 
     assert out["same"]
 
 
-def run_node(script: str) -> dict:
+def run_node(script: str) -> dict[str, Any]:
+    """What a node script printed as JSON (its exit checked)."""
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stderr
     return json.loads(res.stdout)
 
 
-def test_the_tracks_are_shaded_per_cell_and_a_change_redoes_exactly_the_cells_it_reaches():
+def test_the_tracks_are_shaded_per_cell_and_a_change_redoes_exactly_the_cells_it_reaches() -> None:
     """``shadeMarks``: untouched snow is exactly 1 (MARKS_ONE), a groove bluish and darker, the wall facing the
     sun lighter than the one turned away; shading only the cells a change reaches gives what shading the whole
     grid gives. Break it: redo the changed cells without the one-cell margin (the slope of the neighbours) and
@@ -84,7 +86,7 @@ console.log(JSON.stringify({{ ...before, one: r.MARKS_ONE, same: shade.every((v,
     assert out["same"], "shading the cells a change reaches differs from shading the whole grid"
 
 
-def test_the_ground_disc_covers_the_ground_round_the_eye_once():
+def test_the_ground_disc_covers_the_ground_round_the_eye_once() -> None:
     """``groundDisc``: its triangles tile the polygon of its outer ring (their areas add up to it, none flipped)
     and the ones under the eye are small. Break it: leave out the centre's fan and the areas fall short."""
     script = f"""
