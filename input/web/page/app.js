@@ -150,13 +150,20 @@ function connect() {
   worker.postMessage({ connect: (location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws?t=" + encodeURIComponent(token) });
 }
 
+let sensorShown = -Infinity;
 function onOrientation(e) {
   if (state.kind === "xr") return;
   if (e.alpha === null && e.beta === null && e.gamma === null) return;
   state.o = [e.alpha || 0, e.beta || 0, e.gamma || 0];
   if (state.sensor === "none") { state.sensor = "orientation"; setMode(); }
-  $("status").textContent = "sensor: α " + state.o[0].toFixed(0) + "° β " + state.o[1].toFixed(0) + "° γ " + state.o[2].toFixed(0) + "°";
   sendReading();
+  // The angles on the page four times a second, not at every event: each change of text lays out and
+  // repaints the page on this thread, which also carries the readings.
+  const now = performance.now();
+  if (now - sensorShown > 250) {
+    sensorShown = now;
+    $("status").textContent = "sensor: α " + state.o[0].toFixed(0) + "° β " + state.o[1].toFixed(0) + "° γ " + state.o[2].toFixed(0) + "°";
+  }
 }
 
 function onMotion(e) {

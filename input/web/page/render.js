@@ -82,23 +82,25 @@ void main() {
 const FLAKE_VS = `#version 300 es
 layout(location=0) in vec4 flake;
 uniform mat4 viewProj; uniform float fall; uniform float height; uniform float sway; uniform vec2 phase;
-uniform float size; uniform float focal; uniform vec3 eye;
-out float vFade;
+uniform float size; uniform float focal; uniform vec3 eye; uniform vec3 color; uniform vec3 horizon;
+flat out vec3 vColor;
 void main() {
   vec3 p = vec3(flake.x + sway * sin(phase.x + flake.w), mod(flake.y - fall, height), flake.z + sway * cos(phase.y + flake.w));
   gl_Position = viewProj * vec4(p, 1.0);
   gl_PointSize = clamp(size * focal / max(gl_Position.w, 0.05), 1.0, 24.0);
-  vFade = clamp(length(p - eye) / 35.0, 0.0, 1.0);
+  float fade = clamp(length(p - eye) / 35.0, 0.0, 1.0);
+  vColor = mix(color, horizon, fade * fade);
 }`;
 
+// A round flake: its colour (faded to the horizon per flake, in the vertex stage), nothing outside its circle.
 const FLAKE_FS = `#version 300 es
 precision mediump float;
-in float vFade; uniform vec3 color; uniform vec3 horizon;
+flat in vec3 vColor;
 out vec4 frag;
 void main() {
   vec2 d = gl_PointCoord - 0.5;
   if (dot(d, d) > 0.25) discard;
-  frag = vec4(mix(color, horizon, vFade * vFade), 1.0);
+  frag = vec4(vColor, 1.0);
 }`;
 
 const FLAT_FS = `#version 300 es
@@ -106,36 +108,50 @@ precision mediump float;
 in vec3 vColor; out vec4 frag;
 void main() { frag = vec4(vColor, 1.0); }`;
 
-// The ground as a grid of 2 m cells: its colour, the fade to the horizon and where it falls in the shadow
-// mask are worked out per vertex; a pixel reads the mask once (its border is kept clear, so no test) and,
-// only where the game draws grid lines, works out the lines.
+// The ground as a disc of rings round the eye (groundDisc), out to where it has long faded into the horizon.
+// A field of snow (no grid lines) is coloured per vertex, faded to the horizon there, and its pixels are a
+// copy. Few, large triangles: the software rasteriser a phone-sized canvas is judged on (SwiftShader) pays
+// per triangle as well as per pixel (a grid of 2 m cells, 3200 triangles, cost more than half the screen's
+// pixels). Where a game draws grid lines, a pixel works them out (GRID_FS). The blob shadows, tracks and
+// footprints go on afterwards, each over what it covers.
 const GROUND_VS = `#version 300 es
-layout(location=0) in vec2 xz; uniform mat4 viewProj; uniform float height; uniform vec3 eye; uniform vec4 shadowRect;
-out vec3 vP; out float vFade; out vec2 vMask;
+layout(location=0) in vec2 around; uniform mat4 viewProj; uniform float height; uniform vec3 eye;
+uniform vec3 color; uniform vec3 horizon;
+out vec3 vColor;
 void main() {
-  vP = vec3(xz.x, height, xz.y);
-  vFade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
-  vMask = (vP.xz - shadowRect.xy) / shadowRect.zw;
-  gl_Position = viewProj * vec4(vP, 1.0);
+  float fade = clamp(length(around) / 35.0, 0.0, 1.0);
+  vColor = mix(color, horizon, fade * fade);
+  gl_Position = viewProj * vec4(eye.x + around.x, height, eye.z + around.y, 1.0);
 }`;
 
-const GROUND_FS = `#version 300 es
-precision highp float;
-in vec3 vP; in float vFade; in vec2 vMask;
+const GRID_VS = `#version 300 es
+layout(location=0) in vec2 around; uniform mat4 viewProj; uniform float height; uniform vec3 eye;
+out vec2 vXZ; out float vFade;
+void main() {
+  vXZ = eye.xz + around;
+  vFade = clamp(length(around) / 35.0, 0.0, 1.0);
+  gl_Position = viewProj * vec4(vXZ.x, height, vXZ.y, 1.0);
+}`;
+
+// The ground's colour at ``xz`` with the grid lines (the same in GRID_FS and SHADOW_FS, so a shade is never
+// lighter than the ground it falls on).
+const GROUND_COLOUR = `
 uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
-uniform vec3 horizon; uniform float alpha; uniform sampler2D shadowMask; uniform vec3 shadowTint;
-out vec4 frag;
-void main() {
-  vec3 c = color;
-  if (gridStrength > 0.0) {  // a field of snow has none: the software rasteriser skips the derivatives
-    vec2 g = abs(fract(vP.xz / spacing + 0.5) - 0.5) / fwidth(vP.xz / spacing);
-    c = mix(color, gridColor, (1.0 - min(min(g.x, g.y), 1.0)) * gridStrength * (1.0 - vFade));
-  }
-  c *= mix(vec3(1.0), shadowTint, texture(shadowMask, vMask).r);
-  frag = vec4(mix(c, horizon, vFade * vFade), alpha);
+vec3 groundColour(vec2 xz, float fade) {
+  if (gridStrength <= 0.0) return color;
+  vec2 g = abs(fract(xz / spacing + 0.5) - 0.5) / fwidth(xz / spacing);
+  return mix(color, gridColor, (1.0 - min(min(g.x, g.y), 1.0)) * gridStrength * (1.0 - fade));
 }`;
 
-// The sky's gradient per vertex of a screen-covering grid (behind everything: depth 1).
+const GRID_FS = `#version 300 es
+precision highp float;
+in vec2 vXZ; in float vFade; uniform vec3 horizon;
+out vec4 frag;
+${GROUND_COLOUR}
+void main() { frag = vec4(mix(groundColour(vXZ, vFade), horizon, vFade * vFade), 1.0); }`;
+
+// The sky's gradient per vertex of a screen-covering grid of SKY_CELLS² cells (behind everything: depth 1).
+const SKY_CELLS = 24;  // the gradient steepens at the horizon: coarser cells show a step there
 const SKY_VS = `#version 300 es
 layout(location=0) in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
 out vec3 vColor;
@@ -146,13 +162,15 @@ void main() {
 }`;
 
 // Blob shadows: each round thing (capsule, sphere; a box as its footprint's circle) cast along the sun
-// onto the ground as a soft stadium, drawn into a small mask over the rectangle the casters cover (MAX
-// blending: overlapping limbs do not darken twice). The ground reads the mask: its blue-tinted shade.
-const BLOB_VS = `#version 300 es
+// onto the ground as a soft stadium, drawn over the ground as a quad round that stadium. A pixel works out
+// the ground's colour in that much shade (blue-tinted: the sky's light stays) and the blending keeps the
+// darker of it and what is there (MIN): where limbs overlap the deepest shade wins and nothing darkens twice,
+// with no mask to render and no texture for the ground to read.
+const SHADOW_VS = `#version 300 es
 layout(location=0) in vec2 corner;
 layout(location=1) in vec3 a; layout(location=2) in vec3 b; layout(location=3) in float r;
-uniform vec3 sunDir; uniform float height; uniform vec4 rect;
-out vec2 vXZ; flat out vec2 vA; flat out vec2 vB; flat out float vR; flat out float vSoft; flat out float vStrength;
+uniform mat4 viewProj; uniform vec3 sunDir; uniform float height; uniform vec3 eye;
+out vec2 vXZ; out float vFade; flat out vec2 vA; flat out vec2 vB; flat out float vR; flat out float vSoft; flat out float vStrength;
 vec2 onGround(vec3 p) { return p.xz - sunDir.xz * (max(p.y - height, 0.0) / sunDir.y); }
 void main() {
   vec2 pa = onGround(a), pb = onGround(b);
@@ -163,17 +181,20 @@ void main() {
   vec2 u = len > 1e-5 ? ax / len : vec2(1.0, 0.0), v = vec2(-u.y, u.x);
   float e = r + vSoft;
   vXZ = mix(pa, pb, 0.5 + 0.5 * corner.x) + u * corner.x * e + v * corner.y * e;
-  gl_Position = vec4((vXZ - rect.xy) / rect.zw * 2.0 - 1.0, 0.0, 1.0);
+  vFade = clamp(length(vXZ - eye.xz) / 35.0, 0.0, 1.0);
+  gl_Position = viewProj * vec4(vXZ.x, height, vXZ.y, 1.0);
 }`;
 
-const BLOB_FS = `#version 300 es
+const SHADOW_FS = `#version 300 es
 precision highp float;
-in vec2 vXZ; flat in vec2 vA; flat in vec2 vB; flat in float vR; flat in float vSoft; flat in float vStrength;
+in vec2 vXZ; in float vFade; flat in vec2 vA; flat in vec2 vB; flat in float vR; flat in float vSoft; flat in float vStrength;
+uniform vec3 horizon; uniform vec3 shadowTint;
 out vec4 frag;
+${GROUND_COLOUR}
 void main() {
   vec2 ab = vB - vA; float t = clamp(dot(vXZ - vA, ab) / max(dot(ab, ab), 1e-8), 0.0, 1.0);
-  float d = length(vXZ - vA - ab * t);
-  frag = vec4(vStrength * (1.0 - smoothstep(vR - vSoft, vR + vSoft, d)), 0.0, 0.0, 1.0);
+  float m = vStrength * (1.0 - smoothstep(vR - vSoft, vR + vSoft, length(vXZ - vA - ab * t)));
+  frag = vec4(mix(groundColour(vXZ, vFade) * mix(vec3(1.0), shadowTint, m), horizon, vFade * vFade), 1.0);
 }`;
 
 // Decals over the ground (multiplied in: blend dst·src·2, so 0.5 keeps the colour), as on the desktop:
@@ -184,21 +205,19 @@ uniform mat4 viewProj; uniform vec4 rect; uniform float height;
 out vec3 vP; out vec2 vUV;
 void main() { vUV = corner; vP = vec3(rect.x + corner.x * rect.z, height, rect.y + corner.y * rect.w); gl_Position = viewProj * vec4(vP, 1.0); }`;
 
+// A shaded track cell's factor 1 (the snow's own colour) as a byte: up to 255 / MARKS_ONE (the sunlit wall).
+const MARKS_ONE = 200;
+
 const MARKS_FS = `#version 300 es
 precision highp float;
+#define MARKS_ONE ${MARKS_ONE}.0
 in vec3 vP; in vec2 vUV;
-uniform sampler2D marks; uniform vec2 texel; uniform vec4 uvRect; uniform vec3 sunDir; uniform vec3 eye;
+uniform sampler2D marks; uniform vec4 uvRect; uniform vec3 eye;
 out vec4 frag;
-// The grid comes softened (stream.js softenMarks): one read per pixel, four more for the slope.
+// The grid comes shaded per cell (marksShade: the groove's tint and its slope in the sun, as the desktop's
+// MARKS_FS works them out per pixel): one read per pixel.
 void main() {
-  vec2 uv = uvRect.xy + vUV * uvRect.zw;
-  float m = texture(marks, uv).r;
-  if (m < 0.01) discard;
-  vec2 dx = vec2(texel.x, 0.0), dz = vec2(0.0, texel.y);
-  vec3 n = normalize(vec3((texture(marks, uv + dx).r - texture(marks, uv - dx).r) * 1.6, 1.0,
-    (texture(marks, uv + dz).r - texture(marks, uv - dz).r) * 1.6));
-  float light = clamp(max(dot(n, sunDir), 0.0) / max(sunDir.y, 0.2), 0.72, 1.12);
-  vec3 k = mix(vec3(1.0), vec3(0.76, 0.82, 0.92), smoothstep(0.0, 1.0, m)) * mix(1.0, light, smoothstep(0.0, 0.4, m));
+  vec3 k = texture(marks, uvRect.xy + vUV * uvRect.zw).rgb * (255.0 / MARKS_ONE);
   float fade = clamp(length(vP.xz - eye.xz) / 35.0, 0.0, 1.0);
   frag = vec4(0.5 * mix(k, vec3(1.0), fade * fade), 1.0);
 }`;
@@ -235,7 +254,6 @@ void main() {
   frag = vec4(vec3(0.5 * k) * vec3(0.97, 0.985, 1.0), 1.0);
 }`;
 
-const SHADOW_SIZE = 256;
 
 function compile(gl, vs, fs) {
   const prog = gl.createProgram();
@@ -282,6 +300,25 @@ function coneMesh(segments = 16, rings = 4) {
   v.push(0, 0, 0, 1);
   for (let k = 0; k < segments; k++) { const a = (2 * Math.PI * k) / segments; v.push(Math.cos(a), Math.sin(a), 0, 1); }
   for (let k = 0; k < segments; k++) idx.push(centre, centre + 1 + k, centre + 1 + ((k + 1) % segments));
+  return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
+}
+
+// The ground round the eye: rings at ``radii`` (metres; the first 0, the centre), ``segments`` round, as
+// offsets (x, z) from the eye, and triangles. Small rings under the eye: a triangle from right below the
+// camera out to 5 m, clipped at the near plane, got its depth wrong in SwiftShader (the ground hid the
+// puppet's legs); then rings every 5 m while the ground fades (the fade's square, interpolated linearly
+// along 5 m, is off by under a thousandth), and one far out.
+function groundDisc(radii = [0, 0.5, 1.5, 3, 5, 10, 15, 20, 25, 30, 35, 60], segments = 24) {
+  const v = [0, 0], idx = [];
+  for (let i = 1; i < radii.length; i++) for (let k = 0; k < segments; k++) {
+    const a = (2 * Math.PI * k) / segments;
+    v.push(radii[i] * Math.cos(a), radii[i] * Math.sin(a));
+  }
+  const at = (ring, k) => (ring === 0 ? 0 : 1 + (ring - 1) * segments + (k % segments));
+  for (let i = 0; i < radii.length - 1; i++) for (let k = 0; k < segments; k++) {
+    if (i === 0) { idx.push(0, at(1, k), at(1, k + 1)); continue; }
+    idx.push(at(i, k), at(i + 1, k), at(i + 1, k + 1), at(i, k), at(i + 1, k + 1), at(i, k + 1));
+  }
   return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
 }
 
@@ -371,6 +408,32 @@ function shadowTint(look) {
   });
 }
 
+// The softened tracks ``soft`` (stream.js softenInto) shaded per cell into ``out`` (RGBA bytes, MARKS_ONE =
+// the snow's own colour), as the desktop's MARKS_FS shades each pixel: the groove tinted blue by its depth,
+// and its walls lit by the sun along their slope (neighbouring cells, edges repeated); an untouched cell is
+// exactly 1. Redoes the cells whose slope the softened cells ``soft`` changed at [r0, c0, r1, c1) reach (one
+// cell round them) and returns that region.
+function shadeMarks(soft, out, nx, nz, region, sun) {
+  const len = Math.hypot(sun[0], sun[1], sun[2]), sx = sun[0] / len, sy = sun[1] / len, sz = sun[2] / len;
+  const r0 = Math.max(region[0] - 1, 0), c0 = Math.max(region[1] - 1, 0), r1 = Math.min(region[2] + 1, nz), c1 = Math.min(region[3] + 1, nx);
+  const smooth = (e, x) => { const t = Math.min(Math.max(x / e, 0), 1); return t * t * (3 - 2 * t); };
+  const tint = [0.76, 0.82, 0.92];
+  for (let r = r0; r < r1; r++) for (let c = c0; c < c1; c++) {
+    const i = r * nx + c, m = soft[i] / 255;
+    let k = [1, 1, 1];
+    if (m >= 0.01) {
+      const gx = ((soft[r * nx + Math.min(c + 1, nx - 1)] - soft[r * nx + Math.max(c - 1, 0)]) / 255) * 1.6;
+      const gz = ((soft[Math.min(r + 1, nz - 1) * nx + c] - soft[Math.max(r - 1, 0) * nx + c]) / 255) * 1.6;
+      const n = Math.hypot(gx, 1, gz), light = Math.min(Math.max(Math.max((gx * sx + sy + gz * sz) / n, 0) / Math.max(sy, 0.2), 0.72), 1.12);
+      const deep = smooth(1, m), lit = 1 + (light - 1) * smooth(0.4, m);
+      k = tint.map((t) => (1 + (t - 1) * deep) * lit);
+    }
+    for (let j = 0; j < 3; j++) out[4 * i + j] = Math.min(255, Math.round(k[j] * MARKS_ONE));
+    out[4 * i + 3] = 255;
+  }
+  return [r0, c0, r1, c1];
+}
+
 // Every round thing as one capsule row a[3] b[3] r colour[3] outline: capsules, spheres, lines, points.
 function roundRows(rows) {
   const caps = rows.capsules, sph = rows.spheres, lines = rows.lines, pts = rows.points;
@@ -397,7 +460,8 @@ class PageRenderer {
     this.gl = gl; this.canvas = canvas;
     this.capsule = compile(gl, CAPSULE_VS, FLAT_FS);
     this.box = compile(gl, BOX_VS, FLAT_FS);
-    this.ground = compile(gl, GROUND_VS, GROUND_FS);
+    this.ground = compile(gl, GROUND_VS, FLAT_FS);
+    this.grid = compile(gl, GRID_VS, GRID_FS);
     this.sky = compile(gl, SKY_VS, FLAT_FS);
     const mesh = capsuleMesh();
     this.capVao = gl.createVertexArray(); gl.bindVertexArray(this.capVao);
@@ -411,33 +475,28 @@ class PageRenderer {
     gl.enableVertexAttribArray(6); gl.vertexAttribPointer(6, 3, gl.FLOAT, false, 24, 12);
     this.boxInst = this.instances([3, 3, 4, 3, 1]);
     this.groundVao = gl.createVertexArray(); gl.bindVertexArray(this.groundVao);
-    const ground = gridMesh(40, -40, 40, -40, 40);
+    const ground = groundDisc();
     this.buffer(ground.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     const gb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, ground.indices, gl.STATIC_DRAW);
     this.groundCount = ground.indices.length;
     this.skyVao = gl.createVertexArray(); gl.bindVertexArray(this.skyVao);
-    const sky = gridMesh(24, -1, 1, -1, 1);
+    const sky = gridMesh(SKY_CELLS, -1, 1, -1, 1);
     this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     const sb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, sb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sky.indices, gl.STATIC_DRAW);
     this.skyCount = sky.indices.length;
-    this.blob = compile(gl, BLOB_VS, BLOB_FS);
+    this.shadow = compile(gl, SHADOW_VS, SHADOW_FS);
     this.marksProg = compile(gl, DECAL_VS, MARKS_FS);
     this.printProg = compile(gl, PRINT_VS, PRINT_FS);
     const square = new Float32Array([-1, -1, 1, -1, -1, 1, 1, 1]);
-    this.blobVao = gl.createVertexArray(); gl.bindVertexArray(this.blobVao);
+    this.shadowVao = gl.createVertexArray(); gl.bindVertexArray(this.shadowVao);
     this.buffer(square); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
-    this.blobInst = this.instances([3, 3, 1, 3, 1]);
+    this.shadowInst = this.instances([3, 3, 1, 3, 1]);
     this.printVao = gl.createVertexArray(); gl.bindVertexArray(this.printVao);
     this.buffer(square); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     this.printInst = this.instances([2, 2, 2, 1]);
     this.decalVao = gl.createVertexArray(); gl.bindVertexArray(this.decalVao);
     this.buffer(new Float32Array([0, 0, 1, 0, 0, 1, 1, 1])); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     gl.bindVertexArray(null);
-    this.shadowTex = this.texture(SHADOW_SIZE, SHADOW_SIZE, null);
-    this.shadowFbo = gl.createFramebuffer();
-    gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.shadowTex, 0);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     this.cone = compile(gl, CONE_VS, FLAT_FS);
     const cone = coneMesh();
     this.coneVao = gl.createVertexArray(); gl.bindVertexArray(this.coneVao);
@@ -450,8 +509,8 @@ class PageRenderer {
     this.flakeBuf = this.buffer(new Float32Array(4)); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 16, 0);
     this.flakes = null;
     gl.bindVertexArray(null);
-    this.shadowRect = null; this.shadowCasters = null;
-    this.marksTex = null; this.marksSrc = null; this.marksSoft = null; this.marksRect = null;
+    this.casters = { key: [], rows: new Float32Array(0) };
+    this.marksTex = null; this.marksSrc = null; this.marksSoft = null; this.marksShade = null; this.marksSun = null; this.marksRect = null;
     this.uploaded = new Map(); this.round = { key: [], rows: new Float32Array(0) };
   }
 
@@ -471,69 +530,87 @@ class PageRenderer {
     return c.rows;
   }
 
-  // A one-channel texture, linearly filtered, clamped at its edges.
+  // An RGBA texture, linearly filtered, clamped at its edges.
   texture(w, h, data) {
     const gl = this.gl, tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, tex);
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
-    gl.texImage2D(gl.TEXTURE_2D, 0, gl.R8, w, h, 0, gl.RED, gl.UNSIGNED_BYTE, data);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, w, h, 0, gl.RGBA, gl.UNSIGNED_BYTE, data);
     for (const [k, v] of [[gl.TEXTURE_MIN_FILTER, gl.LINEAR], [gl.TEXTURE_MAG_FILTER, gl.LINEAR],
       [gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE], [gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE]]) gl.texParameteri(gl.TEXTURE_2D, k, v);
     return tex;
   }
 
-  // The blob shadows of ``round`` rows (capsule layout) into the mask; its rectangle on the ground, or null.
-  drawShadows(round, look) {
-    const gl = this.gl, n = round.length / 11, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]);
-    const sx = d[0] / len, sy = Math.max(d[1] / len, 0.2), sz = d[2] / len, g = look.ground.height;
-    let x0 = Infinity, z0 = Infinity, x1 = -Infinity, z1 = -Infinity;
-    for (let i = 0; i < n; i++) {
-      const o = i * 11, r = round[o + 6];
-      for (const e of [o, o + 3]) {
-        const lift = Math.max(round[e + 1] - g, 0) / sy, x = round[e] - sx * lift, z = round[e + 2] - sz * lift;
-        const m = 1.35 * r + 0.25 * Math.max(round[e + 1] - g, 0) + 0.05;
-        x0 = Math.min(x0, x - m); x1 = Math.max(x1, x + m); z0 = Math.min(z0, z - m); z1 = Math.max(z1, z + m);
-      }
+  // Every caster of a blob shadow as a capsule row (round rows, and each box as the circle round its
+  // footprint), rebuilt only when the rows it comes from changed.
+  castersOf(round, boxes) {
+    const c = this.casters;
+    if (c.key[0] === round && c.key[1] === boxes) return c.rows;
+    const nb = boxes.length / 14, casters = new Float32Array(round.length + 11 * nb);
+    casters.set(round);
+    for (let i = 0, at = round.length; i < nb; i++, at += 11) {
+      const o = i * 14;
+      casters.set(boxes.subarray(o, o + 3), at); casters.set(boxes.subarray(o, o + 3), at + 3);
+      casters[at + 1] = casters[at + 4] = boxes[o + 1] - boxes[o + 4] + Math.hypot(boxes[o + 3], boxes[o + 5]);
+      casters[at + 6] = Math.hypot(boxes[o + 3], boxes[o + 5]);
     }
-    if (!(x1 > x0)) return null;
-    const size = Math.min(Math.max(x1 - x0, z1 - z0), 48), cx = Math.min(Math.max((x0 + x1) / 2, -60), 60), cz = Math.min(Math.max((z0 + z1) / 2, -60), 60);
-    const rect = [cx - size / 2, cz - size / 2, size, size];
-    gl.bindFramebuffer(gl.FRAMEBUFFER, this.shadowFbo);
-    gl.viewport(1, 1, SHADOW_SIZE - 2, SHADOW_SIZE - 2);  // a clear border: the ground reads it outside the rect
-    gl.disable(gl.DEPTH_TEST);
-    gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT);
-    gl.enable(gl.BLEND); gl.blendEquation(gl.MAX);
-    gl.useProgram(this.blob.prog);
-    const u = this.blob.u;
-    gl.uniform3f(u.sunDir, sx, sy, sz); gl.uniform1f(u.height, g); gl.uniform4fv(u.rect, rect);
-    gl.bindVertexArray(this.blobVao);
-    this.upload(this.blobInst, round);
-    gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, n);
-    gl.blendEquation(gl.FUNC_ADD); gl.disable(gl.BLEND);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    const grow = 1 / (SHADOW_SIZE - 2);  // the whole mask, border included, as the ground reads it
-    return [rect[0] - rect[2] * grow, rect[1] - rect[3] * grow, rect[2] * (1 + 2 * grow), rect[3] * (1 + 2 * grow)];
+    c.key = [round, boxes]; c.rows = casters;
+    return casters;
   }
 
-  // The tracks' texture and the rectangle of marked cells. A new grid is softened and uploaded whole; the
-  // same grid with ``dirty`` cells ([row0, col0, row1, col1)) has only those and their neighbours softened
-  // again and re-uploaded (a ball rolling changes a few cells a step, not the 240 × 240 grid).
-  updateMarks(marks, dirty) {
+  // The blob shadows of ``casters`` (capsule rows) on the ground just drawn (SHADOW_VS): a quad each,
+  // kept where darker (MIN), behind whatever stands in front (depth test, no depth writes).
+  drawShadows(casters, look, viewProj, eye) {
+    const n = casters.length / 11;
+    if (!n) return;
+    const gl = this.gl, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]), g = look.ground, u = this.shadow.u;
+    gl.useProgram(this.shadow.prog);
+    gl.uniformMatrix4fv(u.viewProj, false, viewProj);
+    gl.uniform3f(u.sunDir, d[0] / len, Math.max(d[1] / len, 0.2), d[2] / len); gl.uniform1f(u.height, g.height);
+    gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform3fv(u.shadowTint, shadowTint(look));
+    this.groundUniforms(u, g);
+    gl.enable(gl.BLEND); gl.blendEquation(gl.MIN);
+    gl.depthFunc(gl.LEQUAL); gl.depthMask(false);
+    gl.enable(gl.POLYGON_OFFSET_FILL); gl.polygonOffset(-2, -8);
+    gl.bindVertexArray(this.shadowVao);
+    this.upload(this.shadowInst, casters);
+    gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, n);
+    gl.disable(gl.POLYGON_OFFSET_FILL); gl.blendEquation(gl.FUNC_ADD); gl.disable(gl.BLEND);
+    gl.depthMask(true); gl.depthFunc(gl.LESS);
+  }
+
+  // The ground's colour and grid lines (GROUND_COLOUR) into a program's uniforms.
+  groundUniforms(u, g) {
     const gl = this.gl;
-    if (marks !== this.marksSrc) {
+    gl.uniform3fv(u.color, g.color);
+    if (u.gridColor) {
+      gl.uniform3fv(u.gridColor, g.grid_color); gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0);
+      gl.uniform1f(u.spacing, g.grid_spacing);
+    }
+  }
+
+  // The tracks' shaded texture (shadeMarks) and the rectangle of marked cells. A new grid is softened,
+  // shaded and uploaded whole; the same grid with ``dirty`` cells ([row0, col0, row1, col1)) has only those
+  // and the cells their blur and slope reach done again and re-uploaded (a ball rolling changes a few cells
+  // a step, not the 240 × 240 grid).
+  updateMarks(marks, dirty, sun) {
+    const gl = this.gl;
+    if (marks !== this.marksSrc || (marks && sun !== this.marksSun)) {
       if (this.marksTex) gl.deleteTexture(this.marksTex);
-      this.marksTex = null; this.marksRect = null; this.marksSrc = marks; this.marksSoft = null; this.marksBox = null;
+      this.marksTex = null; this.marksRect = null; this.marksSrc = marks; this.marksSoft = null; this.marksShade = null; this.marksBox = null;
       if (!marks) return;
-      this.marksSoft = new Uint8Array(marks.nx * marks.nz);
+      this.marksSun = sun;
+      this.marksSoft = new Uint8Array(marks.nx * marks.nz); this.marksShade = new Uint8Array(4 * marks.nx * marks.nz);
       dirty = softenInto(marks.cells, this.marksSoft, marks.nx, marks.nz, [0, 0, marks.nz, marks.nx]);
-      this.marksTex = this.texture(marks.nx, marks.nz, this.marksSoft);
+      shadeMarks(this.marksSoft, this.marksShade, marks.nx, marks.nz, dirty, sun);
+      this.marksTex = this.texture(marks.nx, marks.nz, this.marksShade);
     } else if (marks && dirty) {
-      dirty = softenInto(marks.cells, this.marksSoft, marks.nx, marks.nz, dirty);
-      const [r0, c0, r1, c1] = dirty;
+      const [r0, c0, r1, c1] = shadeMarks(this.marksSoft, this.marksShade, marks.nx, marks.nz,
+        softenInto(marks.cells, this.marksSoft, marks.nx, marks.nz, dirty), sun);
       gl.bindTexture(gl.TEXTURE_2D, this.marksTex);
       gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1); gl.pixelStorei(gl.UNPACK_ROW_LENGTH, marks.nx);
       gl.pixelStorei(gl.UNPACK_SKIP_ROWS, r0); gl.pixelStorei(gl.UNPACK_SKIP_PIXELS, c0);
-      gl.texSubImage2D(gl.TEXTURE_2D, 0, c0, r0, c1 - c0, r1 - r0, gl.RED, gl.UNSIGNED_BYTE, this.marksSoft);
+      gl.texSubImage2D(gl.TEXTURE_2D, 0, c0, r0, c1 - c0, r1 - r0, gl.RGBA, gl.UNSIGNED_BYTE, this.marksShade);
       gl.pixelStorei(gl.UNPACK_ROW_LENGTH, 0); gl.pixelStorei(gl.UNPACK_SKIP_ROWS, 0); gl.pixelStorei(gl.UNPACK_SKIP_PIXELS, 0);
     } else return;
     // The marked cells' bounds grow by what the changed cells hold (a filled cell keeps them: drawn, discarded).
@@ -561,9 +638,8 @@ class PageRenderer {
       gl.useProgram(p.prog);
       gl.activeTexture(gl.TEXTURE1); gl.bindTexture(gl.TEXTURE_2D, this.marksTex); gl.uniform1i(u.marks, 1);
       gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform4fv(u.rect, rect); gl.uniform1f(u.height, g);
-      gl.uniform2f(u.texel, 1 / marks.nx, 1 / marks.nz);
       gl.uniform4f(u.uvRect, (rect[0] - marks.x0) / w, (rect[1] - marks.z0) / h, rect[2] / w, rect[3] / h);
-      gl.uniform3f(u.sunDir, d[0] / len, d[1] / len, d[2] / len); gl.uniform3fv(u.eye, eye);
+      gl.uniform3fv(u.eye, eye);
       gl.bindVertexArray(this.decalVao); gl.drawArrays(gl.TRIANGLE_STRIP, 0, 4);
       gl.activeTexture(gl.TEXTURE0);
     }
@@ -614,24 +690,7 @@ class PageRenderer {
     const gl = this.gl;
     let proj, view, eye, basis;
     const round = this.roundOf(frame.rows);
-    if (!xr) {
-      // The blob shadows again only when something round or a box moved. Boxes cast as the circle round
-      // their footprint.
-      const boxes = frame.rows.boxes;
-      if (this.shadowCasters === null || this.shadowCasters[0] !== round || this.shadowCasters[1] !== boxes) {
-        const nb = boxes.length / 14, casters = new Float32Array(round.length + 11 * nb);
-        casters.set(round);
-        for (let i = 0, at = round.length; i < nb; i++, at += 11) {
-          const o = i * 14;
-          casters.set(boxes.subarray(o, o + 3), at); casters.set(boxes.subarray(o, o + 3), at + 3);
-          casters[at + 1] = casters[at + 4] = boxes[o + 1] - boxes[o + 4] + Math.hypot(boxes[o + 3], boxes[o + 5]);
-          casters[at + 6] = Math.hypot(boxes[o + 3], boxes[o + 5]);
-        }
-        this.shadowCasters = [round, boxes];
-        this.shadowRect = this.drawShadows(casters, look);
-      }
-      this.updateMarks(frame.marks, frame.marksDirty);
-    }
+    if (!xr) this.updateMarks(frame.marks, frame.marksDirty, look.sun.direction);
     if (xr) {
       ({ proj, view, eye } = xr);
       gl.viewport(...xr.viewport);
@@ -644,7 +703,9 @@ class PageRenderer {
     }
     const viewProj = mul4(proj, view), planes = frustumPlanes(viewProj);
     gl.enable(gl.DEPTH_TEST); gl.disable(gl.CULL_FACE);
-    if (!xr || xr.first) { gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT); }
+    // The magic window's sky and ground cover every pixel: only the depth is cleared there.
+    if (xr && xr.first) { gl.clearColor(0, 0, 0, 0); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT); }
+    else if (!xr) gl.clear(gl.DEPTH_BUFFER_BIT);
     const shown = cull(round, 11, planes);
     if (shown.length) {
       gl.useProgram(this.capsule.prog);
@@ -672,27 +733,21 @@ class PageRenderer {
       this.upload(this.coneInst, cones);
       gl.drawElementsInstanced(gl.TRIANGLES, this.coneCount, gl.UNSIGNED_SHORT, 0, cones.length / 11);
     }
-    if (!xr) this.backdrop(frame, look, viewProj, eye, basis);
+    if (!xr) this.backdrop(frame, look, viewProj, eye, basis, round);
     gl.bindVertexArray(null);
   }
 
-  // Ground, then sky, after the objects: the depth test skips every pixel they already cover.
-  backdrop(frame, look, viewProj, eye, basis) {
-    const gl = this.gl;
-    {
-      const g = look.ground;
-      gl.useProgram(this.ground.prog);
-      gl.bindVertexArray(this.groundVao);
-      const u = this.ground.u;
-      gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g.height);
-      gl.uniform3fv(u.color, g.color); gl.uniform3fv(u.gridColor, g.grid_color);
-      gl.uniform1f(u.gridStrength, g.grid ? g.grid_strength : 0); gl.uniform1f(u.spacing, g.grid_spacing);
-      gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform1f(u.alpha, 1);
-      gl.activeTexture(gl.TEXTURE0); gl.bindTexture(gl.TEXTURE_2D, this.shadowTex); gl.uniform1i(u.shadowMask, 0);
-      gl.uniform4fv(u.shadowRect, this.shadowRect || [1e6, 1e6, 1, 1]);  // none: the mask's clear border
-      gl.uniform3fv(u.shadowTint, shadowTint(look));
-      gl.drawElements(gl.TRIANGLES, this.groundCount, gl.UNSIGNED_SHORT, 0);
-    }
+  // Ground, then sky, after the objects: the depth test skips every pixel they already cover. The blob
+  // shadows of ``round`` rows and the boxes, the tracks and footprints go on the ground in between.
+  backdrop(frame, look, viewProj, eye, basis, round) {
+    const gl = this.gl, g = look.ground, p = g.grid ? this.grid : this.ground, u = p.u;
+    gl.useProgram(p.prog);
+    gl.bindVertexArray(this.groundVao);
+    gl.uniformMatrix4fv(u.viewProj, false, viewProj); gl.uniform1f(u.height, g.height);
+    gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon);
+    this.groundUniforms(u, g);
+    gl.drawElements(gl.TRIANGLES, this.groundCount, gl.UNSIGNED_SHORT, 0);
+    this.drawShadows(this.castersOf(round, frame.rows.boxes), look, viewProj, eye);
     this.drawDecals(frame, look, viewProj, eye);
     const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
     gl.useProgram(this.sky.prog);
@@ -748,4 +803,4 @@ class FrameCounter {
 }
 const MIN_RESOLUTION = 0.5;
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, shadeMarks, MARKS_ONE, groundDisc, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };

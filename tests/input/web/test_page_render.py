@@ -9,9 +9,11 @@ count; one that drops rows half in view fails the edge case.
 from __future__ import annotations
 
 import json
+import math
 import shutil
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -43,3 +45,65 @@ console.log(JSON.stringify({{ kept: Array.from(kept.filter((_, i) => i % 11 === 
     out = json.loads(res.stdout)
     assert out["kept"] == [0, pytest.approx(1.4)], out
     assert out["same"]
+
+
+def run_node(script: str) -> dict[str, Any]:
+    """What a node script printed as JSON (its exit checked)."""
+    res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, res.stderr
+    return json.loads(res.stdout)
+
+
+def test_the_tracks_are_shaded_per_cell_and_a_change_redoes_exactly_the_cells_it_reaches() -> None:
+    """``shadeMarks``: untouched snow is exactly 1 (MARKS_ONE), a groove bluish and darker, the wall facing the
+    sun lighter than the one turned away; shading only the cells a change reaches gives what shading the whole
+    grid gives. Break it: redo the changed cells without the one-cell margin (the slope of the neighbours) and
+    the incremental grid differs from the whole one; drop the tint and the groove is not bluish."""
+    script = f"""
+const r = require({json.dumps(str(PAGE / "render.js"))});
+const s = require({json.dumps(str(PAGE / "stream.js"))});
+const nx = 20, nz = 12, sun = [1, 1, 0];  // the sun low in +x
+const cells = new Uint8Array(nx * nz);
+for (let row = 4; row < 8; row++) for (let c = 6; c < 12; c++) cells[row * nx + c] = 255;  // a groove
+const soft = new Uint8Array(nx * nz), shade = new Uint8Array(4 * nx * nz);
+r.shadeMarks(soft, shade, nx, nz, s.softenInto(cells, soft, nx, nz, [0, 0, nz, nx]), sun);
+const at = (g, row, c) => Array.from(g.subarray(4 * (row * nx + c), 4 * (row * nx + c) + 3));
+const before = {{ plain: at(shade, 0, 0), centre: at(shade, 5, 9), westWall: at(shade, 5, 5), eastWall: at(shade, 5, 12) }};
+// The ball rolls on: two more cells, shaded incrementally, against the whole grid shaded afresh.
+cells[5 * nx + 12] = 255; cells[6 * nx + 12] = 255;
+r.shadeMarks(soft, shade, nx, nz, s.softenInto(cells, soft, nx, nz, [5, 12, 7, 13]), sun);
+const soft2 = new Uint8Array(nx * nz), whole = new Uint8Array(4 * nx * nz);
+r.shadeMarks(soft2, whole, nx, nz, s.softenInto(cells, soft2, nx, nz, [0, 0, nz, nx]), sun);
+console.log(JSON.stringify({{ ...before, one: r.MARKS_ONE, same: shade.every((v, i) => v === whole[i]) }}));
+"""
+    out = run_node(script)
+    assert out["plain"] == [out["one"]] * 3, out
+    centre = out["centre"]
+    assert max(centre) < out["one"] and centre[2] > centre[0] + 10, f"the groove is not darker and bluish: {out}"
+    # The amount grows eastwards over the west wall: its slope tilts the normal towards the sun in +x (as
+    # MARKS_FS's); the east wall's turns away.
+    assert sum(out["westWall"]) > sum(out["eastWall"]) + 20, f"the sun does not light the walls differently: {out}"
+    assert out["same"], "shading the cells a change reaches differs from shading the whole grid"
+
+
+def test_the_ground_disc_covers_the_ground_round_the_eye_once() -> None:
+    """``groundDisc``: its triangles tile the polygon of its outer ring (their areas add up to it, none flipped)
+    and the ones under the eye are small. Break it: leave out the centre's fan and the areas fall short."""
+    script = f"""
+const r = require({json.dumps(str(PAGE / "render.js"))});
+const d = r.groundDisc(), v = d.vertices, idx = d.indices;
+let area = 0, flipped = 0, centreEdge = 0;
+for (let t = 0; t < idx.length; t += 3) {{
+  const [a, b, c] = [idx[t], idx[t + 1], idx[t + 2]].map((i) => [v[2 * i], v[2 * i + 1]]);
+  const s = ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])) / 2;
+  area += Math.abs(s); if (s < 0) flipped += 1;
+  if ([a, b, c].some((p) => p[0] === 0 && p[1] === 0)) centreEdge = Math.max(centreEdge, ...[a, b, c].map((p) => Math.hypot(p[0], p[1])));
+}}
+console.log(JSON.stringify({{ area, flipped, triangles: idx.length / 3, centreEdge }}));
+"""
+    out = run_node(script)
+    polygon = 0.5 * 24 * 60.0**2 * math.sin(2 * math.pi / 24)
+    assert out["area"] == pytest.approx(polygon, rel=1e-5), out
+    assert out["flipped"] in (0, out["triangles"]), "the triangles do not all wind the same way"
+    assert out["centreEdge"] <= 1.0, out
+    assert out["triangles"] < 600, out
