@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.blend.space import BlendSpace
-from engine.jit import njit, qnormalize
+from engine.jit import njit, qmul, qnormalize
 
-__all__ = ["Packed", "packed", "play"]
+__all__ = ["Packed", "packed", "place", "play"]
 
 from engine.arrays import F64 as F
 from engine.arrays import I64 as I
@@ -333,3 +333,54 @@ def _frame_rotations(
             q = (-q[0], -q[1], -q[2], -q[3])
         for c in range(4):
             out[j, c] += wn * q[c]
+
+
+@njit
+def place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F, headings: F, world_roots: F) -> None:
+    """Move every puppet by its travel and turn (both in its clip frame) and place its pose in the world:
+    ``positions`` advanced in place, new ``headings``, the root in world space, the heading folded into
+    joint 0 of ``rots`` (in place). The numpy twin is the end of :func:`engine.blend.locomotion._animate_group`;
+    the operations are :mod:`engine.quat`'s in its order (an axis-angle about +Y keeps its zero products),
+    so both agree bit for bit."""
+    for p in range(rotation.shape[0]):
+        w, x, y, z = rotation[p, 0], rotation[p, 1], rotation[p, 2], rotation[p, 3]
+        yaw = math.atan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
+        hq = _yaw_quat(yaw)
+        step = _rotate(hq, (travel[p, 0], travel[p, 1], travel[p, 2]))
+        turn_q = _yaw_quat(turn[p])
+        hq_new = _yaw_quat(yaw + turn[p])
+        r0 = qmul(hq_new, (rots[p, 0, 0], rots[p, 0, 1], rots[p, 0, 2], rots[p, 0, 3]))
+        for c in range(4):
+            rots[p, 0, c] = r0[c]
+        offset = _rotate(hq_new, (roots[p, 0], roots[p, 1], roots[p, 2]))
+        for c in range(3):
+            positions[p, c] = positions[p, c] + step[c]
+            world_roots[p, c] = positions[p, c] + offset[c]
+        heading = qmul(turn_q, (w, x, y, z))
+        n = math.sqrt(
+            heading[0] * heading[0] + heading[1] * heading[1] + heading[2] * heading[2] + heading[3] * heading[3]
+        )
+        for c in range(4):
+            headings[p, c] = heading[c] / n if n > 1e-12 else (1.0 if c == 0 else 0.0)
+
+
+@njit
+def _yaw_quat(angle: float) -> tuple[float, float, float, float]:
+    """:func:`engine.quat.from_axis_angle` about +Y: ``(cos h, sin h·0, sin h·1, sin h·0)``, ``h = angle/2``."""
+    half = 0.5 * angle
+    s = math.sin(half)
+    return (math.cos(half), s * 0.0, s * 1.0, s * 0.0)
+
+
+@njit
+def _rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """:func:`engine.quat.rotate`: ``v + w·t + u×t`` with ``t = 2·(u×v)``, in its order of operations."""
+    ux, uy, uz = q[1], q[2], q[3]
+    t0 = 2.0 * (uy * v[2] - uz * v[1])
+    t1 = 2.0 * (uz * v[0] - ux * v[2])
+    t2 = 2.0 * (ux * v[1] - uy * v[0])
+    return (
+        v[0] + q[0] * t0 + (uy * t2 - uz * t1),
+        v[1] + q[0] * t1 + (uz * t0 - ux * t2),
+        v[2] + q[0] * t2 + (ux * t1 - uy * t0),
+    )

@@ -15,14 +15,17 @@ lookup it saved; the answers are the same, bit for bit, whichever rows are resol
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from itertools import repeat
 from operator import attrgetter, is_
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from engine import jit
 from engine.arrays import F64 as F
+from engine.arrays import Bool
 from engine.ecs import Entity
 
 if TYPE_CHECKING:
@@ -49,7 +52,7 @@ class Requests:
 
     speeds: F
     heights: F
-    standing: np.ndarray[Any, np.dtype[np.bool_]]
+    standing: Bool
     scales: F
     phases: F
     points: tuple[F | None, ...]
@@ -72,16 +75,39 @@ def read(entities: list[Entity], players: list[LocomotionPlayer]) -> Requests:
     standing = np.fromiter(map(is_, height, repeat(None)), dtype=np.bool_, count=len(height))
     heights = np.array(height, dtype=np.float64)  # None becomes NaN
     scales = np.array(scale, dtype=np.float64)
-    good_request = np.isfinite(speeds) & (speeds >= 0.0) & (standing | np.isfinite(heights))
-    good_scale = np.isfinite(scales) & (scales > 0.0)
-    if not (good_request.all() and good_scale.all()):
-        i = int(np.flatnonzero(~(good_request & good_scale))[0])
-        if not good_request[i]:
+    i, request_bad = _first_invalid(speeds, heights, standing, scales)
+    if i >= 0:
+        if request_bad:
             raise ValueError(
                 f"entity {entities[i]}: locomotion request speed={speed[i]!r}, height={height[i]!r} is invalid"
             )
         raise ValueError(f"entity {entities[i]}: locomotion scale {scale[i]!r} must be positive")
     return Requests(speeds, heights, standing, scales, np.array(phase, dtype=np.float64), point, override)
+
+
+def _first_invalid(speeds: F, heights: F, standing: Bool, scales: F) -> tuple[int, bool]:
+    """The first row with an invalid request or scale (``-1`` if none), and whether its request is the bad part."""
+    return (
+        _first_invalid_compiled(speeds, heights, standing, scales)
+        if jit.enabled()
+        else _first_invalid_numpy(speeds, heights, standing, scales)
+    )
+
+
+def _first_invalid_numpy(speeds: F, heights: F, standing: Bool, scales: F) -> tuple[int, bool]:
+    good_request = np.isfinite(speeds) & (speeds >= 0.0) & (standing | np.isfinite(heights))
+    bad = np.flatnonzero(~(good_request & np.isfinite(scales) & (scales > 0.0)))
+    return (-1, False) if not len(bad) else (int(bad[0]), not good_request[bad[0]])
+
+
+@jit.njit
+def _first_invalid_compiled(speeds: F, heights: F, standing: Bool, scales: F) -> tuple[int, bool]:
+    for i in range(speeds.shape[0]):
+        s, h, k = speeds[i], heights[i], scales[i]
+        request_ok = math.isfinite(s) and s >= 0.0 and (standing[i] or math.isfinite(h))
+        if not (request_ok and math.isfinite(k) and k > 0.0):
+            return i, not request_ok
+    return -1, False
 
 
 @dataclass(frozen=True)
@@ -90,7 +116,7 @@ class Answers:
 
     points: F
     feasible: F
-    inside: np.ndarray[Any, np.dtype[np.bool_]]
+    inside: Bool
     rates: F
 
 
@@ -101,7 +127,7 @@ class LastAnswers:
     loco: LocomotionSet
     speeds: F
     heights: F
-    standing: np.ndarray[Any, np.dtype[np.bool_]]
+    standing: Bool
     answers: Answers
 
 

@@ -345,19 +345,16 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
             faded[i] = weight
     _contacts(world, entities, req.speeds, votes, faded)
     # Heading, travel and the world root for the whole group at once.
-    rotation_column = cols.get(Transform, "rotation")
-    rotation = rotation_column.read(transforms).copy()
-    yaw = _yaw(rotation)
-    hq = quat.from_axis_angle(_UP, yaw)
-    step = quat.rotate(hq, travel)
-    turn_q = quat.from_axis_angle(_UP, turn * keep_turn)
-    hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
-    rots[:, 0] = quat.mul(hq_new, rots[:, 0])
-    offsets = quat.rotate(hq_new, roots)
-    position_column = cols.get(Transform, "position")
-    positions = position_column.read(transforms) + step
-    headings = quat.normalize(quat.mul(turn_q, rotation))
-    world_roots = positions + offsets
+    rotation_column, position_column = cols.get(Transform, "rotation"), cols.get(Transform, "position")
+    rotation = rotation_column.read(transforms)
+    if req.any_override():
+        turn = turn * keep_turn
+    if jit.enabled():
+        positions = position_column.read(transforms)  # moved in place
+        headings, world_roots = np.empty_like(rotation), np.empty_like(roots)
+        _kernel.place(rotation, positions, travel, turn, roots, rots, headings, world_roots)
+    else:
+        positions, headings, world_roots = _place(rotation, position_column.read(transforms), travel, turn, roots, rots)
     position_column.write(transforms, positions)
     rotation_column.write(transforms, headings)
     poses = list(map(world.components(LocalPose).get, entities))
@@ -369,6 +366,18 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
     joints = rots.shape[1]
     cols.get(LocalPose, "root", joints).write(poses, world_roots)
     cols.get(LocalPose, "rotations", joints).write(poses, rots)
+
+
+def _place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F) -> tuple[F, F, F]:
+    """Numpy twin of :func:`engine.blend._kernel.place`: new positions, headings and world roots; the
+    heading is folded into joint 0 of ``rots`` (in place)."""
+    yaw = _yaw(rotation)
+    step = quat.rotate(quat.from_axis_angle(_UP, yaw), travel)
+    turn_q = quat.from_axis_angle(_UP, turn)
+    hq_new = quat.from_axis_angle(_UP, yaw + turn)
+    rots[:, 0] = quat.mul(hq_new, rots[:, 0])
+    moved = positions + step
+    return moved, quat.normalize(quat.mul(turn_q, rotation)), moved + quat.rotate(hq_new, roots)
 
 
 def _contacts(world: World, entities: list[Entity], speeds: F, votes: F | None, faded: F) -> None:
