@@ -28,7 +28,7 @@ only as costly as the gather it replaces.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from operator import attrgetter
+from operator import attrgetter, is_
 from typing import Any
 
 import numpy as np
@@ -76,9 +76,15 @@ class Column:
     def _sync(self, rows: slice | list[int], take_in: bool) -> bool:
         """Point the fields replaced by other code at their rows again, first copying their values in
         if ``take_in``; ``False`` (and nothing re-linked after it) if such a value has another shape."""
-        index = range(len(self._owners)) if rows is _ALL else rows
-        assert isinstance(index, range | list)
         owners, views = self._owners, self._views
+        if rows is _ALL:
+            # the common case, every field still viewing its row, settled by one C-level pass
+            if all(map(is_, map(self._get, owners), views)):
+                return True
+            index: range | list[int] = range(len(owners))
+        else:
+            assert isinstance(rows, list)
+            index = rows
         for i in index:
             now = self._get(owners[i])
             if now is views[i]:

@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.blend.space import BlendSpace
-from engine.jit import njit, qnormalize, qslerp
+from engine.jit import njit, qmul, qnormalize
 
-__all__ = ["Packed", "packed", "play"]
+__all__ = ["Packed", "packed", "place", "play"]
 
 from engine.arrays import F64 as F
 from engine.arrays import I64 as I
@@ -45,9 +45,56 @@ class Packed:
     tables: F  # [ΣF + K, 4] root motion tables (closing row appended)
     cycles: F  # [K, 4]
     contacts: F  # [ΣF, L] contact labels (0/1), L = 0 without feet
+    arc_next: F  # [ΣF, J, 4] each row's next frame (cyclic) in the row's hemisphere
+    arc_angle: F  # [ΣF, J] the angle between a row's rotation and its next frame's
+    arc_sin: F  # [ΣF, J] its sine
 
 
 _CACHE: dict[int, tuple[BlendSpace, Packed | None]] = {}
+
+
+@njit
+def _arc(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
+) -> tuple[tuple[float, float, float, float], float, float]:
+    """The part of :func:`~engine.jit.qslerp` that depends only on its ends: ``b`` in ``a``'s hemisphere,
+    the angle between them and its sine. Same operations, so :func:`_slerp_arc` after it is ``qslerp``."""
+    if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0:
+        b = (-b[0], -b[1], -b[2], -b[3])
+    d = min(max(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], -1.0), 1.0)
+    theta = math.acos(d)
+    return b, theta, math.sin(theta)
+
+
+@njit
+def _slerp_arc(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float], theta: float, s: float, t: float
+) -> tuple[float, float, float, float]:
+    """The rest of :func:`~engine.jit.qslerp` from :func:`_arc`'s answer: the point at ``t`` on the arc."""
+    if s < 1e-6:
+        wa, wb = 1.0 - t, t
+    else:
+        wa, wb = math.sin((1.0 - t) * theta) / s, math.sin(t * theta) / s
+    return qnormalize((wa * a[0] + wb * b[0], wa * a[1] + wb * b[1], wa * a[2] + wb * b[2], wa * a[3] + wb * b[3]))
+
+
+@njit
+def _arcs(rotations: F, start: I, frames: I, arc_next: F, arc_angle: F, arc_sin: F) -> None:
+    """:func:`_arc` from every frame of every clip to its next (the last frame's next is the first):
+    a crowd's slerps then cost two sines each instead of a dot, an arc cosine and three sines."""
+    for k in range(start.shape[0]):
+        n = frames[k]
+        for i in range(n):
+            r0, r1 = start[k] + i, start[k] + (i + 1) % n
+            for j in range(rotations.shape[1]):
+                b, theta, s = _arc(
+                    (rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
+                    (rotations[r1, j, 0], rotations[r1, j, 1], rotations[r1, j, 2], rotations[r1, j, 3]),
+                )
+                for c in range(4):
+                    arc_next[r0, j, c] = b[c]
+                arc_angle[r0, j] = theta
+                arc_sin[r0, j] = s
 
 
 def packed(space: BlendSpace, tracks: list[NDArray[np.bool_]] | None) -> Packed | None:
@@ -63,6 +110,13 @@ def packed(space: BlendSpace, tracks: list[NDArray[np.bool_]] | None) -> Packed 
     knots = space.sync._knots
     frames = np.array([c.num_frames for c in clips], dtype=np.int64)
     start = np.concatenate([[0], np.cumsum(frames)[:-1]]).astype(np.int64)
+    rotations = np.ascontiguousarray(np.concatenate([c.rotations for c in clips]), dtype=np.float64)
+    arc_next, arc_angle, arc_sin = (
+        np.empty_like(rotations),
+        np.empty(rotations.shape[:2]),
+        np.empty(rotations.shape[:2]),
+    )
+    _arcs(rotations, start, frames, arc_next, arc_angle, arc_sin)
     result = Packed(
         points=np.ascontiguousarray(space.points, dtype=np.float64),
         durations=np.ascontiguousarray(space.sync.durations, dtype=np.float64),
@@ -72,7 +126,7 @@ def packed(space: BlendSpace, tracks: list[NDArray[np.bool_]] | None) -> Packed 
         knot_x=np.stack([x for x, _ in knots]).astype(np.float64),
         knot_y=np.stack([y for _, y in knots]).astype(np.float64),
         roots=np.ascontiguousarray(np.concatenate([c.root for c in clips]), dtype=np.float64),
-        rotations=np.ascontiguousarray(np.concatenate([c.rotations for c in clips]), dtype=np.float64),
+        rotations=rotations,
         tables=np.ascontiguousarray(np.concatenate([t for t, _ in space.sync._root_tables]), dtype=np.float64),
         cycles=np.stack([c for _, c in space.sync._root_tables]).astype(np.float64),
         contacts=(
@@ -80,6 +134,9 @@ def packed(space: BlendSpace, tracks: list[NDArray[np.bool_]] | None) -> Packed 
             if tracks is None
             else np.concatenate([np.asarray(t, dtype=np.float64) for t in tracks])
         ),
+        arc_next=arc_next,
+        arc_angle=arc_angle,
+        arc_sin=arc_sin,
     )
     _CACHE[key] = (space, result)
     return result
@@ -145,6 +202,9 @@ def play(
     tables: F,
     cycles: F,
     contacts: F,
+    arc_next: F,
+    arc_angle: F,
+    arc_sin: F,
     points: F,
     phase: F,
     rate: F,
@@ -190,6 +250,9 @@ def play(
         # every clip's joints are turned into the hemisphere of the heaviest clip's (blend_quaternions)
         _frame_rotations(
             rotations,
+            arc_next,
+            arc_angle,
+            arc_sin,
             start[ref],
             frames[ref],
             _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1) * fps[ref],
@@ -220,7 +283,14 @@ def play(
             r0, r1 = start[k] + i0, start[k] + i1
             for c in range(3):
                 root_out[p, c] += wn * (roots[r0, c] + a * (roots[r1, c] - roots[r0, c]))
-            _frame_rotations(rotations, start[k], n, t1 * fps[k], ref_rot, rot_out[p], True, wn)
+            if k == ref:  # the heaviest clip's pose is ref_rot itself, already in its own hemisphere
+                for j in range(joints):
+                    for c in range(4):
+                        rot_out[p, j, c] += wn * ref_rot[j, c]
+                continue
+            _frame_rotations(
+                rotations, arc_next, arc_angle, arc_sin, start[k], n, t1 * fps[k], ref_rot, rot_out[p], True, wn
+            )
         for j in range(joints):
             m = qnormalize((rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3]))
             rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3] = m
@@ -228,19 +298,31 @@ def play(
 
 @njit
 def _frame_rotations(
-    rotations: F, first: int, n: int, frame: float, ref: F, out: F, accumulate: bool, wn: float = 1.0
+    rotations: F,
+    arc_next: F,
+    arc_angle: F,
+    arc_sin: F,
+    first: int,
+    n: int,
+    frame: float,
+    ref: F,
+    out: F,
+    accumulate: bool,
+    wn: float = 1.0,
 ) -> None:
-    """A loop's joint rotations at fractional ``frame`` (slerp between its frames, :meth:`Clip.frame_pair`):
-    stored in ``out``, or (``accumulate``) turned into ``ref``'s hemisphere and added with weight ``wn``."""
+    """A loop's joint rotations at fractional ``frame`` (slerp between its frames, :meth:`Clip.frame_pair`,
+    on the arcs :func:`_arcs` measured): stored in ``out``, or (``accumulate``) turned into ``ref``'s
+    hemisphere and added with weight ``wn``."""
     f = frame % n
     i0 = math.floor(f) % n
-    i1 = (i0 + 1) % n
     a = f - math.floor(f)
-    r0, r1 = first + i0, first + i1
+    r0 = first + i0
     for j in range(rotations.shape[1]):
-        q = qslerp(
+        q = _slerp_arc(
             (rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
-            (rotations[r1, j, 0], rotations[r1, j, 1], rotations[r1, j, 2], rotations[r1, j, 3]),
+            (arc_next[r0, j, 0], arc_next[r0, j, 1], arc_next[r0, j, 2], arc_next[r0, j, 3]),
+            arc_angle[r0, j],
+            arc_sin[r0, j],
             a,
         )
         if not accumulate:
@@ -251,3 +333,54 @@ def _frame_rotations(
             q = (-q[0], -q[1], -q[2], -q[3])
         for c in range(4):
             out[j, c] += wn * q[c]
+
+
+@njit
+def place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F, headings: F, world_roots: F) -> None:
+    """Move every puppet by its travel and turn (both in its clip frame) and place its pose in the world:
+    ``positions`` advanced in place, new ``headings``, the root in world space, the heading folded into
+    joint 0 of ``rots`` (in place). The numpy twin is the end of :func:`engine.blend.locomotion._animate_group`;
+    the operations are :mod:`engine.quat`'s in its order (an axis-angle about +Y keeps its zero products),
+    so both agree bit for bit."""
+    for p in range(rotation.shape[0]):
+        w, x, y, z = rotation[p, 0], rotation[p, 1], rotation[p, 2], rotation[p, 3]
+        yaw = math.atan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
+        hq = _yaw_quat(yaw)
+        step = _rotate(hq, (travel[p, 0], travel[p, 1], travel[p, 2]))
+        turn_q = _yaw_quat(turn[p])
+        hq_new = _yaw_quat(yaw + turn[p])
+        r0 = qmul(hq_new, (rots[p, 0, 0], rots[p, 0, 1], rots[p, 0, 2], rots[p, 0, 3]))
+        for c in range(4):
+            rots[p, 0, c] = r0[c]
+        offset = _rotate(hq_new, (roots[p, 0], roots[p, 1], roots[p, 2]))
+        for c in range(3):
+            positions[p, c] = positions[p, c] + step[c]
+            world_roots[p, c] = positions[p, c] + offset[c]
+        heading = qmul(turn_q, (w, x, y, z))
+        n = math.sqrt(
+            heading[0] * heading[0] + heading[1] * heading[1] + heading[2] * heading[2] + heading[3] * heading[3]
+        )
+        for c in range(4):
+            headings[p, c] = heading[c] / n if n > 1e-12 else (1.0 if c == 0 else 0.0)
+
+
+@njit
+def _yaw_quat(angle: float) -> tuple[float, float, float, float]:
+    """:func:`engine.quat.from_axis_angle` about +Y: ``(cos h, sin h·0, sin h·1, sin h·0)``, ``h = angle/2``."""
+    half = 0.5 * angle
+    s = math.sin(half)
+    return (math.cos(half), s * 0.0, s * 1.0, s * 0.0)
+
+
+@njit
+def _rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """:func:`engine.quat.rotate`: ``v + w·t + u×t`` with ``t = 2·(u×v)``, in its order of operations."""
+    ux, uy, uz = q[1], q[2], q[3]
+    t0 = 2.0 * (uy * v[2] - uz * v[1])
+    t1 = 2.0 * (uz * v[0] - ux * v[2])
+    t2 = 2.0 * (ux * v[1] - uy * v[0])
+    return (
+        v[0] + q[0] * t0 + (uy * t2 - uz * t1),
+        v[1] + q[0] * t1 + (uz * t0 - ux * t2),
+        v[2] + q[0] * t2 + (ux * t1 - uy * t0),
+    )

@@ -15,11 +15,14 @@ border segments, so the inside test and the projection are a few numpy calls.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
+
+from engine import jit
 
 __all__ = ["FeasibleSet", "kuhn_simplices", "border_facets", "closest_point_on_simplices"]
 
@@ -96,6 +99,65 @@ def closest_point_on_simplices(verts: ArrayLike, u: ArrayLike) -> tuple[F, F]:
     return best_pt, best
 
 
+@jit.njit
+def _line_range_compiled(inv: F, ok: NDArray[np.bool_], x: F, axis: int, lo: F, hi: F) -> None:
+    """:meth:`FeasibleSet.line_range` for points ``x [B, N]``, compiled (same sums, same order)."""
+    n = x.shape[1]
+    for r in range(x.shape[0]):
+        low, high, found = math.inf, -math.inf, False
+        for f in range(inv.shape[0]):
+            if not ok[f]:
+                continue
+            hit, s = True, 0.0
+            for i in range(n + 1):
+                acc = inv[f, i, 0] * x[r, 0] + inv[f, i, n]
+                for j in range(1, n):
+                    acc = acc + inv[f, i, j] * x[r, j]
+                if i == n:
+                    s = acc
+                elif not acc >= -1e-12:
+                    hit = False
+                    break
+            if hit:
+                found = True
+                low, high = min(low, s), max(high, s)
+        base = x[r, axis]
+        lo[r] = base + low if found else math.nan
+        hi[r] = base + high if found else math.nan
+
+
+@jit.njit
+def _contains_compiled(
+    values: F, simplices: Ix, inv: F, valid: NDArray[np.bool_], near: Ix, x: F, tol: float, out: NDArray[np.bool_]
+) -> None:
+    """:meth:`FeasibleSet.contains_many` after its k-d tree query, compiled: the ``near`` simplices of each
+    point first, every simplex when none holds it (barycentrics summed in numpy's order)."""
+    n = x.shape[1]
+    for r in range(x.shape[0]):
+        out[r] = False
+        for pass_ in range(2):
+            count = near.shape[1] if pass_ == 0 else simplices.shape[0]
+            for c in range(count):
+                s = near[r, c] if pass_ == 0 else c
+                if not valid[s]:
+                    continue
+                v0 = simplices[s, 0]
+                total, ok = 0.0, True
+                for i in range(n):
+                    lam = 0.0
+                    for j in range(n):
+                        lam = lam + inv[s, i, j] * (x[r, j] - values[v0, j])
+                    if not lam >= -tol:
+                        ok = False
+                        break
+                    total = total + lam
+                if ok and total <= 1.0 + tol:
+                    out[r] = True
+                    break
+            if out[r]:
+                break
+
+
 @dataclass(frozen=True)
 class FeasibleSet:
     """The image of a probe grid in (scaled) property space: inside test and border projection.
@@ -154,17 +216,27 @@ class FeasibleSet:
         return np.linalg.inv(np.where(ok[:, None, None], a, np.eye(n + 1))), ok
 
     def _line_solutions(self, x: F, axis: int) -> tuple[F, NDArray[np.bool_]]:
-        """Crossing offsets ``[..., B]`` of lines through ``x [..., N]`` with every facet, and which are hits."""
+        """Crossing offsets ``[..., B]`` of lines through ``x [..., N]`` with every facet, and which are hits.
+
+        Each unknown is ``inv·(x, 1)`` summed in a fixed order (first term, the constant, then the
+        rest; numpy's einsum's order for ``N = 2``), which :func:`_line_range_compiled` repeats."""
         inv, ok = self._line[axis]
         n = x.shape[-1]
-        rhs = np.concatenate([x, np.ones(x.shape[:-1] + (1,))], axis=-1)
-        sol = np.einsum("fij,...j->...fi", inv, rhs)
+        xs = x[..., None, None, :]
+        sol = inv[:, :, 0] * xs[..., 0] + inv[:, :, n]
+        for j in range(1, n):
+            sol = sol + inv[:, :, j] * xs[..., j]
         hit = ok & np.all(sol[..., :n] >= -1e-12, axis=-1)
         return sol[..., n], hit
 
     def line_range(self, x: ArrayLike, axis: int) -> tuple[F, F]:
         """Lowest and highest border crossing ``[...]`` along ``axis`` through points ``x [..., N]`` (NaN: none)."""
         xs = np.asarray(x, dtype=np.float64)
+        if jit.enabled() and xs.ndim == 2:
+            inv, ok = self._line[axis]
+            lo, hi = np.empty(len(xs)), np.empty(len(xs))
+            _line_range_compiled(inv, ok, xs, axis, lo, hi)
+            return lo, hi
         s, hit = self._line_solutions(xs, axis)
         lo = np.where(hit, s, np.inf).min(axis=-1)
         hi = np.where(hit, s, -np.inf).max(axis=-1)
@@ -178,6 +250,10 @@ class FeasibleSet:
         k = min(12, len(self.simplices))
         _, near = self._centroids.query(xs, k=k)
         near = near.reshape(len(xs), -1)
+        if jit.enabled():
+            out = np.empty(len(xs), dtype=np.bool_)
+            _contains_compiled(self.values, self.simplices, self._inv, self._valid, near, xs, tol, out)
+            return out
         base = self.values[self.simplices[near, 0]]  # [B, k, N]
         lam = np.einsum("bkij,bkj->bki", self._inv[near], xs[:, None, :] - base)
         inside = (self._valid[near] & np.all(lam >= -tol, axis=-1) & (lam.sum(axis=-1) <= 1.0 + tol)).any(axis=-1)

@@ -19,25 +19,25 @@ Puppets sharing a locomotion set are evaluated together, batched over puppets:
 one inside test and one k-d tree query for all their requests, one sample per
 active clip for all their phases; with numba (:mod:`engine.jit`) steps 3–5's blend
 (weights, phase, root motion, pose, votes) is one compiled pass over the group
-(:mod:`engine.blend._kernel`). Answers are memoised per request (a puppet held
-still, or an idle crowd, asks the same thing every step).
+(:mod:`engine.blend._kernel`). A puppet asking what it asked last step is answered
+from last step (:mod:`engine.blend._requests`): only the changed requests are resolved.
 Assets (spaces, tables, clips) live in the :class:`BlendLibrary` resource; the
 component holds only what changes per frame. Time is ``world.dt`` steps only.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from typing import cast
+from itertools import repeat
+from operator import attrgetter, is_, itemgetter
 
 import numpy as np
 from numpy.typing import NDArray
 
 from engine import jit, quat
 from engine.app import App
-from engine.blend import _kernel
-from engine.blend.lookup import LookupTable, Resolution
+from engine.blend import _kernel, _requests
+from engine.blend.lookup import LookupTable
 from engine.blend.measure import contact_votes
 from engine.blend.pose_blend import crossfade, fade_weight
 from engine.blend.space import BlendSpace
@@ -45,7 +45,7 @@ from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
 from engine.columns import columns
 from engine.components import LocalPose, Puppet, Transform
-from engine.ecs import World
+from engine.ecs import Entity, World
 from engine.ik.foot_lock import FootLock
 from engine.ik.system import IKRequest
 from engine.pose import Pose
@@ -88,13 +88,13 @@ class BlendLibrary:
 
     def __init__(self) -> None:
         self.sets: dict[str, LocomotionSet] = {}
-        self.memo: dict[tuple[str, float, float | None], Resolution] = {}
+        self.last_answers: dict[str, _requests.LastAnswers] = {}
         self.contact_tracks: dict[str, list[NDArray[np.bool_]] | None] = {}
 
     def add(self, name: str, locomotion: LocomotionSet) -> None:
         """Register (or replace) a set."""
         self.sets[name] = locomotion
-        self.memo.clear()
+        self.last_answers.pop(name, None)
         self.contact_tracks.pop(name, None)
 
     def tracks(self, name: str) -> list[NDArray[np.bool_]] | None:
@@ -220,39 +220,6 @@ def _yaw(rotation: F) -> F:
 _Row = tuple[int, Transform, Puppet, "LocomotionPlayer"]
 
 
-def _resolve_group(library: BlendLibrary, key: str, loco: LocomotionSet, members: list[_Row]) -> list[Resolution]:
-    """The table's answers for a group's requests, batched; memoised, as a held stick repeats its request."""
-    out: list[Resolution | None] = []  # filled below for every miss
-    misses: list[int] = []
-    missed: list[tuple[float, float | None]] = []  # their requests in the set's units
-    for i, (e, _tr, _pup, player) in enumerate(members):
-        speed, height = player.speed, player.height
-        if not (math.isfinite(speed) and speed >= 0.0 and (height is None or math.isfinite(height))):
-            raise ValueError(f"entity {e}: locomotion request speed={speed!r}, height={height!r} is invalid")
-        if not (math.isfinite(player.scale) and player.scale > 0.0):
-            raise ValueError(f"entity {e}: locomotion scale {player.scale!r} must be positive")
-        request = (float(speed / player.scale), None if height is None else float(height / player.scale))
-        res = library.memo.get((key, *request))
-        out.append(res)
-        if res is None:
-            misses.append(i)
-            missed.append(request)
-    if misses:
-        speeds = np.array([s for s, _ in missed], dtype=np.float64)
-        heights = np.array([np.nan if h is None else h for _, h in missed], dtype=np.float64)
-        standing = np.isnan(heights)
-        if standing.any():
-            heights[standing] = loco.standing_heights(speeds[standing])
-        points, feasible, inside, rates = loco.table.resolve_many(np.stack([speeds, heights], axis=-1))
-        if len(library.memo) + len(misses) > 4096:
-            library.memo.clear()
-        for j, i in enumerate(misses):
-            res = Resolution(points[j], feasible[j], bool(inside[j]), float(rates[j]))
-            library.memo[(key, *missed[j])] = res
-            out[i] = res
-    return cast(list[Resolution], out)  # every None was a miss, and every miss is filled above
-
-
 def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F, dt: float) -> tuple[F, F, F, F, F, F | None]:
     """:meth:`BlendSpace.advance`, :meth:`~BlendSpace.sample` and :func:`contact_votes` of a group in one
     compiled pass: (root, rotations, new phase, travel, turn, votes or ``None``)."""
@@ -277,6 +244,9 @@ def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F, dt: float)
         pk.tables,
         pk.cycles,
         pk.contacts,
+        pk.arc_next,
+        pk.arc_angle,
+        pk.arc_sin,
         np.ascontiguousarray(points, dtype=np.float64),
         phase,
         np.ascontiguousarray(rates, dtype=np.float64),
@@ -297,41 +267,53 @@ def animate(world: World) -> None:
     library = world.try_resource(BlendLibrary)
     if library is None:
         return
-    groups: dict[str, list[_Row]] = {}
-    for e, tr, pup, player in world.query(Transform, Puppet, LocomotionPlayer):
-        groups.setdefault(player.library_key, []).append((e, tr, pup, player))
+    rows = world.query(Transform, Puppet, LocomotionPlayer)
+    if not rows:
+        return
+    keys = list(map(_KEY, map(itemgetter(3), rows)))
+    if keys.count(keys[0]) == len(keys):  # one set for the whole crowd: the query's rows are the batch
+        groups: dict[str, list[_Row]] = {keys[0]: rows}
+    else:
+        groups = {}
+        for key, row in zip(keys, rows, strict=True):
+            groups.setdefault(key, []).append(row)
     dt = world.dt
     for key, members in groups.items():
         _animate_group(world, library, key, members, dt)
 
 
+_KEY = attrgetter("library_key")
+
+
 def _animate_group(world: World, library: BlendLibrary, key: str, members: list[_Row], dt: float) -> None:
-    """One locomotion set's puppets: array passes, and per-puppet Python only for scalar fields and
-    for a puppet playing an override clip. The array fields (blend point, feasible request, position,
-    local pose, foot-contact votes) are written through the world's :mod:`engine.columns`."""
+    """One locomotion set's puppets: array passes, and per-puppet Python only to write the players'
+    scalar fields and for a puppet playing an override clip. The array fields (blend point, feasible
+    request, position, local pose, foot-contact votes) are written through the world's
+    :mod:`engine.columns`."""
     loco = library[key]
     space = loco.space
     cols = columns(world)
-    players = [m[3] for m in members]
-    transforms = [m[1] for m in members]
+    entities: list[Entity] = list(map(itemgetter(0), members))
+    transforms: list[Transform] = list(map(itemgetter(1), members))
+    players: list[LocomotionPlayer] = list(map(itemgetter(3), members))
     alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
-    resolved = _resolve_group(library, key, loco, members)
-    target = np.array([res.point for res in resolved])
+    req = _requests.read(entities, players)
+    answers = _requests.resolve(library.last_answers, key, loco, req)
+    target = answers.points
     point_column = cols.get(LocomotionPlayer, "point", key)
-    if any(player.point is None for player in players):
-        previous = [res.point if p.point is None else p.point for p, res in zip(players, resolved, strict=True)]
-        eased = np.array(previous)
-        fresh = np.array([player.point is None for player in players])
+    if req.any_fresh():
+        eased = np.array([t if p is None else p for p, t in zip(req.points, target, strict=True)])
+        fresh = np.fromiter(map(is_, req.points, repeat(None)), dtype=np.bool_, count=len(players))
         points = np.where(fresh[:, None], target, eased + alpha * (target - eased))
     else:
         eased = point_column.read(players)
         points = eased + alpha * (target - eased)
-    scale = np.array([player.scale for player in players])
-    rates = np.array([res.rate for res in resolved])
-    feasible = np.array([res.feasible for res in resolved]) * scale[:, None]
+    scale = req.scales
+    rates = answers.rates
+    feasible = answers.feasible * scale[:, None]
     point_column.write(players, points)
     cols.get(LocomotionPlayer, "feasible", key).write(players, feasible)
-    phase = np.array([player.phase for player in players])
+    phase = req.phases
     tracks = library.tracks(key)
     packed = _kernel.packed(space, tracks) if jit.enabled() else None
     if packed is None:
@@ -348,12 +330,9 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
     keep_turn = np.ones(len(members))
     faded = np.zeros(len(members))  # the override clip's weight, where one plays
     wrapped = (new_phase % 1.0).tolist()
-    overrides = []
-    for player, res, ph in zip(players, resolved, wrapped, strict=True):
-        player.finished, player.inside, player.rate, player.phase = None, res.inside, res.rate, ph
-        if player.override is not None:
-            overrides.append(player)
-    for i, player in enumerate(players) if overrides else ():
+    for player, inside, rate, ph in zip(players, answers.inside.tolist(), rates.tolist(), wrapped, strict=True):
+        player.finished, player.inside, player.rate, player.phase = None, inside, rate, ph
+    for i, player in enumerate(players) if req.any_override() else ():
         if player.override is None:  # the unusual puppet: a one-shot or a held pose over its blend
             continue
         clip, weight, clip_travel = _override(player, loco, dt)
@@ -364,27 +343,23 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
             travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
             keep_turn[i] = 1.0 - weight
             faded[i] = weight
-    _contacts(world, members, players, votes, faded)
+    _contacts(world, entities, req.speeds, votes, faded)
     # Heading, travel and the world root for the whole group at once.
-    rotation_column = cols.get(Transform, "rotation")
-    rotation = rotation_column.read(transforms).copy()
-    yaw = _yaw(rotation)
-    hq = quat.from_axis_angle(_UP, yaw)
-    step = quat.rotate(hq, travel)
-    turn_q = quat.from_axis_angle(_UP, turn * keep_turn)
-    hq_new = quat.from_axis_angle(_UP, yaw + turn * keep_turn)
-    rots[:, 0] = quat.mul(hq_new, rots[:, 0])
-    offsets = quat.rotate(hq_new, roots)
-    position_column = cols.get(Transform, "position")
-    positions = position_column.read(transforms) + step
-    headings = quat.normalize(quat.mul(turn_q, rotation))
-    world_roots = positions + offsets
+    rotation_column, position_column = cols.get(Transform, "rotation"), cols.get(Transform, "position")
+    rotation = rotation_column.read(transforms)
+    if req.any_override():
+        turn = turn * keep_turn
+    if jit.enabled():
+        positions = position_column.read(transforms)  # moved in place
+        headings, world_roots = np.empty_like(rotation), np.empty_like(roots)
+        _kernel.place(rotation, positions, travel, turn, roots, rots, headings, world_roots)
+    else:
+        positions, headings, world_roots = _place(rotation, position_column.read(transforms), travel, turn, roots, rots)
     position_column.write(transforms, positions)
     rotation_column.write(transforms, headings)
-    pose_store = world.components(LocalPose)
-    poses = [pose_store.get(m[0]) for m in members]
-    if None in poses:  # a puppet's first pose
-        for i, (e, *_rest) in enumerate(members):
+    poses = list(map(world.components(LocalPose).get, entities))
+    if any(map(is_, poses, repeat(None))):  # a puppet's first pose
+        for i, e in enumerate(entities):
             if poses[i] is None:
                 world.queue_add(e, LocalPose(world_roots[i], rots[i]))
         return
@@ -393,17 +368,28 @@ def _animate_group(world: World, library: BlendLibrary, key: str, members: list[
     cols.get(LocalPose, "rotations", joints).write(poses, rots)
 
 
-def _contacts(world: World, members: list[_Row], players: list[LocomotionPlayer], votes: F | None, faded: F) -> None:
+def _place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F) -> tuple[F, F, F]:
+    """Numpy twin of :func:`engine.blend._kernel.place`: new positions, headings and world roots; the
+    heading is folded into joint 0 of ``rots`` (in place)."""
+    yaw = _yaw(rotation)
+    step = quat.rotate(quat.from_axis_angle(_UP, yaw), travel)
+    turn_q = quat.from_axis_angle(_UP, turn)
+    hq_new = quat.from_axis_angle(_UP, yaw + turn)
+    rots[:, 0] = quat.mul(hq_new, rots[:, 0])
+    moved = positions + step
+    return moved, quat.normalize(quat.mul(turn_q, rotation)), moved + quat.rotate(hq_new, roots)
+
+
+def _contacts(world: World, entities: list[Entity], speeds: F, votes: F | None, faded: F) -> None:
     """The blend's foot-contact votes (less an override clip's weight) and the settle flag to each
     puppet's foot lock, so the leg IK holds planted feet where they landed."""
-    requests = world.components(IKRequest)
-    locks = []
-    settle = []
-    for (e, *_rest), player in zip(members, players, strict=True):
-        req = requests.get(e)
-        if req is not None:
-            locks.append(req.foot_lock)
-            settle.append(player.speed < _SETTLE_SPEED)
+    requests = list(map(world.components(IKRequest).get, entities))
+    settle = (speeds < _SETTLE_SPEED).tolist()
+    has = None if not any(map(is_, requests, repeat(None))) else [r is not None for r in requests]
+    if has is not None:  # puppets without leg IK take no votes
+        settle = [flag for flag, ok in zip(settle, has, strict=True) if ok]
+        requests = [r for r in requests if r is not None]
+    locks: list[FootLock] = list(map(_FOOT_LOCK, requests))
     for lock, flag in zip(locks, settle, strict=True):
         lock.settle = flag
     if votes is None:
@@ -411,10 +397,12 @@ def _contacts(world: World, members: list[_Row], players: list[LocomotionPlayer]
             lock.contacts = None
         return
     contacts = votes * (1.0 - faded)[:, None]
-    if len(locks) < len(members):
-        has = np.array([requests.get(e) is not None for e, *_rest in members])
-        contacts = contacts[has]
+    if has is not None:
+        contacts = contacts[np.array(has)]
     columns(world).get(FootLock, "contacts", contacts.shape[1]).write(locks, contacts)
+
+
+_FOOT_LOCK = attrgetter("foot_lock")
 
 
 def install_blend(app: App) -> None:

@@ -111,3 +111,46 @@ def test_the_compiled_lookup_agrees_with_numpy(gradients: bool) -> None:
         np.testing.assert_allclose(a, b, atol=1e-12)
     with jit.use(True):
         np.testing.assert_allclose(table.query(table.values[:6]), np.clip(table.probes[:6], 0, 1), atol=1e-12)
+
+
+def _unit(rng: np.random.Generator, n: int) -> np.ndarray:
+    q = rng.normal(size=(n, 4))
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def test_a_slerp_on_a_measured_arc_is_qslerp_bit_for_bit() -> None:
+    """``_arc`` then ``_slerp_arc`` (the crowd's slerp, its arc measured once per clip) against
+    :func:`engine.jit.qslerp` on random, nearly equal and opposite pairs. Broken once by taking the
+    sine of the arc as ``sqrt(1 - d²)`` (differs in the last bits)."""
+    rng = np.random.default_rng(4)
+    a = _unit(rng, 400)
+    b = _unit(rng, 400)
+    b[:50] = a[:50] + 1e-9 * rng.normal(size=(50, 4))
+    b[50:100] = -a[50:100]
+    for qa, qb, t in zip(a, b, rng.uniform(0, 1, 400), strict=True):
+        ta, tb = tuple(qa.tolist()), tuple(qb.tolist())
+        far, theta, s = _kernel._arc(ta, tb)
+        assert _kernel._slerp_arc(ta, far, theta, s, t) == jit.qslerp(ta, tb, t)
+
+
+def test_placing_the_crowd_compiled_is_the_numpy_sequence_bit_for_bit() -> None:
+    """:func:`_kernel.place` against its numpy twin ``locomotion._place`` (the ``engine.quat`` calls it
+    replaced) on random headings, travels, turns and poses: the state hashes depend on every bit.
+    Broken once by composing the new heading as ``turn_q · hq`` (the same rotation, other last bits)."""
+    from engine.blend.locomotion import _place
+
+    rng = np.random.default_rng(6)
+    n = 64
+    rotation = _unit(rng, n)
+    positions = rng.normal(size=(n, 3))
+    travel = rng.normal(size=(n, 3)) * 0.02
+    turn = rng.normal(size=n) * 0.05
+    roots = rng.normal(size=(n, 3))
+    rots = _unit(rng, n * 17).reshape(n, 17, 4)
+    rots_a = rots.copy()
+    moved_a, headings_a, world_a = _place(rotation, positions, travel, turn, roots, rots_a)
+    moved_b, rots_b = positions.copy(), rots.copy()
+    headings_b, world_b = np.empty_like(rotation), np.empty_like(roots)
+    _kernel.place(rotation, moved_b, travel, turn, roots, rots_b, headings_b, world_b)
+    for x, y in ((moved_a, moved_b), (headings_a, headings_b), (world_a, world_b), (rots_a, rots_b)):
+        assert np.array_equal(x, y)
