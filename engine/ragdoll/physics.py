@@ -36,7 +36,8 @@ from engine.pose import Pose
 from engine.ragdoll._building import Building
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
-from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
+from engine.ragdoll._bounds import command_boxes, geom_boxes
+from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
 from engine.ragdoll._pool import RagdollPool, kind_of
 from engine.ragdoll._readback import Readback
@@ -362,11 +363,47 @@ class PhysicsWorld(Readback, Building):
             source_radii = np.concatenate([radii[needs], [r for _, r in props]])
             inside = np.array([s.in_model for s in slots], dtype=bool)
             wanted = needs.copy()
-            wanted[~needs] = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+            near = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+            if near.any():  # the spheres hold any pose: the candidates' boxes in their poses decide
+                cand = np.nonzero(~needs)[0][near]
+                src = np.nonzero(needs)[0]
+                boxes = np.concatenate(
+                    [self._boxes([slots[i] for i in src]), np.array([[c - r, c + r] for c, r in props]).reshape(-1, 2, 3)]
+                )
+                near[near] = near_boxes(self._boxes([slots[i] for i in cand]), boxes, inside[cand])
+            wanted[~needs] = near
         for slot, want in zip(slots, wanted, strict=True):
             if slot.in_model != bool(want):
                 slot.in_model, slot.placed = bool(want), False
                 self._moved = True
+
+    def _boxes(self, slots: list[RagdollSlot]) -> _F:
+        """Boxes ``[n,2,3]`` around ragdolls in their current poses: a simulated one's from MuJoCo's
+        geoms, an animated or newly joined one's from its command (:mod:`engine.ragdoll._bounds`)."""
+        out = np.empty((len(slots), 2, 3))
+        L, m, d = self.layout, self.model, self.data
+        live = [
+            i for i, s in enumerate(slots) if s.in_model and s.placed and not s.cmd.kinematic and not self._moved
+        ]
+        if live and L is not None and m is not None and d is not None:
+            box_of = np.full(L.num_ragdolls, -1)
+            box_of[[L.ordinal(slots[i].spec.key) for i in live]] = np.arange(len(live))
+            own = box_of[L.geom_owner]
+            order = np.argsort(own, kind="stable")[np.count_nonzero(own < 0) :]
+            out[live] = geom_boxes(m, d, L.geom[order], own[order], len(live))
+        else:
+            live = []
+        done = set(live)
+        kinds: dict[bytes, list[int]] = {}
+        for i, s in enumerate(slots):
+            if i not in done:
+                kinds.setdefault(s.kind, []).append(i)
+        for kind, idx in kinds.items():
+            cmds = [slots[i].cmd for i in idx]
+            out[idx] = command_boxes(
+                kind, slots[idx[0]].spec, np.array([c.root for c in cmds]), np.array([c.rot for c in cmds])
+            )
+        return out
 
     def _centre(self, slot: RagdollSlot) -> _F:
         """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
