@@ -237,7 +237,8 @@ class PhysicsWorld(Readback, Building):
         """
         if not keys:
             return []
-        slots = [self._slot(k) for k in keys]
+        rag = self._ragdolls
+        slots = [rag[k] if k in rag else self._slot(k) for k in keys]
         sizes = [s.spec.skeleton.num_joints for s in slots]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
@@ -275,6 +276,10 @@ class PhysicsWorld(Readback, Building):
         slot.cmd.hold = joint
         if t is not None:
             slot.cmd.hold_target = t
+
+    def holding(self) -> list[int]:
+        """The ragdolls whose body is held now (so a crowd's physics stage lets go of those only)."""
+        return [k for k, s in self._ragdolls.items() if s.cmd.hold is not None]
 
     def set_pose(self, key: int, root: ArrayLike, rotations: ArrayLike) -> None:
         """Place the ragdoll on a pose at rest now (teleport); the next step has no target velocity."""
@@ -356,7 +361,7 @@ class PhysicsWorld(Readback, Building):
             wanted = np.ones(len(slots), dtype=bool)
         else:
             needs = np.array([not s.cmd.kinematic or s.cmd.hold is not None for s in slots], dtype=bool)
-            centres = np.array([self._centre(s) for s in slots]).reshape(-1, 3)
+            centres = np.array([self._centre(s) if s.in_model else s.cmd.root for s in slots]).reshape(-1, 3)
             radii = np.array([s.reach for s in slots])
             props = [self._prop_sphere(k) for k in sorted(self._props)]
             sources = np.concatenate([centres[needs], np.array([c for c, _ in props]).reshape(-1, 3)])
