@@ -74,6 +74,7 @@ class PhysicsWorld(Readback, Building):
         self.rebuilds = 0
         self._ragdolls: dict[int, RagdollSlot] = {}
         self._props: dict[int, PropSlot] = {}
+        self._held: set[int] = set()  # ragdolls with a held body
         self._dirty = False
         self._sized = True
         self._moved = False
@@ -116,7 +117,7 @@ class PhysicsWorld(Readback, Building):
         kind = kind_of(spec)
         if kind not in self._reach:  # a crowd is a few kinds of ragdoll many times over
             self._reach[kind] = reach(skeleton, profile, off)
-        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind)
+        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind, skeleton.num_joints)
         self._sized = False
 
     def add_prop(
@@ -143,6 +144,7 @@ class PhysicsWorld(Readback, Building):
     def remove(self, key: int) -> None:
         """Remove a ragdoll or prop (no error if absent)."""
         slot = self._ragdolls.pop(key, None)
+        self._held.discard(key)
         if slot is not None and slot.pool >= 0:
             self._give_back(slot)
         if self._props.pop(key, None) is not None:
@@ -239,7 +241,7 @@ class PhysicsWorld(Readback, Building):
             return []
         rag = self._ragdolls
         slots = [rag[k] if k in rag else self._slot(k) for k in keys]
-        sizes = [s.spec.skeleton.num_joints for s in slots]
+        sizes = [s.joints for s in slots]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
         if stacked:
@@ -274,12 +276,16 @@ class PhysicsWorld(Readback, Building):
         if t is not None and not np.isfinite(t).all():
             raise ValueError(f"ragdoll {key}: hold target has NaN or infinite values")
         slot.cmd.hold = joint
+        if joint is None:
+            self._held.discard(key)
+        else:
+            self._held.add(key)
         if t is not None:
             slot.cmd.hold_target = t
 
     def holding(self) -> list[int]:
         """The ragdolls whose body is held now (so a crowd's physics stage lets go of those only)."""
-        return [k for k, s in self._ragdolls.items() if s.cmd.hold is not None]
+        return sorted(self._held)
 
     def set_pose(self, key: int, root: ArrayLike, rotations: ArrayLike) -> None:
         """Place the ragdoll on a pose at rest now (teleport); the next step has no target velocity."""

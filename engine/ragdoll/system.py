@@ -115,7 +115,8 @@ def _animated_targets(
 ) -> tuple[NDArray[np.float64] | list[NDArray[np.float64]], NDArray[np.float64] | list[NDArray[np.float64]]]:
     """The animated ragdolls' targets: their local poses' roots ``[P, 3]`` and rotations ``[P, J, 4]``
     read from the pose columns (:mod:`engine.columns`) when all have ``J`` joints, else as lists."""
-    joints = {puppet.skeleton.num_joints for _, rd, puppet, _ in rows if rd.mode is RagdollMode.ANIMATED}
+    skeletons = {id(puppet.skeleton): puppet.skeleton for _, rd, puppet, _ in rows if rd.mode is RagdollMode.ANIMATED}
+    joints = {sk.num_joints for sk in skeletons.values()}
     poses = [pose for _, _, pose in animated]
     if len(joints) != 1:
         return [p.root for p in poses], [p.rotations for p in poses]
