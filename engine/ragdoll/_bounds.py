@@ -45,10 +45,14 @@ def command_boxes(kind: bytes, spec: RagdollSpec, roots: _F, rotations: _F) -> _
     return capsule_boxes(a, b, np.tile(r, n), np.repeat(np.arange(n), joints), n)
 
 
-def geom_boxes(m: mujoco.MjModel, d: mujoco.MjData, geoms: NDArray[np.int64], owner: NDArray[np.int64], count: int) -> _F:
+def geom_boxes(
+    m: mujoco.MjModel, d: mujoco.MjData, geoms: NDArray[np.int64], owner: NDArray[np.int64], count: int
+) -> _F:
     """Boxes ``[count,2,3]`` around MuJoCo's capsule and sphere ``geoms`` where they are now,
     geom ``i`` belonging to box ``owner[i]`` (sorted)."""
     centre = d.geom_xpos[geoms]
     axis = d.geom_xmat[geoms].reshape(-1, 3, 3)[:, :, 2]
     half = np.where(m.geom_type[geoms] == int(mujoco.mjtGeom.mjGEOM_CAPSULE), m.geom_size[geoms, 1], 0.0)
-    return capsule_boxes(centre - axis * half[:, None], centre + axis * half[:, None], m.geom_size[geoms, 0], owner, count)
+    return capsule_boxes(
+        centre - axis * half[:, None], centre + axis * half[:, None], m.geom_size[geoms, 0], owner, count
+    )

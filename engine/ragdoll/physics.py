@@ -33,10 +33,10 @@ from engine import quat
 from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.pose import Pose
+from engine.ragdoll._bounds import command_boxes, geom_boxes
 from engine.ragdoll._building import Building
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
-from engine.ragdoll._bounds import command_boxes, geom_boxes
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
 from engine.ragdoll._pool import RagdollPool, kind_of
@@ -379,7 +379,10 @@ class PhysicsWorld(Readback, Building):
                 cand = np.nonzero(~needs)[0][near]
                 src = np.nonzero(needs)[0]
                 boxes = np.concatenate(
-                    [self._boxes([slots[i] for i in src]), np.array([[c - r, c + r] for c, r in props]).reshape(-1, 2, 3)]
+                    [
+                        self._boxes([slots[i] for i in src]),
+                        np.array([[c - r, c + r] for c, r in props]).reshape(-1, 2, 3),
+                    ]
                 )
                 near[near] = near_boxes(self._boxes([slots[i] for i in cand]), boxes, inside[cand])
             wanted[~needs] = near
@@ -393,9 +396,7 @@ class PhysicsWorld(Readback, Building):
         geoms, an animated or newly joined one's from its command (:mod:`engine.ragdoll._bounds`)."""
         out = np.empty((len(slots), 2, 3))
         L, m, d = self.layout, self.model, self.data
-        live = [
-            i for i, s in enumerate(slots) if s.in_model and s.placed and not s.cmd.kinematic and not self._moved
-        ]
+        live = [i for i, s in enumerate(slots) if s.in_model and s.placed and not s.cmd.kinematic and not self._moved]
         if live and L is not None and m is not None and d is not None:
             box_of = np.full(L.num_ragdolls, -1)
             box_of[[L.ordinal(slots[i].spec.key) for i in live]] = np.arange(len(live))
