@@ -29,7 +29,12 @@ from numpy.typing import NDArray
 __all__ = ["MAX_LINEAR", "MAX_ANGULAR", "velocity_limits", "guarded_step", "collect_warnings", "PhysicsRecovery"]
 
 MAX_LINEAR = 30.0  # m/s: faster than any throw or fall in the field
-MAX_ANGULAR = 1000.0  # rad/s: a foot snapping back inside its joint limit on entry reaches ~550
+# rad/s per degree of freedom. An animated target asks for at most pi/dt (188 at 60 Hz, the shortest
+# way round in one step). A limp hand (0.5 kg, 4e-4 kg m²) pinched between its own lower arm and head
+# in a crowd fall reached 861 rad/s in one substep (1.8 rad per 1/480 s) and the step diverged under
+# the old bound of 1000; at 200 it turns at most 0.42 rad per substep and settles. (A foot snapping
+# back inside its joint limit on entry, ~550, now takes a few substeps.)
+MAX_ANGULAR = 200.0
 _BLOWUP = 10.0  # a substep that ends this many times over the bound has exploded
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 _PENDING: list[str] = []

@@ -13,6 +13,13 @@ swapping pool slots every step). A crowd walking on an empty field is then no
 MuJoCo work at all; joining or leaving borrows or returns a slot of the ragdoll pool
 (:mod:`engine.ragdoll._pool`), a state copy, not a compile.
 
+Spheres that hold a ragdoll in *any* pose are loose: a standing puppet's is ~2 m wide for a
+body 0.5 m wide, and ten puppets falling in a crowd of a hundred pulled some fifty walking
+neighbours into the model (each costs as much MuJoCo work as a faller). So the spheres only
+pick the candidates; a candidate joins when the axis-aligned boxes of the capsules in their
+*current* poses (:func:`capsule_boxes`, :func:`box_gaps`) are also that close. Both are lower
+bounds of the true distance between the bodies, so the larger of the two is too.
+
 Puppets can also end up inside each other (two dropped on one spot, one walked into
 another as it falls): MuJoCo would push them apart at 10⁵ m/s. A simulated ragdoll whose
 root is that close to another's is a *ghost* (:func:`ghosts`): it touches only the
@@ -28,7 +35,19 @@ from engine.arrays import F64 as _F
 from engine.ragdoll.profile import RagdollProfile, bone_segments
 from engine.skeleton import Skeleton
 
-__all__ = ["reach", "near_simulated", "ghosts", "ENTER", "LEAVE", "LOOKAHEAD", "OVERLAP", "APART"]
+__all__ = [
+    "reach",
+    "near_simulated",
+    "capsule_boxes",
+    "box_gaps",
+    "near_boxes",
+    "ghosts",
+    "ENTER",
+    "LEAVE",
+    "LOOKAHEAD",
+    "OVERLAP",
+    "APART",
+]
 
 ENTER = 0.4  # m of clearance between bounding spheres under which an animated ragdoll joins
 LEAVE = 1.0  # m of clearance over which it leaves again
@@ -59,6 +78,33 @@ def near_simulated(
     gap = np.linalg.norm(centres[:, None, :] - sources[None, :, :], axis=2) - radii[:, None] - source_radii[None, :]
     limit = np.where(inside, LEAVE, ENTER)
     return np.asarray((gap < limit[:, None]).any(axis=1))
+
+
+def capsule_boxes(a: _F, b: _F, r: _F, owner: NDArray[np.int64], count: int) -> _F:
+    """Axis-aligned boxes ``[count, 2, 3]`` (low, high corners) around capsules from ``a [N,3]`` to
+    ``b [N,3]`` of radius ``r [N]``, capsule ``i`` belonging to box ``owner[i]`` (owners sorted)."""
+    lo = np.minimum(a, b) - r[:, None]
+    hi = np.maximum(a, b) + r[:, None]
+    out = np.empty((count, 2, 3))
+    starts = np.searchsorted(owner, np.arange(count))
+    out[:, 0] = np.minimum.reduceat(lo, starts, axis=0)
+    out[:, 1] = np.maximum.reduceat(hi, starts, axis=0)
+    return out
+
+
+def box_gaps(boxes: _F, others: _F) -> _F:
+    """Distance ``[A,S]`` between each of ``boxes [A,2,3]`` and each of ``others [S,2,3]`` (0 when they overlap)."""
+    sep = np.maximum(others[None, :, 0] - boxes[:, None, 1], boxes[:, None, 0] - others[None, :, 1])
+    return np.asarray(np.linalg.norm(np.maximum(sep, 0.0), axis=2))
+
+
+def near_boxes(boxes: _F, sources: _F, inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """:func:`near_simulated` for boxes: which of ``boxes [A,2,3]`` are near one of ``sources [S,2,3]``,
+    with the same hysteresis (``inside [A]``: in the model now)."""
+    if len(boxes) == 0 or len(sources) == 0:
+        return np.zeros(len(boxes), dtype=bool)
+    limit = np.where(inside, LEAVE, ENTER)
+    return np.asarray((box_gaps(boxes, sources) < limit[:, None]).any(axis=1))
 
 
 def ghosts(roots: _F, simulated: NDArray[np.bool_], ghost: NDArray[np.bool_]) -> NDArray[np.bool_]:

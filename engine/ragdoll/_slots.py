@@ -19,6 +19,7 @@ class RagdollSlot:
     cmd: Command
     reach: float
     kind: bytes  # which pool slots fit it (:func:`engine.ragdoll._pool.kind_of`)
+    joints: int  # its skeleton's joint count (read for every puppet every step)
     placed: bool = False
     in_model: bool = False  # simulated this step (animated and alone: left out, see _islands)
     pool: int = -1  # the pool slot lent to it while in the model

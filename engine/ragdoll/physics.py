@@ -33,10 +33,11 @@ from engine import quat
 from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.pose import Pose
+from engine.ragdoll._bounds import command_boxes, geom_boxes
 from engine.ragdoll._building import Building
 from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
-from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_simulated, reach
+from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
 from engine.ragdoll._pool import RagdollPool, kind_of
 from engine.ragdoll._readback import Readback
@@ -73,6 +74,7 @@ class PhysicsWorld(Readback, Building):
         self.rebuilds = 0
         self._ragdolls: dict[int, RagdollSlot] = {}
         self._props: dict[int, PropSlot] = {}
+        self._held: set[int] = set()  # ragdolls with a held body
         self._dirty = False
         self._sized = True
         self._moved = False
@@ -115,7 +117,7 @@ class PhysicsWorld(Readback, Building):
         kind = kind_of(spec)
         if kind not in self._reach:  # a crowd is a few kinds of ragdoll many times over
             self._reach[kind] = reach(skeleton, profile, off)
-        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind)
+        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind, skeleton.num_joints)
         self._sized = False
 
     def add_prop(
@@ -142,6 +144,7 @@ class PhysicsWorld(Readback, Building):
     def remove(self, key: int) -> None:
         """Remove a ragdoll or prop (no error if absent)."""
         slot = self._ragdolls.pop(key, None)
+        self._held.discard(key)
         if slot is not None and slot.pool >= 0:
             self._give_back(slot)
         if self._props.pop(key, None) is not None:
@@ -236,8 +239,9 @@ class PhysicsWorld(Readback, Building):
         """
         if not keys:
             return []
-        slots = [self._slot(k) for k in keys]
-        sizes = [s.spec.skeleton.num_joints for s in slots]
+        rag = self._ragdolls
+        slots = [rag[k] if k in rag else self._slot(k) for k in keys]
+        sizes = [s.joints for s in slots]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
         if stacked:
@@ -272,8 +276,16 @@ class PhysicsWorld(Readback, Building):
         if t is not None and not np.isfinite(t).all():
             raise ValueError(f"ragdoll {key}: hold target has NaN or infinite values")
         slot.cmd.hold = joint
+        if joint is None:
+            self._held.discard(key)
+        else:
+            self._held.add(key)
         if t is not None:
             slot.cmd.hold_target = t
+
+    def holding(self) -> list[int]:
+        """The ragdolls whose body is held now (so a crowd's physics stage lets go of those only)."""
+        return sorted(self._held)
 
     def set_pose(self, key: int, root: ArrayLike, rotations: ArrayLike) -> None:
         """Place the ragdoll on a pose at rest now (teleport); the next step has no target velocity."""
@@ -355,18 +367,55 @@ class PhysicsWorld(Readback, Building):
             wanted = np.ones(len(slots), dtype=bool)
         else:
             needs = np.array([not s.cmd.kinematic or s.cmd.hold is not None for s in slots], dtype=bool)
-            centres = np.array([self._centre(s) for s in slots]).reshape(-1, 3)
+            centres = np.array([self._centre(s) if s.in_model else s.cmd.root for s in slots]).reshape(-1, 3)
             radii = np.array([s.reach for s in slots])
             props = [self._prop_sphere(k) for k in sorted(self._props)]
             sources = np.concatenate([centres[needs], np.array([c for c, _ in props]).reshape(-1, 3)])
             source_radii = np.concatenate([radii[needs], [r for _, r in props]])
             inside = np.array([s.in_model for s in slots], dtype=bool)
             wanted = needs.copy()
-            wanted[~needs] = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+            near = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+            if near.any():  # the spheres hold any pose: the candidates' boxes in their poses decide
+                cand = np.nonzero(~needs)[0][near]
+                src = np.nonzero(needs)[0]
+                boxes = np.concatenate(
+                    [
+                        self._boxes([slots[i] for i in src]),
+                        np.array([[c - r, c + r] for c, r in props]).reshape(-1, 2, 3),
+                    ]
+                )
+                near[near] = near_boxes(self._boxes([slots[i] for i in cand]), boxes, inside[cand])
+            wanted[~needs] = near
         for slot, want in zip(slots, wanted, strict=True):
             if slot.in_model != bool(want):
                 slot.in_model, slot.placed = bool(want), False
                 self._moved = True
+
+    def _boxes(self, slots: list[RagdollSlot]) -> _F:
+        """Boxes ``[n,2,3]`` around ragdolls in their current poses: a simulated one's from MuJoCo's
+        geoms, an animated or newly joined one's from its command (:mod:`engine.ragdoll._bounds`)."""
+        out = np.empty((len(slots), 2, 3))
+        L, m, d = self.layout, self.model, self.data
+        live = [i for i, s in enumerate(slots) if s.in_model and s.placed and not s.cmd.kinematic and not self._moved]
+        if live and L is not None and m is not None and d is not None:
+            box_of = np.full(L.num_ragdolls, -1)
+            box_of[[L.ordinal(slots[i].spec.key) for i in live]] = np.arange(len(live))
+            own = box_of[L.geom_owner]
+            order = np.argsort(own, kind="stable")[np.count_nonzero(own < 0) :]
+            out[live] = geom_boxes(m, d, L.geom[order], own[order], len(live))
+        else:
+            live = []
+        done = set(live)
+        kinds: dict[bytes, list[int]] = {}
+        for i, s in enumerate(slots):
+            if i not in done:
+                kinds.setdefault(s.kind, []).append(i)
+        for kind, idx in kinds.items():
+            cmds = [slots[i].cmd for i in idx]
+            out[idx] = command_boxes(
+                kind, slots[idx[0]].spec, np.array([c.root for c in cmds]), np.array([c.rot for c in cmds])
+            )
+        return out
 
     def _centre(self, slot: RagdollSlot) -> _F:
         """Where a ragdoll's root is: simulated while in the model, else its commanded target."""

@@ -36,11 +36,11 @@ __all__ = ["physics_step", "install_physics", "spawn_snowball"]
 def _sync(world: World, pw: PhysicsWorld) -> None:
     rows = world.query(Ragdoll, Puppet, LocalPose)
     present = {e for e, *_ in rows}
-    for key in pw.ragdoll_keys:
-        if key not in present:
-            pw.remove(key)
+    known = set(pw.ragdoll_keys)
+    for key in sorted(known - present):
+        pw.remove(key)
     for e, rd, puppet, pose in rows:
-        if not pw.has_ragdoll(e):
+        if e not in known:
             pw.add_ragdoll(e, puppet.skeleton, rd.profile, pose.root, pose.rotations, puppet.joint_offsets())
     props = world.query(Prop, Transform)
     present = {e for e, *_ in props}
@@ -88,8 +88,10 @@ def physics_step(world: World) -> None:
             rd.ramp(world.dt)  # (at its targets a ragdoll's ramp changes nothing)
         # not simulated: the body is its animation (no energy of its own, nothing to settle)
         rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
+    holding = set(pw.holding())  # a crowd holds nothing: one call per held puppet, not per puppet
     for e, rd, _, _ in rows:
-        pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
+        if rd.held is not None or e in holding:
+            pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
     for e, prop, tr in world.query(Prop, Transform):
         if prop.carried or prop.placed:
             pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
@@ -113,7 +115,8 @@ def _animated_targets(
 ) -> tuple[NDArray[np.float64] | list[NDArray[np.float64]], NDArray[np.float64] | list[NDArray[np.float64]]]:
     """The animated ragdolls' targets: their local poses' roots ``[P, 3]`` and rotations ``[P, J, 4]``
     read from the pose columns (:mod:`engine.columns`) when all have ``J`` joints, else as lists."""
-    joints = {puppet.skeleton.num_joints for _, rd, puppet, _ in rows if rd.mode is RagdollMode.ANIMATED}
+    skeletons = {id(puppet.skeleton): puppet.skeleton for _, rd, puppet, _ in rows if rd.mode is RagdollMode.ANIMATED}
+    joints = {sk.num_joints for sk in skeletons.values()}
     poses = [pose for _, _, pose in animated]
     if len(joints) != 1:
         return [p.root for p in poses], [p.rotations for p in poses]

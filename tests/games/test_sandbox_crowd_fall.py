@@ -88,3 +88,31 @@ def _draw_crowd(app) -> None:  # type: ignore[no-untyped-def]
         viewer.close()
     blue = (img[..., 2] - img[..., 0]) > 40  # the crowd's blue puppets on the white field
     assert np.count_nonzero(blue) > 500
+
+
+def test_ten_of_a_hundred_fall_without_a_recovery() -> None:
+    """The bench's fall (``bench crowd-scale``, seed 3): ten of a hundred walking puppets go limp.
+
+    Step 38 after the fall used to be undone ("velocity blow-up"): a limp hand pinched between
+    its own lower arm and head spun up to 861 rad/s in one substep. With angular speeds bounded
+    at 200 rad/s (``engine/ragdoll/_guard.py``) it settles. Broken once to see it fail:
+    ``MAX_ANGULAR = 1000.0`` again gives one recovery at that step.
+    """
+    import warnings
+
+    from engine.ragdoll._guard import PhysicsRecovery
+
+    seed = 3
+    app = make_app("sandbox", seed, InputHub(), {"puppets": 100})
+    app.run_steps(60)
+    w = app.world
+    pw = w.resource(PhysicsWorld)
+    ragdolls = [e for e, _ in w.query(Ragdoll)]
+    for e in sorted(np.random.default_rng(seed).choice(ragdolls, size=10, replace=False).tolist()):
+        w.get(int(e), Ragdoll).set_mode(RagdollMode.LIMP, immediate=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PhysicsRecovery)
+        app.run_steps(45)
+    assert pw.recoveries == 0
+    for _, pose in w.query(LocalPose):
+        assert np.isfinite(pose.root).all() and np.isfinite(pose.rotations).all()

@@ -82,3 +82,21 @@ def test_going_limp_keeps_the_walk_s_momentum(make_app: Callable[..., tuple[App,
     app.step()
     assert pw.in_model(e)
     assert pw.root_velocity(e)[2] > 1.0  # it joined the model moving, not at rest
+
+
+def test_a_limp_neighbour_pulls_in_only_a_puppet_its_bodies_come_near(skeleton: Skeleton) -> None:
+    """Reach spheres (any pose) of puppets 1.6 m apart overlap, their posed capsules do not: the
+    animated neighbour stays out. Half a metre closer it joins. (Breaking it: return the sphere
+    test alone in PhysicsWorld._update_islands and the first assertion fails.)"""
+    prof = default_profile(skeleton)
+    rot = np.tile([1.0, 0.0, 0.0, 0.0], (skeleton.num_joints, 1))
+    hips = float(skeleton.offsets[0][1])
+    assert 2 * reach(skeleton, prof, skeleton.offsets) + ENTER > 1.6  # the spheres alone would pull it in
+    for gap, joins in ((1.6, False), (0.6, True)):
+        pw = PhysicsWorld()
+        pw.add_ragdoll(1, skeleton, prof, [0.0, hips, 0.0], rot)
+        pw.add_ragdoll(2, skeleton, prof, [gap, hips, 0.0], rot)
+        pw.drive(1, [0.0, hips, 0.0], rot, 0.0, 0.0)
+        pw.drive_animated([2], [[gap, hips, 0.0]], [rot])
+        pw.step()
+        assert pw.in_model(1) and pw.in_model(2) is joins
