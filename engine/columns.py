@@ -27,6 +27,7 @@ only as costly as the gather it replaces.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Sequence
 from operator import attrgetter
 from typing import Any
@@ -76,6 +77,8 @@ class Column:
     def _sync(self, rows: slice | list[int], take_in: bool) -> bool:
         """Point the fields replaced by other code at their rows again, first copying their values in
         if ``take_in``; ``False`` (and nothing re-linked after it) if such a value has another shape."""
+        if rows is _ALL and all(map(operator.is_, map(self._get, self._owners), self._views)):
+            return True  # the common case, every field still its row: one C-level pass
         index = range(len(self._owners)) if rows is _ALL else rows
         assert isinstance(index, range | list)
         owners, views = self._owners, self._views

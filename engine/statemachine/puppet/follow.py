@@ -25,6 +25,8 @@ pass, with the same numbers. Time is ``world.dt``.
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
@@ -163,10 +165,10 @@ def follow_released(
     # The single path brakes when |goal| = 0 < |v|, i.e. when v·v > 0 (a sum of squares is
     # positive exactly when one of them is).
     braking = (value * value).sum(axis=1) > 0.0
-    omega = (np.array([b.tuning.follow_omega for b in bodies]) * np.where(braking, 2.0, 1.0))[:, None]
+    omega = (np.fromiter(map(_OMEGA, bodies), np.float64, n) * np.where(braking, 2.0, 1.0))[:, None]
     value, rate = spring_step(value, rate, goal, omega, dt)
     speed = np.hypot(value[:, 0], value[:, 2])
-    heading = np.array([b.heading for b in bodies])
+    heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
     rotation = yaw_rotation(heading)
     recent = np.concatenate([recent[:, 1:], value[:, None]], axis=1)
     if cols is None:
@@ -177,14 +179,24 @@ def follow_released(
         cols.get(PuppetBody, "walk_rate").write(bodies, rate)
         cols.get(PuppetBody, "recent").write(bodies, recent)
     speeds = speed.tolist()
-    still = [i for i, v in enumerate(speeds) if not v > 1e-3]
-    for i, v in enumerate(speeds):
-        if v > 1e-3:
-            _face(transforms[i], bodies[i], players[i], v, dt, 1.0)
-    for i in still:
-        players[i].speed = speeds[i]
-    if cols is None or len(still) < n // 2:
-        for i in still:
-            transforms[i].rotation = rotation[i]
+    moving = speed > 1e-3
+    turning = np.flatnonzero(moving).tolist()
+    for i in turning:
+        _face(transforms[i], bodies[i], players[i], speeds[i], dt, 1.0)
+    if turning:
+        still = np.flatnonzero(~moving).tolist()
+        players = [players[i] for i in still]
+        speeds = [speeds[i] for i in still]
+        transforms = [transforms[i] for i in still]
+        rotation = rotation[still]
+    for player, v in zip(players, speeds, strict=True):
+        player.speed = v
+    if cols is None or len(transforms) < n // 2:
+        for tr, q in zip(transforms, rotation, strict=True):
+            tr.rotation = q
     else:
-        cols.get(Transform, "rotation").write([transforms[i] for i in still], rotation[still])
+        cols.get(Transform, "rotation").write(transforms, rotation)
+
+
+_OMEGA = operator.attrgetter("tuning.follow_omega")
+_HEADING = operator.attrgetter("heading")
