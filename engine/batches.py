@@ -16,6 +16,7 @@ Only membership is cached: the values in the components are read fresh by the ca
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -57,7 +58,7 @@ class Batches:
         entities = [r[0] for r in rows]
         lists = [[r[k] for r in rows] for k in range(1, len(required) + 1)]
         for t in optional:
-            store = world.components(t)
+            store: Mapping[Entity, Any] = world.components(t)
             lists.append([store.get(e) for e in entities])
         made = Batch(entities, tuple(lists), tuple(any(c is None for c in comps) for comps in lists))
         self._kept[key] = (sources, made)

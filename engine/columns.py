@@ -70,18 +70,23 @@ class Column:
             return _ALL
         row = self._row
         try:
-            return [row[k] for k in ids]
+            return list(map(row.__getitem__, ids))
         except KeyError:
             return None
 
     def _sync(self, rows: slice | list[int], take_in: bool) -> bool:
         """Point the fields replaced by other code at their rows again, first copying their values in
         if ``take_in``; ``False`` (and nothing re-linked after it) if such a value has another shape."""
-        if rows is _ALL and all(map(operator.is_, map(self._get, self._owners), self._views)):
-            return True  # the common case, every field still its row: one C-level pass
+        owners, views = self._owners, self._views
+        if rows is _ALL:
+            if all(map(operator.is_, map(self._get, owners), views)):
+                return True  # the common case, every field still its row: one C-level pass
+        elif isinstance(rows, list) and all(
+            map(operator.is_, map(self._get, map(owners.__getitem__, rows)), map(views.__getitem__, rows))
+        ):
+            return True
         index = range(len(self._owners)) if rows is _ALL else rows
         assert isinstance(index, range | list)
-        owners, views = self._owners, self._views
         for i in index:
             now = self._get(owners[i])
             if now is views[i]:

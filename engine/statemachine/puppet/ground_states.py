@@ -15,6 +15,7 @@ decided over arrays (a guard of a ground state can only fire for a held puppet) 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -167,7 +168,7 @@ def _rows_of(
 ) -> list[Any]:
     """The ``ctype`` components of ``rows``: from the list the caller kept, else looked up (``None`` if missing)."""
     if kept is None:
-        store = world.components(ctype)
+        store: Mapping[Entity, Any] = world.components(ctype)
         return [store.get(entities[i]) for i in rows]
     return kept if every else [kept[i] for i in rows]
 
