@@ -27,8 +27,9 @@ only as costly as the gather it replaces.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Sequence
-from operator import attrgetter, is_
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -69,7 +70,7 @@ class Column:
             return _ALL
         row = self._row
         try:
-            return [row[k] for k in ids]
+            return list(map(row.__getitem__, ids))
         except KeyError:
             return None
 
@@ -78,13 +79,14 @@ class Column:
         if ``take_in``; ``False`` (and nothing re-linked after it) if such a value has another shape."""
         owners, views = self._owners, self._views
         if rows is _ALL:
-            # the common case, every field still viewing its row, settled by one C-level pass
-            if all(map(is_, map(self._get, owners), views)):
-                return True
-            index: range | list[int] = range(len(owners))
-        else:
-            assert isinstance(rows, list)
-            index = rows
+            if all(map(operator.is_, map(self._get, owners), views)):
+                return True  # the common case, every field still its row: one C-level pass
+        elif isinstance(rows, list) and all(
+            map(operator.is_, map(self._get, map(owners.__getitem__, rows)), map(views.__getitem__, rows))
+        ):
+            return True
+        index = range(len(self._owners)) if rows is _ALL else rows
+        assert isinstance(index, range | list)
         for i in index:
             now = self._get(owners[i])
             if now is views[i]:

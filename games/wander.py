@@ -10,12 +10,14 @@ steering is batched over all wanderers: a crowd of a hundred is one numpy pass.
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
 from engine.app import App
+from engine.batches import batch
 from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import columns
 from engine.components import Transform
@@ -40,39 +42,45 @@ class Wanderer:
 
 
 def wander_system(world: World) -> None:
-    """Steer every free wanderer toward its goal; pick a new goal when one is reached."""
-    jumps, ragdolls = world.components(Jumping), world.components(Ragdoll)
-    placed, locomotion = world.components(Transform), world.components(LocomotionPlayer)
-    rows = [
-        (w, body, tr, player)
-        for e, w, body in world.query(Wanderer, PuppetBody)
+    """Steer every free wanderer toward its goal; pick a new goal when one is reached.
+
+    The wanderers' component lists are kept between structural changes (:mod:`engine.batches`),
+    their positions, rotations and goals are columns (:mod:`engine.columns`)."""
+    kept = batch(world, "wanderers", (Wanderer, PuppetBody), (Jumping, Ragdoll, Transform, LocomotionPlayer))
+    free = [
+        i
+        for i, (body, jump, rd, tr, player) in enumerate(zip(*kept.lists[1:], strict=True))
         if body.held_by is None
-        and ((jump := jumps.get(e)) is None or jump.air == 0.0)
-        and (rd := ragdolls.get(e)) is not None
+        and (jump is None or jump.air == 0.0)
+        and rd is not None
         and rd.mode is RagdollMode.ANIMATED
-        and (tr := placed.get(e)) is not None
-        and (player := locomotion.get(e)) is not None
+        and tr is not None
+        and player is not None
     ]
-    if not rows:
+    if not free:
         return
+    if len(free) == len(kept.entities):
+        wanderers, bodies, _, _, transforms, players = kept.lists
+    else:
+        wanderers, bodies, _, _, transforms, players = ([c[i] for i in free] for c in kept.lists)
+    n = len(free)
     cols = columns(world)
-    transforms = [r[2] for r in rows]
     pos = cols.get(Transform, "position").read(transforms)
-    goal = np.array([r[0].goal for r in rows])
+    goal = cols.get(Wanderer, "goal").read(wanderers)
     err = goal - pos
     dist = np.hypot(err[:, 0], err[:, 2])
-    heading = np.array([r[1].heading for r in rows])
+    heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
     turn = (np.arctan2(err[:, 0], err[:, 2]) - heading + np.pi) % (2 * np.pi) - np.pi
     step = _TURN_RATE * world.dt
     heading = (heading + np.clip(turn, -step, step) + np.pi) % (2 * np.pi) - np.pi
     facing = np.maximum(np.cos(turn), 0.0)
     cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
-    speeds = (np.array([r[0].speed for r in rows]) * facing).tolist()
-    for (_w, body, _tr, player), h, v in zip(rows, heading.tolist(), speeds, strict=True):
+    speeds = (np.fromiter(map(_SPEED, wanderers), np.float64, n) * facing).tolist()
+    for body, player, h, v in zip(bodies, players, heading.tolist(), speeds, strict=True):
         body.heading = h
         player.speed = v
     for i in np.flatnonzero(dist < _REACHED).tolist():
-        w = rows[i][0]
+        w = wanderers[i]
         w.goal = np.array(
             [
                 *world.rng.uniform(-w.field_half, w.field_half, 1),
@@ -80,6 +88,10 @@ def wander_system(world: World) -> None:
                 *world.rng.uniform(-w.field_half, w.field_half, 1),
             ]
         )
+
+
+_HEADING = operator.attrgetter("heading")
+_SPEED = operator.attrgetter("speed")
 
 
 def install_wander(app: App) -> None:

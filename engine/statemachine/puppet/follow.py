@@ -25,6 +25,8 @@ pass, with the same numbers. Time is ``world.dt``.
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
@@ -159,32 +161,57 @@ def follow_released(
         value = cols.get(PuppetBody, "walk_velocity").read(bodies)
         rate = cols.get(PuppetBody, "walk_rate").read(bodies)
         recent = cols.get(PuppetBody, "recent").read(bodies)
-    goal = np.zeros((n, 3))
-    # The single path brakes when |goal| = 0 < |v|, i.e. when v·v > 0 (a sum of squares is
-    # positive exactly when one of them is).
-    braking = (value * value).sum(axis=1) > 0.0
-    omega = (np.array([b.tuning.follow_omega for b in bodies]) * np.where(braking, 2.0, 1.0))[:, None]
-    value, rate = spring_step(value, rate, goal, omega, dt)
-    speed = np.hypot(value[:, 0], value[:, 2])
-    heading = np.array([b.heading for b in bodies])
+    follow_omega = np.fromiter(map(_OMEGA, bodies), np.float64, n)
+    heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
     rotation = yaw_rotation(heading)
-    recent = np.concatenate([recent[:, 1:], value[:, None]], axis=1)
-    if cols is None:
-        for i, body in enumerate(bodies):
-            body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
+    if cols is not None and _at_rest(value, rate, recent, follow_omega, dt):
+        speed = np.zeros(n)  # the spring's exact rest is a fixed point: nothing to step, nothing to write
     else:
-        cols.get(PuppetBody, "walk_velocity").write(bodies, value)
-        cols.get(PuppetBody, "walk_rate").write(bodies, rate)
-        cols.get(PuppetBody, "recent").write(bodies, recent)
+        goal = np.zeros((n, 3))
+        # The single path brakes when |goal| = 0 < |v|, i.e. when v·v > 0 (a sum of squares is
+        # positive exactly when one of them is).
+        braking = (value * value).sum(axis=1) > 0.0
+        omega = (follow_omega * np.where(braking, 2.0, 1.0))[:, None]
+        value, rate = spring_step(value, rate, goal, omega, dt)
+        speed = np.hypot(value[:, 0], value[:, 2])
+        recent = np.concatenate([recent[:, 1:], value[:, None]], axis=1)
+        if cols is None:
+            for i, body in enumerate(bodies):
+                body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
+        else:
+            cols.get(PuppetBody, "walk_velocity").write(bodies, value)
+            cols.get(PuppetBody, "walk_rate").write(bodies, rate)
+            cols.get(PuppetBody, "recent").write(bodies, recent)
     speeds = speed.tolist()
-    still = [i for i, v in enumerate(speeds) if not v > 1e-3]
-    for i, v in enumerate(speeds):
-        if v > 1e-3:
-            _face(transforms[i], bodies[i], players[i], v, dt, 1.0)
-    for i in still:
-        players[i].speed = speeds[i]
-    if cols is None or len(still) < n // 2:
-        for i in still:
-            transforms[i].rotation = rotation[i]
+    moving = speed > 1e-3
+    turning = np.flatnonzero(moving).tolist()
+    for i in turning:
+        _face(transforms[i], bodies[i], players[i], speeds[i], dt, 1.0)
+    if turning:
+        still = np.flatnonzero(~moving).tolist()
+        players = [players[i] for i in still]
+        speeds = [speeds[i] for i in still]
+        transforms = [transforms[i] for i in still]
+        rotation = rotation[still]
+    for player, v in zip(players, speeds, strict=True):
+        player.speed = v
+    if cols is None or len(transforms) < n // 2:
+        for tr, q in zip(transforms, rotation, strict=True):
+            tr.rotation = q
     else:
-        cols.get(Transform, "rotation").write([transforms[i] for i in still], rotation[still])
+        cols.get(Transform, "rotation").write(transforms, rotation)
+
+
+def _at_rest(value: F, rate: F, recent: F, omega: F, dt: float) -> bool:
+    """Whether every spring is exactly at rest (all its numbers +0.0; stiffness and step finite, ≥ 0).
+
+    Then :func:`spring_step` toward a goal of 0 gives +0.0 again to the last bit (``0 · ω = 0``,
+    ``(0 + 0·dt) · e^{-ωdt} = 0`` with ``e^{-ωdt}`` in ``[0, 1]``) and the history shifts in
+    zeros: the step changes nothing. A crowd nobody has held is in this state all the time."""
+    if not (0.0 <= dt < np.inf and np.isfinite(omega).all() and (omega >= 0.0).all()):
+        return False
+    return not any(np.ascontiguousarray(a).view(np.uint64).any() for a in (value, rate, recent))
+
+
+_OMEGA = operator.attrgetter("tuning.follow_omega")
+_HEADING = operator.attrgetter("heading")

@@ -15,6 +15,9 @@ decided over arrays (a guard of a ground state can only fire for a held puppet) 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
@@ -131,29 +134,43 @@ def update_crouch(world: World, entity: Entity, brain: Brain) -> None:
 
 def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) -> None:
     """:func:`update_locomotion` for many puppets: those no stick holds, with the spring control, in one pass."""
+    bodies = columns.bodies
     fast: list[int] = []
-    for i in rows:
-        body = columns.bodies[i]
+    for i in rows.tolist():
+        body = bodies[i]
         if body.held_by is None and body.tuning.controller != "legacy":
-            fast.append(int(i))
+            fast.append(i)
         else:
             update_locomotion(world, columns.entities[i], world.get(columns.entities[i], Brain))
-    transforms, players = [], []
-    handling, locomotion = world.components(Handling), world.components(LocomotionPlayer)
-    requests, placed = world.components(IKRequest), world.components(Transform)
-    for i in fast:
-        e = columns.entities[i]
-        handling[e].left = None  # standing
-        player = locomotion[e]
+    if not fast:
+        return
+    entities = columns.entities
+    every = len(fast) == len(entities)
+    handling = _rows_of(world, Handling, columns.handling, entities, fast, every)
+    players = _rows_of(world, LocomotionPlayer, columns.players, entities, fast, every)
+    requests = _rows_of(world, IKRequest, columns.ik, entities, fast, every)
+    transforms = _rows_of(world, Transform, columns.transforms, entities, fast, every)
+    for h in handling:
+        h.left = None  # standing
+    for player in players:
         player.height = None
-        ik = requests.get(e)
+    for ik in requests:
         if ik is not None:
             ik.foot_lock.enabled = True
             ik.grounding = True
             ik.sphere_centre, ik.sphere_radius = None, 0.0
-        transforms.append(placed[e])
-        players.append(player)
-    follow_released(world.dt, [columns.bodies[i] for i in fast], transforms, players, engine_columns(world))
+    fast_bodies = bodies if every else [bodies[i] for i in fast]
+    follow_released(world.dt, fast_bodies, transforms, players, engine_columns(world))
+
+
+def _rows_of(
+    world: World, ctype: type, kept: list[Any] | None, entities: list[Entity], rows: list[int], every: bool
+) -> list[Any]:
+    """The ``ctype`` components of ``rows``: from the list the caller kept, else looked up (``None`` if missing)."""
+    if kept is None:
+        store: Mapping[Entity, Any] = world.components(ctype)
+        return [store.get(entities[i]) for i in rows]
+    return kept if every else [kept[i] for i in rows]
 
 
 _LOCOMOTION: PuppetStateDef = PuppetStateDef(

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from engine.app import App
+from engine.batches import batch
 from engine.blend.locomotion import BlendLibrary, LocomotionPlayer
 from engine.blend.puppet import install_puppet_locomotion
 from engine.components import Grabbable, LocalPose, Name, Puppet, Transform
@@ -24,7 +25,7 @@ from engine.ragdoll.profile import RagdollProfile, default_profile
 from engine.ragdoll.system import install_physics
 from engine.skeleton import Skeleton
 from engine.statemachine.machine import Brain, StateMachine, step_machines
-from engine.statemachine.puppet.body import PUPPET_COMPONENTS, PoseOverride, PuppetBody, PuppetTuning
+from engine.statemachine.puppet.body import PUPPET_COMPONENTS, Handling, PoseOverride, PuppetBody, PuppetTuning
 from engine.statemachine.puppet.machine import puppet_machine
 from engine.statemachine.puppet.props import held_props_system
 from engine.statemachine.puppet.senses import sense_all, yaw_rotation
@@ -48,11 +49,13 @@ def brain_system(world: World) -> None:
 
     Sensing is one pass over all puppets; the machines are stepped by
     :func:`~engine.statemachine.machine.step_machines`: the puppets walking free in
-    Locomotion over arrays, the others (held, jumping, fallen…) one by one in entity order."""
-    rows = world.query(PuppetBody, Brain)
-    entities = [r[0] for r in rows]
-    columns = sense_all(world, entities, [r[1] for r in rows])
-    step_machines(world, entities, [r[2] for r in rows], columns)
+    Locomotion over arrays, the others (held, jumping, fallen…) one by one in entity order.
+    The puppets' component lists are kept between structural changes (:mod:`engine.batches`)."""
+    kept = batch(world, "puppet brains", (PuppetBody, Brain), (Transform, LocomotionPlayer, Handling, IKRequest))
+    bodies, brains, transforms, players, handling, ik = kept.lists
+    columns = sense_all(world, kept.entities, bodies, None if kept.missing[2] else transforms)
+    columns.players, columns.handling, columns.ik = players, handling, ik
+    step_machines(world, kept.entities, brains, columns)
 
 
 def apply_pose_overrides(world: World) -> None:

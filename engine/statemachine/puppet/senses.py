@@ -13,9 +13,13 @@ holders from one pass over the sticks, and only the held puppets one by one.
 
 from __future__ import annotations
 
+import operator
+from itertools import repeat
+
 import numpy as np
 
 from engine import quat
+from engine.columns import columns
 from engine.components import Stick, Transform
 from engine.ecs import Entity, World
 from engine.ragdoll.components import Prop
@@ -48,7 +52,20 @@ def heading_vector(heading: float) -> F:
 
 
 def yaw_rotation(heading: float | F) -> F:
-    """The rotation about +Y of a heading angle (``[4]``), or of an array of them (``[n, 4]``)."""
+    """The rotation about +Y of a heading angle (``[4]``), or of an array of them (``[n, 4]``).
+
+    For a 1-D array it is :func:`engine.quat.from_axis_angle` about ``+Y`` written out, in half
+    the numpy calls (a crowd's facing every step) and with the same bits: the axis is exactly
+    ``(0, 1, 0)``, so its ``x`` and ``z`` parts are ``sin · 0.0`` (keeping the sign of zero)
+    and its ``y`` part ``sin · 1.0 = sin``."""
+    if isinstance(heading, np.ndarray) and heading.ndim == 1 and heading.dtype == np.float64:
+        half = 0.5 * heading
+        s = np.sin(half)
+        out = np.empty((len(heading), 4))
+        out[:, 0] = np.cos(half)
+        out[:, 2] = s
+        out[:, 1] = out[:, 3] = s * 0.0
+        return out
     return quat.from_axis_angle(_UP, heading)
 
 
@@ -77,34 +94,60 @@ def _sense_stick(body: PuppetBody, controller: Entity, stick: Stick) -> Stick:
     return stick
 
 
-def sense_all(world: World, entities: list[Entity], bodies: list[PuppetBody]) -> PuppetColumns:
+def sense_all(
+    world: World, entities: list[Entity], bodies: list[PuppetBody], transforms: list[Transform] | None = None
+) -> PuppetColumns:
     """:func:`sense` for every puppet at once (the same numbers); the columns the array guards read.
 
-    The rows' new ``ground_velocity``, ``last_position`` and ``lead`` are views into one
-    array per step each (fresh every step, never written in place)."""
+    ``transforms`` (row ``i`` for ``entities[i]``) saves looking them up. Once every puppet
+    has a ``last_position``, the rows' ``ground_velocity``, ``last_position`` and ``lead``
+    are kept in columns (:mod:`engine.columns`): written in place each step, never gathered;
+    before that (a puppet's first step) they are views into one fresh array per step each."""
     n = len(entities)
     sticks: dict[Entity, tuple[Entity, Stick]] = {}
     for e, stick in world.query(Stick):  # entity order: the lowest id holds, as in holder()
         if stick.grabbed is not None:
             sticks.setdefault(stick.grabbed, (e, stick))
-    pos = np.array([world.get(e, Transform).position for e in entities], dtype=np.float64).reshape(n, 3)
+    if transforms is None:
+        transforms = [world.get(e, Transform) for e in entities]
+    cols = columns(world)
+    if n and not any(map(operator.is_, map(_LAST, bodies), repeat(None))):
+        pos = np.array(cols.get(Transform, "position").read(transforms))  # its own copy: kept as last_position
+        last = cols.get(PuppetBody, "last_position").read(bodies)
+        cols.get(PuppetBody, "ground_velocity").write(bodies, (pos - last) * _GROUND / world.dt)
+        cols.get(PuppetBody, "last_position").write(bodies, pos)
+        cols.get(PuppetBody, "lead").write(bodies, np.zeros((n, 3)))
+        for body in bodies:
+            body.held_by, body.speed = None, 0.0
+    else:
+        _sense_first(world, bodies, transforms)
+    held = np.zeros(n, dtype=bool)
+    for e, by in sticks.items():
+        if e in entities:
+            i = entities.index(e)
+            held[i] = True
+            _sense_stick(bodies[i], *by)
+    return PuppetColumns(entities, bodies, held, transforms)
+
+
+_LAST = operator.attrgetter("last_position")
+_GROUND = np.array([1.0, 0.0, 1.0])
+
+
+def _sense_first(world: World, bodies: list[PuppetBody], transforms: list[Transform]) -> None:
+    """The momentum and rest values of :func:`sense_all` when some puppet has no ``last_position`` yet."""
+    n = len(bodies)
+    pos = np.array([tr.position for tr in transforms], dtype=np.float64).reshape(n, 3)
     known = [i for i, b in enumerate(bodies) if b.last_position is not None]
     if known:
         last = np.array([bodies[i].last_position for i in known], dtype=np.float64)
-        velocity = (pos[known] - last) * np.array([1.0, 0.0, 1.0]) / world.dt
+        velocity = (pos[known] - last) * _GROUND / world.dt
         for j, i in enumerate(known):
             bodies[i].ground_velocity = velocity[j]
     zeros = np.zeros((n, 3))
-    held = np.zeros(n, dtype=bool)
-    for i, (e, body) in enumerate(zip(entities, bodies, strict=True)):
+    for i, body in enumerate(bodies):
         body.last_position = pos[i]
-        by = sticks.get(e)
-        if by is None:
-            body.held_by, body.speed, body.lead = None, 0.0, zeros[i]
-        else:
-            held[i] = True
-            _sense_stick(body, *by)
-    return PuppetColumns(entities, bodies, held)
+        body.held_by, body.speed, body.lead = None, 0.0, zeros[i]
 
 
 def prop_in_front(

@@ -18,20 +18,31 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.blend.locomotion import LocomotionPlayer
+from engine.components import Transform
 from engine.ecs import Entity, World
+from engine.ik.system import IKRequest
 from engine.statemachine.machine import Rows, State, Transition
-from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.body import Handling, PuppetBody
 
 __all__ = ["PuppetColumns", "PuppetStateDef", "PuppetTransition", "StateSpec", "free_rows", "held_rows"]
 
 
 @dataclass
 class PuppetColumns:
-    """Per-step columns over all puppets: the entities, their bodies, and who is held by a stick."""
+    """Per-step columns over all puppets: the entities, their bodies, and who is held by a stick.
+
+    The other components the array updates work on come along where the caller has them
+    (kept by :func:`engine.batches.batch`), row ``i`` for ``entities[i]``, ``None`` in a list
+    for a puppet without one; a list left ``None`` is looked up entity by entity."""
 
     entities: list[Entity]
     bodies: list[PuppetBody]
     held: NDArray[np.bool_]
+    transforms: list[Transform] | None = None
+    players: list[LocomotionPlayer | None] | None = None
+    handling: list[Handling | None] | None = None
+    ik: list[IKRequest | None] | None = None
 
 
 PuppetStateDef = State[PuppetColumns]

@@ -152,3 +152,35 @@ def test_step_machines_steps_quiet_entities_over_arrays_and_the_rest_alone() -> 
     assert [b.active for b in bs] == ["idle", "run", "idle", "jump"]
     assert calls == [[0, 2]]
     assert bs[0].time_in_state == pytest.approx(2 * w.dt) and bs[1].time_in_state == pytest.approx(w.dt)
+
+
+def test_step_machines_groups_a_shared_machine_as_the_entity_by_entity_rule() -> None:
+    """The crowd's shortcut (one machine, no events: rows sorted by state in C-level passes) groups
+    exactly as the rule it replaces, taken entity by entity. Fails if the shortcut merged
+    states, lost their order of first appearance, or batched a state that cannot be."""
+    import random
+
+    from engine.statemachine.machine import _groups
+
+    states = [State("a", batch_update=lambda w, c, r: None), State("b"), State("c", batch_update=lambda w, c, r: None)]
+    m = StateMachine("m", states, [Transition("a", "b", event="go")], default="b", initial="a")
+    other = StateMachine("o", states, [], default="b", initial="a")
+    rng = random.Random(3)
+    for trial in range(200):
+        brains = [m.new_brain() for _ in range(rng.randint(0, 12))]
+        for b in brains:
+            b.active = rng.choice(["a", "b", "c", ""])
+            if trial % 3 == 0 and rng.random() < 0.2:
+                b.raise_event("go")
+            if trial % 5 == 0 and rng.random() < 0.2:
+                b.machine = other
+        want: dict[tuple[int, str], list[int]] = {}
+        alone: list[int] = []
+        for i, b in enumerate(brains):
+            if b.active and not b.pending_events and b.machine.batchable(b.active):
+                want.setdefault((id(b.machine), b.active), []).append(i)
+            else:
+                alone.append(i)
+        groups, single = _groups(brains)
+        assert list(groups.items()) == list(want.items())
+        assert sorted(single) == alone

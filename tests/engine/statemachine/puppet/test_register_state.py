@@ -88,3 +88,45 @@ def test_the_array_path_steps_a_crowd_exactly_as_one_by_one(monkeypatch: pytest.
         assert state_hash(batched.world) == state_hash(single.world), f"differs at step {step}"
     moved = [b.heading for _, b in batched.world.query(PuppetBody)]
     assert len(set(moved)) > 5  # the crowd did walk and turn
+
+
+def test_a_crowd_at_rest_steps_exactly_as_one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Nobody ever held these puppets: their springs sit at exact rest and the array path skips the
+    spring step (``follow._at_rest``); the state is still the one-by-one path's, bit for bit.
+    Fails if the rest shortcut left a spring or its history unwritten that the step would change,
+    or skipped the speed and facing of the puppets."""
+    from engine.statemachine.puppet import follow
+
+    rested: list[bool] = []
+    at_rest = follow._at_rest
+
+    def spy(*args):  # type: ignore[no-untyped-def]
+        rested.append(at_rest(*args))
+        return rested[-1]
+
+    monkeypatch.setattr(follow, "_at_rest", spy)
+    batched = make_app("sandbox", 6, InputHub([]), {"puppets": 8})
+    monkeypatch.setattr(puppet_plugin, "brain_system", _one_by_one)
+    single = make_app("sandbox", 6, InputHub([]), {"puppets": 8})
+    for step in range(40):
+        batched.step()
+        single.step()
+        assert state_hash(batched.world) == state_hash(single.world), f"differs at step {step}"
+    assert rested and all(rested)
+
+
+def test_the_rest_shortcut_needs_every_number_at_plus_zero() -> None:
+    """-0.0, a tiny velocity or a bad stiffness is not rest (the spring step would change them)."""
+    from engine.statemachine.puppet.follow import _at_rest
+
+    z, h, w = np.zeros((4, 3)), np.zeros((4, 12, 3)), np.full(4, 40.0)
+    assert _at_rest(z, z, h, w, 1 / 60)
+    negative = z.copy()
+    negative[2, 1] = -0.0
+    assert not _at_rest(negative, z, h, w, 1 / 60)
+    assert not _at_rest(z, z + 1e-300, h, w, 1 / 60)
+    late = h.copy()
+    late[0, 0, 0] = 1e-9
+    assert not _at_rest(z, z, late, w, 1 / 60)
+    assert not _at_rest(z, z, h, np.array([40.0, np.nan, 40.0, 40.0]), 1 / 60)
+    assert not _at_rest(z, z, h, np.array([40.0, -1e9, 40.0, 40.0]), 1 / 60)

@@ -1,0 +1,78 @@
+"""Batches: the component lists of a query's entities, gathered once and kept until a structural change.
+
+A system over a crowd starts every step by gathering, puppet by puppet, the components it
+works on (``[world.get(e, Transform) for e in entities]``, one list per type). Between
+structural changes (a spawn, a despawn, a component added, removed or replaced) those
+lists are the same objects step after step, and gathering them again is Python work per
+puppet for nothing. :func:`batch` keeps them: it hands back the lists gathered last time
+for as long as the world's cached query results it was built from (the query of the
+required types, and one query per optional type) are still the very same list objects —
+the world drops those on every structural change that touches their types
+(:meth:`World.query`), so a kept batch can never be stale. The cache holds the query lists
+it compares against, so their ids are never reused while it keeps them.
+
+Only membership is cached: the values in the components are read fresh by the caller.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from engine.ecs import Entity, World
+
+__all__ = ["Batch", "Batches", "batch"]
+
+
+@dataclass(frozen=True)
+class Batch:
+    """The entities of a query and, per type, their components (``None`` where an optional one is missing).
+
+    Attributes:
+        entities: the entities having every required type, in entity order.
+        lists: one list per type, required types first, then the optional ones, row ``i`` for ``entities[i]``.
+        missing: per list, whether some entity lacks that component (its row is ``None``).
+    """
+
+    entities: list[Entity]
+    lists: tuple[list[Any], ...]
+    missing: tuple[bool, ...]
+
+
+class Batches:
+    """Resource: the kept batches, by key. Not simulation state (membership only, rebuilt on demand)."""
+
+    SIM_STATE = False
+
+    def __init__(self) -> None:
+        self._kept: dict[object, tuple[tuple[list[Any], ...], Batch]] = {}
+
+    def get(self, world: World, key: object, required: tuple[type, ...], optional: tuple[type, ...] = ()) -> Batch:
+        """The batch of ``required`` (with ``optional`` beside it) named ``key``, rebuilt if the world changed."""
+        sources = (world.query(*required), *(world.query(t) for t in optional))
+        kept = self._kept.get(key)
+        if kept is not None and len(kept[0]) == len(sources) and all(map(_same, kept[0], sources)):
+            return kept[1]
+        rows = sources[0]
+        entities = [r[0] for r in rows]
+        lists = [[r[k] for r in rows] for k in range(1, len(required) + 1)]
+        for t in optional:
+            store: Mapping[Entity, Any] = world.components(t)
+            lists.append([store.get(e) for e in entities])
+        made = Batch(entities, tuple(lists), tuple(any(c is None for c in comps) for comps in lists))
+        self._kept[key] = (sources, made)
+        return made
+
+
+def _same(a: object, b: object) -> bool:
+    return a is b
+
+
+def batch(world: World, key: object, required: tuple[type, ...], optional: tuple[type, ...] = ()) -> Batch:
+    """The world's kept batch named ``key`` (see the module docstring; the resource is inserted on first use)."""
+    found = world.try_resource(Batches)
+    if found is None:
+        found = Batches()
+        world.insert_resource(found)
+    return found.get(world, key, required, optional)
