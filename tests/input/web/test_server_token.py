@@ -13,15 +13,21 @@ from __future__ import annotations
 import contextlib
 import gc
 import inspect
+import ipaddress
+import json
 import socket
+import time
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
+from cryptography import x509
 
+from input.sample import PoseSample
 from input.web.cert import WebCertificate, load_or_create
 from input.web.server import DEFAULT_WEB_PORT, PAGE_FILES, WebSource
 
@@ -216,3 +222,53 @@ def test_a_port_that_cannot_be_bound_leaves_no_socket_open(certificate: WebCerti
         assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
     finally:
         first.stop()
+
+
+def _fill(src: WebSource, n: int) -> None:
+    sample = PoseSample(time=0.0, source="web:1", orientation=np.array([1.0, 0.0, 0.0, 0.0]))
+    for _ in range(n):
+        src.push(sample)
+
+
+def test_the_queue_holds_capacity_items(certificate: WebCertificate) -> None:
+    """A queue of 256 by default, ``capacity`` when given; beyond it the oldest go and are counted."""
+    for capacity, kwargs in ((256, {}), (4, {"capacity": 4})):
+        src = WebSource(port=0, certificate=certificate, **kwargs)  # type: ignore[arg-type]  # capacity: an int
+        _fill(src, capacity + 1)
+        assert src.status().drop_reasons == {"queue full": 1} and len(src.drain()) == capacity
+        src.stop()
+
+
+def test_the_given_certificate_and_clock_are_the_ones_used(certificate: WebCertificate) -> None:
+    def clock() -> float:
+        return 12.5
+
+    src = WebSource(port=0, certificate=certificate, clock=clock)
+    assert src.certificate is certificate and src.clock is clock
+    src.stop()
+    src = WebSource(port=0, certificate=certificate)
+    assert src.clock is time.monotonic
+    src.stop()
+
+
+def test_without_a_certificate_one_is_made_for_the_lan_addresses(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The user's certificate, made in ``$XDG_DATA_HOME`` on first use, names this machine's LAN address."""
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))
+    monkeypatch.setattr("input.pairing.lan_addresses", lambda: ["192.168.1.77"])
+    src = WebSource(port=0)
+    src.stop()
+    assert src.certificate.cert_path == tmp_path / "puppetphone" / "web" / "cert.pem"
+    cert = x509.load_pem_x509_certificate(src.certificate.cert_path.read_bytes())
+    alt = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+    assert ipaddress.ip_address("192.168.1.77") in alt.get_values_for_type(x509.IPAddress)
+
+
+def test_a_reading_is_queued_with_its_page_time(source: WebSource) -> None:
+    """What a connection does with one reading: a sample for its controller, the page's clock remembered."""
+    reading = {"seq": 0, "t": 1.5, "kind": "orientation", "o": [0.0, 10.0, 0.0], "touch": False}
+    assert source._handle(json.dumps(reading), "web:1", [240.0, 3.0], 3.0) is None
+    (sample,) = source.drain()
+    assert isinstance(sample, PoseSample) and sample.source == "web:1"
+    assert dict(source.page_times) == {sample.time: 1.5}
