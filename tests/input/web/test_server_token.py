@@ -272,3 +272,15 @@ def test_a_reading_is_queued_with_its_page_time(source: WebSource) -> None:
     (sample,) = source.drain()
     assert isinstance(sample, PoseSample) and sample.source == "web:1"
     assert dict(source.page_times) == {sample.time: 1.5}
+
+
+@pytest.mark.parametrize("token", ["XXXX", "t", "None"])
+def test_a_request_without_a_token_matches_no_session_token(certificate: WebCertificate, token: str) -> None:
+    """Whatever the session token is (any text the caller chose), leaving ``t`` out never equals it."""
+    src = WebSource(port=0, certificate=certificate, token=token)
+    try:
+        for route in GUARDED:
+            assert _is_refusal(_http(src, route)) and _is_refusal(_http(src, f"{route}?x={token}"))
+        assert _http(src, f"/ws?t={token}") is None
+    finally:
+        src.stop()
