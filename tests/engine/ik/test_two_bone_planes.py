@@ -5,7 +5,8 @@ millionths of its length; only a limb straight to that tolerance takes a plane o
 puppet of a batch decides that for itself. Shown to fail by mutation (docs/mutation.md, fifth round):
 the straight-limb threshold ``1e-6 · lab·lcb`` made ``1e-6 / (lab·lcb)`` or ``1e-6 · lab/lcb`` (the
 nearly straight leg bends sideways no more); the weak-fallback norm taken over the whole batch
-(``axis=None``, no axis: the arm along x stays straight and misses); ``quat.identity(*shape[:+2])``
+(``axis=None``, no axis: the arm along x stays straight and misses); the weak fallback's axis
+``[0, 0, 1]`` made ``[0, 1, 1]`` (the elbow leaves the forward plane); ``quat.identity(*shape[:+2])``
 for a chain from the root joint (a one-axis batch no longer broadcasts).
 """
 
@@ -59,7 +60,12 @@ def test_a_nearly_straight_leg_keeps_its_own_bend_plane() -> None:
 
 
 def test_each_puppet_of_a_batch_finds_its_own_fallback_plane() -> None:
-    """One arm held out along x (its first fallback plane is degenerate), one hanging straight down."""
+    """One arm held out along x (its first fallback plane is degenerate), one hanging straight down.
+
+    Without a pole a straight limb bends in the plane it makes with the forward axis z: the elbow
+    moves forward or back, never up, down or sideways (the fallback for the arm along x made
+    ``cross(c − a, [0, 1, 1])`` lifts the elbow out of that plane).
+    """
     sk = humanoid_skeleton()
     ia, ib, ic = (sk.index(j) for j in ARM)
     pose = Pose.rest(sk, 2)
@@ -74,6 +80,8 @@ def test_each_puppet_of_a_batch_finds_its_own_fallback_plane() -> None:
     after = world(sk, pose)
     np.testing.assert_allclose(after[:, ic], targets, atol=1e-9)
     assert np.all(np.linalg.norm(np.cross(c - a, after[:, ib] - a), axis=-1) > 1e-3)  # both bent
+    np.testing.assert_allclose(after[0, ib, 1], a[0, 1], atol=1e-9)  # the arm along x: elbow at shoulder height
+    np.testing.assert_allclose(after[1, ib, 0], a[1, 0], atol=1e-9)  # the hanging arm: no sideways move
 
 
 def test_a_chain_from_the_root_joint_solves_on_a_one_axis_batch() -> None:
