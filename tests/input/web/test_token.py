@@ -20,8 +20,13 @@ from input.web.server import WebSource
 
 
 @pytest.fixture(scope="module")
-def source(tmp_path_factory):
-    certificate = load_or_create(["192.168.1.20"], tmp_path_factory.mktemp("web"))
+def certificate(tmp_path_factory):
+    return load_or_create(["192.168.1.20"], tmp_path_factory.mktemp("web"))
+
+
+@pytest.fixture
+def source(certificate):
+    """A server per test (not per module): the mutation run then maps every test to the code it starts."""
     src = WebSource(port=0, certificate=certificate, token="s3cr3t-Session-Token").start()
     yield src
     src.stop()
