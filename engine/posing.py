@@ -95,8 +95,8 @@ def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
                 worlds=tuple(worlds[row[0]] for row in rows) if worlds else (),
             )
         )
-    puppets = [row[1] for row in table]
-    return FKPlan(table, posed, list(map(_SKELETON, puppets)), list(map(_OFFSETS, puppets)), groups)
+    everyone = [row[1] for row in table]
+    return FKPlan(table, posed, list(map(_SKELETON, everyone)), list(map(_OFFSETS, everyone)), groups)
 
 
 def _compiled(cols: Columns, group: _Group) -> bool:
@@ -105,10 +105,9 @@ def _compiled(cols: Columns, group: _Group) -> bool:
     joints = group.skeleton.num_joints
     roots = cols.get(LocalPose, "root", joints).linked(group.locals_)
     rots = cols.get(LocalPose, "rotations", joints).linked(group.locals_)
-    out = [cols.get(WorldPose, name, joints).linked(group.worlds) for name in _WORLD_FIELDS]
-    if roots is None or rots is None or any(o is None for o in out):
+    pos, rot, prev_pos, prev_rot = (cols.get(WorldPose, name, joints).linked(group.worlds) for name in _WORLD_FIELDS)
+    if roots is None or rots is None or pos is None or rot is None or prev_pos is None or prev_rot is None:
         return False
-    pos, rot, prev_pos, prev_rot = out
     if not (roots.flags.c_contiguous and rots.flags.c_contiguous and roots.dtype == rots.dtype == np.float64):
         return False
     np.copyto(prev_pos, pos)

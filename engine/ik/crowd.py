@@ -21,6 +21,7 @@ code, numba off) is left to the general path of :func:`engine.ik.system.ik_syste
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import repeat
 from operator import attrgetter, is_
@@ -82,7 +83,7 @@ def _plain(req: Any, settings: tuple[float, ...]) -> bool:
     )
 
 
-def _same_objects(a: list[Any], b: list[Any]) -> bool:
+def _same_objects(a: Sequence[Any], b: Sequence[Any]) -> bool:
     """``a[i] is b[i]`` for every ``i`` (equal lengths), in C."""
     return len(a) == len(b) and all(map(is_, a, b))
 
@@ -215,8 +216,12 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
     roots = cols.get(LocalPose, "root", joints).linked(plan.locals_)
     rots = cols.get(LocalPose, "rotations", joints).linked(plan.locals_)
     contacts = cols.get(FootLock, "contacts", legs).linked(locks)
-    state = [cols.get(FootLock, name, legs, _LOCK_TYPES.get(name, np.float64)).linked(locks) for name in _LOCK_STATE]
-    if roots is None or rots is None or contacts is None or any(s is None for s in state):
+    points, weights, planted, stepping, yaw, animated = (
+        cols.get(FootLock, name, legs, _LOCK_TYPES.get(name, np.float64)).linked(locks) for name in _LOCK_STATE
+    )
+    if roots is None or rots is None or contacts is None:
+        return False
+    if points is None or weights is None or planted is None or stepping is None or yaw is None or animated is None:
         return False
     count = len(reqs)
     weight = np.fromiter(map(_WEIGHT, reqs), dtype=np.float64, count=count)
@@ -238,7 +243,7 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
         sk.parents, roots, rots, plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
         sole, qfeet, ankles, hips, height, normal, weight,
         ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT, dt, plan.settings_array,
-        *state, contacts, settle, shift,
+        points, weights, planted, stepping, yaw, animated, contacts, settle, shift,
     )  # fmt: skip
     if not finite:
         raise ValueError("ground query returned non-finite values")
