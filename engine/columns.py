@@ -27,9 +27,8 @@ only as costly as the gather it replaces.
 
 from __future__ import annotations
 
-import operator
 from collections.abc import Sequence
-from operator import attrgetter
+from operator import attrgetter, is_
 from typing import Any
 
 import numpy as np
@@ -48,7 +47,7 @@ class Column:
         dtype: the array's type (a field of another type is converted when taken in).
     """
 
-    __slots__ = ("attr", "dtype", "_get", "_ids", "_owners", "_row", "base", "_views")
+    __slots__ = ("attr", "dtype", "_get", "_ids", "_owners", "_row", "base", "_views", "_whole")
 
     def __init__(self, attr: str, dtype: type = np.float64) -> None:
         self.attr = attr
@@ -59,14 +58,19 @@ class Column:
         self._row: dict[int, int] = {}
         self.base: NDArray[Any] | None = None
         self._views: list[NDArray[Any]] = []
+        self._whole: tuple[Any, ...] | None = None  # a tuple of owners last found to be the whole column
 
     def _rows(self, owners: Sequence[Any]) -> slice | list[int] | None:
         """Where ``owners`` are in the column: all of it in order (``slice(None)``), some of its rows,
         or ``None`` when one is not in it (or the rows are no views of the array: a copied world)."""
         if self.base is None or (self._views and self._views[0].base is not self.base):
             return None
+        if owners is self._whole:  # a tuple cannot have changed: no id to compare
+            return _ALL
         ids = list(map(id, owners))
         if ids == self._ids:
+            if isinstance(owners, tuple):
+                self._whole = owners
             return _ALL
         row = self._row
         try:
@@ -79,10 +83,10 @@ class Column:
         if ``take_in``; ``False`` (and nothing re-linked after it) if such a value has another shape."""
         owners, views = self._owners, self._views
         if rows is _ALL:
-            if all(map(operator.is_, map(self._get, owners), views)):
-                return True  # the common case, every field still its row: one C-level pass
+            if self._intact():
+                return True
         elif isinstance(rows, list) and all(
-            map(operator.is_, map(self._get, map(owners.__getitem__, rows)), map(views.__getitem__, rows))
+            map(is_, map(self._get, map(owners.__getitem__, rows)), map(views.__getitem__, rows))
         ):
             return True
         index = range(len(self._owners)) if rows is _ALL else rows
@@ -99,11 +103,16 @@ class Column:
             setattr(owners[i], self.attr, views[i])
         return True
 
+    def _intact(self) -> bool:
+        """Whether every owner's field is still the view of its row (one pass in C, no Python per row)."""
+        return all(map(is_, map(self._get, self._owners), self._views))
+
     def _link(self, owners: Sequence[Any], base: NDArray[Any]) -> NDArray[Any]:
         """Make ``base`` the column of ``owners`` and point every component's field at its row."""
         if base.ndim < 2:
             raise ValueError(f"a column holds array fields, one row each: {self.attr} has shape {base.shape[1:]}")
         self.base, self._owners, self._ids = base, list(owners), list(map(id, owners))
+        self._whole = None
         self._row = {k: i for i, k in enumerate(self._ids)}
         self._views = list(base)
         for owner, view in zip(owners, self._views, strict=True):
@@ -123,6 +132,14 @@ class Column:
             return self._link(owners, np.array([self._get(o) for o in owners], dtype=self.dtype))
         assert self.base is not None
         return self.base if rows is _ALL else self.base[rows]
+
+    def linked(self, owners: Sequence[Any]) -> NDArray[Any] | None:
+        """The column itself when it is the field of exactly ``owners``, in order, and no field was
+        replaced since; ``None`` otherwise (then :meth:`read` takes the fields in). A crowd in its usual
+        state is checked without Python per row, and a kernel may then update it in place."""
+        if self._rows(owners) is not _ALL or not self._intact():
+            return None
+        return self.base
 
     def write(self, owners: Sequence[Any], values: ArrayLike) -> None:
         """Set the field of every component of ``owners`` to its row of ``values`` ``[N, ...]`` (copied)."""

@@ -4,45 +4,152 @@ Puppets that share a hierarchy (the default humanoid, every snowman) are stacked
 into one array and go through :func:`engine.fk.forward_kinematics` together, so a
 hundred puppets cost one batched call per depth level, not a hundred FK passes.
 The previous world pose is kept for render interpolation.
+
+With numba (:mod:`engine.jit`) a crowd in its usual state costs no Python per puppet: the
+grouping is made once per membership (an :class:`FKPlan`, remade when the ECS hands out a
+new query result or a puppet's skeleton or offsets object changes), and when every pose is
+in its column (:meth:`engine.columns.Column.linked`) the compiled kernel
+(:func:`engine.fk.fk_kernel`, the arithmetic :func:`~engine.fk.forward_kinematics` runs)
+writes the world poses into their columns in place, after the last step's are copied aside.
 """
 
 from __future__ import annotations
 
-from engine.app import App
-from engine.columns import columns
-from engine.components import LocalPose, Puppet, WorldPose
-from engine.ecs import World
-from engine.fk import forward_kinematics
+from dataclasses import dataclass, field
+from itertools import repeat
+from operator import attrgetter, is_
+from typing import Any, ClassVar
 
-__all__ = ["fk_system", "install_fk"]
+import numpy as np
+
+from engine import jit
+from engine.app import App
+from engine.arrays import F64 as F
+from engine.columns import Columns, columns
+from engine.components import LocalPose, Puppet, WorldPose
+from engine.ecs import Entity, World
+from engine.fk import fk_kernel, forward_kinematics
+from engine.skeleton import Skeleton
+
+__all__ = ["FKPlan", "fk_system", "install_fk"]
+
+_SKELETON = attrgetter("skeleton")
+_OFFSETS = attrgetter("offsets")
+
+
+@dataclass
+class _Group:
+    """Puppets of one hierarchy, in entity order, with what their FK needs that does not change per step."""
+
+    key: bytes
+    skeleton: Skeleton
+    entities: list[Entity]
+    puppets: tuple[Puppet, ...]
+    locals_: tuple[LocalPose, ...]
+    offsets: F
+    worlds: tuple[WorldPose, ...] = ()
+
+
+@dataclass
+class FKPlan:
+    """Resource: the FK stage's grouping, kept while the world's queries return the same lists.
+
+    ``table``/``posed`` are the query results it was made for (``(Puppet, LocalPose)`` and the
+    same with ``WorldPose``; kept so their ids are not reused); ``skeletons``/``offset_fields``
+    every puppet's ``skeleton`` and ``offsets`` objects then."""
+
+    SIM_STATE: ClassVar[bool] = False
+    table: list[tuple[Any, ...]] = field(default_factory=list)
+    posed: list[tuple[Any, ...]] = field(default_factory=list)
+    skeletons: list[Skeleton] = field(default_factory=list)
+    offset_fields: list[Any] = field(default_factory=list)
+    groups: list[_Group] = field(default_factory=list)
+
+    def holds(self, table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> bool:
+        """Whether the plan still describes these query results (C-level passes over the puppets)."""
+        if table is not self.table or posed is not self.posed or len(posed) != len(table):
+            return False
+        puppets = [row[1] for row in table]
+        return all(map(is_, map(_SKELETON, puppets), self.skeletons)) and all(
+            map(is_, map(_OFFSETS, puppets), self.offset_fields)
+        )
+
+
+def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
+    """Group ``table``'s puppets by hierarchy; their world poses too if every puppet has one (``posed``)."""
+    by_key: dict[bytes, list[tuple[Any, ...]]] = {}
+    for row in table:
+        by_key.setdefault(row[1].skeleton.parents.tobytes(), []).append(row)
+    groups = []
+    worlds = {row[0]: row[3] for row in posed} if len(posed) == len(table) else {}
+    for key, rows in by_key.items():
+        puppets = tuple(row[1] for row in rows)
+        groups.append(
+            _Group(
+                key=key,
+                skeleton=puppets[0].skeleton,
+                entities=[row[0] for row in rows],
+                puppets=puppets,
+                locals_=tuple(row[2] for row in rows),
+                offsets=np.array([p.joint_offsets() for p in puppets], dtype=np.float64),
+                worlds=tuple(worlds[row[0]] for row in rows) if worlds else (),
+            )
+        )
+    everyone = [row[1] for row in table]
+    return FKPlan(table, posed, list(map(_SKELETON, everyone)), list(map(_OFFSETS, everyone)), groups)
+
+
+def _compiled(cols: Columns, group: _Group) -> bool:
+    """FK of ``group`` straight into its world poses' columns; ``False`` (nothing done) unless every
+    pose, local and world, is in its column and the local columns are C-contiguous doubles."""
+    joints = group.skeleton.num_joints
+    roots = cols.get(LocalPose, "root", joints).linked(group.locals_)
+    rots = cols.get(LocalPose, "rotations", joints).linked(group.locals_)
+    pos, rot, prev_pos, prev_rot = (cols.get(WorldPose, name, joints).linked(group.worlds) for name in _WORLD_FIELDS)
+    if roots is None or rots is None or pos is None or rot is None or prev_pos is None or prev_rot is None:
+        return False
+    if not (roots.flags.c_contiguous and rots.flags.c_contiguous and roots.dtype == rots.dtype == np.float64):
+        return False
+    np.copyto(prev_pos, pos)
+    np.copyto(prev_rot, rot)
+    fk_kernel(group.skeleton.parents, roots, rots, group.offsets, pos, rot)
+    return True
+
+
+_WORLD_FIELDS = ("positions", "rotations", "prev_positions", "prev_rotations")
 
 
 def fk_system(world: World) -> None:
     """Compute world joint transforms for every puppet with a ``LocalPose``."""
-    groups: dict[bytes, list[tuple[int, Puppet, LocalPose]]] = {}
-    for e, puppet, local in world.query(Puppet, LocalPose):
-        groups.setdefault(puppet.skeleton.parents.tobytes(), []).append((e, puppet, local))
+    table = world.query(Puppet, LocalPose)
+    posed = world.query(Puppet, LocalPose, WorldPose)
+    plan = world.try_resource(FKPlan)
+    if plan is None or not plan.holds(table, posed):
+        plan = _plan(table, posed)
+        world.insert_resource(plan)
     cols = columns(world)
     world_poses = world.components(WorldPose)
-    for key, members in groups.items():
-        skeleton = members[0][1].skeleton
+    for group in plan.groups:
+        if group.worlds and jit.enabled() and _compiled(cols, group):
+            continue
+        skeleton = group.skeleton
         joints = skeleton.num_joints
-        locals_ = [m[2] for m in members]
+        locals_ = group.locals_
         roots = cols.get(LocalPose, "root", joints).read(locals_)
         rots = cols.get(LocalPose, "rotations", joints).read(locals_)
-        offsets = cols.stacked(("offsets", key))([m[1].joint_offsets() for m in members])
+        offsets = cols.stacked(("offsets", group.key))([p.joint_offsets() for p in group.puppets])
         pos, rot = forward_kinematics(skeleton, roots, rots, offsets)
-        poses = [world_poses.get(e) for e, _, _ in members]
-        if None in poses:  # a puppet's first pose
-            for k, (e, _, _) in enumerate(members):
+        poses = [world_poses.get(e) for e in group.entities]
+        if any(map(is_, poses, repeat(None))):  # a puppet's first pose
+            for k, e in enumerate(group.entities):
                 if poses[k] is None:
                     world.add(e, WorldPose(pos[k], rot[k], pos[k].copy(), rot[k].copy()))
-            poses = [world_poses[e] for e, _, _ in members]
+            poses = [world_poses[e] for e in group.entities]
         # The previous step is kept for render interpolation: copied into its own columns, as
         # this step's values are written over the last step's in place.
-        for field in ("positions", "rotations"):
-            now = cols.get(WorldPose, field, joints)
-            cols.get(WorldPose, f"prev_{field}", joints).write(poses, now.read(poses))
+        for name in ("positions", "rotations"):
+            now = cols.get(WorldPose, name, joints)
+            cols.get(WorldPose, f"prev_{name}", joints).write(poses, now.read(poses))
         cols.get(WorldPose, "positions", joints).write(poses, pos)
         cols.get(WorldPose, "rotations", joints).write(poses, rot)
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -49,6 +50,8 @@ from engine.arrays import F64 as F
 GroundQuery = Callable[[F, F], tuple[F, F]]
 _UP = (0.0, 1.0, 0.0)
 _STILL = 0.1  # m/s: an animated toe slower than this has found its standing place
+#: The defaults of :func:`ground_feet` / :func:`ground_feet_batch` (the crowd pass of :mod:`engine.ik.crowd` uses them).
+ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT = 0.25, 0.03, 0.5
 
 
 @dataclass(frozen=True)
@@ -58,13 +61,18 @@ class PlaneGround:
     point: tuple[float, float, float] = (0.0, 0.0, 0.0)
     normal: tuple[float, float, float] = (0.0, 1.0, 0.0)
 
-    def __call__(self, x: ArrayLike, z: ArrayLike) -> tuple[F, F]:
-        """Height ``[...]`` and unit normal ``[...,3]`` under ``(x, z)``."""
+    @cached_property
+    def frame(self) -> tuple[F, F]:
+        """``(point, unit normal)`` as arrays (made once: a crowd asks every step)."""
         n = np.asarray(self.normal, dtype=np.float64)
         n = n / np.linalg.norm(n)
         if n[1] < 1e-6:
             raise ValueError("ground plane must not be vertical")
-        p = np.asarray(self.point, dtype=np.float64)
+        return np.asarray(self.point, dtype=np.float64), n
+
+    def __call__(self, x: ArrayLike, z: ArrayLike) -> tuple[F, F]:
+        """Height ``[...]`` and unit normal ``[...,3]`` under ``(x, z)``."""
+        p, n = self.frame
         x, z = np.asarray(x, dtype=np.float64), np.asarray(z, dtype=np.float64)
         h = p[1] - (n[0] * (x - p[0]) + n[2] * (z - p[2])) / n[1]
         return h, np.broadcast_to(n, h.shape + (3,)).copy()
@@ -317,9 +325,9 @@ def ground_feet(
     legs: tuple[Leg, ...] = HUMANOID_LEGS,
     *,
     offsets: ArrayLike | None = None,
-    align_height: float = 0.25,
-    contact_height: float = 0.03,
-    max_pelvis_shift: float = 0.5,
+    align_height: float = ALIGN_HEIGHT,
+    contact_height: float = CONTACT_HEIGHT,
+    max_pelvis_shift: float = MAX_PELVIS_SHIFT,
     weight: float = 1.0,
     lock: FootLock | None = None,
     dt: float = 0.0,
@@ -402,9 +410,9 @@ def ground_feet_batch(
     legs: tuple[Leg, ...] = HUMANOID_LEGS,
     *,
     offsets: ArrayLike | None = None,
-    align_height: float = 0.25,
-    contact_height: float = 0.03,
-    max_pelvis_shift: float = 0.5,
+    align_height: float = ALIGN_HEIGHT,
+    contact_height: float = CONTACT_HEIGHT,
+    max_pelvis_shift: float = MAX_PELVIS_SHIFT,
     weight: ArrayLike = 1.0,
     locks: Sequence[FootLock | None] | None = None,
     dt: float = 0.0,

@@ -7,7 +7,9 @@ stage, after blending and before physics, and edits the puppet's
 optimisation IK's arbitrary targets first, then foot grounding (it moves the
 pelvis), then the hands (they follow the shoulders wherever the pelvis went).
 Groups of :data:`BATCH` or more alike puppets that only need their feet planted (a
-crowd) are grounded together as arrays (:func:`~engine.ik.grounding.ground_feet_batch`).
+crowd) are grounded together as arrays (:func:`~engine.ik.grounding.ground_feet_batch`);
+the largest such group, in its usual state, by the crowd pass (:mod:`engine.ik.crowd`),
+with no Python per puppet.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from engine.columns import columns
 from engine.components import LocalPose, Puppet
 from engine.ecs import World
 from engine.humanoid import JOINTS
+from engine.ik.crowd import CrowdPlan, current_plan, ground_crowd
 from engine.ik.foot_lock import FootLock
 from engine.ik.grounding import GroundQuery, PlaneGround, ground_feet, ground_feet_batch
 from engine.ik.hands import hands_on_sphere
@@ -78,6 +81,7 @@ class IKRigCache:
     rigs: dict[int, IKRig] = field(default_factory=dict)
     canonical: dict[int, Skeleton] = field(default_factory=dict)
     batch_from: int = BATCH  # alike puppets from which grounding is batched (benches raise it to compare)
+    crowd: CrowdPlan | None = None  # who the crowd pass serves (engine.ik.crowd), remade when that changes
 
     def rig(self, skeleton: Skeleton) -> IKRig:
         """The rig of ``skeleton``: the humanoid preset for the default puppet, ball joints otherwise."""
@@ -166,7 +170,16 @@ def ik_system(world: World) -> None:
     if cache is None:
         cache = IKRigCache()
         world.insert_resource(cache)
-    rows = [(puppet, local, req) for _, puppet, local, req in world.query(Puppet, LocalPose, IKRequest)]
+    table = world.query(Puppet, LocalPose, IKRequest)
+    cache.crowd = plan = current_plan(cache.crowd, table, cache.same_as, cache.batch_from)
+    query = ground.query if ground is not None else PlaneGround()
+    if ground_crowd(plan, columns(world), query, world.dt):
+        if len(plan.rows) == len(table):
+            return
+        crowd = set(plan.rows)
+        rows = [(row[1], row[2], row[3]) for i, row in enumerate(table) if i not in crowd]
+    else:
+        rows = [(puppet, local, req) for _, puppet, local, req in table]
     done = _ground_batches(world, rows, cache)
     for puppet, local, req in rows:
         if id(req) in done:

@@ -122,3 +122,30 @@ def test_the_world_resource_is_made_once_and_never_hashed() -> None:
     assert columns(world) is cols and cols.get(_Pose, "root", 3) is cols.get(_Pose, "root", 3)
     assert cols.get(_Pose, "root", 3) is not cols.get(_Pose, "root", 4)
     assert Columns.SIM_STATE is False
+
+
+def test_linked_is_the_column_only_while_it_is_exactly_the_owners_fields() -> None:
+    """Broken once by letting :meth:`Column.linked` skip the check of replaced fields (the second
+    assertion fails: a kernel would have written into a row no component shows)."""
+    poses = tuple(_poses(3))
+    col = Column("root")
+    col.write(poses, np.ones((3, 3)))
+    assert col.linked(poses) is col.base and col.linked(list(poses)) is col.base
+    poses[1].root = np.zeros(3)  # other code replaced one field
+    assert col.linked(poses) is None
+    col.read(poses)  # taken in and linked again
+    assert col.linked(poses) is col.base
+    assert col.linked(poses[:2]) is None and col.linked(poses[::-1]) is None  # part, or another order
+
+
+def test_a_tuple_of_owners_seen_whole_is_known_again_without_ids() -> None:
+    """The tuple fast path of ``_rows`` must not outlive a rebuilt column (broken once by not
+    clearing it in ``_link``: the old tuple was then taken for the new batch)."""
+    poses = tuple(_poses(3))
+    col = Column("root")
+    col.write(poses, np.ones((3, 3)))
+    assert col.linked(poses) is col.base  # seen whole: remembered
+    others = _poses(2)
+    col.write(others, np.zeros((2, 3)))  # another batch: the column is rebuilt
+    assert col.linked(poses) is None
+    assert np.array_equal(col.read(poses), np.ones((3, 3)))  # gathered from the fields again

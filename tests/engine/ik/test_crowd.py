@@ -1,0 +1,123 @@
+"""The IK stage's crowd pass (:mod:`engine.ik.crowd`) against the general path it stands in for.
+
+A crowd of 24 puppets is stepped through the ``ik`` stage while its poses and contact votes
+change as the animation stage would write them (through the columns), and while members
+leave and rejoin (a jump), have a lock field replaced, get hands on a sphere or lose their
+contacts. With the crowd pass and with it switched off (every step on the general path that
+:func:`~engine.ik.grounding.ground_feet_batch` serves) every pose, lock state, pelvis shift
+and state hash must be equal bit for bit; against the pure-numpy path (numba off) to 1e-9.
+Broken once by skipping the foot locks in ``_ground_kernel.ground_crowd``: the rotations
+then differ from the general path's at the first served step.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+import engine.ik.system as system
+from engine import jit, quat
+from engine.app import App
+from engine.columns import columns
+from engine.components import LocalPose, Puppet
+from engine.hashing import state_hash
+from engine.humanoid import humanoid_skeleton
+from engine.ik import IKGround, IKRequest, PlaneGround, install_ik
+from engine.ik.foot_lock import FootLock
+
+N = 24
+STEPS = 14
+
+
+def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], list[int]]:
+    """Step the crowd; ``mode``: ``crowd`` (the pass), ``general`` (pass off), ``numpy`` (numba off).
+    Returns each step's state and the steps the crowd pass served."""
+    served: list[int] = []
+    original = system.ground_crowd
+
+    def counted(*args: Any) -> bool:
+        done = mode == "crowd" and original(*args)
+        if done:
+            served.append(len(out))
+        return done
+
+    monkeypatch.setattr(system, "ground_crowd", counted)
+    rng = np.random.default_rng(4)
+    app = App(seed=1, plugins=[install_ik])
+    app.world.insert_resource(IKGround(ground))
+    sk = humanoid_skeleton()
+    ents = []
+    for i in range(N):
+        offsets = sk.offsets * (1.0 + 0.1 * (i % 3)) if i % 4 == 0 else None
+        pose = LocalPose(np.array([rng.uniform(-3, 3), 0.95, rng.uniform(-3, 3)]), quat.identity(17))
+        ents.append(app.world.spawn(Puppet(sk, offsets), pose, IKRequest(grounding=True)))
+    world = app.world
+    reqs = [world.get(e, IKRequest) for e in ents]
+    poses = [world.get(e, LocalPose) for e in ents]
+    out: list[Any] = []
+    with jit.use(mode != "numpy"):
+        for step in range(STEPS):
+            cols = columns(world)
+            roots = np.array([p.root for p in poses]) + rng.normal(0, 0.01, (N, 3))
+            rots = quat.normalize(quat.identity(N, 17) + rng.normal(0, 0.08, (N, 17, 4)))
+            cols.get(LocalPose, "root", 17).write(poses, roots)
+            cols.get(LocalPose, "rotations", 17).write(poses, rots)
+            contacts = rng.uniform(0, 1, (N, 2))
+            locks = [r.foot_lock for r in reqs]
+            for lock, settle in zip(locks, rng.uniform(0, 1, N) < 0.3, strict=True):
+                lock.settle = bool(settle)
+            cols.get(FootLock, "contacts", 2).write(locks, contacts)
+            if step == 3:
+                reqs[5].grounding = False  # a jump: the crowd goes on without it
+            if step == 6:
+                reqs[5].grounding = True
+            if step == 8:
+                reqs[7].foot_lock.yaw = np.array([0.3, -0.2])  # other code replaced a lock field
+            if step == 10:
+                reqs[9].sphere_centre, reqs[9].sphere_radius = np.array([0.0, 0.85, 0.45]), 0.2
+            if step == 11:
+                reqs[9].sphere_centre = None
+                reqs[2].foot_lock.contacts = None
+            app.step()
+            out.append(
+                (
+                    np.array([p.root for p in poses]),
+                    np.array([p.rotations for p in poses]),
+                    np.array([r.pelvis_shift for r in reqs]),
+                    np.array([r.foot_lock.points for r in reqs]),
+                    np.array([r.foot_lock.weights for r in reqs]),
+                    np.array([r.foot_lock.planted for r in reqs]),
+                    state_hash(world),
+                )
+            )
+    return out, served
+
+
+@pytest.mark.skipif(not jit.AVAILABLE, reason="numba not installed: there is no crowd pass")
+@pytest.mark.parametrize(
+    "ground",
+    [PlaneGround(normal=(0.1, 1.0, -0.2)), PlaneGround(), None],
+    ids=["slope", "flat", "heightfield"],
+)
+def test_the_crowd_pass_is_the_general_path_bit_for_bit(ground: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    if ground is None:
+        from engine.ik.grounding import HeightfieldGround
+
+        ground = HeightfieldGround(np.random.default_rng(9).uniform(-0.1, 0.1, (16, 16)), 0.5, -4, -4)
+    crowd, served = _run("crowd", ground, monkeypatch)
+    general, none = _run("general", ground, monkeypatch)
+    numpy_path, _ = _run("numpy", ground, monkeypatch)
+    # Served but where it must stand aside: at the start (no lock state in columns yet), while
+    # one puppet is in the air (3-5: the crowd is not the animation's whole batch), when the
+    # jumper rejoins with its reset lock (6), a lock field was replaced (8), a member has hands
+    # on a sphere (10) or no contact votes (11 on). The step after each, it serves again.
+    assert none == [] and served == [1, 2, 7, 9]
+    for a, b, c in zip(crowd, general, numpy_path, strict=True):
+        for x, y in zip(a[:-1], b[:-1], strict=True):
+            np.testing.assert_array_equal(x, y)
+        assert a[-1] == b[-1]
+        for x, z in zip(a[:-2], c[:-2], strict=True):
+            np.testing.assert_allclose(x, z, atol=1e-9)
+        np.testing.assert_array_equal(a[-2], c[-2])
