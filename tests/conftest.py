@@ -228,9 +228,9 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Tests marked ``slow`` run first, in their collected order, the rest after them as collected.
+    """Tests marked ``slow`` (tens of seconds or more) run first, in their collected order, the rest after them.
 
-    Under xdist each of the few tests of a minute or more then starts while the short ones still
+    Under xdist each of those long tests then starts while the short ones still
     fill the other workers, instead of one of them starting near the end and keeping a worker
     busy alone after the rest are done. Every worker collects, and so sorts, the same way."""
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
