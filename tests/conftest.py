@@ -6,8 +6,10 @@ import importlib.metadata
 import importlib.util
 import os
 import pickle
+import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -176,22 +178,62 @@ def _compile_kernels_once(config: pytest.Config) -> None:
     if importlib.util.find_spec("numba") is None or _kernel_caches_fresh():
         return
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
+    # Both at once, one per core: numba's cache takes concurrent writers, and the wait before the
+    # first test is the longer of the two instead of their sum.
+    runs = []
     for args in (["sandbox", "--puppets", "4", "--frames", "30"], ["snowman", "--frames", "2"]):
         cmd = [sys.executable, "-m", "puppetphone", "play", *args, "--headless"]
-        done = subprocess.run(cmd, env=env, cwd=_ROOT, capture_output=True, text=True, check=False)
-        if done.returncode != 0:
-            raise pytest.UsageError(f"compiling the kernels failed: {' '.join(cmd)}\n{done.stderr}")
+        runs.append((cmd, subprocess.Popen(cmd, env=env, cwd=_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)))
+    for cmd, run in runs:
+        _, err = run.communicate()
+        if run.returncode != 0:
+            raise pytest.UsageError(f"compiling the kernels failed: {' '.join(cmd)}\n{err.decode(errors='replace')}")
+
+
+# -- the user's cache ---------------------------------------------------------------------------
+# The code keeps derived data (lookup tables, built-in clips, SEcurves) in $XDG_CACHE_HOME/puppetphone.
+# A test run must neither write the real user's cache nor pass because of what an older run left
+# there, so the session gets a fresh one, shared by its workers and removed at the end, unless the
+# environment already names one (a CI that gives the run a cache folder of its own). The glTF
+# validator that .ci/run installs into the real cache is still found there ($PUPPETPHONE_NPM).
+_SESSION_CACHE = "PUPPETPHONE_TEST_SESSION_CACHE"  # set while the session's own cache is in use
+
+
+def _own_cache_folder(config: pytest.Config) -> None:
+    """Point ``$XDG_CACHE_HOME`` at a fresh folder for the session (the controller's; workers inherit it)."""
+    if hasattr(config, "workerinput") or os.environ.get("XDG_CACHE_HOME"):
+        return
+    os.environ.setdefault("PUPPETPHONE_NPM", str(Path.home() / ".cache" / "puppetphone" / "npm"))
+    folder = tempfile.mkdtemp(prefix="puppetphone-test-cache-")
+    os.environ["XDG_CACHE_HOME"] = os.environ[_SESSION_CACHE] = folder
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """The session's own cache folder goes with the session."""
+    folder = os.environ.get(_SESSION_CACHE)
+    if folder and not hasattr(config, "workerinput"):
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """Kernels compiled once; ``pytest -m fuzz``: the fuzz tests only, each a long campaign
+    """The session's own cache folder; kernels compiled once; ``pytest -m fuzz``: the fuzz tests only, each a long campaign
     (50,000 cases, a fresh seed)."""
+    _own_cache_folder(config)
     _compile_kernels_once(config)
     if "fuzz" in (config.option.markexpr or "") and "not fuzz" not in config.option.markexpr:
         settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "fuzz"))
         os.environ.setdefault("FUZZ_CASES", "50000")
         os.environ.setdefault("FUZZ_SEED", str(int.from_bytes(os.urandom(4), "little")))
         print(f"fuzz campaign: {os.environ['FUZZ_CASES']} byte mutations per format, seed {os.environ['FUZZ_SEED']}")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Tests marked ``slow`` (tens of seconds or more) run first, in their collected order, the rest after them.
+
+    Under xdist each of those long tests then starts while the short ones still
+    fill the other workers, instead of one of them starting near the end and keeping a worker
+    busy alone after the rest are done. Every worker collects, and so sorts, the same way."""
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
 class CaseTimeout(BaseException):

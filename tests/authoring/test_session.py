@@ -25,6 +25,7 @@ def test_every_registered_tool_has_a_run():
     assert set(RUNS) == set(TOOLS)
 
 
+@pytest.mark.slow  # the flow scene's SEcurve search runs twice (record, replay): ~25 s of CPU
 @pytest.mark.parametrize("tool", sorted(RUNS))
 def test_tool_session_records_and_replays(tool, tmp_path, capsys):
     rec = tmp_path / f"{tool}.rec"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import pytest
 
 from authoring.flowcurves.background import BackgroundSession
 from authoring.flowcurves.session import FlowSession
@@ -12,6 +13,7 @@ from authoring.flowcurves.session import FlowSession
 from .conftest import tree_scene
 
 
+@pytest.mark.slow  # the tree's SEcurve search in a child process
 def test_the_background_search_finds_the_same_securves_and_reports_progress(tree_securves):
     scene = tree_scene()
     seen = []

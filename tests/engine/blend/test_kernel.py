@@ -49,6 +49,7 @@ def _crowd(compiled: bool, steps: int):  # type: ignore[no-untyped-def]
     return out
 
 
+@pytest.mark.slow  # 24 puppets stepped 40 times on each path
 def test_the_compiled_animation_agrees_with_numpy_step_by_step() -> None:
     a, b = _crowd(False, 40), _crowd(True, 40)
     for step_a, step_b in zip(a, b, strict=True):

@@ -102,6 +102,7 @@ def _check_motion(text: bytes) -> None:
     assert 0 < m.frame_time <= 10
 
 
+@pytest.mark.slow  # 1200 parses under tracemalloc: ~15 s of CPU
 def test_fuzz_bvh_bytes(campaign, mutations, fuzz_budget, mocap_dir):
     cases, seed = fuzz_budget(1200)
     c = campaign(BvhError)

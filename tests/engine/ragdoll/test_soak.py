@@ -16,6 +16,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from engine.app import App
 from engine.components import LocalPose, Transform
@@ -82,6 +83,7 @@ def _check(app: App, since: dict[int, tuple[str, float]]) -> None:
         assert brain.active == "Locomotion" or w.time - start < STUCK, (e, brain.active)
 
 
+@pytest.mark.slow  # the suite's longest: 700 steps of 34 ragdoll puppets after the pile (~0.2 s of CPU each)
 def test_rough_play_never_breaks_the_physics() -> None:
     rng = np.random.default_rng(17)
     app = App(seed=17)
