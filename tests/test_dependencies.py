@@ -78,5 +78,5 @@ def test_readme_and_ci_install_with_the_constraints() -> None:
     assert "grep -m1 -E \"^pip install -e '\\.\\[test\\]'\" README.md" in ci
     assert "PUPPETPHONE_STRICT_SKIPS=1" in ci
     # the side environments, installed from a copy of the checkout: pose tests and the FK peer; the floors
-    assert 'pip install -q --no-compile -e "$side/src[test,pose,peers]" -c constraints.txt' in ci
-    assert 'pip install -q --no-compile -e "$side/src[test]" -c constraints-floor.txt' in ci
+    assert 'pip install -q -e "$side/src[test,pose,peers]" -c constraints.txt' in ci
+    assert 'pip install -q -e "$side/src[test]" -c constraints-floor.txt' in ci
