@@ -1,13 +1,14 @@
-"""A flood from loopback while a phone plays 600 paced steps: the phone still drives, the flood is counted.
+"""A flood from loopback while a phone sends 900 readings at 60 Hz: they reach the steps, the flood is counted.
 
 The flood is what the issue's campaign found expensive: 62 KB bundles of poses, 8 KB
 bundles of 64 messages that do get parsed, nested bundles and garbage, from two other
 loopback addresses (127.0.0.2, 127.0.0.3) that stay *candidates* (``max_senders=3``), so
 their datagrams are not refused as locked out but reach the size checks and the decoder.
 
-Asserted on counts only (issue 37): 600 steps, not "10 s of wall clock", and no steps-per-second
-floor (it failed at 53.3 steps/s on a loaded machine); the rate is printed for the log. The flood
-runs until the steps are done and is then stopped, so it covers every step whatever the machine's load.
+Asserted on counts only (issue 37): the phone's readings that reached a step against the number it sent,
+not "10 s of wall clock", nor steps that saw the phone, nor a steps-per-second floor (each failed on a
+loaded machine). The flood runs until the phone has sent everything and is then stopped, so it covers
+every reading whatever the machine's load.
 """
 
 from __future__ import annotations
@@ -31,12 +32,13 @@ from input.sample import InputFrame
 PHONE = textwrap.dedent("""
     import math, socket, sys, time
     from pythonosc.osc_message_builder import OscMessageBuilder
-    port, seconds = int(sys.argv[1]), float(sys.argv[2])
+    port, count = int(sys.argv[1]), int(sys.argv[2])
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.bind(("127.0.0.1", 0))
     t0 = time.perf_counter()
     i = 0
-    while (t := time.perf_counter() - t0) < seconds:
+    while i < count:
+        t = time.perf_counter() - t0
         yaw = 0.8 * math.sin(2 * math.pi * t / 4)   # sweep left and right every 4 s
         b = OscMessageBuilder("/puppetphone/orientation")
         for v in (math.cos(yaw / 2), 0.0, math.sin(yaw / 2), 0.0):
@@ -44,6 +46,7 @@ PHONE = textwrap.dedent("""
         sock.sendto(b.build().dgram, ("127.0.0.1", port))
         i += 1
         time.sleep(max(0.0, t0 + i / 60 - time.perf_counter()))
+    print(i)
 """)
 
 FLOOD = textwrap.dedent("""
@@ -84,63 +87,73 @@ FLOOD = textwrap.dedent("""
 FLOOD_RATE = 4000  # datagrams/s, a quarter of them 62 KB: ~70 MB/s, more than a LAN delivers to a laptop
 
 
-STEPS = 600
+PHONE_READINGS = 900  # 15 s at 60 Hz: admission, the flood's start, then ~12 s of steps under the flood
 
 
 def _drops(src: OscSource) -> int:
     return sum(src.status().drop_reasons.values())
 
 
-def test_a_flood_leaves_the_phone_driving_every_step():
+def test_a_flood_loses_few_of_the_phones_readings_and_the_phone_still_steers():
+    """Counted against what the phone sent, not against steps or wall time: a starved phone process sends late,
+    not less, so a loaded machine no longer fails it (at load 24 the old "phone in ≥ 60 % of steps" saw 325/600)."""
     src = OscSource(host="127.0.0.1", port=0, max_senders=3)
     hub = InputHub([src]).start()
     app = App(seed=0)
     install_input(app, hub)
     GAME.install(app)
-    phone = subprocess.Popen([sys.executable, "-c", PHONE, str(src.port), "600"])
+    phone = subprocess.Popen(
+        [sys.executable, "-c", PHONE, str(src.port), str(PHONE_READINGS)], stdout=subprocess.PIPE, text=True
+    )
     flood = None
+    pacer = RealTimePacer(app.world.dt)
+    received, headings, drops_by_step = 0, [], []
+
+    def step() -> None:
+        nonlocal received
+        pacer.wait()
+        app.step()
+        received += len(app.world.resource(InputFrame).samples_of("osc:127.0.0.1"))
+
     try:
         end = time.monotonic() + 30
         while app.world.query(Stick)[0][1].source != "osc:127.0.0.1" and time.monotonic() < end:
-            app.step()
-            time.sleep(1 / 60)
+            step()
         assert app.world.query(Stick)[0][1].source == "osc:127.0.0.1", "the phone was not admitted"
         flood = subprocess.Popen(
             [sys.executable, "-c", FLOOD, str(src.port), "600", str(FLOOD_RATE)], stdout=subprocess.DEVNULL
         )
         end = time.monotonic() + 30
         while _drops(src) < 200 and time.monotonic() < end:  # the flood is under way
-            time.sleep(0.05)
+            step()
         assert _drops(src) >= 200, "the flood never reached the decoder"
-        pacer = RealTimePacer(app.world.dt)
-        with_phone, headings, late_drops = 0, [], 0
-        t0 = time.perf_counter()
-        for step in range(STEPS):
-            pacer.wait()
-            app.step()
-            frame = app.world.resource(InputFrame)
-            with_phone += frame.latest("osc:127.0.0.1") is not None
+        end = time.monotonic() + 300  # a deadline, not an assertion: the phone ends after its readings
+        while phone.poll() is None and time.monotonic() < end:
+            step()
             d = app.world.query(Stick)[0][1].direction
             headings.append(float(np.arctan2(d[0], d[2])))
-            if step == STEPS - 60:
-                late_drops = _drops(src)
-        rate = STEPS / (time.perf_counter() - t0)
-        assert flood.poll() is None and _drops(src) > late_drops, "the flood stopped before the last second of steps"
+            drops_by_step.append(_drops(src))
+        assert phone.poll() is not None, "the phone did not end"
+        sent = int(phone.communicate()[0])
+        for _ in range(30):  # what the hub still holds
+            step()
+        assert len(drops_by_step) > 60, "the phone had ended before the flood was under way"
+        assert flood.poll() is None and _drops(src) > drops_by_step[-60], "the flood stopped before the phone did"
     finally:
         if flood is not None:
             flood.kill()
             flood.wait(5)
-        phone.kill()
-        phone.wait(5)
+        if phone.poll() is None:
+            phone.kill()
+        phone.communicate(timeout=5)  # reaps it and closes its pipe
         hub.close()
     st = src.status()
     print(
-        f"flood: {STEPS} steps at {rate:.1f} steps/s (not asserted), phone samples in {with_phone}/{STEPS} steps, "
+        f"flood: {received}/{sent} phone readings reached the steps over {len(headings)} flooded steps, "
         f"drops {st.drop_reasons}"
     )
-    # The phone's 60 Hz stream still reaches most steps (steps without one are clock jitter; before
-    # the size and budget checks, a receiver busy decoding let 1 step in 100 see the phone).
-    assert with_phone >= 0.6 * STEPS
+    # Before the size and budget checks, a receiver busy decoding let 1 step in 100 see the phone.
+    assert received >= 0.9 * sent
     assert max(headings) > 0.6 and min(headings) < -0.6  # and its sweep still turns the stick
     for reason in ("oversize packet", "bundle too deep", "over budget", "non-unit quaternion"):
         assert st.drop_reasons.get(reason, 0) > 100, reason
