@@ -35,7 +35,9 @@ __all__ = [
     "qmul",
     "qnormalize",
     "qrot",
+    "qarc",
     "qslerp",
+    "qslerp_arc",
     "use",
     "vcross",
     "vdot",
@@ -159,20 +161,37 @@ def qaxis_angle(axis: tuple[float, float, float], angle: float) -> tuple[float, 
 
 
 @njit
-def qslerp(
-    a: tuple[float, float, float, float], b: tuple[float, float, float, float], t: float
-) -> tuple[float, float, float, float]:
-    """Spherical interpolation along the shorter arc (:func:`engine.quat.slerp`)."""
+def qarc(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
+) -> tuple[tuple[float, float, float, float], float, float]:
+    """The part of :func:`qslerp` that depends only on its ends: ``b`` in ``a``'s hemisphere, the angle
+    between them and its sine (a crowd's kernel computes it once per pair of clip frames)."""
     if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0:
         b = (-b[0], -b[1], -b[2], -b[3])
     d = min(max(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], -1.0), 1.0)
     theta = math.acos(d)
-    s = math.sin(theta)
+    return b, theta, math.sin(theta)
+
+
+@njit
+def qslerp_arc(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float], theta: float, s: float, t: float
+) -> tuple[float, float, float, float]:
+    """The rest of :func:`qslerp` from :func:`qarc`'s answer: the point at ``t`` on the arc."""
     if s < 1e-6:
         wa, wb = 1.0 - t, t
     else:
         wa, wb = math.sin((1.0 - t) * theta) / s, math.sin(t * theta) / s
     return qnormalize((wa * a[0] + wb * b[0], wa * a[1] + wb * b[1], wa * a[2] + wb * b[2], wa * a[3] + wb * b[3]))
+
+
+@njit
+def qslerp(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float], t: float
+) -> tuple[float, float, float, float]:
+    """Spherical interpolation along the shorter arc (:func:`engine.quat.slerp`)."""
+    b, theta, s = qarc(a, b)
+    return qslerp_arc(a, b, theta, s, t)
 
 
 @njit

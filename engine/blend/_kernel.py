@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.blend.space import BlendSpace
-from engine.jit import njit, qmul, qnormalize
+from engine.jit import njit, qarc, qmul, qnormalize, qslerp_arc
 
 __all__ = ["Packed", "packed", "place", "play"]
 
@@ -54,40 +54,15 @@ _CACHE: dict[int, tuple[BlendSpace, Packed | None]] = {}
 
 
 @njit
-def _arc(
-    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
-) -> tuple[tuple[float, float, float, float], float, float]:
-    """The part of :func:`~engine.jit.qslerp` that depends only on its ends: ``b`` in ``a``'s hemisphere,
-    the angle between them and its sine. Same operations, so :func:`_slerp_arc` after it is ``qslerp``."""
-    if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0.0:
-        b = (-b[0], -b[1], -b[2], -b[3])
-    d = min(max(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], -1.0), 1.0)
-    theta = math.acos(d)
-    return b, theta, math.sin(theta)
-
-
-@njit
-def _slerp_arc(
-    a: tuple[float, float, float, float], b: tuple[float, float, float, float], theta: float, s: float, t: float
-) -> tuple[float, float, float, float]:
-    """The rest of :func:`~engine.jit.qslerp` from :func:`_arc`'s answer: the point at ``t`` on the arc."""
-    if s < 1e-6:
-        wa, wb = 1.0 - t, t
-    else:
-        wa, wb = math.sin((1.0 - t) * theta) / s, math.sin(t * theta) / s
-    return qnormalize((wa * a[0] + wb * b[0], wa * a[1] + wb * b[1], wa * a[2] + wb * b[2], wa * a[3] + wb * b[3]))
-
-
-@njit
 def _arcs(rotations: F, start: I, frames: I, arc_next: F, arc_angle: F, arc_sin: F) -> None:
-    """:func:`_arc` from every frame of every clip to its next (the last frame's next is the first):
+    """:func:`~engine.jit.qarc` from every frame of every clip to its next (the last frame's next is the first):
     a crowd's slerps then cost two sines each instead of a dot, an arc cosine and three sines."""
     for k in range(start.shape[0]):
         n = frames[k]
         for i in range(n):
             r0, r1 = start[k] + i, start[k] + (i + 1) % n
             for j in range(rotations.shape[1]):
-                b, theta, s = _arc(
+                b, theta, s = qarc(
                     (rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
                     (rotations[r1, j, 0], rotations[r1, j, 1], rotations[r1, j, 2], rotations[r1, j, 3]),
                 )
@@ -318,7 +293,7 @@ def _frame_rotations(
     a = f - math.floor(f)
     r0 = first + i0
     for j in range(rotations.shape[1]):
-        q = _slerp_arc(
+        q = qslerp_arc(
             (rotations[r0, j, 0], rotations[r0, j, 1], rotations[r0, j, 2], rotations[r0, j, 3]),
             (arc_next[r0, j, 0], arc_next[r0, j, 1], arc_next[r0, j, 2], arc_next[r0, j, 3]),
             arc_angle[r0, j],

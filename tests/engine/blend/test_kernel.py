@@ -119,10 +119,13 @@ def _unit(rng: np.random.Generator, n: int) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def test_a_slerp_on_a_measured_arc_is_qslerp_bit_for_bit() -> None:
-    """``_arc`` then ``_slerp_arc`` (the crowd's slerp, its arc measured once per clip) against
-    :func:`engine.jit.qslerp` on random, nearly equal and opposite pairs. Broken once by taking the
-    sine of the arc as ``sqrt(1 - d²)`` (differs in the last bits)."""
+def test_a_slerp_on_a_measured_arc_is_the_numpy_slerp_bit_for_bit() -> None:
+    """:func:`engine.jit.qarc` then :func:`engine.jit.qslerp_arc` (the crowd's slerp, its arc measured once per
+    clip; :func:`engine.jit.qslerp` is the two in a row) against the numpy path's :func:`engine.quat.slerp` on
+    random, nearly equal and opposite pairs. Broken once by taking the sine of the arc as ``sqrt(1 - d²)``
+    (differs in the last bits)."""
+    from engine import quat
+
     rng = np.random.default_rng(4)
     a = _unit(rng, 400)
     b = _unit(rng, 400)
@@ -130,8 +133,9 @@ def test_a_slerp_on_a_measured_arc_is_qslerp_bit_for_bit() -> None:
     b[50:100] = -a[50:100]
     for qa, qb, t in zip(a, b, rng.uniform(0, 1, 400), strict=True):
         ta, tb = tuple(qa.tolist()), tuple(qb.tolist())
-        far, theta, s = _kernel._arc(ta, tb)
-        assert _kernel._slerp_arc(ta, far, theta, s, t) == jit.qslerp(ta, tb, t)
+        far, theta, s = jit.qarc(ta, tb)
+        assert np.array_equal(jit.qslerp_arc(ta, far, theta, s, t), quat.slerp(qa, qb, t))
+        assert jit.qslerp(ta, tb, t) == jit.qslerp_arc(ta, far, theta, s, t)
 
 
 def test_placing_the_crowd_compiled_is_the_numpy_sequence_bit_for_bit() -> None:
