@@ -10,6 +10,7 @@ import numpy as np
 __all__ = ["pick", "pick_capsules", "shorten"]
 
 from engine.arrays import F64 as F
+from engine.arrays import Bool
 
 
 def pick(origin: F, direction: F, centers: F, radii: F, max_distance: float = 50.0) -> tuple[int, float] | None:
@@ -27,12 +28,7 @@ def pick(origin: F, direction: F, centers: F, radii: F, max_distance: float = 50
     inside = np.einsum("ij,ij->i", oc, oc) <= r2
     thc = np.sqrt(np.maximum(r2 - d2, 0.0))
     t = np.where(inside, 0.0, tca - thc)
-    valid = (d2 <= r2) & (t >= 0.0) & (t <= max_distance)
-    if not np.any(valid):
-        return None
-    t = np.where(valid, t, np.inf)
-    i = int(np.argmin(t))
-    return i, float(t[i])
+    return _nearest(t, (d2 <= r2) & (t >= 0.0) & (t <= max_distance))
 
 
 def pick_capsules(
@@ -73,7 +69,11 @@ def pick_capsules(
     inside = np.einsum("ij,ij->i", oc, oc) <= r2
     t = np.where(inside, 0.0, t_near - np.sqrt(np.maximum(r2 - np.where(np.isfinite(d2), d2, 0.0), 0.0)))
     d2 = np.where(inside, 0.0, d2)
-    valid = (d2 <= r2) & (t >= 0.0) & (t <= max_distance)
+    return _nearest(t, (d2 <= r2) & (t >= 0.0) & (t <= max_distance))
+
+
+def _nearest(t: F, valid: Bool) -> tuple[int, float] | None:
+    """``(index, t)`` of the smallest valid ``t``, or ``None``: the hit a ray meets first."""
     if not np.any(valid):
         return None
     t = np.where(valid, t, np.inf)
