@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 from engine.clip import Clip
 from engine.skeleton import Skeleton
 
-__all__ = ["measure", "write_puppet_egg", "load_characters", "joint_positions", "FRAMES", "REPEATS", "ANIMS"]
+__all__ = ["measure", "advance", "write_puppet_egg", "load_characters", "joint_positions", "FRAMES", "REPEATS", "ANIMS"]
 
 FRAMES = 60
 REPEATS = 5
@@ -170,6 +170,16 @@ def joint_positions(bundle: Any, names: tuple[str, ...]) -> NDArray[np.float64]:
     return out
 
 
+def advance(clock: Any, bundles: list[Any], controls: list[tuple[Any, Any]], tick: int) -> None:
+    """One timed frame: the clock steps, each character's blend weight moves, every joint is recomputed."""
+    clock.tick()
+    for i, (bundle, (walk, run)) in enumerate(zip(bundles, controls, strict=True)):
+        w = 0.5 + 0.5 * math.sin(0.05 * tick + 0.3 * i)  # the blend moves every frame: nothing to reuse
+        bundle.set_control_effect(walk, 1.0 - w)
+        bundle.set_control_effect(run, w)
+        bundle.force_update()
+
+
 def measure(characters: int = 100, frames: int = FRAMES, repeats: int = REPEATS) -> float:
     """Median thread CPU seconds per frame to advance, blend and update ``characters`` characters."""
     from panda3d.core import ClockObject, load_prc_file_data
@@ -184,12 +194,7 @@ def measure(characters: int = 100, frames: int = FRAMES, repeats: int = REPEATS)
 
     def frame() -> None:
         tick[0] += 1
-        clock.tick()
-        for i, (bundle, (walk, run)) in enumerate(zip(bundles, controls, strict=True)):
-            w = 0.5 + 0.5 * math.sin(0.05 * tick[0] + 0.3 * i)  # the blend moves every frame
-            bundle.set_control_effect(walk, 1.0 - w)
-            bundle.set_control_effect(run, w)
-            bundle.force_update()
+        advance(clock, bundles, controls, tick[0])
 
     for _ in range(10):
         frame()
