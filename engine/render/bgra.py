@@ -13,7 +13,7 @@ it brought the stretch from 4.5 to 2.8 ms (``/work/scratch/b32r/blit.py`` and h3
 moderngl always uploads ``GL_RGBA``, and Mesa then stores ``GL_RGBA8`` as R8G8B8A8; asked
 for ``GL_RGBA8`` with ``GL_BGRA`` client data, it stores B8G8R8A8 (no conversion on
 upload). So :func:`colour_texture` allocates the texture itself with that one call
-through the system GL library (which dispatches to the current context) and wraps it
+through the system GL library (:mod:`engine.render.rawgl`) and wraps it
 with ``ctx.external_texture``. To GL and to moderngl it is an ordinary ``GL_RGBA8``
 texture: drawing, sampling and reading pixels back give the same values as before.
 Where the library cannot be loaded, or on a GPU (which has no use for it), it is a plain
@@ -23,10 +23,10 @@ moderngl texture.
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
-import functools
 
 import moderngl
+
+from engine.render.rawgl import clear_errors, gl
 
 __all__ = ["colour_texture", "release_texture"]
 
@@ -36,32 +36,9 @@ _OWNED = "bgra-owned"
 """``Texture.extra`` of the textures made here: their GL name is ours to delete."""
 
 
-@functools.cache
-def _gl() -> ctypes.CDLL | None:
-    """The system GL library with the five entry points used here, or ``None``."""
-    for name in ("OpenGL", "GL"):
-        path = ctypes.util.find_library(name)
-        if path is None:
-            continue
-        try:
-            gl = ctypes.CDLL(path)
-            gl.glGenTextures.argtypes = [ctypes.c_int, ctypes.POINTER(ctypes.c_uint)]
-            gl.glDeleteTextures.argtypes = [ctypes.c_int, ctypes.POINTER(ctypes.c_uint)]
-            gl.glBindTexture.argtypes = [ctypes.c_uint, ctypes.c_uint]
-            gl.glGetIntegerv.argtypes = [ctypes.c_uint, ctypes.POINTER(ctypes.c_int)]
-            gl.glGetError.restype = ctypes.c_uint
-            gl.glTexImage2D.argtypes = [ctypes.c_uint, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int]
-            gl.glTexImage2D.argtypes += [ctypes.c_int, ctypes.c_uint, ctypes.c_uint, ctypes.c_void_p]
-        except (OSError, AttributeError):
-            continue
-        return gl
-    return None
-
-
 def _bgra_name(gl: ctypes.CDLL, size: tuple[int, int]) -> int | None:
     """A new texture name holding ``size`` of BGRA-stored ``GL_RGBA8`` storage (``None`` if GL refused)."""
-    while gl.glGetError() != _NO_ERROR:  # start from a clean error state (bounded by GL's error flags)
-        pass
+    clear_errors(gl)
     bound, name = ctypes.c_int(0), ctypes.c_uint(0)
     gl.glGetIntegerv(_TEXTURE_BINDING_2D, ctypes.byref(bound))
     gl.glGenTextures(1, ctypes.byref(name))
@@ -78,8 +55,8 @@ def _bgra_name(gl: ctypes.CDLL, size: tuple[int, int]) -> int | None:
 def colour_texture(ctx: moderngl.Context, size: tuple[int, int], bgra: bool) -> moderngl.Texture:
     """An RGBA8 colour texture of ``size``, stored as BGRA when ``bgra`` (callers ask for it on a
     software rasteriser) and the GL library is reachable; release it with :func:`release_texture`."""
-    gl = _gl() if bgra else None
-    name = _bgra_name(gl, size) if gl is not None else None
+    lib = gl() if bgra else None
+    name = _bgra_name(lib, size) if lib is not None else None
     if name is None:
         return ctx.texture(size, 4)
     tex = ctx.external_texture(name, size, 4, 0, "f1")
@@ -93,7 +70,7 @@ def release_texture(tex: moderngl.Texture) -> None:
     moderngl leaves external names alone)."""
     name = tex.glo
     tex.release()
-    gl = _gl()
-    if tex.extra == _OWNED and gl is not None and name > 0:
-        gl.glDeleteTextures(1, ctypes.byref(ctypes.c_uint(name)))
+    lib = gl()
+    if tex.extra == _OWNED and lib is not None and name > 0:
+        lib.glDeleteTextures(1, ctypes.byref(ctypes.c_uint(name)))
         tex.extra = None

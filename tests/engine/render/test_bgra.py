@@ -60,12 +60,13 @@ def test_a_released_bgra_texture_frees_its_gl_name() -> None:
 
     Broken once by skipping the ``glDeleteTextures`` call: the name stays a texture.
     """
-    from engine.render.bgra import _gl, colour_texture, release_texture
+    from engine.render.bgra import colour_texture, release_texture
     from engine.render.headless import HeadlessTarget
+    from engine.render.rawgl import gl as system_gl
 
     target = HeadlessTarget(16, 16, samples=0)
     try:
-        gl = _gl()
+        gl = system_gl()
         assert gl is not None
         gl.glIsTexture.argtypes = [ctypes.c_uint]
         tex = colour_texture(target.ctx, (8, 4), True)
