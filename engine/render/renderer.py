@@ -4,7 +4,8 @@ Passes, in order (each kind of primitive is one instanced draw call):
 
 1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
    (:mod:`engine.render.shadows`), both fitted around the casters each frame, and kept from the
-   last frame when nothing they are drawn from changed (``reuse_shadows``).
+   last frame when nothing they are drawn from changed (``reuse_shadows``); the scenery's part
+   of the map (cones, boxes) is kept while it and the sun's matrix stay.
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.
 3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
