@@ -7,15 +7,15 @@ pixel went through the general per-pixel shader path. llvmpipe has a second path
 exactly this kind of pass (one texture fetch, no depth buffer bound, no blending): the
 "linear" rasteriser, which copies rows of texels with SIMD code. It is taken only when
 the source texture and the destination are both stored B8G8R8A8; measured in isolation
-it brought the stretch from 4.5 to 2.8 ms (``/work/scratch/b32r/blit.py`` and h32r's
-``bgra.py``).
+it brought the stretch from 4.5 to 2.2-3.3 ms. (A scaled ``glBlitFramebuffer`` cost 6-8 ms.)
 
-moderngl always uploads ``GL_RGBA``, and Mesa then stores ``GL_RGBA8`` as R8G8B8A8; asked
-for ``GL_RGBA8`` with ``GL_BGRA`` client data, it stores B8G8R8A8 (no conversion on
-upload). So :func:`colour_texture` allocates the texture itself with that one call
-through the system GL library (:mod:`engine.render.rawgl`) and wraps it
-with ``ctx.external_texture``. To GL and to moderngl it is an ordinary ``GL_RGBA8``
-texture: drawing, sampling and reading pixels back give the same values as before.
+moderngl allocates ``GL_RGBA8`` from ``GL_RGBA`` data, which Mesa stores R8G8B8A8. Mesa
+picks the storage that matches the client data only for an *unsized* internal format:
+``GL_RGBA`` from ``GL_BGRA`` data is stored B8G8R8A8 (``GL_RGBA8`` from the same data was
+not: no gain, measured). So :func:`colour_texture` allocates the texture itself with that
+one call through the system GL library (:mod:`engine.render.rawgl`) and wraps it with
+``ctx.external_texture``. To GL and to moderngl it is an ordinary 8-bit RGBA texture:
+drawing, sampling and reading pixels back give the same values as before.
 Where the library cannot be loaded, or on a GPU (which has no use for it), it is a plain
 moderngl texture.
 """
@@ -37,7 +37,7 @@ _OWNED = "bgra-owned"
 
 
 def _bgra_name(gl: ctypes.CDLL, size: tuple[int, int]) -> int | None:
-    """A new texture name holding ``size`` of BGRA-stored ``GL_RGBA8`` storage (``None`` if GL refused)."""
+    """A new texture name holding ``size`` of BGRA-stored 8-bit RGBA storage (``None`` if GL refused)."""
     clear_errors(gl)
     bound, name = ctypes.c_int(0), ctypes.c_uint(0)
     gl.glGetIntegerv(_TEXTURE_BINDING_2D, ctypes.byref(bound))
