@@ -435,7 +435,7 @@ def test_publishing_before_the_server_runs_or_after_it_stopped_only_keeps_the_st
     later, _ = _state(2)
     src.publish(later, look)
     latest = src._latest
-    assert latest is not None and latest[0] is later and latest[2:] == (None, 1 / 60)
+    assert latest is not None and latest[0] is later and latest[2] is None and latest[3] == 1 / 60
 
 
 # -- one message ------------------------------------------------------------------------------------
