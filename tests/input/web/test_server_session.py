@@ -18,7 +18,9 @@ them, the GLB or a delta built from other arguments, the same step sent twice, t
 from __future__ import annotations
 
 import asyncio
+import inspect
 import json
+import threading
 from collections.abc import Awaitable, Callable, Coroutine, Iterator
 from typing import Any
 
@@ -30,6 +32,7 @@ from websockets.frames import Close, CloseCode
 from engine.render.scene import RenderScene
 from engine.render.snowfall import Snowfall
 from input.sample import PoseSample
+from input.source import PoseSource
 from input.web.cert import WebCertificate, load_or_create
 from input.web.protocol import Ack, WebMessageError, parse_message
 from input.web.scene_glb import scene_glb
@@ -493,3 +496,34 @@ def test_the_page_times_keep_the_newest_4096(make: Callable[..., WebSource]) -> 
     src._handle(_reading(t=8000.0), "web:1", [5.0, 100.0], 5000.0)
     assert len(src.page_times) == 4096
     assert next(iter(src.page_times)) == 1.0 and src.page_times[5000.0] == 8000.0
+
+
+# -- stopping ---------------------------------------------------------------------------------------
+
+
+def test_stop_gives_up_on_a_stuck_server_thread_and_still_closes_the_port(
+    make: Callable[..., WebSource], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Quitting the game never hangs on the web thread: ``stop`` waits ``timeout`` seconds for it (0.1 s
+    here, the thread's own join limit), then closes the listening socket anyway. Passing ``None`` on to
+    the join instead (a mutant) waits for ever."""
+    src = make()
+    release = threading.Event()
+    monkeypatch.setattr(src, "_run", release.wait)  # a server thread that does not see `stopping`
+    src.start()
+    thread = src._thread
+    assert thread is not None
+    try:
+        src.stop(0.1)
+        assert thread.is_alive() and src._thread is None and src._sock.fileno() == -1
+    finally:
+        release.set()
+        thread.join(GUARD)
+    assert not thread.is_alive()
+
+
+def test_stop_waits_as_long_as_every_source_does() -> None:
+    """The hub stops every source the same way (``stop()``): the web source keeps its base's wait."""
+    assert inspect.signature(WebSource.stop).parameters["timeout"].default == (
+        inspect.signature(PoseSource.stop).parameters["timeout"].default
+    )
