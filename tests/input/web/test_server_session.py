@@ -522,8 +522,24 @@ def test_stop_gives_up_on_a_stuck_server_thread_and_still_closes_the_port(
     assert not thread.is_alive()
 
 
-def test_stop_waits_as_long_as_every_source_does() -> None:
-    """The hub stops every source the same way (``stop()``): the web source keeps its base's wait."""
-    assert inspect.signature(WebSource.stop).parameters["timeout"].default == (
-        inspect.signature(PoseSource.stop).parameters["timeout"].default
-    )
+class _Thread:
+    """Stands for the server thread: records how long ``stop`` waits for it."""
+
+    def __init__(self) -> None:
+        self.waits: list[float | None] = []
+
+    def join(self, timeout: float | None = None) -> None:
+        self.waits.append(timeout)
+
+
+def test_stop_waits_as_long_as_every_source_does(
+    make: Callable[..., WebSource], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The hub stops every source the same way (``stop()``): the web source waits its base's default for
+    the thread (read from ``PoseSource.stop``; a changed default of its own fails)."""
+    src = make()
+    thread = _Thread()
+    monkeypatch.setattr(src, "_thread", thread)
+    src.stop()
+    assert thread.waits == [inspect.signature(PoseSource.stop).parameters["timeout"].default]
+    assert src._thread is None and src._sock.fileno() == -1
