@@ -1,0 +1,84 @@
+"""The lookup table's public calls on the inputs their callers really pass: one request as a 1-D
+vector, integer requests, a feasible set whose bounds move with the speed.
+
+Small hand-made tables (milliseconds each), so the expected answers are worked out here. Shown to
+fail by mutation (docs/mutation.md, sixth round): ``query_brute`` sorting along ``axis=+1`` (a
+single request has one axis), ``extent``/``extent_many`` dividing by the property's range instead of
+multiplying, ``extent`` taking the second hit or the one before last, ``resolve_many`` keeping an
+integer request's dtype (a projected request is truncated to whole numbers) or answering float
+``inside`` flags.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from engine.blend.lookup import LookupTable, probe_grid
+
+F = np.ndarray
+
+
+def sheared_table() -> LookupTable:
+    """speed = 2·p₀ (0..2 m/s), height = 0.5 + 0.2·p₀ + 0.4·p₁: at speed s the hips go from
+    0.5 + 0.1·s to 0.9 + 0.1·s, so the lowest height is not the table's lowest."""
+    probes, shape = probe_grid(2, 5)
+    values = np.stack([2.0 * probes[:, 0], 0.5 + 0.2 * probes[:, 0] + 0.4 * probes[:, 1]], axis=-1)
+    return LookupTable(probes, values, ("speed", "height"), shape)
+
+
+def test_one_request_as_a_vector_gives_one_blend_point() -> None:
+    """``query_brute`` and ``query`` take a single request ``[M]`` as well as a batch ``[B, M]``."""
+    t = sheared_table()
+    full = LookupTable(t.probes, t.values, t.properties, t.grid_shape, neighbours=len(t.probes))
+    u = np.array([0.9, 0.75])
+    one = t.query_brute(u)
+    assert one.shape == (2,)
+    np.testing.assert_allclose(one, full.query(u), atol=1e-12)
+    np.testing.assert_allclose(one, t.query_brute(u[None])[0], atol=1e-12)
+    np.testing.assert_allclose(one, [0.45, (0.75 - 0.5 - 0.09) / 0.4], atol=1e-9)  # the map is linear
+
+
+@pytest.mark.parametrize("speed", [0.9, 1.3])
+def test_extent_is_the_height_range_at_that_speed(speed: float) -> None:
+    """At a speed between grid lines the vertical line crosses the border twice: the range is
+    ``[0.5 + 0.1·s, 0.9 + 0.1·s]`` in metres, whatever the height asked."""
+    t = sheared_table()
+    for height in (0.55, 0.7, 1.2):
+        got = t.extent([speed, height], 1)
+        assert got is not None
+        assert got == pytest.approx((0.5 + 0.1 * speed, 0.9 + 0.1 * speed), abs=1e-9)
+    speed_range = t.extent([1.0, 0.7], 0)  # height 0.7: speed from 0 up to where 0.5 + 0.1·s = 0.7
+    assert speed_range == pytest.approx((0.0, 2.0), abs=1e-9)
+    assert t.extent([1.0, 1.0], 0) == pytest.approx((1.0, 2.0), abs=1e-9)  # 0.9 + 0.1·s ≥ 1 from s = 1
+    lo, hi = t.extent_many(np.array([[speed, 0.7], [3.0, 0.7]]), 1)
+    np.testing.assert_allclose([lo[0], hi[0]], [0.5 + 0.1 * speed, 0.9 + 0.1 * speed], atol=1e-9)
+    assert np.isnan(lo[1]) and np.isnan(hi[1])
+
+
+def test_integer_requests_resolve_like_float_ones() -> None:
+    """A batch of whole-number requests (``[[3, 1]]``: 3 m/s, 1 m) is projected to the same point,
+    with fractions, as the float request; nothing is rounded to the requests' integer dtype."""
+    t = sheared_table()
+    ints = np.array([[3, 1], [2, 1], [0, 0]])
+    points, feasible, inside, rate = t.resolve_many(ints)
+    assert inside.tolist() == [False, True, False]
+    for i, r in enumerate(ints.astype(np.float64)):
+        one = t.resolve(r)
+        np.testing.assert_allclose(feasible[i], one.feasible, atol=1e-12)
+        np.testing.assert_allclose(points[i], one.point, atol=1e-12)
+        assert rate[i] == pytest.approx(one.rate)
+    assert feasible[0, 1] == pytest.approx(1.0) and feasible[0, 0] == pytest.approx(2.0)  # kept 1 m, sped up
+    assert feasible[2, 1] == pytest.approx(0.5)  # 0 m is below any crouch: as low as it goes, at 0 m/s
+    assert feasible.dtype == np.float64 and points.dtype == np.float64
+
+
+def test_inside_flags_are_booleans_with_and_without_a_border() -> None:
+    """``inside`` is a boolean mask (callers index with it and negate it with ``~``)."""
+    t = sheared_table()
+    free = LookupTable(t.probes, t.values, t.properties)
+    reqs = np.array([[1.0, 0.7], [3.0, 0.7]])
+    for table in (t, free):
+        _, _, inside, _ = table.resolve_many(reqs)
+        assert inside.dtype == np.bool_
+        assert (~inside).sum() == (0 if table is free else 1)
