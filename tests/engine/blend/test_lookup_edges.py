@@ -6,7 +6,10 @@ fail by mutation (docs/mutation.md, sixth round): ``query_brute`` sorting along 
 single request has one axis), ``extent``/``extent_many`` dividing by the property's range instead of
 multiplying, ``extent`` taking the second hit or the one before last, ``resolve_many`` keeping an
 integer request's dtype (a projected request is truncated to whole numbers) or answering float
-``inside`` flags.
+``inside`` flags, ``resolve`` without a border answering no blend point or keeping an integer request, the
+playback rate of a request slower than the slowest gait not slowed (``want · got > 1``, ``abs(got) > 1.000001``),
+not clamped below (``clip(…, None, …)``, ``2 / max_rate``), or a standing or backwards request given one
+(``or``, ``want · got >= 0``).
 """
 
 from __future__ import annotations
@@ -82,3 +85,46 @@ def test_inside_flags_are_booleans_with_and_without_a_border() -> None:
         _, _, inside, _ = table.resolve_many(reqs)
         assert inside.dtype == np.bool_
         assert (~inside).sum() == (0 if table is free else 1)
+
+
+def test_a_table_without_a_border_plays_each_request_as_asked() -> None:
+    """No border: ``resolve`` answers the blend point of the request itself, at rate 1, and the request
+    it reports is a float copy (an integer request is not kept as integers, a caller's array is not shared)."""
+    t = sheared_table()
+    free = LookupTable(t.probes, t.values, t.properties)
+    asked = np.array([3, 1])
+    res = free.resolve(asked)
+    assert res.inside and res.rate == 1.0
+    np.testing.assert_array_equal(res.point, free.query(asked.astype(np.float64)))
+    assert res.point.shape == (2,) and 0.0 <= res.point.min() and res.point.max() <= 1.0
+    assert res.feasible.dtype == np.float64 and res.feasible.tolist() == [3.0, 1.0]
+    res.feasible[0] = 0.5
+    assert asked.tolist() == [3, 1]
+
+
+def slow_floor_table() -> LookupTable:
+    """speed = 0.5 + 1.5·p₀ (the slowest gait still moves at 0.5 m/s), height = 0.5 + 0.4·p₁."""
+    probes, shape = probe_grid(2, 5)
+    values = np.stack([0.5 + 1.5 * probes[:, 0], 0.5 + 0.4 * probes[:, 1]], axis=-1)
+    return LookupTable(probes, values, ("speed", "height"), shape)
+
+
+@pytest.mark.parametrize(
+    "speed,rate",
+    [
+        (3.0, 1.5),  # faster than the run: sped up
+        (0.4, 0.8),  # slower than the slowest gait: slowed down, u/u'
+        (0.1, 1.0 / 3.0),  # far slower: slowed down no more than max_rate allows
+        (0.0, 1.0),  # standing still asked: no rate to divide by the request, played as is
+        (-1.0, 1.0),  # backwards: never a negative or reversed rate
+    ],
+)
+def test_the_playback_rate_outside_follows_the_requested_speed(speed: float, rate: float) -> None:
+    t = slow_floor_table()
+    res = t.resolve([speed, 0.7])
+    assert not res.inside
+    assert res.feasible[1] == pytest.approx(0.7, abs=1e-9)  # the height is kept
+    assert res.feasible[0] == pytest.approx(2.0 if speed > 2.0 else 0.5, abs=1e-9)
+    assert res.rate == pytest.approx(rate, rel=1e-12)
+    _, _, _, rates = t.resolve_many(np.array([[speed, 0.7]]))
+    assert rates[0] == pytest.approx(rate, rel=1e-12)
