@@ -9,7 +9,10 @@ integer request's dtype (a projected request is truncated to whole numbers) or a
 ``inside`` flags, ``resolve`` without a border answering no blend point or keeping an integer request, the
 playback rate of a request slower than the slowest gait not slowed (``want · got > 1``, ``abs(got) > 1.000001``),
 not clamped below (``clip(…, None, …)``, ``2 / max_rate``), or a standing or backwards request given one
-(``or``, ``want · got >= 0``).
+(``or``, ``want · got >= 0``); the projection's cost taken on ``c + x``, with the speed change's cost
+replaced or divided by ``keep_cost``, every speed change penalised (``or``), the penalty's bounds
+``want · got > 1``, ``max_rate <= u/u'``, ``2 / max_rate``, ``u·u'`` for ``u/u'``, the speed read back
+without its offset, the penalty replacing the cost (``cost = 1e3``), and the refusal's message.
 """
 
 from __future__ import annotations
@@ -128,3 +131,69 @@ def test_the_playback_rate_outside_follows_the_requested_speed(speed: float, rat
     assert res.rate == pytest.approx(rate, rel=1e-12)
     _, _, _, rates = t.resolve_many(np.array([[speed, 0.7]]))
     assert rates[0] == pytest.approx(rate, rel=1e-12)
+
+
+def leaning_table() -> LookupTable:
+    """speed = 0.5 + 1.5·p₀, height = 0.5 + 0.2·p₀ + 0.4·p₁: the feasible set is the parallelogram
+    (0.5, 0.5), (2, 0.7), (2, 1.1), (0.5, 0.9) — faster gaits stand taller, the slowest still moves."""
+    probes, shape = probe_grid(2, 5)
+    values = np.stack([0.5 + 1.5 * probes[:, 0], 0.5 + 0.2 * probes[:, 0] + 0.4 * probes[:, 1]], axis=-1)
+    return LookupTable(probes, values, ("speed", "height"), shape)
+
+
+def nearest_on_the_parallelogram(u: F) -> F:
+    """The border point nearest ``u`` when speed changes count a tenth (both properties scaled by
+    their ranges, 1.5 m/s and 0.6 m), by projecting onto each of the four edges in those units."""
+    corners = np.array([[0.5, 0.5], [2.0, 0.7], [2.0, 1.1], [0.5, 0.9]])
+    units = np.array([0.1 / 1.5, 1.0 / 0.6])
+    x, best, best_d = u * units, u, np.inf
+    for i in range(4):
+        p0, p1 = corners[i] * units, corners[(i + 1) % 4] * units
+        s = np.clip(np.dot(x - p0, p1 - p0) / np.dot(p1 - p0, p1 - p0), 0.0, 1.0)
+        q = p0 + s * (p1 - p0)
+        if np.linalg.norm(q - x) < best_d:
+            best, best_d = q / units, float(np.linalg.norm(q - x))
+    return best
+
+
+@pytest.mark.parametrize("request_", [[1.0, 1.05], [0.6, 1.05], [1.0, 0.55], [1.6, 0.6], [2.5, 1.2], [0.05, 1.05]])
+def test_projection_is_the_cheapest_border_point_within_the_rate_limit(request_: list[float]) -> None:
+    """Outside, the request moves to the border point nearest it with speed changes at a tenth of
+    their cost, as long as the speed-up it then needs stays within ``[1/3, 3]`` — or when every way
+    back needs more (``[0.05, 1.05]``: every gait is at least 10× faster), still the cheapest."""
+    t = leaning_table()
+    u = np.array(request_)
+    want = nearest_on_the_parallelogram(u)
+    got, inside = t.project(u)
+    assert not inside
+    np.testing.assert_allclose(got, want, atol=1e-9)
+    res = t.resolve(u)
+    np.testing.assert_allclose(res.feasible, want, atol=1e-9)
+    assert res.rate == pytest.approx(float(np.clip(u[0] / want[0], 1.0 / 3.0, 3.0)), rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "request_,lowered",
+    [([0.5, 1.08], 0.9), ([0.55, 1.08], 0.9 + 0.2 * 0.05 / 1.5), ([0.6, 1.2], 0.9 + 0.2 * 0.1 / 1.5)],
+)
+def test_a_request_too_tall_for_a_slow_gait_is_lowered_not_sped_up_past_the_limit(
+    request_: list[float], lowered: float
+) -> None:
+    """The nearest border point (speed changes are cheap) would need a gait more than three times faster
+    than asked; the request keeps its speed and is lowered to the tallest height at that speed."""
+    t = leaning_table()
+    u = np.array(request_)
+    near = nearest_on_the_parallelogram(u)
+    assert u[0] / near[0] < 1.0 / 3.0  # beyond max_rate: the cheap move is refused
+    got, inside = t.project(u)
+    assert not inside
+    np.testing.assert_allclose(got, [u[0], lowered], atol=1e-9)
+
+
+def test_a_table_without_a_border_cannot_project() -> None:
+    t = sheared_table()
+    free = LookupTable(t.probes, t.values, t.properties)
+    with pytest.raises(
+        ValueError, match=r"^this table has no feasible border: it needs a probe grid with one property per axis$"
+    ):
+        free.project([1.0, 0.7])
