@@ -99,7 +99,7 @@ def test_a_table_without_a_border_plays_each_request_as_asked() -> None:
     res = free.resolve(asked)
     assert res.inside and res.rate == 1.0
     np.testing.assert_array_equal(res.point, free.query(asked.astype(np.float64)))
-    assert res.point.shape == (2,) and 0.0 <= res.point.min() and res.point.max() <= 1.0
+    assert res.point.shape == (2,) and res.point.min() >= 0.0 and res.point.max() <= 1.0
     assert res.feasible.dtype == np.float64 and res.feasible.tolist() == [3.0, 1.0]
     res.feasible[0] = 0.5
     assert asked.tolist() == [3, 1]
