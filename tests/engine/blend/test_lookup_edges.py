@@ -12,7 +12,9 @@ not clamped below (``clip(…, None, …)``, ``2 / max_rate``), or a standing or
 (``or``, ``want · got >= 0``); the projection's cost taken on ``c + x``, with the speed change's cost
 replaced or divided by ``keep_cost``, every speed change penalised (``or``), the penalty's bounds
 ``want · got > 1``, ``max_rate <= u/u'``, ``2 / max_rate``, ``u·u'`` for ``u/u'``, the speed read back
-without its offset, the penalty replacing the cost (``cost = 1e3``), and the refusal's message.
+without its offset, the penalty replacing the cost (``cost = 1e3``), and the refusal's message; the
+probe slopes' fold test made absolute (``1e-3 / s₀``, ``max(s₀, 1.000000000001)``: a nearly flat but
+well-conditioned stretch loses its slope); the probes kept as integers.
 """
 
 from __future__ import annotations
@@ -197,3 +199,30 @@ def test_a_table_without_a_border_cannot_project() -> None:
         ValueError, match=r"^this table has no feasible border: it needs a probe grid with one property per axis$"
     ):
         free.project([1.0, 0.7])
+
+
+def test_a_nearly_flat_stretch_of_the_measurement_is_still_inverted() -> None:
+    """Speed rises by only 10⁻⁴ of its range over the first two probes, then normally: the slope there,
+    small but well conditioned (a 1×1 Jacobian), still maps a request between them to its blend point —
+    it is a fold only relative to the Jacobian's own largest singular value, not to an absolute 10⁻³."""
+    probes = np.linspace(0.0, 1.0, 5)[:, None]
+    values = np.array([[0.0], [1e-4], [2e-4], [0.5], [1.0]])
+    t = LookupTable(probes, values, ("speed",), (5,), power=7.0)
+    assert t.slopes is not None
+    np.testing.assert_allclose(t.slopes[:2, 0, 0], [1.0 / 4e-4, 1.0 / 4e-4], rtol=1e-9)  # 0.25 / 1e-4
+    assert t.query([4e-5])[0] == pytest.approx(0.1, abs=1e-3)  # on the line through the first two probes
+    plain = LookupTable(probes, values, ("speed",), (5,), power=7.0, gradients=False)
+    assert plain.query([4e-5])[0] < 0.02  # without the slope it sticks to the first probe
+
+
+def test_integer_probes_and_measurements_are_taken_as_floats() -> None:
+    """A table built from whole numbers (a 0/1 probe grid, speeds in whole m/s) stores floats and answers
+    as the same table built from floats."""
+    probes = np.array([[0, 0], [0, 1], [1, 0], [1, 1]])
+    values = np.array([[0, 1], [0, 2], [2, 1], [2, 2]])
+    t = LookupTable(probes, values, ("speed", "height"), (2, 2))
+    f = LookupTable(probes.astype(np.float64), values.astype(np.float64), ("speed", "height"), (2, 2))
+    assert t.probes.dtype == np.float64 and t.values.dtype == np.float64
+    u = np.array([[1.0, 1.5], [0.5, 1.2], [2, 2]])
+    np.testing.assert_array_equal(t.query(u), f.query(u))
+    np.testing.assert_allclose(t.query(u), [[0.5, 0.5], [0.25, 0.2], [1.0, 1.0]], atol=1e-12)
