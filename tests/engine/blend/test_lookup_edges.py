@@ -10,7 +10,7 @@ integer request's dtype (a projected request is truncated to whole numbers) or a
 playback rate of a request slower than the slowest gait not slowed (``want · got > 1``, ``abs(got) > 1.000001``),
 not clamped below (``clip(…, None, …)``, ``2 / max_rate``), or a standing or backwards request given one
 (``or``, ``want · got >= 0``); the projection's cost taken on ``c + x``, with the speed change's cost
-replaced or divided by ``keep_cost``, every speed change penalised (``or``), the penalty's bounds
+replaced or divided by ``keep_cost``, every speed change penalised (``or``), ``abs(want + got)`` for ``abs(want - got)``, the penalty's bounds
 ``want · got > 1``, ``max_rate <= u/u'``, ``2 / max_rate``, ``u·u'`` for ``u/u'``, the speed read back
 without its offset, the penalty replacing the cost (``cost = 1e3``), and the refusal's message; the
 probe slopes' fold test made absolute (``1e-3 / s₀``, ``max(s₀, 1.000000000001)``: a nearly flat but
@@ -158,11 +158,14 @@ def nearest_on_the_parallelogram(u: F) -> F:
     return best
 
 
-@pytest.mark.parametrize("request_", [[1.0, 1.05], [0.6, 1.05], [1.0, 0.55], [1.6, 0.6], [2.5, 1.2], [0.05, 1.05]])
+@pytest.mark.parametrize(
+    "request_", [[1.0, 1.05], [0.6, 1.05], [1.0, 0.55], [1.6, 0.6], [2.5, 1.2], [0.05, 1.05], [-1.0, 0.9 + 0.1 / 1.5]]
+)
 def test_projection_is_the_cheapest_border_point_within_the_rate_limit(request_: list[float]) -> None:
     """Outside, the request moves to the border point nearest it with speed changes at a tenth of
-    their cost, as long as the speed-up it then needs stays within ``[1/3, 3]`` — or when every way
-    back needs more (``[0.05, 1.05]``: every gait is at least 10× faster), still the cheapest."""
+        their cost, as long as the speed-up it then needs stays within ``[1/3, 3]`` — or when every way
+        back needs more (``[0.05, 1.05]``: every gait is at least 10× faster; ``[-1, 0.967]``: backwards, where the
+    crossing at 1 m/s, the mirrored speed, is refused like any other), still the cheapest."""
     t = leaning_table()
     u = np.array(request_)
     want = nearest_on_the_parallelogram(u)
@@ -171,7 +174,8 @@ def test_projection_is_the_cheapest_border_point_within_the_rate_limit(request_:
     np.testing.assert_allclose(got, want, atol=1e-9)
     res = t.resolve(u)
     np.testing.assert_allclose(res.feasible, want, atol=1e-9)
-    assert res.rate == pytest.approx(float(np.clip(u[0] / want[0], 1.0 / 3.0, 3.0)), rel=1e-9)
+    rate = float(np.clip(u[0] / want[0], 1.0 / 3.0, 3.0)) if u[0] > 0 else 1.0
+    assert res.rate == pytest.approx(rate, rel=1e-9)
 
 
 @pytest.mark.parametrize(
