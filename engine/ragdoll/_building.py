@@ -47,7 +47,6 @@ class Building:
     _moved: bool
     _digest: bytes
     _ke: _F | None
-    _derived: bool  # MuJoCo's derived quantities beyond kinematics (mass matrix...) match the state
     _read: tuple[_F, _F] | None
     _limit: _F
     _owners: NDArray[np.int64]
@@ -173,11 +172,10 @@ class Building:
             else:
                 self._place(key, last[0], last[1], prev)
             C.has_last[i], C.placed[i] = had, True
-        # settle runs the kinematics (body and geom poses, all a step's commands and the join test
-        # read); the rest of mj_forward (~4 ms with a fall in the model) waits for the step, which
-        # recomputes it from the same state, or for a read that needs it (:attr:`_derived`)
         settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
-        self._derived = False
+        # (settle's kinematics is all the next step's commands read, but leaving the rest of this to
+        # the step is not bit-identical: games/snowman/demo.rec then differs from frame 227)
+        mujoco.mj_forward(m, d)
 
     def _give_back(self, row: int) -> None:
         """Return a ragdoll's pool slot (command row ``row``): parked, asleep, free for the next one of its kind."""

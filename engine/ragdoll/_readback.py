@@ -32,7 +32,6 @@ class Readback:
     data: mujoco.MjData | None
     layout: Layout | None
     _ke: _F | None
-    _derived: bool
     _read: tuple[_F, _F] | None
 
     if TYPE_CHECKING:  # what the mixin reads of PhysicsWorld, the class it mixes into
@@ -104,9 +103,6 @@ class Readback:
         L, m, d = self.layout, self.model, self.data
         assert L is not None and m is not None and d is not None
         if self._ke is None:
-            if not self._derived:  # a slot was lent since the last step: its mass matrix is not built yet
-                mujoco.mj_forward(m, d)
-                self._derived = True
             res = np.zeros(m.nv)
             mujoco.mj_mulM(m, d, res, d.qvel)
             cum = np.concatenate([[0.0], np.cumsum(0.5 * d.qvel * res)])

@@ -86,7 +86,6 @@ class PhysicsWorld(Readback, Building):
         self._pool_layout: Layout | None = None
         self._digest = b""
         self._ke: _F | None = None
-        self._derived = True
         self._read: tuple[_F, _F] | None = None
         self.simulate_animated = False
         self.recoveries = 0
@@ -322,7 +321,6 @@ class PhysicsWorld(Readback, Building):
         self._place(key, r, q)
         assert self.model is not None and self.data is not None
         mujoco.mj_forward(self.model, self.data)
-        self._derived = True
 
     def _place(self, key: int, root: _F, rot: _F, before: tuple[_F, _F] | None = None) -> None:
         """Put a ragdoll's bodies on a pose, at rest or moving as it moved from ``before`` in one step."""
@@ -376,7 +374,6 @@ class PhysicsWorld(Readback, Building):
             self._ke = self._read = None
             return
         reason = guarded_step(self.model, self.data, self.substeps, self._limit, self._owners)
-        self._derived = True
         if reason is None:
             project_twist(self.layout, self.data)
         else:
@@ -536,7 +533,6 @@ class PhysicsWorld(Readback, Building):
         if d.qpos[s.qadr + 1] < old + 0.02 and radius > old:
             d.qpos[s.qadr + 1] += radius - old
         mujoco.mj_forward(m, d)
-        self._derived = True
         self._ke = self._read = None
 
     def set_prop_kinematic(self, key: int, position: ArrayLike, rotation: ArrayLike, velocity: ArrayLike) -> None:
