@@ -75,6 +75,10 @@ class PhysicsWorld(Readback, Building):
         self.rebuilds = 0
         self._ragdolls: dict[int, RagdollSlot] = {}
         self._cmds = Commands()
+        self._changes = 0
+        # the physics stage's record of what it last synced the ragdolls from (a world query's
+        # result and :attr:`ragdoll_changes` then: engine.ragdoll.system)
+        self.synced: tuple[object, int] | None = None
         self._props: dict[int, PropSlot] = {}
         self._held: set[int] = set()  # ragdolls with a held body
         self._dirty = False
@@ -121,6 +125,7 @@ class PhysicsWorld(Readback, Building):
             self._reach[kind] = reach(skeleton, profile, off)
         self._ragdolls[key] = RagdollSlot(spec, kind, skeleton.num_joints)
         self._cmds.add(key, r, q, self._reach[kind])
+        self._changes += 1
         self._sized = False
 
     def add_prop(
@@ -149,6 +154,7 @@ class PhysicsWorld(Readback, Building):
         slot = self._ragdolls.pop(key, None)
         self._held.discard(key)
         if slot is not None:
+            self._changes += 1
             C = self.commands
             i = C.row[key]
             if C.pool[i] >= 0:
@@ -169,6 +175,11 @@ class PhysicsWorld(Readback, Building):
     def ragdoll_keys(self) -> list[int]:
         """Entity ids of the ragdolls, in order."""
         return sorted(self._ragdolls)
+
+    @property
+    def ragdoll_changes(self) -> int:
+        """How many ragdolls were added or removed so far (a cheap "did the set change" check)."""
+        return self._changes
 
     @property
     def prop_keys(self) -> list[int]:
