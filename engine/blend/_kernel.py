@@ -181,25 +181,42 @@ def play(
     arc_angle: F,
     arc_sin: F,
     points: F,
+    target: F,
+    alpha: float,
+    ease: bool,
     phase: F,
     rate: F,
+    scale: F,
+    feasible: F,
     dt: float,
+    feasible_out: F,
     w_out: F,
     phase_out: F,
+    wrapped: F,
     travel: F,
     turn: F,
     root_out: F,
     rot_out: F,
     votes: F,
 ) -> None:
-    """Play ``dt`` seconds of every puppet (blend ``points [P,N]``, ``phase``, ``rate [P]``): weights, new
-    phase, root travel (clip frame) and turn, the blended pose at the new phase and the feet's votes."""
+    """Play ``dt`` seconds of every puppet: its blend point eased toward the lookup's ``target`` (in place in
+    ``points [P,N]``, when ``ease``), the ``feasible`` request scaled to the puppet, then weights, new phase
+    (and wrapped to ``[0, 1)``), root travel (clip frame, scaled) and turn, the blended pose at the new
+    phase (root scaled) and the feet's votes. The easing and scalings are the numpy path's
+    ``eased + alpha·(target − eased)`` and ``x·scale``, operation for operation."""
     k_all = pk_points.shape[0]
     joints = rotations.shape[1]
     legs = contacts.shape[1]
+    dims = points.shape[1]
     row0, row1 = np.empty(4), np.empty(4)
     ref_rot = np.empty((joints, 4))
     for p in range(points.shape[0]):
+        size = scale[p]
+        if ease:
+            for c in range(dims):
+                points[p, c] = points[p, c] + alpha * (target[p, c] - points[p, c])
+        for c in range(feasible.shape[1]):
+            feasible_out[p, c] = feasible[p, c] * size
         w = w_out[p]
         _weights(pk_points, points[p], w)
         period = 0.0
@@ -266,6 +283,10 @@ def play(
             _frame_rotations(
                 rotations, arc_next, arc_angle, arc_sin, start[k], n, t1 * fps[k], ref_rot, rot_out[p], True, wn
             )
+        for c in range(3):
+            root_out[p, c] = root_out[p, c] * size
+            travel[p, c] = travel[p, c] * size
+        wrapped[p] = ph1 % 1.0
         for j in range(joints):
             m = qnormalize((rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3]))
             rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3] = m
