@@ -147,7 +147,41 @@ def _weights(points: F, q: F, out: F) -> None:
 def _clip_time(pk_x: F, pk_y: F, duration: float, phase: float) -> float:
     """A clip's unwrapped time (s) at group ``phase`` (:meth:`SyncGroup.clip_times`)."""
     cycles = math.floor(phase)
-    return (cycles + np.interp(phase - cycles, pk_x, pk_y)) * duration
+    return (cycles + interp(phase - cycles, pk_x, pk_y)) * duration
+
+
+@njit
+def interp(x: float, xp: F, fp: F) -> float:
+    """``np.interp`` of one value, as numba's ``np.interp`` computes it (numpy's C code, transcribed) but
+    without the arrays that one allocates for its answer and its slopes on every call (a crowd's kernel
+    calls it a dozen times per puppet). ``j`` is the last knot at or below ``x`` (what numpy's guessed
+    binary search finds in a sorted ``xp``)."""
+    n = xp.shape[0]
+    if n == 1:
+        return fp[0]
+    if math.isnan(x):
+        return x
+    if x > xp[n - 1]:
+        return fp[n - 1]
+    if x < xp[0]:
+        return fp[0]
+    lo, hi = 0, n
+    while lo < hi:
+        mid = lo + ((hi - lo) >> 1)
+        if x >= xp[mid]:
+            lo = mid + 1
+        else:
+            hi = mid
+    j = lo - 1
+    if j == n - 1 or xp[j] == x:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    out = slope * (x - xp[j]) + fp[j]
+    if math.isnan(out):  # a nan one way: the other way (numpy ≥ 1.17)
+        out = slope * (x - xp[j + 1]) + fp[j + 1]
+        if math.isnan(out) and fp[j] == fp[j + 1]:
+            out = fp[j]
+    return out
 
 
 @njit
@@ -240,6 +274,7 @@ def play(
             for c in range(4):
                 rot_out[p, j, c] = 0.0
         # every clip's joints are turned into the hemisphere of the heaviest clip's (blend_quaternions)
+        t_ref = _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1)
         _frame_rotations(
             rotations,
             arc_next,
@@ -247,20 +282,20 @@ def play(
             arc_sin,
             start[ref],
             frames[ref],
-            _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1) * fps[ref],
+            t_ref * fps[ref],
             ref_rot,
             ref_rot,
             False,
         )
         for k in range(k_all):
+            if w[k] <= 0.0:  # no vote either: adding w·label = +0 to a sum of non-negative votes changes no bit
+                continue
             n = frames[k]
-            t1 = _clip_time(knot_x[k], knot_y[k], durations[k], ph1)
+            t1 = t_ref if k == ref else _clip_time(knot_x[k], knot_y[k], durations[k], ph1)
             if legs > 0:
                 fr = int(np.rint(t1 * fps[k])) % n
                 for c in range(legs):
                     votes[p, c] = votes[p, c] + w[k] * contacts[start[k] + fr, c]
-            if w[k] <= 0.0:
-                continue
             t0 = _clip_time(knot_x[k], knot_y[k], durations[k], ph0)
             _root_row(tables, cycles, start[k] + k, n, k, t0, fps[k], row0)
             _root_row(tables, cycles, start[k] + k, n, k, t1, fps[k], row1)

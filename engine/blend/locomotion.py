@@ -226,8 +226,10 @@ def _play_compiled(
     target: F,
     alpha: float,
     ease: bool,
-    req: _requests.Requests,
-    answers: _requests.Answers,
+    phases: F,
+    rates: F,
+    scales: F,
+    feasible: F,
     dt: float,
     out: _Out,
 ) -> None:
@@ -253,10 +255,10 @@ def _play_compiled(
         target,
         alpha,
         ease,
-        req.phases,
-        answers.rates,
-        req.scales,
-        answers.feasible,
+        phases,
+        rates,
+        scales,
+        feasible,
         dt,
         out.feasible,
         out.weights,
@@ -284,12 +286,13 @@ def animate(world: World) -> None:
 
 
 class _Out:
-    """The compiled pass's outputs for a group of ``count`` puppets: fresh arrays, or (``into``) the
-    columns themselves where the components' fields all view them (written in place, nothing to copy)."""
+    """The compiled pass's outputs for a group of ``count`` puppets (blend points of ``dims``, ``weights`` clips,
+    ``joints``, ``legs``): fresh arrays, some replaced by the columns themselves where the components' fields
+    all view them (written in place, nothing to copy after)."""
 
-    def __init__(self, count: int, dims: int, joints: int, legs: int) -> None:
+    def __init__(self, count: int, dims: int, weights: int, joints: int, legs: int) -> None:
         self.feasible = np.empty((count, dims))
-        self.weights = np.empty((count, 0))
+        self.weights = np.empty((count, weights))
         self.phase, self.wrapped, self.turn = np.empty(count), np.empty(count), np.empty(count)
         self.travel, self.roots = np.empty((count, 3)), np.empty((count, 3))
         self.rotations = np.empty((count, joints, 4))
@@ -346,8 +349,7 @@ def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt
         wrapped = new_phase % 1.0
     else:
         joints, legs = packed.rotations.shape[1], packed.contacts.shape[1]
-        out = _Out(count, target.shape[1], joints, legs)
-        out.weights = np.empty((count, len(packed.points)))
+        out = _Out(count, target.shape[1], len(packed.points), joints, legs)
         if group.poses is not None:  # posed straight into the local poses' column when they all view it
             linked = _linked(cols.get(LocalPose, "rotations", joints), group.poses, out.rotations.shape)
             if linked is not None:
@@ -360,7 +362,9 @@ def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt
         if feasible_in is not None:
             out.feasible = feasible_in
         in_place = eased is point_column.base
-        _play_compiled(packed, eased, target, float(alpha), in_place, req, answers, dt, out)
+        _play_compiled(
+            packed, eased, target, float(alpha), in_place, req.phases, answers.rates, scale, answers.feasible, dt, out
+        )
         if not in_place:
             point_column.write(players, eased)
         if feasible_in is None:
