@@ -27,6 +27,7 @@ import numpy as np
 from engine import jit
 from engine.arrays import F64 as F
 from engine.arrays import Bool
+from engine.blend._resolve import resolve_rows
 from engine.ecs import Entity
 
 if TYPE_CHECKING:
@@ -143,12 +144,10 @@ def resolve(last: dict[str, LastAnswers], key: str, loco: LocomotionSet, req: Re
         if not changed.any():
             return before.answers
         todo = np.flatnonzero(changed)
-    s = speeds if todo is None else speeds[todo]
-    h = heights.copy() if todo is None else heights[todo]
-    standing = req.standing if todo is None else req.standing[todo]
-    if standing.any():
-        h[standing] = loco.standing_heights(s[standing])
-    points, feasible, inside, rates = loco.table.resolve_many(np.stack([s, h], axis=-1))
+    if todo is None:
+        points, feasible, inside, rates = resolve_rows(loco, speeds, heights, req.standing)
+    else:
+        points, feasible, inside, rates = resolve_rows(loco, speeds[todo], heights[todo], req.standing[todo])
     if todo is not None and before is not None:
         old = before.answers
         points, part = old.points.copy(), points
