@@ -49,6 +49,7 @@ class _Group:
     locals_: tuple[LocalPose, ...]
     offsets: F
     worlds: tuple[WorldPose, ...] = ()
+    checked: tuple[NDArray[np.int64], ...] = ()  # the columns' row arrays last found to agree (_compiled)
 
 
 @dataclass
@@ -107,14 +108,21 @@ def _compiled(cols: Columns, group: _Group) -> bool:
     joints = group.skeleton.num_joints
     roots = cols.get(LocalPose, "root", joints).rows(group.locals_)
     rots = cols.get(LocalPose, "rotations", joints).rows(group.locals_)
-    if roots is None or rots is None or not np.array_equal(roots[1], rots[1]):
+    if roots is None or rots is None:
         return False
     worlds: list[tuple[NDArray[Any], NDArray[np.int64]]] = []
     for name in _WORLD_FIELDS:
         found = cols.get(WorldPose, name, joints).rows(group.worlds)
-        if found is None or (worlds and not np.array_equal(found[1], worlds[0][1])):
+        if found is None:
             return False
         worlds.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in worlds))
+    if not (len(index) == len(group.checked) and all(map(is_, index, group.checked))):
+        # The same rows in the two local and in the four world columns (checked once while the
+        # columns keep their rows: the row arrays stay the same objects).
+        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
+            return False
+        group.checked = index
     pos, rot, prev_pos, prev_rot = (found[0] for found in worlds)
     if not all(
         a.flags.c_contiguous and a.dtype == np.float64 for a in (roots[0], rots[0], pos, rot, prev_pos, prev_rot)

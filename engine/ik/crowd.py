@@ -27,7 +27,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 from itertools import repeat
-from operator import attrgetter
+from operator import attrgetter, is_
 from typing import Any
 
 import numpy as np
@@ -120,6 +120,7 @@ class CrowdPlan:
             ``(effectors, sphere_centre, foot_lock)``.
         settings, tuning, settings_array: the locks' tuning (:meth:`FootLock.settings`), one for all;
             ``tuning`` with ``enabled`` first, as each lock must still read.
+        checked: the row arrays of the members' columns last found to agree (:func:`ground_crowd`).
     """
 
     table: list[tuple[Any, ...]]
@@ -143,6 +144,7 @@ class CrowdPlan:
     tips: F
     heels: F
     knees: F
+    checked: tuple[I64, ...] = ()
 
 
 def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
@@ -255,15 +257,22 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
     roots = _place(cols, LocalPose, "root", joints, plan.locals_, (3,))
     rots = _place(cols, LocalPose, "rotations", joints, plan.locals_, (joints, 4))
     contacts = _place(cols, FootLock, "contacts", legs, locks, (legs,))
-    if roots is None or rots is None or contacts is None or not np.array_equal(roots[1], rots[1]):
+    if roots is None or rots is None or contacts is None:
         return None
     state: list[tuple[NDArray[Any], I64]] = []
     for name in _LOCK_STATE:
         found = _place(cols, FootLock, name, legs, locks, (legs, 3) if name in ("points", "animated") else (legs,),
                        _LOCK_TYPES.get(name, np.float64))  # fmt: skip
-        if found is None or (state and not np.array_equal(found[1], state[0][1])):
+        if found is None:
             return None
         state.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in state))
+    if not (len(index) == len(plan.checked) and all(map(is_, index, plan.checked))):
+        # The poses' two columns, and the locks' six, must hold the members at the same rows; the row
+        # arrays stay the same objects while the columns keep their rows, so this is checked once.
+        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
+            return None
+        plan.checked = index
     count = len(reqs)
     weight = np.fromiter(map(_WEIGHT, reqs), dtype=np.float64, count=count)
     if np.any((weight < 0.0) | (weight > 1.0)):
