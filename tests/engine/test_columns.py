@@ -155,7 +155,7 @@ def test_rows_are_where_part_of_the_batch_is_and_take_in_a_replaced_field() -> N
     """:meth:`Column.rows`: the column itself and the owners' rows, a replaced field copied into its
     row first; ``None`` for an owner not in the column or a replaced field of another shape, and
     rows looked up anew after a relink. Broken once by returning the remembered rows without the
-    per-call check (the replaced field was then not taken in: the row kept 2.0)."""
+    per-call check (the replaced field was then not taken in: the row kept its old values)."""
     poses = _poses(5)
     col = Column("root")
     col.write(poses, np.arange(15.0).reshape(5, 3))
