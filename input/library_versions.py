@@ -6,13 +6,20 @@ stores the versions it was made with (``libraries``), and ``replay`` says in one
 running ones differ ("recorded with mujoco 4.0.0, running 3.17.0: hashes may differ"), before
 a hash mismatch leaves the person guessing. Recordings made before the header had them
 (the shipped ones among them) carry none, and are replayed without the line.
+
+Beside the versions, the same map keeps what the CPU makes of them: the machine (``x86_64``,
+``aarch64``: another instruction set runs other code) and ``numpy-simd``, the widest SIMD
+target numpy's kernels dispatch to here (``X86_V3`` is AVX2; the launcher caps it there,
+:mod:`puppetphone.simd_ceiling`, since the AVX-512 kernels round differently).
 """
 
 from __future__ import annotations
 
+import importlib
+import platform
 from functools import lru_cache
 
-__all__ = ["NUMERIC_LIBRARIES", "libraries_problem", "running_versions", "version_difference"]
+__all__ = ["NUMERIC_LIBRARIES", "libraries_problem", "numpy_simd_level", "running_versions", "version_difference"]
 
 #: The distributions whose version can change a state hash: exactly the ones constraints.txt pins.
 NUMERIC_LIBRARIES = (
@@ -42,11 +49,29 @@ def _versions() -> tuple[tuple[str, str], ...]:
             found.append((name, version(name)))
         except PackageNotFoundError:
             found.append((name, "none"))  # not installed: recorded as such, so a later install is noticed
+    found.append(("numpy-simd", numpy_simd_level()))
+    found.append(("machine", platform.machine() or "unknown"))
     return tuple(found)
 
 
+def numpy_simd_level() -> str:
+    """The widest SIMD target numpy dispatches to in this process ("X86_V3", "AVX512_SKX", …, or "baseline")."""
+    for where in ("numpy._core._multiarray_umath", "numpy.core._multiarray_umath"):  # numpy 2, numpy 1
+        try:
+            umath = importlib.import_module(where)
+        except ImportError:
+            continue
+        break
+    else:
+        return "unknown"
+    features, targets = umath.__cpu_features__, umath.__cpu_dispatch__
+    enabled = [t for t in targets if features.get(t)]
+    return enabled[-1] if enabled else "baseline"
+
+
 def running_versions() -> dict[str, str]:
-    """``{distribution: version}`` of :data:`NUMERIC_LIBRARIES` in this process ("none" when absent)."""
+    """``{distribution: version}`` of :data:`NUMERIC_LIBRARIES` in this process ("none" when absent),
+    with ``numpy-simd`` and ``machine`` (see the module docstring)."""
     return dict(_versions())
 
 

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+import puppetphone  # noqa: F401  (first: caps numpy's SIMD before numpy loads, as the launcher does; puppetphone.simd_ceiling)
+
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from input.hub import InputHub
-from input.library_versions import NUMERIC_LIBRARIES, running_versions, version_difference
+from input.library_versions import NUMERIC_LIBRARIES, numpy_simd_level, running_versions, version_difference
 from input.recording import MAGIC, Recorder, RecordingError, RecordingHeader, read_recording
 from puppetphone.games import make_app
 
@@ -86,7 +86,8 @@ def recording(tmp_path: Path) -> Path:
 
 def test_a_new_recording_keeps_the_running_versions_and_replays_without_a_note(recording: Path) -> None:
     assert read_recording(recording).header.libraries == running_versions()
-    assert set(running_versions()) == set(NUMERIC_LIBRARIES) and running_versions()["numpy"] != "none"
+    assert set(running_versions()) == {*NUMERIC_LIBRARIES, "numpy-simd", "machine"}
+    assert running_versions()["numpy"] != "none" and running_versions()["numpy-simd"] == numpy_simd_level()
     done = _replay(recording)
     assert done.returncode == 0 and "hashes may differ" not in done.stderr, done.stderr
 
@@ -98,6 +99,24 @@ def test_a_recording_made_with_another_mujoco_says_so_in_one_line_and_still_repl
     notes = [line for line in done.stderr.splitlines() if "hashes may differ" in line]
     assert notes == [f"note: recorded with mujoco 0.0.1, running {running}: hashes may differ"], done.stderr
     assert done.returncode == 0 and "all 10 state hashes match" in done.stdout
+
+
+def test_a_recording_made_on_an_avx512_machine_says_so_in_one_line_and_still_replays(recording: Path) -> None:
+    """Made where numpy ran its AVX-512 kernels (a program that imported numpy before the launcher's cap)."""
+    running = numpy_simd_level()
+    _with_header(recording, lambda head: head["libraries"].update({"numpy-simd": "X86_V4"}))
+    done = _replay(recording)
+    notes = [line for line in done.stderr.splitlines() if "hashes may differ" in line]
+    assert notes == [f"note: recorded with numpy-simd X86_V4, running {running}: hashes may differ"], done.stderr
+    assert done.returncode == 0 and "all 10 state hashes match" in done.stdout
+
+
+def test_the_simd_level_is_the_widest_target_numpy_has_enabled() -> None:
+    from numpy._core import _multiarray_umath as umath  # type: ignore[attr-defined]  # private, no stubs
+
+    enabled = [t for t in umath.__cpu_dispatch__ if umath.__cpu_features__[t]]
+    assert numpy_simd_level() == (enabled[-1] if enabled else "baseline")
+    assert numpy_simd_level() not in ("X86_V4", "AVX512_ICL", "AVX512_SPR")  # the launcher's cap held here
 
 
 def test_a_recording_from_before_the_versions_reads_and_verifies_with_no_note(recording: Path) -> None:
