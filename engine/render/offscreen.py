@@ -15,6 +15,7 @@ import moderngl
 import numpy as np
 from numpy.typing import NDArray
 
+from engine.render.bgra import colour_texture, release_texture
 from engine.render.target import save_image
 
 __all__ = ["OffscreenBuffers", "is_software"]
@@ -28,6 +29,8 @@ def is_software(ctx: moderngl.Context) -> bool:
 
 class OffscreenBuffers:
     """A ``width`` x ``height`` RGBA8 + depth framebuffer with optional MSAA.
+
+    Its resolved colour is a texture (:func:`~engine.render.bgra.colour_texture`), not a renderbuffer.
 
     ``samples=None`` picks 4x MSAA on a GPU and none on a software rasteriser, where
     multisampling multiplies the frame cost (measured: 4x MSAA quadrupled it on llvmpipe).
@@ -44,8 +47,11 @@ class OffscreenBuffers:
     def _make(self, width: int, height: int) -> None:
         size = (width, height)
         ctx = self.ctx
+        # A colour texture stored as BGRA on a software rasteriser: the scale-up of quality low
+        # and medium can then take llvmpipe's fast copying path (see engine.render.bgra).
         self.resolved = ctx.framebuffer(
-            color_attachments=[ctx.renderbuffer(size, 4)], depth_attachment=ctx.depth_renderbuffer(size)
+            color_attachments=[colour_texture(ctx, size, is_software(ctx))],
+            depth_attachment=ctx.depth_renderbuffer(size),
         )
         # The same colour renderbuffer without depth: what a window presents (a blit to
         # the default framebuffer must not include depth, whose format may differ).
@@ -99,7 +105,9 @@ class OffscreenBuffers:
         for fb in (self.resolved, self._msaa):
             if fb is not None:
                 for att in (*fb.color_attachments, fb.depth_attachment):
-                    if att is not None:
+                    if isinstance(att, moderngl.Texture):
+                        release_texture(att)
+                    elif att is not None:
                         att.release()
                 fb.release()
         self._msaa = None

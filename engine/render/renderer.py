@@ -4,7 +4,8 @@ Passes, in order (each kind of primitive is one instanced draw call):
 
 1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
    (:mod:`engine.render.shadows`), both fitted around the casters each frame, and kept from the
-   last frame when nothing they are drawn from changed (``reuse_shadows``).
+   last frame when nothing they are drawn from changed (``reuse_shadows``); the scenery's part
+   of the map (cones, boxes) is kept while it and the sun's matrix stay.
 2. **outline** — highlighted items, inflated by a few pixels and drawn with front-face
    culling in a flat colour: only a rim around the silhouette stays visible.
 3. **objects** — capsules, spheres, cones, boxes, lit by sun, sky ambient and shadow; capsules
@@ -44,12 +45,14 @@ from engine.camera import Camera
 from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
+from engine.render.bgra import colour_texture, release_texture
 from engine.render.env_meshes import cone_mesh
 from engine.render.environment import RIDGE_RADIUS, Environment, ground_fills_view
 from engine.render.gpu import Instances, LodBatches, Releasable, mesh_buffers, set_uniform
 from engine.render.impostors import Impostors
 from engine.render.lod import LEVELS, LIMITS, choose_levels, level_meshes
 from engine.render.noise import snow_noise
+from engine.render.offscreen import is_software
 from engine.render.quality import QUALITIES, Quality
 from engine.render.scene import BOX_STRIDE, CAPSULE_STRIDE, CONE_STRIDE, LINE_STRIDE, POINT_STRIDE, RenderScene
 from engine.render.shadows import BOX_FMT, CAPSULE_FMT, Shadows, ground_rect, light_matrix
@@ -235,6 +238,8 @@ class Renderer:
         self.quality = quality
         self.shadows = Shadows(ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask, self._inst["cones"])
         self._scaled: tuple[moderngl.Framebuffer, moderngl.Texture] | None = None
+        self._colour_only: tuple[object, moderngl.Framebuffer] | None = None
+        """The target's colour attachment and a framebuffer of it alone (the scale-up draws there)."""
         self._blank = ctx.texture((1, 1), 3, bytes([255, 255, 255]))
         noise = snow_noise()
         self._noise = ctx.texture(noise.shape[:2][::-1], 4, noise.tobytes())
@@ -308,7 +313,7 @@ class Renderer:
         size = (max(1, round(w * s)), max(1, round(h * s)))
         if self._scaled is None or self._scaled[1].size != size:
             self._release_scaled()
-            tex = self.ctx.texture(size, 4)
+            tex = colour_texture(self.ctx, size, is_software(self.ctx))  # BGRA: see _upscale
             tex.filter = (moderngl.NEAREST, moderngl.NEAREST)  # the scale-up's fetch (see _UPSCALE_FS)
             tex.repeat_x = tex.repeat_y = False
             self._scaled = (self.ctx.framebuffer([tex], self.ctx.depth_renderbuffer(size)), tex)
@@ -319,8 +324,23 @@ class Renderer:
             fbo, tex = self._scaled
             fbo.depth_attachment.release()
             fbo.release()
-            tex.release()
+            release_texture(tex)
             self._scaled = None
+        if self._colour_only is not None:
+            self._colour_only[1].release()
+            self._colour_only = None
+
+    def _colour_target(self, framebuffer: moderngl.Framebuffer) -> moderngl.Framebuffer:
+        """``framebuffer``'s first colour attachment alone (made once per attachment), or ``framebuffer``
+        itself when it has no depth to leave out (or no attachment to take, as a window's own)."""
+        if framebuffer.depth_attachment is None or not framebuffer.color_attachments:
+            return framebuffer
+        colour = framebuffer.color_attachments[0]
+        if self._colour_only is None or self._colour_only[0] is not colour:
+            if self._colour_only is not None:
+                self._colour_only[1].release()
+            self._colour_only = (colour, self.ctx.framebuffer(color_attachments=[colour]))
+        return self._colour_only[1]
 
     # -- frame ------------------------------------------------------------------------
     def render(self, scene: RenderScene, camera: Camera, framebuffer: moderngl.Framebuffer) -> None:
@@ -415,6 +435,7 @@ class Renderer:
         target.depth_mask = True
         if target is not framebuffer:
             self._upscale(framebuffer)
+            framebuffer.use()  # the text, and whatever the caller draws next, go to the frame itself
         self._mark("upscale")
         ctx.enable_only(moderngl.BLEND)
         self._draw_text(scene, framebuffer.size)
@@ -472,10 +493,17 @@ class Renderer:
         ctx.enable_only(moderngl.DEPTH_TEST)
 
     def _upscale(self, framebuffer: moderngl.Framebuffer) -> None:
-        """Stretch the smaller 3-D buffer over ``framebuffer`` (nearest texel)."""
+        """Stretch the smaller 3-D buffer over ``framebuffer`` (nearest texel).
+
+        Drawn into the colour attachment alone: with no depth buffer bound, a BGRA source and
+        destination (:mod:`engine.render.bgra`), one texture fetch and no blending, llvmpipe
+        copies the texels on its linear path instead of shading each pixel (same pixels,
+        measured 5.6 -> 3 ms at 1280x720). Nothing after this pass reads the depth.
+        """
         assert self._scaled is not None
-        framebuffer.use()
-        framebuffer.viewport = (0, 0, *framebuffer.size)
+        target = self._colour_target(framebuffer)
+        target.use()
+        target.viewport = (0, 0, *framebuffer.size)
         self.ctx.enable_only(moderngl.NOTHING)
         self._scaled[1].use(location=0)
         set_uniform(self._programs["upscale"], "u_tex", 0)

@@ -9,6 +9,12 @@
   one request and a crowd's 100, against SciPy's ``cKDTree`` query plus textbook IDW (weights
   ``1/dᵖ`` over the same k neighbours) — the peer does less (no slopes, no exact-hit guard), so
   this is generous to it. Ours weights the neighbours in one compiled loop when numba is installed.
+- ``peer_animate_fk_100_puppets_ms``: the animation and FK stages of the 100-puppet sandbox crowd
+  (:func:`puppetphone.bench.crowd.crowd_app`, the step's own systems) against 100 Panda3D characters
+  of our skeleton playing and blending our walk and run clips, every joint forced to update each
+  frame (:mod:`puppetphone.bench.anim_panda`, in its own process). Each side: the median of
+  :data:`REPEATS` repeats, each the mean thread CPU time of 60 frames. Skipped with a line when
+  Panda3D (the ``[peers]`` extra) is absent.
 
 Every figure is the median of :data:`REPEATS` samples, each sample the mean of enough calls to
 run :data:`SAMPLE_S` seconds of thread CPU time.
@@ -32,7 +38,7 @@ from engine.humanoid import humanoid_skeleton
 from engine.skeleton import Skeleton
 from puppetphone.bench.figures import Figure, median_time
 
-__all__ = ["run", "cpu_time", "pinocchio_model", "REPEATS"]
+__all__ = ["run", "cpu_time", "pinocchio_model", "animate_fk_ms", "panda_animate_fk_ms", "REPEATS"]
 
 REPEATS = 5
 SAMPLE_S = 0.05
@@ -60,6 +66,35 @@ def _pin_configs(rots: np.ndarray, roots: np.ndarray) -> list[np.ndarray]:
     """Our ``[P,J,4]`` (w, x, y, z) poses as pinocchio configurations (x, y, z, w quaternions)."""
     xyzw = np.concatenate([rots[..., 1:], rots[..., :1]], axis=-1)
     return [np.concatenate([roots[i], xyzw[i].ravel()]) for i in range(len(roots))]
+
+
+def animate_fk_ms(frames: int = 60, repeats: int = REPEATS) -> float:
+    """Our animation + FK stages for the 100-puppet crowd: median over ``repeats`` of the mean thread
+    CPU milliseconds per step."""
+    from puppetphone.bench.crowd import crowd_app, timed_steps
+
+    app = crowd_app(100)
+    samples = []
+    for _ in range(repeats):
+        _, per = timed_steps(app, frames)
+        samples.append(float(np.mean(per["animation"] + per["fk"])) * 1e3)
+    return float(np.median(samples))
+
+
+def panda_animate_fk_ms() -> float | str:
+    """Panda3D's 100 characters (:mod:`puppetphone.bench.anim_panda`, its own process): milliseconds
+    per frame, or the line saying why the peer was skipped."""
+    import importlib.util
+    import subprocess
+
+    if importlib.util.find_spec("panda3d") is None:
+        return "peers: Panda3D not installed (pip install '.[peers]'): animate+FK peer skipped"
+    done = subprocess.run(
+        [sys.executable, "-m", "puppetphone.bench.anim_panda"], capture_output=True, text=True, timeout=600, check=False
+    )
+    if done.returncode != 0 or not done.stdout.split():
+        return f"peers: the Panda3D animation peer failed ({done.returncode}): {done.stderr.strip()[-200:]}"
+    return float(done.stdout.split()[-1]) * 1e3
 
 
 def run() -> list[Figure]:
@@ -116,6 +151,20 @@ def run() -> list[Figure]:
         w = 1.0 / np.maximum(dist, 1e-12) ** power
         return np.einsum("...k,...kn->...n", w, table.probes[idx]) / w.sum(axis=-1, keepdims=True)
 
+    theirs_ms = panda_animate_fk_ms()
+    if isinstance(theirs_ms, str):
+        print(theirs_ms, file=sys.stderr)
+    else:
+        figures.append(
+            Figure(
+                _BENCH,
+                "peer_animate_fk_100_puppets_ms",
+                animate_fk_ms(),
+                "ms",
+                "Panda3D, 100 characters blending 2 clips, forced update",
+                theirs_ms,
+            )
+        )
     lo, hi = table.values.min(axis=0), table.values.max(axis=0)
     many = lo + rng.random((puppets, len(lo))) * (hi - lo)
     one = many[0]

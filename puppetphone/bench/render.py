@@ -24,6 +24,12 @@ of 3 repeats of several frames each (:func:`cpu_frame_time`):
   ``flat_fill_ms_1280x720``: a clear plus one flat-colour triangle over the screen, the
   least any per-pixel pass costs on this rasteriser (what a drawn sky and ground can
   approach, not beat).
+  At ``low`` the empty frame is more than sky and ground: the clear of the half-size buffer
+  (~0.7 ms), the frame's Python (uniforms, culling of nothing: ~0.8 ms), the ground mesh at
+  640x360 (~2.2 ms: 0.4 of it vertex work; the sky is not drawn, the ground fills the view)
+  and the scale-up of that buffer over 1280x720 pixels (~3 ms on llvmpipe's linear path,
+  :mod:`engine.render.bgra`; 4.5-5.6 ms before). The scale-up alone writes as many pixels as
+  the clear it is compared with, so this figure cannot reach a clear while ``low`` scales up.
 
 These machines are shared, so wall-clock frame rates swing with other people's load. The
 bench therefore also reads each thread's CPU time per frame from ``/proc`` (Linux): the
