@@ -58,7 +58,7 @@ def test_certificate_is_made_once_kept_private_and_served(tmp_path, certificate,
     assert not again.created and certificate.created and again.fingerprint == certificate.fingerprint
     assert stat.S_IMODE(os.stat(certificate.key_path).st_mode) == 0o600
     with (
-        socket.create_connection(("127.0.0.1", source.port)) as raw,
+        socket.create_connection(("127.0.0.1", source.port), timeout=10) as raw,
         _tls().wrap_socket(raw, server_hostname="localhost") as tls,
     ):
         served = tls.getpeercert(binary_form=True)
