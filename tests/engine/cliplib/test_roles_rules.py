@@ -270,3 +270,23 @@ def test_a_loop_a_little_off_sixty_frames_a_second_is_resampled() -> None:
     )
     assert 60.5 < raw.fps < 61.0
     assert conform(raw, "walk").fps == 60.0
+
+
+@pytest.mark.parametrize(("faster", "planted"), [(1.3, True), (1.6, False)])
+def test_a_foot_skating_faster_than_0_6_m_s_does_not_plant(faster: float, planted: bool) -> None:
+    """The built-in walk (1.3 m/s) with its root motion sped up: its stance feet skate at ``(faster − 1)·1.3``
+    m/s. Skating at 0.39 m/s is still a walk; at 0.78 m/s neither foot plants (both speeds are in the walk's
+    0.5–2.2 m/s range, so only the contact check decides). Kills the second round's survivors of
+    ``check_role``'s contact speed: ``max_speed=0.6`` dropped (the 0.3 m/s default refuses the first) or made
+    1.6 (accepts the second) — both applied by hand to ``engine/cliplib/roles.py``, each fails one case.
+    """
+    walk = default_clips()["walk"]
+    rm = walk.root_motion
+    assert rm is not None
+    skating = replace(walk, root_motion=RootMotion(rm.translation * faster, rm.heading), name="skating")
+    assert 0.5 <= skating.average_speed() <= 2.2
+    if planted:
+        check_role(skating, "walk", SK)
+    else:
+        with pytest.raises(RoleError, match="plants both feet in turn; in 'skating' the left foot never touches"):
+            check_role(skating, "walk", SK)
