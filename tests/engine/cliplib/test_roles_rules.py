@@ -272,6 +272,14 @@ def test_a_loop_a_little_off_sixty_frames_a_second_is_resampled() -> None:
     assert conform(raw, "walk").fps == 60.0
 
 
+def _skating(faster: float) -> Clip:
+    """The built-in walk (1.3 m/s) with its root motion sped up: its stance feet skate at ``(faster − 1)·1.3`` m/s."""
+    walk = default_clips()["walk"]
+    rm = walk.root_motion
+    assert rm is not None
+    return replace(walk, root_motion=RootMotion(rm.translation * faster, rm.heading), name="skating")
+
+
 @pytest.mark.parametrize(("faster", "planted"), [(1.3, True), (1.6, False)])
 def test_a_foot_skating_faster_than_0_6_m_s_does_not_plant(faster: float, planted: bool) -> None:
     """The built-in walk (1.3 m/s) with its root motion sped up: its stance feet skate at ``(faster − 1)·1.3``
@@ -280,13 +288,27 @@ def test_a_foot_skating_faster_than_0_6_m_s_does_not_plant(faster: float, plante
     ``check_role``'s contact speed: ``max_speed=0.6`` dropped (the 0.3 m/s default refuses the first) or made
     1.6 (accepts the second) — both applied by hand to ``engine/cliplib/roles.py``, each fails one case.
     """
-    walk = default_clips()["walk"]
-    rm = walk.root_motion
-    assert rm is not None
-    skating = replace(walk, root_motion=RootMotion(rm.translation * faster, rm.heading), name="skating")
+    skating = _skating(faster)
     assert 0.5 <= skating.average_speed() <= 2.2
     if planted:
         check_role(skating, "walk", SK)
     else:
         with pytest.raises(RoleError, match="plants both feet in turn; in 'skating' the left foot never touches"):
             check_role(skating, "walk", SK)
+
+
+@pytest.mark.parametrize(("faster", "lands"), [(1.3, True), (1.6, False)])
+def test_a_heel_strike_is_a_landing_slower_than_0_6_m_s(faster: float, lands: bool) -> None:
+    """The heel-strike markers use the role check's contact speed: feet skating at 0.39 m/s still land (two
+    markers in the cycle), at 0.78 m/s they never do. Kills the second round's survivors of ``_heel_strikes``'
+    ``max_speed=0.6`` dropped (the 0.3 m/s default: no landing at 0.39) or made 1.6 (a landing at 0.78) —
+    both applied by hand to ``engine/cliplib/roles.py``, each fails one case.
+    """
+    skating = _skating(faster)
+    if lands:
+        marks = roles._heel_strikes(skating)
+        assert set(marks) == {"left_down", "right_down"}
+        assert all(0.0 <= t < 1.0 for t in marks.values())
+    else:
+        with pytest.raises(RoleError, match="'skating': the left foot never lands"):
+            roles._heel_strikes(skating)
