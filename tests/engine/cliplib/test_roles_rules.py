@@ -66,6 +66,24 @@ def test_a_glitch_on_the_first_frame_is_a_seam_jump_too() -> None:
         check_role(_jolted(default_clips()["walk"], "l_hand", 0, 4.0), "walk", SK)
 
 
+def test_a_few_jumps_inside_the_clip_do_not_excuse_the_seam() -> None:
+    """The hand, still in the walk, given four jumps among its 65 steps (10° in and out of frame 10, 13.5°
+    at frame 40 where it stays turned, 13.5° more on the last frame): its seam jumps 27°. The usual step is
+    the 95th percentile of the steps, 0.8 of the way from the still ones to the smallest jump: 8°, so the
+    allowance is 24° and the seam is refused. Kills the second round's survivor ``np.percentile(step, 96.0)``
+    (the usual step is then 10° and 27° passes), applied by hand to ``engine/cliplib/roles.py``.
+    """
+    walk = default_clips()["walk"]
+    hand = SK.index("l_hand")
+    rot = np.array(walk.rotations)
+    rot[10, hand] = quat.mul(rot[10, hand], quat.from_axis_angle(_X, np.radians(10.0)))
+    rot[40:, hand] = quat.mul(rot[40:, hand], quat.from_axis_angle(_X, np.radians(13.5)))
+    rot[-1, hand] = quat.mul(rot[-1, hand], quat.from_axis_angle(_X, np.radians(13.5)))
+    assert walk.num_frames == 66 and np.count_nonzero(_steps(rot)[:, hand] > 1.0) == 4
+    with pytest.raises(RoleError, match=r"last frame jumps 27° at l_hand .* steps inside are up to 8\.0°"):
+        check_role(replace(walk, rotations=rot, name="glitchy"), "walk", SK)
+
+
 @pytest.mark.parametrize(("factor", "refused"), [(2.5, False), (3.5, True)])
 def test_a_moving_joint_may_jump_three_of_its_usual_steps(factor: float, refused: bool) -> None:
     """The knee's usual step (95th percentile between frames) is about 6.4°: the seam may jump up to 3×."""
