@@ -66,6 +66,28 @@ def test_a_glitch_on_the_first_frame_is_a_seam_jump_too() -> None:
         check_role(_jolted(default_clips()["walk"], "l_hand", 0, 4.0), "walk", SK)
 
 
+def test_of_two_joints_jumping_at_the_seam_the_one_furthest_past_its_allowance_is_named() -> None:
+    """The still hand jumps 2.6° (0.6° past its 2° floor), the knee 0.3° past three of its usual steps: the
+    hand is named. Kills the second round's "near-equivalent" survivor, ``_seam_jump``'s floor made 3°
+    (``np.maximum(_SEAM_FACTOR * usual, 3.0)``): the hand is then 0.4° *inside* it and the knee is named —
+    the clip is refused either way, only the joint in the message changes. Applied by hand to
+    ``engine/cliplib/roles.py``.
+    """
+    walk = default_clips()["walk"]
+    knee, hand = SK.index("l_lower_leg"), SK.index("l_hand")
+    rot = np.array(walk.rotations)
+    rot[-1, hand] = quat.mul(rot[-1, hand], quat.from_axis_angle(_X, np.radians(2.6)))
+    jump = 3.0 * float(np.percentile(_steps(rot)[:, knee], 95.0)) + 0.3
+    for _ in range(5):  # the last frame's knee is one of its steps too: settle the usual step it sees
+        rot[-1, knee] = quat.mul(rot[0, knee], quat.from_axis_angle(_X, np.radians(jump)))
+        jump = 3.0 * float(np.percentile(_steps(rot)[:, knee], 95.0)) + 0.3
+    usual = float(np.percentile(_steps(rot)[:, knee], 95.0))
+    seam = float(np.degrees(2.0 * np.arccos(min(1.0, abs(float(rot[0, knee] @ rot[-1, knee]))))))
+    assert 0.2 < seam - 3.0 * usual < 0.4 and 3.0 * usual > 3.0  # past its allowance, which is not the floor
+    with pytest.raises(RoleError, match=r"'two' does not loop: its last frame jumps 3° at l_hand "):
+        check_role(replace(walk, rotations=rot, name="two"), "walk", SK)
+
+
 def test_a_few_jumps_inside_the_clip_do_not_excuse_the_seam() -> None:
     """The hand, still in the walk, given four jumps among its 65 steps (10° in and out of frame 10, 13.5°
     at frame 40 where it stays turned, 13.5° more on the last frame): its seam jumps 27°. The usual step is
