@@ -22,7 +22,7 @@ const state = {
 const worker = new Worker("stream_worker.js");
 worker.onerror = (e) => { $("status").textContent = "stream: " + e.message; };
 const stream = new SceneStream(), counter = new FrameCounter();
-let renderer = null, drawsHere = false, painter = null;
+let renderer = null, drawsHere = false, painter = null, looping = false;
 // What the bench and the tests read: frames drawn, the step on screen, frames per second, who draws;
 // report() gives the logs (per step: published, reached the stream worker, decoded, available to the
 // drawer; and when each step was first drawn), all in ms since the epoch.
@@ -52,6 +52,7 @@ function drawHere(reason) {
   worker.postMessage({ drawer: null });
   try { renderer = new PageRenderer(canvas, { xrCompatible: true }); } catch (err) { $("fps").textContent = "view: " + err.message; }
   if (reason) $("status").textContent = "view: " + reason;
+  startDrawing();
 }
 
 function onPainter(e) {
@@ -203,10 +204,15 @@ function confirmCalibration() {
   setTimeout(() => { $("calibrated").hidden = true; }, 1500);
 }
 
-// The magic window on this thread (where the worker cannot draw): the newest frames, interpolated.
+// The magic window on this thread (where the worker cannot draw): the newest frames, interpolated. The loop
+// runs only while this thread draws: an idle animation frame loop here cost the page's main thread a frame
+// (style, layout, paint, commit) every 16.7 ms, on the cores the software rasteriser and the stream need.
+function startDrawing() { if (!looping && drawsHere && state.kind !== "xr") { looping = true; requestAnimationFrame(drawFrame); } }
 function drawFrame(now) {
-  if (state.kind !== "xr") requestAnimationFrame(drawFrame);
-  if (!drawsHere || !renderer || !stream.extras) return;
+  looping = drawsHere && state.kind !== "xr";
+  if (!looping) return;
+  requestAnimationFrame(drawFrame);
+  if (!renderer || !stream.extras) return;
   const canvas = $("view"), [cw, ch] = canvasSize();
   const w = Math.max(1, Math.round(cw * counter.resolution)), h = Math.max(1, Math.round(ch * counter.resolution));
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
@@ -274,7 +280,7 @@ async function startXR() {
   session.addEventListener("end", () => {
     state.kind = "orientation"; state.sensor = "orientation"; state.placement = null; document.body.classList.remove("ar");
     if (painter && !drawsHere) { const link = new MessageChannel(); painter.postMessage({ pause: false, port: link.port2 }, [link.port2]); worker.postMessage({ drawer: link.port1 }, [link.port1]); }
-    setMode(); requestAnimationFrame(drawFrame);
+    setMode(); startDrawing();
   });
   session.requestAnimationFrame(frame);
 }
@@ -324,4 +330,4 @@ setInterval(() => { if (performance.now() - state.lastSent > 250) sendReading();
 setInterval(() => send({ ping: clock() }), 1000);
 setMode();
 connect();
-requestAnimationFrame(drawFrame);
+startDrawing();
