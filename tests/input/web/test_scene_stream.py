@@ -337,8 +337,9 @@ onmessage({{ data: {{ drawer: port }} }});
 
 @needs_node
 def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
-    """Every frame is acknowledged to the engine as soon as it is decoded; the drawer gets at most two frames
-    it has not taken, then, once it takes one, the newest frame (not the next in a queue). Each message
+    """Every frame is acknowledged to the engine as soon as it is decoded; the drawer gets at most four frames
+    it has not taken (one drawing's wait in software compositing), then, once it takes one, the newest frame
+    (not the next in a queue). Each message
     carries only the kinds that changed since the drawer's last one (the trees once) and, of the tracks, the
     block of cells changed since (the whole grid first); the drawer's picture is then the decoder's, cell for
     cell. (A worker that posts every frame fails the count; one that keeps a queue fails the newest step;
@@ -359,13 +360,13 @@ console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn
 """,
     )
     assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
-    assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
-    assert out["after"] == 3 and out["end"] == 3
-    first, second, newest = out["drawn"]
+    assert out["before"] == 4, f"{out['before']} frames given to a drawer that took none"
+    assert out["after"] == 5 and out["end"] == 5
+    first, second, _, _, newest = out["drawn"]
     assert first["step"] == 1 and first["extras"] and first["marks"] == "grid" and "cones" in first["kinds"]
     assert second["step"] == 2 and not second["extras"] and second["marks"] == "same"
     assert "cones" not in second["kinds"] and "capsules" in second["kinds"], second["kinds"]
     assert newest["step"] == 7 and newest["marks"] == "patch"
-    # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4); step 6 was held back and replaced by 7.
+    # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4); steps 5 and 6 were held back and replaced by 7.
     assert newest["rect"] == [50, 50, 61, 74]
     assert out["rows"] and out["cells"], "the drawer's picture is not the decoder's"
