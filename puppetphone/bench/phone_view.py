@@ -15,6 +15,13 @@
   page also notes when the frame reached its stream worker and when it was decoded
   there. All are against the engine's publication time (end of the step); every clock
   is this machine's system clock.
+  Under the bench's software compositing (``--disable-gpu``) each drawing holds the render
+  worker until the rasteriser has finished the picture and it is read back (``GLES2::ReadPixels``
+  in ``OffscreenCanvas::PushFrame``: 20-50 ms a drawing, most of the worker's time in a
+  trace): a frame decoded meanwhile waits in that worker's queue, so *available* − *decoded* is
+  the drawing's cadence, not a queue of frames (at most 4 are in flight to the drawer). GPU
+  compositing on SwiftShader frees the worker, but the display then shows about half the
+  drawings (a trace counts the ``Display::DrawAndSwap``), so the bench keeps software compositing.
 - **Step → client latency** on loopback, the same session with a Python WebSocket client
   in place of the browser (it decodes and acknowledges at once): the engine's and the
   network's part of the latency, without the page's main thread.
