@@ -265,7 +265,8 @@ class PhysicsWorld(Readback, Building):
         if not keys:
             return []
         C = self.commands
-        rows = C.rows(keys)
+        want = np.asarray(keys, dtype=np.int64)
+        rows = C.rows(want)
         sizes: I64 = C.joints[rows]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
@@ -275,14 +276,17 @@ class PhysicsWorld(Readback, Building):
             q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
         if q.shape != (int(sizes.sum()), 4):
             raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes.tolist()}")
-        ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
-        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
-        q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
-        if ok.all() and C.whole(keys):  # the whole crowd in key order, every target good
-            C.root[:], C.rot[:] = r, q
+        finite = np.isfinite(q)
+        if finite.all() and np.isfinite(r).all() and C.whole(want):
+            # the whole crowd in key order, every target good (a walking crowd): nothing to refuse or select
+            C.root[:] = r
+            C.rot[:] = quat.normalize(q)
             C.kinematic[:] = True
             C.muscle[:] = C.pin[:] = C.support[:] = 1.0
             return []
+        ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
+        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(finite.all(axis=1), ends - sizes)
+        q = quat.normalize(np.where(finite, q, quat.identity()))  # refused rows are not used
         good = rows[ok]
         C.root[good] = r[ok]
         C.rot[joint_rows(C.starts, good)] = q[np.repeat(ok, sizes)]
