@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.app import App
+from engine.arrays import I64
 from engine.columns import columns
 from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import Entity, World
@@ -104,7 +105,8 @@ def physics_step(world: World) -> None:
                 simulated.append((e, rd, pose))
             if rd.held is not None or e in holding:
                 held.append((e, rd))
-        keys, poses = [row[0] for row in animated], tuple(row[3] for row in animated)
+        keys = np.array([row[0] for row in animated], dtype=np.int64)
+        poses = tuple(row[3] for row in animated)
     refused = pw.drive_animated(keys, *_animated_targets(world, pw, keys, poses))
     targets: dict[Entity, Pose] = {}
     for e, rd, pose in simulated:
@@ -157,7 +159,7 @@ class WalkingCrowd:
     SIM_STATE: ClassVar[bool] = False
     table: list[tuple[Entity, Ragdoll, Puppet, LocalPose]]
     ragdolls: tuple[Ragdoll, ...]
-    keys: list[Entity]
+    keys: I64
     poses: tuple[LocalPose, ...]
 
 
@@ -166,7 +168,12 @@ def _walking(world: World, table: list[tuple[Entity, Ragdoll, Puppet, LocalPose]
     (what the stage's loop would find row by row, found in C-level passes); ``None`` otherwise."""
     crowd = world.try_resource(WalkingCrowd)
     if crowd is None or crowd.table is not table:
-        crowd = WalkingCrowd(table, tuple(r[1] for r in table), [r[0] for r in table], tuple(r[3] for r in table))
+        crowd = WalkingCrowd(
+            table,
+            tuple(r[1] for r in table),
+            np.array([r[0] for r in table], dtype=np.int64),
+            tuple(r[3] for r in table),
+        )
         world.insert_resource(crowd)
     rds = crowd.ragdolls
     if list(map(_MODE_HELD, rds)).count((RagdollMode.ANIMATED, None)) != len(rds):
@@ -177,7 +184,7 @@ def _walking(world: World, table: list[tuple[Entity, Ragdoll, Puppet, LocalPose]
 
 
 def _animated_targets(
-    world: World, pw: PhysicsWorld, keys: list[Entity], poses: Sequence[LocalPose]
+    world: World, pw: PhysicsWorld, keys: I64, poses: Sequence[LocalPose]
 ) -> tuple[NDArray[np.float64] | list[NDArray[np.float64]], NDArray[np.float64] | list[NDArray[np.float64]]]:
     """The animated ragdolls' targets: their local poses' roots ``[P, 3]`` and rotations ``[P, J, 4]``
     read from the pose columns (:mod:`engine.columns`) when all have ``J`` joints, else as lists."""
