@@ -60,7 +60,7 @@ _SETTLE = attrgetter("settle")
 #: What a member's request, puppet and lock must keep for the plan to hold (compared as tuples, in C).
 _REQUEST = attrgetter("effectors", "sphere_centre", "foot_lock")
 _PUPPET = attrgetter("skeleton", "offsets")
-_TUNING_FIELDS = (
+_TUNING = attrgetter(
     "enabled",
     "release_time",
     "max_stretch",
@@ -71,12 +71,6 @@ _TUNING_FIELDS = (
     "step_time",
     "step_height",
 )
-_TUNING = attrgetter(*_TUNING_FIELDS)
-#: A lock's tuning and the fields the pass updates in their columns (contacts, then ``_LOCK_STATE``),
-#: and a pose's two columns: read in one pass per kind of component, to check that each still
-#: has its tuning and still views its rows (:attr:`CrowdPlan.placed`).
-_LOCK_FIELDS = attrgetter(*_TUNING_FIELDS, "contacts", *_LOCK_STATE)
-_POSE_FIELDS = attrgetter("root", "rotations")
 
 
 def _plain(req: Any, settings: tuple[float, ...]) -> bool:
@@ -127,10 +121,6 @@ class CrowdPlan:
         settings, tuning, settings_array: the locks' tuning (:meth:`FootLock.settings`), one for all;
             ``tuning`` with ``enabled`` first, as each lock must still read.
         checked: the row arrays of the members' columns last found to agree (:func:`ground_crowd`).
-        placed: the columns the pass found the members in last step, as :func:`_placed` saw them (or
-            ``None``): then :func:`_holds` checks the tuning and the fields in one pass per kind of
-            component, and sets ``in_place`` when no field was replaced since, so this step's pass
-            skips the nine column look-ups (each a pass over the members).
     """
 
     table: list[tuple[Any, ...]]
@@ -155,22 +145,6 @@ class CrowdPlan:
     heels: F
     knees: F
     checked: tuple[I64, ...] = ()
-    placed: Placed | None = None
-    in_place: bool = False
-
-
-@dataclass
-class Placed:
-    """Where the crowd's poses and lock state were found (:func:`ground_crowd`): the nine columns'
-    arrays and the members' rows in them, and what each member's pose and lock held then (their
-    fields' row views, and the lock's tuning). While every field is still that view, those rows
-    of those arrays are the members' fields (a column relinked since for other owners does not
-    matter: the members still view the arrays kept here)."""
-
-    arrays: tuple[NDArray[Any], ...]  # roots, rotations, contacts, then _LOCK_STATE
-    rows: tuple[I64, ...]
-    poses: list[tuple[Any, ...]]
-    locks: list[tuple[Any, ...]]
 
 
 def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
@@ -236,21 +210,14 @@ def _holds(plan: CrowdPlan, table: list[tuple[Any, ...]]) -> bool:
     then it is served, correctly, by the general path."""
     if table is not plan.table or list(map(_GROUNDING, plan.all_requests)) != plan.grounding:
         return False
-    plan.in_place = False
     if not plan.rows:
         return True
-    if not (
+    return (
         _unchanged(list(map(_REQUEST, plan.requests)), plan.request_fields)
         and _unchanged(list(map(_PUPPET, plan.puppets)), plan.puppet_fields)
-    ):
-        return False
-    placed = plan.placed
-    if placed is not None and _unchanged(list(map(_LOCK_FIELDS, plan.locks)), placed.locks):
-        # every lock kept its tuning (``placed.locks`` start with ``plan.tuning``) and its column views
-        plan.in_place = _unchanged(list(map(_POSE_FIELDS, plan.locals_)), placed.poses)
-    elif list(map(_TUNING, plan.locks)).count(plan.tuning) != len(plan.locks):
-        return False
-    return not any(_plain(req, plan.settings) for req in plan.outsiders)
+        and list(map(_TUNING, plan.locks)).count(plan.tuning) == len(plan.locks)
+        and not any(_plain(req, plan.settings) for req in plan.outsiders)
+    )
 
 
 def current_plan(plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
@@ -277,38 +244,6 @@ def _place(cols: Columns, ctype: type, name: str, key: int, owners: tuple[Any, .
     return found
 
 
-def _placed(plan: CrowdPlan, cols: Columns, joints: int) -> list[tuple[NDArray[Any], I64]] | None:
-    """The members' poses and lock state in their columns (:func:`_place`): roots, rotations,
-    contacts, then ``_LOCK_STATE``, each with the members' rows; ``None`` if one cannot be, or the
-    columns do not hold the members at the same rows. Remembered in ``plan.placed``."""
-    legs, locks = len(plan.legs), plan.locks
-    wanted = [(LocalPose, "root", joints, plan.locals_, (3,), np.float64),
-              (LocalPose, "rotations", joints, plan.locals_, (joints, 4), np.float64),
-              (FootLock, "contacts", legs, locks, (legs,), np.float64)] + [
-             (FootLock, name, legs, locks, (legs, 3) if name in ("points", "animated") else (legs,),
-              _LOCK_TYPES.get(name, np.float64)) for name in _LOCK_STATE]  # fmt: skip
-    found: list[tuple[NDArray[Any], I64]] = []
-    for ctype, name, key, owners, shape, dtype in wanted:
-        place = _place(cols, ctype, name, key, owners, shape, dtype)
-        if place is None:
-            return None
-        found.append(place)
-    index = tuple(rows for _, rows in found)
-    if not (len(index) == len(plan.checked) and all(map(is_, index, plan.checked))):
-        # The poses' two columns, and the locks' six, must hold the members at the same rows; the row
-        # arrays stay the same objects while the columns keep their rows, so this is checked once.
-        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
-            return None
-        plan.checked = index
-    plan.placed = Placed(
-        arrays=tuple(array for array, _ in found),
-        rows=index,
-        poses=list(map(_POSE_FIELDS, plan.locals_)),
-        locks=list(map(_LOCK_FIELDS, locks)),
-    )
-    return found
-
-
 def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float) -> NDArray[np.bool_] | None:
     """Plant the feet of ``plan``'s crowd (a plan that holds this step: :func:`current_plan`) in place,
     if numba runs and every member's pose and lock state can be in their columns (fields replaced
@@ -318,16 +253,27 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
     sk, reqs, locks = plan.skeleton, plan.requests, plan.locks
     if sk is None or not jit.enabled():
         return None
-    found: list[tuple[NDArray[Any], I64]] | None
-    if plan.in_place and plan.placed is not None:  # where they were last step (checked by _holds)
-        found = list(zip(plan.placed.arrays, plan.placed.rows, strict=True))
-    else:
-        plan.placed = None
-        found = _placed(plan, cols, sk.num_joints)
-    if found is None:
+    joints, legs = sk.num_joints, len(plan.legs)
+    roots = _place(cols, LocalPose, "root", joints, plan.locals_, (3,))
+    rots = _place(cols, LocalPose, "rotations", joints, plan.locals_, (joints, 4))
+    contacts = _place(cols, FootLock, "contacts", legs, locks, (legs,))
+    if roots is None or rots is None or contacts is None:
         return None
-    roots, rots, contacts, *state = found
-    count, legs = len(reqs), len(plan.legs)
+    state: list[tuple[NDArray[Any], I64]] = []
+    for name in _LOCK_STATE:
+        found = _place(cols, FootLock, name, legs, locks, (legs, 3) if name in ("points", "animated") else (legs,),
+                       _LOCK_TYPES.get(name, np.float64))  # fmt: skip
+        if found is None:
+            return None
+        state.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in state))
+    if not (len(index) == len(plan.checked) and all(map(is_, index, plan.checked))):
+        # The poses' two columns, and the locks' six, must hold the members at the same rows; the row
+        # arrays stay the same objects while the columns keep their rows, so this is checked once.
+        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
+            return None
+        plan.checked = index
+    count = len(reqs)
     weight = np.fromiter(map(_WEIGHT, reqs), dtype=np.float64, count=count)
     if np.any((weight < 0.0) | (weight > 1.0)):
         raise ValueError("weight must lie in 0..1")
@@ -344,7 +290,7 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
         height = np.ascontiguousarray(np.broadcast_to(np.asarray(height, dtype=np.float64), (count, legs)))
         normal = np.ascontiguousarray(np.broadcast_to(np.asarray(normal, dtype=np.float64), (count, legs, 3)))
     shift, kept = np.empty(count), np.empty(count, dtype=np.bool_)
-    points, weights, planted, stepping, yaw, animated = (array for array, _ in state)
+    points, weights, planted, stepping, yaw, animated = (found[0] for found in state)
     finite = _kernel.ground_crowd(
         sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
         sole, qfeet, ankles, hips, height, normal, weight,

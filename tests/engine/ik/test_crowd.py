@@ -7,11 +7,8 @@ contacts. With the crowd pass and with it switched off (every step on the genera
 :func:`~engine.ik.grounding.ground_feet_batch` serves) every pose, lock state, pelvis shift
 and state hash must be equal bit for bit; against the pure-numpy path (numba off) to 1e-9.
 Broken once by skipping the foot locks in ``_ground_kernel.ground_crowd``: the rotations
-then differ from the general path's at the first served step. The pass reuses last step's
-columns when nothing was replaced (:attr:`~engine.ik.crowd.CrowdPlan.placed`): a replaced lock
-field (step 8), a replaced pose field (step 9) and a lock column relinked by another batch's
-read (step 13) must be seen. Broken once by skipping the pose check in ``crowd._holds`` (fails
-at step 9) and once by checking only the locks' tuning there (fails at step 8).
+then differ from the general path's at the first served step. A replaced pose field (step 9)
+and a lock column relinked by another batch's read (step 13) must be taken in as well.
 """
 
 from __future__ import annotations
