@@ -53,7 +53,10 @@ def normalize(q: ArrayLike) -> F:
     """Unit quaternions; a zero quaternion becomes the identity rather than NaN."""
     q = np.asarray(q, dtype=np.float64)
     n = np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(n > 1e-12, q / np.where(n > 1e-12, n, 1.0), IDENTITY)
+    big = n > 1e-12
+    if big.all():  # the usual case (a crowd's 17,000 rotations a step): the same quotients, without the selects
+        return np.true_divide(q, n, order="C")
+    return np.where(big, q / np.where(big, n, 1.0), IDENTITY)
 
 
 def mul(a: ArrayLike, b: ArrayLike) -> F:

@@ -139,7 +139,7 @@ class Commands:
         self._added.clear()
         self._removed.clear()
 
-    def rows(self, keys: list[int]) -> I64:
+    def rows(self, keys: list[int] | I64) -> I64:
         """The rows of ``keys`` (:meth:`sync` first); ``KeyError`` for a key without a ragdoll."""
         want = np.asarray(keys, dtype=np.int64)
         if self.whole(want):

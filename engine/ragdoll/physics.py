@@ -250,7 +250,7 @@ class PhysicsWorld(Readback, Building):
         C.muscle[i], C.pin[i] = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
         C.support[i] = float(np.clip(gravity_support, 0, 1))
 
-    def drive_animated(self, keys: list[int], roots: list[_F] | _F, rotations: list[_F] | _F) -> list[int]:
+    def drive_animated(self, keys: list[int] | I64, roots: list[_F] | _F, rotations: list[_F] | _F) -> list[int]:
         """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
         in one pass: a crowd of animated puppets is most of the physics stage's Python work).
 
@@ -262,10 +262,12 @@ class PhysicsWorld(Readback, Building):
         Returns:
             The keys whose targets were refused.
         """
-        if not keys:
+        if not len(keys):
             return []
         C = self.commands
-        rows = C.rows(keys)
+        want = np.asarray(keys, dtype=np.int64)
+        whole = C.whole(want)
+        rows = np.arange(len(want), dtype=np.int64) if whole else C.rows(want)
         sizes: I64 = C.joints[rows]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
@@ -275,20 +277,23 @@ class PhysicsWorld(Readback, Building):
             q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
         if q.shape != (int(sizes.sum()), 4):
             raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes.tolist()}")
-        ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
-        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
-        q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
-        if ok.all() and C.whole(keys):  # the whole crowd in key order, every target good
-            C.root[:], C.rot[:] = r, q
+        finite = np.isfinite(q)
+        if whole and finite.all() and np.isfinite(r).all():
+            # the whole crowd in key order, every target good (a walking crowd): nothing to refuse or select
+            C.root[:] = r
+            C.rot[:] = quat.normalize(q)
             C.kinematic[:] = True
             C.muscle[:] = C.pin[:] = C.support[:] = 1.0
             return []
+        ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
+        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(finite.all(axis=1), ends - sizes)
+        q = quat.normalize(np.where(finite, q, quat.identity()))  # refused rows are not used
         good = rows[ok]
         C.root[good] = r[ok]
         C.rot[joint_rows(C.starts, good)] = q[np.repeat(ok, sizes)]
         C.kinematic[rows] = True
         C.muscle[rows] = C.pin[rows] = C.support[rows] = 1.0
-        return [k for k, g in zip(keys, ok.tolist(), strict=True) if not g]
+        return list(want[~ok].tolist())
 
     def target(self, key: int) -> Pose:
         """The ragdoll's current command (its last accepted target pose)."""

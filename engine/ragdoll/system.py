@@ -16,11 +16,19 @@ Ragdolls and props that appear in the same step are added in one rebuild.
 
 from __future__ import annotations
 
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+from itertools import repeat
+from operator import attrgetter, ne
+from typing import ClassVar
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.app import App
+from engine.arrays import I64
 from engine.columns import columns
 from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import Entity, World
@@ -74,24 +82,32 @@ def physics_step(world: World) -> None:
     simulated: list[tuple[Entity, Ragdoll, LocalPose]] = []
     held: list[tuple[Entity, Ragdoll]] = []
     dt, anim = world.dt, RagdollMode.ANIMATED
-    for row in world.query(Ragdoll, Puppet, LocalPose):  # the one pass over the crowd
-        e, rd, _, pose = row
-        if rd.mode is anim:
-            animated.append(row)
-            if (
-                rd.muscle_weight != rd.muscle_target
-                or rd.pin_weight != rd.pin_target
-                or rd.blend_weight != rd.blend_target
-            ):
-                rd.ramp(dt)  # (at its targets a ragdoll's ramp changes nothing)
-            # not simulated: the body is its animation (no energy of its own, nothing to settle)
-            rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
-        else:
-            simulated.append((e, rd, pose))
-        if rd.held is not None or e in holding:
-            held.append((e, rd))
-    keys = [row[0] for row in animated]
-    refused = pw.drive_animated(keys, *_animated_targets(world, pw, keys, [row[3] for row in animated]))
+    table = world.query(Ragdoll, Puppet, LocalPose)
+    crowd = None if holding else _walking(world, table)
+    if crowd is not None:  # every ragdoll animated, at its weights, held by nobody: no Python per puppet
+        for name, value in _AT_REST:
+            deque(map(setattr, crowd.ragdolls, repeat(name), repeat(value)), maxlen=0)
+        keys, poses = crowd.keys, crowd.poses
+    else:
+        for row in table:  # the one pass over the crowd
+            e, rd, _, pose = row
+            if rd.mode is anim:
+                animated.append(row)
+                if (
+                    rd.muscle_weight != rd.muscle_target
+                    or rd.pin_weight != rd.pin_target
+                    or rd.blend_weight != rd.blend_target
+                ):
+                    rd.ramp(dt)  # (at its targets a ragdoll's ramp changes nothing)
+                # not simulated: the body is its animation (no energy of its own, nothing to settle)
+                rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
+            else:
+                simulated.append((e, rd, pose))
+            if rd.held is not None or e in holding:
+                held.append((e, rd))
+        keys = np.array([row[0] for row in animated], dtype=np.int64)
+        poses = tuple(row[3] for row in animated)
+    refused = pw.drive_animated(keys, *_animated_targets(world, pw, keys, poses))
     targets: dict[Entity, Pose] = {}
     for e, rd, pose in simulated:
         rd.ramp(world.dt)
@@ -124,8 +140,51 @@ def physics_step(world: World) -> None:
             tr.position, tr.rotation, prop.velocity = pos, rot, vel
 
 
+#: An animated ragdoll's settle state: not simulated, the body is its animation (no energy, nothing to settle).
+_AT_REST = (("kinetic_energy", 0.0), ("settled", False), ("still_frames", 0))
+_MODE_HELD = attrgetter("mode", "held")
+_WEIGHTS = (
+    (attrgetter("muscle_weight"), attrgetter("muscle_target")),
+    (attrgetter("pin_weight"), attrgetter("pin_target")),
+    (attrgetter("blend_weight"), attrgetter("blend_target")),
+)
+
+
+@dataclass
+class WalkingCrowd:
+    """The physics stage's view of its query list (remade when the ECS hands out another list): the
+    ragdolls, keys and local poses in row order, so a crowd that only walks is checked and driven
+    in C-level passes. Not simulation state (the rows of a query, cached)."""
+
+    SIM_STATE: ClassVar[bool] = False
+    table: list[tuple[Entity, Ragdoll, Puppet, LocalPose]]
+    ragdolls: tuple[Ragdoll, ...]
+    keys: I64
+    poses: tuple[LocalPose, ...]
+
+
+def _walking(world: World, table: list[tuple[Entity, Ragdoll, Puppet, LocalPose]]) -> WalkingCrowd | None:
+    """The crowd of ``table`` if every ragdoll is animated, at its weights' targets and not held
+    (what the stage's loop would find row by row, found in C-level passes); ``None`` otherwise."""
+    crowd = world.try_resource(WalkingCrowd)
+    if crowd is None or crowd.table is not table:
+        crowd = WalkingCrowd(
+            table,
+            tuple(r[1] for r in table),
+            np.array([r[0] for r in table], dtype=np.int64),
+            tuple(r[3] for r in table),
+        )
+        world.insert_resource(crowd)
+    rds = crowd.ragdolls
+    if list(map(_MODE_HELD, rds)).count((RagdollMode.ANIMATED, None)) != len(rds):
+        return None
+    if any(any(map(ne, map(now, rds), map(target, rds))) for now, target in _WEIGHTS):
+        return None  # some ramp: the loop does it
+    return crowd
+
+
 def _animated_targets(
-    world: World, pw: PhysicsWorld, keys: list[Entity], poses: list[LocalPose]
+    world: World, pw: PhysicsWorld, keys: I64, poses: Sequence[LocalPose]
 ) -> tuple[NDArray[np.float64] | list[NDArray[np.float64]], NDArray[np.float64] | list[NDArray[np.float64]]]:
     """The animated ragdolls' targets: their local poses' roots ``[P, 3]`` and rotations ``[P, J, 4]``
     read from the pose columns (:mod:`engine.columns`) when all have ``J`` joints, else as lists."""

@@ -7,7 +7,8 @@ contacts. With the crowd pass and with it switched off (every step on the genera
 :func:`~engine.ik.grounding.ground_feet_batch` serves) every pose, lock state, pelvis shift
 and state hash must be equal bit for bit; against the pure-numpy path (numba off) to 1e-9.
 Broken once by skipping the foot locks in ``_ground_kernel.ground_crowd``: the rotations
-then differ from the general path's at the first served step.
+then differ from the general path's at the first served step. A replaced pose field (step 9)
+and a lock column relinked by another batch's read (step 13) must be taken in as well.
 """
 
 from __future__ import annotations
@@ -77,11 +78,15 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch, n: int = N) ->
                 reqs[5].grounding = True
             elif step == 8:
                 reqs[7].foot_lock.yaw = np.array([0.3, -0.2])  # other code replaced a lock field
+            elif step == 9:  # other code replaced a member's pose field after the animation wrote it
+                poses[4].rotations = quat.normalize(poses[4].rotations + 0.05)
             elif step == 10:
                 reqs[9].sphere_centre, reqs[9].sphere_radius = np.array([0.0, 0.85, 0.45]), 0.2
             elif step == 11:
                 reqs[9].sphere_centre = None
                 reqs[2].foot_lock.contacts = None
+            elif step == 13:  # another batch's read relinks a lock column: members past the tenth keep old views
+                cols.get(FootLock, "points", 2).read([*locks[:10], FootLock(points=np.ones((2, 3)))])
             app.step()
             out.append(
                 (
