@@ -374,6 +374,22 @@ class Renderer:
         bounds = scene.bounds() if scene.sun.shadows else None
         light_vp = light_matrix(scene, bounds) if bounds is not None else None
         rect = ground_rect(scene, bounds=bounds) if light_vp is not None else None
+        self._set_frame_uniforms(scene, camera, vp, light_vp, (w, h))
+        self._mark("uniforms")
+        # The sky and ground, before the shadow pass is queued: copied in from the last frame of the
+        # same view, or drawn and kept (a copy waits for the rasteriser's work on the buffers: here
+        # there is none). Where they cannot be kept, they are drawn after the objects (early depth test).
+        shadow_rect = rect if light_vp is not None else None
+        ground = self._ground_uniforms(scene, camera, shadow_rect)
+        view = self._view_key(scene, camera, target, ground)
+        target.use()
+        target.viewport = (0, 0, w, h)
+        if view is not None and not self.env_cache.restore(view, target):
+            target.clear(*scene.horizon_color, 1.0, depth=1.0)
+            self._noise.use(location=3)
+            self._draw_sky_and_ground(scene, camera, ground)
+            self.env_cache.store(view, target)
+        self._mark("sky_ground")
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
             casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
@@ -391,22 +407,12 @@ class Renderer:
 
         target.use()
         target.viewport = (0, 0, w, h)
-        self._set_frame_uniforms(scene, camera, vp, light_vp, (w, h))
-        self._mark("uniforms")
+        if view is None:
+            target.clear(*scene.horizon_color, 1.0, depth=1.0)
+        self._mark("clear")
         self.shadows.depth.use(location=1)
         self._background_texture(scene).use(location=2)
         self._noise.use(location=3)
-        # The sky and ground: copied in from the last frame of the same view, or drawn (and kept)
-        # before the objects; where they cannot be kept, drawn after the objects (early depth test).
-        shadow_rect = rect if light_vp is not None else None
-        ground = self._ground_uniforms(scene, camera, shadow_rect)
-        view = self._view_key(scene, camera, target, ground)
-        if view is None or not self.env_cache.restore(view, target):
-            target.clear(*scene.horizon_color, 1.0, depth=1.0)
-            if view is not None:
-                self._draw_sky_and_ground(scene, camera, ground)
-                self.env_cache.store(view, target)
-        self._mark("clear")
 
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
         ctx.front_face = "ccw"
