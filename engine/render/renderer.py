@@ -2,6 +2,8 @@
 
 Passes, in order (each kind of primitive is one instanced draw call):
 
+0. **sky and ground** of a view that stays still: copied in from the frame that drew them
+   (:mod:`engine.render.env_cache`), in place of the clear; a new view is drawn here and kept.
 1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
    (:mod:`engine.render.shadows`), both fitted around the casters each frame, and kept from the
    last frame when nothing they are drawn from changed (``reuse_shadows``); the scenery's part
@@ -14,7 +16,7 @@ Passes, in order (each kind of primitive is one instanced draw call):
    and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
    and the sun, shaded per vertex (the last three not drawn when the ground fills the view),
-   then the decals laid on the ground over the rectangles they cover: soft shadow, snow track,
+   here only when they cannot be kept (the ground reads the shadow mask or a photo); then the decals laid on the ground over the rectangles they cover: soft shadow, snow track,
    footprints.
 5. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
 6. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
