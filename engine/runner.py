@@ -405,6 +405,8 @@ class Runner:
     def _take_screenshot(self, activity: Activity) -> None:
         from engine.render.target import save_image
 
+        if self.viewer is not None:
+            self.viewer.keep_next_frame()  # a window may otherwise draw the frame where it cannot be read
         self.draw(activity, complete=True)
         assert self.options.screenshot is not None
         self._shot = save_image(self.viewer.read_pixels(), self.options.screenshot)

@@ -148,6 +148,7 @@ class Environment:
         self._marks_tex: moderngl.Texture | None = None
         self._marks_src: bytes = b""
         self._common: dict[str, Any] = {}
+        self._reads: dict[str, tuple[str, ...]] = {}
 
     def _keep(self, *bufs: moderngl.Buffer) -> tuple[moderngl.Buffer, ...]:
         self._buffers += list(bufs)
@@ -166,6 +167,16 @@ class Environment:
             vbo, ibo = self._ground_mesh
             self._vaos[key] = self.ctx.vertex_array(prog, [(vbo, "3f", "in_ring")], ibo, 4)
         return self._programs[key]
+
+    def reads(self, detail: bool, grid: bool, photo: bool) -> tuple[str, ...]:
+        """The names of the uniforms the ground of this variant, the ridge, the sky and the sun read
+        (asked of the compiled programs: what a kept copy of them depends on, :mod:`engine.render.env_cache`)."""
+        prog = self.ground_program(detail, grid, photo)
+        key = next(k for k, p in self._programs.items() if p is prog)
+        if key not in self._reads:
+            progs = (prog, *(self._programs[k] for k in ("ridge", "sky", "sun")))
+            self._reads[key] = tuple(sorted({n for p in progs for n in p if isinstance(p[n], moderngl.Uniform)}))
+        return self._reads[key]
 
     def set_common(self, uniforms: dict[str, Any], changed: Iterable[str] | None = None) -> None:
         """The frame's shared uniforms (camera, sun, fog), on every program and on any compiled later.

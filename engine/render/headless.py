@@ -64,6 +64,9 @@ class HeadlessTarget:
     def end(self) -> None:
         self.buffers.resolve()
 
+    def keep_next_frame(self) -> None:
+        """Nothing to do: every frame drawn here can be read back."""
+
     def read_pixels(self) -> NDArray[np.uint8]:
         return self.buffers.read_pixels()
 

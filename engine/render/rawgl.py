@@ -2,7 +2,8 @@
 
 moderngl covers nearly everything the renderer needs; two things it does not: allocating a
 texture from ``GL_BGRA`` client data (:mod:`engine.render.bgra`) and copying a depth buffer
-(its ``copy_framebuffer`` copies colour only). The system library (GLVND's ``libOpenGL``, or
+(its ``copy_framebuffer`` copies colour only; the renderer also copies colour and depth together,
+:mod:`engine.render.env_cache`). The system library (GLVND's ``libOpenGL``, or
 ``libGL``) dispatches each call to the context current on this thread, which is moderngl's.
 Every user has a fallback for when the library cannot be loaded: :func:`gl` returns ``None``.
 """
@@ -13,9 +14,10 @@ import ctypes
 import ctypes.util
 import functools
 
-__all__ = ["gl", "blit_depth", "clear_errors"]
+__all__ = ["gl", "blit", "blit_depth", "clear_errors", "DEPTH_BUFFER_BIT", "COLOR_BUFFER_BIT"]
 
-_READ_FRAMEBUFFER, _DRAW_FRAMEBUFFER, _DEPTH_BUFFER_BIT, _NEAREST = 0x8CA8, 0x8CA9, 0x100, 0x2600
+_READ_FRAMEBUFFER, _DRAW_FRAMEBUFFER, _NEAREST = 0x8CA8, 0x8CA9, 0x2600
+DEPTH_BUFFER_BIT, COLOR_BUFFER_BIT = 0x100, 0x4000
 _NO_ERROR = 0
 
 
@@ -50,11 +52,14 @@ def clear_errors(lib: ctypes.CDLL) -> None:
             return
 
 
-def blit_depth(dst: int, src: int, size: tuple[int, int]) -> bool:
-    """Copy the depth of framebuffer ``src`` into ``dst`` (GL names, both ``size``, same depth format).
+def blit(dst: int, src: int, size: tuple[int, int], bits: int) -> bool:
+    """Copy the buffers ``bits`` (:data:`COLOR_BUFFER_BIT`, :data:`DEPTH_BUFFER_BIT`, or both) of
+    framebuffer ``src`` into ``dst`` (GL names, both ``size``, same formats, neither multisampled).
 
-    Returns false, having copied nothing, when the library is missing or GL refused; the caller then
-    draws instead. The framebuffer bindings are left to the caller to set again.
+    Returns false when the library is missing or GL refused (nothing is copied then); the caller
+    then draws instead. The framebuffer bindings are left to the caller to set again. Between
+    buffers of the same size and format Mesa's llvmpipe copies memory: 0.14 ms for colour and
+    depth at 640x360 against 0.59 ms for a clear of them (process CPU, median of 7 x 20).
     """
     lib = gl()
     if lib is None:
@@ -62,5 +67,10 @@ def blit_depth(dst: int, src: int, size: tuple[int, int]) -> bool:
     clear_errors(lib)
     lib.glBindFramebuffer(_READ_FRAMEBUFFER, src)
     lib.glBindFramebuffer(_DRAW_FRAMEBUFFER, dst)
-    lib.glBlitFramebuffer(0, 0, size[0], size[1], 0, 0, size[0], size[1], _DEPTH_BUFFER_BIT, _NEAREST)
+    lib.glBlitFramebuffer(0, 0, size[0], size[1], 0, 0, size[0], size[1], bits, _NEAREST)
     return bool(lib.glGetError() == _NO_ERROR)
+
+
+def blit_depth(dst: int, src: int, size: tuple[int, int]) -> bool:
+    """Copy the depth of framebuffer ``src`` into ``dst`` (:func:`blit` of the depth alone)."""
+    return blit(dst, src, size, DEPTH_BUFFER_BIT)

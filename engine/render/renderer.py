@@ -2,6 +2,8 @@
 
 Passes, in order (each kind of primitive is one instanced draw call):
 
+0. **sky and ground** of a view that stays still: copied in from the frame that drew them
+   (:mod:`engine.render.env_cache`), in place of the clear; a new view is drawn here and kept.
 1. **shadows** — a sun depth map for objects and, read from it, a blurred mask for the ground
    (:mod:`engine.render.shadows`), both fitted around the casters each frame, and kept from the
    last frame when nothing they are drawn from changed (``reuse_shadows``); the scenery's part
@@ -14,7 +16,7 @@ Passes, in order (each kind of primitive is one instanced draw call):
    and only those whose bounding sphere is in view.
 4. **environment** (:mod:`engine.render.environment`) — the ground, the far ridge, the sky
    and the sun, shaded per vertex (the last three not drawn when the ground fills the view),
-   then the decals laid on the ground over the rectangles they cover: soft shadow, snow track,
+   here only when they cannot be kept (the ground reads the shadow mask or a photo); then the decals laid on the ground over the rectangles they cover: soft shadow, snow track,
    footprints.
 5. **lines**, **points** — screen-space quads and round point sprites, depth-tested.
 6. **overlays** — pictures aligned with the photo (:class:`~engine.render.scene.Overlay`): at a
@@ -46,6 +48,7 @@ from engine.render import meshes
 from engine.render import shaders as S
 from engine.render import shaders_env as E
 from engine.render.bgra import colour_texture, release_texture
+from engine.render.env_cache import EnvironmentCache, single_sampled, view_key
 from engine.render.env_meshes import cone_mesh
 from engine.render.environment import RIDGE_RADIUS, Environment, ground_fills_view
 from engine.render.gpu import Instances, LodBatches, Releasable, mesh_buffers, set_uniform
@@ -234,6 +237,7 @@ class Renderer:
         for name in ("sky_photo", "upscale"):
             self._vaos[name] = ctx.vertex_array(p[name], [])
         self.env = Environment(ctx)
+        self.env_cache = EnvironmentCache(ctx, is_software(ctx))
         self.impostors = Impostors(ctx)
         self.quality = quality
         self.shadows = Shadows(ctx, self._inst["boxes"], quality.shadow_map, quality.shadow_mask, self._inst["cones"])
@@ -372,6 +376,22 @@ class Renderer:
         bounds = scene.bounds() if scene.sun.shadows else None
         light_vp = light_matrix(scene, bounds) if bounds is not None else None
         rect = ground_rect(scene, bounds=bounds) if light_vp is not None else None
+        self._set_frame_uniforms(scene, camera, vp, light_vp, (w, h))
+        self._mark("uniforms")
+        # The sky and ground, before the shadow pass is queued: copied in from the last frame of the
+        # same view, or drawn and kept (a copy waits for the rasteriser's work on the buffers: here
+        # there is none). Where they cannot be kept, they are drawn after the objects (early depth test).
+        shadow_rect = rect if light_vp is not None else None
+        ground = self._ground_uniforms(scene, camera, shadow_rect)
+        view = self._view_key(scene, camera, target, ground)
+        target.use()
+        target.viewport = (0, 0, w, h)
+        if view is not None and not self.env_cache.restore(view, target):
+            target.clear(*scene.horizon_color, 1.0, depth=1.0)
+            self._noise.use(location=3)
+            self._draw_sky_and_ground(scene, camera, ground)
+            self.env_cache.store(view, target)
+        self._mark("sky_ground")
         if light_vp is not None and rect is not None:
             n = self.quality.max_casters  # rows are nearest-first: the nearest cast shadows
             casters = {kind: (rows[kind][:n], levels[kind][:n]) for kind in self._lod}
@@ -389,10 +409,9 @@ class Renderer:
 
         target.use()
         target.viewport = (0, 0, w, h)
-        target.clear(*scene.horizon_color, 1.0, depth=1.0)
+        if view is None:
+            target.clear(*scene.horizon_color, 1.0, depth=1.0)
         self._mark("clear")
-        self._set_frame_uniforms(scene, camera, vp, light_vp, (w, h))
-        self._mark("uniforms")
         self.shadows.depth.use(location=1)
         self._background_texture(scene).use(location=2)
         self._noise.use(location=3)
@@ -420,7 +439,9 @@ class Renderer:
         if scene.skinned:
             self.skinned.draw(scene.skinned)
         self._mark("objects")
-        self._draw_environment(scene, camera, rect if light_vp is not None else None)
+        if view is None:
+            self._draw_sky_and_ground(scene, camera, ground)
+        self._draw_decals(scene, shadow_rect)
         self._mark("environment")
 
         ctx.enable_only(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
@@ -442,55 +463,82 @@ class Renderer:
         ctx.enable_only(moderngl.NOTHING)
         self._mark("text")
 
-    def _draw_environment(
+    def _ground_uniforms(
         self, scene: RenderScene, camera: Camera, rect: tuple[float, float, float, float] | None
-    ) -> None:
-        """Ground, ridge, sky and sun, then the decals on the ground (see :mod:`engine.render.environment`)."""
+    ) -> dict[str, Any]:
+        """The ground program's own uniforms this frame (``rect``: the ground shadow's, if any)."""
+        g, eye = scene.ground, camera.eye
+        return {
+            "u_center": (float(eye[0]), 0.0, float(eye[2])),
+            "u_extent": min(camera.far * 0.9, 150.0),  # of the ground mesh around the eye
+            "u_height": float(g.height),
+            "u_ground_lin": _linear(g.color),
+            "u_snow": float(g.snow),
+            "u_grid_spacing": float(g.grid_spacing),
+            "u_grid_lin": _linear(g.grid_color),
+            "u_grid_strength": float(g.grid_strength),
+            "u_noise": 3,
+            "u_ground_mask": 4,
+            "u_rect": rect if rect is not None else (0.0, 0.0, 1.0, 1.0),
+            "u_shadow_strength": 0.9 if rect is not None else 0.0,
+        }
+
+    def _ground_detail(self, scene: RenderScene) -> bool:
+        """Whether the ground is shaded per pixel near the camera (it then reads its shadow mask itself:
+        one more fetch in a pass it pays anyway; otherwise the shadow is a decal over the casters' rectangle)."""
+        return self.quality.ground_detail and scene.ground.snow > 0
+
+    def _view_key(
+        self, scene: RenderScene, camera: Camera, target: moderngl.Framebuffer, ground: dict[str, Any]
+    ) -> bytes | None:
+        """What this frame's sky and ground are drawn from (:mod:`engine.render.env_cache`), or ``None``
+        when they cannot be kept: the ground reads the shadow mask (detail) or a photo, or ``target``
+        is multisampled (no copy into it)."""
+        photo = scene.background is not None and scene.background_fade < 1.0
+        detail = self._ground_detail(scene)
+        if detail or photo or not single_sampled(target):
+            return None
+        g = scene.ground
+        names = self.env.reads(detail, g.grid, photo)
+        hidden = self._sky_hidden(scene, camera, ground["u_extent"])
+        flags = (target.size, g.grid, g.visible, hidden, tuple(float(c) for c in scene.horizon_color))
+        return view_key(flags, names, {**self._common, **ground})
+
+    def _sky_hidden(self, scene: RenderScene, camera: Camera, extent: float) -> bool:
+        """Whether the ground fills the view, hiding the ridge, sky and sun (with a margin for the mesh's
+        straight edges on the ground's extent and the ridge's distance)."""
+        g = scene.ground
+        photo = scene.background is not None and scene.background_fade < 1.0
+        reach = 0.9 * min(extent, RIDGE_RADIUS)
+        return (
+            g.visible and not photo and ground_fills_view(self._common["u_inv_view_proj"], camera.eye, g.height, reach)
+        )
+
+    def _draw_sky_and_ground(self, scene: RenderScene, camera: Camera, ground: dict[str, Any]) -> None:
+        """Ground, ridge, sky and sun (see :mod:`engine.render.environment`); ``ground``: the ground's uniforms."""
         ctx = self.ctx
         ctx.enable_only(moderngl.DEPTH_TEST)
         photo = scene.background is not None and scene.background_fade < 1.0
         g = scene.ground
-        eye = camera.eye
-        # With per-pixel snow detail the ground reads its shadow mask itself (one more fetch in a
-        # pass it pays anyway); otherwise the shadow is a decal over the casters' rectangle only.
-        detail = self.quality.ground_detail and g.snow > 0
-        extent = min(camera.far * 0.9, 150.0)  # of the ground mesh around the eye
         self.shadows.mask.use(location=4)
         if g.visible:
-            self.env.draw_ground(
-                scene,
-                detail,
-                photo,
-                {
-                    "u_center": (float(eye[0]), 0.0, float(eye[2])),
-                    "u_extent": extent,
-                    "u_height": float(g.height),
-                    "u_ground_lin": _linear(g.color),
-                    "u_snow": float(g.snow),
-                    "u_grid_spacing": float(g.grid_spacing),
-                    "u_grid_lin": _linear(g.grid_color),
-                    "u_grid_strength": float(g.grid_strength),
-                    "u_noise": 3,
-                    "u_ground_mask": 4,
-                    "u_rect": rect if rect is not None else (0.0, 0.0, 1.0, 1.0),
-                    "u_shadow_strength": 0.9 if rect is not None else 0.0,
-                },
-            )
+            self.env.draw_ground(scene, self._ground_detail(scene), photo, ground)
         self._mark("ground")
-        # The ground's extent, and the ridge's distance, with a margin for the mesh's straight edges.
-        reach = 0.9 * min(extent, RIDGE_RADIUS)
-        hidden = g.visible and not photo and ground_fills_view(self._common["u_inv_view_proj"], eye, g.height, reach)
-        if not hidden:
+        if not self._sky_hidden(scene, camera, ground["u_extent"]):
             self.env.draw_sky(scene, photo, float(g.height))
         self._mark("sky")
         if photo:
             ctx.depth_func = "<="
             self._vaos["sky_photo"].render(moderngl.TRIANGLES, vertices=3)
             ctx.depth_func = "<"
-        if g.visible:
-            decal = rect if rect is not None and not detail else None
-            self.env.draw_decals(scene, decal, self.shadows.mask if decal is not None else None)
         ctx.enable_only(moderngl.DEPTH_TEST)
+
+    def _draw_decals(self, scene: RenderScene, rect: tuple[float, float, float, float] | None) -> None:
+        """The decals laid on the ground: soft shadow (unless the ground read it), snow track, footprints."""
+        if scene.ground.visible:
+            decal = rect if rect is not None and not self._ground_detail(scene) else None
+            self.env.draw_decals(scene, decal, self.shadows.mask if decal is not None else None)
+        self.ctx.enable_only(moderngl.DEPTH_TEST)
 
     def _upscale(self, framebuffer: moderngl.Framebuffer) -> None:
         """Stretch the smaller 3-D buffer over ``framebuffer`` (nearest texel).
@@ -639,6 +687,7 @@ class Renderer:
         self.shadows.release()
         self.skinned.release()
         self.env.release()
+        self.env_cache.release()
         self.impostors.release()
         self._release_scaled()
         for batches in self._lod.values():

@@ -4,7 +4,7 @@
 :class:`~engine.render.window.WindowTarget` (pygame/SDL2 window with a GL 3.3 context)
 or a :class:`~engine.render.headless.HeadlessTarget` (EGL standalone context and an
 off-screen framebuffer). Both offer ``ctx``, ``size``, ``framebuffer``, ``begin()``,
-``end()``, ``read_pixels()``, ``screenshot(path)``, ``poll_events()`` and ``close()``,
+``end()``, ``keep_next_frame()``, ``read_pixels()``, ``screenshot(path)``, ``poll_events()`` and ``close()``,
 so the play loop, replays and tests do not care which one they have.
 """
 
@@ -46,8 +46,14 @@ class RenderTarget(Protocol):
         """Finish the frame (present it, or resolve it for reading)."""
         ...
 
+    def keep_next_frame(self) -> None:
+        """Make the next frame readable by :meth:`read_pixels` (a window may otherwise draw it where
+        it cannot be read back once shown)."""
+        ...
+
     def read_pixels(self) -> NDArray[np.uint8]:
-        """The last finished frame as ``[H,W,3]`` uint8, top row first."""
+        """The last finished frame as ``[H,W,3]`` uint8, top row first (in a window: one drawn after
+        :meth:`keep_next_frame`)."""
         ...
 
     def screenshot(self, path: str | Path) -> Path:

@@ -54,6 +54,10 @@ class Viewer:
         """Window events since the last call (empty when headless)."""
         return self.target.poll_events()
 
+    def keep_next_frame(self) -> None:
+        """Make the next :meth:`draw` readable by :meth:`read_pixels` and :meth:`screenshot` (see the target's)."""
+        self.target.keep_next_frame()
+
     def read_pixels(self) -> NDArray[np.uint8]:
         """The last drawn frame, ``[H,W,3]`` uint8."""
         with self.target.ctx:
