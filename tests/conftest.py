@@ -184,16 +184,18 @@ def _compile_kernels_once(config: pytest.Config) -> None:
     if importlib.util.find_spec("numba") is None or _kernel_caches_fresh():
         return
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
-    # Both at once, one per core: numba's cache takes concurrent writers, and the wait before the
-    # first test is the longer of the two instead of their sum.
-    runs = []
+    # One after the other: the second loads what the first compiled. Run at once, both compiled the same
+    # kernels (numba does not wait for another process's compile): twice the CPU, for a wait only ~4 s
+    # shorter on an idle machine and longer on a busy one. Measured in fresh caches (h8c), the sandbox
+    # run compiles all 47 kernel variants (46 s of CPU) and the snowman run after it none (4 s: start-up
+    # and loading); it stays for a kernel only its path would reach.
     for args in (["sandbox", "--puppets", "4", "--frames", "30"], ["snowman", "--frames", "2"]):
         cmd = [sys.executable, "-m", "puppetphone", "play", *args, "--headless"]
-        runs.append((cmd, subprocess.Popen(cmd, env=env, cwd=_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)))
-    for cmd, run in runs:
-        _, err = run.communicate()
+        run = subprocess.run(cmd, env=env, cwd=_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, check=False)
         if run.returncode != 0:
-            raise pytest.UsageError(f"compiling the kernels failed: {' '.join(cmd)}\n{err.decode(errors='replace')}")
+            raise pytest.UsageError(
+                f"compiling the kernels failed: {' '.join(cmd)}\n{run.stderr.decode(errors='replace')}"
+            )
 
 
 # -- the user's cache ---------------------------------------------------------------------------

@@ -2,7 +2,9 @@
 
 Each command runs as a user types it, against a real fault (a full tmpfs, a read-only mount):
 F5 in a snowman window and Ctrl+S in an ``author edit`` window are real key presses sent to
-an X server (Xvfb, ``xdotool``); the tasbada progress and a growing ``--record`` run headless.
+an X server (Xvfb, ``xdotool``; the ``display`` fixture of tests/puppetphone/xvfb.py, which picks a
+free number itself and does not reset between clients); the tasbada progress and a growing
+``--record`` run headless.
 Each test then opens the recovered file the way the line says to.
 
 Broken on purpose to see these fail: :class:`engine.recovery.Rescue` writing nothing after the
@@ -17,7 +19,6 @@ import shutil
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -46,27 +47,6 @@ def _puppetphone(*args: str, data: Path) -> subprocess.CompletedProcess[str]:
         check=False,
         timeout=300,
     )
-
-
-@pytest.fixture(scope="module")
-def display() -> Iterator[str]:
-    """A fresh Xvfb display; its name."""
-    for number in range(131, 160):
-        if not Path(f"/tmp/.X11-unix/X{number}").exists() and not Path(f"/tmp/.X{number}-lock").exists():
-            break
-    name = f":{number}"
-    server = subprocess.Popen(
-        ["Xvfb", name, "-screen", "0", "1024x600x24", "-nolisten", "tcp"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    deadline = time.monotonic() + 20
-    while not Path(f"/tmp/.X11-unix/X{number}").exists():
-        assert server.poll() is None and time.monotonic() < deadline, "Xvfb did not start"
-        time.sleep(0.1)
-    yield name
-    server.terminate()
-    server.wait(10)
 
 
 def _in_window(display: str, args: list[str], data: Path, keys: list[str], said: str) -> tuple[int, str, str]:
