@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from engine import jit
 from engine.arrays import F64 as F
 from engine.arrays import Bool
-from engine.blend.feasible import _contains_compiled, line_range_row
+from engine.blend.feasible import line_range_row
 from engine.blend.lookup import LookupTable
 
 if TYPE_CHECKING:
@@ -49,9 +49,7 @@ def resolve_rows(loco: LocomotionSet, speeds: F, heights: F, standing: Bool) -> 
     inv, ok = fs._line[1]
     if not _prepare(speeds, heights, standing, table.offset, table.scale, fastest, floor, tallest, inv, ok, u, x):
         raise ValueError("request contains NaN or infinite values")
-    _, near = fs._centroids.query(x, k=min(12, len(fs.simplices)))
-    inside = np.empty(count, dtype=np.bool_)
-    _contains_compiled(fs.values, fs.simplices, fs._inv, fs._valid, near.reshape(count, -1), x, _TOLERANCE, inside)
+    inside = fs.contains_compiled(x, _TOLERANCE)
     rates = np.ones(count)
     for i in np.flatnonzero(~inside):  # outside the feasible set: projected one by one (the unusual request)
         res = table.resolve(u[i])
