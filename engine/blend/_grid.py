@@ -27,9 +27,9 @@ import numpy as np
 
 from engine.arrays import F64 as F
 from engine.arrays import I64 as Ix
-from engine.jit import njit
+from engine.jit import njit, njit_inline
 
-__all__ = ["BoxGrid", "PointGrid", "box_grid", "grid_of", "knn"]
+__all__ = ["BoxGrid", "PointGrid", "box_grid", "cell_of", "grid_of", "knn", "knn_row"]
 
 _PER_CELL = 2.0  # points per cell aimed at: a request's k nearest lie within two or three rings
 _MARGIN = 1e-9  # a ring's clearance is shrunk by this (scaled units) before it can stop the search
@@ -122,67 +122,86 @@ def cell_of(lo: F, size: F, shape: Ix, x0: float, x1: float) -> int:
 def knn(
     points: F, lo: F, size: F, shape: Ix, start: Ix, items: Ix, x: F, k: int, dist: F, idx: Ix, exact: np.ndarray
 ) -> None:
-    """The ``k`` nearest points of each request ``x [Q, 2]``, nearest first, into ``dist``/``idx [Q, k]``;
-    ``exact[r]`` is ``False`` where two of the ``k + 1`` nearest are equally far (then ``cKDTree`` may
-    order or pick them otherwise: ask it)."""
-    total = points.shape[0]
-    m = min(k + 1, total)
-    best_d = np.empty(m)
-    best_i = np.empty(m, dtype=np.int64)
-    gx, gy = shape[0], shape[1]
+    """:func:`knn_row` of every request ``x [Q, 2]``."""
+    m = min(k + 1, points.shape[0])
+    best_d, best_i = np.empty(m), np.empty(m, dtype=np.int64)
     for r in range(x.shape[0]):
-        x0, x1 = x[r, 0], x[r, 1]
-        cx = min(max(math.floor((x0 - lo[0]) / size[0]), 0), gx - 1)
-        cy = min(max(math.floor((x1 - lo[1]) / size[1]), 0), gy - 1)
-        found = 0
-        ring = 0
-        while True:
-            for i in range(cx - ring, cx + ring + 1):
-                if i < 0 or i >= gx:
-                    continue
-                edge = i == cx - ring or i == cx + ring
-                j = cy - ring
-                while j <= cy + ring:
-                    if 0 <= j < gy:
-                        c = i * gy + j
-                        for s in range(start[c], start[c + 1]):
-                            q = items[s]
-                            d0 = x0 - points[q, 0]
-                            d1 = x1 - points[q, 1]
-                            d = d0 * d0 + d1 * d1
-                            if found == m and not d < best_d[m - 1]:
-                                continue
-                            t = found if found < m else m - 1
-                            while t > 0 and best_d[t - 1] > d:
-                                best_d[t] = best_d[t - 1]
-                                best_i[t] = best_i[t - 1]
-                                t -= 1
-                            best_d[t] = d
-                            best_i[t] = q
-                            if found < m:
-                                found += 1
-                    j = j + 1 if edge or j == cy + ring else cy + ring
-            if cx - ring <= 0 and cy - ring <= 0 and cx + ring >= gx - 1 and cy + ring >= gy - 1:
-                break  # every cell seen
-            if found == m:
-                gap = math.inf  # how far the request is from any cell not seen yet
-                if cx - ring > 0:
-                    gap = min(gap, x0 - (lo[0] + (cx - ring) * size[0]))
-                if cx + ring < gx - 1:
-                    gap = min(gap, lo[0] + (cx + ring + 1) * size[0] - x0)
-                if cy - ring > 0:
-                    gap = min(gap, x1 - (lo[1] + (cy - ring) * size[1]))
-                if cy + ring < gy - 1:
-                    gap = min(gap, lo[1] + (cy + ring + 1) * size[1] - x1)
-                gap -= _MARGIN
-                if gap > 0.0 and gap * gap > best_d[m - 1]:
-                    break
-            ring += 1
-        tie = False
-        for t in range(min(k, m - 1)):
-            if best_d[t] == best_d[t + 1]:
-                tie = True
-        exact[r] = not tie
-        for t in range(k):
-            dist[r, t] = math.sqrt(best_d[t])
-            idx[r, t] = best_i[t]
+        exact[r] = knn_row(points, lo, size, shape, start, items, x, r, k, best_d, best_i, dist, idx)
+
+
+@njit_inline
+def knn_row(
+    points: F,
+    lo: F,
+    size: F,
+    shape: Ix,
+    start: Ix,
+    items: Ix,
+    x: F,
+    r: int,
+    k: int,
+    best_d: F,
+    best_i: Ix,
+    dist: F,
+    idx: Ix,
+) -> bool:
+    """The ``k`` nearest points of request ``x[r]``, nearest first, into ``dist[r]``/``idx[r]`` (``best_d``/``best_i``:
+    scratch of ``min(k + 1, P)``); ``False`` where two of the ``k + 1`` nearest are equally far (then ``cKDTree``
+    may order or pick them otherwise: ask it)."""
+    m = best_d.shape[0]
+    gx, gy = shape[0], shape[1]
+    x0, x1 = x[r, 0], x[r, 1]
+    cx = min(max(math.floor((x0 - lo[0]) / size[0]), 0), gx - 1)
+    cy = min(max(math.floor((x1 - lo[1]) / size[1]), 0), gy - 1)
+    found = 0
+    ring = 0
+    while True:
+        for i in range(cx - ring, cx + ring + 1):
+            if i < 0 or i >= gx:
+                continue
+            edge = i == cx - ring or i == cx + ring
+            j = cy - ring
+            while j <= cy + ring:
+                if 0 <= j < gy:
+                    c = i * gy + j
+                    for s in range(start[c], start[c + 1]):
+                        q = items[s]
+                        d0 = x0 - points[q, 0]
+                        d1 = x1 - points[q, 1]
+                        d = d0 * d0 + d1 * d1
+                        if found == m and not d < best_d[m - 1]:
+                            continue
+                        t = found if found < m else m - 1
+                        while t > 0 and best_d[t - 1] > d:
+                            best_d[t] = best_d[t - 1]
+                            best_i[t] = best_i[t - 1]
+                            t -= 1
+                        best_d[t] = d
+                        best_i[t] = q
+                        if found < m:
+                            found += 1
+                j = j + 1 if edge or j == cy + ring else cy + ring
+        if cx - ring <= 0 and cy - ring <= 0 and cx + ring >= gx - 1 and cy + ring >= gy - 1:
+            break  # every cell seen
+        if found == m:
+            gap = math.inf  # how far the request is from any cell not seen yet
+            if cx - ring > 0:
+                gap = min(gap, x0 - (lo[0] + (cx - ring) * size[0]))
+            if cx + ring < gx - 1:
+                gap = min(gap, lo[0] + (cx + ring + 1) * size[0] - x0)
+            if cy - ring > 0:
+                gap = min(gap, x1 - (lo[1] + (cy - ring) * size[1]))
+            if cy + ring < gy - 1:
+                gap = min(gap, lo[1] + (cy + ring + 1) * size[1] - x1)
+            gap -= _MARGIN
+            if gap > 0.0 and gap * gap > best_d[m - 1]:
+                break
+        ring += 1
+    tie = False
+    for t in range(min(k, m - 1)):
+        if best_d[t] == best_d[t + 1]:
+            tie = True
+    for t in range(k):
+        dist[r, t] = math.sqrt(best_d[t])
+        idx[r, t] = best_i[t]
+    return not tie

@@ -173,6 +173,37 @@ def _contains_compiled(
                 break
 
 
+@jit.njit_inline
+def contains_row(
+    values: F,
+    simplices: Ix,
+    inv: F,
+    valid: NDArray[np.bool_],
+    lo: F,
+    size: F,
+    shape: Ix,
+    start: Ix,
+    items: Ix,
+    x: F,
+    r: int,
+    tol: float,
+) -> bool:
+    """Whether some simplex holds point ``x[r]``: the simplices whose bounds touch its cell
+    (:class:`engine.blend._grid.BoxGrid`) tried first, then every simplex, so the answer is
+    :func:`_contains_compiled`'s whatever its first guesses."""
+    cell = cell_of(lo, size, shape, x[r, 0], x[r, 1])
+    if cell >= 0:
+        for c in range(start[cell], start[cell + 1]):
+            if _holds(values, simplices, inv, valid, items[c], x, r, tol):
+                return True
+    inside = False
+    for c in range(simplices.shape[0]):  # a plain loop: numba compiles no generator for any()
+        if _holds(values, simplices, inv, valid, c, x, r, tol):
+            inside = True
+            break
+    return inside
+
+
 @jit.njit
 def _contains_cells(
     values: F,
@@ -188,23 +219,10 @@ def _contains_cells(
     tol: float,
     out: NDArray[np.bool_],
 ) -> None:
-    """:func:`_contains_compiled` with the simplices whose bounds touch each point's cell
-    (:class:`engine.blend._grid.BoxGrid`) as the first guesses instead of the k-d tree's: every simplex is
-    still tried when none of them holds the point, so the answer is the same."""
+    """:func:`contains_row` of every point ``x [B, 2]``: :func:`_contains_compiled` with the cell's simplices
+    as the first guesses instead of the k-d tree's."""
     for r in range(x.shape[0]):
-        out[r] = False
-        cell = cell_of(lo, size, shape, x[r, 0], x[r, 1])
-        if cell >= 0:
-            for c in range(start[cell], start[cell + 1]):
-                if _holds(values, simplices, inv, valid, items[c], x, r, tol):
-                    out[r] = True
-                    break
-        if out[r]:
-            continue
-        for c in range(simplices.shape[0]):
-            if _holds(values, simplices, inv, valid, c, x, r, tol):
-                out[r] = True
-                break
+        out[r] = contains_row(values, simplices, inv, valid, lo, size, shape, start, items, x, r, tol)
 
 
 @dataclass(frozen=True)

@@ -66,33 +66,51 @@ def probe_grid(dims: int, density: int | Sequence[int]) -> tuple[F, tuple[int, .
 def _idw_kernel(
     x: F, dist: F, idx: NDArray[np.int64], probes: F, scaled: F, slopes: F, use_slopes: bool, power: float, out: F
 ) -> None:
-    """:meth:`LookupTable._idw` for requests ``x [Q, M]`` with their neighbours ``dist``/``idx [Q, k]``, compiled:
-    weights ``(d₀/d)^q``, each probe's value (plus its slope times the offset), normalised, clamped to [0, 1]."""
-    n, m = probes.shape[1], x.shape[1]
-    acc = np.empty(n)
+    """:meth:`LookupTable._idw` for requests ``x [Q, M]`` with their neighbours ``dist``/``idx [Q, k]``, compiled
+    (:func:`idw_row` of each)."""
+    acc = np.empty(probes.shape[1])
     for r in range(x.shape[0]):
-        exact = dist[r, 0] <= 1e-12
-        if exact:
-            for c in range(n):
-                out[r, c] = min(max(probes[idx[r, 0], c], 0.0), 1.0)
-            continue
-        d0 = dist[r, 0]
-        total = 0.0
+        idw_row(x, r, dist, idx, probes, scaled, slopes, use_slopes, power, acc, out)
+
+
+@jit.njit_inline
+def idw_row(
+    x: F,
+    r: int,
+    dist: F,
+    idx: NDArray[np.int64],
+    probes: F,
+    scaled: F,
+    slopes: F,
+    use_slopes: bool,
+    power: float,
+    acc: F,
+    out: F,
+) -> None:
+    """The IDW answer of request ``x[r]`` into ``out[r]``: weights ``(d₀/d)^q``, each probe's value (plus its slope
+    times the offset), normalised, clamped to [0, 1] (``acc``: scratch of ``N``)."""
+    n, m = probes.shape[1], x.shape[1]
+    if dist[r, 0] <= 1e-12:
         for c in range(n):
-            acc[c] = 0.0
-        for j in range(dist.shape[1]):
-            dj = dist[r, j]
-            w = min(max(d0 / (dj if dj > 0 else 1.0), 0.0), 1.0) ** power
-            total += w
-            q = idx[r, j]
-            for c in range(n):
-                v = probes[q, c]
-                if use_slopes:
-                    for e in range(m):
-                        v += slopes[q, c, e] * (x[r, e] - scaled[q, e])
-                acc[c] += w * v
+            out[r, c] = min(max(probes[idx[r, 0], c], 0.0), 1.0)
+        return
+    d0 = dist[r, 0]
+    total = 0.0
+    for c in range(n):
+        acc[c] = 0.0
+    for j in range(dist.shape[1]):
+        dj = dist[r, j]
+        w = min(max(d0 / (dj if dj > 0 else 1.0), 0.0), 1.0) ** power
+        total += w
+        q = idx[r, j]
         for c in range(n):
-            out[r, c] = min(max(acc[c] / total, 0.0), 1.0)
+            v = probes[q, c]
+            if use_slopes:
+                for e in range(m):
+                    v += slopes[q, c, e] * (x[r, e] - scaled[q, e])
+            acc[c] += w * v
+    for c in range(n):
+        out[r, c] = min(max(acc[c] / total, 0.0), 1.0)
 
 
 def _probe_slopes(probes: F, values: F, shape: tuple[int, ...]) -> F:
