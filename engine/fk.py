@@ -91,6 +91,37 @@ def forward_kinematics(
     return wpos, wrot
 
 
+@jit.njit_inline
+def _fk_puppet(
+    parents: NDArray[np.int64],
+    root: NDArray[np.float64],
+    rot: NDArray[np.float64],
+    off: NDArray[np.float64],
+    r: int,
+    p: int,
+    out_pos: NDArray[np.float64],
+    out_rot: NDArray[np.float64],
+    o: int,
+) -> None:
+    """FK of one puppet, the one loop :func:`fk_kernel` and :func:`fk_rows` share: root and local rotations
+    from row ``r`` of ``root``/``rot``, offsets from row ``p`` of ``off``, world pose into row ``o`` of
+    ``out_pos``/``out_rot``. Parents before children, each joint ``pos = parent_pos + parent_rot·offset``,
+    ``rot = parent_rot·local``, the numpy path's operations."""
+    for c in range(3):
+        out_pos[o, 0, c] = root[r, c]
+    for c in range(4):
+        out_rot[o, 0, c] = rot[r, 0, c]
+    for j in range(1, rot.shape[1]):
+        a = parents[j]
+        pq = (out_rot[o, a, 0], out_rot[o, a, 1], out_rot[o, a, 2], out_rot[o, a, 3])
+        d = qrot(pq, (off[p, j, 0], off[p, j, 1], off[p, j, 2]))
+        out_pos[o, j, 0] = out_pos[o, a, 0] + d[0]
+        out_pos[o, j, 1] = out_pos[o, a, 1] + d[1]
+        out_pos[o, j, 2] = out_pos[o, a, 2] + d[2]
+        q = qmul(pq, (rot[r, j, 0], rot[r, j, 1], rot[r, j, 2], rot[r, j, 3]))
+        out_rot[o, j, 0], out_rot[o, j, 1], out_rot[o, j, 2], out_rot[o, j, 3] = q
+
+
 @jit.njit
 def fk_kernel(
     parents: NDArray[np.int64],
@@ -100,22 +131,10 @@ def fk_kernel(
     out_pos: NDArray[np.float64],
     out_rot: NDArray[np.float64],
 ) -> None:
-    """FK of ``P`` puppets into ``out_pos [P,J,3]`` / ``out_rot [P,J,4]``: parents before children,
-    each joint ``pos = parent_pos + parent_rot·offset``, ``rot = parent_rot·local`` as the numpy path."""
+    """FK of ``P`` puppets into ``out_pos [P,J,3]`` / ``out_rot [P,J,4]``: :func:`_fk_puppet` of each, row ``p``
+    to row ``p``."""
     for p in range(rot.shape[0]):
-        for c in range(3):
-            out_pos[p, 0, c] = root[p, c]
-        for c in range(4):
-            out_rot[p, 0, c] = rot[p, 0, c]
-        for j in range(1, rot.shape[1]):
-            a = parents[j]
-            pq = (out_rot[p, a, 0], out_rot[p, a, 1], out_rot[p, a, 2], out_rot[p, a, 3])
-            d = qrot(pq, (off[p, j, 0], off[p, j, 1], off[p, j, 2]))
-            out_pos[p, j, 0] = out_pos[p, a, 0] + d[0]
-            out_pos[p, j, 1] = out_pos[p, a, 1] + d[1]
-            out_pos[p, j, 2] = out_pos[p, a, 2] + d[2]
-            q = qmul(pq, (rot[p, j, 0], rot[p, j, 1], rot[p, j, 2], rot[p, j, 3]))
-            out_rot[p, j, 0], out_rot[p, j, 1], out_rot[p, j, 2], out_rot[p, j, 3] = q
+        _fk_puppet(parents, root, rot, off, p, p, out_pos, out_rot, p)
 
 
 @jit.njit
@@ -142,19 +161,7 @@ def fk_rows(
                 prev_pos[o, j, c] = out_pos[o, j, c]
             for c in range(4):
                 prev_rot[o, j, c] = out_rot[o, j, c]
-        for c in range(3):
-            out_pos[o, 0, c] = root[r, c]
-        for c in range(4):
-            out_rot[o, 0, c] = rot[r, 0, c]
-        for j in range(1, rot.shape[1]):
-            a = parents[j]
-            pq = (out_rot[o, a, 0], out_rot[o, a, 1], out_rot[o, a, 2], out_rot[o, a, 3])
-            d = qrot(pq, (off[p, j, 0], off[p, j, 1], off[p, j, 2]))
-            out_pos[o, j, 0] = out_pos[o, a, 0] + d[0]
-            out_pos[o, j, 1] = out_pos[o, a, 1] + d[1]
-            out_pos[o, j, 2] = out_pos[o, a, 2] + d[2]
-            q = qmul(pq, (rot[r, j, 0], rot[r, j, 1], rot[r, j, 2], rot[r, j, 3]))
-            out_rot[o, j, 0], out_rot[o, j, 1], out_rot[o, j, 2], out_rot[o, j, 3] = q
+        _fk_puppet(parents, root, rot, off, r, p, out_pos, out_rot, o)
 
 
 def world_points(skeleton: Skeleton, wpos: ArrayLike, wrot: ArrayLike) -> NDArray[np.float64]:

@@ -29,6 +29,7 @@ __all__ = [
     "AVAILABLE",
     "enabled",
     "njit",
+    "njit_inline",
     "qaxis_angle",
     "qbetween",
     "qconj",
@@ -81,6 +82,14 @@ def njit(fn: T) -> T:
     if _numba is None:
         return fn
     return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
+
+
+def njit_inline(fn: T) -> T:
+    """:func:`njit`, inlined by numba into every kernel that calls it (``inline="always"``): a helper run per
+    puppet that takes arrays then costs its callers no call and no reference counting of those arrays."""
+    if _numba is None:
+        return fn
+    return _numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")(fn)
 
 
 @njit

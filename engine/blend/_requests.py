@@ -27,7 +27,7 @@ import numpy as np
 from engine import jit
 from engine.arrays import F64 as F
 from engine.arrays import Bool
-from engine.blend._resolve import resolve_rows
+from engine.blend._resolve import resolve_changed, resolve_rows
 from engine.ecs import Entity
 
 if TYPE_CHECKING:
@@ -134,16 +134,30 @@ class LastAnswers:
 
 def resolve(last: dict[str, LastAnswers], key: str, loco: LocomotionSet, req: Requests) -> Answers:
     """The set's answers for a batch's requests; rows unchanged since ``last[key]`` are not resolved again."""
+    before = last.get(key)
+    if before is not None and (before.loco is not loco or len(before.speeds) != len(req.speeds)):
+        before = None
+    kept = None
+    if before is not None:
+        old = before.answers
+        kept = (before.speeds, before.heights, before.standing, old.points, old.feasible, old.inside, old.rates)
+    fused = resolve_changed(loco, req.speeds, req.heights, req.standing, req.scales, kept)
+    if fused is not None:
+        changed, speeds, heights, (points, feasible, inside, rates) = fused
+        if before is not None and not changed:
+            return before.answers
+        answers = Answers(points, feasible, inside, rates)
+        last[key] = LastAnswers(loco, speeds, heights, req.standing, answers)
+        return answers
     speeds = req.speeds / req.scales
     heights = np.where(req.standing, 0.0, req.heights / req.scales)
-    before = last.get(key)
-    if before is None or before.loco is not loco or len(before.speeds) != len(speeds):
+    if before is None:
         todo = None
     else:
-        changed = (speeds != before.speeds) | (heights != before.heights) | (req.standing != before.standing)
-        if not changed.any():
+        changed_rows = (speeds != before.speeds) | (heights != before.heights) | (req.standing != before.standing)
+        if not changed_rows.any():
             return before.answers
-        todo = np.flatnonzero(changed)
+        todo = np.flatnonzero(changed_rows)
     if todo is None:
         points, feasible, inside, rates = resolve_rows(loco, speeds, heights, req.standing)
     else:

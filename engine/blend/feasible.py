@@ -23,11 +23,14 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
 from engine import jit
+from engine.blend._grid import BoxGrid, box_grid, cell_of
 
 __all__ = ["FeasibleSet", "kuhn_simplices", "border_facets", "closest_point_on_simplices"]
 
 from engine.arrays import F64 as F
 from engine.arrays import I64 as Ix
+
+_CELL_MARGIN = 1e-6  # the simplices' bounds grown by this (scaled units) when sorted into cells
 
 
 def kuhn_simplices(shape: tuple[int, ...]) -> Ix:
@@ -132,36 +135,94 @@ def line_range_row(inv: F, ok: NDArray[np.bool_], x: F, axis: int) -> tuple[floa
     return (base + low, base + high) if found else (math.nan, math.nan)
 
 
+@jit.njit_inline
+def _holds(values: F, simplices: Ix, inv: F, valid: NDArray[np.bool_], s: int, x: F, r: int, tol: float) -> bool:
+    """Whether simplex ``s`` holds point ``x[r]`` (barycentrics summed in numpy's order, ``tol`` slack)."""
+    if not valid[s]:
+        return False
+    n = x.shape[1]
+    v0 = simplices[s, 0]
+    total = 0.0
+    for i in range(n):
+        lam = 0.0
+        for j in range(n):
+            lam = lam + inv[s, i, j] * (x[r, j] - values[v0, j])
+        if not lam >= -tol:
+            return False
+        total = total + lam
+    return total <= 1.0 + tol
+
+
 @jit.njit
 def _contains_compiled(
     values: F, simplices: Ix, inv: F, valid: NDArray[np.bool_], near: Ix, x: F, tol: float, out: NDArray[np.bool_]
 ) -> None:
     """:meth:`FeasibleSet.contains_many` after its k-d tree query, compiled: the ``near`` simplices of each
     point first, every simplex when none holds it (barycentrics summed in numpy's order)."""
-    n = x.shape[1]
     for r in range(x.shape[0]):
         out[r] = False
-        for pass_ in range(2):
-            count = near.shape[1] if pass_ == 0 else simplices.shape[0]
-            for c in range(count):
-                s = near[r, c] if pass_ == 0 else c
-                if not valid[s]:
-                    continue
-                v0 = simplices[s, 0]
-                total, ok = 0.0, True
-                for i in range(n):
-                    lam = 0.0
-                    for j in range(n):
-                        lam = lam + inv[s, i, j] * (x[r, j] - values[v0, j])
-                    if not lam >= -tol:
-                        ok = False
-                        break
-                    total = total + lam
-                if ok and total <= 1.0 + tol:
-                    out[r] = True
-                    break
-            if out[r]:
+        for c in range(near.shape[1]):
+            if _holds(values, simplices, inv, valid, near[r, c], x, r, tol):
+                out[r] = True
                 break
+        if out[r]:
+            continue
+        for c in range(simplices.shape[0]):
+            if _holds(values, simplices, inv, valid, c, x, r, tol):
+                out[r] = True
+                break
+
+
+@jit.njit_inline
+def contains_row(
+    values: F,
+    simplices: Ix,
+    inv: F,
+    valid: NDArray[np.bool_],
+    lo: F,
+    size: F,
+    shape: Ix,
+    start: Ix,
+    items: Ix,
+    x: F,
+    r: int,
+    tol: float,
+) -> bool:
+    """Whether some simplex holds point ``x[r]``: the simplices whose bounds touch its cell
+    (:class:`engine.blend._grid.BoxGrid`) tried first, then every simplex, so the answer is
+    :func:`_contains_compiled`'s whatever its first guesses."""
+    cell = cell_of(lo, size, shape, x[r, 0], x[r, 1])
+    if cell >= 0:
+        for c in range(start[cell], start[cell + 1]):
+            if _holds(values, simplices, inv, valid, items[c], x, r, tol):
+                return True
+    inside = False
+    for c in range(simplices.shape[0]):  # a plain loop: numba compiles no generator for any()
+        if _holds(values, simplices, inv, valid, c, x, r, tol):
+            inside = True
+            break
+    return inside
+
+
+@jit.njit
+def _contains_cells(
+    values: F,
+    simplices: Ix,
+    inv: F,
+    valid: NDArray[np.bool_],
+    lo: F,
+    size: F,
+    shape: Ix,
+    start: Ix,
+    items: Ix,
+    x: F,
+    tol: float,
+    out: NDArray[np.bool_],
+) -> None:
+    """:func:`contains_row` of every point ``x [B, 2]``: :func:`_contains_compiled` with the cell's simplices
+    as the first guesses instead of the k-d tree's."""
+    for r in range(x.shape[0]):
+        out[r] = contains_row(values, simplices, inv, valid, lo, size, shape, start, items, x, r, tol)
 
 
 @dataclass(frozen=True)
@@ -181,6 +242,7 @@ class FeasibleSet:
     _inv: F = field(init=False, repr=False)
     _valid: NDArray[np.bool_] = field(init=False, repr=False)
     _centroids: cKDTree = field(init=False, repr=False)
+    _cells: BoxGrid | None = field(init=False, repr=False)  # the simplices' bounds by cell, in the plane
     _line: tuple[tuple[F, NDArray[np.bool_]], ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -203,6 +265,7 @@ class FeasibleSet:
             ("_inv", inv),
             ("_valid", valid),
             ("_centroids", cKDTree(v.mean(axis=1))),
+            ("_cells", box_grid(v.min(axis=1), v.max(axis=1), _CELL_MARGIN) if n == 2 else None),
         ):
             object.__setattr__(self, name, value)
         object.__setattr__(self, "_line", tuple(self._line_system(axis) for axis in range(n)))
@@ -253,19 +316,44 @@ class FeasibleSet:
     def contains_many(self, x: ArrayLike, tol: float = 1e-6) -> NDArray[np.bool_]:
         """:meth:`contains` for points ``x [B, N]`` at once."""
         xs = np.atleast_2d(np.asarray(x, dtype=np.float64))
+        if jit.enabled():
+            return self.contains_compiled(xs, tol)
         k = min(12, len(self.simplices))
         _, near = self._centroids.query(xs, k=k)
         near = near.reshape(len(xs), -1)
-        if jit.enabled():
-            out = np.empty(len(xs), dtype=np.bool_)
-            _contains_compiled(self.values, self.simplices, self._inv, self._valid, near, xs, tol, out)
-            return out
         base = self.values[self.simplices[near, 0]]  # [B, k, N]
         lam = np.einsum("bkij,bkj->bki", self._inv[near], xs[:, None, :] - base)
         inside = (self._valid[near] & np.all(lam >= -tol, axis=-1) & (lam.sum(axis=-1) <= 1.0 + tol)).any(axis=-1)
         for i in np.flatnonzero(~inside):
             inside[i] = self._inside(xs[i], slice(None), tol)
         return inside
+
+    def contains_compiled(self, xs: F, tol: float = 1e-6) -> NDArray[np.bool_]:
+        """:meth:`contains_many` of points ``xs [B, N]`` on the compiled path (numba on): the simplices of each
+        point's cell tried first in the plane (no k-d tree query), the k-d tree's nearest in other dimensions."""
+        out = np.empty(len(xs), dtype=np.bool_)
+        cells = self._cells
+        if cells is None:
+            _, near = self._centroids.query(xs, k=min(12, len(self.simplices)))
+            _contains_compiled(
+                self.values, self.simplices, self._inv, self._valid, near.reshape(len(xs), -1), xs, tol, out
+            )
+            return out
+        _contains_cells(
+            self.values,
+            self.simplices,
+            self._inv,
+            self._valid,
+            cells.lo,
+            cells.size,
+            cells.shape,
+            cells.start,
+            cells.items,
+            xs,
+            tol,
+            out,
+        )
+        return out
 
     def _inside(self, x: F, which: NDArray[np.int64] | slice, tol: float) -> bool:
         base = self.values[self.simplices[which, 0]]

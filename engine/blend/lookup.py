@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
 from engine import jit
+from engine.blend._grid import PointGrid, grid_of, knn
 from engine.blend.feasible import FeasibleSet
 
 __all__ = ["LookupTable", "Resolution", "probe_grid", "LinearMapping"]
@@ -65,33 +66,51 @@ def probe_grid(dims: int, density: int | Sequence[int]) -> tuple[F, tuple[int, .
 def _idw_kernel(
     x: F, dist: F, idx: NDArray[np.int64], probes: F, scaled: F, slopes: F, use_slopes: bool, power: float, out: F
 ) -> None:
-    """:meth:`LookupTable._idw` for requests ``x [Q, M]`` with their neighbours ``dist``/``idx [Q, k]``, compiled:
-    weights ``(d₀/d)^q``, each probe's value (plus its slope times the offset), normalised, clamped to [0, 1]."""
-    n, m = probes.shape[1], x.shape[1]
-    acc = np.empty(n)
+    """:meth:`LookupTable._idw` for requests ``x [Q, M]`` with their neighbours ``dist``/``idx [Q, k]``, compiled
+    (:func:`idw_row` of each)."""
+    acc = np.empty(probes.shape[1])
     for r in range(x.shape[0]):
-        exact = dist[r, 0] <= 1e-12
-        if exact:
-            for c in range(n):
-                out[r, c] = min(max(probes[idx[r, 0], c], 0.0), 1.0)
-            continue
-        d0 = dist[r, 0]
-        total = 0.0
+        idw_row(x, r, dist, idx, probes, scaled, slopes, use_slopes, power, acc, out)
+
+
+@jit.njit_inline
+def idw_row(
+    x: F,
+    r: int,
+    dist: F,
+    idx: NDArray[np.int64],
+    probes: F,
+    scaled: F,
+    slopes: F,
+    use_slopes: bool,
+    power: float,
+    acc: F,
+    out: F,
+) -> None:
+    """The IDW answer of request ``x[r]`` into ``out[r]``: weights ``(d₀/d)^q``, each probe's value (plus its slope
+    times the offset), normalised, clamped to [0, 1] (``acc``: scratch of ``N``)."""
+    n, m = probes.shape[1], x.shape[1]
+    if dist[r, 0] <= 1e-12:
         for c in range(n):
-            acc[c] = 0.0
-        for j in range(dist.shape[1]):
-            dj = dist[r, j]
-            w = min(max(d0 / (dj if dj > 0 else 1.0), 0.0), 1.0) ** power
-            total += w
-            q = idx[r, j]
-            for c in range(n):
-                v = probes[q, c]
-                if use_slopes:
-                    for e in range(m):
-                        v += slopes[q, c, e] * (x[r, e] - scaled[q, e])
-                acc[c] += w * v
+            out[r, c] = min(max(probes[idx[r, 0], c], 0.0), 1.0)
+        return
+    d0 = dist[r, 0]
+    total = 0.0
+    for c in range(n):
+        acc[c] = 0.0
+    for j in range(dist.shape[1]):
+        dj = dist[r, j]
+        w = min(max(d0 / (dj if dj > 0 else 1.0), 0.0), 1.0) ** power
+        total += w
+        q = idx[r, j]
         for c in range(n):
-            out[r, c] = min(max(acc[c] / total, 0.0), 1.0)
+            v = probes[q, c]
+            if use_slopes:
+                for e in range(m):
+                    v += slopes[q, c, e] * (x[r, e] - scaled[q, e])
+            acc[c] += w * v
+    for c in range(n):
+        out[r, c] = min(max(acc[c] / total, 0.0), 1.0)
 
 
 def _probe_slopes(probes: F, values: F, shape: tuple[int, ...]) -> F:
@@ -191,6 +210,7 @@ class LookupTable:
     feasible: FeasibleSet | None = field(init=False, repr=False)
     slopes: F | None = field(init=False, repr=False)
     _scaled_values: F = field(init=False, repr=False)
+    _grid: PointGrid | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         p = np.array(self.probes, dtype=np.float64)
@@ -214,6 +234,7 @@ class LookupTable:
         object.__setattr__(self, "scale", scale)
         object.__setattr__(self, "_scaled_values", (u - offset) / scale)
         object.__setattr__(self, "tree", cKDTree((u - offset) / scale))
+        object.__setattr__(self, "_grid", grid_of((u - offset) / scale))
         feas = None
         if self.grid_shape is not None and u.shape[1] == p.shape[1]:
             feas = FeasibleSet(tuple(self.grid_shape), (u - offset) / scale)
@@ -292,10 +313,29 @@ class LookupTable:
     def query_scaled(self, x: F) -> F:
         """:meth:`query` of requests already scaled to the table's units (``(u − offset) / scale``, finite)."""
         k = min(self.neighbours, len(self.probes))
-        dist, idx = self.tree.query(x, k=k)
-        if k == 1:
-            dist, idx = dist[..., None], idx[..., None]
+        grid = self._grid
+        if grid is not None and jit.enabled():
+            dist, idx = self._neighbours(grid, x, k)
+        else:
+            dist, idx = self.tree.query(x, k=k)
+            if k == 1:
+                dist, idx = dist[..., None], idx[..., None]
         return self._idw(x, np.asarray(dist), np.asarray(idx))
+
+    def _neighbours(self, grid: PointGrid, x: F, k: int) -> tuple[F, NDArray[np.int64]]:
+        """The ``k`` nearest probes of ``x [..., 2]`` (distances, indices) as ``self.tree`` answers, found on the
+        compiled grid (:func:`engine.blend._grid.knn`); the rows with equally far neighbours ask the tree."""
+        xs = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, 2)
+        count = len(xs)
+        dist, idx = np.empty((count, k)), np.empty((count, k), dtype=np.int64)
+        exact = np.empty(count, dtype=np.bool_)
+        knn(grid.points, grid.lo, grid.size, grid.shape, grid.start, grid.items, xs, k, dist, idx, exact)
+        if not exact.all():
+            rows = np.flatnonzero(~exact)
+            tied_dist, tied_idx = self.tree.query(xs[rows], k=k)
+            dist[rows], idx[rows] = np.reshape(tied_dist, (len(rows), k)), np.reshape(tied_idx, (len(rows), k))
+        shape = np.shape(x)[:-1] + (k,)
+        return dist.reshape(shape), idx.reshape(shape)
 
     def query_brute(self, u: ArrayLike) -> F:
         """The same IDW summed over every probe, without the tree (the baseline of the bench)."""

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from engine import quat
-from engine.fk import forward_kinematics, world_points
+from engine import jit, quat
+from engine.fk import fk_kernel, fk_rows, forward_kinematics, world_points
 from engine.humanoid import humanoid_skeleton
 
 
@@ -118,3 +118,36 @@ def test_inputs_of_any_float_type_are_computed_in_double_precision():
     assert pos.dtype == np.float64 and rot.dtype == np.float64
     np.testing.assert_allclose(pos, ref, atol=1e-12)
     np.testing.assert_allclose(rot, ref_rot, atol=1e-12)
+
+
+@pytest.mark.skipif(not jit.AVAILABLE, reason="numba not installed: there are no compiled kernels")
+def test_the_rows_kernel_is_the_batch_kernel_at_other_rows_bit_for_bit() -> None:
+    """:func:`fk_rows` (the FK stage's pass on the columns) and :func:`fk_kernel` (``forward_kinematics``) run
+    one per-puppet function: the same puppets read from and written to shuffled rows give the same bits, the
+    previous values are copied aside first, and both agree with the numpy path to 1e-12.
+
+    Broken once by reading the offsets at the output row (``off[o]`` instead of ``off[p]``) in the shared
+    function: the shuffled rows' positions differ and it fails."""
+    sk = humanoid_skeleton()
+    rng = np.random.default_rng(12)
+    count = 40
+    rots = quat.exp(rng.normal(scale=0.6, size=(count, sk.num_joints, 3)))
+    roots = rng.normal(size=(count, 3))
+    offsets = sk.offsets * rng.uniform(0.5, 1.5, size=(count, sk.num_joints, 1))
+    pos, rot = np.empty((count, sk.num_joints, 3)), np.empty((count, sk.num_joints, 4))
+    fk_kernel(sk.parents, roots, rots, offsets, pos, rot)
+    with jit.use(False):
+        numpy_pos, numpy_rot = forward_kinematics(sk, roots, rots, offsets)
+    np.testing.assert_allclose(pos, numpy_pos, atol=1e-12)
+    np.testing.assert_allclose(rot, numpy_rot, atol=1e-12)
+    rows, out_rows = rng.permutation(count), rng.permutation(count)
+    inverse = np.empty(count, dtype=np.int64)
+    inverse[rows] = np.arange(count)
+    at_rows = (roots[inverse], rots[inverse])  # puppet p's pose at row rows[p]
+    out_pos, out_rot = rng.normal(size=pos.shape), rng.normal(size=rot.shape)
+    before = (out_pos.copy(), out_rot.copy())
+    prev_pos, prev_rot = np.empty_like(out_pos), np.empty_like(out_rot)
+    fk_rows(sk.parents, rows, *at_rows, offsets, out_rows, out_pos, out_rot, prev_pos, prev_rot)
+    assert out_pos[out_rows].tobytes() == pos.tobytes() and out_rot[out_rows].tobytes() == rot.tobytes()
+    np.testing.assert_array_equal(prev_pos, before[0])
+    np.testing.assert_array_equal(prev_rot, before[1])
