@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from engine.arrays import F64 as _F
 from engine.ragdoll._carry import restore, snapshot
+from engine.ragdoll._commands import Commands
 from engine.ragdoll._guard import velocity_limits
 from engine.ragdoll._layout import Layout, build_layout, select
 from engine.ragdoll._pool import CHUNK, INITIAL, MAX_SLOTS, RagdollPool, park, settle, wake
@@ -37,6 +38,7 @@ class Building:
     rebuilds: int
     left_out: int
     _ragdolls: dict[int, RagdollSlot]
+    _cmds: Commands
     _props: dict[int, PropSlot]
     _pool: RagdollPool
     _pool_layout: Layout | None
@@ -112,22 +114,20 @@ class Building:
         """Park the slots of ragdolls that left, lend slots to those that joined (growing the pool
         when a kind has too few: to what is needed and a quarter more), and place the newcomers (see :mod:`._pool`)."""
         self._moved = False
-        order = sorted(self._ragdolls)
-        for k in order:
-            slot = self._ragdolls[k]
-            if not slot.in_model and slot.pool >= 0:
-                self._give_back(slot)
+        C = self._cmds
+        C.sync()
+        for i in np.nonzero(~C.in_model & (C.pool >= 0))[0].tolist():
+            self._give_back(i)
         # simulated ragdolls first, then the animated ones near them; past MAX_SLOTS of a kind the
         # rest stay out this step (an animated one then passes through, it does not crash the game)
-        joining = sorted(
-            (k for k in order if self._ragdolls[k].in_model and self._ragdolls[k].pool < 0),
-            key=lambda k: (self._ragdolls[k].cmd.kinematic, k),
-        )
+        new = np.nonzero(C.in_model & (C.pool < 0))[0]
+        joining = new[np.argsort(C.kinematic[new], kind="stable")].tolist()  # rows are in key order
+        kind_of_row = {i: self._ragdolls[int(C.keys[i])].kind for i in joining}
         short: dict[bytes, int] = {}
-        for k in joining:
-            short[self._ragdolls[k].kind] = short.get(self._ragdolls[k].kind, 0) + 1
-        for k in joining:
-            slot = self._ragdolls[k]
+        for i in joining:
+            short[kind_of_row[i]] = short.get(kind_of_row[i], 0) + 1
+        for i in joining:
+            slot = self._ragdolls[int(C.keys[i])]
             need = short.pop(slot.kind, 0)
             free, have = self._pool.free(slot.kind), self._pool.count(slot.kind)
             if need > free and have < MAX_SLOTS:
@@ -135,15 +135,15 @@ class Building:
                 # compiling is superlinear in the pool's size, so doubling would cost more than it saves
                 self._pool.grow_to(slot.spec, min(MAX_SLOTS, max(have + CHUNK, -(-5 * (have - free + need) // 4))))
                 self._dirty = True
-        room = dict.fromkeys({self._ragdolls[k].kind for k in joining}, 0)
+        room = dict.fromkeys(set(kind_of_row.values()), 0)
         self.left_out = 0
-        for k in joining:
-            slot = self._ragdolls[k]
-            if room[slot.kind] >= self._pool.free(slot.kind):
-                slot.in_model = False
+        for i in joining:
+            kind = kind_of_row[i]
+            if room[kind] >= self._pool.free(kind):
+                C.in_model[i] = False
                 self.left_out += 1
             else:
-                room[slot.kind] += 1
+                room[kind] += 1
         if self._dirty:
             self._compile()
             self._moved = False
@@ -152,33 +152,36 @@ class Building:
             self.layout = None
             return
         m, d, pool = self.model, self.data, self._pool_layout
-        for k in order:
-            slot = self._ragdolls[k]
-            if slot.in_model and slot.pool < 0:
-                taken = self._pool.take(slot.kind, k)
-                assert taken is not None
-                slot.pool = taken
-                wake(m, d, pool, taken)
-        keys = [k for k in order if self._ragdolls[k].pool >= 0]
-        self.layout = select(pool, [self._ragdolls[k].pool for k in keys], keys)
-        for key in keys:
-            slot = self._ragdolls[key]
-            if not slot.placed:
-                # joining from outside: where its animation was a step ago, moving as it moved then
-                # (as if it had been simulated all along), so it keeps its momentum
-                last, prev = slot.cmd.last, slot.prev
-                if last is None:
-                    self._place(key, slot.cmd.root, slot.cmd.rot)
-                else:
-                    self._place(key, last[0], last[1], prev)
-                slot.cmd.last, slot.placed = last, True
+        for i in np.nonzero(C.in_model & (C.pool < 0))[0].tolist():
+            key = int(C.keys[i])
+            taken = self._pool.take(kind_of_row[i], key)
+            assert taken is not None
+            C.pool[i] = taken
+            wake(m, d, pool, taken)
+        rows = np.nonzero(C.pool >= 0)[0]
+        keys = C.keys[rows].tolist()
+        self.layout = select(pool, C.pool[rows].tolist(), keys)
+        for i in rows[~C.placed[rows]].tolist():
+            # joining from outside: where its animation was a step ago, moving as it moved then
+            # (as if it had been simulated all along), so it keeps its momentum
+            key = int(C.keys[i])
+            last, prev, had = C.last(i), C.prev(i), bool(C.has_last[i])
+            if last is None:
+                root, rot = C.pose(i)
+                self._place(key, root.copy(), rot.copy())
+            else:
+                self._place(key, last[0], last[1], prev)
+            C.has_last[i], C.placed[i] = had, True
         settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
+        # (settle's kinematics is all the next step's commands read, but leaving the rest of this to
+        # the step is not bit-identical: games/snowman/demo.rec then differs from frame 227)
         mujoco.mj_forward(m, d)
 
-    def _give_back(self, slot: RagdollSlot) -> None:
-        """Return a ragdoll's pool slot: parked, asleep, free for the next one of its kind."""
+    def _give_back(self, row: int) -> None:
+        """Return a ragdoll's pool slot (command row ``row``): parked, asleep, free for the next one of its kind."""
+        C = self._cmds
         if self.model is not None and self.data is not None and self._pool_layout is not None:
-            park(self.model, self.data, self._pool_layout, slot.pool)
-        self._pool.release(slot.pool)
-        slot.pool = -1
+            park(self.model, self.data, self._pool_layout, int(C.pool[row]))
+        self._pool.release(int(C.pool[row]))
+        C.pool[row] = -1
         self._moved = True

@@ -1,15 +1,14 @@
 """Applying ragdoll commands and reading poses back, batched over every ragdoll.
 
-A :class:`Command` is what one ragdoll should do (target pose, weights, hold, kinematic
-placement) plus the target it had last step, from which target velocities follow.
-:func:`apply_commands` turns all commands into MuJoCo inputs in one vectorised pass over
-the flat :class:`~engine.ragdoll._layout.Layout`; :func:`project_twist` enforces the
+A ragdoll's command is what it should do (target pose, weights, hold, kinematic placement)
+plus the target it had last step, from which target velocities follow; all of them are the
+columns of :class:`~engine.ragdoll._commands.Commands`. :func:`apply_commands` turns the
+commands of the ragdolls in the model into MuJoCo inputs in one vectorised pass over the flat
+:class:`~engine.ragdoll._layout.Layout`; :func:`project_twist` enforces the
 ball joints' twist limits; :func:`read_poses` gathers every ragdoll's pose.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -17,32 +16,19 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.arrays import F64 as _F
+from engine.arrays import I64
+from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
 
-__all__ = ["Command", "apply_commands", "project_twist", "read_poses", "hinge_angles", "GRAVITY"]
+__all__ = ["apply_commands", "project_twist", "read_poses", "hinge_angles", "GRAVITY"]
 
 GRAVITY = 9.81
 _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
 _PIN_DAMPING = 100.0  # and damping (1/s): critically damped
 _MAX_LEAD = 0.5  # s: cap on the velocity lead at tiny weights
 _HOLD_REACH = 0.5  # m: farthest the hold spring's anchor is from the held body (a stick flicked into the sky)
-
-
-@dataclass
-class Command:
-    """What one ragdoll should do on the next steps, and the target it had last step."""
-
-    root: _F
-    rot: _F
-    muscle: float = 0.0
-    pin: float = 0.0
-    support: float = 0.0
-    kinematic: bool = False
-    hold: str | None = None
-    hold_target: _F = field(default_factory=lambda: np.zeros(3))
-    last: tuple[_F, _F] | None = None
 
 
 def hinge_angles(rot: _F, axes: _F) -> _F:
@@ -55,22 +41,23 @@ def apply_commands(
     L: Layout,
     m: mujoco.MjModel,
     d: mujoco.MjData,
-    cmds: list[Command],
+    C: Commands,
+    rows: I64,
     dt: float,
     ghost: NDArray[np.bool_] | None = None,
 ) -> None:
-    """Turn every ragdoll's command into servo targets, gains, pins, holds and placements
-    (``ghost [P]``: which simulated ragdolls pass through other ragdolls this step)."""
-    if not cmds:
+    """Turn the commands of ragdolls ``rows`` (the layout's ragdolls, in its order) into servo targets,
+    gains, pins, holds and placements (``ghost [P]``: which simulated ragdolls pass through other
+    ragdolls this step); their targets then become their last targets."""
+    if not len(rows):
         return
-    root = np.stack([c.root for c in cmds])
-    rot = np.concatenate([c.rot for c in cmds])
-    last_root = np.stack([c.root if c.last is None else c.last[0] for c in cmds])
-    last_rot = np.concatenate([c.rot if c.last is None else c.last[1] for c in cmds])
-    muscle = np.array([c.muscle for c in cmds])
-    pin = np.array([c.pin for c in cmds])
-    kin = np.array([c.kinematic for c in cmds])
-    ghost = np.zeros(len(cmds), dtype=bool) if ghost is None else ghost
+    j = joint_rows(C.starts, rows)
+    has = C.has_last[rows]
+    root, rot = C.root[rows], C.rot[j]
+    last_root = np.where(has[:, None], C.last_root[rows], root)
+    last_rot = np.where(np.repeat(has, C.joints[rows])[:, None], C.last_rot[j], rot)
+    muscle, pin, kin = C.muscle[rows], C.pin[rows], C.kinematic[rows]
+    ghost = np.zeros(len(rows), dtype=bool) if ghost is None else ghost
     r0 = L.starts[:-1]
     # target velocities from the previous target (zero after a placement)
     v_root = (root - last_root) / dt
@@ -99,7 +86,7 @@ def apply_commands(
     d.mocap_pos[L.pin_mocap] = root + v_root * pin_lead[:, None]
     d.mocap_quat[L.pin_mocap] = quat.mul(quat.exp(w_root * pin_lead[:, None]), rot[r0])
     d.xfrc_applied[L.body] = 0.0
-    d.xfrc_applied[L.body, 1] = m.body_mass[L.body] * GRAVITY * np.array([c.support for c in cmds])[L.body_owner]
+    d.xfrc_applied[L.body, 1] = m.body_mass[L.body] * GRAVITY * C.support[rows][L.body_owner]
     # An animated (kinematic) ragdoll touches only simulated bodies and props: not the
     # ground (neither can give way), not other animated bodies and not itself -- a
     # crouching pose lays the arms into the legs, and the contact impulses inside the
@@ -108,18 +95,19 @@ def apply_commands(
     kind = np.where(kin, 1, np.where(ghost, 2, 0))[L.geom_owner]
     bits = np.array([SIMULATED_BITS, ANIMATED_BITS, GHOST_BITS])[kind]
     set_contact_bits(m, L.geom, bits[:, 0], bits[:, 1])
-    for p, c in enumerate(cmds):
+    for p, i in enumerate(rows.tolist()):
+        hold = C.hold[i]
         for name, eq in L.hold_eq[p].items():
-            d.eq_active[eq] = name == c.hold
-        target = c.hold_target
-        if c.hold is not None:  # the spring pulls from at most _HOLD_REACH away: a bounded force
-            held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][c.hold]]]
+            d.eq_active[eq] = name == hold
+        target = C.hold_target[i]
+        if hold is not None:  # the spring pulls from at most _HOLD_REACH away: a bounded force
+            held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][hold]]]
             gap = target - held
             dist = float(np.linalg.norm(gap))
             if dist > _HOLD_REACH:
                 target = held + gap * (_HOLD_REACH / dist)
         d.mocap_pos[L.hold_mocap[p]] = target
-        c.last = (c.root, c.rot)
+    C.roll(rows, keep_prev=False)
     if kin.any():
         k = np.nonzero(kin)[0]
         d.qpos[L.root_q[k, None] + np.arange(3)] = root[k]

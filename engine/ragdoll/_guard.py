@@ -80,7 +80,7 @@ def guarded_step(
     """
     saved = np.empty(mujoco.mj_stateSize(m, _STATE))
     mujoco.mj_getState(m, d, saved, _STATE)
-    counts = [int(w.number) for w in d.warning]
+    counts = d.warning.number.copy()  # one array read (a loop over the warning structs cost ~0.3 ms)
     del _PENDING[:]
     reason = None
     np.clip(d.qvel, -limit, limit, out=d.qvel)  # commanded (kinematic) velocities too
@@ -95,7 +95,7 @@ def guarded_step(
         reason = f"MuJoCo error: {exc}"
     if reason is None and _PENDING:
         reason = f"MuJoCo warning: {_PENDING[0]}"
-    if reason is None and any(int(w.number) > c for w, c in zip(d.warning, counts, strict=True)):
+    if reason is None and (d.warning.number > counts).any():
         reason = "MuJoCo warning"
     if reason is None and not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
         reason = "non-finite state"
@@ -103,8 +103,7 @@ def guarded_step(
         return None
     bad = ~np.isfinite(d.qvel) | (np.abs(d.qvel) >= limit) | ~np.isfinite(d.qacc)
     mujoco.mj_setState(m, d, saved, _STATE)
-    for i, w in enumerate(d.warning):
-        w.number = counts[i]
+    d.warning.number[:] = counts
     rest = np.isin(owners, owners[bad]) if bad.any() else np.ones(m.nv, dtype=bool)
     d.qvel[rest] = 0.0
     d.qvel[~np.isfinite(d.qvel)] = 0.0

@@ -10,6 +10,12 @@ velocity are copied in and the slot is woken; a puppet that leaves gives the slo
 put to sleep with MuJoCo's sleeping (``mjENBL_SLEEP``), so its bodies cost almost nothing per
 step (MuJoCo skips sleeping trees in every stage; ~2-3 µs per parked ragdoll per substep here).
 
+Parked slots are not free, though: MuJoCo's kinematics and constraint making still walk every
+body and joint of the model, about 0.45 ms per substep for 96 parked slots (with one ragdoll awake,
+a 96-slot model stepped 8 substeps in ~4 ms where one ragdoll alone costs well under 1). So the first
+build is no bigger than a crowd's falls need: ten of a hundred falling pull 30-38 ragdolls into the
+model (the fallers and the walking neighbours their capsules come near), hence :data:`INITIAL` 48.
+
 Slots are added in chunks (:func:`grow_to`): the first build of a crowd holds enough for
 ``min(ragdolls of the kind, INITIAL)``, and only when more are needed at once than the pool holds
 does it grow, to what is needed and a quarter more (one compile, carrying every state by name;
@@ -45,7 +51,7 @@ __all__ = [
 ]
 
 CHUNK = 4  # slots: the pool grows in multiples of this
-INITIAL = 96  # slots of a kind compiled at a crowd's first build at most: ten of a hundred falling pull ~60 in
+INITIAL = 48  # slots of a kind compiled at a crowd's first build at most (see below)
 MAX_SLOTS = 128  # slots of a kind at most: compiling 128 costs ~1.4 s, 256 ~7 s, ~1000 cannot be allocated
 _TEMPLATE = -1  # the key a kind's template is rendered under before its names are replaced
 _AWAKE = -(1 + mujoco.mjMINAWAKE)

@@ -17,6 +17,7 @@ from engine import quat
 from engine.arrays import F64 as _F
 from engine.fk import forward_kinematics
 from engine.pose import Pose
+from engine.ragdoll._commands import Commands
 from engine.ragdoll._control import read_poses
 from engine.ragdoll._layout import Layout
 from engine.ragdoll._slots import RagdollSlot
@@ -42,6 +43,9 @@ class Readback:
 
         def _slot(self, key: int) -> RagdollSlot: ...
 
+        @property
+        def commands(self) -> Commands: ...
+
     def _readback(self) -> tuple[_F, _F]:
         """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll (cached per step)."""
         self.ensure_built()
@@ -50,16 +54,18 @@ class Readback:
             self._read = read_poses(self.layout, self.data)
         return self._read
 
-    def _outside(self, key: int) -> RagdollSlot | None:
-        """The slot of a ragdoll left out of the model (it is exactly on its target), else ``None``."""
-        slot = self._slot(key)
+    def _outside(self, key: int) -> int | None:
+        """The command row of a ragdoll left out of the model (it is exactly on its target), else ``None``."""
+        self._slot(key)
         self.ensure_built()
-        return None if slot.in_model else slot
+        i = self.commands.row[key]
+        return None if self.commands.in_model[i] else i
 
     def pose(self, key: int) -> Pose:
         """The ragdoll's simulated pose as an engine :class:`Pose` (root + local rotations)."""
         if (out := self._outside(key)) is not None:
-            return Pose(out.cmd.root.copy(), out.cmd.rot.copy())
+            root, rot = self.commands.pose(out)
+            return Pose(root.copy(), rot.copy())
         roots, rot = self._readback()
         L = self.layout
         assert L is not None
@@ -69,7 +75,9 @@ class Readback:
     def body_positions(self, key: int) -> _F:
         """World positions ``[J,3]`` of the ragdoll's joint origins."""
         if (out := self._outside(key)) is not None:
-            return forward_kinematics(out.spec.skeleton, out.cmd.root, out.cmd.rot, out.spec.offsets)[0]
+            spec = self._slot(key).spec
+            root, rot = self.commands.pose(out)
+            return forward_kinematics(spec.skeleton, root, rot, spec.offsets)[0]
         L, d = self.layout, self.data
         assert L is not None and d is not None
         return d.xpos[L.body[L.body_owner == L.ordinal(key)]].copy()
@@ -77,7 +85,7 @@ class Readback:
     def root_velocity(self, key: int) -> _F:
         """The root's free-joint velocity ``[6]`` (linear world, angular local)."""
         if (out := self._outside(key)) is not None:  # its target's velocity over the last step
-            v, last, prev = np.zeros(6), out.cmd.last, out.prev
+            v, last, prev = np.zeros(6), self.commands.last(out), self.commands.prev(out)
             if last is not None and prev is not None:
                 v[:3] = (last[0] - prev[0]) / self.dt
                 v[3:] = quat.log(quat.mul(quat.conjugate(prev[1][0]), last[1][0])) / self.dt

@@ -1,11 +1,11 @@
-"""What the physics world keeps per ragdoll and per prop, beside MuJoCo's own state."""
+"""What the physics world keeps per ragdoll and per prop, beside MuJoCo's own state and the
+ragdolls' command columns (:mod:`engine.ragdoll._commands`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from engine.arrays import F64 as _F
-from engine.ragdoll._control import Command
 from engine.ragdoll.mjcf import PropSpec, RagdollSpec
 
 __all__ = ["RagdollSlot", "PropSlot"]
@@ -13,18 +13,11 @@ __all__ = ["RagdollSlot", "PropSlot"]
 
 @dataclass
 class RagdollSlot:
-    """One ragdoll: how to build it, its command, and whether (and how) it is in the model now."""
+    """One ragdoll: how to build it (its command and membership are rows of the command columns)."""
 
     spec: RagdollSpec
-    cmd: Command
-    reach: float
     kind: bytes  # which pool slots fit it (:func:`engine.ragdoll._pool.kind_of`)
-    joints: int  # its skeleton's joint count (read for every puppet every step)
-    placed: bool = False
-    in_model: bool = False  # simulated this step (animated and alone: left out, see _islands)
-    pool: int = -1  # the pool slot lent to it while in the model
-    prev: tuple[_F, _F] | None = None  # out of the model: the target before the last step's
-    ghost: bool = False  # inside another ragdoll: touches only the ground and props
+    joints: int  # its skeleton's joint count
 
 
 @dataclass

@@ -35,7 +35,8 @@ from engine.arrays import I64
 from engine.pose import Pose
 from engine.ragdoll._bounds import command_boxes, geom_boxes
 from engine.ragdoll._building import Building
-from engine.ragdoll._control import Command, apply_commands, hinge_angles, project_twist
+from engine.ragdoll._commands import Commands, joint_rows
+from engine.ragdoll._control import apply_commands, hinge_angles, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
@@ -73,6 +74,11 @@ class PhysicsWorld(Readback, Building):
         self.layout: Layout | None = None
         self.rebuilds = 0
         self._ragdolls: dict[int, RagdollSlot] = {}
+        self._cmds = Commands()
+        self._changes = 0
+        # the physics stage's record of what it last synced the ragdolls from (a world query's
+        # result and :attr:`ragdoll_changes` then: engine.ragdoll.system)
+        self.synced: tuple[object, int] | None = None
         self._props: dict[int, PropSlot] = {}
         self._held: set[int] = set()  # ragdolls with a held body
         self._dirty = False
@@ -117,7 +123,9 @@ class PhysicsWorld(Readback, Building):
         kind = kind_of(spec)
         if kind not in self._reach:  # a crowd is a few kinds of ragdoll many times over
             self._reach[kind] = reach(skeleton, profile, off)
-        self._ragdolls[key] = RagdollSlot(spec, Command(r, q), self._reach[kind], kind, skeleton.num_joints)
+        self._ragdolls[key] = RagdollSlot(spec, kind, skeleton.num_joints)
+        self._cmds.add(key, r, q, self._reach[kind])
+        self._changes += 1
         self._sized = False
 
     def add_prop(
@@ -145,8 +153,13 @@ class PhysicsWorld(Readback, Building):
         """Remove a ragdoll or prop (no error if absent)."""
         slot = self._ragdolls.pop(key, None)
         self._held.discard(key)
-        if slot is not None and slot.pool >= 0:
-            self._give_back(slot)
+        if slot is not None:
+            self._changes += 1
+            C = self.commands
+            i = C.row[key]
+            if C.pool[i] >= 0:
+                self._give_back(i)
+            C.remove(key)
         if self._props.pop(key, None) is not None:
             self._dirty = True
 
@@ -162,6 +175,11 @@ class PhysicsWorld(Readback, Building):
     def ragdoll_keys(self) -> list[int]:
         """Entity ids of the ragdolls, in order."""
         return sorted(self._ragdolls)
+
+    @property
+    def ragdoll_changes(self) -> int:
+        """How many ragdolls were added or removed so far (a cheap "did the set change" check)."""
+        return self._changes
 
     @property
     def prop_keys(self) -> list[int]:
@@ -180,6 +198,12 @@ class PhysicsWorld(Readback, Building):
             self._assign()
 
     # -- commands -------------------------------------------------------------------------
+    @property
+    def commands(self) -> Commands:
+        """The ragdolls' command columns, rows in key order (current: added and removed ones applied)."""
+        self._cmds.sync()
+        return self._cmds
+
     def _checked(self, key: int, root: ArrayLike, rotations: ArrayLike, n: int) -> tuple[_F, _F]:
         r = np.array(root, dtype=np.float64).reshape(3)
         q = np.asarray(rotations, dtype=np.float64)
@@ -220,10 +244,11 @@ class PhysicsWorld(Readback, Building):
         """
         slot = self._slot(key)
         r, q = self._checked(key, root, rotations, slot.spec.skeleton.num_joints)
-        c = slot.cmd
-        c.root, c.rot, c.kinematic = r, q, bool(kinematic)
-        c.muscle, c.pin = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
-        c.support = float(np.clip(gravity_support, 0, 1))
+        C = self.commands
+        i = C.row[key]
+        C.root[i], C.rot[C.starts[i] : C.starts[i + 1]], C.kinematic[i] = r, q, bool(kinematic)
+        C.muscle[i], C.pin[i] = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
+        C.support[i] = float(np.clip(gravity_support, 0, 1))
 
     def drive_animated(self, keys: list[int], roots: list[_F] | _F, rotations: list[_F] | _F) -> list[int]:
         """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
@@ -239,33 +264,37 @@ class PhysicsWorld(Readback, Building):
         """
         if not keys:
             return []
-        rag = self._ragdolls
-        slots = [rag[k] if k in rag else self._slot(k) for k in keys]
-        sizes = [s.joints for s in slots]
+        C = self.commands
+        rows = C.rows(keys)
+        sizes: I64 = C.joints[rows]
         r = np.array(roots, dtype=np.float64).reshape(len(keys), 3)
         stacked = isinstance(rotations, np.ndarray) and rotations.ndim == 3
         if stacked:
             q = np.asarray(rotations, dtype=np.float64).reshape(-1, 4)
         else:
             q = np.concatenate([np.asarray(x, dtype=np.float64) for x in rotations])
-        if q.shape != (sum(sizes), 4):
-            raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes}")
+        if q.shape != (int(sizes.sum()), 4):
+            raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes.tolist()}")
         ends: I64 = np.cumsum(sizes)  # numpy's stubs leave a cumsum of ints untyped
         ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
         q = quat.normalize(np.where(np.isfinite(q), q, quat.identity()))  # refused rows are not used
-        per_ragdoll = list(q.reshape(len(keys), -1, 4)) if stacked else np.split(q, ends[:-1])
-        for slot, good, root, rot in zip(slots, ok.tolist(), r, per_ragdoll, strict=True):
-            c = slot.cmd
-            if good:
-                c.root, c.rot = root, rot
-            c.kinematic = True
-            c.muscle = c.pin = c.support = 1.0
-        return [k for k, good in zip(keys, ok, strict=True) if not good]
+        if ok.all() and C.whole(keys):  # the whole crowd in key order, every target good
+            C.root[:], C.rot[:] = r, q
+            C.kinematic[:] = True
+            C.muscle[:] = C.pin[:] = C.support[:] = 1.0
+            return []
+        good = rows[ok]
+        C.root[good] = r[ok]
+        C.rot[joint_rows(C.starts, good)] = q[np.repeat(ok, sizes)]
+        C.kinematic[rows] = True
+        C.muscle[rows] = C.pin[rows] = C.support[rows] = 1.0
+        return [k for k, g in zip(keys, ok.tolist(), strict=True) if not g]
 
     def target(self, key: int) -> Pose:
         """The ragdoll's current command (its last accepted target pose)."""
-        c = self._slot(key).cmd
-        return Pose(c.root.copy(), c.rot.copy())
+        self._slot(key)
+        root, rot = self.commands.pose(self.commands.row[key])
+        return Pose(root.copy(), rot.copy())
 
     def hold(self, key: int, joint: str | None, target: ArrayLike | None = None) -> None:
         """Hold one body of the ragdoll by a spring at ``target`` (``joint=None`` lets go)."""
@@ -275,13 +304,15 @@ class PhysicsWorld(Readback, Building):
         t = None if target is None else np.array(target, dtype=np.float64).reshape(3)
         if t is not None and not np.isfinite(t).all():
             raise ValueError(f"ragdoll {key}: hold target has NaN or infinite values")
-        slot.cmd.hold = joint
+        C = self.commands
+        i = C.row[key]
+        C.hold[i] = joint
         if joint is None:
             self._held.discard(key)
         else:
             self._held.add(key)
         if t is not None:
-            slot.cmd.hold_target = t
+            C.hold_target[i] = t
 
     def holding(self) -> list[int]:
         """The ragdolls whose body is held now (so a crowd's physics stage lets go of those only)."""
@@ -292,9 +323,11 @@ class PhysicsWorld(Readback, Building):
         self.ensure_built()
         slot = self._slot(key)
         r, q = self._checked(key, root, rotations, slot.spec.skeleton.num_joints)
-        slot.cmd.root, slot.cmd.rot = r, q
-        if not slot.in_model:
-            slot.cmd.last = None
+        C = self.commands
+        i = C.row[key]
+        C.root[i], C.rot[C.starts[i] : C.starts[i + 1]] = r, q
+        if not C.in_model[i]:
+            C.has_last[i] = False
             return
         self._place(key, r, q)
         assert self.model is not None and self.data is not None
@@ -325,7 +358,7 @@ class PhysicsWorld(Readback, Building):
             d.qvel[L.hinge_d[h]] = (hinge - hinge_angles(q0[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])) / self.dt
         d.mocap_pos[L.pin_mocap[p]] = root
         d.mocap_quat[L.pin_mocap[p]] = rot[0]
-        self._slot(key).cmd.last = None
+        self._cmds.has_last[self._cmds.row[key]] = False
         self._ke = self._read = None
 
     # -- stepping -----------------------------------------------------------------------
@@ -335,20 +368,19 @@ class PhysicsWorld(Readback, Building):
         of the model first (:mod:`engine.ragdoll._islands`)."""
         self._update_islands()
         self.ensure_built()
-        for slot in self._ragdolls.values():
-            if not slot.in_model:  # it moves with its target: where it was is its last target
-                slot.prev, slot.cmd.last = slot.cmd.last, (slot.cmd.root, slot.cmd.rot)
+        C = self.commands
+        out = np.nonzero(~C.in_model)[0]
+        if len(out):  # it moves with its target: where it was is its last target
+            C.roll(out, keep_prev=True)
         if self.model is None or self.data is None:
             return
         assert self.layout is not None
         L, d = self.layout, self.data
-        slots = [self._ragdolls[k] for k in L.keys]
+        rows = C.rows(L.keys)
         roots = d.qpos[L.root_q[:, None] + np.arange(3)]
-        simulated = np.array([not s.cmd.kinematic for s in slots], dtype=bool)
-        ghost = ghosts(roots, simulated, np.array([s.ghost for s in slots], dtype=bool))
-        for slot, g in zip(slots, ghost, strict=True):
-            slot.ghost = bool(g)
-        apply_commands(L, self.model, d, [s.cmd for s in slots], self.dt, ghost)
+        ghost = ghosts(roots, ~C.kinematic[rows], C.ghost[rows])
+        C.ghost[rows] = ghost
+        apply_commands(L, self.model, d, C, rows, self.dt, ghost)
         if d.ntree_awake == 0:  # every pool slot parked and no prop: nothing in MuJoCo can move
             self._ke = self._read = None
             return
@@ -362,67 +394,81 @@ class PhysicsWorld(Readback, Building):
 
     def _update_islands(self) -> None:
         """Put the ragdolls that need dynamics (or may touch what has them) in the model, and only those."""
-        slots = [self._ragdolls[k] for k in sorted(self._ragdolls)]
+        C = self.commands
         if self.simulate_animated:
-            wanted = np.ones(len(slots), dtype=bool)
+            wanted = np.ones(len(C.keys), dtype=bool)
         else:
-            needs = np.array([not s.cmd.kinematic or s.cmd.hold is not None for s in slots], dtype=bool)
-            centres = np.array([self._centre(s) if s.in_model else s.cmd.root for s in slots]).reshape(-1, 3)
-            radii = np.array([s.reach for s in slots])
+            needs = ~C.kinematic
+            if self._held:
+                needs[C.rows(sorted(self._held))] = True
+            centres = self._centres()
             props = [self._prop_sphere(k) for k in sorted(self._props)]
             sources = np.concatenate([centres[needs], np.array([c for c, _ in props]).reshape(-1, 3)])
-            source_radii = np.concatenate([radii[needs], [r for _, r in props]])
-            inside = np.array([s.in_model for s in slots], dtype=bool)
+            source_radii = np.concatenate([C.reach[needs], [r for _, r in props]])
+            inside = C.in_model
             wanted = needs.copy()
-            near = near_simulated(centres[~needs], radii[~needs], sources, source_radii, inside[~needs])
+            near = near_simulated(centres[~needs], C.reach[~needs], sources, source_radii, inside[~needs])
             if near.any():  # the spheres hold any pose: the candidates' boxes in their poses decide
                 cand = np.nonzero(~needs)[0][near]
-                src = np.nonzero(needs)[0]
                 boxes = np.concatenate(
                     [
-                        self._boxes([slots[i] for i in src]),
+                        self._boxes(np.nonzero(needs)[0]),
                         np.array([[c - r, c + r] for c, r in props]).reshape(-1, 2, 3),
                     ]
                 )
-                near[near] = near_boxes(self._boxes([slots[i] for i in cand]), boxes, inside[cand])
+                near[near] = near_boxes(self._boxes(cand), boxes, inside[cand])
             wanted[~needs] = near
-        for slot, want in zip(slots, wanted, strict=True):
-            if slot.in_model != bool(want):
-                slot.in_model, slot.placed = bool(want), False
-                self._moved = True
+        changed = C.in_model != wanted
+        if changed.any():
+            C.in_model[changed] = wanted[changed]
+            C.placed[changed] = False
+            self._moved = True
 
-    def _boxes(self, slots: list[RagdollSlot]) -> _F:
-        """Boxes ``[n,2,3]`` around ragdolls in their current poses: a simulated one's from MuJoCo's
-        geoms, an animated or newly joined one's from its command (:mod:`engine.ragdoll._bounds`)."""
-        out = np.empty((len(slots), 2, 3))
+    def _live(self, rows: I64) -> tuple[I64, I64]:
+        """Which of ``rows`` (positions in ``rows``) are simulated where the model's state is current,
+        and their ordinals in the layout."""
+        C, L = self._cmds, self.layout
+        if L is None or self.data is None or self._moved or not L.keys:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        live = np.nonzero(C.in_model[rows] & C.placed[rows])[0]
+        return live, np.searchsorted(np.asarray(L.keys), C.keys[rows[live]])
+
+    def _centres(self) -> _F:
+        """Where every ragdoll's root is: simulated while in the model, else its commanded target."""
+        C = self._cmds
+        out = C.root.copy()
+        live, ordinal = self._live(np.arange(len(C.keys)))
+        if len(live):
+            assert self.layout is not None and self.data is not None
+            out[live] = self.data.qpos[self.layout.root_q[ordinal][:, None] + np.arange(3)]
+        return out
+
+    def _boxes(self, rows: I64) -> _F:
+        """Boxes ``[n,2,3]`` around ragdolls ``rows`` in their current poses: a simulated one's from
+        MuJoCo's geoms, an animated or newly joined one's from its command (:mod:`engine.ragdoll._bounds`)."""
+        C = self._cmds
+        out = np.empty((len(rows), 2, 3))
+        live, ordinal = self._live(rows)
+        keep = ~C.kinematic[rows[live]]
+        live, ordinal = live[keep], ordinal[keep]
         L, m, d = self.layout, self.model, self.data
-        live = [i for i, s in enumerate(slots) if s.in_model and s.placed and not s.cmd.kinematic and not self._moved]
-        if live and L is not None and m is not None and d is not None:
+        if len(live) and L is not None and m is not None and d is not None:
             box_of = np.full(L.num_ragdolls, -1)
-            box_of[[L.ordinal(slots[i].spec.key) for i in live]] = np.arange(len(live))
+            box_of[ordinal] = np.arange(len(live))
             own = box_of[L.geom_owner]
             order = np.argsort(own, kind="stable")[np.count_nonzero(own < 0) :]
             out[live] = geom_boxes(m, d, L.geom[order], own[order], len(live))
-        else:
-            live = []
-        done = set(live)
+        rest = np.ones(len(rows), dtype=bool)
+        rest[live] = False
         kinds: dict[bytes, list[int]] = {}
-        for i, s in enumerate(slots):
-            if i not in done:
-                kinds.setdefault(s.kind, []).append(i)
+        for i in np.nonzero(rest)[0].tolist():
+            kinds.setdefault(self._ragdolls[int(C.keys[rows[i]])].kind, []).append(i)
         for kind, idx in kinds.items():
-            cmds = [slots[i].cmd for i in idx]
-            out[idx] = command_boxes(
-                kind, slots[idx[0]].spec, np.array([c.root for c in cmds]), np.array([c.rot for c in cmds])
-            )
+            r = rows[idx]
+            spec = self._ragdolls[int(C.keys[r[0]])].spec
+            rot = C.rot[joint_rows(C.starts, r)].reshape(len(r), spec.skeleton.num_joints, 4)
+            out[idx] = command_boxes(kind, spec, C.root[r], rot)
         return out
-
-    def _centre(self, slot: RagdollSlot) -> _F:
-        """Where a ragdoll's root is: simulated while in the model, else its commanded target."""
-        if slot.in_model and slot.placed and self.layout is not None and self.data is not None and not self._moved:
-            rq = int(self.layout.root_q[self.layout.ordinal(slot.spec.key)])
-            return np.asarray(self.data.qpos[rq : rq + 3])
-        return slot.cmd.root
 
     def _prop_sphere(self, key: int) -> tuple[_F, float]:
         """A prop's bounding sphere over the next :data:`LOOKAHEAD` seconds."""
@@ -437,10 +483,11 @@ class PhysicsWorld(Readback, Building):
         """MuJoCo's name of a part (joint name, ``<joint>_hold``, ``pin``…) of the pool slot lent to
         ragdoll ``key`` (slots are named by their place in the pool, not by the puppet)."""
         self.ensure_built()
-        slot = self._slot(key)
-        if slot.pool < 0:
+        self._slot(key)
+        pool = int(self.commands.pool[self.commands.row[key]])
+        if pool < 0:
             raise KeyError(f"ragdoll {key} is not simulated now: it has no MuJoCo bodies")
-        return rd_name(slot.pool, part)
+        return rd_name(pool, part)
 
     def asleep(self) -> int:
         """How many pool slots are parked asleep (free, costing no dynamics)."""
@@ -449,7 +496,8 @@ class PhysicsWorld(Readback, Building):
 
     def in_model(self, key: int) -> bool:
         """Whether ragdoll ``key`` is simulated this step (animated ragdolls alone are not)."""
-        return self._slot(key).in_model
+        self._slot(key)
+        return bool(self.commands.in_model[self.commands.row[key]])
 
     # -- props ----------------------------------------------------------------------------
     def _prop(self, key: int) -> PropSlot:
@@ -535,16 +583,18 @@ class PhysicsWorld(Readback, Building):
         pooled = bool(self._pool.slots)
         if pooled:  # (a model of props alone hashes as it did before the pool)
             parts += [m.tree_sleep_policy, d.tree_asleep]
-        for k in sorted(self._ragdolls):
-            c = self._ragdolls[k].cmd
+        C = self.commands
+        for i in range(len(C.keys)):
+            root, rot = C.pose(i)
+            last = C.last(i)
             if pooled:
-                parts.append(np.array([self._ragdolls[k].pool]))
+                parts.append(C.pool[i : i + 1])
             parts += [
-                c.root,
-                c.rot,
-                np.array([c.muscle, c.pin, c.support, c.kinematic]),
-                c.hold_target,
-                (c.hold or "").encode(),
-                b"L" if c.last is None else c.last[0].tobytes() + c.last[1].tobytes(),
+                root,
+                rot,
+                np.array([C.muscle[i], C.pin[i], C.support[i], C.kinematic[i]]),
+                C.hold_target[i],
+                (C.hold[i] or "").encode(),
+                b"L" if last is None else last[0].tobytes() + last[1].tobytes(),
             ]
         return b"".join(p if isinstance(p, bytes) else np.ascontiguousarray(p).tobytes() for p in parts)

@@ -35,13 +35,17 @@ __all__ = ["physics_step", "install_physics", "spawn_snowball"]
 
 def _sync(world: World, pw: PhysicsWorld) -> None:
     rows = world.query(Ragdoll, Puppet, LocalPose)
-    present = {e for e, *_ in rows}
-    known = set(pw.ragdoll_keys)
-    for key in sorted(known - present):
-        pw.remove(key)
-    for e, rd, puppet, pose in rows:
-        if e not in known:
-            pw.add_ragdoll(e, puppet.skeleton, rd.profile, pose.root, pose.rotations, puppet.joint_offsets())
+    # the world hands out the same query list until a Ragdoll, Puppet or LocalPose comes or goes:
+    # then, with no ragdoll added or removed here since, the crowd is the one last synced
+    if pw.synced is None or pw.synced[0] is not rows or pw.synced[1] != pw.ragdoll_changes:
+        present = {e for e, *_ in rows}
+        known = set(pw.ragdoll_keys)
+        for key in sorted(known - present):
+            pw.remove(key)
+        for e, rd, puppet, pose in rows:
+            if e not in known:
+                pw.add_ragdoll(e, puppet.skeleton, rd.profile, pose.root, pose.rotations, puppet.joint_offsets())
+        pw.synced = (rows, pw.ragdoll_changes)
     props = world.query(Prop, Transform)
     present = {e for e, *_ in props}
     for key in pw.prop_keys:
@@ -65,10 +69,29 @@ def physics_step(world: World) -> None:
             "set PhysicsWorld(timestep=world.dt / substeps)"
         )
     _sync(world, pw)
-    rows = world.query(Ragdoll, Puppet, LocalPose)
-    animated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is RagdollMode.ANIMATED]
-    simulated = [(e, rd, pose) for e, rd, _, pose in rows if rd.mode is not RagdollMode.ANIMATED]
-    refused = pw.drive_animated([e for e, _, _ in animated], *_animated_targets(world, rows, animated))
+    holding = set(pw.holding())  # a crowd holds nothing: one call per held puppet, not per puppet
+    animated: list[tuple[Entity, Ragdoll, Puppet, LocalPose]] = []
+    simulated: list[tuple[Entity, Ragdoll, LocalPose]] = []
+    held: list[tuple[Entity, Ragdoll]] = []
+    dt, anim = world.dt, RagdollMode.ANIMATED
+    for row in world.query(Ragdoll, Puppet, LocalPose):  # the one pass over the crowd
+        e, rd, _, pose = row
+        if rd.mode is anim:
+            animated.append(row)
+            if (
+                rd.muscle_weight != rd.muscle_target
+                or rd.pin_weight != rd.pin_target
+                or rd.blend_weight != rd.blend_target
+            ):
+                rd.ramp(dt)  # (at its targets a ragdoll's ramp changes nothing)
+            # not simulated: the body is its animation (no energy of its own, nothing to settle)
+            rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
+        else:
+            simulated.append((e, rd, pose))
+        if rd.held is not None or e in holding:
+            held.append((e, rd))
+    keys = [row[0] for row in animated]
+    refused = pw.drive_animated(keys, *_animated_targets(world, pw, keys, [row[3] for row in animated]))
     targets: dict[Entity, Pose] = {}
     for e, rd, pose in simulated:
         rd.ramp(world.dt)
@@ -83,15 +106,8 @@ def physics_step(world: World) -> None:
         pw.recoveries += 1
         pose = world.get(e, LocalPose)
         pose.root, pose.rotations = pw.target(e).root, pw.target(e).rotations
-    for _, rd, _ in animated:
-        if rd.muscle_weight != rd.muscle_target or rd.pin_weight != rd.pin_target or rd.blend_weight != rd.blend_target:
-            rd.ramp(world.dt)  # (at its targets a ragdoll's ramp changes nothing)
-        # not simulated: the body is its animation (no energy of its own, nothing to settle)
-        rd.kinetic_energy, rd.settled, rd.still_frames = 0.0, False, 0
-    holding = set(pw.holding())  # a crowd holds nothing: one call per held puppet, not per puppet
-    for e, rd, _, _ in rows:
-        if rd.held is not None or e in holding:
-            pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
+    for e, rd in held:
+        pw.hold(e, rd.held, rd.hold_target if rd.held is not None else None)
     for e, prop, tr in world.query(Prop, Transform):
         if prop.carried or prop.placed:
             pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
@@ -109,18 +125,15 @@ def physics_step(world: World) -> None:
 
 
 def _animated_targets(
-    world: World,
-    rows: list[tuple[Entity, Ragdoll, Puppet, LocalPose]],
-    animated: list[tuple[Entity, Ragdoll, LocalPose]],
+    world: World, pw: PhysicsWorld, keys: list[Entity], poses: list[LocalPose]
 ) -> tuple[NDArray[np.float64] | list[NDArray[np.float64]], NDArray[np.float64] | list[NDArray[np.float64]]]:
     """The animated ragdolls' targets: their local poses' roots ``[P, 3]`` and rotations ``[P, J, 4]``
     read from the pose columns (:mod:`engine.columns`) when all have ``J`` joints, else as lists."""
-    skeletons = {id(puppet.skeleton): puppet.skeleton for _, rd, puppet, _ in rows if rd.mode is RagdollMode.ANIMATED}
-    joints = {sk.num_joints for sk in skeletons.values()}
-    poses = [pose for _, _, pose in animated]
-    if len(joints) != 1:
+    cmds = pw.commands
+    joints = cmds.joints if cmds.whole(keys) else cmds.joints[cmds.rows(keys)]
+    if not len(joints) or (joints != joints[0]).any():
         return [p.root for p in poses], [p.rotations for p in poses]
-    cols, count = columns(world), joints.pop()
+    cols, count = columns(world), int(joints[0])
     return cols.get(LocalPose, "root", count).read(poses), cols.get(LocalPose, "rotations", count).read(poses)
 
 
