@@ -11,7 +11,10 @@ steering is batched over all wanderers: a crowd of a hundred is one numpy pass.
 from __future__ import annotations
 
 import operator
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from itertools import repeat
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,6 +26,7 @@ from engine.columns import columns
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
+from engine.rows import RowBlock, row_store
 from engine.statemachine.puppet import Jumping, PuppetBody
 from engine.statemachine.puppet.senses import yaw_rotation
 
@@ -45,11 +49,41 @@ def wander_system(world: World) -> None:
     """Steer every free wanderer toward its goal; pick a new goal when one is reached.
 
     The wanderers' component lists are kept between structural changes (:mod:`engine.batches`),
-    their positions, rotations and goals are columns (:mod:`engine.columns`)."""
+    their positions, rotations and goals are columns (:mod:`engine.columns`); when their bodies are
+    linked to the brain stage's row block (:mod:`engine.rows`), who is held and the headings are
+    read and written in its arrays."""
     kept = batch(world, "wanderers", (Wanderer, PuppetBody), (Jumping, Ragdoll, Transform, LocomotionPlayer))
+    wanderers, bodies, jumps, rds, transforms, players = kept.lists
+    found = None if any(kept.missing) else row_store(world).rows(PuppetBody, bodies)
+    if found is None:
+        _wander(world, *_free_one_by_one(kept.lists), None)
+        return
+    block, rows = found
+    n = len(bodies)
+    ok = ~block.present["held_by"][rows]
+    ok &= np.fromiter(map(_AIR, jumps), np.float64, n) == 0.0
+    ok &= np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, n)
+    if ok.all():
+        _wander(world, wanderers, bodies, transforms, players, (block, rows))
+        return
+    free = np.flatnonzero(ok)
+    if len(free):
+        at = free.tolist()
+        _wander(
+            world,
+            [wanderers[i] for i in at],
+            [bodies[i] for i in at],
+            [transforms[i] for i in at],
+            [players[i] for i in at],
+            (block, np.arange(n)[rows][free]),
+        )
+
+
+def _free_one_by_one(lists: tuple[tuple[Any, ...], ...]) -> tuple[list[Any], list[Any], list[Any], list[Any]]:
+    """The free wanderers' components, tested one by one (a batch with a missing component, or bodies not in rows)."""
     free = [
         i
-        for i, (body, jump, rd, tr, player) in enumerate(zip(*kept.lists[1:], strict=True))
+        for i, (body, jump, rd, tr, player) in enumerate(zip(*lists[1:], strict=True))
         if body.held_by is None
         and (jump is None or jump.air == 0.0)
         and rd is not None
@@ -57,27 +91,43 @@ def wander_system(world: World) -> None:
         and tr is not None
         and player is not None
     ]
-    if not free:
+    wanderers, bodies, _, _, transforms, players = ([c[i] for i in free] for c in lists)
+    return wanderers, bodies, transforms, players
+
+
+def _wander(
+    world: World,
+    wanderers: Sequence[Wanderer],
+    bodies: Sequence[PuppetBody],
+    transforms: Sequence[Transform],
+    players: Sequence[LocomotionPlayer],
+    block_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
+) -> None:
+    """Steer the free wanderers given (row ``i`` of each list for one puppet; their rows of the bodies' block)."""
+    n = len(wanderers)
+    if n == 0:
         return
-    if len(free) == len(kept.entities):
-        wanderers, bodies, _, _, transforms, players = kept.lists
-    else:
-        wanderers, bodies, _, _, transforms, players = ([c[i] for i in free] for c in kept.lists)
-    n = len(free)
     cols = columns(world)
     pos = cols.get(Transform, "position").read(transforms)
     goal = cols.get(Wanderer, "goal").read(wanderers)
     err = goal - pos
     dist = np.hypot(err[:, 0], err[:, 2])
-    heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
+    if block_rows is None:
+        heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
+    else:
+        heading = block_rows[0].arrays["heading"][block_rows[1]]
     turn = (np.arctan2(err[:, 0], err[:, 2]) - heading + np.pi) % (2 * np.pi) - np.pi
     step = _TURN_RATE * world.dt
     heading = (heading + np.clip(turn, -step, step) + np.pi) % (2 * np.pi) - np.pi
     facing = np.maximum(np.cos(turn), 0.0)
     cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
     speeds = (np.fromiter(map(_SPEED, wanderers), np.float64, n) * facing).tolist()
-    for body, player, h, v in zip(bodies, players, heading.tolist(), speeds, strict=True):
-        body.heading = h
+    if block_rows is None:
+        for body, h in zip(bodies, heading.tolist(), strict=True):
+            body.heading = h
+    else:
+        block_rows[0].arrays["heading"][block_rows[1]] = heading
+    for player, v in zip(players, speeds, strict=True):
         player.speed = v
     for i in np.flatnonzero(dist < _REACHED).tolist():
         w = wanderers[i]
@@ -92,6 +142,8 @@ def wander_system(world: World) -> None:
 
 _HEADING = operator.attrgetter("heading")
 _SPEED = operator.attrgetter("speed")
+_AIR = operator.attrgetter("air")
+_MODE = operator.attrgetter("mode")
 
 
 def install_wander(app: App) -> None:

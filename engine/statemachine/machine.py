@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from engine.arrays import Intp as Rows
 from engine.ecs import Entity, World
+from engine.rows import RowBlock, keep_in_rows, row_store
 
 __all__ = [
     "ANY",
@@ -149,6 +150,10 @@ class Brain:
         if self.crossfade_total <= 0:
             return 1.0
         return 1.0 - self.crossfade / self.crossfade_total
+
+
+keep_in_rows(Brain, time_in_state=("float", (), False), crossfade=("float", (), False))
+"""A crowd's clocks are arrays (:mod:`engine.rows`): :func:`step_machines` advances them in one operation."""
 
 
 class StateMachine(Generic[C]):
@@ -280,6 +285,9 @@ def step_machines(world: World, entities: Sequence[Entity], brains: Sequence[Bra
     """
     groups, single = _groups(brains)
     dt = world.dt
+    block = row_store(world).block(Brain, brains) if isinstance(brains, tuple) and brains else None
+    if block is not None and block.stale:
+        block = None
     for (_, state), members in groups.items():
         rows = np.array(members, dtype=np.intp)
         machine = brains[members[0]].machine
@@ -290,18 +298,34 @@ def step_machines(world: World, entities: Sequence[Entity], brains: Sequence[Bra
             update = machine.states[state].batch_update
             assert update is not None  # batchable() checked it
             update(world, columns, quiet)
-            for brain in brains if len(quiet) == len(brains) else [brains[i] for i in quiet.tolist()]:
-                brain.time_in_state += dt
-                fade = brain.crossfade
-                # max(0.0, fade - dt), which is 0.0 whenever fade is not positive (NaN included)
-                brain.crossfade = max(0.0, fade - dt) if fade > 0.0 else 0.0
+            if block is not None and not block.stale:
+                _tick(block, quiet if len(quiet) < len(brains) else _ALL, dt)
+            else:
+                for brain in brains if len(quiet) == len(brains) else [brains[i] for i in quiet.tolist()]:
+                    brain.time_in_state += dt
+                    fade = brain.crossfade
+                    # max(0.0, fade - dt), which is 0.0 whenever fade is not positive (NaN included)
+                    brain.crossfade = max(0.0, fade - dt) if fade > 0.0 else 0.0
     for i in sorted(single):
         step_machine(world, entities[i], brains[i])
 
 
-_MACHINE = operator.attrgetter("machine")
-_ACTIVE = operator.attrgetter("active")
-_PENDING = operator.attrgetter("pending_events")
+_ALL = slice(None)
+
+
+def _tick(block: RowBlock, rows: Rows | slice, dt: float) -> None:
+    """The clocks of the brains at ``rows`` of a row block, as :func:`step_machine` advances one: the same
+    operations on the same float64 numbers (``max(0.0, x)`` is ``x`` only where ``x > 0``, so NaN and -0.0
+    give +0.0)."""
+    time = block.arrays["time_in_state"]
+    time[rows] += dt
+    fade = block.arrays["crossfade"]
+    f = fade[rows]
+    left = f - dt
+    fade[rows] = np.where(f > 0.0, np.where(left > 0.0, left, 0.0), 0.0)
+
+
+_KEYS = operator.attrgetter("pending_events", "machine", "active")
 
 
 def _groups(brains: Sequence[Brain]) -> tuple[dict[tuple[int, str], list[int]], list[int]]:
@@ -312,18 +336,15 @@ def _groups(brains: Sequence[Brain]) -> tuple[dict[tuple[int, str], list[int]], 
     groups: dict[tuple[int, str], list[int]] = {}
     single: list[int] = []
     machine = brains[0].machine if brains else None
-    if (
-        machine is None
-        or any(map(_PENDING, brains))
-        or not all(map(operator.is_, map(_MACHINE, brains), repeat(machine)))
-    ):
+    # One pass over the brains (each a cold object in a crowd), then C-level passes over the tuples.
+    pending, machines, actives = zip(*map(_KEYS, brains)) if brains else ((), (), ())
+    if machine is None or any(pending) or not all(map(operator.is_, machines, repeat(machine))):
         for i, brain in enumerate(brains):
             if brain.active and not brain.pending_events and brain.machine.batchable(brain.active):
                 groups.setdefault((id(brain.machine), brain.active), []).append(i)
             else:
                 single.append(i)
         return groups, single
-    actives = list(map(_ACTIVE, brains))
     states = dict.fromkeys(actives)
     for state in states:
         members = list(range(len(actives))) if len(states) == 1 else [i for i, a in enumerate(actives) if a == state]
