@@ -43,13 +43,15 @@ class RowBlock:
     """The arrays of one linked batch: ``arrays[name]`` ``[N, ...]``, ``present[name]`` for a field that may be
     ``None``, and ``views[name]`` (the row views handed out for an array field, one object per row)."""
 
-    __slots__ = ("arrays", "present", "views", "stale", "objects_set", "memo")
+    __slots__ = ("arrays", "present", "views", "stale", "failed", "objects_set", "memo")
 
     def __init__(self) -> None:
         self.arrays: dict[str, NDArray[Any]] = {}
         self.present: dict[str, NDArray[np.bool_]] = {}
         self.views: dict[str, list[NDArray[np.float64]]] = {}
         self.stale = False
+        self.failed = False
+        """Linking failed (a value it cannot hold exactly): the batch stays plain objects until it changes."""
         self.objects_set = 0
         """How many times an ``"object"`` field was assigned: what a system derived from those objects
         (kept in ``memo``) holds while it is unchanged."""
@@ -214,9 +216,10 @@ class RowStore:
 
         Kept while ``owners`` is the same tuple object and no component was unlinked; otherwise the
         batch is linked anew from its components' current values (Python per component, once per
-        structural change)."""
+        structural change). A batch holding a value no block can hold exactly gets a stale block (the
+        callers use the plain objects) and is not tried again while it is the same tuple."""
         kept = self._kept.get(ctype)
-        if kept is not None and kept[0] is owners and not kept[1].stale:
+        if kept is not None and kept[0] is owners and (not kept[1].stale or kept[1].failed):
             return kept[1]
         block = _link(ctype, owners)
         self._kept[ctype] = (owners, block)
@@ -258,7 +261,7 @@ def _link(ctype: type, owners: tuple[Any, ...]) -> RowBlock:
             for o in owners:
                 if o.__dict__.get(_LINK) is not None:
                     _unlink(o)
-            block.stale = True
+            block.stale = block.failed = True
             return block
         block.arrays[f.name], present = made
         if present is not None:

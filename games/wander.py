@@ -26,7 +26,7 @@ from engine.columns import columns
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
-from engine.rows import RowBlock, row_store
+from engine.rows import RowBlock, keep_in_rows, row_store
 from engine.statemachine.puppet import Jumping, PuppetBody
 from engine.statemachine.puppet.senses import yaw_rotation
 
@@ -56,15 +56,19 @@ def wander_system(world: World) -> None:
     wanderers, bodies, jumps, rds, transforms, players = kept.lists
     found = None if any(kept.missing) else row_store(world).rows(PuppetBody, bodies)
     if found is None:
-        _wander(world, *_free_one_by_one(kept.lists), None)
+        _wander(world, *_free_one_by_one(kept.lists), None, None)
         return
     block, rows = found
+    own = row_store(world).block(Wanderer, wanderers)
+    if own.stale:
+        _wander(world, *_free_one_by_one(kept.lists), None, None)
+        return
     n = len(bodies)
     ok = ~block.present["held_by"][rows]
     ok &= np.fromiter(map(_AIR, jumps), np.float64, n) == 0.0
     ok &= np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, n)
     if ok.all():
-        _wander(world, wanderers, bodies, transforms, players, (block, rows))
+        _wander(world, wanderers, bodies, transforms, players, (block, rows), (own, _ALL))
         return
     free = np.flatnonzero(ok)
     if len(free):
@@ -76,6 +80,7 @@ def wander_system(world: World) -> None:
             [transforms[i] for i in at],
             [players[i] for i in at],
             (block, np.arange(n)[rows][free]),
+            (own, free),
         )
 
 
@@ -102,14 +107,21 @@ def _wander(
     transforms: Sequence[Transform],
     players: Sequence[LocomotionPlayer],
     block_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
+    wander_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
 ) -> None:
-    """Steer the free wanderers given (row ``i`` of each list for one puppet; their rows of the bodies' block)."""
+    """Steer the free wanderers given (row ``i`` of each list for one puppet; their rows of the bodies' and
+    the wanderers' row blocks, if they are linked)."""
     n = len(wanderers)
     if n == 0:
         return
     cols = columns(world)
     pos = cols.get(Transform, "position").read(transforms)
-    goal = cols.get(Wanderer, "goal").read(wanderers)
+    if wander_rows is None:
+        goal = np.array([w.goal for w in wanderers], dtype=np.float64).reshape(n, 3)
+        pace = np.fromiter(map(_SPEED, wanderers), np.float64, n)
+    else:
+        goal = wander_rows[0].arrays["goal"][wander_rows[1]]
+        pace = wander_rows[0].arrays["speed"][wander_rows[1]]
     err = goal - pos
     dist = np.hypot(err[:, 0], err[:, 2])
     if block_rows is None:
@@ -121,7 +133,7 @@ def _wander(
     heading = (heading + np.clip(turn, -step, step) + np.pi) % (2 * np.pi) - np.pi
     facing = np.maximum(np.cos(turn), 0.0)
     cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
-    speeds = (np.fromiter(map(_SPEED, wanderers), np.float64, n) * facing).tolist()
+    speeds = (pace * facing).tolist()
     if block_rows is None:
         for body, h in zip(bodies, heading.tolist(), strict=True):
             body.heading = h
@@ -140,6 +152,10 @@ def _wander(
         )
 
 
+keep_in_rows(Wanderer, speed=("float", (), False), goal=("vector", (3,), False))
+"""A crowd's paces and goals are arrays (:mod:`engine.rows`): the steering reads them whole."""
+
+_ALL = slice(None)
 _HEADING = operator.attrgetter("heading")
 _SPEED = operator.attrgetter("speed")
 _AIR = operator.attrgetter("air")

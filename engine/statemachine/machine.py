@@ -33,7 +33,7 @@ entity is simply evaluated exactly, and the result is the same as stepping each 
 from __future__ import annotations
 
 import operator
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
 from typing import Any, Generic, TypeVar
@@ -152,8 +152,15 @@ class Brain:
         return 1.0 - self.crossfade / self.crossfade_total
 
 
-keep_in_rows(Brain, time_in_state=("float", (), False), crossfade=("float", (), False))
-"""A crowd's clocks are arrays (:mod:`engine.rows`): :func:`step_machines` advances them in one operation."""
+keep_in_rows(
+    Brain,
+    machine=("object", (), False),
+    active=("object", (), False),
+    time_in_state=("float", (), False),
+    crossfade=("float", (), False),
+)
+"""A crowd's machines, states and clocks are arrays (:mod:`engine.rows`): :func:`step_machines` sorts the
+brains by state and advances their clocks without touching them one by one."""
 
 
 class StateMachine(Generic[C]):
@@ -283,11 +290,11 @@ def step_machines(world: World, entities: Sequence[Entity], brains: Sequence[Bra
     write only its own entities' components (what :func:`step_machine` of another
     entity changes cannot decide it).
     """
-    groups, single = _groups(brains)
-    dt = world.dt
     block = row_store(world).block(Brain, brains) if isinstance(brains, tuple) and brains else None
     if block is not None and block.stale:
         block = None
+    groups, single = _groups(brains, block)
+    dt = world.dt
     for (_, state), members in groups.items():
         rows = np.array(members, dtype=np.intp)
         machine = brains[members[0]].machine
@@ -326,18 +333,29 @@ def _tick(block: RowBlock, rows: Rows | slice, dt: float) -> None:
 
 
 _KEYS = operator.attrgetter("pending_events", "machine", "active")
+_PENDING = operator.attrgetter("pending_events")
 
 
-def _groups(brains: Sequence[Brain]) -> tuple[dict[tuple[int, str], list[int]], list[int]]:
+def _groups(
+    brains: Sequence[Brain], block: RowBlock | None = None
+) -> tuple[dict[tuple[int, str], list[int]], list[int]]:
     """The rows that may go over arrays, by (machine, active state) in order of first appearance, and the others.
 
     A crowd shares one machine and has no events most steps: then the rows are sorted by
-    state in a few C-level passes instead of a test per entity."""
+    state in a few C-level passes instead of a test per entity; with the brains' row ``block``
+    (row ``i`` for ``brains[i]``) their machines and states are read from its arrays."""
     groups: dict[tuple[int, str], list[int]] = {}
     single: list[int] = []
     machine = brains[0].machine if brains else None
-    # One pass over the brains (each a cold object in a crowd), then C-level passes over the tuples.
-    pending, machines, actives = zip(*map(_KEYS, brains)) if brains else ((), (), ())
+    pending: Sequence[Any]
+    machines: Iterable[Any]
+    actives: Sequence[str]
+    if block is not None:
+        pending = () if not any(map(_PENDING, brains)) else (True,)
+        machines, actives = block.arrays["machine"], block.arrays["active"].tolist()
+    else:
+        # One pass over the brains (each a cold object in a crowd), then C-level passes over the tuples.
+        pending, machines, actives = zip(*map(_KEYS, brains)) if brains else ((), (), ())
     if machine is None or any(pending) or not all(map(operator.is_, machines, repeat(machine))):
         for i, brain in enumerate(brains):
             if brain.active and not brain.pending_events and brain.machine.batchable(brain.active):

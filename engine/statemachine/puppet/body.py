@@ -214,5 +214,8 @@ keep_in_rows(
 """A crowd's bodies keep what the brain stage updates every step in arrays (:mod:`engine.rows`): the stage
 reads and writes them whole, and a reader of one puppet sees the same values as plain fields."""
 
+keep_in_rows(Handling, left=("int", (), True))
+"""Locomotion lets go of the ball a puppet left (``left = None``) for the whole crowd at once."""
+
 PUPPET_COMPONENTS = (Jumping, Landing, GettingUp, Handling)
 """The per-state components every puppet carries (a spawned puppet gets one fresh instance of each)."""

@@ -161,8 +161,12 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
     players = _rows_of(world, LocomotionPlayer, columns.players, entities, fast, every)
     requests = _rows_of(world, IKRequest, columns.ik, entities, fast, every)
     transforms = _rows_of(world, Transform, columns.transforms, entities, fast, every)
-    for h in handling:
-        h.left = None  # standing
+    hb = columns.handling_block
+    if hb is not None and not hb.stale:
+        hb.present["left"][_ALL if every else fast] = False  # standing
+    else:
+        for h in handling:
+            h.left = None  # standing
     for player in players:
         player.height = None
     for ik in requests:

@@ -23,6 +23,7 @@ from engine.posing import install_fk
 from engine.ragdoll.components import Ragdoll, RagdollMode
 from engine.ragdoll.profile import RagdollProfile, default_profile
 from engine.ragdoll.system import install_physics
+from engine.rows import row_store
 from engine.skeleton import Skeleton
 from engine.statemachine.machine import Brain, StateMachine, step_machines
 from engine.statemachine.puppet.body import PUPPET_COMPONENTS, Handling, PoseOverride, PuppetBody, PuppetTuning
@@ -55,6 +56,8 @@ def brain_system(world: World) -> None:
     bodies, brains, transforms, players, handling, ik = kept.lists
     columns = sense_all(world, kept.entities, bodies, None if kept.missing[2] else transforms)
     columns.players, columns.handling, columns.ik = players, handling, ik
+    if handling and not kept.missing[4]:
+        columns.handling_block = row_store(world).block(Handling, handling)
     step_machines(world, kept.entities, brains, columns)
 
 

@@ -47,6 +47,8 @@ class PuppetColumns:
     ik: Sequence[IKRequest | None] | None = None
     block: RowBlock | None = None
     """The row block the bodies are linked to, row ``i`` for ``bodies[i]`` (:mod:`engine.rows`), if they are."""
+    handling_block: RowBlock | None = None
+    """The row block ``handling`` is linked to, if every puppet has one and they are."""
 
 
 PuppetStateDef = State[PuppetColumns]
