@@ -79,7 +79,7 @@ def wander_system(world: World) -> None:
             [bodies[i] for i in at],
             [transforms[i] for i in at],
             [players[i] for i in at],
-            (block, np.arange(n)[rows][free]),
+            (block, free if isinstance(rows, slice) else rows[free]),
             (own, free),
         )
 

@@ -322,8 +322,8 @@ _ALL = slice(None)
 
 def _tick(block: RowBlock, rows: Rows | slice, dt: float) -> None:
     """The clocks of the brains at ``rows`` of a row block, as :func:`step_machine` advances one: the same
-    operations on the same float64 numbers (``max(0.0, x)`` is ``x`` only where ``x > 0``, so NaN and -0.0
-    give +0.0)."""
+    operations on the same float64 numbers (Python's ``max(0.0, x)`` is ``x`` only where ``x > 0``: a NaN
+    gives +0.0, where ``np.maximum`` would keep it)."""
     time = block.arrays["time_in_state"]
     time[rows] += dt
     fade = block.arrays["crossfade"]
