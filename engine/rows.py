@@ -227,6 +227,11 @@ class RowStore:
             del self._rows[key]
         return block
 
+    def owners(self, ctype: type) -> tuple[Any, ...] | None:
+        """The batch the type's current block holds (row ``i`` for ``owners[i]``), if there is one."""
+        kept = self._kept.get(ctype)
+        return None if kept is None else kept[0]
+
     def rows(self, ctype: type, owners: tuple[Any, ...]) -> tuple[RowBlock, slice | NDArray[np.intp]] | None:
         """Where ``owners`` (a tuple kept by the caller) are in the type's current block: every row in order
         (``slice(None)``) or their row indices; ``None`` if one of them is not in it."""

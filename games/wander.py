@@ -28,6 +28,7 @@ from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
 from engine.rows import RowBlock, keep_in_rows, row_store
 from engine.statemachine.puppet import Jumping, PuppetBody
+from engine.statemachine.puppet.plugin import puppet_batch
 from engine.statemachine.puppet.senses import yaw_rotation
 
 __all__ = ["Wanderer", "wander_system", "install_wander"]
@@ -67,8 +68,12 @@ def wander_system(world: World) -> None:
     ok = ~block.present["held_by"][rows]
     ok &= np.fromiter(map(_AIR, jumps), np.float64, n) == 0.0
     ok &= np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, n)
+    puppets = puppet_batch(world)
+    whole = (
+        None if puppets.missing[2] or row_store(world).owners(PuppetBody) is not puppets.lists[0] else puppets.lists[2]
+    )
     if ok.all():
-        _wander(world, wanderers, bodies, transforms, players, (block, rows), (own, _ALL))
+        _wander(world, wanderers, bodies, transforms, players, (block, rows), (own, _ALL), whole)
         return
     free = np.flatnonzero(ok)
     if len(free):
@@ -81,6 +86,7 @@ def wander_system(world: World) -> None:
             [players[i] for i in at],
             (block, free if isinstance(rows, slice) else rows[free]),
             (own, free),
+            whole,
         )
 
 
@@ -108,14 +114,21 @@ def _wander(
     players: Sequence[LocomotionPlayer],
     block_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
     wander_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
+    whole: tuple[Transform, ...] | None = None,
 ) -> None:
     """Steer the free wanderers given (row ``i`` of each list for one puppet; their rows of the bodies' and
-    the wanderers' row blocks, if they are linked)."""
+    the wanderers' row blocks, if they are linked). ``whole`` (the transforms of the bodies' block, row for
+    row) lets the positions and rotations be read and written in the brain stage's columns at the bodies'
+    rows, instead of columns of the wanderers' own."""
     n = len(wanderers)
     if n == 0:
         return
     cols = columns(world)
-    pos = cols.get(Transform, "position").read(transforms)
+    at = None if whole is None or block_rows is None else block_rows[1]
+    if whole is None or at is None:
+        pos = cols.get(Transform, "position").read(transforms)
+    else:
+        pos = cols.get(Transform, "position").read(whole)[at]
     if wander_rows is None:
         goal = np.array([w.goal for w in wanderers], dtype=np.float64).reshape(n, 3)
         pace = np.fromiter(map(_SPEED, wanderers), np.float64, n)
@@ -132,7 +145,10 @@ def _wander(
     step = _TURN_RATE * world.dt
     heading = (heading + np.clip(turn, -step, step) + np.pi) % (2 * np.pi) - np.pi
     facing = np.maximum(np.cos(turn), 0.0)
-    cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
+    if whole is None or at is None:
+        cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
+    else:  # every row's field is its view after the read; only the wanderers' rows change
+        cols.get(Transform, "rotation").read(whole)[at] = yaw_rotation(heading)
     speeds = (pace * facing).tolist()
     if block_rows is None:
         for body, h in zip(bodies, heading.tolist(), strict=True):

@@ -146,6 +146,7 @@ def follow_released(
     players: Sequence[LocomotionPlayer],
     cols: Columns | None = None,
     block_rows: tuple[RowBlock, Rows | slice] | None = None,
+    stand: bool = False,
 ) -> None:
     """:func:`follow_velocity` (``speed_scale`` 1) for puppets no stick holds, over arrays.
 
@@ -156,7 +157,8 @@ def follow_released(
     block the bodies are linked to and their rows in it, :mod:`engine.rows`) the bodies'
     spring state, heading and stiffness are read and written in the block's arrays, no
     body touched; with ``cols`` the rotations of the puppets that stand are written as a
-    column of :mod:`engine.columns`."""
+    column of :mod:`engine.columns`. ``stand`` also sets every player's ``height`` to ``None``
+    (standing tall) in the pass that sets its speed: one visit of each player."""
     n = len(bodies)
     if n == 0:
         return
@@ -196,6 +198,10 @@ def follow_released(
     speeds = speed.tolist()
     moving = speed > 1e-3
     turning = np.flatnonzero(moving).tolist()
+    if stand:  # every player's speed now; a turning puppet's is set again by _face below
+        for player, v in zip(players, speeds, strict=True):
+            player.height = None
+            player.speed = v
     for i in turning:
         _face(transforms[i], bodies[i], players[i], speeds[i], dt, 1.0)
     if turning:
@@ -204,8 +210,9 @@ def follow_released(
         speeds = [speeds[i] for i in still]
         transforms = [transforms[i] for i in still]
         rotation = rotation[still]
-    for player, v in zip(players, speeds, strict=True):
-        player.speed = v
+    if not stand:
+        for player, v in zip(players, speeds, strict=True):
+            player.speed = v
     if cols is None or len(transforms) < n // 2:
         for tr, q in zip(transforms, rotation, strict=True):
             tr.rotation = q

@@ -167,8 +167,6 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
     else:
         for h in handling:
             h.left = None  # standing
-    for player in players:
-        player.height = None
     for ik in requests:
         if ik is not None:
             ik.foot_lock.enabled = True
@@ -177,7 +175,7 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
     fast_bodies = bodies if every else [bodies[i] for i in fast]
     linked = block is not None and not block.stale
     block_rows = (block, _ALL if every else np.asarray(fast, dtype=np.intp)) if linked and block is not None else None
-    follow_released(world.dt, fast_bodies, transforms, players, engine_columns(world), block_rows)
+    follow_released(world.dt, fast_bodies, transforms, players, engine_columns(world), block_rows, stand=True)
 
 
 _ALL = slice(None)
