@@ -66,7 +66,8 @@ def wander_system(world: World) -> None:
         return
     n = len(bodies)
     ok = ~block.present["held_by"][rows]
-    ok &= np.fromiter(map(_AIR, jumps), np.float64, n) == 0.0
+    on_ground = row_store(world).block(Jumping, jumps)
+    ok &= (np.fromiter(map(_AIR, jumps), np.float64, n) if on_ground.stale else on_ground.arrays["air"]) == 0.0
     ok &= np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, n)
     puppets = puppet_batch(world)
     whole = (

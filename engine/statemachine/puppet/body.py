@@ -217,5 +217,8 @@ reads and writes them whole, and a reader of one puppet sees the same values as 
 keep_in_rows(Handling, left=("int", (), True))
 """Locomotion lets go of the ball a puppet left (``left = None``) for the whole crowd at once."""
 
+keep_in_rows(Jumping, air=("float", (), False))
+"""Who is on the ground is one array comparison for a crowd (a wandering crowd steers only those)."""
+
 PUPPET_COMPONENTS = (Jumping, Landing, GettingUp, Handling)
 """The per-state components every puppet carries (a spawned puppet gets one fresh instance of each)."""
