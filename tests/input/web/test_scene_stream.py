@@ -246,30 +246,61 @@ console.log(JSON.stringify({{ step: state.step, rows: out, marks: [m.nx, m.nz, m
     assert page["marks"][5] == [[int(i), int(flat[i])] for i in np.flatnonzero(flat)]
 
 
-@needs_node
-def test_the_page_blends_between_frames_and_holds_the_last_one_when_the_next_is_late(tmp_path):
+def blend_script(tmp_path: Path, second_step: int, probe: str) -> object:
+    """Node: a page's SceneStream given the GLB at 1000 ms and a frame of step ``second_step`` (both capsules
+    10 cm along every axis) at 1020 ms; the JSON of ``probe`` (``s``: the stream; ``x(t)``: the first
+    capsule's x drawn at ``t``)."""
     scene = scene_with(2)
     first = quantise(scene, 1, 0.0, CAM)
-    moved = quantise(scene_with(2, 0.1, 2), 2, 0.0, CAM)  # both capsules 10 cm along every axis
+    moved = quantise(scene_with(2, 0.1, 2), second_step, 0.0, CAM)
     (tmp_path / "0.bin").write_bytes(scene_glb(first, scene))
     (tmp_path / "1.bin").write_bytes(encode_frame(first, moved))
     script = f"""
 const fs = require("fs"); const {{ SceneStream, StreamDecoder }} = require({json.dumps(str(PAGE / "stream.js"))});
 globalThis.performance = {{ timeOrigin: 0 }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const s = new SceneStream(), d = new StreamDecoder(); s.receive(d, buf(0), 1000); s.receive(d, buf(1), 1020);
+const s = new SceneStream(), d = new StreamDecoder(); s.receive(d, buf(0), 1000); s.sample(1010); s.receive(d, buf(1), 1020);
 const x = (t) => s.sample(t).rows.capsules[0];
-console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
+console.log(JSON.stringify({probe}));
 """
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stderr
-    at_arrival, halfway, done, late = json.loads(res.stdout)
-    a0, a1 = first.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
+    return json.loads(res.stdout)
+
+
+@needs_node
+def test_the_page_blends_frames_steps_apart_and_holds_the_last_one_when_the_next_is_late(tmp_path):
+    """Frames three steps apart (back-pressure gave a slow phone every third): the picture moves from the
+    last frame to the new one over the arrival interval, then holds. (Blending every frame, whatever the
+    step gap, fails the next test; never blending fails this one.)"""
+    at_arrival, wants, halfway, done, late = blend_script(
+        tmp_path, 4, "[x(1020), s.wants(1025), x(1030), x(1040), x(5000)]"
+    )
+    scene, moved = quantise(scene_with(2), 1, 0.0, CAM), quantise(scene_with(2, 0.1, 2), 4, 0.0, CAM)
+    a0, a1 = scene.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
     assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
+    assert wants, "a blend under way should ask for its next picture"
     assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
     assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), (
         "a late frame must hold, not run on"
     )
+
+
+@needs_node
+def test_the_page_shows_a_frame_one_step_after_the_last_at_once_and_never_draws_the_same_picture_twice(tmp_path):
+    """At the engine's pace (frames a step apart) there is nothing between two frames: the first drawing
+    after a frame shows it (blending there showed the frame before, a step late); once drawn, the stream
+    wants no drawing until the next frame. (Blending whatever the gap fails the first assertion; a
+    ``wants`` that stays true fails the second.)"""
+    at_arrival, time, wants_after, late = blend_script(
+        tmp_path, 2, "[x(1020), s.sample(1021).time, s.wants(1022), x(5000)]"
+    )
+    a1 = quantise(scene_with(2, 0.1, 2), 2, 0.0, CAM).rows["capsules"][0, 0] / 1000
+    assert at_arrival == pytest.approx(a1, abs=1e-6) and time == 2, (
+        "a frame a step after the last one is shown as it is"
+    )
+    assert not wants_after, "the same picture should not be drawn again"
+    assert late == pytest.approx(a1, abs=1e-6)
 
 
 @needs_node
@@ -337,8 +368,9 @@ onmessage({{ data: {{ drawer: port }} }});
 
 @needs_node
 def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_newest_for_a_busy_drawer(tmp_path):
-    """Every frame is acknowledged to the engine as soon as it is decoded; the drawer gets at most two frames
-    it has not taken, then, once it takes one, the newest frame (not the next in a queue). Each message
+    """Every frame is acknowledged to the engine as soon as it is decoded; the drawer gets one frame at a
+    time (the render worker says it took one only once its drawing is done), then the newest frame (not
+    the next in a queue). Each message
     carries only the kinds that changed since the drawer's last one (the trees once) and, of the tracks, the
     block of cells changed since (the whole grid first); the drawer's picture is then the decoder's, cell for
     cell. (A worker that posts every frame fails the count; one that keeps a queue fails the newest step;
@@ -347,19 +379,23 @@ def test_the_stream_worker_acknowledges_every_frame_and_holds_back_all_but_the_n
     out = run_worker(
         tmp_path,
         f"""
-for (let i = 0; i < {len(blobs)}; i++) arrive(i);
+arrive(0); arrive(1);
+const first = drawn.length;
+port.onmessage({{ data: {{ got: true }} }});
+for (let i = 2; i < {len(blobs)}; i++) arrive(i);
 const before = drawn.length;
-port.onmessage({{ data: {{ got: 1 }} }});
+port.onmessage({{ data: {{ got: true }} }});
 const after = drawn.length;
-port.onmessage({{ data: {{ got: 2 }} }});
+port.onmessage({{ data: {{ got: true }} }});
 const rows = KINDS.every((k) => Array.from(shown.cur.rows[k]).join() === Array.from(truth.state.rows[k]).map((v, i) =>
   v / truth.scales[k][i % truth.scales[k].length]).map((v) => Math.fround(v)).join());
 const cells = Array.from(shown.marks.cells).join() === Array.from(truth.state.marks.cells).join();
-console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn, end: drawn.length, rows, cells }}));
+console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), first, before, after, drawn, end: drawn.length, rows, cells }}));
 """,
     )
     assert out["acks"] == list(range(1, 8)), "every decoded frame is acknowledged at once"
-    assert out["before"] == 2, f"{out['before']} frames given to a drawer that took none"
+    assert out["first"] == 1, f"{out['first']} frames given to a drawer that took none"
+    assert out["before"] == 2, f"{out['before']} frames given to a drawer that took one"
     assert out["after"] == 3 and out["end"] == 3
     first, second, newest = out["drawn"]
     assert first["step"] == 1 and first["extras"] and first["marks"] == "grid" and "cones" in first["kinds"]
