@@ -233,7 +233,7 @@ class Forwarder {
       marks = { nx: m.nx, nz: m.nz, x0: m.x0, z0: m.z0, cell: m.cell, patch: { rect: this.dirty, cells: block } };
     }
     const out = { extras: this.whole ? extras : null, step: frame.step, published: frame.published, camera: frame.camera, rows, marks,
-      arrived: frame.arrived, decoded: frame.decoded, received: frame.received, bytes: frame.bytes };
+      arrived: frame.arrived, decoded: frame.decoded, received: frame.received, bytes: frame.bytes, behind: !!frame.behind };
     this.marks = m; this.dirty = null; this.whole = false;
     return out;
   }
@@ -257,7 +257,7 @@ class SceneStream {
     // Kinds a forwarded frame leaves out are as in the frame before (the same arrays).
     const rows = frame.extras || !this.cur ? frame.rows : { ...this.cur.rows, ...frame.rows };
     this.prev = this.cur;
-    this.cur = { rows, camera: frame.camera, arrived: now, interval, step: frame.step };
+    this.cur = { rows, camera: frame.camera, arrived: now, interval, step: frame.step, behind: !!frame.behind };
     this.fresh = true;
     this.frames = frame.received; this.bytes = frame.bytes;
     // The tracks: undefined, as before; null, none; a patch of changed cells (forwarded) or the grid held
@@ -286,10 +286,12 @@ class SceneStream {
   // How far the picture at ``now`` is from prev to cur (1: cur). Frames a step apart (the engine's pace) have
   // nothing between them to show: cur at once, so a drawing made when a frame arrives shows that frame,
   // not the one before. Frames farther apart (the back-pressure gave a slow phone fewer) are blended over
-  // their arrival interval: the newest shows one interval late, but the motion stays smooth.
+  // their arrival interval: the newest shows one interval late, but the motion stays smooth. Not when the
+  // gap is the drawer's own (``behind``: the stream worker replaced a frame it held for a drawer still
+  // busy): blending then spent its few drawings on pictures older than the frame it had.
   blendOf(now) {
     const cur = this.cur, prev = this.prev;
-    if (!prev || cur.step - prev.step <= 1) return 1;
+    if (!prev || cur.behind || cur.step - prev.step <= 1) return 1;
     return Math.min(Math.max((now - cur.arrived) / cur.interval, 0), 1);
   }
 

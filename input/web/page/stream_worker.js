@@ -49,6 +49,8 @@ function open(url) {
     sock.send(JSON.stringify({ ack: frame.step }));
     frame.arrived = arrived; frame.decoded = clock();
     forward.note(frame);
+    // A frame that replaces one held back: the drawer is behind, and shows it as it is (no blend: stream.js).
+    if (held) frame.behind = true;
     held = frame;
     flush();
   };
