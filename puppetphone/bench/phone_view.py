@@ -10,7 +10,7 @@
 - **Step → page latency** on loopback: a snowman session paced to real time streams to
   headless Chromium at 390×844. A *page frame* is counted three ways: **available** — the
   frame is decoded (in the page's stream worker) and has been taken by the thread that
-  draws (the render worker), which draws it at once; **drawn** — the draw calls of the
+  draws (the render worker), which draws it at its next animation frame; **drawn** — the draw calls of the
   first drawing with that step as the newest frame have returned (the render worker's
   drawing then blocks until the software rasteriser has finished and the canvas is read
   back for the compositor: that wait falls on the next frame's "available"); and
@@ -22,9 +22,9 @@
   notes when the frame reached its stream worker and when it was decoded there. All are
   against the engine's publication time (end of the step); every clock is this machine's
   system clock. A drawing counts only because Chromium composits it: checked with a trace
-  (one ``OffscreenCanvas::PushFrame`` and ``Display::DrawAndSwap`` per drawing, drawings
-  on arrival included; with GPU compositing, drawings outside an animation frame were
-  mostly dropped, so the bench keeps Chromium's software compositing).
+  (one ``OffscreenCanvas::PushFrame`` and ``Display::DrawAndSwap`` per drawing; with GPU
+  compositing, drawings outside an animation frame were mostly dropped and animation
+  frames came at 3-7 a second, so the bench keeps Chromium's software compositing).
 - **Which loopback is fair**: engine and browser on one machine, unpinned, as a user runs
   them over loopback; this bench runs that. On 2 cores Chromium's rasteriser threads, the
   page's workers and the engine then share the cores, which a phone and a PC do not;
@@ -36,7 +36,7 @@
   network's part of the latency, without the page's main thread.
 - **Page frame rate** at 390×844 in headless Chromium's software WebGL2 (SwiftShader),
   the median of the page's one-second counts while the stream runs (distinct pictures: the
-  page draws when a frame arrives, at most at 60 Hz, and never draws a picture twice;
+  page draws at an animation frame only when it has something new, never a picture twice;
   before issue 33's second pass it redrew the last picture at each animation frame, and
   those redrawings counted): first with the
   drawing held at full resolution (every device pixel: the goal is judged there), then

@@ -112,6 +112,7 @@ function sendReading(t) {
 worker.onmessage = (e) => {
   const m = e.data;
   if (m.frame) {
+    if (stream.fresh) m.frame.behind = true;  // the frame before was never drawn: this thread is behind
     stream.accept(m.frame, performance.now());
     worker.postMessage({ got: m.frame.step });
   } else if (m.text !== undefined) {

@@ -7,18 +7,17 @@
 // every step, and the readings that turn the view waited behind the drawing too (bench phone-view and the
 // page-view test, reported with issue 33). So frames go on, as messages that carry only what changed
 // (stream.js Forwarder), to whoever draws: the render worker (render_worker.js, through a MessagePort) or,
-// in AR and where a worker cannot draw, the main thread. One frame at a time goes there, the next when the
-// drawer says {got}; until then the newest is held here (a newer one replaces it), so a busy drawer gets
-// the newest frame, never a queue. The render worker says {got} only when its drawing is done (the task
-// that draws blocks on the software rasteriser: render_worker.js), the main thread when it took the frame.
+// in AR and where a worker cannot draw, the main thread. At most IN_FLIGHT frames wait there for the
+// drawer; a newer one replaces the one held back, so a busy drawer gets the newest frame, never a queue
+// (one in flight, released once the drawer's drawing was over, was tried: render_worker.js).
 //
 // From the main thread: {connect: url}, {send: text} (a reading, a ping), {drawer: port | null} (where
 // frames go; null: the main thread), {got: step} (the main thread took a frame). To it: {open}, {close},
-// {text} (the engine's JSON), {frame}, {error}. From the drawer's port: {got} (ready for the next frame).
+// {text} (the engine's JSON), {frame}, {error}. From the drawer's port: {got: step}.
 "use strict";
 importScripts("stream.js");
 
-const IN_FLIGHT = 1;
+const IN_FLIGHT = 2;
 let ws = null, decoder = null, inFlight = 0, held = null, drawer = null;
 const forward = new Forwarder();
 const clock = () => performance.timeOrigin + performance.now();
