@@ -7,7 +7,7 @@
 // Neither sensor events nor the page's layout on the main thread delay a frame, and the WebSocket is
 // read on its own thread while this one draws.
 //
-// Measured and not kept (bench phone-view, issue 33, reported in /work/scratch/reports/b33.md): the
+// Measured and not kept (bench phone-view and a worker timing its drawings, issue 33, session b33): the
 // drawing's JavaScript takes about a millisecond, but its task then blocks while the software rasteriser
 // finishes the picture and the canvas is read back for the compositor (65-80 ms at load 19). Drawing each
 // frame as it arrived (not at the animation frame) drew the older of two frames queued meanwhile first;
