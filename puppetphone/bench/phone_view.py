@@ -8,18 +8,37 @@
   gets it (:mod:`input.web.scene_stream`). Baseline: the same rows and the track grid
   sent whole as float32 each step (a straw man: streaming them without the codec).
 - **Step → page latency** on loopback: a snowman session paced to real time streams to
-  headless Chromium at 390×844. A *page frame* is counted two ways: **available** — the
-  frame is decoded (in the page's stream worker) and has reached the thread that draws
-  (the render worker), so the next animation frame can show it; and **drawn** — the
-  draw calls of the first animation frame that shows that step have returned. The
-  page also notes when the frame reached its stream worker and when it was decoded
-  there. All are against the engine's publication time (end of the step); every clock
-  is this machine's system clock.
+  headless Chromium at 390×844. A *page frame* is counted three ways: **available** — the
+  frame is decoded (in the page's stream worker) and has been taken by the thread that
+  draws (the render worker), which draws it at its next animation frame; **drawn** — the draw calls of the
+  first drawing with that step as the newest frame have returned (the render worker's
+  drawing then blocks until the software rasteriser has finished and the canvas is read
+  back for the compositor: that wait falls on the next frame's "available"); and
+  **shown**, stricter — the first drawing whose picture is that step's own, not a blend
+  towards it. At the engine's pace the page shows each frame as it is and the two agree;
+  frames more than a step apart (a slow phone given fewer) are blended. (Until issue 33's
+  second pass every frame was blended from the one before, so the first drawing "of" a
+  step showed the step before: drawn was the only stamp, and it flattered.) The page also
+  notes when the frame reached its stream worker and when it was decoded there. All are
+  against the engine's publication time (end of the step); every clock is this machine's
+  system clock. A drawing counts only because Chromium composits it: checked with a trace
+  (one ``OffscreenCanvas::PushFrame`` and ``Display::DrawAndSwap`` per drawing; with GPU
+  compositing, drawings outside an animation frame were mostly dropped and animation
+  frames came at 3-7 a second, so the bench keeps Chromium's software compositing).
+- **Which loopback is fair**: engine and browser on one machine, unpinned, as a user runs
+  them over loopback; this bench runs that. On 2 cores Chromium's rasteriser threads, the
+  page's workers and the engine then share the cores, which a phone and a PC do not;
+  pinning the engine to one core and Chromium to the other (``taskset``) models that
+  split, but gives Chromium, which alone spends more than a core at full resolution, half
+  the machine. The session of issue 33 reports both.
 - **Step → client latency** on loopback, the same session with a Python WebSocket client
   in place of the browser (it decodes and acknowledges at once): the engine's and the
   network's part of the latency, without the page's main thread.
 - **Page frame rate** at 390×844 in headless Chromium's software WebGL2 (SwiftShader),
-  the median of the page's one-second counts while the stream runs: first with the
+  the median of the page's one-second counts while the stream runs (distinct pictures: the
+  page draws at an animation frame only when it has something new, never a picture twice;
+  before issue 33's second pass it redrew the last picture at each animation frame, and
+  those redrawings counted): first with the
   drawing held at full resolution (every device pixel: the goal is judged there), then
   with the page free to lower its resolution when it cannot hold 40 fps (the resolution
   it settled at is reported too). The latencies cover both halves. Since a loaded
@@ -105,13 +124,15 @@ def stream_bytes(demo_steps: int = 1800, crowd_steps: int = 600) -> dict[str, fl
 @dataclass(frozen=True)
 class PageLatency:
     """Per step after the first two seconds, ms from the engine's publication (end of the step) to: the frame
-    reaching the page's stream worker, decoded there, available to the thread that draws, and first drawn
-    (the draw calls of the first animation frame showing it have returned); and the page's drawing."""
+    reaching the page's stream worker, decoded there, available to the thread that draws, first drawn (the
+    draw calls of the first drawing with it as the newest frame have returned) and first shown (a drawing
+    of that step's own picture, not a blend towards it); and the page's drawing."""
 
     received_ms: np.ndarray
     decoded_ms: np.ndarray
     available_ms: np.ndarray
     drawn_ms: np.ndarray
+    shown_ms: np.ndarray
     fps: float
     fps_full: float
     cpu_ms_per_frame_full: float
@@ -144,7 +165,7 @@ def _tree_cpu_seconds(pid: int) -> float:
 
 
 def page_latency(steps: int = 840) -> PageLatency:
-    """Publication → receipt, decoding, availability and first drawing of each step on the page, and its fps."""
+    """Publication → receipt, decoding, availability, first drawing and showing of each step on the page, and its fps."""
     from engine.pacing import RealTimePacer
     from input.hub import InputHub
     from input.web.cert import load_or_create
@@ -184,7 +205,7 @@ def page_latency(steps: int = 840) -> PageLatency:
                         fps.append(float(browser.evaluate("ppView.fps")))
                 time.sleep(0.3)
                 report = browser.evaluate("ppView.report()")
-                received, drawn, frames = report["log"], report["drawLog"], report["frames"]
+                received, drawn, shown, frames = report["log"], report["drawLog"], report["shownLog"], report["frames"]
                 resolution = float(browser.evaluate("ppView.resolution"))
                 where = browser.evaluate("ppView.where")
         finally:
@@ -192,11 +213,13 @@ def page_latency(steps: int = 840) -> PageLatency:
     published = {int(row[0]): row[1] for row in received}
     late = np.array([row for row in received if row[0] > 120])
     draw = np.array([t - published[s] for s, t in drawn if s in published and s > 120])
+    show = np.array([t - published[s] for s, t in shown if s in published and s > 120])
     return PageLatency(
         late[:, 2] - late[:, 1],
         late[:, 3] - late[:, 1],
         late[:, 4] - late[:, 1],
         draw,
+        show,
         float(np.median(fps)),
         float(np.median(full)),
         cpu_per_frame,
@@ -316,6 +339,7 @@ def run() -> list[Figure]:
         ("page_decoded", lat.decoded_ms),
         ("page_available", lat.available_ms),
         ("page_drawn", lat.drawn_ms),
+        ("page_shown", lat.shown_ms),
     ):
         for q in (50, 99):
             out.append(

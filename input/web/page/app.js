@@ -25,12 +25,13 @@ const stream = new SceneStream(), counter = new FrameCounter();
 let renderer = null, drawsHere = false, painter = null;
 // What the bench and the tests read: frames drawn, the step on screen, frames per second, who draws;
 // report() gives the logs (per step: published, reached the stream worker, decoded, available to the
-// drawer; and when each step was first drawn), all in ms since the epoch.
+// drawer; when each step was first drawn, and first drawn as itself rather than a blend towards it), all in
+// ms since the epoch; camera: the rotation of the view last drawn (x y z w).
 const reportWaiters = [];
 // holdResolution(r) keeps the drawing at r of the device's pixels (null: adapt to the frame rate again).
-window.ppView = { drawn: 0, step: -1, fps: 0, resolution: 1, frames: 0, bytes: 0, where: "render worker",
+window.ppView = { drawn: 0, step: -1, fps: 0, resolution: 1, frames: 0, bytes: 0, camera: null, where: "render worker",
   report: () => (drawsHere || state.kind === "xr"
-    ? Promise.resolve({ log: stream.log, drawLog: counter.drawLog, frames: stream.frames, bytes: stream.bytes })
+    ? Promise.resolve({ log: stream.log, drawLog: counter.drawLog, shownLog: counter.shownLog, frames: stream.frames, bytes: stream.bytes })
     : new Promise((resolve) => { reportWaiters.push(resolve); painter.postMessage({ report: true }); })),
   holdResolution: (r) => { counter.hold(r); if (painter) painter.postMessage({ resolution: r }); } };
 
@@ -111,6 +112,7 @@ function sendReading(t) {
 worker.onmessage = (e) => {
   const m = e.data;
   if (m.frame) {
+    if (stream.fresh) m.frame.behind = true;  // the frame before was never drawn: this thread is behind
     stream.accept(m.frame, performance.now());
     worker.postMessage({ got: m.frame.step });
   } else if (m.text !== undefined) {
@@ -204,22 +206,24 @@ function confirmCalibration() {
 }
 
 // The magic window on this thread (where the worker cannot draw): the newest frames, interpolated.
-function drawFrame(now) {
+function drawFrame() {
   if (state.kind !== "xr") requestAnimationFrame(drawFrame);
   if (!drawsHere || !renderer || !stream.extras) return;
   const canvas = $("view"), [cw, ch] = canvasSize();
   const w = Math.max(1, Math.round(cw * counter.resolution)), h = Math.max(1, Math.round(ch * counter.resolution));
-  if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
-  const frame = stream.sample(now);
+  const resized = canvas.width !== w || canvas.height !== h;
+  if (resized) { canvas.width = w; canvas.height = h; }
+  if (!resized && !stream.wants(performance.now())) return;  // the same picture again: not drawn (render_worker.js)
+  const frame = stream.sample(performance.now());
   if (!frame) return;
   renderer.draw(frame, stream.extras);
-  countFrame(frame.step, performance.now());  // not rAF's time: that is the frame's start, before the message came
+  countFrame(frame, performance.now());  // not rAF's time: that is the frame's start, before the message came
 }
 
-function countFrame(step, now) {
-  const renewed = counter.count(step, now), view = window.ppView;
+function countFrame(frame, now) {
+  const renewed = counter.count(frame.step, now, frame.time), view = window.ppView, q = frame.camera.q;
   Object.assign(view, { drawn: counter.drawn, step: counter.step, fps: counter.fps, resolution: counter.resolution,
-    frames: stream.frames, bytes: stream.bytes });
+    frames: stream.frames, bytes: stream.bytes, camera: [q[0], q[1], q[2], q[3]] });
   if (renewed) showFps(view);
 }
 
@@ -269,7 +273,7 @@ async function startXR() {
       renderer.draw(shown, look, { proj: view.projectionMatrix, view: mul4(view.transform.inverse.matrix, toLocal), eye,
         viewport: [vp.x, vp.y, vp.width, vp.height], first: i === 0 });
     });
-    countFrame(shown.step, time);
+    countFrame(shown, time);
   };
   session.addEventListener("end", () => {
     state.kind = "orientation"; state.sensor = "orientation"; state.placement = null; document.body.classList.remove("ar");

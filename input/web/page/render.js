@@ -783,14 +783,23 @@ class PageRenderer {
 // stretched, rather than fewer frames. Used by whichever thread draws (the view worker, or the main
 // thread in AR and where a worker cannot draw).
 class FrameCounter {
-  constructor() { this.drawn = 0; this.step = -1; this.fps = 0; this.resolution = 1; this.held = null; this.drawLog = []; this.ticks = 0; this.since = null; }
+  constructor() {
+    this.drawn = 0; this.step = -1; this.fps = 0; this.resolution = 1; this.held = null; this.ticks = 0; this.since = null;
+    this.drawLog = []; this.shownLog = []; this.shown = -1;
+  }
 
   // Keep the resolution at ``r`` (the bench measures the full resolution's frame rate); null: adapt again.
   hold(r) { this.held = r; if (r !== null) this.resolution = r; this.ticks = 0; this.since = null; }
 
-  // One frame drawn at ``now`` (ms, performance.now()) showing ``step``; true when ``fps`` was renewed.
-  count(step, now) {
+  // One frame drawn at ``now`` (ms, performance.now()) with ``step`` the newest frame, its picture at ``time``
+  // (fractional while blending towards ``step``); true when ``fps`` was renewed. ``drawLog``: when each step
+  // was first drawn as the newest; ``shownLog``: when the picture first was that step's, not a blend towards it.
+  count(step, now, time = step) {
     if (step !== this.step) { this.drawLog.push([step, performance.timeOrigin + now]); if (this.drawLog.length > 4000) this.drawLog.shift(); }
+    if (time >= step && step !== this.shown) {
+      this.shown = step; this.shownLog.push([step, performance.timeOrigin + now]);
+      if (this.shownLog.length > 4000) this.shownLog.shift();
+    }
     this.drawn += 1; this.step = step; this.ticks += 1;
     if (this.since === null) this.since = now;
     if (now - this.since < 1000) return false;

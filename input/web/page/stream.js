@@ -1,8 +1,9 @@
 // PuppetPhone scene stream: the GLB a page gets once, then delta-coded frames (input/web/scene_stream.py).
 // The reader mirrors scene_stream.decode_frame. StreamDecoder runs in the stream worker (stream_worker.js),
 // which holds the socket; Forwarder makes each frame a message for the thread that draws (render_worker.js,
-// or the main thread in AR), and SceneStream, there, keeps the newest two frames and interpolates one frame
-// behind the newest, so a late frame never stalls the picture (the last holds). Nothing that did not change
+// or the main thread in AR), and SceneStream, there, keeps the newest two frames: a frame one step after the
+// last is shown as it is, frames further apart are interpolated one frame behind the newest, and a late frame
+// never stalls the picture (the last holds). Nothing that did not change
 // is copied: a kind a frame leaves alone keeps its array (the drawer sees the same object and uploads
 // nothing), and the tracks go as the block of cells that changed.
 "use strict";
@@ -232,7 +233,7 @@ class Forwarder {
       marks = { nx: m.nx, nz: m.nz, x0: m.x0, z0: m.z0, cell: m.cell, patch: { rect: this.dirty, cells: block } };
     }
     const out = { extras: this.whole ? extras : null, step: frame.step, published: frame.published, camera: frame.camera, rows, marks,
-      arrived: frame.arrived, decoded: frame.decoded, received: frame.received, bytes: frame.bytes };
+      arrived: frame.arrived, decoded: frame.decoded, received: frame.received, bytes: frame.bytes, behind: !!frame.behind };
     this.marks = m; this.dirty = null; this.whole = false;
     return out;
   }
@@ -240,13 +241,13 @@ class Forwarder {
 
 function sameGrid(a, b) { return !!a && !!b && a.nx === b.nx && a.nz === b.nz && a.x0 === b.x0 && a.z0 === b.z0 && a.cell === b.cell; }
 
-// The drawing thread's half: the newest two frames, blended by arrival time at each drawing, and the
-// tracks with the cells changed since the last drawing.
+// The drawing thread's half: the newest two frames, blended by arrival time at each drawing when they are
+// more than a step apart, and the tracks with the cells changed since the last drawing.
 class SceneStream {
-  constructor() { this.extras = null; this.prev = null; this.cur = null; this.marks = null; this.marksDirty = null; this.log = []; this.frames = 0; this.bytes = 0; }
+  constructor() { this.reset(); this.log = []; this.frames = 0; this.bytes = 0; }
 
   // Forget the scene (a new connection starts from a new GLB).
-  reset() { this.extras = null; this.prev = null; this.cur = null; this.marks = null; this.marksDirty = null; }
+  reset() { this.extras = null; this.prev = null; this.cur = null; this.marks = null; this.marksDirty = null; this.fresh = false; this.lastBlend = 1; }
 
   // One decoded frame, given to the page at ``now`` (ms, performance.now()).
   accept(frame, now) {
@@ -256,7 +257,8 @@ class SceneStream {
     // Kinds a forwarded frame leaves out are as in the frame before (the same arrays).
     const rows = frame.extras || !this.cur ? frame.rows : { ...this.cur.rows, ...frame.rows };
     this.prev = this.cur;
-    this.cur = { rows, camera: frame.camera, arrived: now, interval, step: frame.step };
+    this.cur = { rows, camera: frame.camera, arrived: now, interval, step: frame.step, behind: !!frame.behind };
+    this.fresh = true;
     this.frames = frame.received; this.bytes = frame.bytes;
     // The tracks: undefined, as before; null, none; a patch of changed cells (forwarded) or the grid held
     // here with cells changed in place (decoded here): those cells; else a new grid.
@@ -281,15 +283,31 @@ class SceneStream {
     return frame;
   }
 
-  // The rows and camera to draw at ``now`` (ms): prev → cur over the arrival interval; ``time``: the step
-  // shown, fractional while blending; the tracks and the cells changed since the last call (taken).
+  // How far the picture at ``now`` is from prev to cur (1: cur). Frames a step apart (the engine's pace) have
+  // nothing between them to show: cur at once, so a drawing made when a frame arrives shows that frame,
+  // not the one before. Frames farther apart (the back-pressure gave a slow phone fewer) are blended over
+  // their arrival interval: the newest shows one interval late, but the motion stays smooth. Not when the
+  // gap is the drawer's own (``behind``: the stream worker replaced a frame it held for a drawer still
+  // busy): blending then spent its few drawings on pictures older than the frame it had.
+  blendOf(now) {
+    const cur = this.cur, prev = this.prev;
+    if (!prev || cur.behind || cur.step - prev.step <= 1) return 1;
+    return Math.min(Math.max((now - cur.arrived) / cur.interval, 0), 1);
+  }
+
+  // Whether a drawing at ``now`` would show something not drawn yet: a frame that came since the last
+  // ``sample``, or a blend still under way. The drawer does not draw the same picture twice.
+  wants(now) { return !!this.cur && (this.fresh || this.lastBlend < 1 || this.blendOf(now) < 1); }
+
+  // The rows and camera to draw at ``now`` (ms): prev → cur (``blendOf``); ``time``: the step shown,
+  // fractional while blending; the tracks and the cells changed since the last call (taken).
   sample(now) {
     const cur = this.cur, prev = this.prev;
     if (!cur) return null;
     const marks = this.marks, marksDirty = this.marksDirty;
-    this.marksDirty = null;
+    this.marksDirty = null; this.fresh = false; this.lastBlend = this.blendOf(now);
     if (!prev) return { rows: cur.rows, camera: cur.camera, step: cur.step, time: cur.step, marks, marksDirty };
-    const t = Math.min(Math.max((now - cur.arrived) / cur.interval, 0), 1);
+    const t = this.blendOf(now);
     const rows = {};
     for (const kind of KINDS) {
       const a = prev.rows[kind], b = cur.rows[kind];

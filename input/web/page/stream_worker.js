@@ -8,7 +8,8 @@
 // page-view test, reported with issue 33). So frames go on, as messages that carry only what changed
 // (stream.js Forwarder), to whoever draws: the render worker (render_worker.js, through a MessagePort) or,
 // in AR and where a worker cannot draw, the main thread. At most IN_FLIGHT frames wait there for the
-// drawer; a newer one replaces the one held back, so a busy drawer gets the newest frame, never a queue.
+// drawer; a newer one replaces the one held back, so a busy drawer gets the newest frame, never a queue
+// (one in flight, released once the drawer's drawing was over, was tried: render_worker.js).
 //
 // From the main thread: {connect: url}, {send: text} (a reading, a ping), {drawer: port | null} (where
 // frames go; null: the main thread), {got: step} (the main thread took a frame). To it: {open}, {close},
@@ -47,6 +48,8 @@ function open(url) {
     sock.send(JSON.stringify({ ack: frame.step }));
     frame.arrived = arrived; frame.decoded = clock();
     forward.note(frame);
+    // A frame that replaces one held back: the drawer is behind, and shows it as it is (no blend: stream.js).
+    if (held) frame.behind = true;
     held = frame;
     flush();
   };

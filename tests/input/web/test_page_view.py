@@ -70,7 +70,34 @@ def wait_steps(browser: Chromium, steps: int) -> None:
     browser.wait_for(f"ppView.step >= {start + steps} && ppView.drawn > 3", timeout=30)
 
 
-def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_desktop(tmp_path):
+def turn_degrees(a: list[float], b: list[float]) -> float:
+    """The angle (degrees) between two rotations given as quaternions."""
+    return float(np.degrees(2.0 * np.arccos(min(1.0, abs(float(np.dot(a, b)))))))
+
+
+def settled_view(browser: Chromium, since: list[float] | None = None, turned: float = 0.0) -> list[float]:
+    """Wait on the page, not on time: until the view the page last drew (``ppView.camera``) has turned at
+    least ``turned`` degrees from ``since`` and stayed within 0.5° over three of its drawings, then two more
+    drawings, so the picture on screen is that view. Its rotation. (Waiting a number of steps instead let a
+    loaded machine's screenshot catch the view before the turn: "1596 tree pixels", issue 33.)"""
+    end = time.monotonic() + 60
+    last: list[float] | None = None
+    still, drawn = 0, -1
+    while time.monotonic() < end:
+        n, cam = browser.evaluate("[ppView.drawn, ppView.camera]")
+        if cam is not None and n != drawn:
+            drawn = n
+            far = since is None or turn_degrees(cam, since) >= turned
+            still = still + 1 if far and last is not None and turn_degrees(cam, last) < 0.5 else 0
+            last = cam
+            if still >= 3:
+                browser.wait_for(f"ppView.drawn >= {n + 2}", timeout=30)
+                return cam
+        time.sleep(0.02)
+    raise AssertionError(f"the page's view did not settle {turned}° from {since}: last drawn {last}")
+
+
+def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_desktop(tmp_path: Path) -> None:
     desk = tmp_path / "desktop.png"
     play, url = start_play(
         tmp_path, 480, "--view", "phone", "--size", f"{W}x{H}", "--screenshot", str(desk), game="snowman"
@@ -89,12 +116,15 @@ def test_the_page_draws_the_snowman_field_from_the_phone_and_agrees_with_the_des
             )
             assert "magic window" in mode
             calibrate(browser)
+            # Full resolution: under load the page lowers it, and the pixel counts below would follow the load.
+            browser.evaluate("ppView.holdResolution(1)")
             browser.orientation(0.0, -10.0, 0.0)  # at the puppet, a little down
             wait_steps(browser, 40)
+            view = settled_view(browser)
             browser.screenshot(tmp_path / "page.png")  # with the controls: what a player sees
             ahead = bare_shot(browser, tmp_path / "ahead.png")
             browser.orientation(45.0, -10.0, 0.0)  # turn the phone to the left
-            wait_steps(browser, 40)
+            settled_view(browser, view, 30.0)
             turned = bare_shot(browser, tmp_path / "turned.png")
             browser.orientation(0.0, -10.0, 0.0)
             _, err = play.communicate(timeout=120)  # the session ends; the page holds its last frame

@@ -246,30 +246,74 @@ console.log(JSON.stringify({{ step: state.step, rows: out, marks: [m.nx, m.nz, m
     assert page["marks"][5] == [[int(i), int(flat[i])] for i in np.flatnonzero(flat)]
 
 
-@needs_node
-def test_the_page_blends_between_frames_and_holds_the_last_one_when_the_next_is_late(tmp_path):
+def blend_script(tmp_path: Path, second_step: int, probe: str, behind: bool = False) -> object:
+    """Node: a page's SceneStream given the GLB at 1000 ms and a frame of step ``second_step`` (both capsules
+    10 cm along every axis) at 1020 ms, marked ``behind`` (it replaced a frame held for a busy drawer); the
+    JSON of ``probe`` (``s``: the stream; ``x(t)``: the first capsule's x drawn at ``t``)."""
     scene = scene_with(2)
     first = quantise(scene, 1, 0.0, CAM)
-    moved = quantise(scene_with(2, 0.1, 2), 2, 0.0, CAM)  # both capsules 10 cm along every axis
+    moved = quantise(scene_with(2, 0.1, 2), second_step, 0.0, CAM)
     (tmp_path / "0.bin").write_bytes(scene_glb(first, scene))
     (tmp_path / "1.bin").write_bytes(encode_frame(first, moved))
     script = f"""
 const fs = require("fs"); const {{ SceneStream, StreamDecoder }} = require({json.dumps(str(PAGE / "stream.js"))});
 globalThis.performance = {{ timeOrigin: 0 }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
-const s = new SceneStream(), d = new StreamDecoder(); s.receive(d, buf(0), 1000); s.receive(d, buf(1), 1020);
+const s = new SceneStream(), d = new StreamDecoder(); s.receive(d, buf(0), 1000); s.sample(1010);
+const f = d.receive(buf(1)); f.arrived = f.decoded = 1020; f.behind = {json.dumps(behind)}; s.accept(f, 1020);
 const x = (t) => s.sample(t).rows.capsules[0];
-console.log(JSON.stringify([x(1020), x(1030), x(1040), x(5000)]));
+console.log(JSON.stringify({probe}));
 """
     res = subprocess.run(["node", "-e", script], capture_output=True, text=True, timeout=30)
     assert res.returncode == 0, res.stderr
-    at_arrival, halfway, done, late = json.loads(res.stdout)
-    a0, a1 = first.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
+    return json.loads(res.stdout)
+
+
+@needs_node
+def test_the_page_blends_frames_steps_apart_and_holds_the_last_one_when_the_next_is_late(tmp_path):
+    """Frames three steps apart (back-pressure gave a slow phone every third): the picture moves from the
+    last frame to the new one over the arrival interval, then holds. (Blending every frame, whatever the
+    step gap, fails the next test; never blending fails this one.)"""
+    at_arrival, wants, halfway, done, late = blend_script(
+        tmp_path, 4, "[x(1020), s.wants(1025), x(1030), x(1040), x(5000)]"
+    )
+    scene, moved = quantise(scene_with(2), 1, 0.0, CAM), quantise(scene_with(2, 0.1, 2), 4, 0.0, CAM)
+    a0, a1 = scene.rows["capsules"][0, 0] / 1000, moved.rows["capsules"][0, 0] / 1000
     assert at_arrival == pytest.approx(a0, abs=1e-6), "a new frame should start from where the last one was drawn"
+    assert wants, "a blend under way should ask for its next picture"
     assert halfway == pytest.approx((a0 + a1) / 2, abs=1e-6)
     assert done == pytest.approx(a1, abs=1e-6) and late == pytest.approx(a1, abs=1e-6), (
         "a late frame must hold, not run on"
     )
+
+
+@needs_node
+def test_the_page_shows_a_frame_one_step_after_the_last_at_once_and_never_draws_the_same_picture_twice(tmp_path):
+    """At the engine's pace (frames a step apart) there is nothing between two frames: the first drawing
+    after a frame shows it (blending there showed the frame before, a step late); once drawn, the stream
+    wants no drawing until the next frame. (Blending whatever the gap fails the first assertion; a
+    ``wants`` that stays true fails the second.)"""
+    at_arrival, time, wants_after, late = blend_script(
+        tmp_path, 2, "[x(1020), s.sample(1021).time, s.wants(1022), x(5000)]"
+    )
+    a1 = quantise(scene_with(2, 0.1, 2), 2, 0.0, CAM).rows["capsules"][0, 0] / 1000
+    assert at_arrival == pytest.approx(a1, abs=1e-6) and time == 2, (
+        "a frame a step after the last one is shown as it is"
+    )
+    assert not wants_after, "the same picture should not be drawn again"
+    assert late == pytest.approx(a1, abs=1e-6)
+
+
+@needs_node
+def test_the_page_does_not_blend_towards_a_frame_its_drawer_was_too_busy_to_take_in_time(tmp_path):
+    """Frames three steps apart because the drawer was busy (the stream worker replaced the one it held):
+    the newest is shown as it is; blending would spend the busy drawer's next drawing on an older picture.
+    (Ignoring ``behind`` fails it.)"""
+    at_arrival, wants_after = blend_script(tmp_path, 4, "[x(1020), s.wants(1021)]", behind=True)
+    assert at_arrival == pytest.approx(
+        quantise(scene_with(2, 0.1, 2), 4, 0.0, CAM).rows["capsules"][0, 0] / 1000, abs=1e-6
+    )
+    assert not wants_after
 
 
 @needs_node
@@ -322,7 +366,7 @@ require(page + "/stream_worker.js");
 const {{ SceneStream, StreamDecoder, KINDS }} = require(page + "/stream.js");
 const shown = new SceneStream(), truth = new StreamDecoder();
 const port = {{ postMessage: (m) => {{ const f = m.frame; shown.accept(structuredClone(f), 0);
-  drawn.push({{ step: f.step, extras: !!f.extras, kinds: Object.keys(f.rows), marks: f.marks === undefined ? "same" : f.marks === null ? "none" : f.marks.patch ? "patch" : "grid",
+  drawn.push({{ step: f.step, behind: f.behind, extras: !!f.extras, kinds: Object.keys(f.rows), marks: f.marks === undefined ? "same" : f.marks === null ? "none" : f.marks.patch ? "patch" : "grid",
     rect: f.marks && f.marks.patch ? f.marks.patch.rect : null }}); }} }};
 const buf = (i) => {{ const b = fs.readFileSync({json.dumps(str(tmp_path))} + "/" + i + ".bin"); return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength); }};
 const arrive = (i) => {{ truth.receive(buf(i)); FakeSocket.last.onmessage({{ data: buf(i) }}); }};
@@ -366,6 +410,7 @@ console.log(JSON.stringify({{ acks: sent.map((m) => m.ack), before, after, drawn
     assert second["step"] == 2 and not second["extras"] and second["marks"] == "same"
     assert "cones" not in second["kinds"] and "capsules" in second["kinds"], second["kinds"]
     assert newest["step"] == 7 and newest["marks"] == "patch"
+    assert newest["behind"] and not second["behind"], "a frame that replaced a held one is marked: the drawer is behind"
     # Steps 6 and 7 cleared (50, 50, 2, 2) and (60, 70, 1, 4); step 6 was held back and replaced by 7.
     assert newest["rect"] == [50, 50, 61, 74]
     assert out["rows"] and out["cells"], "the drawer's picture is not the decoder's"
