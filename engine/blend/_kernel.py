@@ -147,7 +147,41 @@ def _weights(points: F, q: F, out: F) -> None:
 def _clip_time(pk_x: F, pk_y: F, duration: float, phase: float) -> float:
     """A clip's unwrapped time (s) at group ``phase`` (:meth:`SyncGroup.clip_times`)."""
     cycles = math.floor(phase)
-    return (cycles + np.interp(phase - cycles, pk_x, pk_y)) * duration
+    return (cycles + interp(phase - cycles, pk_x, pk_y)) * duration
+
+
+@njit
+def interp(x: float, xp: F, fp: F) -> float:
+    """``np.interp`` of one value, as numba's ``np.interp`` computes it (numpy's C code, transcribed) but
+    without the arrays that one allocates for its answer and its slopes on every call (a crowd's kernel
+    calls it a dozen times per puppet). ``j`` is the last knot at or below ``x`` (what numpy's guessed
+    binary search finds in a sorted ``xp``)."""
+    n = xp.shape[0]
+    if n == 1:
+        return fp[0]
+    if math.isnan(x):
+        return x
+    if x > xp[n - 1]:
+        return fp[n - 1]
+    if x < xp[0]:
+        return fp[0]
+    lo, hi = 0, n
+    while lo < hi:
+        mid = lo + ((hi - lo) >> 1)
+        if x >= xp[mid]:
+            lo = mid + 1
+        else:
+            hi = mid
+    j = lo - 1
+    if j == n - 1 or xp[j] == x:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    out = slope * (x - xp[j]) + fp[j]
+    if math.isnan(out):  # a nan one way: the other way (numpy ≥ 1.17)
+        out = slope * (x - xp[j + 1]) + fp[j + 1]
+        if math.isnan(out) and fp[j] == fp[j + 1]:
+            out = fp[j]
+    return out
 
 
 @njit
@@ -181,25 +215,42 @@ def play(
     arc_angle: F,
     arc_sin: F,
     points: F,
+    target: F,
+    alpha: float,
+    ease: bool,
     phase: F,
     rate: F,
+    scale: F,
+    feasible: F,
     dt: float,
+    feasible_out: F,
     w_out: F,
     phase_out: F,
+    wrapped: F,
     travel: F,
     turn: F,
     root_out: F,
     rot_out: F,
     votes: F,
 ) -> None:
-    """Play ``dt`` seconds of every puppet (blend ``points [P,N]``, ``phase``, ``rate [P]``): weights, new
-    phase, root travel (clip frame) and turn, the blended pose at the new phase and the feet's votes."""
+    """Play ``dt`` seconds of every puppet: its blend point eased toward the lookup's ``target`` (in place in
+    ``points [P,N]``, when ``ease``), the ``feasible`` request scaled to the puppet, then weights, new phase
+    (and wrapped to ``[0, 1)``), root travel (clip frame, scaled) and turn, the blended pose at the new
+    phase (root scaled) and the feet's votes. The easing and scalings are the numpy path's
+    ``eased + alpha·(target − eased)`` and ``x·scale``, operation for operation."""
     k_all = pk_points.shape[0]
     joints = rotations.shape[1]
     legs = contacts.shape[1]
+    dims = points.shape[1]
     row0, row1 = np.empty(4), np.empty(4)
     ref_rot = np.empty((joints, 4))
     for p in range(points.shape[0]):
+        size = scale[p]
+        if ease:
+            for c in range(dims):
+                points[p, c] = points[p, c] + alpha * (target[p, c] - points[p, c])
+        for c in range(feasible.shape[1]):
+            feasible_out[p, c] = feasible[p, c] * size
         w = w_out[p]
         _weights(pk_points, points[p], w)
         period = 0.0
@@ -223,6 +274,7 @@ def play(
             for c in range(4):
                 rot_out[p, j, c] = 0.0
         # every clip's joints are turned into the hemisphere of the heaviest clip's (blend_quaternions)
+        t_ref = _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1)
         _frame_rotations(
             rotations,
             arc_next,
@@ -230,20 +282,20 @@ def play(
             arc_sin,
             start[ref],
             frames[ref],
-            _clip_time(knot_x[ref], knot_y[ref], durations[ref], ph1) * fps[ref],
+            t_ref * fps[ref],
             ref_rot,
             ref_rot,
             False,
         )
         for k in range(k_all):
+            if w[k] <= 0.0:  # no vote either: adding w·label = +0 to a sum of non-negative votes changes no bit
+                continue
             n = frames[k]
-            t1 = _clip_time(knot_x[k], knot_y[k], durations[k], ph1)
+            t1 = t_ref if k == ref else _clip_time(knot_x[k], knot_y[k], durations[k], ph1)
             if legs > 0:
                 fr = int(np.rint(t1 * fps[k])) % n
                 for c in range(legs):
                     votes[p, c] = votes[p, c] + w[k] * contacts[start[k] + fr, c]
-            if w[k] <= 0.0:
-                continue
             t0 = _clip_time(knot_x[k], knot_y[k], durations[k], ph0)
             _root_row(tables, cycles, start[k] + k, n, k, t0, fps[k], row0)
             _root_row(tables, cycles, start[k] + k, n, k, t1, fps[k], row1)
@@ -266,6 +318,10 @@ def play(
             _frame_rotations(
                 rotations, arc_next, arc_angle, arc_sin, start[k], n, t1 * fps[k], ref_rot, rot_out[p], True, wn
             )
+        for c in range(3):
+            root_out[p, c] = root_out[p, c] * size
+            travel[p, c] = travel[p, c] * size
+        wrapped[p] = ph1 % 1.0
         for j in range(joints):
             m = qnormalize((rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3]))
             rot_out[p, j, 0], rot_out[p, j, 1], rot_out[p, j, 2], rot_out[p, j, 3] = m

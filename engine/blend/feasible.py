@@ -102,28 +102,34 @@ def closest_point_on_simplices(verts: ArrayLike, u: ArrayLike) -> tuple[F, F]:
 @jit.njit
 def _line_range_compiled(inv: F, ok: NDArray[np.bool_], x: F, axis: int, lo: F, hi: F) -> None:
     """:meth:`FeasibleSet.line_range` for points ``x [B, N]``, compiled (same sums, same order)."""
-    n = x.shape[1]
     for r in range(x.shape[0]):
-        low, high, found = math.inf, -math.inf, False
-        for f in range(inv.shape[0]):
-            if not ok[f]:
-                continue
-            hit, s = True, 0.0
-            for i in range(n + 1):
-                acc = inv[f, i, 0] * x[r, 0] + inv[f, i, n]
-                for j in range(1, n):
-                    acc = acc + inv[f, i, j] * x[r, j]
-                if i == n:
-                    s = acc
-                elif not acc >= -1e-12:
-                    hit = False
-                    break
-            if hit:
-                found = True
-                low, high = min(low, s), max(high, s)
-        base = x[r, axis]
-        lo[r] = base + low if found else math.nan
-        hi[r] = base + high if found else math.nan
+        lo[r], hi[r] = line_range_row(inv, ok, x[r], axis)
+
+
+@jit.njit
+def line_range_row(inv: F, ok: NDArray[np.bool_], x: F, axis: int) -> tuple[float, float]:
+    """The lowest and highest border crossing along ``axis`` through one point ``x [N]`` (NaN: none), with
+    the line systems ``inv``/``ok`` of :meth:`FeasibleSet._line_system`: ``(p₀ + p_N) + p₁ + …`` as numpy sums."""
+    n = x.shape[0]
+    low, high, found = math.inf, -math.inf, False
+    for f in range(inv.shape[0]):
+        if not ok[f]:
+            continue
+        hit, s = True, 0.0
+        for i in range(n + 1):
+            acc = inv[f, i, 0] * x[0] + inv[f, i, n]
+            for j in range(1, n):
+                acc = acc + inv[f, i, j] * x[j]
+            if i == n:
+                s = acc
+            elif not acc >= -1e-12:
+                hit = False
+                break
+        if hit:
+            found = True
+            low, high = min(low, s), max(high, s)
+    base = x[axis]
+    return (base + low, base + high) if found else (math.nan, math.nan)
 
 
 @jit.njit

@@ -27,25 +27,27 @@ component holds only what changes per frame. Time is ``world.dt`` steps only.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
-from operator import attrgetter, is_, itemgetter
+from operator import is_
 
 import numpy as np
 from numpy.typing import NDArray
 
 from engine import jit, quat
 from engine.app import App
-from engine.blend import _kernel, _requests
+from engine.batches import batch
+from engine.blend import _groups, _kernel, _requests
 from engine.blend.lookup import LookupTable
 from engine.blend.measure import contact_votes
 from engine.blend.pose_blend import crossfade, fade_weight
 from engine.blend.space import BlendSpace
 from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
-from engine.columns import columns
+from engine.columns import Column, Columns, columns
 from engine.components import LocalPose, Puppet, Transform
-from engine.ecs import Entity, World
+from engine.ecs import World
 from engine.ik.foot_lock import FootLock
 from engine.ik.system import IKRequest
 from engine.pose import Pose
@@ -90,6 +92,7 @@ class BlendLibrary:
         self.sets: dict[str, LocomotionSet] = {}
         self.last_answers: dict[str, _requests.LastAnswers] = {}
         self.contact_tracks: dict[str, list[NDArray[np.bool_]] | None] = {}
+        self.groups = _groups.Groups()
 
     def add(self, name: str, locomotion: LocomotionSet) -> None:
         """Register (or replace) a set."""
@@ -217,20 +220,21 @@ def _yaw(rotation: F) -> F:
     return np.arctan2(2.0 * (x * z + w * y), 1.0 - 2.0 * (x * x + y * y))
 
 
-_Row = tuple[int, Transform, Puppet, "LocomotionPlayer"]
-
-
-def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F, dt: float) -> tuple[F, F, F, F, F, F | None]:
-    """:meth:`BlendSpace.advance`, :meth:`~BlendSpace.sample` and :func:`contact_votes` of a group in one
-    compiled pass: (root, rotations, new phase, travel, turn, votes or ``None``)."""
-    count, joints, legs = len(points), pk.rotations.shape[1], pk.contacts.shape[1]
-    w, new_phase, travel, turn = (
-        np.empty((count, len(pk.points))),
-        np.empty(count),
-        np.empty((count, 3)),
-        np.empty(count),
-    )
-    root, rots, votes = np.empty((count, 3)), np.empty((count, joints, 4)), np.empty((count, legs))
+def _play_compiled(
+    pk: _kernel.Packed,
+    eased: F,
+    target: F,
+    alpha: float,
+    ease: bool,
+    phases: F,
+    rates: F,
+    scales: F,
+    feasible: F,
+    dt: float,
+    out: _Out,
+) -> None:
+    """Easing, :meth:`BlendSpace.advance`, :meth:`~BlendSpace.sample`, :func:`contact_votes` and the scalings
+    of a group in one compiled pass (:func:`engine.blend._kernel.play`), into ``out``'s arrays."""
     _kernel.play(
         pk.points,
         pk.durations,
@@ -247,19 +251,25 @@ def _play_compiled(pk: _kernel.Packed, points: F, phase: F, rates: F, dt: float)
         pk.arc_next,
         pk.arc_angle,
         pk.arc_sin,
-        np.ascontiguousarray(points, dtype=np.float64),
-        phase,
-        np.ascontiguousarray(rates, dtype=np.float64),
+        eased,
+        target,
+        alpha,
+        ease,
+        phases,
+        rates,
+        scales,
+        feasible,
         dt,
-        w,
-        new_phase,
-        travel,
-        turn,
-        root,
-        rots,
-        votes,
+        out.feasible,
+        out.weights,
+        out.phase,
+        out.wrapped,
+        out.travel,
+        out.turn,
+        out.roots,
+        out.rotations,
+        out.votes,
     )
-    return root, rots, new_phase, travel, turn, (votes if legs else None)
 
 
 def animate(world: World) -> None:
@@ -267,105 +277,149 @@ def animate(world: World) -> None:
     library = world.try_resource(BlendLibrary)
     if library is None:
         return
-    rows = world.query(Transform, Puppet, LocomotionPlayer)
-    if not rows:
+    kept = batch(world, "locomotion", (Transform, Puppet, LocomotionPlayer), (LocalPose, IKRequest))
+    if not kept.entities:
         return
-    keys = list(map(_KEY, map(itemgetter(3), rows)))
-    if keys.count(keys[0]) == len(keys):  # one set for the whole crowd: the query's rows are the batch
-        groups: dict[str, list[_Row]] = {keys[0]: rows}
-    else:
-        groups = {}
-        for key, row in zip(keys, rows, strict=True):
-            groups.setdefault(key, []).append(row)
     dt = world.dt
-    for key, members in groups.items():
-        _animate_group(world, library, key, members, dt)
+    for group in library.groups.of(kept):
+        _animate_group(world, library, group, dt)
 
 
-_KEY = attrgetter("library_key")
+class _Out:
+    """The compiled pass's outputs for a group of ``count`` puppets (blend points of ``dims``, ``weights`` clips,
+    ``joints``, ``legs``): fresh arrays, some replaced by the columns themselves where the components' fields
+    all view them (written in place, nothing to copy after)."""
+
+    def __init__(self, count: int, dims: int, weights: int, joints: int, legs: int) -> None:
+        self.feasible = np.empty((count, dims))
+        self.weights = np.empty((count, weights))
+        self.phase, self.wrapped, self.turn = np.empty(count), np.empty(count), np.empty(count)
+        self.travel, self.roots = np.empty((count, 3)), np.empty((count, 3))
+        self.rotations = np.empty((count, joints, 4))
+        self.votes = np.empty((count, legs))
 
 
-def _animate_group(world: World, library: BlendLibrary, key: str, members: list[_Row], dt: float) -> None:
-    """One locomotion set's puppets: array passes, and per-puppet Python only to write the players'
-    scalar fields and for a puppet playing an override clip. The array fields (blend point, feasible
-    request, position, local pose, foot-contact votes) are written through the world's
-    :mod:`engine.columns`."""
+def _linked(column: Column, owners: Sequence[object], shape: tuple[int, ...]) -> F | None:
+    """The column of ``owners`` when their fields all view it and it has ``shape`` (to write in place)."""
+    base = column.linked(owners)
+    return base if base is not None and base.shape == shape and base.dtype == np.float64 else None
+
+
+def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt: float) -> None:
+    """One locomotion set's puppets: array passes, and per-puppet Python only to read the requests, write
+    the players' scalar fields and for a puppet playing an override clip. The array fields (blend point,
+    feasible request, position, local pose, foot-contact votes) are written through the world's
+    :mod:`engine.columns`; on the compiled path straight into them, when every component views its row."""
+    key = group.key
     loco = library[key]
     space = loco.space
     cols = columns(world)
-    entities: list[Entity] = list(map(itemgetter(0), members))
-    transforms: list[Transform] = list(map(itemgetter(1), members))
-    players: list[LocomotionPlayer] = list(map(itemgetter(3), members))
+    entities, players = group.entities, group.players
+    count = len(players)
     alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
     req = _requests.read(entities, players)
     answers = _requests.resolve(library.last_answers, key, loco, req)
     target = answers.points
-    point_column = cols.get(LocomotionPlayer, "point", key)
-    if req.any_fresh():
-        eased = np.array([t if p is None else p for p, t in zip(req.points, target, strict=True)])
-        fresh = np.fromiter(map(is_, req.points, repeat(None)), dtype=np.bool_, count=len(players))
-        points = np.where(fresh[:, None], target, eased + alpha * (target - eased))
-    else:
-        eased = point_column.read(players)
-        points = eased + alpha * (target - eased)
     scale = req.scales
-    rates = answers.rates
-    feasible = answers.feasible * scale[:, None]
-    point_column.write(players, points)
-    cols.get(LocomotionPlayer, "feasible", key).write(players, feasible)
-    phase = req.phases
+    overrides = req.override_rows()
     tracks = library.tracks(key)
     packed = _kernel.packed(space, tracks) if jit.enabled() else None
+    point_column, feasible_column = (
+        cols.get(LocomotionPlayer, "point", key),
+        cols.get(LocomotionPlayer, "feasible", key),
+    )
+    eased = _linked(point_column, players, target.shape)  # every player has a point: eased in place
+    if eased is None:
+        now = [p.point for p in players]
+        fresh = np.fromiter(map(is_, now, repeat(None)), dtype=np.bool_, count=count)
+        start = np.array([t if p is None else p for p, t in zip(now, target, strict=True)])
+        eased = np.where(fresh[:, None], target, start + alpha * (target - start))
+    elif packed is None:
+        eased = eased + alpha * (target - eased)
     if packed is None:
-        w = space.weights(points)
+        point_column.write(players, eased)
+        feasible_column.write(players, answers.feasible * scale[:, None])
+        w = space.weights(eased)
         # Scaling the phase step by the rate already scales the root travel: feet keep pace with the ground.
-        new_phase, travel, turn = space.advance(phase, w, dt, rates)
+        new_phase, travel, turn = space.advance(req.phases, w, dt, answers.rates)
         pose = space.sample(w, new_phase)
-        blended, rots = pose.root, pose.rotations.copy()
+        roots, rots = pose.root * scale[:, None], pose.rotations.copy()
+        travel = travel * scale[:, None]
         votes = None if tracks is None else contact_votes(space, w, new_phase, tracks)
+        wrapped = new_phase % 1.0
     else:
-        blended, rots, new_phase, travel, turn, votes = _play_compiled(packed, points, phase, rates, dt)
-    roots = blended * scale[:, None]
-    travel = travel * scale[:, None]
-    keep_turn = np.ones(len(members))
-    faded = np.zeros(len(members))  # the override clip's weight, where one plays
-    wrapped = (new_phase % 1.0).tolist()
-    for player, inside, rate, ph in zip(players, answers.inside.tolist(), rates.tolist(), wrapped, strict=True):
+        joints, legs = packed.rotations.shape[1], packed.contacts.shape[1]
+        out = _Out(count, target.shape[1], len(packed.points), joints, legs)
+        if group.poses is not None:  # posed straight into the local poses' column when they all view it
+            linked = _linked(cols.get(LocalPose, "rotations", joints), group.poses, out.rotations.shape)
+            if linked is not None:
+                out.rotations = linked
+        if legs and not overrides and group.ik_rows is None:  # votes straight into the foot locks' column
+            linked = _linked(cols.get(FootLock, "contacts", legs), group.foot_locks(), out.votes.shape)
+            if linked is not None:
+                out.votes = linked
+        feasible_in = _linked(feasible_column, players, out.feasible.shape)
+        if feasible_in is not None:
+            out.feasible = feasible_in
+        in_place = eased is point_column.base
+        _play_compiled(
+            packed, eased, target, float(alpha), in_place, req.phases, answers.rates, scale, answers.feasible, dt, out
+        )
+        if not in_place:
+            point_column.write(players, eased)
+        if feasible_in is None:
+            feasible_column.write(players, out.feasible)
+        roots, rots, travel, turn, wrapped = out.roots, out.rotations, out.travel, out.turn, out.wrapped
+        votes = out.votes if legs else None
+    for player, inside, rate, ph in zip(
+        players, answers.inside.tolist(), answers.rates.tolist(), wrapped.tolist(), strict=True
+    ):
         player.finished, player.inside, player.rate, player.phase = None, inside, rate, ph
-    for i, player in enumerate(players) if req.any_override() else ():
-        if player.override is None:  # the unusual puppet: a one-shot or a held pose over its blend
-            continue
-        clip, weight, clip_travel = _override(player, loco, dt)
-        if clip is not None:
-            over = clip.sample(player.override_time)
-            local = crossfade(Pose(roots[i], rots[i]), Pose(over.root * scale[i], over.rotations), weight)
-            roots[i], rots[i] = local.root, local.rotations
-            travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
-            keep_turn[i] = 1.0 - weight
-            faded[i] = weight
-    _contacts(world, entities, req.speeds, votes, faded)
-    # Heading, travel and the world root for the whole group at once.
+    faded = None  # the override clips' weights, where one plays
+    if overrides:
+        keep_turn, faded = np.ones(count), np.zeros(count)
+        for i in overrides:  # the unusual puppets: a one-shot or a held pose over the blend
+            player = players[i]
+            clip, weight, clip_travel = _override(player, loco, dt)
+            if clip is not None:
+                over = clip.sample(player.override_time)
+                local = crossfade(Pose(roots[i], rots[i]), Pose(over.root * scale[i], over.rotations), weight)
+                roots[i], rots[i] = local.root, local.rotations
+                travel[i] = (1.0 - weight) * travel[i] + weight * clip_travel * scale[i]
+                keep_turn[i] = 1.0 - weight
+                faded[i] = weight
+        turn = turn * keep_turn
+    _contacts(group, req.speeds, votes, faded, cols)
+    _move(world, cols, group, travel, turn, roots, rots)
+
+
+def _move(world: World, cols: Columns, group: _groups.Group, travel: F, turn: F, roots: F, rots: F) -> None:
+    """Heading, travel and the world root for the whole group at once; the local poses written (on the
+    compiled path ``rots`` may be the local poses' column already)."""
+    transforms = group.transforms
     rotation_column, position_column = cols.get(Transform, "rotation"), cols.get(Transform, "position")
     rotation = rotation_column.read(transforms)
-    if req.any_override():
-        turn = turn * keep_turn
+    poses = group.poses
+    root_column = None if poses is None else cols.get(LocalPose, "root", rots.shape[1])
     if jit.enabled():
         positions = position_column.read(transforms)  # moved in place
-        headings, world_roots = np.empty_like(rotation), np.empty_like(roots)
+        headings = rotation if rotation is rotation_column.base else np.empty_like(rotation)  # turned in place
+        world_roots = None if root_column is None or poses is None else _linked(root_column, poses, roots.shape)
+        if world_roots is None:
+            world_roots = np.empty_like(roots)
         _kernel.place(rotation, positions, travel, turn, roots, rots, headings, world_roots)
     else:
         positions, headings, world_roots = _place(rotation, position_column.read(transforms), travel, turn, roots, rots)
     position_column.write(transforms, positions)
     rotation_column.write(transforms, headings)
-    poses = list(map(world.components(LocalPose).get, entities))
-    if any(map(is_, poses, repeat(None))):  # a puppet's first pose
-        for i, e in enumerate(entities):
-            if poses[i] is None:
+    if root_column is None or poses is None:  # a puppet's first pose (the others wait for the next step)
+        have = world.components(LocalPose)
+        for i, e in enumerate(group.entities):
+            if e not in have:
                 world.queue_add(e, LocalPose(world_roots[i], rots[i]))
         return
-    joints = rots.shape[1]
-    cols.get(LocalPose, "root", joints).write(poses, world_roots)
-    cols.get(LocalPose, "rotations", joints).write(poses, rots)
+    root_column.write(poses, world_roots)
+    cols.get(LocalPose, "rotations", rots.shape[1]).write(poses, rots)
 
 
 def _place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F) -> tuple[F, F, F]:
@@ -380,29 +434,22 @@ def _place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F) -> 
     return moved, quat.normalize(quat.mul(turn_q, rotation)), moved + quat.rotate(hq_new, roots)
 
 
-def _contacts(world: World, entities: list[Entity], speeds: F, votes: F | None, faded: F) -> None:
-    """The blend's foot-contact votes (less an override clip's weight) and the settle flag to each
+def _contacts(group: _groups.Group, speeds: F, votes: F | None, faded: F | None, cols: Columns) -> None:
+    """The blend's foot-contact votes (less an override clip's weight ``faded``) and the settle flag to each
     puppet's foot lock, so the leg IK holds planted feet where they landed."""
-    requests = list(map(world.components(IKRequest).get, entities))
-    settle = (speeds < _SETTLE_SPEED).tolist()
-    has = None if not any(map(is_, requests, repeat(None))) else [r is not None for r in requests]
-    if has is not None:  # puppets without leg IK take no votes
-        settle = [flag for flag, ok in zip(settle, has, strict=True) if ok]
-        requests = [r for r in requests if r is not None]
-    locks: list[FootLock] = list(map(_FOOT_LOCK, requests))
-    for lock, flag in zip(locks, settle, strict=True):
+    locks = group.foot_locks()
+    settle = speeds < _SETTLE_SPEED
+    rows = group.ik_rows
+    for lock, flag in zip(locks, (settle if rows is None else settle[rows]).tolist(), strict=True):
         lock.settle = flag
     if votes is None:
         for lock in locks:
             lock.contacts = None
         return
-    contacts = votes * (1.0 - faded)[:, None]
-    if has is not None:
-        contacts = contacts[np.array(has)]
-    columns(world).get(FootLock, "contacts", contacts.shape[1]).write(locks, contacts)
-
-
-_FOOT_LOCK = attrgetter("foot_lock")
+    contacts = votes if faded is None else votes * (1.0 - faded)[:, None]
+    if rows is not None:  # puppets without leg IK take no votes
+        contacts = contacts[rows]
+    cols.get(FootLock, "contacts", contacts.shape[1]).write(locks, contacts)
 
 
 def install_blend(app: App) -> None:

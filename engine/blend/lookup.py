@@ -287,7 +287,10 @@ class LookupTable:
         The weights ``wₖ`` are Eq. 6.2 unchanged, so the map is still exact at the
         probes, continuous, and local; it now also reproduces locally linear maps.
         """
-        x = self._scaled(u)
+        return self.query_scaled(self._scaled(u))
+
+    def query_scaled(self, x: F) -> F:
+        """:meth:`query` of requests already scaled to the table's units (``(u − offset) / scale``, finite)."""
         k = min(self.neighbours, len(self.probes))
         dist, idx = self.tree.query(x, k=k)
         if k == 1:

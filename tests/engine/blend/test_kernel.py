@@ -15,7 +15,7 @@ import pytest
 
 from engine import jit
 from engine.blend import _kernel
-from engine.blend.locomotion import LocomotionPlayer
+from engine.blend.locomotion import BlendLibrary, LocomotionPlayer, LocomotionSet, _Out, _play_compiled
 from engine.blend.puppet import puppet_locomotion
 from engine.components import LocalPose, Transform
 from engine.ik.system import IKRequest
@@ -62,32 +62,105 @@ def test_the_compiled_animation_agrees_with_numpy_step_by_step() -> None:
                     np.testing.assert_allclose(y, x, atol=1e-9)
 
 
-def test_the_kernel_pose_is_the_blend_space_sample() -> None:
-    """One call of :func:`_kernel.play` against ``weights``/``advance``/``sample`` on random blends."""
-    from engine.blend.locomotion import BlendLibrary, _play_compiled
-    from engine.blend.measure import contact_votes
+def _play(
+    pk: _kernel.Packed,
+    points: np.ndarray,
+    target: np.ndarray,
+    ease: bool,
+    phase: np.ndarray,
+    rates: np.ndarray,
+    scales: np.ndarray,
+    feasible: np.ndarray,
+) -> _Out:
 
+    out = _Out(len(points), points.shape[1], len(pk.points), pk.rotations.shape[1], pk.contacts.shape[1])
+    _play_compiled(pk, points, target, 0.3, ease, phase, rates, scales, feasible, 1 / 60, out)
+    return out
+
+
+def _packed() -> tuple[LocomotionSet, _kernel.Packed, list[np.ndarray]]:
     loco = puppet_locomotion()
     library = BlendLibrary()
     library.add("humanoid", loco)
     tracks = library.tracks("humanoid")
+    assert tracks is not None
     pk = _kernel.packed(loco.space, tracks)
     assert pk is not None
+    return loco, pk, tracks
+
+
+def test_the_kernel_pose_is_the_blend_space_sample() -> None:
+    """One call of :func:`_kernel.play` against ``weights``/``advance``/``sample`` on random blends."""
+    from engine.blend.measure import contact_votes
+
+    loco, pk, tracks = _packed()
+    space = loco.space
     rng = np.random.default_rng(2)
-    points = rng.uniform(-0.1, 1.1, (50, loco.space.dims))
+    points = rng.uniform(-0.1, 1.1, (50, space.dims))
     phase = rng.uniform(0, 3, 50)
     rates = rng.uniform(0.5, 2, 50)
-    root, rots, new_phase, travel, turn, votes = _play_compiled(pk, points, phase, rates, 1 / 60)
-    w = loco.space.weights(points)
-    ref_phase, ref_travel, ref_turn = loco.space.advance(phase, w, 1 / 60, rates)
-    pose = loco.space.sample(w, ref_phase)
-    np.testing.assert_allclose(new_phase, ref_phase, atol=1e-12)
-    np.testing.assert_allclose(travel, ref_travel, atol=1e-12)
-    np.testing.assert_allclose(turn, ref_turn, atol=1e-12)
-    np.testing.assert_allclose(root, pose.root, atol=1e-12)
-    np.testing.assert_allclose(rots, pose.rotations, atol=1e-12)
-    assert votes is not None
-    np.testing.assert_allclose(votes, contact_votes(loco.space, w, ref_phase, tracks), atol=1e-12)
+    ones = np.ones(50)
+    out = _play(pk, points, points, False, phase, rates, ones, points)
+    w = space.weights(points)
+    ref_phase, ref_travel, ref_turn = space.advance(phase, w, 1 / 60, rates)
+    pose = space.sample(w, ref_phase)
+    np.testing.assert_allclose(out.phase, ref_phase, atol=1e-12)
+    np.testing.assert_allclose(out.travel, ref_travel, atol=1e-12)
+    np.testing.assert_allclose(out.turn, ref_turn, atol=1e-12)
+    np.testing.assert_allclose(out.roots, pose.root, atol=1e-12)
+    np.testing.assert_allclose(out.rotations, pose.rotations, atol=1e-12)
+    np.testing.assert_allclose(out.votes, contact_votes(space, w, ref_phase, tracks), atol=1e-12)
+
+
+def test_the_kernel_eases_scales_and_wraps_as_the_numpy_path_bit_for_bit() -> None:
+    """The parts of the animation stage folded into :func:`_kernel.play` (the blend point's easing in place,
+    the feasible request, root and travel times the puppet's scale, the phase wrapped to [0, 1)) against
+    the numpy expressions they replaced, on random crowds: equal to the bit. Broken once by easing as
+    ``(1 − α)·eased + α·target`` (the same point, other last bits): it failed."""
+    _, pk, _ = _packed()
+    rng = np.random.default_rng(9)
+    n = 200
+    eased = rng.uniform(-0.1, 1.1, (n, 2))
+    target = rng.uniform(0.0, 1.0, (n, 2))
+    phase = rng.uniform(0, 40, n)
+    rates = rng.uniform(0.3, 3, n)
+    scales = rng.uniform(0.3, 2.5, n)
+    feasible = rng.uniform(0.0, 3.0, (n, 2))
+    moved = eased.copy()
+    big = _play(pk, moved, target, True, phase, rates, scales, feasible)
+    assert np.array_equal(moved, eased + 0.3 * (target - eased))
+    unit = _play(pk, moved.copy(), target, False, phase, rates, np.ones(n), feasible)
+    assert np.array_equal(big.feasible, feasible * scales[:, None])
+    assert np.array_equal(big.roots, unit.roots * scales[:, None])
+    assert np.array_equal(big.travel, unit.travel * scales[:, None])
+    assert np.array_equal(big.wrapped, big.phase % 1.0)
+    for name in ("phase", "turn", "rotations", "votes", "weights"):
+        assert np.array_equal(getattr(big, name), getattr(unit, name))
+
+
+def test_one_interpolation_is_numbas_np_interp_bit_for_bit() -> None:
+    """:func:`_kernel.interp` (the clip-time lookup without allocations) against ``np.interp`` compiled by
+    numba, which the kernel called before: random knots (3 and 9, strictly increasing or with repeats),
+    points inside, outside, on the knots and NaN. Broken once by taking the knot at or *above* ``x``
+    as the segment's start (``x > xp[mid]`` in the bisection): it failed on the points on knots."""
+    import numba
+
+    @numba.njit
+    def reference(x: float, xp: np.ndarray, fp: np.ndarray) -> float:
+        return np.interp(x, xp, fp)
+
+    rng = np.random.default_rng(11)
+    for size in (1, 2, 3, 9):
+        for repeats in (False, True):
+            for _ in range(30):
+                xp = np.sort(rng.uniform(0, 1, size))
+                if repeats and size > 2:
+                    xp[1] = xp[2]
+                fp = rng.uniform(-2, 2, size)
+                xs = np.concatenate([rng.uniform(-0.2, 1.2, 40), xp, [np.nan, -np.inf, np.inf]])
+                for x in xs:
+                    a, b = _kernel.interp(float(x), xp, fp), reference(float(x), xp, fp)
+                    assert a == b or (np.isnan(a) and np.isnan(b)), (x, xp, fp)
 
 
 @pytest.mark.parametrize("gradients", [True, False])
