@@ -47,7 +47,7 @@ class Column:
         dtype: the array's type (a field of another type is converted when taken in).
     """
 
-    __slots__ = ("attr", "dtype", "_get", "_ids", "_owners", "_row", "base", "_views", "_whole")
+    __slots__ = ("attr", "dtype", "_get", "_ids", "_owners", "_parts", "_row", "base", "_views", "_whole")
 
     def __init__(self, attr: str, dtype: type = np.float64) -> None:
         self.attr = attr
@@ -59,6 +59,8 @@ class Column:
         self.base: NDArray[Any] | None = None
         self._views: list[NDArray[Any]] = []
         self._whole: tuple[Any, ...] | None = None  # a tuple of owners last found to be the whole column
+        # Tuples of owners found in the column (by id, kept so no id is reused): their rows and row views.
+        self._parts: dict[int, tuple[tuple[Any, ...], NDArray[np.int64], list[NDArray[Any]]]] = {}
 
     def _rows(self, owners: Sequence[Any]) -> slice | list[int] | None:
         """Where ``owners`` are in the column: all of it in order (``slice(None)``), some of its rows,
@@ -113,6 +115,7 @@ class Column:
             raise ValueError(f"a column holds array fields, one row each: {self.attr} has shape {base.shape[1:]}")
         self.base, self._owners, self._ids = base, list(owners), list(map(id, owners))
         self._whole = None
+        self._parts = {}
         self._row = {k: i for i, k in enumerate(self._ids)}
         self._views = list(base)
         for owner, view in zip(owners, self._views, strict=True):
@@ -141,6 +144,31 @@ class Column:
             return None
         return self.base
 
+    def rows(self, owners: tuple[Any, ...]) -> tuple[NDArray[Any], NDArray[np.int64]] | None:
+        """The column and the rows ``[N]`` of ``owners`` in it, any field replaced since taken in first
+        (as :meth:`read` does), for a kernel that reads or updates those rows in place; ``None`` when
+        one of ``owners`` is not in the column or a replaced field has another shape.
+
+        ``owners`` may be part of the column's batch (a crowd with one puppet in the air, ten fallen):
+        their rows are looked up once per tuple, then checked each call in one pass in C, so only a
+        puppet whose field was replaced costs Python."""
+        if self.base is None or (self._views and self._views[0].base is not self.base):
+            return None
+        part = self._parts.get(id(owners))
+        if part is None or part[0] is not owners:
+            found = self._rows(owners)
+            if found is None:
+                return None
+            index = list(range(len(self._owners))) if isinstance(found, slice) else found
+            views = self._views
+            part = (owners, np.array(index, dtype=np.int64), [views[i] for i in index])
+            if len(self._parts) >= _PARTS:
+                self._parts.clear()
+            self._parts[id(owners)] = part
+        if not all(map(is_, map(self._get, owners), part[2])) and not self._sync(part[1].tolist(), take_in=True):
+            return None
+        return self.base, part[1]
+
     def write(self, owners: Sequence[Any], values: ArrayLike) -> None:
         """Set the field of every component of ``owners`` to its row of ``values`` ``[N, ...]`` (copied)."""
         values = np.asarray(values, dtype=self.dtype)
@@ -155,6 +183,7 @@ class Column:
 
 
 _ALL = slice(None)
+_PARTS = 8  # owner tuples whose rows a column remembers (a few stages ask about a few crowds)
 
 
 class Columns:

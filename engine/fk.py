@@ -19,7 +19,7 @@ from engine import jit, quat
 from engine.jit import qmul, qrot
 from engine.skeleton import Skeleton
 
-__all__ = ["fk_kernel", "forward_kinematics", "levels", "world_points"]
+__all__ = ["fk_kernel", "fk_rows", "forward_kinematics", "levels", "world_points"]
 
 
 @lru_cache(maxsize=64)
@@ -116,6 +116,45 @@ def fk_kernel(
             out_pos[p, j, 2] = out_pos[p, a, 2] + d[2]
             q = qmul(pq, (rot[p, j, 0], rot[p, j, 1], rot[p, j, 2], rot[p, j, 3]))
             out_rot[p, j, 0], out_rot[p, j, 1], out_rot[p, j, 2], out_rot[p, j, 3] = q
+
+
+@jit.njit
+def fk_rows(
+    parents: NDArray[np.int64],
+    rows: NDArray[np.int64],
+    root: NDArray[np.float64],
+    rot: NDArray[np.float64],
+    off: NDArray[np.float64],
+    out_rows: NDArray[np.int64],
+    out_pos: NDArray[np.float64],
+    out_rot: NDArray[np.float64],
+    prev_pos: NDArray[np.float64],
+    prev_rot: NDArray[np.float64],
+) -> None:
+    """:func:`fk_kernel` in place on a crowd's columns: puppet ``p`` reads row ``rows[p]`` of ``root``/``rot``
+    (offsets ``off [P,J,3]``) and writes row ``out_rows[p]`` of ``out_pos``/``out_rot``, after copying that
+    row's last values into ``prev_pos``/``prev_rot`` (render interpolation). The rows may be any of the
+    arrays' (a crowd that is part of the columns' batch); each puppet's rows are its own."""
+    for p in range(rows.shape[0]):
+        r, o = rows[p], out_rows[p]
+        for j in range(out_pos.shape[1]):
+            for c in range(3):
+                prev_pos[o, j, c] = out_pos[o, j, c]
+            for c in range(4):
+                prev_rot[o, j, c] = out_rot[o, j, c]
+        for c in range(3):
+            out_pos[o, 0, c] = root[r, c]
+        for c in range(4):
+            out_rot[o, 0, c] = rot[r, 0, c]
+        for j in range(1, rot.shape[1]):
+            a = parents[j]
+            pq = (out_rot[o, a, 0], out_rot[o, a, 1], out_rot[o, a, 2], out_rot[o, a, 3])
+            d = qrot(pq, (off[p, j, 0], off[p, j, 1], off[p, j, 2]))
+            out_pos[o, j, 0] = out_pos[o, a, 0] + d[0]
+            out_pos[o, j, 1] = out_pos[o, a, 1] + d[1]
+            out_pos[o, j, 2] = out_pos[o, a, 2] + d[2]
+            q = qmul(pq, (rot[r, j, 0], rot[r, j, 1], rot[r, j, 2], rot[r, j, 3]))
+            out_rot[o, j, 0], out_rot[o, j, 1], out_rot[o, j, 2], out_rot[o, j, 3] = q
 
 
 def world_points(skeleton: Skeleton, wpos: ArrayLike, wrot: ArrayLike) -> NDArray[np.float64]:

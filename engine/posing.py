@@ -8,8 +8,9 @@ The previous world pose is kept for render interpolation.
 With numba (:mod:`engine.jit`) a crowd in its usual state costs no Python per puppet: the
 grouping is made once per membership (an :class:`FKPlan`, remade when the ECS hands out a
 new query result or a puppet's skeleton or offsets object changes), and when every pose is
-in its column (:meth:`engine.columns.Column.linked`) the compiled kernel
-(:func:`engine.fk.fk_kernel`, the arithmetic :func:`~engine.fk.forward_kinematics` runs)
+in its column, at any rows (:meth:`engine.columns.Column.rows`: the group may be part of the
+animation's batch; a pose replaced by other code, a fallen puppet's, is taken in), the compiled
+kernel (:func:`engine.fk.fk_rows`, the arithmetic :func:`~engine.fk.forward_kinematics` runs)
 writes the world poses into their columns in place, after the last step's are copied aside.
 """
 
@@ -21,6 +22,7 @@ from operator import attrgetter, is_
 from typing import Any, ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from engine import jit
 from engine.app import App
@@ -28,13 +30,12 @@ from engine.arrays import F64 as F
 from engine.columns import Columns, columns
 from engine.components import LocalPose, Puppet, WorldPose
 from engine.ecs import Entity, World
-from engine.fk import fk_kernel, forward_kinematics
+from engine.fk import fk_rows, forward_kinematics
 from engine.skeleton import Skeleton
 
 __all__ = ["FKPlan", "fk_system", "install_fk"]
 
-_SKELETON = attrgetter("skeleton")
-_OFFSETS = attrgetter("offsets")
+_PUPPET = attrgetter("skeleton", "offsets")
 
 
 @dataclass
@@ -48,6 +49,7 @@ class _Group:
     locals_: tuple[LocalPose, ...]
     offsets: F
     worlds: tuple[WorldPose, ...] = ()
+    checked: tuple[NDArray[np.int64], ...] = ()  # the columns' row arrays last found to agree (_compiled)
 
 
 @dataclass
@@ -55,24 +57,24 @@ class FKPlan:
     """Resource: the FK stage's grouping, kept while the world's queries return the same lists.
 
     ``table``/``posed`` are the query results it was made for (``(Puppet, LocalPose)`` and the
-    same with ``WorldPose``; kept so their ids are not reused); ``skeletons``/``offset_fields``
-    every puppet's ``skeleton`` and ``offsets`` objects then."""
+    same with ``WorldPose``; kept so their ids are not reused); ``puppets`` the table's ``Puppet``
+    components and ``puppet_fields`` each one's ``(skeleton, offsets)`` objects then."""
 
     SIM_STATE: ClassVar[bool] = False
     table: list[tuple[Any, ...]] = field(default_factory=list)
     posed: list[tuple[Any, ...]] = field(default_factory=list)
-    skeletons: list[Skeleton] = field(default_factory=list)
-    offset_fields: list[Any] = field(default_factory=list)
+    puppets: list[Puppet] = field(default_factory=list)
+    puppet_fields: list[tuple[Any, ...]] = field(default_factory=list)
     groups: list[_Group] = field(default_factory=list)
 
     def holds(self, table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> bool:
-        """Whether the plan still describes these query results (C-level passes over the puppets)."""
+        """Whether the plan still describes these query results (one C-level pass over the puppets)."""
         if table is not self.table or posed is not self.posed or len(posed) != len(table):
             return False
-        puppets = [row[1] for row in table]
-        return all(map(is_, map(_SKELETON, puppets), self.skeletons)) and all(
-            map(is_, map(_OFFSETS, puppets), self.offset_fields)
-        )
+        try:
+            return list(map(_PUPPET, self.puppets)) == self.puppet_fields
+        except ValueError:  # an offsets array compared with another: it was replaced
+            return False
 
 
 def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
@@ -96,23 +98,39 @@ def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
             )
         )
     everyone = [row[1] for row in table]
-    return FKPlan(table, posed, list(map(_SKELETON, everyone)), list(map(_OFFSETS, everyone)), groups)
+    return FKPlan(table, posed, everyone, list(map(_PUPPET, everyone)), groups)
 
 
 def _compiled(cols: Columns, group: _Group) -> bool:
     """FK of ``group`` straight into its world poses' columns; ``False`` (nothing done) unless every
-    pose, local and world, is in its column and the local columns are C-contiguous doubles."""
+    pose, local and world, is in its column (:meth:`~engine.columns.Column.rows`, at the same rows in
+    the two local and in the four world columns) and the columns are C-contiguous doubles."""
     joints = group.skeleton.num_joints
-    roots = cols.get(LocalPose, "root", joints).linked(group.locals_)
-    rots = cols.get(LocalPose, "rotations", joints).linked(group.locals_)
-    pos, rot, prev_pos, prev_rot = (cols.get(WorldPose, name, joints).linked(group.worlds) for name in _WORLD_FIELDS)
-    if roots is None or rots is None or pos is None or rot is None or prev_pos is None or prev_rot is None:
+    roots = cols.get(LocalPose, "root", joints).rows(group.locals_)
+    rots = cols.get(LocalPose, "rotations", joints).rows(group.locals_)
+    if roots is None or rots is None:
         return False
-    if not (roots.flags.c_contiguous and rots.flags.c_contiguous and roots.dtype == rots.dtype == np.float64):
+    worlds: list[tuple[NDArray[Any], NDArray[np.int64]]] = []
+    for name in _WORLD_FIELDS:
+        found = cols.get(WorldPose, name, joints).rows(group.worlds)
+        if found is None:
+            return False
+        worlds.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in worlds))
+    if not (len(index) == len(group.checked) and all(map(is_, index, group.checked))):
+        # The same rows in the two local and in the four world columns (checked once while the
+        # columns keep their rows: the row arrays stay the same objects).
+        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
+            return False
+        group.checked = index
+    pos, rot, prev_pos, prev_rot = (found[0] for found in worlds)
+    if not all(
+        a.flags.c_contiguous and a.dtype == np.float64 for a in (roots[0], rots[0], pos, rot, prev_pos, prev_rot)
+    ):
         return False
-    np.copyto(prev_pos, pos)
-    np.copyto(prev_rot, rot)
-    fk_kernel(group.skeleton.parents, roots, rots, group.offsets, pos, rot)
+    fk_rows(
+        group.skeleton.parents, roots[1], roots[0], rots[0], group.offsets, worlds[0][1], pos, rot, prev_pos, prev_rot
+    )
     return True
 
 

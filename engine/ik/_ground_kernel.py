@@ -5,7 +5,7 @@ microsecond of dispatch for a hundred puppets' worth of nanoseconds. These are t
 steps as loops over puppets and legs, compiled by numba (:mod:`engine.jit`), in the three
 pieces the Python between them needs:
 
-1. :func:`legs_fk` — each puppet's FK, its ankles, feet, hips and soles (where the ground
+1. :func:`legs_fk` — each puppet's leg FK, its ankles, feet, hips and soles (where the ground
    is asked about);
 2. :func:`legs_targets` — after the ground query: each foot turned to the slope, its ankle
    target at the clip's clearance, lifted so no toe or heel is under the floor (the foot
@@ -34,21 +34,6 @@ _EPS = 1e-9
 
 
 @njit
-def _fk(parents: I, root: F, rot: F, off: F, pos: F, wrot: F) -> None:
-    """One puppet's FK into ``pos [J,3]`` / ``wrot [J,4]`` (the order of :func:`engine.fk.fk_kernel`)."""
-    for c in range(3):
-        pos[0, c] = root[c]
-    for c in range(4):
-        wrot[0, c] = rot[0, c]
-    for j in range(1, rot.shape[0]):
-        a = parents[j]
-        pq = (wrot[a, 0], wrot[a, 1], wrot[a, 2], wrot[a, 3])
-        d = qrot(pq, (off[j, 0], off[j, 1], off[j, 2]))
-        pos[j, 0], pos[j, 1], pos[j, 2] = pos[a, 0] + d[0], pos[a, 1] + d[1], pos[a, 2] + d[2]
-        wrot[j, 0], wrot[j, 1], wrot[j, 2], wrot[j, 3] = qmul(pq, (rot[j, 0], rot[j, 1], rot[j, 2], rot[j, 3]))
-
-
-@njit
 def _v(a: F, i: int) -> tuple[float, float, float]:
     return (a[i, 0], a[i, 1], a[i, 2])
 
@@ -59,14 +44,42 @@ def _q(a: F, i: int) -> tuple[float, float, float, float]:
 
 
 @njit
-def legs_fk(parents: I, roots: F, rots: F, offs: F, legs: I, soles: F, ankles: F, qfeet: F, hips: F, sole: F) -> None:
-    """Fill ``ankles``/``hips``/``sole [P,L,3]`` and ``qfeet [P,L,4]`` for legs ``legs [L,3]`` (upper, lower, foot)."""
+def _path_fk(parents: I, root: F, rot: F, off: F, pos: F, wrot: F, joint: int, chain: I) -> None:
+    """:func:`_fk` of only ``joint`` and its ancestors (the same operations on that path; ``chain`` is scratch ``[J]``)."""
+    n = 0
+    j = joint
+    while j > 0:
+        chain[n] = j
+        n += 1
+        j = parents[j]
+    for c in range(3):
+        pos[0, c] = root[c]
+    for c in range(4):
+        wrot[0, c] = rot[0, c]
+    for m in range(n - 1, -1, -1):
+        j = chain[m]
+        a = parents[j]
+        pq = (wrot[a, 0], wrot[a, 1], wrot[a, 2], wrot[a, 3])
+        d = qrot(pq, (off[j, 0], off[j, 1], off[j, 2]))
+        pos[j, 0], pos[j, 1], pos[j, 2] = pos[a, 0] + d[0], pos[a, 1] + d[1], pos[a, 2] + d[2]
+        wrot[j, 0], wrot[j, 1], wrot[j, 2], wrot[j, 3] = qmul(pq, (rot[j, 0], rot[j, 1], rot[j, 2], rot[j, 3]))
+
+
+@njit
+def legs_fk(
+    parents: I, rows: I, roots: F, rots: F, offs: F, legs: I, soles: F, ankles: F, qfeet: F, hips: F, sole: F
+) -> None:
+    """Fill ``ankles``/``hips``/``sole [P,L,3]`` and ``qfeet [P,L,4]`` for legs ``legs [L,3]`` (upper, lower, foot)
+    of the puppets whose poses are rows ``rows [P]`` of ``roots``/``rots`` (offsets ``offs [P, J, 3]``).
+
+    Only each leg's own path (pelvis to foot) is walked: the same operations as the full FK on it."""
     n = rots.shape[1]
-    pos, wrot = np.empty((n, 3)), np.empty((n, 4))
-    for p in range(rots.shape[0]):
-        _fk(parents, roots[p], rots[p], offs[p], pos, wrot)
+    pos, wrot, chain = np.empty((n, 3)), np.empty((n, 4)), np.empty(n, np.int64)
+    for p in range(rows.shape[0]):
+        r = rows[p]
         for k in range(legs.shape[0]):
             u, f = legs[k, 0], legs[k, 2]
+            _path_fk(parents, roots[r], rots[r], offs[p], pos, wrot, f, chain)
             qf = _q(wrot, f)
             s = qrot(qf, _v(soles, k))
             for c in range(3):
@@ -236,28 +249,6 @@ def _solve_limb(
 
 
 @njit
-def _path_fk(parents: I, root: F, rot: F, off: F, pos: F, wrot: F, joint: int, chain: I) -> None:
-    """:func:`_fk` of only ``joint`` and its ancestors (the same operations on that path; ``chain`` is scratch ``[J]``)."""
-    n = 0
-    j = joint
-    while j > 0:
-        chain[n] = j
-        n += 1
-        j = parents[j]
-    for c in range(3):
-        pos[0, c] = root[c]
-    for c in range(4):
-        wrot[0, c] = rot[0, c]
-    for m in range(n - 1, -1, -1):
-        j = chain[m]
-        a = parents[j]
-        pq = (wrot[a, 0], wrot[a, 1], wrot[a, 2], wrot[a, 3])
-        d = qrot(pq, (off[j, 0], off[j, 1], off[j, 2]))
-        pos[j, 0], pos[j, 1], pos[j, 2] = pos[a, 0] + d[0], pos[a, 1] + d[1], pos[a, 2] + d[2]
-        wrot[j, 0], wrot[j, 1], wrot[j, 2], wrot[j, 3] = qmul(pq, (rot[j, 0], rot[j, 1], rot[j, 2], rot[j, 3]))
-
-
-@njit
 def _solve_puppet(
     parents: I,
     roots: F,
@@ -272,11 +263,13 @@ def _solve_puppet(
     max_pelvis_shift: float,
     shift: F,
     p: int,
+    r: int,
     pos: F,
     wrot: F,
     chain: I,
 ) -> None:
-    """:func:`legs_solve` of puppet ``p`` (``pos``/``wrot``/``chain`` are scratch ``[J, …]``)."""
+    """:func:`legs_solve` of puppet ``p``, whose pose is row ``r`` of ``roots``/``rots`` (``pos``/``wrot``/``chain``
+    are scratch ``[J, …]``)."""
     low = math.inf
     for k in range(legs.shape[0]):
         low = min(low, targets[p, k, 1] - ankles[p, k, 1])
@@ -291,14 +284,14 @@ def _solve_puppet(
         need_max = max(need_max, max(need, 0.0))
     s = max(s - need_max, -max_pelvis_shift)
     shift[p] = s
-    roots[p, 1] += s
+    roots[r, 1] += s
     for k in range(legs.shape[0]):
         u, lo, f = legs[k, 0], legs[k, 1], legs[k, 2]
-        _path_fk(parents, roots[p], rots[p], offs[p], pos, wrot, f, chain)
+        _path_fk(parents, roots[r], rots[r], offs[p], pos, wrot, f, chain)
         pk = qrot(_q(wrot, parents[u]), _v(knees, k))
         pole = (pos[lo, 0] + pk[0], pos[lo, 1] + pk[1], pos[lo, 2] + pk[2])
         end = qnormalize(_q(new_rot[p], k))
-        _solve_limb(parents, pos, wrot, rots[p], u, lo, f, _v(targets[p], k), pole, end)
+        _solve_limb(parents, pos, wrot, rots[r], u, lo, f, _v(targets[p], k), pole, end)
 
 
 @njit
@@ -325,7 +318,7 @@ def legs_solve(
     for p in range(rots.shape[0]):
         _solve_puppet(
             parents, roots, rots, offs, legs, knees, targets, new_rot, ankles, hips, max_pelvis_shift, shift,
-            p, pos, wrot, chain,
+            p, p, pos, wrot, chain,
         )  # fmt: skip
 
 
@@ -338,6 +331,7 @@ def _smooth(w: float) -> float:
 def _lock_puppet(
     g: int,
     i: int,
+    cg: int,
     st: bool,
     targets: F,
     new_rot: F,
@@ -359,8 +353,8 @@ def _lock_puppet(
     still: NDArray[np.bool_],
     misplaced: NDArray[np.bool_],
 ) -> None:
-    """:func:`lock_group` for one puppet: lock state row ``g``, targets row ``i``, standing if ``st``
-    (``toe [L,3]`` and the ``[L]`` arrays after ``contacts`` are scratch)."""
+    """:func:`lock_group` for one puppet: lock state row ``g``, targets row ``i``, contact votes row ``cg``,
+    standing if ``st`` (``toe [L,3]`` and the ``[L]`` arrays after ``contacts`` are scratch)."""
     release_time, max_stretch, release_height, settle_gap = settings[0], settings[1], settings[2], settings[3]
     max_twist, settle_twist, step_time, step_height = settings[4], settings[5], settings[6], settings[7]
     legs = targets.shape[1]
@@ -384,7 +378,7 @@ def _lock_puppet(
         w = weights[g, k]
         stepping[g, k] = stepping[g, k] and w > 0.0 and st
         any_stepping = any_stepping or stepping[g, k]
-        down = contacts[g, k] > 0.5
+        down = contacts[cg, k] > 0.5
         start[k] = down and not planted[g, k] and not stepping[g, k]
         if start[k]:
             sw = _smooth(w)
@@ -405,7 +399,7 @@ def _lock_puppet(
         stretched = (gap[k] > max_stretch or twist[k] > max_twist) and not start[k] and not st
         if misplaced[k] and gap[k] >= far and not any_stepping:
             stepping[g, k] = True
-        down = contacts[g, k] > 0.5
+        down = contacts[cg, k] > 0.5
         holding = down or (planted[g, k] and toe[k, 1] - floor[i, k, 1] < release_height)
         planted[g, k] = holding and not stretched and held and not stepping[g, k]
         w = weights[g, k]
@@ -457,7 +451,7 @@ def lock_group(
     start, still, misplaced = np.empty(legs, np.bool_), np.empty(legs, np.bool_), np.empty(legs, np.bool_)
     for g in range(idx.shape[0]):
         _lock_puppet(
-            g, idx[g], settle[g], targets, new_rot, floor, tips, dt, settings, points, weights, planted, stepping,
+            g, idx[g], g, settle[g], targets, new_rot, floor, tips, dt, settings, points, weights, planted, stepping,
             yaw, animated, contacts, toe, twist, gap, start, still, misplaced,
         )  # fmt: skip
 
@@ -465,6 +459,7 @@ def lock_group(
 @njit
 def ground_crowd(
     parents: I,
+    rows: I,
     roots: F,
     rots: F,
     offs: F,
@@ -485,23 +480,27 @@ def ground_crowd(
     max_pelvis_shift: float,
     dt: float,
     settings: F,
+    lock_rows: I,
     points: F,
     weights: F,
     planted: NDArray[np.bool_],
     stepping: NDArray[np.bool_],
     yaw: F,
     animated: F,
+    contact_rows: I,
     contacts: F,
     settle: NDArray[np.bool_],
     shift: F,
+    kept: NDArray[np.bool_],
 ) -> bool:
     """After :func:`legs_fk` and the ground query, the rest of a crowd's grounding in one pass:
-    per puppet :func:`legs_targets`, :func:`lock_group` (every puppet locked, one ``settings``,
-    lock state row ``p``) and :func:`legs_solve`, on ``roots``/``rots`` in place; a puppet whose
-    result is not finite keeps its given pose (its ``shift`` and lock state still advance, as on
-    the path in pieces). Returns ``False``, changing nothing, if the ground's ``height``/``normal``
-    are not all finite."""
-    count, n, nl = rots.shape[0], rots.shape[1], legs.shape[0]
+    per puppet ``p`` :func:`legs_targets`, :func:`lock_group` (every puppet locked, one ``settings``)
+    and :func:`legs_solve`, in place on its pose, row ``rows[p]`` of ``roots``/``rots``, and its lock
+    state, row ``lock_rows[p]`` of the lock arrays (its votes: row ``contact_rows[p]`` of ``contacts``).
+    A puppet whose result is not finite keeps its given pose and is marked in ``kept [P]`` (its
+    ``shift`` and lock state still advance, as on the path in pieces). Returns ``False``, changing
+    nothing, if the ground's ``height``/``normal`` are not all finite."""
+    count, n, nl = rows.shape[0], rots.shape[1], legs.shape[0]
     for p in range(count):
         for k in range(nl):
             if not math.isfinite(height[p, k]):
@@ -516,28 +515,30 @@ def ground_crowd(
     start, still, misplaced = np.empty(nl, np.bool_), np.empty(nl, np.bool_), np.empty(nl, np.bool_)
     given_root, given_rot = np.empty(3), np.empty((n, 4))
     for p in range(count):
+        r = rows[p]
         for k in range(nl):
             _target_leg(
                 sole, qfeet, height, normal, weight[p], soles, tips, heels, align_height, contact_height,
                 targets, new_rot, floor, p, k,
             )  # fmt: skip
         _lock_puppet(
-            p, p, settle[p], targets, new_rot, floor, tips, dt, settings, points, weights, planted, stepping,
-            yaw, animated, contacts, toe, twist, gap, start, still, misplaced,
+            lock_rows[p], p, contact_rows[p], settle[p], targets, new_rot, floor, tips, dt, settings, points, weights,
+            planted, stepping, yaw, animated, contacts, toe, twist, gap, start, still, misplaced,
         )  # fmt: skip
-        given_root[:] = roots[p]
-        given_rot[:, :] = rots[p]
+        given_root[:] = roots[r]
+        given_rot[:, :] = rots[r]
         _solve_puppet(
             parents, roots, rots, offs, legs, knees, targets, new_rot, ankles, hips, max_pelvis_shift, shift,
-            p, pos, wrot, chain,
+            p, r, pos, wrot, chain,
         )  # fmt: skip
         finite = True
         for c in range(3):
-            finite = finite and math.isfinite(roots[p, c])
+            finite = finite and math.isfinite(roots[r, c])
         for j in range(n):
             for c in range(4):
-                finite = finite and math.isfinite(rots[p, j, c])
+                finite = finite and math.isfinite(rots[r, j, c])
+        kept[p] = not finite
         if not finite:
-            roots[p] = given_root
-            rots[p] = given_rot
+            roots[r] = given_root
+            rots[r] = given_rot
     return True

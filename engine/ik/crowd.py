@@ -6,28 +6,32 @@ requests, stacking offsets, fitting and grouping the foot locks, reading their s
 the components, writing the pelvis shifts back. That cost several times the kernels. Here
 a :class:`CrowdPlan` is made once per membership: the puppets that only ask to have their
 feet planted (no effectors, no hands), share one skeleton and have live foot locks of one
-tuning. Each step it checks, with a handful of C-level passes over the members
-(``map``/``all``, no Python frame per puppet), that nothing about them changed, then runs
-:func:`~engine.ik._ground_kernel.legs_fk`, the ground query, and
-:func:`~engine.ik._ground_kernel.ground_crowd` on the columns themselves
-(:meth:`engine.columns.Column.linked`): the local poses and the foot locks' state are
-updated in place.
+tuning — from one puppet up. Each step it checks, with a handful of C-level passes over the
+members (``map``/``all``, no Python frame per puppet), that nothing about them changed, then
+runs :func:`~engine.ik._ground_kernel.legs_fk`, the ground query, and
+:func:`~engine.ik._ground_kernel.ground_crowd` on the columns themselves, at the members'
+rows (:meth:`engine.columns.Column.rows`: the crowd may be part of the animation's batch, with
+one puppet in the air or ten fallen): the local poses and the foot locks' state are updated
+in place.
 
 The arithmetic is the compiled path's of :func:`~engine.ik.grounding.ground_feet_batch`
-operation for operation (the same kernel helpers), so states hash the same. Whatever the
-plan cannot vouch for (a lock replaced, one puppet jumping, a field assigned by other
-code, numba off) is left to the general path of :func:`engine.ik.system.ik_system`.
+operation for operation (the same kernel helpers), which is also the one-puppet float path
+of :func:`~engine.ik.grounding.ground_feet`, so states hash the same whichever path a puppet
+took before. Whatever the plan cannot vouch for (a member with hands on a sphere, a lock not
+yet fitted, numba off) is left to the general path of :func:`engine.ik.system.ik_system`,
+puppet by puppet: the rest of the crowd stays on the pass.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections import deque
 from dataclasses import dataclass
 from itertools import repeat
 from operator import attrgetter, is_
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from engine import jit
 from engine.arrays import F64 as F
@@ -51,15 +55,13 @@ from engine.skeleton import Skeleton
 __all__ = ["CrowdPlan", "current_plan", "ground_crowd", "plan_crowd"]
 
 _GROUNDING = attrgetter("grounding")
-_EFFECTORS = attrgetter("effectors")
-_SPHERE = attrgetter("sphere_centre")
 _WEIGHT = attrgetter("grounding_weight")
-_LOCK = attrgetter("foot_lock")
-_SKELETON = attrgetter("skeleton")
-_OFFSETS = attrgetter("offsets")
-_ENABLED = attrgetter("enabled")
 _SETTLE = attrgetter("settle")
-_SETTINGS = attrgetter(
+#: What a member's request, puppet and lock must keep for the plan to hold (compared as tuples, in C).
+_REQUEST = attrgetter("effectors", "sphere_centre", "foot_lock")
+_PUPPET = attrgetter("skeleton", "offsets")
+_TUNING = attrgetter(
+    "enabled",
     "release_time",
     "max_stretch",
     "release_height",
@@ -83,9 +85,19 @@ def _plain(req: Any, settings: tuple[float, ...]) -> bool:
     )
 
 
-def _same_objects(a: Sequence[Any], b: Sequence[Any]) -> bool:
-    """``a[i] is b[i]`` for every ``i`` (equal lengths), in C."""
-    return len(a) == len(b) and all(map(is_, a, b))
+def _own_tuning(req: Any) -> tuple[float, ...] | None:
+    """The tuning of ``req``'s lock if the request is plain with it (:func:`_plain`), else ``None``."""
+    lock = req.foot_lock
+    return lock.settings() if lock is not None and _plain(req, lock.settings()) else None
+
+
+def _unchanged(now: list[Any], then: list[Any]) -> bool:
+    """``now == then`` for lists of field tuples, where a field that is not the same object may be an
+    array (whose ``==`` cannot say): every field is the same object or an equal plain value."""
+    try:
+        return now == then
+    except ValueError:  # an array compared with something else: it was replaced
+        return False
 
 
 @dataclass
@@ -98,51 +110,63 @@ class CrowdPlan:
         all_requests, grounding: every row's request and its ``grounding`` flag then (a puppet
             that jumps changes the plan).
         rows: the members' positions in ``table`` (none: no crowd, everyone takes the general path).
-        skeleton, puppets: their shared skeleton and their ``Puppet`` components; ``skeletons``/``offset_fields`` each member's own
-            ``Puppet.skeleton``/``Puppet.offsets`` objects, and ``offsets`` their stack ``[P, J, 3]``.
+        outsiders: the requests of the rest of the members' group (alike puppets that only ask
+            to be grounded, but not plain: hands on a sphere, no contact votes); one that becomes
+            plain changes the plan.
+        skeleton, puppets: their shared skeleton and their ``Puppet`` components; ``puppet_fields``
+            each member's ``(skeleton, offsets)`` objects, and ``offsets`` their stack ``[P, J, 3]``.
         locals_, requests, locks: the members' components, in row order (tuples: the columns
-            know an unchanged tuple of owners without comparing ids).
-        settings, settings_array: the locks' tuning (:meth:`FootLock.settings`), one for all.
+            remember their rows by the tuple); ``request_fields`` each request's
+            ``(effectors, sphere_centre, foot_lock)``.
+        settings, tuning, settings_array: the locks' tuning (:meth:`FootLock.settings`), one for all;
+            ``tuning`` with ``enabled`` first, as each lock must still read.
+        checked: the row arrays of the members' columns last found to agree (:func:`ground_crowd`).
     """
 
     table: list[tuple[Any, ...]]
     all_requests: list[Any]
     grounding: list[bool]
     rows: list[int]
+    outsiders: list[Any]
     skeleton: Skeleton | None
     puppets: list[Puppet]
-    skeletons: list[Skeleton]
-    offset_fields: list[Any]
+    puppet_fields: list[tuple[Any, ...]]
     offsets: F
     locals_: tuple[LocalPose, ...]
     requests: list[Any]
+    request_fields: list[tuple[Any, ...]]
     locks: tuple[FootLock, ...]
     settings: tuple[float, ...]
+    tuning: tuple[Any, ...]
     settings_array: F
     legs: I64
     soles: F
     tips: F
     heels: F
     knees: F
+    checked: tuple[I64, ...] = ()
 
 
-def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, batch_from: int) -> CrowdPlan:
+def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
     """The crowd of ``table`` (rows ``(entity, Puppet, LocalPose, IKRequest)``).
 
-    It is the largest of the groups that :func:`engine.ik.system.ik_system` grounds as one
-    batch (rows that ask for grounding and no effectors, of one skeleton — ``same_as`` maps a
-    skeleton to its canonical equal — at least ``batch_from`` of them), taken whole or not at
-    all, and only if every member is plain: no hands on a sphere, a live foot lock, one lock
-    tuning. Otherwise the plan has no members and only remembers that there is no crowd."""
+    It is the plain members of the largest of the groups that :func:`engine.ik.system.ik_system`
+    would ground alike (rows that ask for grounding and no effectors, of one skeleton — ``same_as``
+    maps a skeleton to its canonical equal): no hands on a sphere, a live foot lock, the first plain
+    member's lock tuning; at least ``crowd_from`` of them. Otherwise the plan has no members and
+    only remembers that there is no crowd."""
     requests = [row[3] for row in table]
     groups: dict[int, list[int]] = {}
     for i, (_, puppet, _, req) in enumerate(table):
         if req.grounding and not req.effectors:
             groups.setdefault(id(same_as(puppet.skeleton)), []).append(i)
-    rows = max(groups.values(), key=len) if groups else []
-    settings = table[rows[0]][3].foot_lock.settings() if rows else ()
-    if len(rows) < batch_from or not all(_plain(table[i][3], settings) for i in rows):
-        rows = []
+    group = max(groups.values(), key=len) if groups else []
+    settings = next((t for i in group if (t := _own_tuning(table[i][3])) is not None), ())
+    rows = [i for i in group if _plain(table[i][3], settings)]
+    members_set = set(rows)
+    outsiders = [table[i][3] for i in group if i not in members_set]
+    if len(rows) < crowd_from:
+        rows, outsiders = [], []
     puppets: list[Puppet] = [table[i][1] for i in rows]
     members = [table[i][3] for i in rows]
     locks = tuple(req.foot_lock for req in members)
@@ -157,15 +181,17 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, batch_from: int) -> C
         all_requests=requests,
         grounding=list(map(_GROUNDING, requests)),
         rows=rows,
+        outsiders=outsiders,
         skeleton=sk,
         puppets=puppets,
-        skeletons=list(map(_SKELETON, puppets)),
-        offset_fields=list(map(_OFFSETS, puppets)),
+        puppet_fields=list(map(_PUPPET, puppets)),
         offsets=np.array([p.joint_offsets() for p in puppets], dtype=np.float64),
         locals_=tuple(table[i][2] for i in rows),
         requests=members,
+        request_fields=list(map(_REQUEST, members)),
         locks=locks,
         settings=settings,
+        tuning=(True, *settings),
         settings_array=np.array(settings, dtype=np.float64),
         legs=idx,
         soles=np.array([leg.sole for leg in legs], dtype=np.float64),
@@ -176,53 +202,77 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, batch_from: int) -> C
 
 
 def _holds(plan: CrowdPlan, table: list[tuple[Any, ...]]) -> bool:
-    """Whether ``plan`` still describes ``table``'s crowd this step (C-level passes over the rows).
+    """Whether ``plan`` still describes ``table``'s crowd this step (C-level passes over the members;
+    Python only for the outsiders, the few unusual puppets of the group).
 
-    A puppet outside the crowd that becomes fit to join it without its ``grounding`` flag
+    A puppet outside the group that becomes fit to join it without its ``grounding`` flag
     changing (its effectors cleared, say) is noticed at the next change of membership; until
     then it is served, correctly, by the general path."""
     if table is not plan.table or list(map(_GROUNDING, plan.all_requests)) != plan.grounding:
         return False
     if not plan.rows:
         return True
-    reqs, locks = plan.requests, plan.locks
     return (
-        not any(map(_EFFECTORS, reqs))
-        and all(map(is_, map(_SPHERE, reqs), repeat(None)))
-        and _same_objects(list(map(_LOCK, reqs)), locks)
-        and all(map(_ENABLED, locks))
-        and _same_objects(list(map(_SKELETON, plan.puppets)), plan.skeletons)
-        and _same_objects(list(map(_OFFSETS, plan.puppets)), plan.offset_fields)
-        and list(map(_SETTINGS, locks)).count(plan.settings) == len(locks)
+        _unchanged(list(map(_REQUEST, plan.requests)), plan.request_fields)
+        and _unchanged(list(map(_PUPPET, plan.puppets)), plan.puppet_fields)
+        and list(map(_TUNING, plan.locks)).count(plan.tuning) == len(plan.locks)
+        and not any(_plain(req, plan.settings) for req in plan.outsiders)
     )
 
 
-def current_plan(plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, batch_from: int) -> CrowdPlan:
+def current_plan(plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
     """``plan`` if it still holds for ``table``, else a new one (:func:`plan_crowd`)."""
     if plan is not None and _holds(plan, table):
         return plan
-    return plan_crowd(table, same_as, batch_from)
+    return plan_crowd(table, same_as, crowd_from)
 
 
-def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float) -> bool:
+def _place(cols: Columns, ctype: type, name: str, key: int, owners: tuple[Any, ...], shape: tuple[int, ...],
+           dtype: type = np.float64) -> tuple[NDArray[Any], I64] | None:  # fmt: skip
+    """The column of field ``name`` of ``owners`` and their rows in it (:meth:`~engine.columns.Column.rows`),
+    the column made theirs first if one of them is not in it; ``None`` unless every field has ``shape``."""
+    column = cols.get(ctype, name, key, dtype)
+    found = column.rows(owners)
+    if found is None:
+        try:
+            column.read(owners)
+        except ValueError:  # ragged fields: some lock not fitted yet
+            return None
+        found = column.rows(owners)
+    if found is None or found[0].shape[1:] != shape or not found[0].flags.c_contiguous:
+        return None
+    return found
+
+
+def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float) -> NDArray[np.bool_] | None:
     """Plant the feet of ``plan``'s crowd (a plan that holds this step: :func:`current_plan`) in place,
-    if numba runs and every member's pose and lock state are in their columns
-    (:meth:`~engine.columns.Column.linked`); ``False`` (nothing done) otherwise. Writes each
-    member's ``pelvis_shift``."""
+    if numba runs and every member's pose and lock state can be in their columns (fields replaced
+    by other code are taken in, as a column read does); ``None`` (nothing done) otherwise. Writes
+    each member's ``pelvis_shift``; returns which members kept their given pose (a result that was
+    not finite)."""
     sk, reqs, locks = plan.skeleton, plan.requests, plan.locks
     if sk is None or not jit.enabled():
-        return False
+        return None
     joints, legs = sk.num_joints, len(plan.legs)
-    roots = cols.get(LocalPose, "root", joints).linked(plan.locals_)
-    rots = cols.get(LocalPose, "rotations", joints).linked(plan.locals_)
-    contacts = cols.get(FootLock, "contacts", legs).linked(locks)
-    points, weights, planted, stepping, yaw, animated = (
-        cols.get(FootLock, name, legs, _LOCK_TYPES.get(name, np.float64)).linked(locks) for name in _LOCK_STATE
-    )
+    roots = _place(cols, LocalPose, "root", joints, plan.locals_, (3,))
+    rots = _place(cols, LocalPose, "rotations", joints, plan.locals_, (joints, 4))
+    contacts = _place(cols, FootLock, "contacts", legs, locks, (legs,))
     if roots is None or rots is None or contacts is None:
-        return False
-    if points is None or weights is None or planted is None or stepping is None or yaw is None or animated is None:
-        return False
+        return None
+    state: list[tuple[NDArray[Any], I64]] = []
+    for name in _LOCK_STATE:
+        found = _place(cols, FootLock, name, legs, locks, (legs, 3) if name in ("points", "animated") else (legs,),
+                       _LOCK_TYPES.get(name, np.float64))  # fmt: skip
+        if found is None:
+            return None
+        state.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in state))
+    if not (len(index) == len(plan.checked) and all(map(is_, index, plan.checked))):
+        # The poses' two columns, and the locks' six, must hold the members at the same rows; the row
+        # arrays stay the same objects while the columns keep their rows, so this is checked once.
+        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
+            return None
+        plan.checked = index
     count = len(reqs)
     weight = np.fromiter(map(_WEIGHT, reqs), dtype=np.float64, count=count)
     if np.any((weight < 0.0) | (weight > 1.0)):
@@ -230,7 +280,8 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
     settle = np.fromiter(map(_SETTLE, locks), dtype=np.bool_, count=count)
     ankles, hips, sole, qfeet = (np.empty((count, legs, 3)), np.empty((count, legs, 3)),
                                  np.empty((count, legs, 3)), np.empty((count, legs, 4)))  # fmt: skip
-    _kernel.legs_fk(sk.parents, roots, rots, plan.offsets, plan.legs, plan.soles, ankles, qfeet, hips, sole)
+    rows = roots[1]
+    _kernel.legs_fk(sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, ankles, qfeet, hips, sole)
     if type(ground) is PlaneGround:  # the same heights as its call, without a dozen numpy calls
         height, normal = np.empty((count, legs)), np.empty((count, legs, 3))
         _kernel.plane_query(sole, *ground.frame, height, normal)
@@ -238,15 +289,15 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
         height, normal = ground(sole[..., 0], sole[..., 2])
         height = np.ascontiguousarray(np.broadcast_to(np.asarray(height, dtype=np.float64), (count, legs)))
         normal = np.ascontiguousarray(np.broadcast_to(np.asarray(normal, dtype=np.float64), (count, legs, 3)))
-    shift = np.empty(count)
+    shift, kept = np.empty(count), np.empty(count, dtype=np.bool_)
+    points, weights, planted, stepping, yaw, animated = (found[0] for found in state)
     finite = _kernel.ground_crowd(
-        sk.parents, roots, rots, plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
+        sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
         sole, qfeet, ankles, hips, height, normal, weight,
         ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT, dt, plan.settings_array,
-        points, weights, planted, stepping, yaw, animated, contacts, settle, shift,
+        state[0][1], points, weights, planted, stepping, yaw, animated, contacts[1], contacts[0], settle, shift, kept,
     )  # fmt: skip
     if not finite:
         raise ValueError("ground query returned non-finite values")
-    for req, value in zip(reqs, shift.tolist(), strict=True):
-        req.pelvis_shift = value
-    return True
+    deque(map(setattr, reqs, repeat("pelvis_shift"), shift.tolist()), maxlen=0)
+    return kept

@@ -530,7 +530,7 @@ def _ground_compiled(
     heels = np.array([leg.heel for leg in legs], dtype=np.float64).reshape(n, 3)
     knees = np.array([leg.knee_forward for leg in legs], dtype=np.float64).reshape(n, 3)
     ankles, hips, sole, qfeet = np.empty((p, n, 3)), np.empty((p, n, 3)), np.empty((p, n, 3)), np.empty((p, n, 4))
-    _kernel.legs_fk(skeleton.parents, roots, rotations, offs, leg_idx, soles, ankles, qfeet, hips, sole)
+    _kernel.legs_fk(skeleton.parents, np.arange(p), roots, rotations, offs, leg_idx, soles, ankles, qfeet, hips, sole)
     height, normal = ground(sole[..., 0], sole[..., 2])
     height = np.ascontiguousarray(np.broadcast_to(np.asarray(height, dtype=np.float64), (p, n)))
     normal = np.ascontiguousarray(np.broadcast_to(np.asarray(normal, dtype=np.float64), (p, n, 3)))

@@ -6,10 +6,12 @@ stage, after blending and before physics, and edits the puppet's
 :class:`~engine.components.LocalPose` in place. Order within a puppet: the
 optimisation IK's arbitrary targets first, then foot grounding (it moves the
 pelvis), then the hands (they follow the shoulders wherever the pelvis went).
-Groups of :data:`BATCH` or more alike puppets that only need their feet planted (a
-crowd) are grounded together as arrays (:func:`~engine.ik.grounding.ground_feet_batch`);
-the largest such group, in its usual state, by the crowd pass (:mod:`engine.ik.crowd`),
-with no Python per puppet.
+The largest group of alike puppets that only need their feet planted is served by the
+crowd pass (:mod:`engine.ik.crowd`) with no Python per puppet, from a single puppet up: its
+compiled kernel is the per-puppet float path operation for operation, so even one puppet
+(the snowman game's) gains without changing a bit. What the pass cannot serve goes to the
+general path: groups of :data:`BATCH` or more alike puppets are grounded together as arrays
+(:func:`~engine.ik.grounding.ground_feet_batch`), smaller ones one puppet at a time.
 """
 
 from __future__ import annotations
@@ -81,6 +83,7 @@ class IKRigCache:
     rigs: dict[int, IKRig] = field(default_factory=dict)
     canonical: dict[int, Skeleton] = field(default_factory=dict)
     batch_from: int = BATCH  # alike puppets from which grounding is batched (benches raise it to compare)
+    crowd_from: int = 1  # alike plain puppets from which the crowd pass serves them (benches raise it to compare)
     crowd: CrowdPlan | None = None  # who the crowd pass serves (engine.ik.crowd), remade when that changes
 
     def rig(self, skeleton: Skeleton) -> IKRig:
@@ -171,9 +174,13 @@ def ik_system(world: World) -> None:
         cache = IKRigCache()
         world.insert_resource(cache)
     table = world.query(Puppet, LocalPose, IKRequest)
-    cache.crowd = plan = current_plan(cache.crowd, table, cache.same_as, cache.batch_from)
+    cache.crowd = plan = current_plan(cache.crowd, table, cache.same_as, cache.crowd_from)
     query = ground.query if ground is not None else PlaneGround()
-    if ground_crowd(plan, columns(world), query, world.dt):
+    kept = ground_crowd(plan, columns(world), query, world.dt)
+    if kept is not None:
+        if kept.any() and len(plan.rows) + len(plan.outsiders) < cache.batch_from:  # as the one-puppet path does
+            for i in np.flatnonzero(kept).tolist():
+                plan.requests[i].reached = False
         if len(plan.rows) == len(table):
             return
         crowd = set(plan.rows)

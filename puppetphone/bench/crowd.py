@@ -8,7 +8,7 @@ wall time would measure the neighbours), the median over :data:`STEPS` steps aft
 second of warm-up, against the 60 Hz frame budget. ``crowd_step_ms_100_old`` is the
 same crowd on the path from before animated puppets left the dynamics
 (:attr:`PhysicsWorld.simulate_animated`) and before crowds were grounded in one batch
-(:attr:`IKRigCache.batch_from`), measured in the same run so the ratio is fair; the other
+(:attr:`IKRigCache.batch_from`, :attr:`IKRigCache.crowd_from`), measured in the same run so the ratio is fair; the other
 batching (animated drive, locomotion write-back) has no switch and is in both.
 ``crowd_system_ms_<stage>_100`` splits the 100-puppet step by schedule stage; the animation,
 ik and fk stages, and the whole step (``crowd_step_ms_100_numpy``), are set against the same
@@ -43,7 +43,8 @@ def crowd_app(puppets: int, *, old: bool = False, seed: int = 1) -> App:
     app = make_app("sandbox", seed, InputHub(), {"puppets": puppets})
     app.world.resource(PhysicsWorld).simulate_animated = old
     if old:
-        app.world.resource(IKRigCache).batch_from = puppets + 1
+        cache = app.world.resource(IKRigCache)
+        cache.batch_from = cache.crowd_from = puppets + 1
     app.run_steps(60)
     return app
 

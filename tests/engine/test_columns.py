@@ -149,3 +149,26 @@ def test_a_tuple_of_owners_seen_whole_is_known_again_without_ids() -> None:
     col.write(others, np.zeros((2, 3)))  # another batch: the column is rebuilt
     assert col.linked(poses) is None
     assert np.array_equal(col.read(poses), np.ones((3, 3)))  # gathered from the fields again
+
+
+def test_rows_are_where_part_of_the_batch_is_and_take_in_a_replaced_field() -> None:
+    """:meth:`Column.rows`: the column itself and the owners' rows, a replaced field copied into its
+    row first; ``None`` for an owner not in the column or a replaced field of another shape, and
+    rows looked up anew after a relink. Broken once by returning the remembered rows without the
+    per-call check (the replaced field was then not taken in: the row kept its old values)."""
+    poses = _poses(5)
+    col = Column("root")
+    col.write(poses, np.arange(15.0).reshape(5, 3))
+    part = (poses[3], poses[1])
+    found = col.rows(part)
+    assert found is not None and found[0] is col.base and found[1].tolist() == [3, 1]
+    poses[1].root = np.full(3, -1.0)  # other code replaced a field: taken in, and the view is back
+    found = col.rows(part)
+    assert found is not None and found[1].tolist() == [3, 1]
+    assert np.array_equal(found[0][1], [-1.0, -1.0, -1.0]) and poses[1].root.base is col.base
+    assert col.rows((poses[0], _Pose(np.zeros(3)))) is None  # one of them is not in the column
+    poses[3].root = np.zeros(4)
+    assert col.rows(part) is None  # a replaced field of another shape
+    col.write([*poses[::-1], _Pose(np.zeros(3))], np.zeros((6, 3)))  # relinked in another order: the rows follow
+    found = col.rows(part)
+    assert found is not None and found[1].tolist() == [1, 3]

@@ -3,7 +3,9 @@
 25 puppets of two hierarchies (humanoids, some with their own bone lengths, and a three-joint
 chain) are stepped through :func:`fk_system` while their local poses change through the
 columns, one puppet's local rotations and another's world positions are replaced by other
-code, a puppet's offsets change and a puppet is spawned mid-run. With the compiled pass and
+code (the pass takes them in), a puppet's offsets change, a puppet is spawned mid-run and the
+local poses' columns are rewritten in another order than the FK groups' (the pass reads them
+at their rows). With the compiled pass and
 with it switched off, world poses and previous poses must be equal bit for bit; against the
 pure-numpy path (numba off) to 1e-12. Broken once by copying the previous pose after the
 kernel instead of before (``prev_*`` then equals this step's pose) and once by keeping the
@@ -60,6 +62,8 @@ def _run(mode: str, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], list[in
             cols = columns(world)
             for skel in (sk, chain):
                 mine = [world.get(e, LocalPose) for e in ents if world.get(e, Puppet).skeleton is skel]
+                if step >= 4:  # the local poses' columns in another order than the FK group's: rows, not the whole
+                    mine = mine[::-1]
                 j = skel.num_joints
                 cols.get(LocalPose, "root", j).write(mine, rng.normal(size=(len(mine), 3)))
                 rots = quat.normalize(quat.identity(len(mine), j) + rng.normal(0, 0.2, (len(mine), j, 4)))
@@ -81,8 +85,9 @@ def test_the_compiled_fk_pass_is_the_general_path_bit_for_bit(monkeypatch: pytes
     general, none = _run("general", monkeypatch)
     numpy_path, _ = _run("numpy", monkeypatch)
     # Two groups a step; none at step 0 (no world poses yet) or when a puppet is spawned (4: it
-    # has none), the humanoids not when a field was replaced (2), both on the other steps.
-    assert none == [] and served == [1, 1, 2, 3, 3, 5, 5, 6, 6, 7, 7]
+    # has none); a replaced field (2) is taken in, and the local poses' rows in reversed order
+    # (relinked so at the spawn, 4, on) are read where they are.
+    assert none == [] and served == [1, 1, 2, 2, 3, 3, 5, 5, 6, 6, 7, 7]
     for a, b, c in zip(compiled, general, numpy_path, strict=True):
         for x, y, z in zip(a, b, c, strict=True):
             np.testing.assert_array_equal(x, y)

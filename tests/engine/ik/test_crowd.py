@@ -31,17 +31,17 @@ N = 24
 STEPS = 14
 
 
-def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], list[int]]:
-    """Step the crowd; ``mode``: ``crowd`` (the pass), ``general`` (pass off), ``numpy`` (numba off).
+def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch, n: int = N) -> tuple[list[Any], list[int]]:
+    """Step ``n`` puppets; ``mode``: ``crowd`` (the pass), ``general`` (pass off), ``numpy`` (numba off).
     Returns each step's state and the steps the crowd pass served."""
     served: list[int] = []
     original = system.ground_crowd
 
-    def counted(*args: Any) -> bool:
-        done = mode == "crowd" and original(*args)
-        if done:
+    def counted(*args: Any) -> Any:
+        kept = original(*args) if mode == "crowd" else None
+        if kept is not None:
             served.append(len(out))
-        return done
+        return kept
 
     monkeypatch.setattr(system, "ground_crowd", counted)
     rng = np.random.default_rng(4)
@@ -49,7 +49,7 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch) -> tuple[list[
     app.world.insert_resource(IKGround(ground))
     sk = humanoid_skeleton()
     ents = []
-    for i in range(N):
+    for i in range(n):
         offsets = sk.offsets * (1.0 + 0.1 * (i % 3)) if i % 4 == 0 else None
         pose = LocalPose(np.array([rng.uniform(-3, 3), 0.95, rng.uniform(-3, 3)]), quat.identity(17))
         ents.append(app.world.spawn(Puppet(sk, offsets), pose, IKRequest(grounding=True)))
@@ -60,24 +60,26 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch) -> tuple[list[
     with jit.use(mode != "numpy"):
         for step in range(STEPS):
             cols = columns(world)
-            roots = np.array([p.root for p in poses]) + rng.normal(0, 0.01, (N, 3))
-            rots = quat.normalize(quat.identity(N, 17) + rng.normal(0, 0.08, (N, 17, 4)))
+            roots = np.array([p.root for p in poses]) + rng.normal(0, 0.01, (n, 3))
+            rots = quat.normalize(quat.identity(n, 17) + rng.normal(0, 0.08, (n, 17, 4)))
             cols.get(LocalPose, "root", 17).write(poses, roots)
             cols.get(LocalPose, "rotations", 17).write(poses, rots)
-            contacts = rng.uniform(0, 1, (N, 2))
+            contacts = rng.uniform(0, 1, (n, 2))
             locks = [r.foot_lock for r in reqs]
-            for lock, settle in zip(locks, rng.uniform(0, 1, N) < 0.3, strict=True):
+            for lock, settle in zip(locks, rng.uniform(0, 1, n) < 0.3, strict=True):
                 lock.settle = bool(settle)
             cols.get(FootLock, "contacts", 2).write(locks, contacts)
-            if step == 3:
+            if n < 10:  # one puppet (the snowman game's): no events
+                pass
+            elif step == 3:
                 reqs[5].grounding = False  # a jump: the crowd goes on without it
-            if step == 6:
+            elif step == 6:
                 reqs[5].grounding = True
-            if step == 8:
+            elif step == 8:
                 reqs[7].foot_lock.yaw = np.array([0.3, -0.2])  # other code replaced a lock field
-            if step == 10:
+            elif step == 10:
                 reqs[9].sphere_centre, reqs[9].sphere_radius = np.array([0.0, 0.85, 0.45]), 0.2
-            if step == 11:
+            elif step == 11:
                 reqs[9].sphere_centre = None
                 reqs[2].foot_lock.contacts = None
             app.step()
@@ -113,7 +115,7 @@ def test_the_crowd_pass_is_the_general_path_bit_for_bit(ground: Any, monkeypatch
     # one puppet is in the air (3-5: the crowd is not the animation's whole batch), when the
     # jumper rejoins with its reset lock (6), a lock field was replaced (8), a member has hands
     # on a sphere (10) or no contact votes (11 on). The step after each, it serves again.
-    assert none == [] and served == [1, 2, 7, 9]
+    assert none == [] and served == list(range(1, STEPS))
     for a, b, c in zip(crowd, general, numpy_path, strict=True):
         for x, y in zip(a[:-1], b[:-1], strict=True):
             np.testing.assert_array_equal(x, y)
@@ -121,3 +123,23 @@ def test_the_crowd_pass_is_the_general_path_bit_for_bit(ground: Any, monkeypatch
         for x, z in zip(a[:-2], c[:-2], strict=True):
             np.testing.assert_allclose(x, z, atol=1e-9)
         np.testing.assert_array_equal(a[-2], c[-2])
+
+
+@pytest.mark.skipif(not jit.AVAILABLE, reason="numba not installed: there is no crowd pass")
+@pytest.mark.parametrize("n", [1, 12])
+def test_a_small_crowd_is_served_as_the_one_puppet_path_did_bit_for_bit(
+    n: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Fewer than :data:`~engine.ik.system.BATCH` puppets (one: the snowman game's) took the one-puppet
+    float path (:func:`~engine.ik.grounding.ground_feet`) and now the crowd pass: every pose, lock state,
+    pelvis shift and state hash is the same bit for bit, through the same jump, replaced lock field,
+    sphere and lost contacts (12 puppets). Broken once by skipping ``_lock_puppet`` in the kernel."""
+    assert n < system.BATCH
+    ground = PlaneGround(normal=(0.1, 1.0, -0.2))
+    crowd, served = _run("crowd", ground, monkeypatch, n)
+    one_by_one, none = _run("general", ground, monkeypatch, n)
+    assert none == [] and served == list(range(1, STEPS))
+    for a, b in zip(crowd, one_by_one, strict=True):
+        for x, y in zip(a[:-1], b[:-1], strict=True):
+            np.testing.assert_array_equal(x, y)
+        assert a[-1] == b[-1]
