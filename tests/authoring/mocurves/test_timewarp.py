@@ -96,6 +96,21 @@ def test_drag_across_the_seam_is_unwrapped():
     assert np.all(np.diff(t) >= 0)
 
 
+def test_a_drag_on_the_first_keypoint_holds_its_copy_at_the_seam_as_strongly():
+    """Keypoint 0 dragged with another: the warp is the optimum of the energy with ``E_C`` on both keypoint 0
+    and its copy ``N`` one period later, to rounding (no inequality is active, so the QP's optimum is the least
+    squares one). Without the copy's own constraint only ``E_T`` ties ``N`` to keypoint 0 and the soft terms
+    move it by about 9·10⁻⁷ s: the second round's "near-equivalent" survivor ``constrained[n] = False``, shown
+    to fail this test by hand (it passed every other time-warp test).
+    """
+    n, period = 48, 1.0
+    drags = {0: 0.06, 14: 14 / n - 0.03}
+    t = TimeWarp(n, period).solve(drags)
+    ref = reference_solution(n, period, drags)
+    assert np.all(np.diff(ref) > 0)
+    np.testing.assert_allclose(t, ref, rtol=0, atol=1e-9)  # the mutant is 9e-7 off
+
+
 def test_warm_started_drags_match_cold_solves():
     n = 120
     warm = TimeWarp(n, 2.0)

@@ -66,6 +66,46 @@ def test_a_glitch_on_the_first_frame_is_a_seam_jump_too() -> None:
         check_role(_jolted(default_clips()["walk"], "l_hand", 0, 4.0), "walk", SK)
 
 
+def test_of_two_joints_jumping_at_the_seam_the_one_furthest_past_its_allowance_is_named() -> None:
+    """The still hand jumps 2.6° (0.6° past its 2° floor), the knee 0.3° past three of its usual steps: the
+    hand is named. Kills the second round's "near-equivalent" survivor, ``_seam_jump``'s floor made 3°
+    (``np.maximum(_SEAM_FACTOR * usual, 3.0)``): the hand is then 0.4° *inside* it and the knee is named —
+    the clip is refused either way, only the joint in the message changes. Applied by hand to
+    ``engine/cliplib/roles.py``.
+    """
+    walk = default_clips()["walk"]
+    knee, hand = SK.index("l_lower_leg"), SK.index("l_hand")
+    rot = np.array(walk.rotations)
+    rot[-1, hand] = quat.mul(rot[-1, hand], quat.from_axis_angle(_X, np.radians(2.6)))
+    jump = 3.0 * float(np.percentile(_steps(rot)[:, knee], 95.0)) + 0.3
+    for _ in range(5):  # the last frame's knee is one of its steps too: settle the usual step it sees
+        rot[-1, knee] = quat.mul(rot[0, knee], quat.from_axis_angle(_X, np.radians(jump)))
+        jump = 3.0 * float(np.percentile(_steps(rot)[:, knee], 95.0)) + 0.3
+    usual = float(np.percentile(_steps(rot)[:, knee], 95.0))
+    seam = float(np.degrees(2.0 * np.arccos(min(1.0, abs(float(rot[0, knee] @ rot[-1, knee]))))))
+    assert 0.2 < seam - 3.0 * usual < 0.4 and 3.0 * usual > 3.0  # past its allowance, which is not the floor
+    with pytest.raises(RoleError, match=r"'two' does not loop: its last frame jumps 3° at l_hand "):
+        check_role(replace(walk, rotations=rot, name="two"), "walk", SK)
+
+
+def test_a_few_jumps_inside_the_clip_do_not_excuse_the_seam() -> None:
+    """The hand, still in the walk, given four jumps among its 65 steps (10° in and out of frame 10, 13.5°
+    at frame 40 where it stays turned, 13.5° more on the last frame): its seam jumps 27°. The usual step is
+    the 95th percentile of the steps, 0.8 of the way from the still ones to the smallest jump: 8°, so the
+    allowance is 24° and the seam is refused. Kills the second round's survivor ``np.percentile(step, 96.0)``
+    (the usual step is then 10° and 27° passes), applied by hand to ``engine/cliplib/roles.py``.
+    """
+    walk = default_clips()["walk"]
+    hand = SK.index("l_hand")
+    rot = np.array(walk.rotations)
+    rot[10, hand] = quat.mul(rot[10, hand], quat.from_axis_angle(_X, np.radians(10.0)))
+    rot[40:, hand] = quat.mul(rot[40:, hand], quat.from_axis_angle(_X, np.radians(13.5)))
+    rot[-1, hand] = quat.mul(rot[-1, hand], quat.from_axis_angle(_X, np.radians(13.5)))
+    assert walk.num_frames == 66 and np.count_nonzero(_steps(rot)[:, hand] > 1.0) == 4
+    with pytest.raises(RoleError, match=r"last frame jumps 27° at l_hand .* steps inside are up to 8\.0°"):
+        check_role(replace(walk, rotations=rot, name="glitchy"), "walk", SK)
+
+
 @pytest.mark.parametrize(("factor", "refused"), [(2.5, False), (3.5, True)])
 def test_a_moving_joint_may_jump_three_of_its_usual_steps(factor: float, refused: bool) -> None:
     """The knee's usual step (95th percentile between frames) is about 6.4°: the seam may jump up to 3×."""
@@ -270,3 +310,45 @@ def test_a_loop_a_little_off_sixty_frames_a_second_is_resampled() -> None:
     )
     assert 60.5 < raw.fps < 61.0
     assert conform(raw, "walk").fps == 60.0
+
+
+def _skating(faster: float) -> Clip:
+    """The built-in walk (1.3 m/s) with its root motion sped up: its stance feet skate at ``(faster − 1)·1.3`` m/s."""
+    walk = default_clips()["walk"]
+    rm = walk.root_motion
+    assert rm is not None
+    return replace(walk, root_motion=RootMotion(rm.translation * faster, rm.heading), name="skating")
+
+
+@pytest.mark.parametrize(("faster", "planted"), [(1.3, True), (1.6, False)])
+def test_a_foot_skating_faster_than_0_6_m_s_does_not_plant(faster: float, planted: bool) -> None:
+    """The built-in walk (1.3 m/s) with its root motion sped up: its stance feet skate at ``(faster − 1)·1.3``
+    m/s. Skating at 0.39 m/s is still a walk; at 0.78 m/s neither foot plants (both speeds are in the walk's
+    0.5–2.2 m/s range, so only the contact check decides). Kills the second round's survivors of
+    ``check_role``'s contact speed: ``max_speed=0.6`` dropped (the 0.3 m/s default refuses the first) or made
+    1.6 (accepts the second) — both applied by hand to ``engine/cliplib/roles.py``, each fails one case.
+    """
+    skating = _skating(faster)
+    assert 0.5 <= skating.average_speed() <= 2.2
+    if planted:
+        check_role(skating, "walk", SK)
+    else:
+        with pytest.raises(RoleError, match="plants both feet in turn; in 'skating' the left foot never touches"):
+            check_role(skating, "walk", SK)
+
+
+@pytest.mark.parametrize(("faster", "lands"), [(1.3, True), (1.6, False)])
+def test_a_heel_strike_is_a_landing_slower_than_0_6_m_s(faster: float, lands: bool) -> None:
+    """The heel-strike markers use the role check's contact speed: feet skating at 0.39 m/s still land (two
+    markers in the cycle), at 0.78 m/s they never do. Kills the second round's survivors of ``_heel_strikes``'
+    ``max_speed=0.6`` dropped (the 0.3 m/s default: no landing at 0.39) or made 1.6 (a landing at 0.78) —
+    both applied by hand to ``engine/cliplib/roles.py``, each fails one case.
+    """
+    skating = _skating(faster)
+    if lands:
+        marks = roles._heel_strikes(skating)
+        assert set(marks) == {"left_down", "right_down"}
+        assert all(0.0 <= t < 1.0 for t in marks.values())
+    else:
+        with pytest.raises(RoleError, match="'skating': the left foot never lands"):
+            roles._heel_strikes(skating)
