@@ -171,3 +171,14 @@ def test_the_tuning_columns_follow_the_tunings_assigned() -> None:
     assert tuning_columns(block)[1] is omega  # kept
     bodies[1].tuning = soft
     assert tuning_columns(block)[1].tolist() == [bodies[0].tuning.follow_omega, 3.5, bodies[2].tuning.follow_omega]
+
+
+def test_the_rest_shortcut_takes_a_zero_step_but_not_an_infinite_one() -> None:
+    """A step of 0 s changes nothing (rest); a step of ``inf`` is no step the spring can take (the full
+    step gives NaN there, which the shortcut must not hide). Kills ``0.0 < dt`` and ``dt <= inf``."""
+    from engine.statemachine.puppet.follow import _at_rest
+
+    z, h, w = np.zeros((2, 3)), np.zeros((2, 12, 3)), np.full(2, 40.0)
+    assert _at_rest(z, z, h, w, 0.0)
+    assert not _at_rest(z, z, h, w, float("inf"))
+    assert _at_rest(z, z, h, np.zeros(2), 1 / 60)  # a stiffness of 0 still leaves 0 at 0

@@ -1,0 +1,58 @@
+"""``update_locomotion_batch``: a crowd in Locomotion stepped over arrays, what each puppet is set to.
+
+A crowd's free puppets take the array path; a puppet running the legacy controller must still get the
+legacy follower, which walks without the leg IK's foot locks, and every free puppet stands tall, ends
+a put-down's "leave it there" and is grounded, exactly as ``update_locomotion`` does one by one.
+Written for the seventh mutation round (docs/mutation.md): seen failing on the legacy column read as
+never legacy (``tuning_columns``' ``"legacy"`` misspelt), and on the batch's IK set-up mutated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from engine.ecs import World
+from engine.hashing import state_hash
+from engine.ik.system import IKRequest
+from engine.statemachine import Brain, step_machine
+from engine.statemachine.puppet import Handling, PuppetBody
+from engine.statemachine.puppet import plugin as puppet_plugin
+from engine.statemachine.puppet.senses import sense
+from input.hub import InputHub
+from puppetphone.games import make_app
+
+
+def _one_by_one(world: World) -> None:
+    for e, body, brain in world.query(PuppetBody, Brain):
+        sense(world, e, body)
+        step_machine(world, e, brain)
+
+
+def _crowd(seed: int):  # type: ignore[no-untyped-def]
+    app = make_app("sandbox", seed, InputHub([]), {"puppets": 6})
+    app.run_steps(3)
+    rows = app.world.query(PuppetBody, Handling, IKRequest)
+    e0, body, _, _ = rows[1]
+    body.tuning = replace(body.tuning, controller="legacy")
+    rows[2][2].left = int(e0)  # a put-down's "leave it there"
+    ik = rows[3][3]
+    ik.grounding, ik.sphere_centre, ik.sphere_radius = False, np.array([0.0, 1.0, 0.0]), 0.3
+    rows[4][1].walk_velocity = np.array([0.8, 0.0, -0.5])
+    return app
+
+
+def test_a_legacy_puppet_in_a_crowd_walks_without_foot_locks_as_one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    batched = _crowd(21)
+    monkeypatch.setattr(puppet_plugin, "brain_system", _one_by_one)
+    single = _crowd(21)
+    for step in range(4):
+        batched.step()
+        single.step()
+        assert state_hash(batched.world) == state_hash(single.world), f"differs at step {step}"
+    rows = batched.world.query(PuppetBody, Handling, IKRequest)
+    assert [r[3].foot_lock.enabled for r in rows] == [True, False, True, True, True, True]
+    assert all(r[2].left is None for r in rows)
+    assert all(r[3].grounding and r[3].sphere_centre is None and r[3].sphere_radius == 0.0 for r in rows)
