@@ -47,7 +47,7 @@ def _crowd(seed: int):  # type: ignore[no-untyped-def]
 def _unlink(world: World) -> None:
     """An ``np.float64`` heading no row block holds exactly: the batch stays plain objects (``engine.rows``)."""
     body = world.query(PuppetBody)[5][1]
-    body.heading = np.float64(body.heading)  # type: ignore[assignment]  # what the row block cannot hold
+    body.heading = np.float64(body.heading)  # what the row block cannot hold
 
 
 @pytest.mark.parametrize("linked", [True, False])
