@@ -93,7 +93,8 @@ def test_a_released_batch_steps_bit_for_bit_as_one_by_one(stand: bool, linked: b
         assert not block.stale
         block_rows = (block, np.arange(len(bodies), dtype=np.intp))
     cols = columns(world) if as_column else None
-    follow_released(DT, bodies, transforms, players, cols, block_rows, stand=stand)  # type: ignore[arg-type]  # a stand-in player
+    standing = {"stand": True} if stand else {}  # the default: not standing
+    follow_released(DT, bodies, transforms, players, cols, block_rows, **standing)  # type: ignore[arg-type]  # a stand-in player
     _same(bodies, ref_bodies)
     for tr, ref in zip(transforms, ref_transforms, strict=True):
         assert np.array_equal(tr.rotation, ref.rotation)
