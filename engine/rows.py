@@ -8,9 +8,20 @@ replaced its field since. A *row field* removes both: the component class declar
 field row-backed (:func:`keep_in_rows`), and once a batch of components is linked to a
 :class:`RowBlock` (:meth:`RowStore.block`) the field's value lives in the block's array,
 row ``i`` for component ``i``. Reading ``c.field`` returns it (a Python ``float`` or
-``int``, or a view of the row for an array field), assigning ``c.field = v`` writes it
-into the row: no field can be replaced behind the block's back, so a system reads and
-writes the whole array with no check and no Python per puppet.
+``int``, or a read-only copy of the row for an array field), assigning ``c.field = v``
+writes it into the row: no field can be replaced behind the block's back, so a system
+reads and writes the whole array with no check and no Python per puppet.
+
+An array field keeps a plain field's value semantics. A plain field holds one array
+object that code replaces by assignment (every system of the brain stage assigns new
+arrays, none mutates one in place), so what a reader got keeps its values whatever is
+assigned later: ``old = c.lead; c.lead = new; c.lead = old`` restores the old values, and
+an array read before a step still holds the values it had then. A view of the row would
+break both (it shows whatever the row holds now, and a system writes the rows in place),
+so a read hands out a copy; the copy is read-only, because an in-place change of it
+(``c.lead[0] = x``) — which on a plain field changes the field — would otherwise be lost
+without a word: it raises instead. ``copy``, ``deepcopy`` and ``pickle`` see a plain
+object (:func:`_plain_state`).
 
 What a reader sees is what it saw before, to the type: a value the block cannot hold
 exactly (an ``int`` in a float field, an ``np.float64``, an array of another shape or
@@ -40,15 +51,14 @@ _LINK = "_row_link"
 
 
 class RowBlock:
-    """The arrays of one linked batch: ``arrays[name]`` ``[N, ...]``, ``present[name]`` for a field that may be
-    ``None``, and ``views[name]`` (the row views handed out for an array field, one object per row)."""
+    """The arrays of one linked batch: ``arrays[name]`` ``[N, ...]`` and ``present[name]`` for a field that may be
+    ``None``."""
 
-    __slots__ = ("arrays", "present", "views", "stale", "failed", "objects_set", "memo")
+    __slots__ = ("arrays", "present", "stale", "failed", "objects_set", "memo")
 
     def __init__(self) -> None:
         self.arrays: dict[str, NDArray[Any]] = {}
         self.present: dict[str, NDArray[np.bool_]] = {}
-        self.views: dict[str, list[NDArray[np.float64]]] = {}
         self.stale = False
         self.failed = False
         """Linking failed (a value it cannot hold exactly): the batch stays plain objects until it changes."""
@@ -78,10 +88,22 @@ class _RowField:
         if self.optional and not block.present[name][row]:
             return None
         if self.kind == "vector":
-            return block.views[name][row]
+            return _frozen(block.arrays[name][row])
         if self.kind == "object":
             return block.arrays[name][row]
         return block.arrays[name].item(row)
+
+    def raw(self, obj: Any) -> Any:
+        """The value as kept, an array field as the row itself (no copy): for this module's own moves of values."""
+        link = obj.__dict__.get(_LINK)
+        if link is None:
+            return obj.__dict__[self.name]
+        block, row = link
+        if self.optional and not block.present[self.name][row]:
+            return None
+        if self.kind == "vector":
+            return block.arrays[self.name][row]
+        return self.__get__(obj)
 
     def __set__(self, obj: Any, value: Any) -> None:
         d = obj.__dict__
@@ -115,7 +137,7 @@ class _RowField:
         else:
             if type(value) is not np.ndarray or value.dtype != np.float64 or value.shape != self.shape:
                 return False
-            block.views[name][row][...] = value
+            block.arrays[name][row] = value
         if self.optional:
             block.present[name][row] = True
         return True
@@ -164,7 +186,7 @@ class _Number(_RowField):
 
 
 class _Vector(_RowField):
-    """An array field that is never ``None``: its row's view."""
+    """An array field that is never ``None``: a read-only copy of its row."""
 
     __slots__ = ()
 
@@ -174,7 +196,15 @@ class _Vector(_RowField):
         link = obj.__dict__.get(_LINK)
         if link is None:
             return obj.__dict__[self.name]
-        return link[0].views[self.name][link[1]]
+        return _frozen(link[0].arrays[self.name][link[1]])
+
+
+def _frozen(row: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A read-only copy of a row: it keeps the values it was read with (a plain field's array is replaced, not
+    changed, when the field is assigned or a system steps), and changing it in place raises instead of being lost."""
+    out = row.copy()
+    out.flags.writeable = False
+    return out
 
 
 _INT_MIN, _INT_MAX = -(2**63), 2**63 - 1
@@ -184,11 +214,19 @@ def _unlink(obj: Any) -> None:
     """Move a linked component's values back into the object and mark its block stale."""
     d = obj.__dict__
     block, _ = d[_LINK]
-    values = {f.name: f.__get__(obj) for f in _fields(type(obj))}
+    d.update(_plain_values(obj))
     del d[_LINK]
-    for name, value in values.items():
-        d[name] = np.array(value) if isinstance(value, np.ndarray) else value
     block.stale = True
+
+
+def _plain_values(obj: Any) -> dict[str, Any]:
+    """A linked component's row-field values as a plain object holds them (an array field as its own writable
+    array, sharing no memory with the block)."""
+    values = {}
+    for f in _fields(type(obj)):
+        value = f.raw(obj)
+        values[f.name] = np.array(value) if isinstance(value, np.ndarray) else value
+    return values
 
 
 def _fields(cls: type) -> tuple[_RowField, ...]:
@@ -213,21 +251,17 @@ def keep_in_rows(cls: type, **fields: tuple[str, tuple[int, ...], bool]) -> None
         setattr(cls, name, field)
         made.append(field)
     cls.__row_fields__ = (*_fields(cls), *made)  # type: ignore[attr-defined]  # a class attribute added at run time
-    cls.__copy__ = _copy  # type: ignore[attr-defined]  # a class attribute added at run time
+    cls.__getstate__ = _plain_state  # type: ignore[attr-defined]  # a class attribute added at run time
 
 
-def _copy(obj: Any) -> Any:
-    """``copy.copy`` of a component with row fields: a plain (unlinked) object, its arrays copied — a shallow copy
-    sharing the link would write the original's row."""
-    cls: Any = type(obj)
-    new = cls.__new__(cls)
+def _plain_state(obj: Any) -> dict[str, Any]:
+    """What ``copy.copy``, ``copy.deepcopy`` and ``pickle`` take of a component with row fields: the ``__dict__``
+    of a plain (unlinked) object, its arrays copied — a copy sharing the link would write the original's row, and a
+    pickle would carry the whole block."""
     d = dict(obj.__dict__)
     if d.pop(_LINK, None) is not None:
-        for f in _fields(type(obj)):
-            value = f.__get__(obj)
-            d[f.name] = np.array(value) if isinstance(value, np.ndarray) else value
-    new.__dict__.update(d)
-    return new
+        d.update(_plain_values(obj))
+    return d
 
 
 class RowStore:
@@ -287,7 +321,7 @@ _ALL = slice(None)
 def _link(ctype: type, owners: tuple[Any, ...]) -> RowBlock:
     """A new block holding ``owners``' row fields, each owner pointed at its row (unlinkable ones stay plain)."""
     fields = _fields(ctype)
-    values = {f.name: [f.__get__(o) for o in owners] for f in fields}
+    values = {f.name: [f.raw(o) for o in owners] for f in fields}
     block = RowBlock()
     for f in fields:
         made = f.column(values[f.name])
@@ -300,8 +334,6 @@ def _link(ctype: type, owners: tuple[Any, ...]) -> RowBlock:
         block.arrays[f.name], present = made
         if present is not None:
             block.present[f.name] = present
-        if f.kind == "vector":
-            block.views[f.name] = list(block.arrays[f.name])
     for row, o in enumerate(owners):
         d = o.__dict__
         for f in fields:

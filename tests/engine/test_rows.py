@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import math
+import pickle
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -104,7 +105,11 @@ def test_a_value_the_block_cannot_hold_unlinks_the_component() -> None:
     kept_velocity = bodies[3].velocity
     bodies[2].heading = np.float64(1.5)  # type: ignore[assignment]  # the wrong type on purpose
     assert type(bodies[2].heading) is np.float64 and "_row_link" not in bodies[2].__dict__
-    assert block.stale and bodies[3].velocity is kept_velocity  # the others stay linked meanwhile
+    assert block.stale and "_row_link" in bodies[3].__dict__  # the others stay linked meanwhile
+    assert np.array_equal(bodies[3].velocity, kept_velocity)
+    unlinked = bodies[2].velocity  # an unlinked component's arrays are its own, writable, apart from the block
+    unlinked[0] = 42.0
+    assert bodies[2].velocity[0] == 42.0 and not np.any(block.arrays["velocity"] == 42.0)
     again = store.block(Body, owners)  # cannot link a np.float64 exactly: stays plain, not retried
     assert again.stale and again.failed and store.block(Body, owners) is again
     assert type(bodies[2].heading) is np.float64
@@ -116,6 +121,68 @@ def test_a_value_the_block_cannot_hold_unlinks_the_component() -> None:
     assert bodies[0].velocity.shape == (4,) and fresh.stale
     bodies[1].held_by = 7.0  # type: ignore[assignment]  # a float in an int field
     assert type(bodies[1].held_by) is float
+
+
+def test_an_array_read_keeps_its_values_as_a_plain_fields_array_does() -> None:
+    """``old = c.velocity; c.velocity = new; c.velocity = old`` restores the old values, and an array read
+    before an assignment or a system's whole-array write keeps the values it was read with — as a plain
+    field's array does (the state-hash test saves and restores every field this way). Shown to fail when a
+    read hands out the row's view (``_frozen`` returning ``row``): the restore leaves ``new`` in place."""
+    rng = np.random.default_rng(4)
+    plain = _random_bodies(np.random.default_rng(4), 5)
+    linked = _random_bodies(np.random.default_rng(4), 5)
+    block = RowStore().block(Body, tuple(linked))
+    for p, q in zip(plain, linked, strict=True):
+        for name in ("velocity", "last"):
+            held = (getattr(p, name), getattr(q, name))
+            new = rng.normal(size=3)
+            setattr(p, name, new.copy())
+            setattr(q, name, new.copy())
+            assert held[1] is None or not np.array_equal(held[1], new)  # the earlier read did not follow
+            setattr(p, name, held[0])
+            setattr(q, name, held[1])
+            for a, b in ((getattr(p, name), getattr(q, name)), held):
+                assert (a is None and b is None) or np.array_equal(a, b)
+    before = [q.velocity for q in linked]
+    block.arrays["velocity"][:] = 7.0  # a system stepping the crowd writes the rows in place
+    assert all(np.array_equal(v, p.velocity) for v, p in zip(before, plain, strict=True))
+    assert all(np.all(q.velocity == 7.0) for q in linked) and not block.stale
+
+
+def test_changing_a_read_array_in_place_raises_instead_of_being_lost() -> None:
+    """On a plain field ``c.velocity[0] = x`` changes the field; a linked read is a copy, so the change would be
+    lost without a word: it raises, and the row keeps its value. Shown to fail when the copy is left writable."""
+    bodies = _random_bodies(np.random.default_rng(5), 3)
+    RowStore().block(Body, tuple(bodies))
+    kept = bodies[1].velocity.copy()
+    with pytest.raises(ValueError, match="read-only"):
+        bodies[1].velocity[0] = 99.0
+    last = bodies[0].last if bodies[0].last is not None else bodies[2].last
+    assert last is not None
+    with pytest.raises(ValueError, match="read-only"):
+        last += 1.0
+    assert np.array_equal(bodies[1].velocity, kept)
+
+
+@pytest.mark.parametrize("how", ["copy", "deepcopy", "pickle"])
+def test_copies_of_a_linked_component_are_plain_objects_of_its_values(how: str) -> None:
+    """``copy``, ``deepcopy`` and ``pickle`` take a linked component as the plain object it stands for: no link,
+    its own writable arrays, not the block (a pickle carrying the block would hold every row). Shown to fail
+    without ``__getstate__`` (``_plain_state``): the copy keeps ``_row_link``."""
+    bodies = _random_bodies(np.random.default_rng(6), 50)
+    RowStore().block(Body, tuple(bodies))
+    original = bodies[1]
+    twin = {"copy": copy.copy, "deepcopy": copy.deepcopy, "pickle": lambda b: pickle.loads(pickle.dumps(b))}[how](
+        original
+    )
+    assert "_row_link" not in twin.__dict__ and "_row_link" in original.__dict__
+    assert twin.heading == original.heading and twin.held_by == original.held_by and twin.tag == original.tag
+    assert np.array_equal(twin.velocity, original.velocity)
+    twin.velocity[0] = 99.0
+    twin.heading = 4.0
+    assert original.velocity[0] != 99.0 and original.heading != 4.0
+    if how == "pickle":
+        assert len(pickle.dumps(original)) < 1000  # one body, not the block of fifty
 
 
 def test_copy_of_a_linked_component_is_plain_and_does_not_share_its_row() -> None:
