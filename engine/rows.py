@@ -36,6 +36,7 @@ its own ``__dict__``, as a plain dataclass does.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Sequence
 from typing import Any
 
@@ -94,16 +95,18 @@ class _RowField:
         return block.arrays[name].item(row)
 
     def raw(self, obj: Any) -> Any:
-        """The value as kept, an array field as the row itself (no copy): for this module's own moves of values."""
+        """The value as kept, an array field as the row itself (no copy): for reads that use it at once and keep
+        nothing (linking, unlinking)."""
         link = obj.__dict__.get(_LINK)
         if link is None:
             return obj.__dict__[self.name]
         block, row = link
-        if self.optional and not block.present[self.name][row]:
+        name = self.name
+        if self.optional and not block.present[name][row]:
             return None
-        if self.kind == "vector":
-            return block.arrays[self.name][row]
-        return self.__get__(obj)
+        if self.kind == "vector" or self.kind == "object":
+            return block.arrays[name][row]
+        return block.arrays[name].item(row)
 
     def __set__(self, obj: Any, value: Any) -> None:
         d = obj.__dict__
@@ -252,6 +255,34 @@ def keep_in_rows(cls: type, **fields: tuple[str, tuple[int, ...], bool]) -> None
         made.append(field)
     cls.__row_fields__ = (*_fields(cls), *made)  # type: ignore[attr-defined]  # a class attribute added at run time
     cls.__getstate__ = _plain_state  # type: ignore[attr-defined]  # a class attribute added at run time
+    cls.__state_columns__ = classmethod(_state_columns)  # type: ignore[attr-defined]  # a class attribute added at run time
+
+
+def _state_columns(cls: type, names: Sequence[str], comps: Sequence[Any]) -> list[list[Any]]:
+    """The state hash's columns of ``names`` over ``comps`` (see :mod:`engine.hashing`): the values a plain read of
+    each gives, to the type. Components all linked to one block are read from its arrays, a whole column at once
+    (``tolist`` makes the same Python floats and ints as ``.item``; an array field's values are rows of a gathered
+    copy, used at once) — one by one, the copies the attribute reads hand out would cost more than the hash."""
+    if not comps or not names:
+        return []
+    links = [c.__dict__.get(_LINK) for c in comps]
+    block = links[0][0] if links[0] is not None else None
+    if block is None or any(link is None or link[0] is not block for link in links):
+        return [[getattr(c, name) for c in comps] for name in names]
+    rows = np.fromiter((link[1] for link in links), np.intp, len(links))
+    rowed = {f.name: f for f in _fields(cls)}
+    columns = []
+    for name in names:
+        f = rowed.get(name)
+        if f is None:
+            columns.append(list(map(operator.attrgetter(name), comps)))
+            continue
+        values = block.arrays[name][rows]
+        column = list(values) if f.kind == "vector" else values.tolist()
+        if f.optional:
+            column = [v if p else None for v, p in zip(column, block.present[name][rows].tolist(), strict=True)]
+        columns.append(column)
+    return columns
 
 
 def _plain_state(obj: Any) -> dict[str, Any]:

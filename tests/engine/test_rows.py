@@ -1,7 +1,9 @@
 """Row fields: a linked component reads, writes and hashes exactly as a plain one.
 
 Shown to fail when broken: ``_RowField.__get__`` returning ``block.arrays[name][row]`` (an
-``np.float64``) instead of ``.item(row)`` fails the hash and type tests; ``_store`` accepting an
+``np.float64``) instead of ``.item(row)`` fails the hash and type tests; ``_state_columns`` (the
+state hash's read of a block) gathering a number column with ``list`` (``np.float64`` values) instead
+of ``tolist`` fails the hash test; ``_store`` accepting an
 ``np.float64`` (no unlink) fails ``test_a_value_the_block_cannot_hold_unlinks_the_component``.
 """
 
@@ -95,6 +97,9 @@ def test_a_linked_batch_hashes_and_reads_exactly_as_plain_objects(seed: int) -> 
     for b in plain[:5]:
         b.heading = -0.0
     assert not block.stale and state_hash(wp) == state_hash(wl)
+    # One component unlinked: the hash reads the others from the block and it as a plain object.
+    plain[3].heading = linked[3].heading = np.float64(0.25)  # type: ignore[assignment]  # unlinks: on purpose
+    assert block.stale and state_hash(wp) == state_hash(wl)
 
 
 def test_a_value_the_block_cannot_hold_unlinks_the_component() -> None:
