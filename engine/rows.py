@@ -254,8 +254,8 @@ def keep_in_rows(cls: type, **fields: tuple[str, tuple[int, ...], bool]) -> None
         setattr(cls, name, field)
         made.append(field)
     cls.__row_fields__ = (*_fields(cls), *made)  # type: ignore[attr-defined]  # a class attribute added at run time
-    cls.__getstate__ = _plain_state  # type: ignore[attr-defined]  # a class attribute added at run time
-    cls.__state_columns__ = classmethod(_state_columns)  # type: ignore[attr-defined]  # a class attribute added at run time
+    cls.__getstate__ = _plain_state  # type: ignore[method-assign, assignment]  # object's method replaced per class
+    cls.__state_columns__ = classmethod(_state_columns)  # type: ignore[attr-defined]  # added at run time
 
 
 def _state_columns(cls: type, names: Sequence[str], comps: Sequence[Any]) -> list[list[Any]]:
