@@ -31,12 +31,14 @@ class Batch:
 
     Attributes:
         entities: the entities having every required type, in entity order.
-        lists: one list per type, required types first, then the optional ones, row ``i`` for ``entities[i]``.
+        lists: one tuple per type, required types first, then the optional ones, row ``i`` for ``entities[i]``
+            (tuples: the same object step after step, so a column of :mod:`engine.columns` knows them by identity
+            and does not compare them row by row).
         missing: per list, whether some entity lacks that component (its row is ``None``).
     """
 
     entities: list[Entity]
-    lists: tuple[list[Any], ...]
+    lists: tuple[tuple[Any, ...], ...]
     missing: tuple[bool, ...]
 
 
@@ -56,10 +58,10 @@ class Batches:
             return kept[1]
         rows = sources[0]
         entities = [r[0] for r in rows]
-        lists = [[r[k] for r in rows] for k in range(1, len(required) + 1)]
+        lists = [tuple([r[k] for r in rows]) for k in range(1, len(required) + 1)]
         for t in optional:
             store: Mapping[Entity, Any] = world.components(t)
-            lists.append([store.get(e) for e in entities])
+            lists.append(tuple([store.get(e) for e in entities]))
         made = Batch(entities, tuple(lists), tuple(any(c is None for c in comps) for comps in lists))
         self._kept[key] = (sources, made)
         return made

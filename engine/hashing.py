@@ -36,7 +36,7 @@ import functools
 import hashlib
 import operator
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -185,16 +185,24 @@ def _fed(values: list[Any]) -> bytes:
 
 
 @functools.cache
-def _hashed_fields(ctype: type) -> Callable[[Any], tuple[Any, ...]] | None:
-    """For a dataclass component type: a getter of its hashed fields as a tuple (one C call per
-    component, transposed into columns by ``zip``); ``None`` for other types (hashed whole)."""
+def _hashed_fields(ctype: type) -> Callable[[list[Any]], Iterable[Sequence[Any]]] | None:
+    """For a dataclass component type: the columns of its hashed fields over a list of components
+    (a getter of the fields as a tuple, one C call per component, transposed by ``zip``); ``None`` for
+    other types (hashed whole).
+
+    A type that keeps fields outside its objects gathers its own columns, ``__state_columns__(names,
+    comps)`` (:mod:`engine.rows`: whole columns from its arrays)."""
     if not dataclasses.is_dataclass(ctype) or hasattr(ctype, "state_bytes"):
         return None
     names = [f.name for f in dataclasses.fields(ctype) if f.metadata.get("hash", True)]
+    gather = getattr(ctype, "__state_columns__", None)
+    if gather is not None:
+        return functools.partial(gather, names)
     if len(names) == 1:
         name = names[0]
-        return lambda c: (getattr(c, name),)
-    return operator.attrgetter(*names) if names else (lambda c: ())
+        return lambda comps: zip(*[(getattr(c, name),) for c in comps])
+    getter = operator.attrgetter(*names) if names else (lambda c: ())
+    return lambda comps: zip(*map(getter, comps))
 
 
 def _feed_components(h: Any, ctype: type, rows: list[tuple[Any, ...]]) -> None:
@@ -202,11 +210,11 @@ def _feed_components(h: Any, ctype: type, rows: list[tuple[Any, ...]]) -> None:
     ids = np.array([row[0] for row in rows], dtype=np.int64)
     h.update(b"C" + f"{ctype.__module__}.{ctype.__qualname__}".encode() + b"\0" + _COUNT.pack(len(ids)) + ids.tobytes())
     comps = [row[1] for row in rows]
-    getter = _hashed_fields(ctype)
-    if getter is None:
+    columns = _hashed_fields(ctype)
+    if columns is None:
         h.update(_column(comps))
     else:
-        for column in zip(*map(getter, comps)):
+        for column in columns(comps):
             h.update(_column(list(column)))
 
 

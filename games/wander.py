@@ -11,7 +11,10 @@ steering is batched over all wanderers: a crowd of a hundred is one numpy pass.
 from __future__ import annotations
 
 import operator
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from itertools import repeat
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,7 +26,9 @@ from engine.columns import columns
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
+from engine.rows import RowBlock, keep_in_rows, row_store
 from engine.statemachine.puppet import Jumping, PuppetBody
+from engine.statemachine.puppet.plugin import puppet_batch
 from engine.statemachine.puppet.senses import yaw_rotation
 
 __all__ = ["Wanderer", "wander_system", "install_wander"]
@@ -45,11 +50,52 @@ def wander_system(world: World) -> None:
     """Steer every free wanderer toward its goal; pick a new goal when one is reached.
 
     The wanderers' component lists are kept between structural changes (:mod:`engine.batches`),
-    their positions, rotations and goals are columns (:mod:`engine.columns`)."""
+    their positions, rotations and goals are columns (:mod:`engine.columns`); when their bodies are
+    linked to the brain stage's row block (:mod:`engine.rows`), who is held and the headings are
+    read and written in its arrays."""
     kept = batch(world, "wanderers", (Wanderer, PuppetBody), (Jumping, Ragdoll, Transform, LocomotionPlayer))
+    wanderers, bodies, jumps, rds, transforms, players = kept.lists
+    found = None if any(kept.missing) else row_store(world).rows(PuppetBody, bodies)
+    if found is None:
+        _wander(world, *_free_one_by_one(kept.lists), None, None)
+        return
+    block, rows = found
+    own = row_store(world).block(Wanderer, wanderers)
+    if own.stale:
+        _wander(world, *_free_one_by_one(kept.lists), None, None)
+        return
+    n = len(bodies)
+    ok = ~block.present["held_by"][rows]
+    on_ground = row_store(world).block(Jumping, jumps)
+    ok &= (np.fromiter(map(_AIR, jumps), np.float64, n) if on_ground.stale else on_ground.arrays["air"]) == 0.0
+    ok &= np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, n)
+    puppets = puppet_batch(world)
+    whole = (
+        None if puppets.missing[2] or row_store(world).owners(PuppetBody) is not puppets.lists[0] else puppets.lists[2]
+    )
+    if ok.all():
+        _wander(world, wanderers, bodies, transforms, players, (block, rows), (own, _ALL), whole)
+        return
+    free = np.flatnonzero(ok)
+    if len(free):
+        at = free.tolist()
+        _wander(
+            world,
+            [wanderers[i] for i in at],
+            [bodies[i] for i in at],
+            [transforms[i] for i in at],
+            [players[i] for i in at],
+            (block, free if isinstance(rows, slice) else rows[free]),
+            (own, free),
+            whole,
+        )
+
+
+def _free_one_by_one(lists: tuple[tuple[Any, ...], ...]) -> tuple[list[Any], list[Any], list[Any], list[Any]]:
+    """The free wanderers' components, tested one by one (a batch with a missing component, or bodies not in rows)."""
     free = [
         i
-        for i, (body, jump, rd, tr, player) in enumerate(zip(*kept.lists[1:], strict=True))
+        for i, (body, jump, rd, tr, player) in enumerate(zip(*lists[1:], strict=True))
         if body.held_by is None
         and (jump is None or jump.air == 0.0)
         and rd is not None
@@ -57,27 +103,60 @@ def wander_system(world: World) -> None:
         and tr is not None
         and player is not None
     ]
-    if not free:
+    wanderers, bodies, _, _, transforms, players = ([c[i] for i in free] for c in lists)
+    return wanderers, bodies, transforms, players
+
+
+def _wander(
+    world: World,
+    wanderers: Sequence[Wanderer],
+    bodies: Sequence[PuppetBody],
+    transforms: Sequence[Transform],
+    players: Sequence[LocomotionPlayer],
+    block_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
+    wander_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
+    whole: tuple[Transform, ...] | None = None,
+) -> None:
+    """Steer the free wanderers given (row ``i`` of each list for one puppet; their rows of the bodies' and
+    the wanderers' row blocks, if they are linked). ``whole`` (the transforms of the bodies' block, row for
+    row) lets the positions and rotations be read and written in the brain stage's columns at the bodies'
+    rows, instead of columns of the wanderers' own."""
+    n = len(wanderers)
+    if n == 0:
         return
-    if len(free) == len(kept.entities):
-        wanderers, bodies, _, _, transforms, players = kept.lists
-    else:
-        wanderers, bodies, _, _, transforms, players = ([c[i] for i in free] for c in kept.lists)
-    n = len(free)
     cols = columns(world)
-    pos = cols.get(Transform, "position").read(transforms)
-    goal = cols.get(Wanderer, "goal").read(wanderers)
+    at = None if whole is None or block_rows is None else block_rows[1]
+    if whole is None or at is None:
+        pos = cols.get(Transform, "position").read(transforms)
+    else:
+        pos = cols.get(Transform, "position").read(whole)[at]
+    if wander_rows is None:
+        goal = np.array([w.goal for w in wanderers], dtype=np.float64).reshape(n, 3)
+        pace = np.fromiter(map(_SPEED, wanderers), np.float64, n)
+    else:
+        goal = wander_rows[0].arrays["goal"][wander_rows[1]]
+        pace = wander_rows[0].arrays["speed"][wander_rows[1]]
     err = goal - pos
     dist = np.hypot(err[:, 0], err[:, 2])
-    heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
+    if block_rows is None:
+        heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
+    else:
+        heading = block_rows[0].arrays["heading"][block_rows[1]]
     turn = (np.arctan2(err[:, 0], err[:, 2]) - heading + np.pi) % (2 * np.pi) - np.pi
     step = _TURN_RATE * world.dt
     heading = (heading + np.clip(turn, -step, step) + np.pi) % (2 * np.pi) - np.pi
     facing = np.maximum(np.cos(turn), 0.0)
-    cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
-    speeds = (np.fromiter(map(_SPEED, wanderers), np.float64, n) * facing).tolist()
-    for body, player, h, v in zip(bodies, players, heading.tolist(), speeds, strict=True):
-        body.heading = h
+    if whole is None or at is None:
+        cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
+    else:  # every row's field is its view after the read; only the wanderers' rows change
+        cols.get(Transform, "rotation").read(whole)[at] = yaw_rotation(heading)
+    speeds = (pace * facing).tolist()
+    if block_rows is None:
+        for body, h in zip(bodies, heading.tolist(), strict=True):
+            body.heading = h
+    else:
+        block_rows[0].arrays["heading"][block_rows[1]] = heading
+    for player, v in zip(players, speeds, strict=True):
         player.speed = v
     for i in np.flatnonzero(dist < _REACHED).tolist():
         w = wanderers[i]
@@ -90,8 +169,14 @@ def wander_system(world: World) -> None:
         )
 
 
+keep_in_rows(Wanderer, speed=("float", (), False), goal=("vector", (3,), False))
+"""A crowd's paces and goals are arrays (:mod:`engine.rows`): the steering reads them whole."""
+
+_ALL = slice(None)
 _HEADING = operator.attrgetter("heading")
 _SPEED = operator.attrgetter("speed")
+_AIR = operator.attrgetter("air")
+_MODE = operator.attrgetter("mode")
 
 
 def install_wander(app: App) -> None:

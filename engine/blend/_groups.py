@@ -96,7 +96,7 @@ def _group(kept: Batch, key: str, index: list[int]) -> Group:
     transforms, _, players, poses, requests = kept.lists
     pick = [transforms, players, poses, requests]
     if len(index) != len(kept.entities):
-        pick = [[column[i] for i in index] for column in pick]
+        pick = [tuple(column[i] for i in index) for column in pick]
     mine_transforms, mine_players, mine_poses, mine_requests = pick
     has = [r is not None for r in mine_requests]
     ik = tuple(r for r in mine_requests if r is not None)

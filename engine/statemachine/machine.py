@@ -33,7 +33,7 @@ entity is simply evaluated exactly, and the result is the same as stepping each 
 from __future__ import annotations
 
 import operator
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from itertools import repeat
 from typing import Any, Generic, TypeVar
@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from engine.arrays import Intp as Rows
 from engine.ecs import Entity, World
+from engine.rows import RowBlock, keep_in_rows, row_store
 
 __all__ = [
     "ANY",
@@ -149,6 +150,17 @@ class Brain:
         if self.crossfade_total <= 0:
             return 1.0
         return 1.0 - self.crossfade / self.crossfade_total
+
+
+keep_in_rows(
+    Brain,
+    machine=("object", (), False),
+    active=("object", (), False),
+    time_in_state=("float", (), False),
+    crossfade=("float", (), False),
+)
+"""A crowd's machines, states and clocks are arrays (:mod:`engine.rows`): :func:`step_machines` sorts the
+brains by state and advances their clocks without touching them one by one."""
 
 
 class StateMachine(Generic[C]):
@@ -278,7 +290,10 @@ def step_machines(world: World, entities: Sequence[Entity], brains: Sequence[Bra
     write only its own entities' components (what :func:`step_machine` of another
     entity changes cannot decide it).
     """
-    groups, single = _groups(brains)
+    block = row_store(world).block(Brain, brains) if isinstance(brains, tuple) and brains else None
+    if block is not None and block.stale:
+        block = None
+    groups, single = _groups(brains, block)
     dt = world.dt
     for (_, state), members in groups.items():
         rows = np.array(members, dtype=np.intp)
@@ -290,40 +305,64 @@ def step_machines(world: World, entities: Sequence[Entity], brains: Sequence[Bra
             update = machine.states[state].batch_update
             assert update is not None  # batchable() checked it
             update(world, columns, quiet)
-            for brain in brains if len(quiet) == len(brains) else [brains[i] for i in quiet.tolist()]:
-                brain.time_in_state += dt
-                fade = brain.crossfade
-                # max(0.0, fade - dt), which is 0.0 whenever fade is not positive (NaN included)
-                brain.crossfade = max(0.0, fade - dt) if fade > 0.0 else 0.0
+            if block is not None and not block.stale:
+                _tick(block, quiet if len(quiet) < len(brains) else _ALL, dt)
+            else:
+                for brain in brains if len(quiet) == len(brains) else [brains[i] for i in quiet.tolist()]:
+                    brain.time_in_state += dt
+                    fade = brain.crossfade
+                    # max(0.0, fade - dt), which is 0.0 whenever fade is not positive (NaN included)
+                    brain.crossfade = max(0.0, fade - dt) if fade > 0.0 else 0.0
     for i in sorted(single):
         step_machine(world, entities[i], brains[i])
 
 
-_MACHINE = operator.attrgetter("machine")
-_ACTIVE = operator.attrgetter("active")
+_ALL = slice(None)
+
+
+def _tick(block: RowBlock, rows: Rows | slice, dt: float) -> None:
+    """The clocks of the brains at ``rows`` of a row block, as :func:`step_machine` advances one: the same
+    operations on the same float64 numbers (Python's ``max(0.0, x)`` is ``x`` only where ``x > 0``: a NaN
+    gives +0.0, where ``np.maximum`` would keep it)."""
+    time = block.arrays["time_in_state"]
+    time[rows] += dt
+    fade = block.arrays["crossfade"]
+    f = fade[rows]
+    left = f - dt
+    fade[rows] = np.where(f > 0.0, np.where(left > 0.0, left, 0.0), 0.0)
+
+
+_KEYS = operator.attrgetter("pending_events", "machine", "active")
 _PENDING = operator.attrgetter("pending_events")
 
 
-def _groups(brains: Sequence[Brain]) -> tuple[dict[tuple[int, str], list[int]], list[int]]:
+def _groups(
+    brains: Sequence[Brain], block: RowBlock | None = None
+) -> tuple[dict[tuple[int, str], list[int]], list[int]]:
     """The rows that may go over arrays, by (machine, active state) in order of first appearance, and the others.
 
     A crowd shares one machine and has no events most steps: then the rows are sorted by
-    state in a few C-level passes instead of a test per entity."""
+    state in a few C-level passes instead of a test per entity; with the brains' row ``block``
+    (row ``i`` for ``brains[i]``) their machines and states are read from its arrays."""
     groups: dict[tuple[int, str], list[int]] = {}
     single: list[int] = []
     machine = brains[0].machine if brains else None
-    if (
-        machine is None
-        or any(map(_PENDING, brains))
-        or not all(map(operator.is_, map(_MACHINE, brains), repeat(machine)))
-    ):
+    pending: Sequence[Any]
+    machines: Iterable[Any]
+    actives: Sequence[str]
+    if block is not None:
+        pending = () if not any(map(_PENDING, brains)) else (True,)
+        machines, actives = block.arrays["machine"], block.arrays["active"].tolist()
+    else:
+        # One pass over the brains (each a cold object in a crowd), then C-level passes over the tuples.
+        pending, machines, actives = zip(*map(_KEYS, brains)) if brains else ((), (), ())
+    if machine is None or any(pending) or not all(map(operator.is_, machines, repeat(machine))):
         for i, brain in enumerate(brains):
             if brain.active and not brain.pending_events and brain.machine.batchable(brain.active):
                 groups.setdefault((id(brain.machine), brain.active), []).append(i)
             else:
                 single.append(i)
         return groups, single
-    actives = list(map(_ACTIVE, brains))
     states = dict.fromkeys(actives)
     for state in states:
         members = list(range(len(actives))) if len(states) == 1 else [i for i, a in enumerate(actives) if a == state]

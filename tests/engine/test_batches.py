@@ -61,5 +61,5 @@ def test_a_batch_is_rebuilt_when_an_optional_component_is_replaced_added_or_remo
 
 def test_batches_of_different_keys_are_apart() -> None:
     w, es = _world()
-    assert batch(w, "only a", (A,)).lists == ([w.get(e, A) for e in es],)
+    assert batch(w, "only a", (A,)).lists == (tuple(w.get(e, A) for e in es),)
     assert batch(w, "a and b", (A, B)).entities == [es[1], es[3]]

@@ -20,6 +20,7 @@ import numpy as np
 from engine.ecs import Entity
 from engine.pose import Pose
 from engine.ragdoll.getup import GetUpBlend, LyingOrientation
+from engine.rows import keep_in_rows
 from engine.statemachine.jump_arc import JumpStatus, JumpTracker
 
 __all__ = [
@@ -196,6 +197,28 @@ class Handling:
     onto: Entity | None = None
     left: Entity | None = None
 
+
+keep_in_rows(
+    PuppetBody,
+    tuning=("object", (), False),
+    held_by=("int", (), True),
+    heading=("float", (), False),
+    speed=("float", (), False),
+    lead=("vector", (3,), False),
+    walk_velocity=("vector", (3,), False),
+    walk_rate=("vector", (3,), False),
+    recent=("vector", (12, 3), False),
+    ground_velocity=("vector", (3,), False),
+    last_position=("vector", (3,), True),
+)
+"""A crowd's bodies keep what the brain stage updates every step in arrays (:mod:`engine.rows`): the stage
+reads and writes them whole, and a reader of one puppet sees the same values as plain fields."""
+
+keep_in_rows(Handling, left=("int", (), True))
+"""Locomotion lets go of the ball a puppet left (``left = None``) for the whole crowd at once."""
+
+keep_in_rows(Jumping, air=("float", (), False))
+"""Who is on the ground is one array comparison for a crowd (a wandering crowd steers only those)."""
 
 PUPPET_COMPONENTS = (Jumping, Landing, GettingUp, Handling)
 """The per-state components every puppet carries (a spawned puppet gets one fresh instance of each)."""

@@ -26,17 +26,21 @@ pass, with the same numbers. Time is ``world.dt``.
 from __future__ import annotations
 
 import operator
+from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
+from engine.arrays import Intp as Rows
 from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import Columns
 from engine.components import Transform
 from engine.ecs import Entity, World
+from engine.rows import RowBlock
 from engine.statemachine.puppet.body import PuppetBody, PuppetTuning
 from engine.statemachine.puppet.senses import heading_vector, yaw_rotation
 
-__all__ = ["spring_step", "wanted_velocity", "follow_velocity", "follow_released", "drag_reach"]
+__all__ = ["spring_step", "wanted_velocity", "follow_velocity", "follow_released", "drag_reach", "tuning_columns"]
 
 from engine.arrays import F64 as F
 
@@ -137,34 +141,45 @@ def _face(
 
 def follow_released(
     dt: float,
-    bodies: list[PuppetBody],
-    transforms: list[Transform],
-    players: list[LocomotionPlayer],
+    bodies: Sequence[PuppetBody],
+    transforms: Sequence[Transform],
+    players: Sequence[LocomotionPlayer],
     cols: Columns | None = None,
+    block_rows: tuple[RowBlock, Rows | slice] | None = None,
+    stand: bool = False,
 ) -> None:
     """:func:`follow_velocity` (``speed_scale`` 1) for puppets no stick holds, over arrays.
 
     Unheld, the spring pulls the request to rest; the spring step, the speed and the
     facing rotation are computed for all at once with the very operations of the
     single-puppet path (elementwise, so the numbers are the same), and only a puppet
-    still moving fast enough to turn is turned one by one. With ``cols`` the bodies'
-    spring state and the rotations of the puppets that stand are kept in columns
-    (:mod:`engine.columns`), not gathered and scattered."""
+    still moving fast enough to turn is turned one by one. With ``block_rows`` (the row
+    block the bodies are linked to and their rows in it, :mod:`engine.rows`) the bodies'
+    spring state, heading and stiffness are read and written in the block's arrays, no
+    body touched; with ``cols`` the rotations of the puppets that stand are written as a
+    column of :mod:`engine.columns`. ``stand`` also sets every player's ``height`` to ``None``
+    (standing tall) in the pass that sets its speed: one visit of each player."""
     n = len(bodies)
     if n == 0:
         return
-    if cols is None:
+    if block_rows is None:
         value = np.array([b.walk_velocity for b in bodies], dtype=np.float64).reshape(n, 3)
         rate = np.array([b.walk_rate for b in bodies], dtype=np.float64).reshape(n, 3)
         recent = np.array([b.recent for b in bodies], dtype=np.float64).reshape(n, -1, 3)
+        follow_omega = np.fromiter(map(_OMEGA, bodies), np.float64, n)
+        heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
     else:
-        value = cols.get(PuppetBody, "walk_velocity").read(bodies)
-        rate = cols.get(PuppetBody, "walk_rate").read(bodies)
-        recent = cols.get(PuppetBody, "recent").read(bodies)
-    follow_omega = np.fromiter(map(_OMEGA, bodies), np.float64, n)
-    heading = np.fromiter(map(_HEADING, bodies), np.float64, n)
+        block, rows = block_rows
+        a = block.arrays
+        value, rate, recent, heading = (
+            a["walk_velocity"][rows],
+            a["walk_rate"][rows],
+            a["recent"][rows],
+            a["heading"][rows],
+        )
+        follow_omega = tuning_columns(block)[1][rows]
     rotation = yaw_rotation(heading)
-    if cols is not None and _at_rest(value, rate, recent, follow_omega, dt):
+    if block_rows is not None and _at_rest(value, rate, recent, follow_omega, dt):
         speed = np.zeros(n)  # the spring's exact rest is a fixed point: nothing to step, nothing to write
     else:
         goal = np.zeros((n, 3))
@@ -175,16 +190,18 @@ def follow_released(
         value, rate = spring_step(value, rate, goal, omega, dt)
         speed = np.hypot(value[:, 0], value[:, 2])
         recent = np.concatenate([recent[:, 1:], value[:, None]], axis=1)
-        if cols is None:
+        if block_rows is None:
             for i, body in enumerate(bodies):
                 body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
         else:
-            cols.get(PuppetBody, "walk_velocity").write(bodies, value)
-            cols.get(PuppetBody, "walk_rate").write(bodies, rate)
-            cols.get(PuppetBody, "recent").write(bodies, recent)
+            a["walk_velocity"][rows], a["walk_rate"][rows], a["recent"][rows] = value, rate, recent
     speeds = speed.tolist()
     moving = speed > 1e-3
     turning = np.flatnonzero(moving).tolist()
+    if stand:  # every player's speed now; a turning puppet's is set again by _face below
+        for player, v in zip(players, speeds, strict=True):
+            player.height = None
+            player.speed = v
     for i in turning:
         _face(transforms[i], bodies[i], players[i], speeds[i], dt, 1.0)
     if turning:
@@ -193,13 +210,29 @@ def follow_released(
         speeds = [speeds[i] for i in still]
         transforms = [transforms[i] for i in still]
         rotation = rotation[still]
-    for player, v in zip(players, speeds, strict=True):
-        player.speed = v
+    if not stand:
+        for player, v in zip(players, speeds, strict=True):
+            player.speed = v
     if cols is None or len(transforms) < n // 2:
         for tr, q in zip(transforms, rotation, strict=True):
             tr.rotation = q
     else:
         cols.get(Transform, "rotation").write(transforms, rotation)
+
+
+def tuning_columns(block: RowBlock) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+    """Per row of a block of bodies: whether its tuning asks for the legacy controller, and its ``follow_omega``.
+
+    Derived from the tuning objects once and kept with the block while no tuning is assigned
+    (``RowBlock.objects_set``; a tuning is frozen), so a crowd's step reads no tuning."""
+    kept = block.memo.get("tuning")
+    if kept is None or kept[0] != block.objects_set:
+        tunings = block.arrays["tuning"]
+        n = len(tunings)
+        legacy = np.fromiter((t.controller == "legacy" for t in tunings), np.bool_, n)
+        omega = np.fromiter((t.follow_omega for t in tunings), np.float64, n)
+        kept = block.memo["tuning"] = (block.objects_set, legacy, omega)
+    return kept[1], kept[2]
 
 
 def _at_rest(value: F, rate: F, recent: F, omega: F, dt: float) -> bool:

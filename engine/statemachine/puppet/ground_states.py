@@ -15,7 +15,7 @@ decided over arrays (a guard of a ground state can only fire for a held puppet) 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -27,7 +27,7 @@ from engine.ecs import Entity, World
 from engine.ik.system import IKRequest
 from engine.statemachine.machine import Brain, Rows
 from engine.statemachine.puppet.body import Handling, PuppetBody
-from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity
+from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity, tuning_columns
 from engine.statemachine.puppet.follow_legacy import follow_stick_legacy
 from engine.statemachine.puppet.names import PuppetState
 from engine.statemachine.puppet.spec import (
@@ -133,15 +133,26 @@ def update_crouch(world: World, entity: Entity, brain: Brain) -> None:
 
 
 def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) -> None:
-    """:func:`update_locomotion` for many puppets: those no stick holds, with the spring control, in one pass."""
+    """:func:`update_locomotion` for many puppets: those no stick holds, with the spring control, in one pass.
+
+    When the bodies are linked to a row block (:mod:`engine.rows`) who is held and who runs the
+    legacy controller are read from its arrays, and the spring works on them in place."""
     bodies = columns.bodies
+    block = columns.block
     fast: list[int] = []
-    for i in rows.tolist():
-        body = bodies[i]
-        if body.held_by is None and body.tuning.controller != "legacy":
-            fast.append(i)
-        else:
+    if block is not None and not block.stale:
+        slow = block.present["held_by"][rows] | tuning_columns(block)[0][rows]
+        fast_rows = rows[~slow]
+        for i in rows[slow].tolist():
             update_locomotion(world, columns.entities[i], world.get(columns.entities[i], Brain))
+        fast = fast_rows.tolist()
+    else:
+        for i in rows.tolist():
+            body = bodies[i]
+            if body.held_by is None and body.tuning.controller != "legacy":
+                fast.append(i)
+            else:
+                update_locomotion(world, columns.entities[i], world.get(columns.entities[i], Brain))
     if not fast:
         return
     entities = columns.entities
@@ -150,22 +161,29 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
     players = _rows_of(world, LocomotionPlayer, columns.players, entities, fast, every)
     requests = _rows_of(world, IKRequest, columns.ik, entities, fast, every)
     transforms = _rows_of(world, Transform, columns.transforms, entities, fast, every)
-    for h in handling:
-        h.left = None  # standing
-    for player in players:
-        player.height = None
+    hb = columns.handling_block
+    if hb is not None and not hb.stale:
+        hb.present["left"][_ALL if every else fast] = False  # standing
+    else:
+        for h in handling:
+            h.left = None  # standing
     for ik in requests:
         if ik is not None:
             ik.foot_lock.enabled = True
             ik.grounding = True
             ik.sphere_centre, ik.sphere_radius = None, 0.0
     fast_bodies = bodies if every else [bodies[i] for i in fast]
-    follow_released(world.dt, fast_bodies, transforms, players, engine_columns(world))
+    linked = block is not None and not block.stale
+    block_rows = (block, _ALL if every else np.asarray(fast, dtype=np.intp)) if linked and block is not None else None
+    follow_released(world.dt, fast_bodies, transforms, players, engine_columns(world), block_rows, stand=True)
+
+
+_ALL = slice(None)
 
 
 def _rows_of(
-    world: World, ctype: type, kept: list[Any] | None, entities: list[Entity], rows: list[int], every: bool
-) -> list[Any]:
+    world: World, ctype: type, kept: Sequence[Any] | None, entities: list[Entity], rows: list[int], every: bool
+) -> Sequence[Any]:
     """The ``ctype`` components of ``rows``: from the list the caller kept, else looked up (``None`` if missing)."""
     if kept is None:
         store: Mapping[Entity, Any] = world.components(ctype)

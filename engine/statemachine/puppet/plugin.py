@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from engine.app import App
-from engine.batches import batch
+from engine.batches import Batch, batch
 from engine.blend.locomotion import BlendLibrary, LocomotionPlayer
 from engine.blend.puppet import install_puppet_locomotion
 from engine.components import Grabbable, LocalPose, Name, Puppet, Transform
@@ -23,6 +23,7 @@ from engine.posing import install_fk
 from engine.ragdoll.components import Ragdoll, RagdollMode
 from engine.ragdoll.profile import RagdollProfile, default_profile
 from engine.ragdoll.system import install_physics
+from engine.rows import row_store
 from engine.skeleton import Skeleton
 from engine.statemachine.machine import Brain, StateMachine, step_machines
 from engine.statemachine.puppet.body import PUPPET_COMPONENTS, Handling, PoseOverride, PuppetBody, PuppetTuning
@@ -31,7 +32,7 @@ from engine.statemachine.puppet.props import held_props_system
 from engine.statemachine.puppet.senses import sense_all, yaw_rotation
 from engine.statemachine.puppet.spec import PuppetColumns
 
-__all__ = ["PuppetMachine", "apply_pose_overrides", "brain_system", "install_puppets", "spawn_puppet"]
+__all__ = ["PuppetMachine", "apply_pose_overrides", "brain_system", "install_puppets", "puppet_batch", "spawn_puppet"]
 
 
 class PuppetMachine:
@@ -51,11 +52,20 @@ def brain_system(world: World) -> None:
     :func:`~engine.statemachine.machine.step_machines`: the puppets walking free in
     Locomotion over arrays, the others (held, jumping, fallen…) one by one in entity order.
     The puppets' component lists are kept between structural changes (:mod:`engine.batches`)."""
-    kept = batch(world, "puppet brains", (PuppetBody, Brain), (Transform, LocomotionPlayer, Handling, IKRequest))
+    kept = puppet_batch(world)
     bodies, brains, transforms, players, handling, ik = kept.lists
     columns = sense_all(world, kept.entities, bodies, None if kept.missing[2] else transforms)
     columns.players, columns.handling, columns.ik = players, handling, ik
+    if handling and not kept.missing[4]:
+        columns.handling_block = row_store(world).block(Handling, handling)
     step_machines(world, kept.entities, brains, columns)
+
+
+def puppet_batch(world: World) -> Batch:
+    """The kept batch the brain stage steps (:mod:`engine.batches`): the puppets' bodies and brains, with their
+    transforms, locomotion players, handling and IK requests beside them (row ``i`` of each for one puppet).
+    Its bodies are the row block of :class:`PuppetBody` once the brain stage ran (:mod:`engine.rows`)."""
+    return batch(world, "puppet brains", (PuppetBody, Brain), (Transform, LocomotionPlayer, Handling, IKRequest))
 
 
 def apply_pose_overrides(world: World) -> None:

@@ -13,8 +13,7 @@ holders from one pass over the sticks, and only the held puppets one by one.
 
 from __future__ import annotations
 
-import operator
-from itertools import repeat
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -23,6 +22,7 @@ from engine.columns import columns
 from engine.components import Stick, Transform
 from engine.ecs import Entity, World
 from engine.ragdoll.components import Prop
+from engine.rows import row_store
 from engine.statemachine.puppet.body import PuppetBody
 from engine.statemachine.puppet.spec import PuppetColumns
 
@@ -95,14 +95,18 @@ def _sense_stick(body: PuppetBody, controller: Entity, stick: Stick) -> Stick:
 
 
 def sense_all(
-    world: World, entities: list[Entity], bodies: list[PuppetBody], transforms: list[Transform] | None = None
+    world: World,
+    entities: list[Entity],
+    bodies: Sequence[PuppetBody],
+    transforms: Sequence[Transform] | None = None,
 ) -> PuppetColumns:
     """:func:`sense` for every puppet at once (the same numbers); the columns the array guards read.
 
-    ``transforms`` (row ``i`` for ``entities[i]``) saves looking them up. Once every puppet
-    has a ``last_position``, the rows' ``ground_velocity``, ``last_position`` and ``lead``
-    are kept in columns (:mod:`engine.columns`): written in place each step, never gathered;
-    before that (a puppet's first step) they are views into one fresh array per step each."""
+    ``transforms`` (row ``i`` for ``entities[i]``) saves looking them up. The bodies are linked to
+    a row block (:mod:`engine.rows`; kept while ``bodies`` is the same tuple): once every puppet
+    has a ``last_position``, ``ground_velocity``, ``last_position``, ``lead``, ``held_by`` and
+    ``speed`` are written whole in the block's arrays, no puppet touched; before that (a puppet's
+    first step) puppet by puppet."""
     n = len(entities)
     sticks: dict[Entity, tuple[Entity, Stick]] = {}
     for e, stick in world.query(Stick):  # entity order: the lowest id holds, as in holder()
@@ -110,31 +114,31 @@ def sense_all(
             sticks.setdefault(stick.grabbed, (e, stick))
     if transforms is None:
         transforms = [world.get(e, Transform) for e in entities]
-    cols = columns(world)
-    if n and not any(map(operator.is_, map(_LAST, bodies), repeat(None))):
-        pos = np.array(cols.get(Transform, "position").read(transforms))  # its own copy: kept as last_position
-        last = cols.get(PuppetBody, "last_position").read(bodies)
-        cols.get(PuppetBody, "ground_velocity").write(bodies, (pos - last) * _GROUND / world.dt)
-        cols.get(PuppetBody, "last_position").write(bodies, pos)
-        cols.get(PuppetBody, "lead").write(bodies, np.zeros((n, 3)))
-        for body in bodies:
-            body.held_by, body.speed = None, 0.0
+    block = row_store(world).block(PuppetBody, bodies if isinstance(bodies, tuple) else tuple(bodies)) if n else None
+    if block is not None and not block.stale and block.present["last_position"].all():
+        a = block.arrays
+        pos = columns(world).get(Transform, "position").read(transforms)
+        a["ground_velocity"][...] = (pos - a["last_position"]) * _GROUND / world.dt
+        a["last_position"][...] = pos
+        a["lead"][...] = 0.0
+        a["speed"][...] = 0.0
+        block.present["held_by"][...] = False
     else:
         _sense_first(world, bodies, transforms)
+        block = None
     held = np.zeros(n, dtype=bool)
     for e, by in sticks.items():
         if e in entities:
             i = entities.index(e)
             held[i] = True
             _sense_stick(bodies[i], *by)
-    return PuppetColumns(entities, bodies, held, transforms)
+    return PuppetColumns(entities, bodies, held, transforms, block=block)
 
 
-_LAST = operator.attrgetter("last_position")
 _GROUND = np.array([1.0, 0.0, 1.0])
 
 
-def _sense_first(world: World, bodies: list[PuppetBody], transforms: list[Transform]) -> None:
+def _sense_first(world: World, bodies: Sequence[PuppetBody], transforms: Sequence[Transform]) -> None:
     """The momentum and rest values of :func:`sense_all` when some puppet has no ``last_position`` yet."""
     n = len(bodies)
     pos = np.array([tr.position for tr in transforms], dtype=np.float64).reshape(n, 3)

@@ -13,6 +13,7 @@ is decided over arrays, not puppet by puppet.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +23,7 @@ from engine.blend.locomotion import LocomotionPlayer
 from engine.components import Transform
 from engine.ecs import Entity, World
 from engine.ik.system import IKRequest
+from engine.rows import RowBlock
 from engine.statemachine.machine import Rows, State, Transition
 from engine.statemachine.puppet.body import Handling, PuppetBody
 
@@ -37,12 +39,16 @@ class PuppetColumns:
     for a puppet without one; a list left ``None`` is looked up entity by entity."""
 
     entities: list[Entity]
-    bodies: list[PuppetBody]
+    bodies: Sequence[PuppetBody]
     held: NDArray[np.bool_]
-    transforms: list[Transform] | None = None
-    players: list[LocomotionPlayer | None] | None = None
-    handling: list[Handling | None] | None = None
-    ik: list[IKRequest | None] | None = None
+    transforms: Sequence[Transform] | None = None
+    players: Sequence[LocomotionPlayer | None] | None = None
+    handling: Sequence[Handling | None] | None = None
+    ik: Sequence[IKRequest | None] | None = None
+    block: RowBlock | None = None
+    """The row block the bodies are linked to, row ``i`` for ``bodies[i]`` (:mod:`engine.rows`), if they are."""
+    handling_block: RowBlock | None = None
+    """The row block ``handling`` is linked to, if every puppet has one and they are."""
 
 
 PuppetStateDef = State[PuppetColumns]

@@ -2,11 +2,12 @@
 
 from dataclasses import dataclass
 
+import numpy as np
 import pytest
 
 from engine.ecs import World
 from engine.hashing import state_hash
-from engine.statemachine import ANY, State, StateMachine, Transition, step_machine
+from engine.statemachine import ANY, Brain, State, StateMachine, Transition, step_machine
 
 
 @dataclass
@@ -184,3 +185,31 @@ def test_step_machines_groups_a_shared_machine_as_the_entity_by_entity_rule() ->
         groups, single = _groups(brains)
         assert list(groups.items()) == list(want.items())
         assert sorted(single) == alone
+
+
+def test_the_clocks_of_a_row_block_tick_as_step_machine_ticks_one() -> None:
+    """``_tick`` (the brains' clocks over arrays) gives the bits of ``step_machine``'s
+    ``time_in_state += dt`` and ``crossfade = max(0.0, crossfade - dt)``, signed zeros, NaN and
+    infinities included. Fails with ``fade[rows] = np.maximum(left, 0.0)`` (a NaN cross-fade stays
+    NaN) or with the clocks of every row advanced, not only ``rows``'."""
+    from engine.rows import RowStore
+    from engine.statemachine.machine import _tick
+
+    rng = np.random.default_rng(5)
+    specials = [0.0, -0.0, np.nan, np.inf, -np.inf, 1 / 60, 1 / 60 + 1e-17, 5e-324, -1.0]
+    dt = 1 / 60
+    m = StateMachine("m", [State("a")], [], default="a")
+    for _ in range(20):
+        brains = [m.new_brain() for _ in range(30)]
+        for b in brains:
+            b.time_in_state = float(rng.choice(specials)) if rng.random() < 0.4 else float(rng.normal())
+            b.crossfade = float(rng.choice(specials)) if rng.random() < 0.6 else float(rng.normal())
+        expected = [(b.time_in_state + dt, max(0.0, b.crossfade - dt) if b.crossfade > 0.0 else 0.0) for b in brains]
+        before = [(b.time_in_state, b.crossfade) for b in brains]
+        block = RowStore().block(Brain, tuple(brains))
+        rows = np.flatnonzero(rng.random(len(brains)) < 0.7)
+        _tick(block, rows, dt)
+        for i, b in enumerate(brains):
+            want = expected[i] if i in rows else before[i]
+            got = (b.time_in_state, b.crossfade)
+            assert np.array(got).tobytes() == np.array(want).tobytes(), (i, got, want)
