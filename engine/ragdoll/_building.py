@@ -51,7 +51,7 @@ class Building:
     _limit: _F
     _owners: NDArray[np.int64]
 
-    def _place(self, key: int, root: _F, rot: _F, before: tuple[_F, _F] | None = None) -> None:
+    def _place_rows(self, rows: NDArray[np.int64]) -> None:
         raise NotImplementedError
 
     def _size_pool(self) -> None:
@@ -161,17 +161,10 @@ class Building:
         rows = np.nonzero(C.pool >= 0)[0]
         keys = C.keys[rows].tolist()
         self.layout = select(pool, C.pool[rows].tolist(), keys)
-        for i in rows[~C.placed[rows]].tolist():
-            # joining from outside: where its animation was a step ago, moving as it moved then
-            # (as if it had been simulated all along), so it keeps its momentum
-            key = int(C.keys[i])
-            last, prev, had = C.last(i), C.prev(i), bool(C.has_last[i])
-            if last is None:
-                root, rot = C.pose(i)
-                self._place(key, root.copy(), rot.copy())
-            else:
-                self._place(key, last[0], last[1], prev)
-            C.has_last[i], C.placed[i] = had, True
+        joined = rows[~C.placed[rows]]
+        if len(joined):  # joining from outside: where its animation was a step ago, moving as it moved then
+            self._place_rows(joined)
+            C.placed[joined] = True
         settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
         # (settle's kinematics is all the next step's commands read, but leaving the rest of this to
         # the step is not bit-identical: games/snowman/demo.rec then differs from frame 227)

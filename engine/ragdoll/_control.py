@@ -22,7 +22,7 @@ from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
 
-__all__ = ["apply_commands", "project_twist", "read_poses", "hinge_angles", "GRAVITY"]
+__all__ = ["apply_commands", "place", "project_twist", "read_poses", "hinge_angles", "GRAVITY"]
 
 GRAVITY = 9.81
 _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
@@ -119,6 +119,73 @@ def apply_commands(
         d.qvel[L.ball_d[b, None] + np.arange(3)] = w_ball[b]
         d.qpos[L.hinge_q[h]] = hinge[h]
         d.qvel[L.hinge_d[h]] = w_hinge[h]
+
+
+def _ranges(lo: I64, hi: I64) -> I64:
+    """``lo[0]..hi[0]``, ``lo[1]..hi[1]``, … end to end (half-open ranges) as one index array."""
+    counts = hi - lo
+    total = int(counts.sum())
+    first = np.repeat(lo - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    return np.asarray(first + np.arange(total), dtype=np.int64)
+
+
+def place(
+    L: Layout,
+    d: mujoco.MjData,
+    ordinals: I64,
+    root: _F,
+    rot: _F,
+    before_root: _F,
+    before_rot: _F,
+    moving: NDArray[np.bool_],
+    dt: float,
+) -> None:
+    """Put the bodies of ragdolls ``ordinals`` (ascending, in the layout) on poses: roots ``[n,3]``
+    and their local rotations end to end ``[ΣJ,4]``. Those with ``moving [n]`` move as they moved
+    from ``before_root``/``before_rot`` (same shapes) in ``dt`` (the target velocities of an animated
+    placement); the others are at rest.
+
+    One pass for every ragdoll joining at once: a fall pulls in a dozen, and placing them one by one
+    was most of that step's Python. Each number is the same elementwise arithmetic as one at a time.
+    """
+    n = len(ordinals)
+    if n == 0:
+        return
+    sizes = L.starts[ordinals + 1] - L.starts[ordinals]
+    off = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    which = np.full(L.num_ragdolls, -1, dtype=np.int64)  # layout ordinal -> its place in ``ordinals``
+    which[ordinals] = np.arange(n)
+    shift = np.zeros(L.num_ragdolls, dtype=np.int64)  # layout flat joint -> row of ``rot``
+    shift[ordinals] = off - L.starts[ordinals]
+    rq, rd = L.root_q[ordinals], L.root_d[ordinals]
+    first = rot[off]
+    d.qpos[rq[:, None] + np.arange(3)] = root
+    d.qpos[rq[:, None] + np.arange(3, 7)] = first
+    b = which[L.ball_owner] >= 0
+    b_src = L.ball_src[b] + shift[L.ball_owner[b]]
+    ball = rot[b_src]
+    d.qpos[L.ball_q[b][:, None] + np.arange(4)] = ball
+    h = which[L.hinge_owner] >= 0
+    h_src = L.hinge_src[h] + shift[L.hinge_owner[h]]
+    h_axis = L.hinge_axis[h]
+    hinge = hinge_angles(rot[h_src], h_axis)
+    d.qpos[L.hinge_q[h]] = hinge
+    d.qvel[_ranges(L.dofs[ordinals, 0], L.dofs[ordinals, 1])] = 0.0
+    if moving.any():
+        k = np.nonzero(moving)[0]
+        q0 = before_rot[off[k]]
+        d.qvel[rd[k][:, None] + np.arange(3)] = (root[k] - before_root[k]) / dt
+        d.qvel[rd[k][:, None] + np.arange(3, 6)] = (
+            quat.rotate(q0, quat.log(quat.mul(quat.conjugate(q0), first[k]))) / dt
+        )
+        bm = moving[which[L.ball_owner[b]]]
+        d.qvel[L.ball_d[b][bm][:, None] + np.arange(3)] = (
+            quat.log(quat.mul(quat.conjugate(before_rot[b_src[bm]]), ball[bm])) / dt
+        )
+        hm = moving[which[L.hinge_owner[h]]]
+        d.qvel[L.hinge_d[h][hm]] = (hinge[hm] - hinge_angles(before_rot[h_src[hm]], h_axis[hm])) / dt
+    d.mocap_pos[L.pin_mocap[ordinals]] = root
+    d.mocap_quat[L.pin_mocap[ordinals]] = first
 
 
 def project_twist(L: Layout, d: mujoco.MjData) -> None:

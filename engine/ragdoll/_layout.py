@@ -207,8 +207,9 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
     for owner, names in _GROUPS.items():
         own = getattr(pool, owner)
         lo, hi = np.searchsorted(own, idx, "left"), np.searchsorted(own, idx, "right")
-        rows = np.concatenate([np.arange(a, b) for a, b in zip(lo, hi, strict=True)] or [np.zeros(0, np.int64)])
-        new_owner = np.repeat(np.arange(len(idx)), hi - lo)
+        counts = hi - lo  # each slot's rows lo..hi, end to end (one pass, not a range per slot)
+        rows = np.repeat(lo - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts) + np.arange(int(counts.sum()))
+        new_owner = np.repeat(np.arange(len(idx)), counts)
         fields[owner] = new_owner
         for n in names:
             fields[n] = getattr(pool, n)[rows]

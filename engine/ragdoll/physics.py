@@ -36,7 +36,7 @@ from engine.pose import Pose
 from engine.ragdoll._bounds import command_boxes, geom_boxes
 from engine.ragdoll._building import Building
 from engine.ragdoll._commands import Commands, joint_rows
-from engine.ragdoll._control import apply_commands, hinge_angles, project_twist
+from engine.ragdoll._control import apply_commands, place, project_twist
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
@@ -334,36 +334,25 @@ class PhysicsWorld(Readback, Building):
         if not C.in_model[i]:
             C.has_last[i] = False
             return
-        self._place(key, r, q)
-        assert self.model is not None and self.data is not None
+        assert self.layout is not None and self.model is not None and self.data is not None
+        at_rest = np.zeros(1, dtype=bool)
+        place(self.layout, self.data, np.array([self.layout.ordinal(key)]), r[None], q, r[None], q, at_rest, self.dt)
+        C.has_last[i] = False
+        self._ke = self._read = None
         mujoco.mj_forward(self.model, self.data)
 
-    def _place(self, key: int, root: _F, rot: _F, before: tuple[_F, _F] | None = None) -> None:
-        """Put a ragdoll's bodies on a pose, at rest or moving as it moved from ``before`` in one step."""
-        L, d = self.layout, self.data
+    def _place_rows(self, rows: I64) -> None:
+        """Put ragdolls ``rows`` (command rows, ascending, just given pool slots) where their animation
+        was a step ago, moving as it moved then (as if simulated all along, so they keep their momentum);
+        at rest there without a step before it, and at rest on the target without a last one."""
+        C, L, d = self._cmds, self.layout, self.data
         assert L is not None and d is not None
-        p = L.ordinal(key)
-        rq, rd = int(L.root_q[p]), int(L.root_d[p])
-        d.qpos[rq : rq + 3] = root
-        d.qpos[rq + 3 : rq + 7] = rot[0]
-        b = L.ball_owner == p
-        ball = rot[L.ball_src[b] - L.starts[p]]
-        d.qpos[L.ball_q[b][:, None] + np.arange(4)] = ball
-        h = L.hinge_owner == p
-        hinge = hinge_angles(rot[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])
-        d.qpos[L.hinge_q[h]] = hinge
-        d.qvel[L.dofs[p, 0] : L.dofs[p, 1]] = 0.0
-        if before is not None:  # the same target velocities as an animated (kinematic) placement
-            r0, q0 = before
-            d.qvel[rd : rd + 3] = (root - r0) / self.dt
-            d.qvel[rd + 3 : rd + 6] = quat.rotate(q0[0], quat.log(quat.mul(quat.conjugate(q0[0]), rot[0]))) / self.dt
-            d.qvel[L.ball_d[b][:, None] + np.arange(3)] = (
-                quat.log(quat.mul(quat.conjugate(q0[L.ball_src[b] - L.starts[p]]), ball)) / self.dt
-            )
-            d.qvel[L.hinge_d[h]] = (hinge - hinge_angles(q0[L.hinge_src[h] - L.starts[p]], L.hinge_axis[h])) / self.dt
-        d.mocap_pos[L.pin_mocap[p]] = root
-        d.mocap_quat[L.pin_mocap[p]] = rot[0]
-        self._cmds.has_last[self._cmds.row[key]] = False
+        has = C.has_last[rows]
+        j = joint_rows(C.starts, rows)
+        root = np.where(has[:, None], C.last_root[rows], C.root[rows])
+        rot = np.where(np.repeat(has, C.joints[rows])[:, None], C.last_rot[j], C.rot[j])
+        ordinals = np.searchsorted(np.asarray(L.keys, dtype=np.int64), C.keys[rows])
+        place(L, d, ordinals, root, rot, C.prev_root[rows], C.prev_rot[j], has & C.has_prev[rows], self.dt)
         self._ke = self._read = None
 
     # -- stepping -----------------------------------------------------------------------
