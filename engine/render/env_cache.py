@@ -45,9 +45,15 @@ def view_key(flags: object, names: Iterable[str], values: Mapping[str, object]) 
 
 
 def single_sampled(framebuffer: moderngl.Framebuffer) -> bool:
-    """Whether ``framebuffer`` has attachments and none is multisampled (a copy into it can work)."""
-    attachments = [*framebuffer.color_attachments, framebuffer.depth_attachment]
-    return bool(framebuffer.color_attachments) and all(a is None or a.samples == 0 for a in attachments)
+    """Whether ``framebuffer`` has attachments and none is multisampled (a copy into it can work).
+
+    A framebuffer moderngl detected rather than made (a window's own, drawn into straight) lists no
+    attachments: their formats and samples are unknown, so nothing is copied into it and its sky and
+    ground are drawn each frame."""
+    colour = framebuffer.color_attachments
+    if not colour:
+        return False
+    return all(a is None or a.samples == 0 for a in [*colour, framebuffer.depth_attachment])
 
 
 class EnvironmentCache:

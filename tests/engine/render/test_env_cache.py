@@ -115,3 +115,28 @@ def test_a_ground_that_reads_the_shadow_mask_is_not_kept() -> None:
         assert viewer.renderer.env_cache.stores == 0
     finally:
         viewer.close()
+
+
+def test_a_detected_framebuffer_is_drawn_into_without_a_kept_view() -> None:
+    """A window drawn into straight is a framebuffer moderngl detected: it lists no attachments
+    (``None``), so the view is not kept for it and the frame is drawn as into any buffer. Broken
+    once (reading its attachments as a list): ``author edit`` in a window crashed at its first frame."""
+    from engine.render.env_cache import single_sampled
+
+    scene = _scene(0.0)
+    scene.ground.snow = 0.0  # a ground that could be kept (as in the authoring scenes)
+    viewer = _viewer("high")  # full size: the scene is drawn into the target itself
+    try:
+        with viewer.target.ctx:
+            made = viewer.target.framebuffer
+            detected = viewer.target.ctx.detect_framebuffer(made.glo)
+            assert detected.color_attachments is None
+            assert not single_sampled(detected) and single_sampled(made)
+            viewer.camera = _CAMERA
+            viewer.renderer.render(scene, viewer.camera, detected)
+            pixels = viewer.read_pixels().copy()
+        expected = _uncached(scene, _CAMERA, "high")
+        assert pixels.shape == expected.shape and pixels.std() > 5
+        assert np.abs(pixels.astype(int) - expected.astype(int)).max() <= 2
+    finally:
+        viewer.close()
