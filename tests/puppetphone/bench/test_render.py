@@ -34,13 +34,6 @@ def test_auto_level_is_where_the_governor_settles_from_the_frames_cpu_time() -> 
 
     from puppetphone.bench.render import auto_level
 
-    class Levels:
-        def __init__(self) -> None:
-            self.seen: list[str] = []
-
-        def set_quality(self, q) -> None:  # type: ignore[no-untyped-def]
-            self.seen.append(q.name)
-
     def busy(seconds: float):  # type: ignore[no-untyped-def]
         def frame() -> None:
             end = time.process_time() + seconds
@@ -49,7 +42,7 @@ def test_auto_level_is_where_the_governor_settles_from_the_frames_cpu_time() -> 
 
         return frame
 
-    slow, quick = Levels(), Levels()
+    slow, quick = _Levels(), _Levels()
     assert auto_level(slow, busy(0.040), frames=26) == "low"
     assert slow.seen[0] == "medium" and slow.seen[-1] == "low"
     assert auto_level(quick, busy(0.001), frames=26) == "high"
@@ -64,3 +57,70 @@ def test_without_panda3d_the_peer_is_skipped_with_a_line(monkeypatch) -> None:
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "panda3d" else real(name, *a))
     line = panda3d_peer()
     assert isinstance(line, str) and "Panda3D is not installed" in line
+
+
+class _Levels:
+    """A renderer stand-in that records the levels it is set to."""
+
+    def __init__(self) -> None:
+        self.seen: list[str] = []
+        self.quality: object = None
+
+    def set_quality(self, q) -> None:  # type: ignore[no-untyped-def]  # a Quality; the test needs no import of it
+        self.seen.append(q.name)
+        self.quality = q
+
+
+def _busy(seconds: list[float]):  # type: ignore[no-untyped-def]  # a frame costing seconds[0] of CPU, changeable
+    import time
+
+    def frame() -> None:
+        end = time.process_time() + seconds[0]
+        while time.process_time() < end:
+            pass
+
+    return frame
+
+
+def test_the_governed_frame_keeps_the_governor_deciding_while_it_is_timed() -> None:
+    """Quick frames climb to high; when the frames turn slow the governor, still in the loop, steps down,
+    and a level another measurement set in between is set back. Broken once by no longer feeding the
+    governor after frame 26 (the settled level timed without it): the level stayed high and it failed;
+    once by not setting the governor's level back: the levels seen were high, low, medium."""
+    from engine.render.quality import QUALITIES
+    from puppetphone.bench.render import GovernedFrame
+
+    renderer, cost = _Levels(), [0.001]
+    governed = GovernedFrame(renderer, _busy(cost))  # type: ignore[arg-type]  # the stand-in has what it uses
+    for _ in range(26):
+        governed()
+    assert governed.governor.level == "high" and governed.settled_frames == 12
+    cost[0] = 0.045
+    renderer.set_quality(QUALITIES["low"])  # as the alternated low frames do
+    for _ in range(12):
+        governed()
+    assert renderer.seen[-3:] == ["low", "high", "medium"]
+    assert governed.governor.level == "medium" and governed.settled_frames == 33  # 7 slow frames of 12 move the median
+    assert governed.settle_cpu > 7 * 0.045
+
+
+def test_alternated_figures_take_turns_and_keep_their_own_times() -> None:
+    """Each figure's median is its own frames' CPU time, and the order alternates round by round. Broken
+    once by measuring in the same order every round: the order check failed."""
+    from puppetphone.bench.render import alternated
+
+    order: list[str] = []
+    quick, slow = _busy([0.002]), _busy([0.006])
+
+    def a() -> None:
+        order.append("a")
+        quick()
+
+    def b() -> None:
+        order.append("b")
+        slow()
+
+    times = alternated({"a": a, "b": b}, rounds=3, per_round=2)
+    assert 0.002 <= times["a"] < 0.005 <= 0.006 <= times["b"] < 0.012
+    runs = [order[0]] + [x for i, x in enumerate(order[1:], 1) if x != order[i - 1]]
+    assert runs == ["a", "b", "a", "b"]  # a b | b a | a b
