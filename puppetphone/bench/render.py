@@ -335,7 +335,7 @@ def quality_figures() -> list[Figure]:
             renderer.set_quality(QUALITIES["low"])
             game_frame()
 
-        both = alternated({"low": at_low, "auto": governed})
+        both = alternated({"low": at_low, "auto": governed}, rounds=5, per_round=4)  # 20 frames each, 5 turns
         game_fps["low"], game_fps["auto"] = 1.0 / both["low"], 1.0 / both["auto"]
         clear_ms = t_clear * 1e3
         for name in QUALITIES:
