@@ -63,7 +63,15 @@ if TYPE_CHECKING:
     from engine.render import RenderScene
     from engine.render.renderer import Renderer
 
-__all__ = ["run", "demo_scene", "unloaded_frame_time", "cpu_frame_time", "quality_figures"]
+__all__ = [
+    "run",
+    "demo_scene",
+    "unloaded_frame_time",
+    "cpu_frame_time",
+    "quality_figures",
+    "GovernedFrame",
+    "alternated",
+]
 
 WIDTH, HEIGHT = 1280, 720
 _ROW = 10  # puppets per row of the scene (seven stand in one row, a crowd of fifty in five)
@@ -228,14 +236,6 @@ class GovernedFrame:
         if self.governor.frame(took):
             self.renderer.set_quality(self.governor.quality)
             self.settled_frames, self.settle_cpu = self.frames, self.cpu
-
-
-def auto_level(renderer: Renderer, frame: Callable[[], object], frames: int = 40) -> str:
-    """The level :class:`~engine.render.quality.QualityGovernor` settles on from ``frame``'s CPU times."""
-    governed = GovernedFrame(renderer, frame)
-    for _ in range(frames):
-        governed()
-    return governed.governor.level
 
 
 def alternated(frames: dict[str, Callable[[], object]], rounds: int = 3, per_round: int = 6) -> dict[str, float]:

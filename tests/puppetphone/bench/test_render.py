@@ -27,25 +27,18 @@ def test_frame_times_are_cpu_time_so_waiting_costs_nothing() -> None:
     assert cpu_frame_time(lambda: time.sleep(0.004), frames=3) < 0.002  # wall time is not counted
 
 
-def test_auto_level_is_where_the_governor_settles_from_the_frames_cpu_time() -> None:
+def test_the_governed_frame_settles_where_the_frames_cpu_time_says() -> None:
     """Slow frames (40 ms of CPU) end at low; quick ones (1 ms) climb to high. Broken once: feeding
     the governor a constant 0 s instead of the measured time, the slow case ended at high."""
-    import time
-
-    from puppetphone.bench.render import auto_level
-
-    def busy(seconds: float):  # type: ignore[no-untyped-def]
-        def frame() -> None:
-            end = time.process_time() + seconds
-            while time.process_time() < end:
-                pass
-
-        return frame
+    from puppetphone.bench.render import GovernedFrame
 
     slow, quick = _Levels(), _Levels()
-    assert auto_level(slow, busy(0.040), frames=26) == "low"
+    for renderer, cost, level in ((slow, 0.040, "low"), (quick, 0.001, "high")):
+        governed = GovernedFrame(renderer, _busy([cost]))  # type: ignore[arg-type]  # the stand-in has what it uses
+        for _ in range(26):
+            governed()
+        assert governed.governor.level == level
     assert slow.seen[0] == "medium" and slow.seen[-1] == "low"
-    assert auto_level(quick, busy(0.001), frames=26) == "high"
 
 
 def test_without_panda3d_the_peer_is_skipped_with_a_line(monkeypatch) -> None:
