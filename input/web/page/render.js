@@ -134,7 +134,11 @@ void main() {
 }`;
 
 // The ground's colour at ``xz`` with the grid lines (the same in GRID_FS and SHADOW_FS, so a shade is never
-// lighter than the ground it falls on).
+// lighter than the ground it falls on); PLAIN_COLOUR where the game draws none (the snow: every blob-shadow
+// pixel would pay for the grid's test and derivatives).
+const PLAIN_COLOUR = `
+uniform vec3 color;
+vec3 groundColour(vec2 xz, float fade) { return color; }`;
 const GROUND_COLOUR = `
 uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
 vec3 groundColour(vec2 xz, float fade) {
@@ -185,12 +189,12 @@ void main() {
   gl_Position = viewProj * vec4(vXZ.x, height, vXZ.y, 1.0);
 }`;
 
-const SHADOW_FS = `#version 300 es
+const SHADOW_FS = (ground) => `#version 300 es
 precision highp float;
 in vec2 vXZ; in float vFade; flat in vec2 vA; flat in vec2 vB; flat in float vR; flat in float vSoft; flat in float vStrength;
 uniform vec3 horizon; uniform vec3 shadowTint;
 out vec4 frag;
-${GROUND_COLOUR}
+${ground}
 void main() {
   vec2 ab = vB - vA; float t = clamp(dot(vXZ - vA, ab) / max(dot(ab, ab), 1e-8), 0.0, 1.0);
   float m = vStrength * (1.0 - smoothstep(vR - vSoft, vR + vSoft, length(vXZ - vA - ab * t)));
@@ -484,7 +488,7 @@ class PageRenderer {
     this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
     const sb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, sb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sky.indices, gl.STATIC_DRAW);
     this.skyCount = sky.indices.length;
-    this.shadow = compile(gl, SHADOW_VS, SHADOW_FS);
+    this.shadow = compile(gl, SHADOW_VS, SHADOW_FS(PLAIN_COLOUR)); this.gridShadow = compile(gl, SHADOW_VS, SHADOW_FS(GROUND_COLOUR));
     this.marksProg = compile(gl, DECAL_VS, MARKS_FS);
     this.printProg = compile(gl, PRINT_VS, PRINT_FS);
     const square = new Float32Array([-1, -1, 1, -1, -1, 1, 1, 1]);
@@ -563,8 +567,9 @@ class PageRenderer {
   drawShadows(casters, look, viewProj, eye) {
     const n = casters.length / 11;
     if (!n) return;
-    const gl = this.gl, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]), g = look.ground, u = this.shadow.u;
-    gl.useProgram(this.shadow.prog);
+    const gl = this.gl, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]), g = look.ground;
+    const p = g.grid ? this.gridShadow : this.shadow, u = p.u;
+    gl.useProgram(p.prog);
     gl.uniformMatrix4fv(u.viewProj, false, viewProj);
     gl.uniform3f(u.sunDir, d[0] / len, Math.max(d[1] / len, 0.2), d[2] / len); gl.uniform1f(u.height, g.height);
     gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform3fv(u.shadowTint, shadowTint(look));
@@ -713,7 +718,12 @@ class PageRenderer {
       this.lighting(this.capsule, look, eye);
       gl.bindVertexArray(this.capVao);
       this.upload(this.capInst, shown);
+      // A capsule is closed, so its far side is never seen: culled before the rasteriser sets it up (the
+      // software one pays per triangle; a close-up puppet is ~4000). CAPSULE_VS maps the mesh's axes to (u, w, v),
+      // a mirror, so its outside faces come out clockwise.
+      gl.enable(gl.CULL_FACE); gl.frontFace(gl.CW);
       gl.drawElementsInstanced(gl.TRIANGLES, this.capCount, gl.UNSIGNED_SHORT, 0, shown.length / 11);
+      gl.disable(gl.CULL_FACE); gl.frontFace(gl.CCW);
     }
     const boxes = frame.rows.boxes;
     if (boxes.length) {
