@@ -815,6 +815,8 @@ class FrameCounter {
     return true;
   }
 }
-const MIN_RESOLUTION = 0.5;
+// Never under three quarters of the device's pixels a side: a phone that draws fewer is not showing the scene
+// "at" its size any more (half a side is a quarter of the pixels), and the page says the scale it drew at.
+const MIN_RESOLUTION = 0.75;
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, shadeMarks, MARKS_ONE, groundDisc, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, MIN_RESOLUTION, shadeMarks, MARKS_ONE, groundDisc, skyDome, capsuleMesh, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
