@@ -23,7 +23,7 @@ PAGE = Path(input.web.__file__).parent / "page"
 pytestmark = pytest.mark.skipif(shutil.which("node") is None, reason="no node executable: apt-get install nodejs")
 
 
-def test_rows_outside_the_view_are_culled_and_rows_partly_inside_are_kept():
+def test_rows_outside_the_view_are_culled_and_rows_partly_inside_are_kept() -> None:
     script = f"""
 const r = require({json.dumps(str(PAGE / "render.js"))});
 // The camera 4 m back on +z, 1.5 m up, looking along -z; 60° vertical, a phone's aspect (±1.07 m at z = 0).
