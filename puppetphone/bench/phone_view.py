@@ -28,8 +28,8 @@
 - **Page frame rate** at 390×844 in headless Chromium's software WebGL2 (SwiftShader),
   the median of the page's one-second counts while the stream runs: first with the
   drawing held at full resolution (every device pixel: the goal is judged there), then
-  with the page free to lower its resolution when it cannot hold 40 fps (the resolution
-  it settled at is reported too). The latencies cover both halves. Since a loaded
+  with the page free to lower its resolution when it cannot hold 40 fps, to no less than
+  0.75 a side (the resolution it settled at is reported too, and the page shows it). The latencies cover both halves. Since a loaded
   machine's frame rate says more about the load than the page, the CPU time Chromium
   (all its processes: the page's threads and the software rasteriser) spends per
   frame drawn at full resolution is reported too: ``1000 / that`` is the frame rate

@@ -134,7 +134,11 @@ void main() {
 }`;
 
 // The ground's colour at ``xz`` with the grid lines (the same in GRID_FS and SHADOW_FS, so a shade is never
-// lighter than the ground it falls on).
+// lighter than the ground it falls on); PLAIN_COLOUR where the game draws none (the snow: every blob-shadow
+// pixel would pay for the grid's test and derivatives).
+const PLAIN_COLOUR = `
+uniform vec3 color;
+vec3 groundColour(vec2 xz, float fade) { return color; }`;
 const GROUND_COLOUR = `
 uniform vec3 color; uniform vec3 gridColor; uniform float gridStrength; uniform float spacing;
 vec3 groundColour(vec2 xz, float fade) {
@@ -150,15 +154,16 @@ out vec4 frag;
 ${GROUND_COLOUR}
 void main() { frag = vec4(mix(groundColour(vXZ, vFade), horizon, vFade * vFade), 1.0); }`;
 
-// The sky's gradient per vertex of a screen-covering grid of SKY_CELLS² cells (behind everything: depth 1).
-const SKY_CELLS = 24;  // the gradient steepens at the horizon: coarser cells show a step there
+// The sky's gradient per vertex of a dome of directions (skyDome), at infinity behind everything (depth 1,
+// as the desktop's SKY_DOME_VS). Rings dense where the gradient is steep, just above the horizon, so a phone
+// sees a few dozen triangles of it: a screen-covering grid (24², ~600 triangles in view) cost the software
+// rasteriser more, and was further from the exact gradient (11 levels off at worst against 2).
 const SKY_VS = `#version 300 es
-layout(location=0) in vec2 ndc; uniform mat3 basis; uniform vec2 tanHalf; uniform vec3 sky; uniform vec3 horizon;
+layout(location=0) in vec3 dir; uniform mat4 viewProj; uniform vec3 sky; uniform vec3 horizon;
 out vec3 vColor;
 void main() {
-  vec3 d = normalize(basis * vec3(ndc * tanHalf, -1.0));
-  vColor = mix(horizon, sky, pow(clamp(d.y, 0.0, 1.0), 0.45));
-  gl_Position = vec4(ndc, 1.0, 1.0);
+  vColor = mix(horizon, sky, pow(clamp(dir.y, 0.0, 1.0), 0.45));
+  gl_Position = (viewProj * vec4(dir, 0.0)).xyww;
 }`;
 
 // Blob shadows: each round thing (capsule, sphere; a box as its footprint's circle) cast along the sun
@@ -185,12 +190,12 @@ void main() {
   gl_Position = viewProj * vec4(vXZ.x, height, vXZ.y, 1.0);
 }`;
 
-const SHADOW_FS = `#version 300 es
+const SHADOW_FS = (ground) => `#version 300 es
 precision highp float;
 in vec2 vXZ; in float vFade; flat in vec2 vA; flat in vec2 vB; flat in float vR; flat in float vSoft; flat in float vStrength;
 uniform vec3 horizon; uniform vec3 shadowTint;
 out vec4 frag;
-${GROUND_COLOUR}
+${ground}
 void main() {
   vec2 ab = vB - vA; float t = clamp(dot(vXZ - vA, ab) / max(dot(ab, ab), 1e-8), 0.0, 1.0);
   float m = vStrength * (1.0 - smoothstep(vR - vSoft, vR + vSoft, length(vXZ - vA - ab * t)));
@@ -322,13 +327,19 @@ function groundDisc(radii = [0, 0.5, 1.5, 3, 5, 10, 15, 20, 25, 30, 35, 60], seg
   return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
 }
 
-// An n × n grid of quads over [x0, x1] × [y0, y1]: vertices (x, y) and triangles.
-function gridMesh(n, x0, x1, y0, y1) {
+// The sky dome: unit directions in rings at ``elevations`` (degrees; below the horizon the sky is the
+// horizon's colour, for what the ground disc leaves), ``segments`` round, and triangles. The gradient,
+// pow(height, 0.45), is steepest at the horizon: the rings are spaced so interpolating between them is off by
+// under 2 % of the sky-to-horizon difference anywhere.
+function skyDome(elevations = [-90, -5, 0, 0.1, 0.3, 0.6, 1, 1.6, 2.5, 3.7, 5.3, 7.5, 10.5, 14.5, 20, 27, 36, 48, 63, 90], segments = 24) {
   const v = [], idx = [];
-  for (let j = 0; j <= n; j++) for (let i = 0; i <= n; i++) v.push(x0 + ((x1 - x0) * i) / n, y0 + ((y1 - y0) * j) / n);
-  for (let j = 0; j < n; j++) for (let i = 0; i < n; i++) {
-    const k = j * (n + 1) + i;
-    idx.push(k, k + 1, k + n + 1, k + 1, k + n + 2, k + n + 1);
+  for (const e of elevations) {
+    const r = (e * Math.PI) / 180;
+    for (let k = 0; k < segments; k++) { const a = (2 * Math.PI * k) / segments; v.push(Math.cos(r) * Math.cos(a), Math.sin(r), Math.cos(r) * Math.sin(a)); }
+  }
+  for (let i = 0; i < elevations.length - 1; i++) for (let k = 0; k < segments; k++) {
+    const p = i * segments + k, q = i * segments + ((k + 1) % segments);
+    idx.push(p, q, p + segments, q, q + segments, p + segments);
   }
   return { vertices: new Float32Array(v), indices: new Uint16Array(idx) };
 }
@@ -480,11 +491,11 @@ class PageRenderer {
     const gb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, ground.indices, gl.STATIC_DRAW);
     this.groundCount = ground.indices.length;
     this.skyVao = gl.createVertexArray(); gl.bindVertexArray(this.skyVao);
-    const sky = gridMesh(SKY_CELLS, -1, 1, -1, 1);
-    this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 8, 0);
+    const sky = skyDome();
+    this.buffer(sky.vertices); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 12, 0);
     const sb = gl.createBuffer(); gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, sb); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, sky.indices, gl.STATIC_DRAW);
     this.skyCount = sky.indices.length;
-    this.shadow = compile(gl, SHADOW_VS, SHADOW_FS);
+    this.shadow = compile(gl, SHADOW_VS, SHADOW_FS(PLAIN_COLOUR)); this.gridShadow = compile(gl, SHADOW_VS, SHADOW_FS(GROUND_COLOUR));
     this.marksProg = compile(gl, DECAL_VS, MARKS_FS);
     this.printProg = compile(gl, PRINT_VS, PRINT_FS);
     const square = new Float32Array([-1, -1, 1, -1, -1, 1, 1, 1]);
@@ -563,8 +574,9 @@ class PageRenderer {
   drawShadows(casters, look, viewProj, eye) {
     const n = casters.length / 11;
     if (!n) return;
-    const gl = this.gl, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]), g = look.ground, u = this.shadow.u;
-    gl.useProgram(this.shadow.prog);
+    const gl = this.gl, d = look.sun.direction, len = Math.hypot(d[0], d[1], d[2]), g = look.ground;
+    const p = g.grid ? this.gridShadow : this.shadow, u = p.u;
+    gl.useProgram(p.prog);
     gl.uniformMatrix4fv(u.viewProj, false, viewProj);
     gl.uniform3f(u.sunDir, d[0] / len, Math.max(d[1] / len, 0.2), d[2] / len); gl.uniform1f(u.height, g.height);
     gl.uniform3fv(u.eye, eye); gl.uniform3fv(u.horizon, look.horizon); gl.uniform3fv(u.shadowTint, shadowTint(look));
@@ -688,7 +700,7 @@ class PageRenderer {
   // instead (``first``: the first view of the XR frame, which clears).
   draw(frame, look, xr = null) {
     const gl = this.gl;
-    let proj, view, eye, basis;
+    let proj, view, eye;
     const round = this.roundOf(frame.rows);
     if (!xr) this.updateMarks(frame.marks, frame.marksDirty, look.sun.direction);
     if (xr) {
@@ -699,7 +711,6 @@ class PageRenderer {
       gl.bindFramebuffer(gl.FRAMEBUFFER, null);
       gl.viewport(0, 0, w, h);
       proj = perspective(cam.fov, w / h, 0.05, 200); view = viewMatrix(cam.p, cam.q); eye = cam.p;
-      basis = quatToMat3(cam.q);
     }
     const viewProj = mul4(proj, view), planes = frustumPlanes(viewProj);
     gl.enable(gl.DEPTH_TEST); gl.disable(gl.CULL_FACE);
@@ -713,7 +724,12 @@ class PageRenderer {
       this.lighting(this.capsule, look, eye);
       gl.bindVertexArray(this.capVao);
       this.upload(this.capInst, shown);
+      // A capsule is closed, so its far side is never seen: culled before the rasteriser sets it up (the
+      // software one pays per triangle; a close-up puppet is ~4000). CAPSULE_VS maps the mesh's axes to (u, w, v),
+      // a mirror, so its outside faces come out clockwise.
+      gl.enable(gl.CULL_FACE); gl.frontFace(gl.CW);
       gl.drawElementsInstanced(gl.TRIANGLES, this.capCount, gl.UNSIGNED_SHORT, 0, shown.length / 11);
+      gl.disable(gl.CULL_FACE); gl.frontFace(gl.CCW);
     }
     const boxes = frame.rows.boxes;
     if (boxes.length) {
@@ -733,13 +749,13 @@ class PageRenderer {
       this.upload(this.coneInst, cones);
       gl.drawElementsInstanced(gl.TRIANGLES, this.coneCount, gl.UNSIGNED_SHORT, 0, cones.length / 11);
     }
-    if (!xr) this.backdrop(frame, look, viewProj, eye, basis, round);
+    if (!xr) this.backdrop(frame, look, viewProj, eye, round);
     gl.bindVertexArray(null);
   }
 
   // Ground, then sky, after the objects: the depth test skips every pixel they already cover. The blob
   // shadows of ``round`` rows and the boxes, the tracks and footprints go on the ground in between.
-  backdrop(frame, look, viewProj, eye, basis, round) {
+  backdrop(frame, look, viewProj, eye, round) {
     const gl = this.gl, g = look.ground, p = g.grid ? this.grid : this.ground, u = p.u;
     gl.useProgram(p.prog);
     gl.bindVertexArray(this.groundVao);
@@ -749,10 +765,8 @@ class PageRenderer {
     gl.drawElements(gl.TRIANGLES, this.groundCount, gl.UNSIGNED_SHORT, 0);
     this.drawShadows(this.castersOf(round, frame.rows.boxes), look, viewProj, eye);
     this.drawDecals(frame, look, viewProj, eye);
-    const cam = frame.camera, aspect = this.canvas.width / this.canvas.height, t = Math.tan((cam.fov * Math.PI) / 360);
     gl.useProgram(this.sky.prog);
-    gl.uniformMatrix3fv(this.sky.u.basis, false, new Float32Array([0, 1, 2].flatMap((c) => [basis[0][c], basis[1][c], basis[2][c]])));
-    gl.uniform2f(this.sky.u.tanHalf, t * aspect, t);
+    gl.uniformMatrix4fv(this.sky.u.viewProj, false, viewProj);
     gl.uniform3fv(this.sky.u.sky, look.sky); gl.uniform3fv(this.sky.u.horizon, look.horizon);
     gl.depthFunc(gl.LEQUAL); gl.depthMask(false);
     gl.bindVertexArray(this.skyVao); gl.drawElements(gl.TRIANGLES, this.skyCount, gl.UNSIGNED_SHORT, 0);
@@ -801,6 +815,8 @@ class FrameCounter {
     return true;
   }
 }
-const MIN_RESOLUTION = 0.5;
+// Never under three quarters of the device's pixels a side: a phone that draws fewer is not showing the scene
+// "at" its size any more (half a side is a quarter of the pixels), and the page says the scale it drew at.
+const MIN_RESOLUTION = 0.75;
 
-if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, shadeMarks, MARKS_ONE, groundDisc, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
+if (typeof module !== "undefined") module.exports = { PageRenderer, FrameCounter, MIN_RESOLUTION, shadeMarks, MARKS_ONE, groundDisc, skyDome, capsuleMesh, perspective, viewMatrix, quatToMat3, mul4, roundRows, frustumPlanes, cull };
