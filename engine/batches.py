@@ -9,7 +9,9 @@ for as long as the world's cached query results it was built from (the query of 
 required types, and one query per optional type) are still the very same list objects —
 the world drops those on every structural change that touches their types
 (:meth:`World.query`), so a kept batch can never be stale. The cache holds the query lists
-it compares against, so their ids are never reused while it keeps them.
+it compares against, so their ids are never reused while it keeps them. While the world's
+count of structural changes (:attr:`World.structure`) has not moved since, not even the
+queries are asked again.
 
 Only membership is cached: the values in the components are read fresh by the caller.
 """
@@ -49,12 +51,18 @@ class Batches:
 
     def __init__(self) -> None:
         self._kept: dict[object, tuple[tuple[list[Any], ...], Batch]] = {}
+        # Per key: the world, its structure count and the types it was last checked at.
+        self._at: dict[object, tuple[World, int, tuple[type, ...], tuple[type, ...]]] = {}
 
     def get(self, world: World, key: object, required: tuple[type, ...], optional: tuple[type, ...] = ()) -> Batch:
         """The batch of ``required`` (with ``optional`` beside it) named ``key``, rebuilt if the world changed."""
+        at = self._at.get(key)
+        if at is not None and at[0] is world and at[1] == world.structure and at[2] == required and at[3] == optional:
+            return self._kept[key][1]
         sources = (world.query(*required), *(world.query(t) for t in optional))
         kept = self._kept.get(key)
         if kept is not None and len(kept[0]) == len(sources) and all(map(_same, kept[0], sources)):
+            self._at[key] = (world, world.structure, required, optional)
             return kept[1]
         rows = sources[0]
         entities = [r[0] for r in rows]
@@ -64,6 +72,7 @@ class Batches:
             lists.append(tuple([store.get(e) for e in entities]))
         made = Batch(entities, tuple(lists), tuple(any(c is None for c in comps) for comps in lists))
         self._kept[key] = (sources, made)
+        self._at[key] = (world, world.structure, required, optional)
         return made
 
 

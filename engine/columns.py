@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine.ecs import World
 
-__all__ = ["Column", "Columns", "Stacked", "columns"]
+__all__ = ["Column", "Columns", "Mark", "Stacked", "assignment_mark", "columns", "unassigned_since"]
 
 
 class Column:
@@ -57,7 +57,7 @@ class Column:
         "_row",
         "base",
         "_views",
-        "_whole",
+        "_wholes",
         "_watch",
         "_epoch",
         "_seen",
@@ -73,7 +73,7 @@ class Column:
         self._row: dict[int, int] = {}
         self.base: NDArray[Any] | None = None
         self._views: list[NDArray[Any]] = []
-        self._whole: tuple[Any, ...] | None = None  # a tuple of owners last found to be the whole column
+        self._wholes: dict[int, tuple[Any, ...]] = {}  # tuples of owners found to be the whole column, by id
         # Tuples of owners found in the column (by id, kept so no id is reused): their rows, as an array and a set.
         self._parts: dict[int, tuple[tuple[Any, ...], NDArray[np.int64], frozenset[int]]] = {}
         self._watch: _Watched | None = None  # the owners' field's assignment log, when their class has one
@@ -86,12 +86,14 @@ class Column:
         or ``None`` when one is not in it (or the rows are no views of the array: a copied world)."""
         if self.base is None or (self._views and self._views[0].base is not self.base):
             return None
-        if owners is self._whole:  # a tuple cannot have changed: no id to compare
+        if self._wholes.get(id(owners)) is owners:  # a tuple cannot have changed: no id to compare
             return _ALL
         ids = list(map(id, owners))
         if ids == self._ids:
             if isinstance(owners, tuple):
-                self._whole = owners
+                if len(self._wholes) >= _PARTS:
+                    self._wholes.clear()
+                self._wholes[id(owners)] = owners
             return _ALL
         row = self._row
         try:
@@ -157,7 +159,7 @@ class Column:
         if base.ndim < 2:
             raise ValueError(f"a column holds array fields, one row each: {self.attr} has shape {base.shape[1:]}")
         self.base, self._owners, self._ids = base, list(owners), list(map(id, owners))
-        self._whole = None
+        self._wholes = {}
         self._parts = {}
         self._row = {k: i for i, k in enumerate(self._ids)}
         self._views = list(base)
@@ -263,13 +265,50 @@ _LOG_CAP = 8192
 
 
 def _watched(owners: Sequence[Any], attr: str) -> _Watched | None:
-    """The assignment log of ``attr`` of the owners' class, put on the class on first use; ``None`` when the owners
-    are of several classes or the field is not a plain instance field (a slot, a property, a row field of
-    :mod:`engine.rows`, a class attribute other than the dataclass default): then a column compares every row."""
+    """The assignment log of ``attr`` of the owners' class (see :func:`_field_log`); ``None`` when the owners are of
+    several classes or the field cannot have one: then a column compares every row."""
     if not owners:
         return None
     cls = type(owners[0])
-    if any(type(o) is not cls for o in owners) or "__dict__" not in dir(cls):
+    if any(type(o) is not cls for o in owners):
+        return None
+    return _field_log(cls, attr)
+
+
+Mark = tuple[tuple[_Watched, int, int], ...]
+"""Where the assignment logs of some fields stood (:func:`assignment_mark`)."""
+
+
+def assignment_mark(cls: type, attrs: Sequence[str]) -> Mark | None:
+    """Where the assignment logs of the fields ``attrs`` of ``cls`` stand now (the logs put on the class on first use);
+    ``None`` if one of them cannot have a log. A system that set those fields of many components to values that
+    hold until someone assigns them keeps the mark, and skips setting them again while :func:`unassigned_since`."""
+    logs = [_field_log(cls, attr) for attr in attrs]
+    if any(log is None for log in logs):
+        return None
+    return tuple((log, log.epoch, len(log.log)) for log in logs if log is not None)
+
+
+def unassigned_since(mark: Mark | None) -> bool:
+    """Whether no component of the marked class had one of the marked fields assigned since the mark was taken."""
+    return mark is not None and all(log.epoch == epoch and len(log.log) == at for log, epoch, at in mark)
+
+
+def _field_log(cls: type, attr: str) -> _Watched | None:
+    """The assignment log of field ``attr`` of the class ``cls``, put on the class on first use; ``None`` when the
+    field is not a plain instance field (a slot, a property, a row field of :mod:`engine.rows`, a class attribute
+    other than the dataclass default)."""
+    key = (cls, attr)
+    if key not in _LOGS:
+        _LOGS[key] = _new_field_log(cls, attr)
+    return _LOGS[key]
+
+
+_LOGS: dict[tuple[type, str], _Watched | None] = {}
+
+
+def _new_field_log(cls: type, attr: str) -> _Watched | None:
+    if "__dict__" not in dir(cls):
         return None
     for klass in cls.__mro__:
         if attr in klass.__dict__:
