@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.app import App
-from engine.batches import batch
+from engine.batches import assign, batch
 from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import columns
 from engine.components import Transform
@@ -156,8 +156,7 @@ def _wander(
             body.heading = h
     else:
         block_rows[0].arrays["heading"][block_rows[1]] = heading
-    for player, v in zip(players, speeds, strict=True):
-        player.speed = v
+    assign(players, "speed", speeds)
     for i in np.flatnonzero(dist < _REACHED).tolist():
         w = wanderers[i]
         w.goal = np.array(
