@@ -14,9 +14,16 @@ sets each component's field to a *view* of its row, once. From then on:
 
 The components stay plain objects that any code may read and assign as before. A
 component whose field was replaced by other code (``pose.rotations = other``, a state's
-override) no longer views its row; both methods notice it by identity and take the
-new value in (``read``) or re-link the row (``write``), so a puppet in an unusual state
-costs a little Python and the crowd none. What changes for other code: a field that views a
+override) no longer views its row; both methods notice it and take the new value in
+(``read``) or re-link the row (``write``), so a puppet in an unusual state costs a little
+Python and the crowd none. To notice it without comparing every row on every call, the
+field of a dataclass gets an *assignment log* the first time a column holds it: a
+descriptor with only ``__set__`` (reads stay plain ``__dict__`` reads, in C) that
+notes each component assigned. A column looks only at the components assigned since it
+last looked, so it is validated when a field changes, not on every access; a field the
+log cannot be put on (a slot, a property, owners of several classes) is compared row by
+row in one pass in C, as before. The same logs let a system keep values it set on many
+components while nobody assigned them (:func:`assignment_mark`, :func:`unassigned_since`). What changes for other code: a field that views a
 column is overwritten in place by the next write, so a reference kept across steps must be
 a copy (``np.array(c.rotations)``), as with any array that a system updates in place.
 
