@@ -50,6 +50,9 @@ class World:
         self._entities: dict[Entity, set[type]] = {}
         self._resources: dict[type, Any] = {}
         self._query_cache: dict[tuple[type, ...], list[tuple[Any, ...]]] = {}
+        self.structure = 0
+        """Counts structural changes (spawn, despawn, a component added, replaced or removed): what is kept
+        from the world's membership (:mod:`engine.batches`) holds while it is unchanged."""
         self._pending: list[Callable[[], None]] = []
 
     # -- time -------------------------------------------------------------------------
@@ -163,6 +166,7 @@ class World:
         return rows[0] if rows else None
 
     def _invalidate(self, ctype: type) -> None:
+        self.structure += 1
         for key in [k for k in self._query_cache if ctype in k]:
             del self._query_cache[key]
 

@@ -20,9 +20,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.app import App
-from engine.batches import batch
+from engine.batches import assign, batch
 from engine.blend.locomotion import LocomotionPlayer
-from engine.columns import columns
+from engine.columns import assignment_mark, columns, unassigned_since
 from engine.components import Transform
 from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
@@ -68,7 +68,7 @@ def wander_system(world: World) -> None:
     ok = ~block.present["held_by"][rows]
     on_ground = row_store(world).block(Jumping, jumps)
     ok &= (np.fromiter(map(_AIR, jumps), np.float64, n) if on_ground.stale else on_ground.arrays["air"]) == 0.0
-    ok &= np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, n)
+    ok &= _animated(own, rds)
     puppets = puppet_batch(world)
     whole = (
         None if puppets.missing[2] or row_store(world).owners(PuppetBody) is not puppets.lists[0] else puppets.lists[2]
@@ -89,6 +89,20 @@ def wander_system(world: World) -> None:
             (own, free),
             whole,
         )
+
+
+def _animated(own: RowBlock, rds: tuple[Ragdoll, ...]) -> NDArray[np.bool_]:
+    """Which of the wanderers' ragdolls are animated (not falling, not limp): read from every ragdoll once, then kept
+    (in the wanderers' row block) while no ragdoll's mode was assigned (:func:`engine.columns.assignment_mark`).
+    Shared: read it, never change it."""
+    kept = own.memo.get("animated")
+    if kept is not None and kept[0] is rds and unassigned_since(kept[1]):
+        found: NDArray[np.bool_] = kept[2]
+        return found
+    mark = assignment_mark(Ragdoll, ("mode",))
+    animated = np.fromiter(map(operator.is_, map(_MODE, rds), repeat(RagdollMode.ANIMATED)), np.bool_, len(rds))
+    own.memo["animated"] = (rds, mark, animated)
+    return animated
 
 
 def _free_one_by_one(lists: tuple[tuple[Any, ...], ...]) -> tuple[list[Any], list[Any], list[Any], list[Any]]:
@@ -156,8 +170,7 @@ def _wander(
             body.heading = h
     else:
         block_rows[0].arrays["heading"][block_rows[1]] = heading
-    for player, v in zip(players, speeds, strict=True):
-        player.speed = v
+    assign(players, "speed", speeds)
     for i in np.flatnonzero(dist < _REACHED).tolist():
         w = wanderers[i]
         w.goal = np.array(

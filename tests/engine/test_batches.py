@@ -5,7 +5,9 @@ returning the kept one without comparing the queries) fails the second and third
 
 from dataclasses import dataclass
 
-from engine.batches import batch
+import pytest
+
+from engine.batches import assign, batch
 from engine.ecs import World
 
 
@@ -63,3 +65,44 @@ def test_batches_of_different_keys_are_apart() -> None:
     w, es = _world()
     assert batch(w, "only a", (A,)).lists == (tuple(w.get(e, A) for e in es),)
     assert batch(w, "a and b", (A, B)).entities == [es[1], es[3]]
+
+
+def test_a_kept_batch_asks_no_query_while_the_world_has_no_structural_change() -> None:
+    """Broken once by dropping the structure-count shortcut of ``Batches.get`` (the queries were asked again)."""
+    w, es = _world()
+    first = batch(w, "k", (A,), (B,))
+    asked: list[tuple[type, ...]] = []
+    query = w.query
+    w.query = lambda *types: asked.append(types) or query(*types)  # type: ignore[method-assign]  # a spy
+    w.get(es[0], A).v = 3  # a value, not the structure
+    assert batch(w, "k", (A,), (B,)) is first and asked == []
+    assert batch(w, "k", (A,)) is not first  # the same key asked for other types: built anew
+    w.add(es[0], B(1))
+    assert batch(w, "k", (A,), (B,)).lists[1][0] is w.get(es[0], B) and asked
+
+
+def test_the_structure_count_moves_on_every_structural_change_only() -> None:
+    w, es = _world()
+    seen = [w.structure]
+    w.get(es[0], A).v = 8
+    w.query(A)
+    seen.append(w.structure)
+    assert seen[-1] == seen[-2]
+    for change in (
+        lambda: w.spawn(A()),
+        lambda: w.despawn(es[0]),
+        lambda: w.add(es[1], A(2)),
+        lambda: w.remove(es[1], B),
+    ):
+        change()
+        seen.append(w.structure)
+        assert seen[-1] > seen[-2]
+
+
+def test_assign_sets_every_row_in_order_and_refuses_a_short_list() -> None:
+    """Broken once by assigning ``values`` reversed: the first assertion fails."""
+    objects = [A(i) for i in range(4)]
+    assign(objects, "v", [10, 11, 12, 13])
+    assert [a.v for a in objects] == [10, 11, 12, 13]
+    with pytest.raises(ValueError, match="3 values of v for 4 objects"):
+        assign(objects, "v", [1, 2, 3])

@@ -172,3 +172,58 @@ def test_rows_are_where_part_of_the_batch_is_and_take_in_a_replaced_field() -> N
     col.write([*poses[::-1], _Pose(np.zeros(3))], np.zeros((6, 3)))  # relinked in another order: the rows follow
     found = col.rows(part)
     assert found is not None and found[1].tolist() == [1, 3]
+
+
+@dataclass
+class _Tracked:
+    root: np.ndarray
+
+
+@dataclass(slots=True)
+class _Slotted:
+    root: np.ndarray
+
+
+def test_an_untouched_batch_is_known_intact_from_the_assignment_log_alone() -> None:
+    """A column of a dataclass field reads the field's assignment log instead of comparing every row:
+    a field changed behind the log's back (straight in ``__dict__``, which no code does) is therefore
+    not seen, and one assigned is. Broken once by dropping the log (``_watched`` returning ``None``):
+    the first ``linked`` then compares the rows and returns ``None``."""
+    poses = tuple(_Tracked(np.full(3, float(i))) for i in range(4))
+    col = Column("root")
+    col.write(poses, np.zeros((4, 3)))
+    poses[2].__dict__["root"] = np.ones(3)  # behind the log: not looked at
+    assert col.linked(poses) is col.base
+    poses[1].root = np.full(3, 5.0)  # assigned: in the log
+    assert col.linked(poses) is None
+    assert np.array_equal(col.read(poses)[1], [5.0, 5.0, 5.0]) and poses[1].root.base is col.base
+    assert col.linked(poses) is col.base
+
+
+def test_a_full_log_starts_an_epoch_and_the_column_compares_every_row_once() -> None:
+    """Past the log's cap the log is cleared: a column that had not read it yet compares every row.
+    Broken once by reading the cleared log from the old position (the replaced field was lost)."""
+    from engine import columns as module
+
+    poses = tuple(_Tracked(np.zeros(3)) for _ in range(3))
+    col = Column("root")
+    col.write(poses, np.zeros((3, 3)))
+    poses[0].root = np.full(3, 2.0)
+    other = _Tracked(np.zeros(3))
+    for _ in range(module._LOG_CAP + 1):  # some other component assigned many times
+        other.root = np.zeros(3)
+    assert np.array_equal(col.read(poses)[0], [2.0, 2.0, 2.0]) and poses[0].root.base is col.base
+
+
+@pytest.mark.parametrize("kind", ["slots", "mixed"])
+def test_owners_without_a_log_are_compared_row_by_row(kind: str) -> None:
+    """Slotted components (no ``__dict__``) or owners of several classes get no log: every call compares the rows."""
+    first: object = _Slotted(np.zeros(3)) if kind == "slots" else _Tracked(np.zeros(3))
+    poses = (first, _Slotted(np.zeros(3)), _Slotted(np.zeros(3)))
+    col = Column("root")
+    col.write(poses, np.zeros((3, 3)))
+    assert col._watch is None
+    poses[2].root = np.full(3, 4.0)
+    assert col.linked(poses) is None
+    assert np.array_equal(col.read(poses)[2], [4.0, 4.0, 4.0])
+    assert col.linked(poses) is col.base

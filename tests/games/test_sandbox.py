@@ -50,3 +50,23 @@ def test_the_crowd_size_is_a_checked_option() -> None:
     for bad in ("0", "-2", "1001", "many"):
         with pytest.raises(GameOptionError, match="puppets must be"):
             GAME.prepare({**GAME.options, "puppets": bad})
+
+
+def test_a_wanderer_whose_ragdoll_leaves_the_animation_is_no_longer_steered_at_the_next_step() -> None:
+    """Who is animated is kept between steps while no ragdoll mode is assigned (``wander._animated``); a
+    ``set_mode`` must reach the next step's steering. Broken once by keeping it without the assignment mark:
+    the limp wanderer's heading was still turned toward its goal."""
+    from engine.ragdoll.components import Ragdoll, RagdollMode
+
+    app = _crowd(4, 5)
+    e, wanderer, body, rd = app.world.query(Wanderer, PuppetBody, Ragdoll)[0]
+    wanderer.goal = np.array([50.0, 0.0, 0.0])  # far to the side: steering turns the heading
+    app.step()
+    turned = body.heading
+    app.step()
+    assert body.heading != turned  # still steered
+    rd.set_mode(RagdollMode.LIMP, immediate=True)
+    app.step()
+    kept = body.heading
+    app.step()
+    assert body.heading == kept

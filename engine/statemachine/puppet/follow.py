@@ -27,11 +27,13 @@ from __future__ import annotations
 
 import operator
 from collections.abc import Sequence
+from itertools import repeat
 
 import numpy as np
 from numpy.typing import NDArray
 
 from engine.arrays import Intp as Rows
+from engine.batches import assign
 from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import Columns
 from engine.components import Transform
@@ -199,9 +201,8 @@ def follow_released(
     moving = speed > 1e-3
     turning = np.flatnonzero(moving).tolist()
     if stand:  # every player's speed now; a turning puppet's is set again by _face below
-        for player, v in zip(players, speeds, strict=True):
-            player.height = None
-            player.speed = v
+        assign(players, "height", repeat(None))
+        assign(players, "speed", speeds)
     for i in turning:
         _face(transforms[i], bodies[i], players[i], speeds[i], dt, 1.0)
     if turning:
@@ -211,8 +212,7 @@ def follow_released(
         transforms = [transforms[i] for i in still]
         rotation = rotation[still]
     if not stand:
-        for player, v in zip(players, speeds, strict=True):
-            player.speed = v
+        assign(players, "speed", speeds)
     if cols is None or len(transforms) < n // 2:
         for tr, q in zip(transforms, rotation, strict=True):
             tr.rotation = q

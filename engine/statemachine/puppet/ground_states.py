@@ -21,10 +21,13 @@ from typing import Any
 import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
+from engine.columns import assignment_mark, unassigned_since
 from engine.columns import columns as engine_columns
 from engine.components import Transform
 from engine.ecs import Entity, World
+from engine.ik.foot_lock import FootLock
 from engine.ik.system import IKRequest
+from engine.rows import RowBlock
 from engine.statemachine.machine import Brain, Rows
 from engine.statemachine.puppet.body import Handling, PuppetBody
 from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity, tuning_columns
@@ -167,11 +170,7 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
     else:
         for h in handling:
             h.left = None  # standing
-    for ik in requests:
-        if ik is not None:
-            ik.foot_lock.enabled = True
-            ik.grounding = True
-            ik.sphere_centre, ik.sphere_radius = None, 0.0
+    _stand_requests(block, requests)
     fast_bodies = bodies if every else [bodies[i] for i in fast]
     linked = block is not None and not block.stale
     block_rows = (block, _ALL if every else np.asarray(fast, dtype=np.intp)) if linked and block is not None else None
@@ -179,6 +178,32 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
 
 
 _ALL = slice(None)
+
+
+def _stand_requests(block: RowBlock | None, requests: Sequence[IKRequest | None]) -> None:
+    """Ground the IK requests of puppets that stand: feet locked, grounding on, no sphere to hold.
+
+    A crowd walking free asks this of the same requests step after step, and nothing else
+    assigns those fields meanwhile: with the bodies' row ``block`` the batch of requests and where
+    the fields' assignment logs stood after the last pass are kept (:func:`engine.columns.assignment_mark`),
+    and while no such field was assigned since, on any request, the values are still in place."""
+    kept = None if block is None or block.stale else block.memo.get("stand requests")
+    if kept is not None and kept[0] is requests and unassigned_since(kept[1]) and unassigned_since(kept[2]):
+        return
+    for ik in requests:
+        if ik is not None:
+            ik.foot_lock.enabled = True
+            ik.grounding = True
+            ik.sphere_centre, ik.sphere_radius = None, 0.0
+    if block is not None and not block.stale:
+        block.memo["stand requests"] = (
+            requests,
+            assignment_mark(IKRequest, _STAND_FIELDS),
+            assignment_mark(FootLock, ("enabled",)),
+        )
+
+
+_STAND_FIELDS = ("grounding", "sphere_centre", "sphere_radius", "foot_lock")
 
 
 def _rows_of(
