@@ -28,6 +28,7 @@ from engine.components import LocalPose, Transform
 from engine.ecs import Entity
 from engine.ik.foot_lock import FootLock
 from engine.ik.system import IKRequest
+from engine.rows import RowBlock
 
 if TYPE_CHECKING:
     from engine.blend.locomotion import LocomotionPlayer
@@ -77,10 +78,11 @@ class Groups:
         self._keys: list[str] = []
         self._groups: list[Group] = []
 
-    def of(self, kept: Batch) -> list[Group]:
+    def of(self, kept: Batch, block: RowBlock | None = None) -> list[Group]:
         """The groups of ``kept`` (rows ``(Transform, Puppet, LocomotionPlayer)``, optional
-        ``(LocalPose, IKRequest)``), in order of each set's first puppet."""
-        keys = list(map(_KEY, kept.lists[2]))
+        ``(LocalPose, IKRequest)``), in order of each set's first puppet; the set names are read from
+        ``block`` when the players are linked to it (:mod:`engine.rows`), whole."""
+        keys = list(map(_KEY, kept.lists[2])) if block is None else block.arrays["library_key"].tolist()
         if kept is self._batch and keys == self._keys:
             return self._groups
         rows: dict[str, list[int]] = {}

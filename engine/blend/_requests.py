@@ -23,12 +23,14 @@ from operator import is_, is_not
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from engine import jit
 from engine.arrays import F64 as F
 from engine.arrays import Bool
 from engine.blend._resolve import resolve_changed, resolve_rows
 from engine.ecs import Entity
+from engine.rows import RowBlock
 
 if TYPE_CHECKING:
     from engine.blend.locomotion import LocomotionPlayer, LocomotionSet
@@ -61,17 +63,26 @@ class Requests:
         return list(compress(count(), map(is_not, self.overrides, repeat(None))))
 
 
-def read(entities: Sequence[Entity], players: Sequence[LocomotionPlayer]) -> Requests:
+def read(
+    entities: Sequence[Entity],
+    players: Sequence[LocomotionPlayer],
+    at: tuple[RowBlock, slice | NDArray[np.intp]] | None = None,
+) -> Requests:
     """The players' requests and fields; ``ValueError`` names the first entity with an invalid request
-    (speed not finite or negative, height not finite) or scale (not finite or not positive).
+    (speed not finite or negative, height not finite) or scale (not finite or not positive). ``at``: the
+    players' rows in their block (:mod:`engine.rows`), where their phases and overrides are read whole.
 
     One list per field: a comprehension's attribute loads are the interpreter's cached fast path,
     cheaper per puppet than one ``attrgetter`` of every field and the transposition after it."""
     speed = [p.speed for p in players]
     height = [p.height for p in players]
     scale = [p.scale for p in players]
-    phase = [p.phase for p in players]
-    override = [p.override for p in players]
+    if at is None:
+        phases = np.array([p.phase for p in players], dtype=np.float64)
+        override = [p.override for p in players]
+    else:
+        phases = np.array(at[0].arrays["phase"][at[1]])  # a copy: the stage writes the new phases there
+        override = at[0].arrays["override"][at[1]].tolist()
     speeds = np.array(speed, dtype=np.float64)
     standing = np.fromiter(map(is_, height, repeat(None)), dtype=np.bool_, count=len(height))
     heights = np.array(height, dtype=np.float64)  # None becomes NaN
@@ -83,7 +94,7 @@ def read(entities: Sequence[Entity], players: Sequence[LocomotionPlayer]) -> Req
                 f"entity {entities[i]}: locomotion request speed={speed[i]!r}, height={height[i]!r} is invalid"
             )
         raise ValueError(f"entity {entities[i]}: locomotion scale {scale[i]!r} must be positive")
-    return Requests(speeds, heights, standing, scales, np.array(phase, dtype=np.float64), override)
+    return Requests(speeds, heights, standing, scales, phases, override)
 
 
 def _first_invalid(speeds: F, heights: F, standing: Bool, scales: F) -> tuple[int, bool]:

@@ -51,6 +51,7 @@ from engine.ecs import World
 from engine.ik.foot_lock import FootLock
 from engine.ik.system import IKRequest
 from engine.pose import Pose
+from engine.rows import RowBlock, keep_in_rows, row_store
 
 __all__ = ["LocomotionSet", "BlendLibrary", "LocomotionPlayer", "animate", "install_blend"]
 
@@ -185,6 +186,21 @@ class LocomotionPlayer:
             self.override_fade, self.override_stopping = fade, True
 
 
+# What the stage reads or writes of every player every step, kept in rows (:mod:`engine.rows`): one array
+# each over the crowd, so neither the set names, the phases and overrides read nor the four results written
+# cost a pass over a thousand player objects. A value a row cannot hold exactly (an ``int`` phase) unlinks the
+# batch back to plain objects, and the stage then takes them one by one, as before.
+keep_in_rows(
+    LocomotionPlayer,
+    library_key=("object", (), False),
+    inside=("object", (), False),
+    rate=("float", (), False),
+    phase=("float", (), False),
+    override=("object", (), False),
+    finished=("object", (), False),
+)
+
+
 def _override(player: LocomotionPlayer, loco: LocomotionSet, dt: float) -> tuple[Clip | None, float, F]:
     """Advance the override clip: (clip, eased weight, its root travel this step in clip frame)."""
     if player.override is None:
@@ -281,8 +297,12 @@ def animate(world: World) -> None:
     if not kept.entities:
         return
     dt = world.dt
-    for group in library.groups.of(kept):
-        _animate_group(world, library, group, dt)
+    store = row_store(world)
+    block = store.block(LocomotionPlayer, kept.lists[2])
+    rowed = None if block.stale else block
+    for group in library.groups.of(kept, rowed):
+        at = None if rowed is None else store.rows(LocomotionPlayer, group.players)
+        _animate_group(world, library, group, dt, at)
 
 
 class _Out:
@@ -305,11 +325,18 @@ def _linked(column: Column, owners: Sequence[object], shape: tuple[int, ...]) ->
     return base if base is not None and base.shape == shape and base.dtype == np.float64 else None
 
 
-def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt: float) -> None:
-    """One locomotion set's puppets: array passes, and per-puppet Python only to read the requests, write
-    the players' scalar fields and for a puppet playing an override clip. The array fields (blend point,
-    feasible request, position, local pose, foot-contact votes) are written through the world's
-    :mod:`engine.columns`; on the compiled path straight into them, when every component views its row."""
+def _animate_group(
+    world: World,
+    library: BlendLibrary,
+    group: _groups.Group,
+    dt: float,
+    at: tuple[RowBlock, slice | NDArray[np.intp]] | None,
+) -> None:
+    """One locomotion set's puppets: array passes, and per-puppet Python only to read the requests and for a
+    puppet playing an override clip. The players' row fields are read and written in their block's arrays
+    (rows ``at``; one by one when ``None``). The array fields (blend point, feasible request, position, local
+    pose, foot-contact votes) are written through the world's :mod:`engine.columns`; on the compiled path
+    straight into them, when every component views its row."""
     key = group.key
     loco = library[key]
     space = loco.space
@@ -317,11 +344,12 @@ def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt
     entities, players = group.entities, group.players
     count = len(players)
     alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
-    req = _requests.read(entities, players)
+    req = _requests.read(entities, players, at)
     answers = _requests.resolve(library.last_answers, key, loco, req)
     target = answers.points
     scale = req.scales
     overrides = req.override_rows()
+    locks = group.foot_locks()
     tracks = library.tracks(key)
     packed = _kernel.packed(space, tracks) if jit.enabled() else None
     point_column, feasible_column = (
@@ -355,7 +383,7 @@ def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt
             if linked is not None:
                 out.rotations = linked
         if legs and not overrides and group.ik_rows is None:  # votes straight into the foot locks' column
-            linked = _linked(cols.get(FootLock, "contacts", legs), group.foot_locks(), out.votes.shape)
+            linked = _linked(cols.get(FootLock, "contacts", legs), locks, out.votes.shape)
             if linked is not None:
                 out.votes = linked
         feasible_in = _linked(feasible_column, players, out.feasible.shape)
@@ -371,10 +399,17 @@ def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt
             feasible_column.write(players, out.feasible)
         roots, rots, travel, turn, wrapped = out.roots, out.rotations, out.travel, out.turn, out.wrapped
         votes = out.votes if legs else None
-    for player, inside, rate, ph in zip(
-        players, answers.inside.tolist(), answers.rates.tolist(), wrapped.tolist(), strict=True
-    ):
-        player.finished, player.inside, player.rate, player.phase = None, inside, rate, ph
+    if at is None:
+        for player, inside, rate, ph in zip(
+            players, answers.inside.tolist(), answers.rates.tolist(), wrapped.tolist(), strict=True
+        ):
+            player.finished, player.inside, player.rate, player.phase = None, inside, rate, ph
+    else:  # the same values: an object row of a bool array holds Python bools, a float row reads as a float
+        arrays, rows = at[0].arrays, at[1]
+        arrays["finished"][rows] = None
+        arrays["inside"][rows] = answers.inside
+        arrays["rate"][rows] = answers.rates
+        arrays["phase"][rows] = wrapped
     faded = None  # the override clips' weights, where one plays
     if overrides:
         keep_turn, faded = np.ones(count), np.zeros(count)
@@ -389,7 +424,7 @@ def _animate_group(world: World, library: BlendLibrary, group: _groups.Group, dt
                 keep_turn[i] = 1.0 - weight
                 faded[i] = weight
         turn = turn * keep_turn
-    _contacts(group, req.speeds, votes, faded, cols)
+    _contacts(group, locks, req.speeds, votes, faded, cols)
     _move(world, cols, group, travel, turn, roots, rots)
 
 
@@ -434,10 +469,12 @@ def _place(rotation: F, positions: F, travel: F, turn: F, roots: F, rots: F) -> 
     return moved, quat.normalize(quat.mul(turn_q, rotation)), moved + quat.rotate(hq_new, roots)
 
 
-def _contacts(group: _groups.Group, speeds: F, votes: F | None, faded: F | None, cols: Columns) -> None:
+def _contacts(
+    group: _groups.Group, locks: tuple[FootLock, ...], speeds: F, votes: F | None, faded: F | None, cols: Columns
+) -> None:
     """The blend's foot-contact votes (less an override clip's weight ``faded``) and the settle flag to each
-    puppet's foot lock, so the leg IK holds planted feet where they landed."""
-    locks = group.foot_locks()
+    puppet's foot lock (``locks``, the group's as handed out this step), so the leg IK holds planted feet
+    where they landed."""
     settle = speeds < _SETTLE_SPEED
     rows = group.ik_rows
     for lock, flag in zip(locks, (settle if rows is None else settle[rows]).tolist(), strict=True):
