@@ -9,11 +9,13 @@ the model a step is taken in ``crowd_substeps`` (4): half the MuJoCo work.
 
 Longer substeps need one change to stay stable: a limp hand (0.5 kg, 4e-4 kg m²) pinched between
 its own arm and head, or between two fallen puppets, was thrown at over 10x the velocity bound
-inside one 1/240 s substep (a recovery; seeds 1 and 3 of the crowd-fall bench). Its wrist's
-armature was 1.4e-4 kg m²; at the coarse resolution every ball and hinge joint has at least
-:data:`ARMATURE` (rotor inertia, about the hand's own inertia about its wrist), which slows what a
-contact impulse can do to a light limb within one substep and leaves heavy limbs as they were. No
-recovery in 2.5 s after ten of a hundred fall (seeds 1-3), where the fine resolution had seven.
+inside one 1/240 s substep (a recovery, the step undone; seeds 1 and 3 of the crowd-fall bench).
+Its wrist's armature (rotor inertia) was 1.4e-4 kg m², a foot's 1e-3; at the crowd resolution every
+ball and hinge joint has at least :data:`ARMATURE`, about twice a hand's inertia about its wrist, which
+slows what a contact impulse does to a light limb within one substep and leaves the heavy limbs
+(hips, spine: 0.1-0.2) as they were. Measured over 2.5 s after ten of a hundred go limp: 0.002 left
+one recovery in seeds 1-3, 0.005 none; making only the animated neighbours' joints heavy (0.05, so
+they barely give way) was worse: a walker that does not yield drove a limb 0.3 m into the ground.
 
 Which resolution a step takes depends only on how many ragdolls the model holds, which is part
 of the simulation state: replays take the same one.
@@ -23,16 +25,13 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from engine.arrays import F64 as _F
-from engine.ragdoll._layout import Layout
 
-__all__ = ["ARMATURE", "CROWD", "WALKER", "Detail"]
+__all__ = ["ARMATURE", "CROWD", "Detail"]
 
 CROWD = 8  # ragdolls in the model from which a step is taken at the crowd resolution
-ARMATURE = 0.002  # kg m²: least armature of a ragdoll's ball or hinge joint at the crowd resolution
-WALKER = 0.05  # kg m²: least armature of an animated ragdoll's joints there (see below)
+ARMATURE = 0.005  # kg m²: least armature of a ragdoll's ball or hinge joint at the crowd resolution
 
 
 class Detail:
@@ -64,19 +63,11 @@ class Detail:
         """The substeps the model is set to now."""
         return self.crowd_substeps if self.coarse else self.substeps
 
-    def substeps_for(self, m: mujoco.MjModel, L: Layout, kinematic: NDArray[np.bool_]) -> int:
-        """Set the model to the resolution for the ragdolls of layout ``L`` (``kinematic [P]``: which
-        are animated); the substeps to take."""
-        coarse = self.crowd_substeps < self.substeps and L.num_ragdolls >= CROWD
+    def substeps_for(self, m: mujoco.MjModel, ragdolls: int) -> int:
+        """Set the model to the resolution for ``ragdolls`` in it; the substeps to take."""
+        coarse = self.crowd_substeps < self.substeps and ragdolls >= CROWD
         if coarse != self.coarse:
             self.coarse = coarse
             m.opt.timestep = self._timestep[int(coarse)]
             m.dof_armature[:] = self._armature[int(coarse)]
-        if coarse:  # an animated ragdoll's joints take what it touches almost without giving way
-            walker = np.concatenate(
-                [L.ball_d[kinematic[L.ball_owner], None] + np.arange(3), L.hinge_d[kinematic[L.hinge_owner], None]],
-                axis=None,
-            )
-            m.dof_armature[:] = self._armature[1]
-            m.dof_armature[walker] = np.maximum(self._armature[1][walker], WALKER)
         return self.current

@@ -384,7 +384,7 @@ class PhysicsWorld(Readback, Building):
         if d.ntree_awake == 0:  # every pool slot parked and no prop: nothing in MuJoCo can move
             self._ke = self._read = None
             return
-        substeps = self.detail.substeps_for(self.model, L, C.kinematic[rows])
+        substeps = self.detail.substeps_for(self.model, L.num_ragdolls)
         reason = guarded_step(self.model, self.data, substeps, self._limit, self._owners)
         if reason is None:
             project_twist(self.layout, self.data)
