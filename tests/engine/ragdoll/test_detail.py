@@ -12,7 +12,7 @@ import pytest
 
 from engine import quat
 from engine.ragdoll import default_profile
-from engine.ragdoll._detail import ARMATURE, CROWD
+from engine.ragdoll._detail import ARMATURE
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
 
@@ -42,14 +42,14 @@ def _joint_dofs(m: mujoco.MjModel) -> np.ndarray:
 
 
 def test_a_crowd_in_the_model_steps_in_fewer_substeps_and_a_few_ragdolls_as_compiled(skeleton: Skeleton) -> None:
-    pw = _world(skeleton, CROWD + 2)
-    _drive(pw, skeleton, CROWD - 1)
+    pw = _world(skeleton, 10)
+    _drive(pw, skeleton, 7)  # seven simulated: a few
     pw.step()
     m, d = pw.model, pw.data
     assert m is not None and d is not None
     compiled_step, compiled_armature = m.opt.timestep, m.dof_armature.copy()
     assert pw.detail.current == pw.substeps == 8 and compiled_step == pw.timestep
-    _drive(pw, skeleton, CROWD)
+    _drive(pw, skeleton, 8)  # eight: a crowd
     t0 = d.time
     pw.step()
     assert pw.detail.current == 4 and m.opt.timestep == pytest.approx(pw.dt / 4)
@@ -58,7 +58,7 @@ def test_a_crowd_in_the_model_steps_in_fewer_substeps_and_a_few_ragdolls_as_comp
     assert (m.dof_armature[joint] >= ARMATURE).all()
     assert np.array_equal(m.dof_armature[~joint], compiled_armature[~joint])  # free joints (roots) untouched
     assert (m.dof_armature[joint] > compiled_armature[joint]).any()  # the hands' wrists were lighter
-    _drive(pw, skeleton, CROWD - 1)
+    _drive(pw, skeleton, 7)
     pw.step()
     assert pw.detail.current == 8
     assert m.opt.timestep == compiled_step and np.array_equal(m.dof_armature, compiled_armature)  # bit for bit
