@@ -5,17 +5,20 @@ substep grows with every ragdoll in the model (contacts, limits, islands). One p
 costs little at the fine resolution (``PhysicsWorld.substeps``, 8 at 60 Hz), which the
 single-puppet scenes keep; ten puppets falling in a crowd of a hundred hold some twenty ragdolls
 in the model, whose eight substeps alone overran the 60 Hz frame. From :data:`CROWD` ragdolls in
-the model a step is taken in ``crowd_substeps`` (4): half the MuJoCo work.
+the model a step is taken in ``crowd_substeps`` (5): five eighths of the MuJoCo work.
 
 Longer substeps need one change to stay stable: a limp hand (0.5 kg, 4e-4 kg m²) pinched between
 its own arm and head, or between two fallen puppets, was thrown at over 10x the velocity bound
-inside one 1/240 s substep (a recovery, the step undone; seeds 1 and 3 of the crowd-fall bench).
+inside one 1/240 s substep at 4 substeps (a recovery, the step undone; seeds 1 and 3 of the
+crowd-fall bench).
 Its wrist's armature (rotor inertia) was 1.4e-4 kg m², a foot's 1e-3; at the crowd resolution every
 ball and hinge joint has at least :data:`ARMATURE`, about twice a hand's inertia about its wrist, which
 slows what a contact impulse does to a light limb within one substep and leaves the heavy limbs
-(hips, spine: 0.1-0.2) as they were. Measured over 2.5 s after ten of a hundred go limp: 0.002 left
-one recovery in seeds 1-3, 0.005 none; making only the animated neighbours' joints heavy (0.05, so
-they barely give way) was worse: a walker that does not yield drove a limb 0.3 m into the ground.
+(hips, spine: 0.1-0.2) as they were. Measured over 2.5 s after ten of a hundred go limp, at 4
+substeps: 0.002 left one recovery in seeds 1-3, 0.005 none there but ten in seeds 4-6; making only
+the animated neighbours' joints heavy (0.05, so they barely give way) was worse (a walker that does
+not yield drove a limb 0.3 m into the ground). At 5 substeps with 0.005: none in seeds 1-6, where the
+8 substeps of before had seven in seed 3 and one each in seeds 4 and 5.
 
 Which resolution a step takes depends only on how many ragdolls the model holds, which is part
 of the simulation state: replays take the same one.

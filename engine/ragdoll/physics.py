@@ -67,7 +67,7 @@ class PhysicsWorld(Readback, Building):
     SIM_STATE = True
 
     def __init__(
-        self, timestep: float = 1.0 / 480.0, substeps: int = 8, ground_friction: float = 1.0, crowd_substeps: int = 4
+        self, timestep: float = 1.0 / 480.0, substeps: int = 8, ground_friction: float = 1.0, crowd_substeps: int = 5
     ) -> None:
         if timestep <= 0 or substeps < 1 or crowd_substeps < 1:
             raise ValueError("timestep must be positive and substeps at least 1")

@@ -52,7 +52,7 @@ def test_a_crowd_in_the_model_steps_in_fewer_substeps_and_a_few_ragdolls_as_comp
     _drive(pw, skeleton, 8)  # eight: a crowd
     t0 = d.time
     pw.step()
-    assert pw.detail.current == 4 and m.opt.timestep == pytest.approx(pw.dt / 4)
+    assert pw.detail.current == 5 and m.opt.timestep == pytest.approx(pw.dt / 5)
     assert d.time - t0 == pytest.approx(pw.dt)  # a step is still one world step long
     joint = _joint_dofs(m)
     assert (m.dof_armature[joint] >= ARMATURE).all()
