@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from engine.arrays import F64 as _F
 from engine.ragdoll._carry import restore, snapshot
 from engine.ragdoll._commands import Commands
+from engine.ragdoll._detail import Detail
 from engine.ragdoll._guard import velocity_limits
 from engine.ragdoll._layout import Layout, build_layout, select
 from engine.ragdoll._pool import CHUNK, INITIAL, MAX_SLOTS, RagdollPool, park, settle, wake
@@ -50,6 +51,7 @@ class Building:
     _read: tuple[_F, _F] | None
     _limit: _F
     _owners: NDArray[np.int64]
+    detail: Detail
 
     def _place_rows(self, rows: NDArray[np.int64]) -> None:
         raise NotImplementedError
@@ -91,6 +93,7 @@ class Building:
             ps.qadr, ps.dadr = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
             ps.geom, ps.body = m.geom(n).id, m.body(n).id
         self._limit = velocity_limits(m)
+        self.detail.compiled(m)
         self._owners = np.full(m.nv, -1, dtype=np.int64)
         for p, (a, b) in enumerate(pool.dofs):
             self._owners[a:b] = p

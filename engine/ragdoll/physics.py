@@ -37,6 +37,7 @@ from engine.ragdoll._bounds import command_boxes, geom_boxes
 from engine.ragdoll._building import Building
 from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._control import apply_commands, place, project_twist
+from engine.ragdoll._detail import Detail
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
@@ -59,15 +60,20 @@ class PhysicsWorld(Readback, Building):
         timestep: MuJoCo step in seconds.
         substeps: MuJoCo steps per simulation step (``timestep * substeps`` should equal ``World.dt``).
         ground_friction: sliding friction of the ground plane.
+        crowd_substeps: MuJoCo steps per simulation step while the model holds a crowd
+            (:mod:`engine.ragdoll._detail`; no switch unless fewer than ``substeps``).
     """
 
     SIM_STATE = True
 
-    def __init__(self, timestep: float = 1.0 / 480.0, substeps: int = 8, ground_friction: float = 1.0) -> None:
-        if timestep <= 0 or substeps < 1:
+    def __init__(
+        self, timestep: float = 1.0 / 480.0, substeps: int = 8, ground_friction: float = 1.0, crowd_substeps: int = 5
+    ) -> None:
+        if timestep <= 0 or substeps < 1 or crowd_substeps < 1:
             raise ValueError("timestep must be positive and substeps at least 1")
         self.timestep = timestep
         self.substeps = substeps
+        self.detail = Detail(substeps, crowd_substeps, timestep * substeps)
         self.ground_friction = ground_friction
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
@@ -378,7 +384,8 @@ class PhysicsWorld(Readback, Building):
         if d.ntree_awake == 0:  # every pool slot parked and no prop: nothing in MuJoCo can move
             self._ke = self._read = None
             return
-        reason = guarded_step(self.model, self.data, self.substeps, self._limit, self._owners)
+        substeps = self.detail.substeps_for(self.model, L.num_ragdolls)
+        reason = guarded_step(self.model, self.data, substeps, self._limit, self._owners)
         if reason is None:
             project_twist(self.layout, self.data)
         else:

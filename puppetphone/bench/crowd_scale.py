@@ -9,8 +9,10 @@ step for the step figures, its worst step for the fall), against the 60 Hz frame
   warning (their ragdolls join the physics from the pool); the worst of that step and the
   next :data:`AFTER` steps.
 - ``crowd_fall_physics_ms_100``: the physics stage during that fall, against the best peer —
-  raw ``mj_step`` (``substeps`` times, no Python around it) on a copy of the same MuJoCo model
-  and state, i.e. what our layer costs over MuJoCo itself.
+  raw ``mj_step`` (as many substeps as the stage took, no Python around it) on a copy of the same MuJoCo model
+  and state, i.e. what our layer costs over MuJoCo itself. ``copy.copy`` of an ``MjData`` does not
+  carry MuJoCo's awake lists (the copy would simulate every parked pool slot), so they are
+  rebuilt from its ``tree_asleep`` first.
 - ``crowd_start_s_1000``: building the 1000-puppet sandbox and its first step (process CPU).
 """
 
@@ -25,6 +27,7 @@ import numpy as np
 from engine.app import App
 from engine.ecs import Entity
 from engine.ragdoll import PhysicsWorld, Ragdoll, RagdollMode
+from engine.ragdoll._pool import update_sleep
 from puppetphone.bench.crowd import BUDGET_MS, crowd_app, timed_steps
 from puppetphone.bench.figures import Figure
 
@@ -53,10 +56,11 @@ def fall_run(puppets: int = 100, fallers: int = FALLERS, seed: int = 1) -> tuple
     pw = app.world.resource(PhysicsWorld)
     assert pw.model is not None and pw.data is not None
     d = copy.copy(pw.data)
+    update_sleep(pw.model, d)  # a copy loses MuJoCo's awake lists: it would step every parked pool slot
     raw = []
     for _ in range(5):
         t0 = time.thread_time()
-        for _ in range(pw.substeps):
+        for _ in range(pw.detail.current):  # the resolution the stage stepped at (engine.ragdoll._detail)
             mujoco.mj_step(pw.model, d)
         raw.append(time.thread_time() - t0)
     return total, stages["physics"], float(np.median(raw))

@@ -86,13 +86,15 @@ def test_going_limp_keeps_the_walk_s_momentum(make_app: Callable[..., tuple[App,
 
 def test_a_limp_neighbour_pulls_in_only_a_puppet_its_bodies_come_near(skeleton: Skeleton) -> None:
     """Reach spheres (any pose) of puppets 1.6 m apart overlap, their posed capsules do not: the
-    animated neighbour stays out. Half a metre closer it joins. (Breaking it: return the sphere
-    test alone in PhysicsWorld._update_islands and the first assertion fails.)"""
+    animated neighbour stays out. At 0.7 m (rest-pose boxes 0.44 m wide, 0.26 m of clearance: more
+    than ENTER, less than the 0.4 m it was) it still stays out; at 0.5 m (0.06 m) it joins.
+    (Breaking it: return the sphere test alone in PhysicsWorld._update_islands and the first
+    assertion fails; ENTER back at 0.4 fails the 0.7 m case.)"""
     prof = default_profile(skeleton)
     rot = np.tile([1.0, 0.0, 0.0, 0.0], (skeleton.num_joints, 1))
     hips = float(skeleton.offsets[0][1])
     assert 2 * reach(skeleton, prof, skeleton.offsets) + ENTER > 1.6  # the spheres alone would pull it in
-    for gap, joins in ((1.6, False), (0.6, True)):
+    for gap, joins in ((1.6, False), (0.7, False), (0.5, True)):
         pw = PhysicsWorld()
         pw.add_ragdoll(1, skeleton, prof, [0.0, hips, 0.0], rot)
         pw.add_ragdoll(2, skeleton, prof, [gap, hips, 0.0], rot)
