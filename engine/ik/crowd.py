@@ -38,6 +38,7 @@ from engine.arrays import F64 as F
 from engine.arrays import I64
 from engine.columns import Column, Columns
 from engine.components import LocalPose, Puppet
+from engine.fk import kernel_array
 from engine.ik import _ground_kernel as _kernel
 from engine.ik.foot_lock import FootLock
 from engine.ik.grounding import (
@@ -393,8 +394,7 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
         _kernel.plane_query(sole, *ground.frame, height, normal)
     else:
         height, normal = ground(sole[..., 0], sole[..., 2])
-        height = np.ascontiguousarray(np.broadcast_to(np.asarray(height, dtype=np.float64), (count, legs)))
-        normal = np.ascontiguousarray(np.broadcast_to(np.asarray(normal, dtype=np.float64), (count, legs, 3)))
+        height, normal = kernel_array(height, (count, legs)), kernel_array(normal, (count, legs, 3))
     shift, kept = np.empty(count), np.empty(count, dtype=np.bool_)
     finite = _kernel.ground_crowd(
         sk.parents, rows, roots, rots, plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
