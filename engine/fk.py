@@ -19,7 +19,19 @@ from engine import jit, quat
 from engine.jit import qmul, qrot
 from engine.skeleton import Skeleton
 
-__all__ = ["fk_kernel", "fk_rows", "forward_kinematics", "levels", "world_points"]
+__all__ = ["fk_kernel", "fk_rows", "forward_kinematics", "kernel_array", "levels", "world_points"]
+
+
+def kernel_array(a: ArrayLike, shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """``a`` broadcast to ``shape`` as a C-contiguous, writeable float64 array for a compiled kernel.
+
+    numba types a read-only array apart from a writeable one and compiles the kernel again for it
+    (seconds); ``np.broadcast_to`` hands out a read-only view even when ``a`` has ``shape`` already, and
+    ``np.ascontiguousarray`` passes such a view through. So ``a`` is broadcast only when its shape
+    differs, and copied only when what results is still read-only."""
+    out = np.asarray(a, dtype=np.float64)
+    out = np.ascontiguousarray(out if out.shape == shape else np.broadcast_to(out, shape))
+    return out if out.flags.writeable else out.copy()
 
 
 @lru_cache(maxsize=64)
@@ -65,10 +77,8 @@ def forward_kinematics(
         n = skeleton.num_joints
         flat_rot = np.ascontiguousarray(rot).reshape(-1, n, 4)
         count = len(flat_rot)
-        flat_root = np.ascontiguousarray(np.broadcast_to(np.asarray(root, dtype=np.float64), batch + (3,))).reshape(
-            count, 3
-        )
-        flat_off = np.ascontiguousarray(np.broadcast_to(off, batch + (n, 3))).reshape(count, n, 3)
+        flat_root = kernel_array(root, batch + (3,)).reshape(count, 3)
+        flat_off = kernel_array(off, batch + (n, 3)).reshape(count, n, 3)
         out_pos, out_rot = np.empty((count, n, 3)), np.empty((count, n, 4))
         fk_kernel(skeleton.parents, flat_root, flat_rot, flat_off, out_pos, out_rot)
         return out_pos.reshape(batch + (n, 3)), out_rot.reshape(batch + (n, 4))

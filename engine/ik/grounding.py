@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from engine import jit, quat
 from engine.columns import Columns
+from engine.fk import kernel_array
 from engine.ik import _ground_kernel as _kernel
 from engine.ik._limb import solve_limb
 from engine.ik._scalar import Q_ID, add, between, chain_fk, qmul, qnormalize, qrot, slerp, sub
@@ -523,7 +524,7 @@ def _ground_compiled(
     given_roots, given_rotations = roots, rotations  # the kernels write C-contiguous doubles; copied back below
     roots = np.ascontiguousarray(roots, dtype=np.float64)
     rotations = np.ascontiguousarray(rotations, dtype=np.float64)
-    offs = np.ascontiguousarray(np.broadcast_to(off, rotations.shape[:-1] + (3,)))
+    offs = kernel_array(off, rotations.shape[:-1] + (3,))
     leg_idx = np.array(idx, dtype=np.int64).reshape(n, 3)
     soles = np.array([leg.sole for leg in legs], dtype=np.float64).reshape(n, 3)
     tips = np.array([skeleton.tips[f] for _, _, f in idx], dtype=np.float64).reshape(n, 3)
@@ -532,8 +533,7 @@ def _ground_compiled(
     ankles, hips, sole, qfeet = np.empty((p, n, 3)), np.empty((p, n, 3)), np.empty((p, n, 3)), np.empty((p, n, 4))
     _kernel.legs_fk(skeleton.parents, np.arange(p), roots, rotations, offs, leg_idx, soles, ankles, qfeet, hips, sole)
     height, normal = ground(sole[..., 0], sole[..., 2])
-    height = np.ascontiguousarray(np.broadcast_to(np.asarray(height, dtype=np.float64), (p, n)))
-    normal = np.ascontiguousarray(np.broadcast_to(np.asarray(normal, dtype=np.float64), (p, n, 3)))
+    height, normal = kernel_array(height, (p, n)), kernel_array(normal, (p, n, 3))
     if not (np.all(np.isfinite(height)) and np.all(np.isfinite(normal))):
         raise ValueError("ground query returned non-finite values")
     targets, new_rot, floor = np.empty((p, n, 3)), np.empty((p, n, 4)), np.empty((p, n, 3))
