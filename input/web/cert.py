@@ -46,9 +46,20 @@ class WebCertificate:
     created: bool
 
     def ssl_context(self) -> ssl.SSLContext:
-        """A server context for this certificate (TLS 1.2 and up)."""
+        """A server context for this certificate (TLS 1.2 and up) that sends no TLS 1.3 session tickets.
+
+        By default a TLS 1.3 server sends two tickets just after the handshake, unasked. A client
+        that reads on one thread while it writes its upgrade request on another (``websockets``'
+        threaded client, which the tests and the benches use) then has CPython's ``ssl`` (before
+        3.13.6) read the tickets and write the request on one OpenSSL connection at once, which
+        OpenSSL does not allow; about one handshake in 500 lost its request under load and waited
+        out its 10 s timeout (CI, ``test_a_web_phone_is_released_after_the_silence_it_was_given``).
+        Without tickets the server says nothing until the request has come. A reconnecting phone
+        pays a full handshake instead of a resumed one: a few milliseconds on a LAN.
+        """
         ctx = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
         ctx.minimum_version = ssl.TLSVersion.TLSv1_2
+        ctx.num_tickets = 0
         ctx.load_cert_chain(self.cert_path, self.key_path)
         return ctx
 
