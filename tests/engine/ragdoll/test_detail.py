@@ -11,18 +11,10 @@ import numpy as np
 import pytest
 
 from engine import quat
-from engine.ragdoll import default_profile
 from engine.ragdoll._detail import ARMATURE
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
-
-
-def _world(skeleton: Skeleton, n: int) -> PhysicsWorld:
-    pw = PhysicsWorld()
-    pr = default_profile(skeleton)
-    for k in range(n):
-        pw.add_ragdoll(k + 1, skeleton, pr, [6.0 * k, 1.0, 0.0], quat.identity(skeleton.num_joints))
-    return pw
+from tests.engine.ragdoll.test_pool import _crowd as _world
 
 
 def _drive(pw: PhysicsWorld, skeleton: Skeleton, limp: int) -> None:
