@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from engine import jit
 from engine.app import App
 from engine.arrays import F64 as F
-from engine.columns import Column, Columns, columns
+from engine.columns import Columns, columns
 from engine.components import LocalPose, Puppet, WorldPose
 from engine.ecs import Entity, World
 from engine.fk import fk_rows, forward_kinematics
@@ -36,32 +36,6 @@ from engine.skeleton import Skeleton
 __all__ = ["FKPlan", "fk_system", "install_fk"]
 
 _PUPPET = attrgetter("skeleton", "offsets")
-_BASE = attrgetter("base")
-_LOCAL = attrgetter("root", "rotations")
-_WORLD = attrgetter("positions", "rotations", "prev_positions", "prev_rotations")
-
-
-def _unchanged(now: list[Any], then: list[Any]) -> bool:
-    """``now == then`` for lists of field tuples (identity first); a field that is another array: ``False``."""
-    try:
-        return now == then
-    except ValueError:  # an array compared with another: it was replaced
-        return False
-
-
-def _steady(cols: Columns, group: _Group) -> _Placed | None:
-    """``group.placed`` if its columns still hold their arrays and every pose field its object (so each is
-    still its row's view), else ``None``."""
-    placed = group.placed
-    if (
-        placed is None
-        or placed.cols is not cols
-        or not all(map(is_, map(_BASE, placed.columns), placed.bases))
-        or not _unchanged(list(map(_LOCAL, group.locals_)), placed.locals_)
-        or not _unchanged(list(map(_WORLD, group.worlds)), placed.worlds)
-    ):
-        return None
-    return placed
 
 
 @dataclass
@@ -76,24 +50,6 @@ class _Group:
     offsets: F
     worlds: tuple[WorldPose, ...] = ()
     checked: tuple[NDArray[np.int64], ...] = ()  # the columns' row arrays last found to agree (_compiled)
-    placed: _Placed | None = None  # where _compiled last found the group's poses in their columns
-
-
-@dataclass
-class _Placed:
-    """Where :func:`_compiled` last found a group's poses: the world's columns then, the six columns (local
-    root and rotations, the four world fields) with their arrays, the rows of the local and of the world
-    poses, and each puppet's local ``(root, rotations)`` and world field objects. While every column keeps
-    its array and every field its object, each field is still the view of its row, so the next step needs
-    one tuple pass over the local and one over the world poses (:func:`_steady`), not a pass per column."""
-
-    cols: Columns
-    columns: tuple[Column, ...]
-    bases: tuple[NDArray[Any], ...]
-    rows: NDArray[np.int64]
-    out_rows: NDArray[np.int64]
-    locals_: list[tuple[Any, ...]]
-    worlds: list[tuple[Any, ...]]
 
 
 @dataclass
@@ -148,54 +104,34 @@ def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
 def _compiled(cols: Columns, group: _Group) -> bool:
     """FK of ``group`` straight into its world poses' columns; ``False`` (nothing done) unless every
     pose, local and world, is in its column (:meth:`~engine.columns.Column.rows`, at the same rows in
-    the two local and in the four world columns) and the columns are C-contiguous doubles. A group
-    found as it was last step (:func:`_steady`) skips asking the columns."""
-    placed = _steady(cols, group)
-    if placed is None:
-        placed = group.placed = _place(cols, group)
-        if placed is None:
-            return False
-    root, rot, pos, wrot, prev_pos, prev_rot = placed.bases
-    fk_rows(
-        group.skeleton.parents, placed.rows, root, rot, group.offsets, placed.out_rows, pos, wrot, prev_pos, prev_rot
-    )
-    return True
-
-
-def _place(cols: Columns, group: _Group) -> _Placed | None:
-    """Ask the columns where ``group``'s poses are (fields replaced by other code are taken in); ``None``
-    unless all are in their columns at matching rows, in C-contiguous doubles."""
+    the two local and in the four world columns) and the columns are C-contiguous doubles."""
     joints = group.skeleton.num_joints
-    found: list[tuple[Column, NDArray[Any], NDArray[np.int64]]] = []
-    for ctype, name, owners in (
-        (LocalPose, "root", group.locals_),
-        (LocalPose, "rotations", group.locals_),
-        *((WorldPose, name, group.worlds) for name in _WORLD_FIELDS),
-    ):
-        column = cols.get(ctype, name, joints)
-        rows = column.rows(owners)
-        if rows is None:
-            return None
-        found.append((column, *rows))
-    index = tuple(f[2] for f in found)
+    roots = cols.get(LocalPose, "root", joints).rows(group.locals_)
+    rots = cols.get(LocalPose, "rotations", joints).rows(group.locals_)
+    if roots is None or rots is None:
+        return False
+    worlds: list[tuple[NDArray[Any], NDArray[np.int64]]] = []
+    for name in _WORLD_FIELDS:
+        found = cols.get(WorldPose, name, joints).rows(group.worlds)
+        if found is None:
+            return False
+        worlds.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in worlds))
     if not (len(index) == len(group.checked) and all(map(is_, index, group.checked))):
         # The same rows in the two local and in the four world columns (checked once while the
         # columns keep their rows: the row arrays stay the same objects).
         if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
-            return None
+            return False
         group.checked = index
-    bases = tuple(f[1] for f in found)
-    if not all(a.flags.c_contiguous and a.dtype == np.float64 for a in bases):
-        return None
-    return _Placed(
-        cols,
-        tuple(f[0] for f in found),
-        bases,
-        index[0],
-        index[2],
-        list(map(_LOCAL, group.locals_)),
-        list(map(_WORLD, group.worlds)),
+    pos, rot, prev_pos, prev_rot = (found[0] for found in worlds)
+    if not all(
+        a.flags.c_contiguous and a.dtype == np.float64 for a in (roots[0], rots[0], pos, rot, prev_pos, prev_rot)
+    ):
+        return False
+    fk_rows(
+        group.skeleton.parents, roots[1], roots[0], rots[0], group.offsets, worlds[0][1], pos, rot, prev_pos, prev_rot
     )
+    return True
 
 
 _WORLD_FIELDS = ("positions", "rotations", "prev_positions", "prev_rotations")

@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from engine import jit
 from engine.arrays import F64 as F
 from engine.arrays import I64
-from engine.columns import Column, Columns
+from engine.columns import Columns
 from engine.components import LocalPose, Puppet
 from engine.fk import kernel_array
 from engine.ik import _ground_kernel as _kernel
@@ -58,12 +58,11 @@ __all__ = ["CrowdPlan", "current_plan", "ground_crowd", "plan_crowd"]
 _GROUNDING = attrgetter("grounding")
 _WEIGHT = attrgetter("grounding_weight")
 _SETTLE = attrgetter("settle")
-_BASE = attrgetter("base")
-_POSE = attrgetter("root", "rotations")
 #: What a member's request, puppet and lock must keep for the plan to hold (compared as tuples, in C).
 _REQUEST = attrgetter("effectors", "sphere_centre", "foot_lock")
 _PUPPET = attrgetter("skeleton", "offsets")
-_TUNING_NAMES = (
+_TUNING = attrgetter(
+    "enabled",
     "release_time",
     "max_stretch",
     "release_height",
@@ -73,10 +72,6 @@ _TUNING_NAMES = (
     "step_time",
     "step_height",
 )
-_TUNING = attrgetter("enabled", *_TUNING_NAMES)
-#: What :func:`_still` finds unchanged in a member's request, lock and pose (its puppet: ``_PUPPET``).
-_MEMBER = attrgetter("grounding", "effectors", "sphere_centre", "foot_lock")
-_LOCK_FIELDS = attrgetter("enabled", *_TUNING_NAMES, "contacts", *_LOCK_STATE)
 
 
 def _plain(req: Any, settings: tuple[float, ...]) -> bool:
@@ -107,35 +102,6 @@ def _unchanged(now: list[Any], then: list[Any]) -> bool:
 
 
 @dataclass
-class Verified:
-    """What :func:`ground_crowd` found when it last placed the crowd in its columns, so that the next
-    step can be vouched for by one Python loop over the members (:func:`_still`) instead of a C-level
-    pass per field and column (each pass touches every member again: at a thousand puppets the
-    passes cost more than the kernel).
-
-    Attributes:
-        cols: the world's columns then.
-        columns, bases: the nine columns the pass works on (pose root and rotations, lock contacts,
-            the lock state of ``_LOCK_STATE``) and their arrays; a column that relinked has another.
-        rows, lock_rows, contact_rows: the members' rows in the pose, lock state and contact columns.
-        requests, locks, poses, puppets: per member, the objects its fields held then (``_MEMBER``,
-            ``_LOCK_FIELDS``, ``_POSE``, ``_PUPPET``). While every field still holds its object and
-            every column its array, each field is still the view of its row (the columns made it so).
-    """
-
-    cols: Columns
-    columns: tuple[Column, ...]
-    bases: tuple[NDArray[Any], ...]
-    rows: I64
-    lock_rows: I64
-    contact_rows: I64
-    requests: list[tuple[Any, ...]]
-    locks: list[tuple[Any, ...]]
-    poses: list[tuple[Any, ...]]
-    puppets: list[tuple[Any, ...]]
-
-
-@dataclass
 class CrowdPlan:
     """Who the crowd pass serves, and what it checks every step that they still are.
 
@@ -155,12 +121,7 @@ class CrowdPlan:
             ``(effectors, sphere_centre, foot_lock)``.
         settings, tuning, settings_array: the locks' tuning (:meth:`FootLock.settings`), one for all;
             ``tuning`` with ``enabled`` first, as each lock must still read.
-        others, others_grounding: the requests of the rows that are not members, and their
-            ``grounding`` flags then.
         checked: the row arrays of the members' columns last found to agree (:func:`ground_crowd`).
-        verified: the members' columns and fields as :func:`ground_crowd` last found them in order
-            (:class:`Verified`); ``ready``: :func:`current_plan` found them unchanged this step, so
-            :func:`ground_crowd` runs on them without asking the columns again.
     """
 
     table: list[tuple[Any, ...]]
@@ -184,11 +145,7 @@ class CrowdPlan:
     tips: F
     heels: F
     knees: F
-    others: list[Any]
-    others_grounding: list[bool]
     checked: tuple[I64, ...] = ()
-    verified: Verified | None = None
-    ready: bool = False
 
 
 def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
@@ -210,8 +167,7 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> C
     members_set = set(rows)
     outsiders = [table[i][3] for i in group if i not in members_set]
     if len(rows) < crowd_from:
-        rows, outsiders, members_set = [], [], set()
-    others = [req for i, req in enumerate(requests) if i not in members_set]
+        rows, outsiders = [], []
     puppets: list[Puppet] = [table[i][1] for i in rows]
     members = [table[i][3] for i in rows]
     locks = tuple(req.foot_lock for req in members)
@@ -243,8 +199,6 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> C
         tips=np.array([sk.tips[f] for _, _, f in idx] if sk else np.zeros((0, 3)), dtype=np.float64),
         heels=np.array([leg.heel for leg in legs], dtype=np.float64),
         knees=np.array([leg.knee_forward for leg in legs], dtype=np.float64),
-        others=others,
-        others_grounding=list(map(_GROUNDING, others)),
     )
 
 
@@ -267,47 +221,17 @@ def _holds(plan: CrowdPlan, table: list[tuple[Any, ...]]) -> bool:
     )
 
 
-def _still(plan: CrowdPlan, cols: Columns) -> bool:
-    """Whether ``plan`` holds this step (what :func:`_holds` checks) and its members are still in the
-    columns at the rows :func:`ground_crowd` last found (:class:`Verified`): every column keeps its
-    array and every member's field the object it held then (so it is still the view of its row).
-    One C-level pass per component kind compares each member's fields as a tuple with the recorded
-    one (identity first: a field that is the same object is equal, and tuning values are compared as
-    the very objects): one visit of each member per kind, cheaper than a pass per field, and no Python
-    per member. Anything new says ``False``, and the step takes :func:`_holds` and
-    :meth:`~engine.columns.Column.rows` instead."""
-    found = plan.verified
-    if found is None or found.cols is not cols or not all(map(is_, map(_BASE, found.columns), found.bases)):
-        return False
-    if list(map(_GROUNDING, plan.others)) != plan.others_grounding:
-        return False
-    if any(_plain(req, plan.settings) for req in plan.outsiders):
-        return False
-    return (
-        _unchanged(list(map(_MEMBER, plan.requests)), found.requests)
-        and _unchanged(list(map(_LOCK_FIELDS, plan.locks)), found.locks)
-        and _unchanged(list(map(_POSE, plan.locals_)), found.poses)
-        and _unchanged(list(map(_PUPPET, plan.puppets)), found.puppets)
-    )
-
-
-def current_plan(
-    plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, crowd_from: int, cols: Columns | None = None
-) -> CrowdPlan:
-    """``plan`` if it still holds for ``table``, else a new one (:func:`plan_crowd`). With ``cols``, a plan
-    whose members are found as :func:`ground_crowd` last left them (:func:`_still`) is marked ``ready``."""
-    if plan is not None and table is plan.table:
-        plan.ready = cols is not None and bool(plan.rows) and _still(plan, cols)
-        if plan.ready or _holds(plan, table):
-            return plan
+def current_plan(plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
+    """``plan`` if it still holds for ``table``, else a new one (:func:`plan_crowd`)."""
+    if plan is not None and _holds(plan, table):
+        return plan
     return plan_crowd(table, same_as, crowd_from)
 
 
 def _place(cols: Columns, ctype: type, name: str, key: int, owners: tuple[Any, ...], shape: tuple[int, ...],
-           dtype: type = np.float64) -> tuple[Column, NDArray[Any], I64] | None:  # fmt: skip
-    """The column of field ``name`` of ``owners``, its array and their rows in it
-    (:meth:`~engine.columns.Column.rows`), the column made theirs first if one of them is not in it;
-    ``None`` unless every field has ``shape``."""
+           dtype: type = np.float64) -> tuple[NDArray[Any], I64] | None:  # fmt: skip
+    """The column of field ``name`` of ``owners`` and their rows in it (:meth:`~engine.columns.Column.rows`),
+    the column made theirs first if one of them is not in it; ``None`` unless every field has ``shape``."""
     column = cols.get(ctype, name, key, dtype)
     found = column.rows(owners)
     if found is None:
@@ -318,50 +242,7 @@ def _place(cols: Columns, ctype: type, name: str, key: int, owners: tuple[Any, .
         found = column.rows(owners)
     if found is None or found[0].shape[1:] != shape or not found[0].flags.c_contiguous:
         return None
-    return column, found[0], found[1]
-
-
-def _verify(plan: CrowdPlan, cols: Columns) -> Verified | None:
-    """Place ``plan``'s members in their nine columns (:func:`_place`; fields replaced by other code are
-    taken in) and say where (:class:`Verified`); ``None`` if one cannot be, or the members are not at
-    the same rows in the two pose columns and in the lock state's six."""
-    sk = plan.skeleton
-    assert sk is not None
-    joints, legs = sk.num_joints, len(plan.legs)
-    locks = plan.locks
-    wanted: list[tuple[type, str, tuple[Any, ...], tuple[int, ...], type]] = [
-        (LocalPose, "root", plan.locals_, (3,), np.float64),
-        (LocalPose, "rotations", plan.locals_, (joints, 4), np.float64),
-        (FootLock, "contacts", locks, (legs,), np.float64),
-    ]
-    for state in _LOCK_STATE:
-        wanted.append((FootLock, state, locks, (legs, 3) if state in ("points", "animated") else (legs,),
-                       _LOCK_TYPES.get(state, np.float64)))  # fmt: skip
-    found = []
-    for ctype, name, owners, shape, dtype in wanted:
-        placed = _place(cols, ctype, name, joints if ctype is LocalPose else legs, owners, shape, dtype)
-        if placed is None:
-            return None
-        found.append(placed)
-    index = tuple(p[2] for p in found)
-    if not (len(index) == len(plan.checked) and all(map(is_, index, plan.checked))):
-        # The poses' two columns, and the locks' six, must hold the members at the same rows; the row
-        # arrays stay the same objects while the columns keep their rows, so this is checked once.
-        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[3], i) for i in index[4:])):
-            return None
-        plan.checked = index
-    return Verified(
-        cols,
-        tuple(p[0] for p in found),
-        tuple(p[1] for p in found),
-        index[0],
-        index[3],
-        index[2],
-        list(map(_MEMBER, plan.requests)),
-        list(map(_LOCK_FIELDS, locks)),
-        list(map(_POSE, plan.locals_)),
-        list(map(_PUPPET, plan.puppets)),
-    )
+    return found
 
 
 def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float) -> NDArray[np.bool_] | None:
@@ -371,24 +252,37 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
     each member's ``pelvis_shift``; returns which members kept their given pose (a result that was
     not finite)."""
     sk, reqs, locks = plan.skeleton, plan.requests, plan.locks
-    ready, plan.ready = plan.ready, False
     if sk is None or not jit.enabled():
         return None
-    if not ready:
-        plan.verified = _verify(plan, cols)
-    where = plan.verified
-    if where is None:
+    joints, legs = sk.num_joints, len(plan.legs)
+    roots = _place(cols, LocalPose, "root", joints, plan.locals_, (3,))
+    rots = _place(cols, LocalPose, "rotations", joints, plan.locals_, (joints, 4))
+    contacts = _place(cols, FootLock, "contacts", legs, locks, (legs,))
+    if roots is None or rots is None or contacts is None:
         return None
-    roots, rots, contacts, points, weights, planted, stepping, yaw, animated = where.bases
-    count, legs = len(reqs), len(plan.legs)
+    state: list[tuple[NDArray[Any], I64]] = []
+    for name in _LOCK_STATE:
+        found = _place(cols, FootLock, name, legs, locks, (legs, 3) if name in ("points", "animated") else (legs,),
+                       _LOCK_TYPES.get(name, np.float64))  # fmt: skip
+        if found is None:
+            return None
+        state.append(found)
+    index = (roots[1], rots[1], *(found[1] for found in state))
+    if not (len(index) == len(plan.checked) and all(map(is_, index, plan.checked))):
+        # The poses' two columns, and the locks' six, must hold the members at the same rows; the row
+        # arrays stay the same objects while the columns keep their rows, so this is checked once.
+        if not (np.array_equal(index[0], index[1]) and all(np.array_equal(index[2], i) for i in index[3:])):
+            return None
+        plan.checked = index
+    count = len(reqs)
     weight = np.fromiter(map(_WEIGHT, reqs), dtype=np.float64, count=count)
     if np.any((weight < 0.0) | (weight > 1.0)):
         raise ValueError("weight must lie in 0..1")
     settle = np.fromiter(map(_SETTLE, locks), dtype=np.bool_, count=count)
     ankles, hips, sole, qfeet = (np.empty((count, legs, 3)), np.empty((count, legs, 3)),
                                  np.empty((count, legs, 3)), np.empty((count, legs, 4)))  # fmt: skip
-    rows = where.rows
-    _kernel.legs_fk(sk.parents, rows, roots, rots, plan.offsets, plan.legs, plan.soles, ankles, qfeet, hips, sole)
+    rows = roots[1]
+    _kernel.legs_fk(sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, ankles, qfeet, hips, sole)
     if type(ground) is PlaneGround:  # the same heights as its call, without a dozen numpy calls
         height, normal = np.empty((count, legs)), np.empty((count, legs, 3))
         _kernel.plane_query(sole, *ground.frame, height, normal)
@@ -396,12 +290,12 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
         height, normal = ground(sole[..., 0], sole[..., 2])
         height, normal = kernel_array(height, (count, legs)), kernel_array(normal, (count, legs, 3))
     shift, kept = np.empty(count), np.empty(count, dtype=np.bool_)
+    points, weights, planted, stepping, yaw, animated = (found[0] for found in state)
     finite = _kernel.ground_crowd(
-        sk.parents, rows, roots, rots, plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
+        sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
         sole, qfeet, ankles, hips, height, normal, weight,
         ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT, dt, plan.settings_array,
-        where.lock_rows, points, weights, planted, stepping, yaw, animated, where.contact_rows, contacts, settle, shift,
-        kept,
+        state[0][1], points, weights, planted, stepping, yaw, animated, contacts[1], contacts[0], settle, shift, kept,
     )  # fmt: skip
     if not finite:
         raise ValueError("ground query returned non-finite values")

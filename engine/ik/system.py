@@ -174,10 +174,9 @@ def ik_system(world: World) -> None:
         cache = IKRigCache()
         world.insert_resource(cache)
     table = world.query(Puppet, LocalPose, IKRequest)
-    cols = columns(world)
-    cache.crowd = plan = current_plan(cache.crowd, table, cache.same_as, cache.crowd_from, cols)
+    cache.crowd = plan = current_plan(cache.crowd, table, cache.same_as, cache.crowd_from)
     query = ground.query if ground is not None else PlaneGround()
-    kept = ground_crowd(plan, cols, query, world.dt)
+    kept = ground_crowd(plan, columns(world), query, world.dt)
     if kept is not None:
         if kept.any() and len(plan.rows) + len(plan.outsiders) < cache.batch_from:  # as the one-puppet path does
             for i in np.flatnonzero(kept).tolist():

@@ -9,9 +9,7 @@ at their rows). With the compiled pass and
 with it switched off, world poses and previous poses must be equal bit for bit; against the
 pure-numpy path (numba off) to 1e-12. Broken once by copying the previous pose after the
 kernel instead of before (``prev_*`` then equals this step's pose) and once by keeping the
-plan when a puppet's offsets object changes (that puppet's positions differ). Replacing fields at a
-step the pass finds as it left it (7) must be noticed too: broken by leaving the local or the world
-poses out of ``posing._steady``, the results differ.
+plan when a puppet's offsets object changes (that puppet's positions differ).
 """
 
 from __future__ import annotations
@@ -73,11 +71,6 @@ def _run(mode: str, monkeypatch: pytest.MonkeyPatch) -> tuple[list[Any], list[in
             if step == 2:
                 world.get(ents[1], LocalPose).rotations = quat.exp(rng.normal(0, 0.3, (17, 3)))
                 world.get(ents[2], WorldPose).positions = np.zeros((17, 3))
-            if step == 7:  # the same on a step the pass finds as it left it (one tuple pass per pose kind)
-                local = world.get(ents[5], LocalPose)  # a chain: the other group than the next one
-                local.rotations = quat.normalize(local.rotations + 0.1)
-                last = world.get(ents[8], WorldPose)
-                last.prev_positions = np.zeros_like(last.prev_positions)
             if step == 6:
                 world.get(ents[3], Puppet).offsets = sk.offsets * 0.9
             app.step()
