@@ -95,17 +95,20 @@ def apply_commands(
     kind = np.where(kin, 1, np.where(ghost, 2, 0))[L.geom_owner]
     bits = np.array([SIMULATED_BITS, ANIMATED_BITS, GHOST_BITS])[kind]
     set_contact_bits(m, L.geom, bits[:, 0], bits[:, 1])
+    # holds: every hold constraint off and every anchor on its target, then Python only for the held few
+    d.eq_active[L.hold_eqs] = 0
+    d.mocap_pos[L.hold_mocap] = C.hold_target[rows]
     for p, i in enumerate(rows.tolist()):
         hold = C.hold[i]
-        for name, eq in L.hold_eq[p].items():
-            d.eq_active[eq] = name == hold
-        target = C.hold_target[i]
-        if hold is not None:  # the spring pulls from at most _HOLD_REACH away: a bounded force
-            held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][hold]]]
-            gap = target - held
-            dist = float(np.linalg.norm(gap))
-            if dist > _HOLD_REACH:
-                target = held + gap * (_HOLD_REACH / dist)
+        if hold is None:
+            continue
+        d.eq_active[L.hold_eq[p][hold]] = 1
+        target = C.hold_target[i]  # the spring pulls from at most _HOLD_REACH away: a bounded force
+        held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][hold]]]
+        gap = target - held
+        dist = float(np.linalg.norm(gap))
+        if dist > _HOLD_REACH:
+            target = held + gap * (_HOLD_REACH / dist)
         d.mocap_pos[L.hold_mocap[p]] = target
     C.roll(rows, keep_prev=False)
     if kin.any():

@@ -60,6 +60,8 @@ class Layout:
     hold_mocap: I
     ball_lead: F  # kv/kp at full muscle: how far each servo trails a moving target (s)
     hinge_lead: F
+    hold_eqs: I  # every hold constraint's id, ragdoll by ragdoll (switched off together, the held one back on)
+    hold_eqs_owner: I
     hold_eq: list[dict[str, int]]
     hold_joint: list[dict[str, int]]  # holdable joint name -> its index in the ragdoll's skeleton
 
@@ -140,6 +142,8 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         put("ball_lead", lead[ball])
         put("hinge_lead", lead[hinge])
         hold_eq.append({h: m.eq(rd_name(k, h) + "_hold").id for h in pr.holdable})
+        put("hold_eqs", np.array(list(hold_eq[-1].values()), dtype=np.int64))
+        put("hold_eqs_owner", np.full(len(hold_eq[-1]), p))
         hold_joint.append({h: sk.index(h) for h in pr.holdable})
         starts.append(base + sk.num_joints)
 
@@ -171,6 +175,8 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         "pin_eq",
         "pin_mocap",
         "hold_mocap",
+        "hold_eqs",
+        "hold_eqs_owner",
     )
     floats = ("ball_twist", "ball_cone", "act_kp", "act_kv", "ball_lead", "hinge_lead")
     return Layout(
@@ -194,6 +200,7 @@ _GROUPS = {  # owner array -> the arrays laid out by it (and which of them index
     "act_owner": ("act", "act_kp", "act_kv"),
     "body_owner": ("body",),
     "geom_owner": ("geom",),
+    "hold_eqs_owner": ("hold_eqs",),
 }
 
 
