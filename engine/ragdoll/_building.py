@@ -116,11 +116,11 @@ class Building:
     def _assign(self) -> None:
         """Park the slots of ragdolls that left, lend slots to those that joined (growing the pool
         when a kind has too few: to what is needed and a quarter more), and place the newcomers (see :mod:`._pool`)."""
-        self._moved = False
         C = self._cmds
         C.sync()
         for i in np.nonzero(~C.in_model & (C.pool >= 0))[0].tolist():
             self._give_back(i)
+        self._moved = False  # (after the give-backs, which mark it: else the next reader assigns all over again)
         # simulated ragdolls first, then the animated ones near them; past MAX_SLOTS of a kind the
         # rest stay out this step (an animated one then passes through, it does not crash the game)
         new = np.nonzero(C.in_model & (C.pool < 0))[0]
