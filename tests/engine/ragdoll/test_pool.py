@@ -149,3 +149,26 @@ def test_a_ragdoll_that_falls_again_lands_on_the_ground(skeleton: Skeleton) -> N
     assert hips[1] > 0.0, f"the ragdoll fell through the ground: hips at y = {hips[1]:.2f} m"
     body = m.body(pw.mujoco_name(1, "hips")).id
     assert m.body_contype[body] != 0 and m.body_conaffinity[body] != 0
+
+
+def test_a_step_where_one_leaves_assigns_slots_once(skeleton: Skeleton, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A ragdoll that leaves the model gives its slot back inside the step's own assignment; reading
+    the world after that step must not run a second one (it did: a whole select, settle and
+    ``mj_forward`` more on every step where a ragdoll left). Broken by clearing ``_moved`` before the
+    give-backs in ``Building._assign``: the reads below then assign again."""
+    pw = _crowd(skeleton, 4)
+    _drive(pw, skeleton, {1, 2})
+    pw.step()
+    calls: list[int] = []
+    original = building_module.Building._assign
+
+    def counted(self: PhysicsWorld) -> None:
+        calls.append(1)
+        original(self)
+
+    monkeypatch.setattr(building_module.Building, "_assign", counted)
+    _drive(pw, skeleton, {2})
+    pw.step()
+    assert len(calls) == 1 and not pw.in_model(1)
+    pw.pose(2), pw.root_velocity(2), pw.kinetic_energy(2)
+    assert len(calls) == 1
