@@ -17,7 +17,7 @@ from engine import quat
 from engine.arrays import F64 as _F
 from engine.fk import forward_kinematics
 from engine.pose import Pose
-from engine.ragdoll._commands import Commands
+from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._control import read_poses
 from engine.ragdoll._layout import Layout
 from engine.ragdoll._slots import RagdollSlot
@@ -72,6 +72,35 @@ class Readback:
         p = L.ordinal(key)
         return Pose(roots[p].copy(), rot[L.starts[p] : L.starts[p + 1]].copy())
 
+    def simulated_state(self, keys: list[int]) -> tuple[_F, _F, _F, _F]:
+        """:meth:`pose`, :meth:`root_velocity` and :meth:`kinetic_energy` of many ragdolls at once (the
+        physics stage reads them for every simulated puppet after each step): roots ``[n,3]``, their
+        local rotations end to end ``[ΣJ,4]``, root velocities ``[n,6]`` and energies ``[n]``. Each
+        number is the one the single-ragdoll query gives."""
+        C = self.commands
+        self.ensure_built()
+        rows = C.rows(keys)
+        n = len(keys)
+        roots, vel, ke = np.empty((n, 3)), np.empty((n, 6)), np.empty(n)
+        rot = np.empty((int(C.joints[rows].sum()), 4))
+        ends = np.cumsum(C.joints[rows])
+        inside = np.nonzero(C.in_model[rows])[0]
+        L, d = self.layout, self.data
+        if len(inside):
+            assert L is not None and d is not None
+            all_roots, all_rot = self._readback()
+            ordinal = np.searchsorted(np.asarray(L.keys, dtype=np.int64), C.keys[rows[inside]])
+            roots[inside] = all_roots[ordinal]
+            rot[joint_rows(np.concatenate([[0], ends]), inside)] = all_rot[joint_rows(L.starts, ordinal)]
+            vel[inside] = d.qvel[L.root_d[ordinal][:, None] + np.arange(6)]
+            ke[inside] = self._energies()[ordinal]
+        for k in np.nonzero(~C.in_model[rows])[0].tolist():  # left out (a full pool): from their commands
+            key = int(keys[k])
+            pose = self.pose(key)
+            roots[k], rot[ends[k] - len(pose.rotations) : ends[k]] = pose.root, pose.rotations
+            vel[k], ke[k] = self.root_velocity(key), 0.0
+        return roots, rot, vel, ke
+
     def body_positions(self, key: int) -> _F:
         """World positions ``[J,3]`` of the ragdoll's joint origins."""
         if (out := self._outside(key)) is not None:
@@ -100,6 +129,11 @@ class Readback:
         animated ragdoll left out of the model: nothing is simulated)."""
         if self._outside(key) is not None:
             return 0.0
+        assert self.layout is not None
+        return float(self._energies()[self.layout.ordinal(key)])
+
+    def _energies(self) -> _F:
+        """Kinetic energy of every ragdoll in the layout (cached per step)."""
         L, m, d = self.layout, self.model, self.data
         assert L is not None and m is not None and d is not None
         if self._ke is None:
@@ -107,7 +141,7 @@ class Readback:
             mujoco.mj_mulM(m, d, res, d.qvel)
             cum = np.concatenate([[0.0], np.cumsum(0.5 * d.qvel * res)])
             self._ke = cum[L.dofs[:, 1]] - cum[L.dofs[:, 0]]
-        return float(self._ke[L.ordinal(key)])
+        return self._ke
 
     def joint_limit_violation(self, key: int) -> float:
         """Largest excess (rad) of any simulated joint beyond its cone, twist or hinge range (0 when

@@ -9,12 +9,12 @@ operation in the engine.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from engine import quat
 from engine.pose import Pose
 
-__all__ = ["blend_poses", "max_rotation_jump"]
+__all__ = ["blend_poses", "blend_rows", "max_rotation_jump"]
 
 
 def blend_poses(animated: Pose, simulated: Pose, weight: float | ArrayLike) -> Pose:
@@ -39,6 +39,29 @@ def blend_poses(animated: Pose, simulated: Pose, weight: float | ArrayLike) -> P
     root = animated.root + w_root * (simulated.root - animated.root)
     rot = quat.slerp(animated.rotations, simulated.rotations, w_rot)
     return Pose(root, quat.normalize(rot))
+
+
+def blend_rows(
+    root: NDArray[np.float64],
+    rot: NDArray[np.float64],
+    sim_root: NDArray[np.float64],
+    sim_rot: NDArray[np.float64],
+    weight: NDArray[np.float64],
+    sizes: NDArray[np.int64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`blend_poses` of many poses at once, each with its own scalar weight: roots ``[n,3]``,
+    rotations end to end ``[ΣJ,4]`` (pose ``i`` has ``sizes[i]`` joints), ``weight [n]``. Every number
+    is the one :func:`blend_poses` gives for that pose alone (weights 0 and 1 copy exactly)."""
+    w = np.clip(np.asarray(weight, dtype=np.float64), 0.0, 1.0)
+    per_joint = np.repeat(w, sizes)
+    out_root = np.where((w == 1.0)[:, None], sim_root, root)
+    out_rot = np.where((per_joint == 1.0)[:, None], sim_rot, rot)
+    mid = (w > 0.0) & (w < 1.0)
+    if mid.any():
+        jm = np.repeat(mid, sizes)
+        out_root[mid] = root[mid] + w[mid, None] * (sim_root[mid] - root[mid])
+        out_rot[jm] = quat.normalize(quat.slerp(rot[jm], sim_rot[jm], per_joint[jm]))
+    return out_root, out_rot
 
 
 def max_rotation_jump(rotations: ArrayLike) -> float:

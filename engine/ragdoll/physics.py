@@ -256,6 +256,27 @@ class PhysicsWorld(Readback, Building):
         C.muscle[i], C.pin[i] = float(np.clip(muscle, 0, 1)), float(np.clip(pin, 0, 1))
         C.support[i] = float(np.clip(gravity_support, 0, 1))
 
+    def drive_simulated(self, keys: list[int], roots: _F, rotations: _F, muscle: _F, pin: _F, support: _F) -> None:
+        """:meth:`drive` (not kinematic) for many ragdolls at once: roots ``[n,3]``, their rotations end
+        to end ``[ΣJ,4]``, weights ``[n]`` (validated and normalised in one pass, each number as
+        :meth:`drive` makes it: ten puppets falling in a crowd are ten drives a step)."""
+        if not len(keys):
+            return
+        C = self.commands
+        rows = C.rows(keys)
+        r = np.asarray(roots, dtype=np.float64).reshape(len(rows), 3)
+        q = np.asarray(rotations, dtype=np.float64)
+        sizes: I64 = C.joints[rows]
+        if q.shape != (int(sizes.sum()), 4):
+            raise ValueError(f"rotations must be [J,4] per ragdoll with J = {sizes.tolist()}")
+        ends: I64 = np.cumsum(sizes)
+        ok = np.isfinite(r).all(axis=1) & np.logical_and.reduceat(np.isfinite(q).all(axis=1), ends - sizes)
+        if not ok.all():
+            raise ValueError(f"ragdoll {keys[int(np.argmin(ok))]}: target pose has NaN or infinite values")
+        C.root[rows], C.rot[joint_rows(C.starts, rows)], C.kinematic[rows] = r, quat.normalize(q), False
+        C.muscle[rows], C.pin[rows] = np.clip(muscle, 0, 1), np.clip(pin, 0, 1)
+        C.support[rows] = np.clip(support, 0, 1)
+
     def drive_animated(self, keys: list[int] | I64, roots: list[_F] | _F, rotations: list[_F] | _F) -> list[int]:
         """:meth:`drive` ``kinematic=True`` for many ragdolls at once (validated and normalised
         in one pass: a crowd of animated puppets is most of the physics stage's Python work).

@@ -32,8 +32,7 @@ from engine.arrays import I64
 from engine.columns import columns
 from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import Entity, World
-from engine.pose import Pose
-from engine.ragdoll.blend import blend_poses
+from engine.ragdoll.blend import blend_rows
 from engine.ragdoll.components import Prop, Ragdoll, RagdollMode
 from engine.ragdoll.getup import update_settle
 from engine.ragdoll.physics import PhysicsWorld
@@ -108,16 +107,7 @@ def physics_step(world: World) -> None:
         keys = np.array([row[0] for row in animated], dtype=np.int64)
         poses = tuple(row[3] for row in animated)
     refused = pw.drive_animated(keys, *_animated_targets(world, pw, keys, poses))
-    targets: dict[Entity, Pose] = {}
-    for e, rd, pose in simulated:
-        rd.ramp(world.dt)
-        target = Pose(np.array(pose.root, dtype=np.float64), np.array(pose.rotations, dtype=np.float64))
-        if not target.is_finite():
-            refused.append(e)
-            target = pw.target(e)
-        target.rotations = quat.normalize(target.rotations)
-        targets[e] = target
-        pw.drive(e, target.root, target.rotations, rd.muscle_weight, rd.pin_weight, rd.muscle_weight * rd.pin_weight)
+    targets = _drive_simulated(world, pw, simulated, refused)
     for e in refused:  # a NaN pose from upstream: count it, keep the last good target
         pw.recoveries += 1
         pose = world.get(e, LocalPose)
@@ -129,15 +119,57 @@ def physics_step(world: World) -> None:
             pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
             prop.placed = False
     pw.step()
-    for e, rd, pose in simulated:
-        speed = float(np.linalg.norm(pw.root_velocity(e)[:3]))
-        update_settle(rd, pw.kinetic_energy(e), speed, float(rd.profile.masses.sum()))
-        out = blend_poses(targets[e], pw.pose(e), rd.blend_weight)
-        pose.root, pose.rotations = out.root, out.rotations
+    if simulated:
+        _write_simulated(pw, simulated, *targets)
     for e, prop, tr in world.query(Prop, Transform):
         if not prop.carried:
             pos, rot, vel = pw.prop_state(e)
             tr.position, tr.rotation, prop.velocity = pos, rot, vel
+
+
+def _drive_simulated(
+    world: World, pw: PhysicsWorld, simulated: list[tuple[Entity, Ragdoll, LocalPose]], refused: list[Entity]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], I64]:
+    """Ramp the simulated ragdolls' weights and drive them to their local poses in one batched call
+    (a pose with NaN or infinite values is refused: that ragdoll keeps its last target, and its key is
+    added to ``refused``); their targets, as driven: roots ``[n,3]``, rotations end to end ``[ΣJ,4]``
+    and joints per ragdoll ``[n]``."""
+    roots, rots = [], []
+    for e, rd, pose in simulated:
+        rd.ramp(world.dt)
+        root, rot = np.array(pose.root, dtype=np.float64), np.array(pose.rotations, dtype=np.float64)
+        if not (np.isfinite(root).all() and np.isfinite(rot).all()):
+            refused.append(e)
+            target = pw.target(e)
+            root, rot = target.root, target.rotations
+        roots.append(root)
+        rots.append(rot)
+    sizes = np.array([len(r) for r in rots], dtype=np.int64)
+    root_t = np.array(roots).reshape(-1, 3)
+    rot_t = quat.normalize(np.concatenate(rots)) if rots else np.zeros((0, 4))
+    muscle = np.array([rd.muscle_weight for _, rd, _ in simulated], dtype=np.float64)
+    pin = np.array([rd.pin_weight for _, rd, _ in simulated], dtype=np.float64)
+    pw.drive_simulated([e for e, _, _ in simulated], root_t, rot_t, muscle, pin, muscle * pin)
+    return root_t, rot_t, sizes
+
+
+def _write_simulated(
+    pw: PhysicsWorld,
+    simulated: list[tuple[Entity, Ragdoll, LocalPose]],
+    root: NDArray[np.float64],
+    rot: NDArray[np.float64],
+    sizes: I64,
+) -> None:
+    """After the step: each simulated ragdoll's settle state, and its local pose blended from its
+    target (``root``, ``rot``, ``sizes`` from :func:`_drive_simulated`) to the simulated one."""
+    sim_root, sim_rot, vel, ke = pw.simulated_state([e for e, _, _ in simulated])
+    for k, (_, rd, _) in enumerate(simulated):
+        update_settle(rd, float(ke[k]), float(np.linalg.norm(vel[k, :3])), float(rd.profile.masses.sum()))
+    weights = np.array([rd.blend_weight for _, rd, _ in simulated], dtype=np.float64)
+    out_root, out_rot = blend_rows(root, rot, sim_root, sim_rot, weights, sizes)
+    ends = np.cumsum(sizes).tolist()
+    for k, (_, _, pose) in enumerate(simulated):
+        pose.root, pose.rotations = out_root[k].copy(), out_rot[ends[k] - int(sizes[k]) : ends[k]].copy()
 
 
 #: An animated ragdoll's settle state: not simulated, the body is its animation (no energy, nothing to settle).
