@@ -46,6 +46,7 @@ class Building:
     _dirty: bool
     _sized: bool
     _moved: bool
+    _new_data: bool  # a compiled MjData that no mj_forward has run on yet
     _digest: bytes
     _ke: _F | None
     _read: tuple[_F, _F] | None
@@ -84,6 +85,7 @@ class Building:
         xml = build_mjcf(rd, pr, self.timestep, self.ground_friction, sleep=bool(rd))
         m = self.model = mujoco.MjModel.from_xml_string(xml)
         d = self.data = mujoco.MjData(m)
+        self._new_data = True
         self._digest = hashlib.blake2b(xml.encode(), digest_size=16).digest()
         self.rebuilds += 1
         pool = self._pool_layout = build_layout(m, rd)
@@ -169,9 +171,14 @@ class Building:
             self._place_rows(joined)
             C.placed[joined] = True
         settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
-        # (settle's kinematics is all the next step's commands read, but leaving the rest of this to
-        # the step is not bit-identical: games/snowman/demo.rec then differs from frame 227)
-        mujoco.mj_forward(m, d)
+        # settle's kinematics (body and geom poses) is all that is read before the next step, whose
+        # mj_step computes the rest from the state; a new MjData has no mass matrix yet (a kinetic
+        # energy read before the first step): only then a whole mj_forward. (b32f saw the snowman demo
+        # differ without it: that was the second, post-step _assign that 6626a36 removed, whose
+        # mj_forward refreshed the mass matrix the kinetic energy after that step is read from.)
+        if self._new_data:
+            self._new_data = False
+            mujoco.mj_forward(m, d)
 
     def _give_back(self, row: int) -> None:
         """Return a ragdoll's pool slot (command row ``row``): parked, asleep, free for the next one of its kind."""

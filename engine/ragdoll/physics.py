@@ -90,6 +90,7 @@ class PhysicsWorld(Readback, Building):
         self._dirty = False
         self._sized = True
         self._moved = False
+        self._new_data = False
         self._pool = RagdollPool()
         self._reach: dict[bytes, float] = {}
         self.left_out = 0  # ragdolls that should have joined at the last change but the full pool had no room
