@@ -107,7 +107,7 @@ def physics_step(world: World) -> None:
         keys = np.array([row[0] for row in animated], dtype=np.int64)
         poses = tuple(row[3] for row in animated)
     refused = pw.drive_animated(keys, *_animated_targets(world, pw, keys, poses))
-    targets = _drive_simulated(world, pw, simulated, refused)
+    targets = _drive_simulated(world, pw, simulated, refused) if simulated else None  # (a walking crowd: none)
     for e in refused:  # a NaN pose from upstream: count it, keep the last good target
         pw.recoveries += 1
         pose = world.get(e, LocalPose)
@@ -119,7 +119,7 @@ def physics_step(world: World) -> None:
             pw.set_prop_kinematic(e, tr.position, tr.rotation, prop.velocity)
             prop.placed = False
     pw.step()
-    if simulated:
+    if targets is not None:
         _write_simulated(pw, simulated, *targets)
     for e, prop, tr in world.query(Prop, Transform):
         if not prop.carried:
