@@ -17,7 +17,9 @@ from engine.skeleton import Skeleton
 def _world(skeleton: Skeleton, n: int) -> PhysicsWorld:
     pw = PhysicsWorld()
     for k in range(n):
-        pw.add_ragdoll(k + 1, skeleton, default_profile(skeleton), [1.5 * k, 1.0, 0.0], quat.identity(skeleton.num_joints))
+        pw.add_ragdoll(
+            k + 1, skeleton, default_profile(skeleton), [1.5 * k, 1.0, 0.0], quat.identity(skeleton.num_joints)
+        )
     return pw
 
 
