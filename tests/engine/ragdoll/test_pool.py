@@ -9,6 +9,7 @@ import pytest
 from engine import quat
 from engine.ragdoll import _building as building_module
 from engine.ragdoll import default_profile
+from engine.ragdoll import physics as physics_module
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
 
@@ -172,3 +173,38 @@ def test_a_step_where_one_leaves_assigns_slots_once(skeleton: Skeleton, monkeypa
     assert len(calls) == 1 and not pw.in_model(1)
     pw.pose(2), pw.root_velocity(2), pw.kinetic_energy(2)
     assert len(calls) == 1
+
+
+def test_membership_changes_run_no_forward(skeleton: Skeleton, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Joining and leaving run MuJoCo's kinematics, not a whole ``mj_forward`` (the next ``mj_step``
+    computes the rest): when that step starts, each joiner's root body is where its state puts it, not
+    where its slot was parked. Broken by calling ``mj_forward`` at the end of ``Building._assign`` again
+    (the count is then not zero), or by leaving out settle's kinematics (the bodies are still parked)."""
+    pw = _crowd(skeleton, 4)
+    _drive(pw, skeleton, set())
+    pw.step()
+    calls: list[int] = []
+    forward = mujoco.mj_forward
+
+    def counted(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        calls.append(1)
+        forward(m, d)
+
+    monkeypatch.setattr(building_module.mujoco, "mj_forward", counted)
+    gaps: list[float] = []
+    step = physics_module.guarded_step
+
+    def checked(
+        m: mujoco.MjModel, d: mujoco.MjData, substeps: int, limit: np.ndarray, owners: np.ndarray
+    ) -> str | None:
+        L = pw.layout
+        assert L is not None
+        roots = L.body[L.starts[:-1]]
+        gaps.append(float(np.abs(d.xpos[roots] - d.qpos[L.root_q[:, None] + np.arange(3)]).max()))
+        return step(m, d, substeps, limit, owners)
+
+    monkeypatch.setattr(physics_module, "guarded_step", checked)
+    for falling in ({1, 2}, {2}, {3, 4}, {1, 3}):
+        _drive(pw, skeleton, falling)
+        pw.step()
+    assert calls == [] and len(gaps) == 4 and max(gaps) < 1e-9
