@@ -182,27 +182,36 @@ class Environment:
         Without ``detail`` one draw. With it (quality high) the fine snow is compiled only into
         the draw of the rings that come within :data:`~engine.render.shaders_ground.NEAR_DETAIL`
         of the eye, and the shadow mask is read only when there is a shadow
-        (``u_shadow_strength`` above 0): llvmpipe pays a branch's fetches and arithmetic on
+        (``u_shadow_strength`` above 0), by the rings that reach into its rectangle (``u_rect``,
+        as far as its farthest corner): llvmpipe pays a branch's fetches and arithmetic on
         every pixel of a draw that contains it, taken or not (measured on the empty field at
         1280x720: 45-50 ms with both, 24-29 without the near branch, 32 without the mask's).
         A ring's band lies at least ``radius · cos(π/segments)`` from the centre under the eye
         (its chords' distance), so a band beyond that bound never enters the near branch and
-        its pixels are the same without it.
+        its pixels are the same without it; a band beyond the rectangle's farthest corner never
+        passes the mask's rectangle test, likewise.
         """
         per_pixel = ("PIXEL",) if detail or grid or photo else ()
-        mask = ("MASK",) if detail and uniforms["u_shadow_strength"] > 0.0 else ()
-        rest = per_pixel + mask + tuple(f for f, on in (("GRID", grid), ("PHOTO", photo)) if on)
+        extra = tuple(f for f, on in (("GRID", grid), ("PHOTO", photo)) if on)
         total = len(self._ring_bands) * self._band_indices
         if not detail:
-            return [(self._ground_variant(rest), 0, total)]
+            return [(self._ground_variant(per_pixel + extra), 0, total)]
         reach = self._ring_bands * float(uniforms["u_extent"])
         near_bands = int(np.count_nonzero(reach < G.NEAR_DETAIL * 1.01))  # 1 % margin for float rounding
-        split = near_bands * self._band_indices
-        draws = [
-            (self._ground_variant(("PIXEL", "NEAR", *rest[1:])), 0, split),  # rest[0] is PIXEL
-            (self._ground_variant(rest), split, total - split),
-        ]
-        return [d for d in draws if d[2] > 0]
+        mask_bands = 0
+        if uniforms["u_shadow_strength"] > 0.0:  # the bands that reach into the shadow's rectangle
+            x0, z0, w, d = (float(v) for v in uniforms["u_rect"])
+            cx, _, cz = (float(v) for v in uniforms["u_center"])
+            corner = max(np.hypot(x - cx, z - cz) for x in (x0, x0 + w) for z in (z0, z0 + d))
+            mask_bands = int(np.count_nonzero(reach < corner * 1.01))
+        draws, start = [], 0
+        for end in sorted({near_bands, mask_bands, len(reach)}):
+            if end > start:
+                features = ("NEAR",) * (start < near_bands) + ("MASK",) * (start < mask_bands)
+                key = self._ground_variant(("PIXEL", *features, *extra))
+                draws.append((key, start * self._band_indices, (end - start) * self._band_indices))
+            start = end
+        return draws
 
     def reads(self, draws: list[tuple[str, int, int]]) -> tuple[str, ...]:
         """The names of the uniforms the ground's ``draws`` (:meth:`ground_draws`), the ridge, the sky and the

@@ -81,7 +81,9 @@ def test_the_split_ground_draws_the_same_pixels_as_one_draw_with_all_its_detail(
 
 def test_only_the_rings_within_reach_of_the_eye_get_the_near_snow() -> None:
     """The near draw ends at the first band whose chords all lie beyond ``NEAR_DETAIL``; the mask is read
-    only with a shadow. Broken once by counting bands by their outer ring: the bound check fails."""
+    only with a shadow, and only up to the first band beyond the farthest corner of its rectangle.
+    Broken once by counting bands by their outer ring: the bound check fails; once by measuring the
+    rectangle to its nearest corner: the mask's bound check fails."""
     from engine.render import make_target
 
     target = make_target(True, 8, 8, samples=0)
@@ -95,8 +97,13 @@ def test_only_the_rings_within_reach_of_the_eye_get_the_near_snow() -> None:
         band = count // env._band_indices  # the first band drawn without the near snow
         assert bands[band] >= NEAR_DETAIL > bands[band - 1]
         assert count + count_far == len(bands) * env._band_indices
-        shadowed = env.ground_draws(True, False, False, {"u_extent": extent, "u_shadow_strength": 0.9})
-        assert [k for k, _, _ in shadowed] == ["ground_pixel_near_mask", "ground_pixel_mask"]
+        shadow = {"u_extent": extent, "u_shadow_strength": 0.9, "u_rect": (-3.0, 10.0, 6.0, 14.0), "u_center": (0, 0, 0)}
+        shadowed = env.ground_draws(True, False, False, shadow)
+        assert [k for k, _, _ in shadowed] == ["ground_pixel_near_mask", "ground_pixel_mask", "ground_pixel"]
+        masked = (shadowed[0][2] + shadowed[1][2]) // env._band_indices  # the first band drawn without the mask
+        corner = np.hypot(3.0, 24.0)  # the rectangle's farthest corner from the centre
+        assert bands[masked] >= corner > bands[masked - 1]
+        assert sum(count for _, _, count in shadowed) == len(bands) * env._band_indices
         plain = env.ground_draws(False, False, False, {"u_extent": extent, "u_shadow_strength": 0.9})
         assert [k for k, _, _ in plain] == ["ground"]
         env.release()
