@@ -97,7 +97,12 @@ def test_only_the_rings_within_reach_of_the_eye_get_the_near_snow() -> None:
         band = count // env._band_indices  # the first band drawn without the near snow
         assert bands[band] >= NEAR_DETAIL > bands[band - 1]
         assert count + count_far == len(bands) * env._band_indices
-        shadow = {"u_extent": extent, "u_shadow_strength": 0.9, "u_rect": (-3.0, 10.0, 6.0, 14.0), "u_center": (0, 0, 0)}
+        shadow = {
+            "u_extent": extent,
+            "u_shadow_strength": 0.9,
+            "u_rect": (-3.0, 10.0, 6.0, 14.0),
+            "u_center": (0, 0, 0),
+        }
         shadowed = env.ground_draws(True, False, False, shadow)
         assert [k for k, _, _ in shadowed] == ["ground_pixel_near_mask", "ground_pixel_mask", "ground_pixel"]
         masked = (shadowed[0][2] + shadowed[1][2]) // env._band_indices  # the first band drawn without the mask
