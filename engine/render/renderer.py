@@ -492,14 +492,14 @@ class Renderer:
         self, scene: RenderScene, camera: Camera, target: moderngl.Framebuffer, ground: dict[str, Any]
     ) -> bytes | None:
         """What this frame's sky and ground are drawn from (:mod:`engine.render.env_cache`), or ``None``
-        when they cannot be kept: the ground reads the shadow mask (detail) or a photo, or ``target``
-        is multisampled (no copy into it)."""
+        when they cannot be kept: the ground reads the shadow mask (detail with a shadow) or a photo,
+        or ``target`` is multisampled (no copy into it)."""
         photo = scene.background is not None and scene.background_fade < 1.0
         detail = self._ground_detail(scene)
-        if detail or photo or not single_sampled(target):
+        if (detail and ground["u_shadow_strength"] > 0.0) or photo or not single_sampled(target):
             return None
         g = scene.ground
-        names = self.env.reads(detail, g.grid, photo)
+        names = self.env.reads(self.env.ground_draws(detail, g.grid, photo, ground))
         hidden = self._sky_hidden(scene, camera, ground["u_extent"])
         flags = (target.size, g.grid, g.visible, hidden, tuple(float(c) for c in scene.horizon_color))
         return view_key(flags, names, {**self._common, **ground})
@@ -522,7 +522,7 @@ class Renderer:
         g = scene.ground
         self.shadows.mask.use(location=4)
         if g.visible:
-            self.env.draw_ground(scene, self._ground_detail(scene), photo, ground)
+            self.env.draw_ground(self.env.ground_draws(self._ground_detail(scene), g.grid, photo, ground), ground)
         self._mark("ground")
         if not self._sky_hidden(scene, camera, ground["u_extent"]):
             self.env.draw_sky(scene, photo, float(g.height))

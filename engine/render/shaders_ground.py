@@ -18,6 +18,7 @@ from __future__ import annotations
 __all__ = [
     "GROUND_MESH_VS",
     "GROUND_MESH_FS",
+    "NEAR_DETAIL",
     "SKY_DOME_VS",
     "COLOR_FS",
     "RIDGE_VS",
@@ -59,15 +60,22 @@ void main() {
 }
 """
 
-# The ground's fragment stage. Plain: the vertex colour. DETAIL (quality high): fine drifts
-# and sparkle near the camera. GRID: anti-aliased grid lines. PHOTO: the background photo.
+NEAR_DETAIL = 14.0
+"""Metres from the eye within which the ground's ``NEAR`` variant adds fine drifts and sparkle."""
+
+# The ground's fragment stage. Plain: the vertex colour. PIXEL: the tone curve per pixel (every
+# per-pixel variant has it). Quality high splits its detail in two, since llvmpipe runs a
+# branch's fetches and arithmetic for every pixel of a draw that has it, taken or not:
+# MASK reads the ground shadow (only when there is one) and NEAR adds fine drifts and
+# sparkle within NEAR_DETAIL metres (only on the rings that come that close: see
+# engine.render.environment). GRID: anti-aliased grid lines. PHOTO: the background photo.
 GROUND_MESH_FS = """
 uniform sampler2D u_noise;
 uniform vec3 u_grid_lin;
 uniform float u_snow;
 uniform float u_grid_spacing;
 uniform float u_grid_strength;
-uniform sampler2D u_ground_mask;    // DETAIL: the ground shadow is read here, not drawn as a decal
+uniform sampler2D u_ground_mask;    // MASK: the ground shadow is read here, not drawn as a decal
 uniform vec4 u_rect;
 uniform float u_shadow_strength;
 in vec3 v_pos;
@@ -75,18 +83,20 @@ in vec3 v_lin;
 in vec3 v_color;
 out vec4 f_color;
 void main() {
-#if defined(DETAIL) || defined(GRID) || defined(PHOTO)
+#ifdef PIXEL
     vec3 c = v_lin;
     vec3 to_eye = u_eye - v_pos;
     float dist = length(to_eye);
-#ifdef DETAIL
+#ifdef MASK
     vec2 muv = (v_pos.xz - u_rect.xy) / u_rect.zw;
     if (u_shadow_strength > 0.0 && all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) {
         vec3 sun = u_sun_color * u_sun_dir.y;
         c *= 1.0 - texture(u_ground_mask, muv).r * u_shadow_strength * sun / (sun + u_sky_lin * u_ambient * 1.6);
     }
-    if (dist < 14.0) {
-        float near = 1.0 - dist / 14.0;
+#endif
+#ifdef NEAR
+    if (dist < NEAR_DETAIL) {
+        float near = 1.0 - dist / NEAR_DETAIL;
         vec4 drift = texture(u_noise, v_pos.xz * 0.08);
         vec2 slope = (drift.gb - 0.5) * (0.6 * u_snow) * near;
         c *= 1.0 + (0.6 * dot(slope, -u_sun_dir.xz) - 0.03 * u_snow * (1.0 - drift.r)) * near;

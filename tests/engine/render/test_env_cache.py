@@ -117,6 +117,23 @@ def test_a_ground_that_reads_the_shadow_mask_is_not_kept() -> None:
         viewer.close()
 
 
+def test_at_high_a_ground_without_a_shadow_is_kept() -> None:
+    """At ``high`` with no caster the per-pixel snow reads no mask: it depends on the view alone and is
+    kept like the lower levels' (one drawing for two frames, the same pixels as a renderer that keeps
+    nothing); a caster then draws it every frame. Broken once by keying the ground's mask on detail
+    alone (as before the split): nothing is kept and the count fails."""
+    empty = RenderScene()
+    viewer = _viewer("high")
+    try:
+        for scene in (empty, empty, _scene(0.0)):
+            viewer.camera = _CAMERA
+            viewer.draw(scene)
+            assert np.array_equal(viewer.read_pixels(), _uncached(scene, _CAMERA, "high"))
+        assert viewer.renderer.env_cache.stores == 1
+    finally:
+        viewer.close()
+
+
 def test_a_detected_framebuffer_is_drawn_into_without_a_kept_view() -> None:
     """A window drawn into straight is a framebuffer moderngl detected: it lists no attachments
     (``None``), so the view is not kept for it and the frame is drawn as into any buffer. Broken
