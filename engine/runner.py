@@ -16,7 +16,8 @@ and draws itself. The runner owns everything around it:
   run per frame varies; each step is the same fixed ``dt`` with its own recorded input,
   so the simulation never depends on the frame rate;
 - the **drawing quality** (:mod:`engine.render.quality`): ``--quality`` fixes it, or
-  ``auto`` lets the measured frame time choose; ``G`` cycles low, medium, high, auto;
+  ``auto`` lets the measured drawing time choose (with the two steps a 30 fps frame must
+  also run, not the frame's whole loop time); ``G`` cycles low, medium, high, auto;
 - the **event stack**: window events go to the handlers pushed last first (tools and
   overlays before the game, as in pyglet's handler stack); a handler that returns true
   consumes the event. The runner's own handler sits at the bottom: Esc and closing the
@@ -232,6 +233,8 @@ class Runner:
 
         self.quality = QualityGovernor("high" if options.headless and options.quality == "auto" else options.quality)
         self.keeper = TimeKeeper(MAX_FRAME_TIME)
+        self._step_cost = 0.0
+        """Wall seconds of one simulation step, as the last window frame that stepped measured them."""
         self._note: tuple[str, float] | None = None
 
     # -- event stack ---------------------------------------------------------------------
@@ -350,15 +353,23 @@ class Runner:
             if not self.clock.paused:
                 lost = elapsed - min(elapsed, MAX_FRAME_TIME) + self.clock.dropped_time - dropped_before
                 self.keeper.frame(elapsed, lost)
-            if self.quality.frame(elapsed):
-                self._apply_quality()
+            ran, started = 0, self._wall()
             for _ in range(min(due, self._limit(steps))):
                 if activity.finished():
                     break
                 activity.step()
                 steps += 1
+                ran += 1
                 self._after_step(activity, steps)
+            drawing = self._wall()
+            if ran:
+                self._step_cost = (drawing - started) / ran
             self.draw(activity)
+            # The level is chosen on what it changes, the drawing; the steps count only as many as
+            # a frame at the budget's rate runs (see engine.render.quality), none while paused.
+            fixed = 0.0 if self.clock.paused else self._step_cost * self.quality.budget / activity.dt
+            if self.quality.frame(self._wall() - drawing, fixed):
+                self._apply_quality()
             meter.tick(now)
             self.fps = meter.rate
         return steps
