@@ -12,7 +12,11 @@ and draws itself. The runner owns everything around it:
   3 s countdown still takes 3 s, and a performer's tempo is kept. A slow frame is followed
   by as many steps as it lasted (frames are dropped, not time) up to
   :data:`MAX_FRAME_TIME`; only a longer stall drops time, and then the window says so
-  (:class:`~engine.pacing.TimeKeeper`) until the game keeps time again. How many steps
+  (:class:`~engine.pacing.TimeKeeper`) until the game keeps time again. The same bound
+  holds the wall time a frame's steps may take: when the steps themselves are slower
+  than real time (1000 puppets on a slow machine), a frame runs the steps that fit in
+  :data:`MAX_FRAME_TIME` and drops the rest, rather than run all that are due and leave
+  the window still for seconds while falling further behind. How many steps
   run per frame varies; each step is the same fixed ``dt`` with its own recorded input,
   so the simulation never depends on the frame rate;
 - the **drawing quality** (:mod:`engine.render.quality`): ``--quality`` fixes it, or
@@ -350,17 +354,20 @@ class Runner:
             elapsed, dropped_before = now - last, self.clock.dropped_time
             due = self.clock.advance(min(elapsed, MAX_FRAME_TIME))
             last = now
-            if not self.clock.paused:
-                lost = elapsed - min(elapsed, MAX_FRAME_TIME) + self.clock.dropped_time - dropped_before
-                self.keeper.frame(elapsed, lost)
-            ran, started = 0, self._wall()
-            for _ in range(min(due, self._limit(steps))):
+            todo, ran, started = min(due, self._limit(steps)), 0, self._wall()
+            for _ in range(todo):
                 if activity.finished():
                     break
+                if ran and self._wall() - started >= MAX_FRAME_TIME:
+                    break  # steps slower than real time: catching up would only make the next frame later
                 activity.step()
                 steps += 1
                 ran += 1
                 self._after_step(activity, steps)
+            if not self.clock.paused:
+                skipped = 0 if activity.finished() else (todo - ran) * activity.dt
+                lost = elapsed - min(elapsed, MAX_FRAME_TIME) + self.clock.dropped_time - dropped_before + skipped
+                self.keeper.frame(elapsed, lost)
             drawing = self._wall()
             if ran:
                 self._step_cost = (drawing - started) / ran
