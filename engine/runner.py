@@ -12,11 +12,16 @@ and draws itself. The runner owns everything around it:
   3 s countdown still takes 3 s, and a performer's tempo is kept. A slow frame is followed
   by as many steps as it lasted (frames are dropped, not time) up to
   :data:`MAX_FRAME_TIME`; only a longer stall drops time, and then the window says so
-  (:class:`~engine.pacing.TimeKeeper`) until the game keeps time again. How many steps
+  (:class:`~engine.pacing.TimeKeeper`) until the game keeps time again. The same bound
+  holds the wall time a frame's steps may take: when the steps themselves are slower
+  than real time (1000 puppets on a slow machine), a frame runs the steps that fit in
+  :data:`MAX_FRAME_TIME` and drops the rest, rather than run all that are due and leave
+  the window still for seconds while falling further behind. How many steps
   run per frame varies; each step is the same fixed ``dt`` with its own recorded input,
   so the simulation never depends on the frame rate;
 - the **drawing quality** (:mod:`engine.render.quality`): ``--quality`` fixes it, or
-  ``auto`` lets the measured frame time choose; ``G`` cycles low, medium, high, auto;
+  ``auto`` lets the measured drawing time choose (with the two steps a 30 fps frame must
+  also run, not the frame's whole loop time); ``G`` cycles low, medium, high, auto;
 - the **event stack**: window events go to the handlers pushed last first (tools and
   overlays before the game, as in pyglet's handler stack); a handler that returns true
   consumes the event. The runner's own handler sits at the bottom: Esc and closing the
@@ -232,6 +237,8 @@ class Runner:
 
         self.quality = QualityGovernor("high" if options.headless and options.quality == "auto" else options.quality)
         self.keeper = TimeKeeper(MAX_FRAME_TIME)
+        self._step_cost = 0.0
+        """Wall seconds of one simulation step, as the last window frame that stepped measured them."""
         self._note: tuple[str, float] | None = None
 
     # -- event stack ---------------------------------------------------------------------
@@ -347,18 +354,29 @@ class Runner:
             elapsed, dropped_before = now - last, self.clock.dropped_time
             due = self.clock.advance(min(elapsed, MAX_FRAME_TIME))
             last = now
-            if not self.clock.paused:
-                lost = elapsed - min(elapsed, MAX_FRAME_TIME) + self.clock.dropped_time - dropped_before
-                self.keeper.frame(elapsed, lost)
-            if self.quality.frame(elapsed):
-                self._apply_quality()
-            for _ in range(min(due, self._limit(steps))):
+            todo, ran, started = min(due, self._limit(steps)), 0, self._wall()
+            for _ in range(todo):
                 if activity.finished():
                     break
+                if ran and self._wall() - started >= MAX_FRAME_TIME:
+                    break  # steps slower than real time: catching up would only make the next frame later
                 activity.step()
                 steps += 1
+                ran += 1
                 self._after_step(activity, steps)
+            if not self.clock.paused:
+                skipped = 0 if activity.finished() else (todo - ran) * activity.dt
+                lost = elapsed - min(elapsed, MAX_FRAME_TIME) + self.clock.dropped_time - dropped_before + skipped
+                self.keeper.frame(elapsed, lost)
+            drawing = self._wall()
+            if ran:
+                self._step_cost = (drawing - started) / ran
             self.draw(activity)
+            # The level is chosen on what it changes, the drawing; the steps count only as many as
+            # a frame at the budget's rate runs (see engine.render.quality), none while paused.
+            fixed = 0.0 if self.clock.paused else self._step_cost * self.quality.budget / activity.dt
+            if self.quality.frame(self._wall() - drawing, fixed):
+                self._apply_quality()
             meter.tick(now)
             self.fps = meter.rate
         return steps

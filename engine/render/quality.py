@@ -15,6 +15,13 @@ median of the last frames misses the 30 fps budget, and steps up only when a lev
 frames would still fit with room to spare at the level above (estimated by the ratio of
 the shaded pixels), never back to a level it has left for being too slow. It is display
 only: the simulation never sees the quality.
+
+A frame's cost is judged in two parts: the drawing, which the level changes, and the
+simulation steps a frame at the budget's rate must run (two 60 Hz steps at 30 fps), which
+no level changes. The window's whole loop time is not used: how many steps a frame runs
+grows as the frame rate falls (four at 15 fps), so it would count the simulation twice
+over in a slow window, and the pixel ratio of a step up would be applied to the
+simulation's share too, keeping a cheap drawing at ``low`` for good.
 """
 
 from __future__ import annotations
@@ -79,6 +86,7 @@ class QualityGovernor:
         self.budget, self.window = budget, window
         self.level = "medium" if self.mode == "auto" else self.mode
         self._times: deque[float] = deque(maxlen=window)
+        self._fixed: deque[float] = deque(maxlen=window)
         self._too_slow: set[str] = set()
 
     @property
@@ -90,31 +98,36 @@ class QualityGovernor:
         """Next mode in ``low → medium → high → auto`` (the quality key); returns it."""
         self.mode = QUALITY_NAMES[(QUALITY_NAMES.index(self.mode) + 1) % len(QUALITY_NAMES)]
         self._times.clear()
+        self._fixed.clear()
         self._too_slow.clear()
         if self.mode != "auto":
             self.level = self.mode
         return self.mode
 
-    def frame(self, seconds: float) -> bool:
-        """Record one frame's duration; true when the level changed."""
+    def frame(self, seconds: float, fixed: float = 0.0) -> bool:
+        """Record one frame: ``seconds`` of drawing at the current level, and ``fixed`` seconds that
+        a frame at the budget's rate spends on what no level changes (the simulation steps); true
+        when the level changed."""
         if self.mode != "auto":
             return False
         self._times.append(seconds)
+        self._fixed.append(fixed)
         if len(self._times) < self.window:
             return False
-        median = float(np.median(self._times))
+        drawing, rest = float(np.median(self._times)), float(np.median(self._fixed))
         i = self.ORDER.index(self.level)
-        if median > self.budget and i > 0:
+        if drawing + rest > self.budget and i > 0:
             self._too_slow.add(self.level)
             return self._set(self.ORDER[i - 1])
         if i + 1 < len(self.ORDER):
             up = self.ORDER[i + 1]
             grow = (QUALITIES[up].scale / QUALITIES[self.level].scale) ** 2
-            if up not in self._too_slow and median * grow < 0.8 * self.budget:
+            if up not in self._too_slow and drawing * grow + rest < 0.8 * self.budget:
                 return self._set(up)
         return False
 
     def _set(self, level: str) -> bool:
         self.level = level
         self._times.clear()
+        self._fixed.clear()
         return True

@@ -75,3 +75,43 @@ def test_bindings_are_one_mapping_left_acts_right_drag_orbits_wheel_zooms():
     for op in (Move(1.0, 1.0), Move(2.0, 2.0), Orbit(1.0, 0.0), Orbit(2.0, 1.0), Key("a")):
         b.queue(op)
     assert b.take() == [Move(2.0, 2.0), Orbit(3.0, 1.0), Key("a")]  # one move and one summed orbit per step
+
+
+class _Counting:
+    """A simulation that counts its steps and how often its state was hashed."""
+
+    dt = 1.0 / 60.0
+
+    def __init__(self) -> None:
+        self.steps = self.hashed = 0
+
+    def ready(self) -> bool:
+        return True
+
+    def apply(self, op) -> None:  # type: ignore[no-untyped-def]
+        pass
+
+    def advance(self, frame) -> None:  # type: ignore[no-untyped-def]
+        self.steps += 1
+
+    def digest(self) -> tuple[str, dict[str, bytes]]:
+        self.hashed += 1
+        return f"{self.steps:032x}", {}
+
+
+def test_a_step_hashes_the_state_only_for_a_recording_or_a_check(tmp_path):
+    """Play with no ``--record`` and no ``--verify`` never hashes (55 ms a step with 1000 puppets); a
+    recorder gets every step's hash. Fails if ``Session.step`` hashes unconditionally again."""
+    from authoring.session import Session
+    from input.hub import InputHub
+
+    sim = _Counting()
+    session = Session(sim, InputHub())
+    for _ in range(5):
+        session.step()
+    assert sim.steps == 5 and sim.hashed == 0
+    recorder = session.record(tmp_path / "s.rec", "counting", 0, {}, "none")
+    for _ in range(3):
+        session.step()
+    recorder.close()
+    assert sim.steps == 8 and sim.hashed == 3 and recorder.frames == 3

@@ -256,3 +256,68 @@ def test_the_quality_key_cycles_the_level_and_tells_the_player() -> None:
     runner.run(Counter())
     assert runner.quality.mode == "high" and runner.viewer.renderer.quality.name == "high"
     assert any("quality: high" in t for frame in runner.viewer.texts for t in frame)
+
+
+class CostlySteps(Counter):
+    """A Counter whose every step takes ``cost`` seconds of the scripted wall clock."""
+
+    def __init__(self, wall: list[float], cost: float) -> None:
+        super().__init__()
+        self.wall, self.cost = wall, cost
+
+    def step(self) -> None:
+        self.wall[0] += self.cost
+        super().step()
+
+
+def test_the_window_governor_is_told_the_drawing_and_two_steps_not_the_whole_loop() -> None:
+    """Drawing takes 10 ms and each step 4 ms: about 76 fps with one step a frame or none. Every frame
+    that stepped tells the governor 10 ms of drawing and 8 ms of steps (the two a 30 fps frame runs),
+    and high (17.8 ms of drawing, plus 8) fits in 80 % of 33 ms. Fails if the runner passes the loop
+    time, or the steps of the frame as they came (one or none), or counts a step in the drawing."""
+    wall = [100.0]
+    runner = Runner(RunOptions(frames=240), wall=lambda: wall[0])
+    runner.viewer = FakeWindow(wall, 0.010)
+    seen: list[tuple[float, float]] = []
+    frame = runner.quality.frame
+
+    def spy(seconds: float, fixed: float = 0.0) -> bool:
+        seen.append((seconds, fixed))
+        return frame(seconds, fixed)
+
+    runner.quality.frame = spy  # type: ignore[method-assign]
+    runner.run(CostlySteps(wall, 0.004))
+    assert len(seen) > 100 and all(abs(s - 0.010) < 1e-9 for s, _ in seen)
+    fixed = [f for _, f in seen]
+    first = next(i for i, f in enumerate(fixed) if f > 0)  # no step cost is known before the first step
+    assert first < 3 and all(abs(f - 0.008) < 1e-9 for f in fixed[first:])
+    assert runner.quality.level == "high" and runner.viewer.renderer.quality.name == "high"
+
+
+def test_steps_slower_than_real_time_are_cut_at_the_frame_limit_and_the_window_says_so(capsys) -> None:
+    """Each step takes 100 ms of wall (6x slower than real time), drawing 50 ms. Running every due
+    step (15 after the first frames) would hold each frame for 1.55 s; the frame's steps stop once
+    they have used MAX_FRAME_TIME, so a frame lasts at most 0.25 + 0.1 + 0.05 s, and the dropped time
+    is said. Fails without the wall bound in the step loop (frames of 1.55 s), or when the steps not
+    run are not counted as dropped (the window would say nothing)."""
+    wall = [100.0]
+    runner = Runner(RunOptions(), wall=lambda: wall[0])
+    runner.viewer = Renders(wall, 0.05)
+    activity = CostlySteps(wall, 0.1)
+    times: list[float] = []
+    original = activity.draw
+
+    def draw(scene: RenderScene, alpha: float, size: tuple[int, int]) -> None:
+        times.append(wall[0])
+        if wall[0] - 100.0 >= 6.0:
+            runner.stop()
+        original(scene, alpha, size)
+
+    activity.draw = draw  # type: ignore[method-assign]
+    runner.run(activity)
+    gaps = [b - a for a, b in zip(times, times[1:], strict=False)]
+    assert len(gaps) > 10 and max(gaps) <= 0.25 + 0.1 + 0.05 + 1e-9
+    # A frame runs 3 steps (0.05 s of game) in 0.35 s of wall: the window says 0.14x, the truth.
+    said = [t for frame in runner.viewer.texts[-3:] for t in frame if "too slow" in t]
+    assert said and "0.14x real time" in said[-1]
+    assert "too slow to keep time" in capsys.readouterr().err

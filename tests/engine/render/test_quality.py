@@ -28,6 +28,22 @@ def test_auto_steps_down_while_frames_miss_the_budget_and_up_only_with_room_to_s
     assert fresh.level == "high"
 
 
+def test_a_step_up_scales_only_the_drawing_by_the_pixel_ratio_and_the_steps_count_as_they_are():
+    """8 ms of drawing and 10 ms of steps per 30 fps frame at medium: high would draw 14.2 ms, and with
+    the steps 24.2 ms is inside 80 % of 33 ms, so auto steps up. Scaling the whole 18 ms by the ratio
+    (the old loop-time judgement) reads 32 ms and stays. Fails if ``fixed`` is scaled with the drawing."""
+    gov = QualityGovernor("auto")
+    for _ in range(gov.window):
+        gov.frame(0.008, 0.010)
+    assert gov.level == "high"
+    # The same frames with the steps past the budget: drawing 8 ms + steps 30 ms misses 33 ms,
+    # and the level goes down although the drawing alone would fit (fails if ``fixed`` is ignored).
+    slow = QualityGovernor("auto")
+    for _ in range(slow.window):
+        slow.frame(0.008, 0.030)
+    assert slow.level == "low"
+
+
 def test_a_fixed_level_never_changes_and_the_key_cycles_through_auto():
     gov = QualityGovernor("high")
     for _ in range(50):
