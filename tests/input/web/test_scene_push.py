@@ -17,7 +17,7 @@ from websockets.sync.client import connect
 from engine.render.scene import RenderScene
 from input.web.cert import load_or_create
 from input.web.scene_glb import read_scene_glb
-from input.web.scene_stream import CameraPose, decode_frame, quantise
+from input.web.scene_stream import CameraPose, SceneState, decode_frame, quantise
 from input.web.server import FRAMES_IN_FLIGHT, WebSource
 from tests.input.web.test_server import _tls, _wait
 
@@ -90,3 +90,69 @@ def test_an_ack_is_a_step_number_or_it_is_dropped_as_malformed(bad):
     assert parse_message('{"ack": 42}') == Ack(42)
     with pytest.raises(WebMessageError):
         parse_message(bad)
+
+
+def _binary(message: str | bytes) -> bytes:
+    assert isinstance(message, bytes), "scene frames are binary messages"
+    return message
+
+
+def test_a_frame_right_after_a_pong_is_not_held_for_the_pages_delayed_ack(source: WebSource) -> None:
+    """The page pings once a second; the frame published just after the pong must go at once.
+
+    With Nagle's algorithm on (the listening socket made without ``IPPROTO_TCP``, so asyncio
+    does not set ``TCP_NODELAY``), the frame waits until the client's kernel acknowledges the
+    pong, which it delays by 40 ms: every wait is then 39-48 ms (tried); without it 1-16 ms.
+    """
+    with connect(f"wss://127.0.0.1:{source.port}/ws?t={source.token}", ssl=_tls(), open_timeout=10) as ws:
+        ws.recv(timeout=5)
+        _wait(lambda: source.viewers == 1)
+        publish(source, 1)
+        _, state = read_scene_glb(_binary(ws.recv(timeout=5)))
+        ws.send(json.dumps({"ack": state.step}))
+        waits = []
+        for step in range(2, 12):
+            ws.send(json.dumps({"ping": 1.0}))
+            assert "pong" in json.loads(ws.recv(timeout=5))
+            start = time.perf_counter()
+            publish(source, step)
+            state = decode_frame(state, _binary(ws.recv(timeout=5)))
+            waits.append(1000.0 * (time.perf_counter() - start))
+            ws.send(json.dumps({"ack": state.step}))
+        assert state.step == 11
+        assert float(np.median(waits)) < 25.0, f"frames after a pong waited {sorted(round(w, 1) for w in waits)} ms"
+
+
+def test_a_page_that_keeps_up_gets_frames_coded_on_the_publishing_thread(
+    source: WebSource, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The frame from the previous step is coded once, at publication, so the server thread only writes it.
+
+    Coding it in the server thread (as before) fails the thread check: every frame there.
+    """
+    import threading
+
+    import input.web.server as server
+
+    coded_on: list[int] = []
+    real = server.encode_frame
+
+    def spy(base: SceneState, state: SceneState) -> bytes:
+        coded_on.append(threading.get_ident())
+        return real(base, state)
+
+    monkeypatch.setattr(server, "encode_frame", spy)
+    with connect(f"wss://127.0.0.1:{source.port}/ws?t={source.token}", ssl=_tls(), open_timeout=10) as ws:
+        ws.recv(timeout=5)
+        _wait(lambda: source.viewers == 1)
+        publish(source, 1)
+        _, state = read_scene_glb(_binary(ws.recv(timeout=5)))
+        ws.send(json.dumps({"ack": state.step}))
+        for step in range(2, 8):
+            publish(source, step)
+            state = decode_frame(state, _binary(ws.recv(timeout=5)))
+            ws.send(json.dumps({"ack": state.step}))
+            assert state.step == step
+        assert state.rows["capsules"][0, 2] == 70  # 0.01 m × 7 in millimetres
+    here = threading.get_ident()
+    assert coded_on and all(t == here for t in coded_on), f"{sum(t != here for t in coded_on)} frames coded elsewhere"

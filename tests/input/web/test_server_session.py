@@ -36,7 +36,7 @@ from input.source import PoseSource
 from input.web.cert import WebCertificate, load_or_create
 from input.web.protocol import Ack, WebMessageError, parse_message
 from input.web.scene_glb import scene_glb
-from input.web.scene_stream import CameraPose, SceneState, encode_frame, quantise
+from input.web.scene_stream import CameraPose, SceneState, decode_frame, encode_frame, quantise
 from input.web.server import FRAMES_IN_FLIGHT, WebSource
 
 CAM = CameraPose((0.0, 1.5, 4.0), (1.0, 0.0, 0.0, 0.0), 60.0)
@@ -426,11 +426,16 @@ def test_every_page_is_woken_by_a_publish_and_a_page_that_went_away_gets_nothing
 def test_publishing_before_the_server_runs_or_after_it_stopped_only_keeps_the_state(
     make: Callable[..., WebSource],
 ) -> None:
-    """The engine thread publishes whatever the server thread is doing: no loop yet, or a closed one."""
+    """The engine thread publishes whatever the server thread is doing: no loop yet, or a closed one.
+
+    With no page watching nothing is coded; with one, the frame from the state before is (at publication).
+    """
     src = make()
     state, look = _state(1)
     src.publish(state, look, SNOW, 0.5)
-    assert src._latest == (state, look, SNOW, 0.5)
+    first = src._latest
+    assert first is not None and (first.state, first.look, first.snowfall, first.dt) == (state, look, SNOW, 0.5)
+    assert first.since is None and first.frame is None
     loop = asyncio.new_event_loop()
     loop.close()
     src._loop = loop
@@ -438,7 +443,9 @@ def test_publishing_before_the_server_runs_or_after_it_stopped_only_keeps_the_st
     later, _ = _state(2)
     src.publish(later, look)
     latest = src._latest
-    assert latest is not None and latest[0] is later and latest[2] is None and latest[3] == 1 / 60
+    assert latest is not None and latest.state is later and latest.snowfall is None and latest.dt == 1 / 60
+    assert latest.since is state and latest.frame is not None
+    assert decode_frame(state, latest.frame).step == 2
 
 
 # -- one message ------------------------------------------------------------------------------------
