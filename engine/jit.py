@@ -75,21 +75,13 @@ def use(compiled: bool) -> Iterator[None]:
 
 
 def _numba() -> Any:
-    """numba, imported on first use, with :class:`_Kernel` taught to its type inference.
+    """numba, imported on first use.
 
     Importing numba costs about 1.3 s of CPU, and it imports SciPy (0.7 s more): a process that never
-    runs a kernel (a command that reads or writes files, a test's helper process) does not pay it.
-    A kernel calling another kernel finds a :class:`_Kernel` among its globals; numba types it as the
-    compiled kernel it stands for, so calls and ``inline="always"`` behave as between dispatchers."""
+    runs a kernel (a command that reads or writes files, a test's helper process) does not pay it."""
     global _numba_module
     if _numba_module is None:
         import numba
-        from numba.core import types
-        from numba.extending import typeof_impl
-
-        @typeof_impl.register(_Kernel)
-        def _typeof_kernel(val: _Kernel, c: object) -> Any:
-            return types.Dispatcher(val.dispatcher())
 
         _numba_module = numba
     return _numba_module
@@ -101,7 +93,10 @@ class _Kernel:
     Compilation was already lazy (on the first call, or loaded from the disk cache); this defers the
     dispatcher itself, and so numba's import. Once made, the dispatcher replaces this object under the
     function's name in its module, so later calls through the module go to numba directly; other
-    references forward to it. Attributes (``py_func``, ``targetoptions``, …) are the dispatcher's."""
+    references forward to it. Attributes are the dispatcher's, and through them a kernel that calls this
+    one (``from engine.jit import qmul``) compiles as if it held the dispatcher: numba types any global by
+    its ``_numba_type_`` (a dispatcher's is ``types.Dispatcher``), and inlines by its ``targetoptions``
+    and ``py_func``."""
 
     def __init__(self, fn: Callable[..., Any], options: dict[str, Any]) -> None:
         self._fn, self._options = fn, options
