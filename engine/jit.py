@@ -19,11 +19,14 @@ path to rounding, not always bit for bit: numpy's ``norm``/``sum`` may pair term
 
 from __future__ import annotations
 
+import functools
+import importlib.util
 import math
 import os
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
 __all__ = [
     "AVAILABLE",
@@ -48,14 +51,9 @@ __all__ = [
 
 T = TypeVar("T", bound=Callable[..., Any])
 
-_numba: Any
-try:
-    import numba as _numba
-except ImportError:  # the numpy path runs everywhere then
-    _numba = None
-
-AVAILABLE: bool = _numba is not None
+AVAILABLE: bool = importlib.util.find_spec("numba") is not None
 _state = {"on": AVAILABLE and os.environ.get("PUPPETPHONE_NUMPY", "") not in ("1", "true", "yes")}
+_numba_module: Any = None  # numba, once the first kernel needs it
 
 
 def enabled() -> bool:
@@ -76,20 +74,73 @@ def use(compiled: bool) -> Iterator[None]:
         _state["on"] = before
 
 
+def _numba() -> Any:
+    """numba, imported on first use.
+
+    Importing numba costs about 1.3 s of CPU, and it imports SciPy (0.7 s more): a process that never
+    runs a kernel (a command that reads or writes files, a test's helper process) does not pay it."""
+    global _numba_module
+    if _numba_module is None:
+        import numba
+
+        _numba_module = numba
+    return _numba_module
+
+
+class _Kernel:
+    """A function to be compiled by numba, made into numba's dispatcher on its first call.
+
+    Compilation was already lazy (on the first call, or loaded from the disk cache); this defers the
+    dispatcher itself, and so numba's import. Once made, the dispatcher replaces this object under the
+    function's name in its module, so later calls through the module go to numba directly; other
+    references forward to it. Attributes are the dispatcher's, and through them a kernel that calls this
+    one (``from engine.jit import qmul``) compiles as if it held the dispatcher: numba types any global by
+    its ``_numba_type_`` (a dispatcher's is ``types.Dispatcher``), and inlines by its ``targetoptions``
+    and ``py_func``."""
+
+    def __init__(self, fn: Callable[..., Any], options: dict[str, Any]) -> None:
+        self._fn, self._options = fn, options
+        self._dispatcher: Any = None
+        functools.update_wrapper(self, fn)
+
+    def dispatcher(self) -> Any:
+        """numba's dispatcher of the function (made, and put in the function's module, on first use)."""
+        if self._dispatcher is None:
+            self._dispatcher = _numba().njit(**self._options)(self._fn)
+            module = sys.modules.get(self._fn.__module__)
+            if module is not None and getattr(module, self._fn.__name__, None) is self:
+                setattr(module, self._fn.__name__, self._dispatcher)
+        return self._dispatcher
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return self.dispatcher()(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") or name in ("_fn", "_options", "_dispatcher"):
+            raise AttributeError(name)
+        return getattr(self.dispatcher(), name)
+
+
+def _compiled(fn: T, **options: Any) -> T:
+    """``fn`` compiled by numba with ``options`` when numba is installed; the plain function otherwise
+    (never called then)."""
+    if not AVAILABLE:
+        return fn
+    if _numba_module is not None:  # numba already loaded: no reason to defer
+        return cast(T, _numba_module.njit(**options)(fn))
+    return cast(T, _Kernel(fn, options))  # it calls, and types in numba, as fn's dispatcher
+
+
 def njit(fn: T) -> T:
     """``numba.njit`` (cached; division by zero gives inf/NaN as numpy does) when numba is installed;
-    the plain function otherwise (never called then)."""
-    if _numba is None:
-        return fn
-    return _numba.njit(cache=True, nogil=True, error_model="numpy")(fn)
+    the plain function otherwise (never called then). numba is imported when the first kernel runs."""
+    return _compiled(fn, cache=True, nogil=True, error_model="numpy")
 
 
 def njit_inline(fn: T) -> T:
     """:func:`njit`, inlined by numba into every kernel that calls it (``inline="always"``): a helper run per
     puppet that takes arrays then costs its callers no call and no reference counting of those arrays."""
-    if _numba is None:
-        return fn
-    return _numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")(fn)
+    return _compiled(fn, cache=True, nogil=True, error_model="numpy", inline="always")
 
 
 @njit
