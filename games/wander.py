@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.app import App
-from engine.batches import assign, batch
+from engine.batches import batch
 from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import assignment_mark, columns, unassigned_since
 from engine.components import Transform
@@ -28,6 +28,7 @@ from engine.ecs import World
 from engine.ragdoll.components import Ragdoll, RagdollMode
 from engine.rows import RowBlock, keep_in_rows, row_store
 from engine.statemachine.puppet import Jumping, PuppetBody
+from engine.statemachine.puppet.follow import rows_of, set_requests
 from engine.statemachine.puppet.plugin import puppet_batch
 from engine.statemachine.puppet.senses import yaw_rotation
 
@@ -73,8 +74,9 @@ def wander_system(world: World) -> None:
     whole = (
         None if puppets.missing[2] or row_store(world).owners(PuppetBody) is not puppets.lists[0] else puppets.lists[2]
     )
+    player_rows = row_store(world).rows(LocomotionPlayer, players)
     if ok.all():
-        _wander(world, wanderers, bodies, transforms, players, (block, rows), (own, _ALL), whole)
+        _wander(world, wanderers, bodies, transforms, players, (block, rows), (own, _ALL), whole, player_rows)
         return
     free = np.flatnonzero(ok)
     if len(free):
@@ -88,6 +90,7 @@ def wander_system(world: World) -> None:
             (block, free if isinstance(rows, slice) else rows[free]),
             (own, free),
             whole,
+            rows_of(player_rows, free),
         )
 
 
@@ -130,11 +133,13 @@ def _wander(
     block_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
     wander_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None,
     whole: tuple[Transform, ...] | None = None,
+    player_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None = None,
 ) -> None:
     """Steer the free wanderers given (row ``i`` of each list for one puppet; their rows of the bodies' and
     the wanderers' row blocks, if they are linked). ``whole`` (the transforms of the bodies' block, row for
     row) lets the positions and rotations be read and written in the brain stage's columns at the bodies'
-    rows, instead of columns of the wanderers' own."""
+    rows, instead of columns of the wanderers' own; with ``player_rows`` (the players' rows in their row
+    block) the requested speeds are written there whole."""
     n = len(wanderers)
     if n == 0:
         return
@@ -164,13 +169,12 @@ def _wander(
         cols.get(Transform, "rotation").write(transforms, yaw_rotation(heading))
     else:  # every row's field is its view after the read; only the wanderers' rows change
         cols.get(Transform, "rotation").read(whole)[at] = yaw_rotation(heading)
-    speeds = (pace * facing).tolist()
     if block_rows is None:
         for body, h in zip(bodies, heading.tolist(), strict=True):
             body.heading = h
     else:
         block_rows[0].arrays["heading"][block_rows[1]] = heading
-    assign(players, "speed", speeds)
+    set_requests(players, player_rows, pace * facing)
     for i in np.flatnonzero(dist < _REACHED).tolist():
         w = wanderers[i]
         w.goal = np.array(

@@ -11,12 +11,13 @@ very same tuple of owners without comparing ids, so every column of the stage is
 whole at no cost per puppet.
 
 The one field kept here that is no component is each IK request's ``foot_lock``: plain code
-may replace it, so :meth:`Group.foot_locks` checks it (one C-level pass) before handing it out.
+may replace it, so :meth:`Group.foot_locks` checks it before handing it out: a C-level pass,
+and none while no request's ``foot_lock`` was assigned since the last (:func:`engine.columns.assignment_mark`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from operator import attrgetter, is_
 from typing import TYPE_CHECKING
 
@@ -24,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from engine.batches import Batch
+from engine.columns import Mark, assignment_mark, unassigned_since
 from engine.components import LocalPose, Transform
 from engine.ecs import Entity
 from engine.ik.foot_lock import FootLock
@@ -52,6 +54,10 @@ class Group:
         ik: the leg-IK requests of the puppets that have one.
         ik_rows: which rows those are, ``None`` when every puppet has one.
         locks: their foot locks as last handed out (see :meth:`foot_locks`).
+        locks_mark: where the requests' ``foot_lock`` assignment log stood when ``locks`` was checked.
+        settled: the settle flags last written to ``locks`` by the animation stage, and where the foot locks'
+            ``settle`` assignment log stood after (see :func:`engine.blend.locomotion._contacts`).
+        scaled: the players' scales as last read, and where the players' ``scale`` assignment log stood then.
     """
 
     key: str
@@ -62,11 +68,17 @@ class Group:
     ik: tuple[IKRequest, ...]
     ik_rows: NDArray[np.intp] | None
     locks: tuple[FootLock, ...]
+    locks_mark: Mark | None = None
+    settled: tuple[tuple[FootLock, ...], NDArray[np.bool_], Mark | None] | None = field(default=None, repr=False)
+    scaled: tuple[NDArray[np.float64], Mark | None] | None = field(default=None, repr=False)
 
     def foot_locks(self) -> tuple[FootLock, ...]:
         """The IK requests' foot locks (the same tuple as last time unless one was replaced)."""
+        if unassigned_since(self.locks_mark):
+            return self.locks
         if not all(map(is_, map(_FOOT_LOCK, self.ik), self.locks)):
             self.locks = tuple(map(_FOOT_LOCK, self.ik))
+        self.locks_mark = assignment_mark(IKRequest, ("foot_lock",))
         return self.locks
 
 

@@ -1,7 +1,8 @@
 """The animation stage's first step for one locomotion set's puppets: requests read, checked, resolved.
 
-A step's requests are read from the players one field at a time (a list comprehension
-each), checked as arrays (an invalid one is named by its entity, as before), and turned
+A step's requests are read from the players' row block (:mod:`engine.rows`), where the
+state machine writes them, or one field at a time (a list comprehension each) from players
+not in rows; they are checked as arrays (an invalid one is named by its entity, as before), and turned
 into blend points by the set's lookup table (:meth:`LookupTable.resolve_many`).
 
 The lookup is a pure function of a request in the set's units, so a row asking exactly
@@ -67,33 +68,40 @@ def read(
     entities: Sequence[Entity],
     players: Sequence[LocomotionPlayer],
     at: tuple[RowBlock, slice | NDArray[np.intp]] | None = None,
+    scales: F | None = None,
 ) -> Requests:
     """The players' requests and fields; ``ValueError`` names the first entity with an invalid request
     (speed not finite or negative, height not finite) or scale (not finite or not positive). ``at``: the
-    players' rows in their block (:mod:`engine.rows`), where their phases and overrides are read whole.
+    players' rows in their block (:mod:`engine.rows`), where their requests, phases and overrides are read whole;
+    ``scales``: the players' scales, if the caller has them (read from the players otherwise).
 
     One list per field: a comprehension's attribute loads are the interpreter's cached fast path,
     cheaper per puppet than one ``attrgetter`` of every field and the transposition after it."""
-    speed = [p.speed for p in players]
-    height = [p.height for p in players]
-    scale = [p.scale for p in players]
+    if scales is None:
+        scales = np.array([p.scale for p in players], dtype=np.float64)
     if at is None:
+        height = [p.height for p in players]
+        speeds = np.array([p.speed for p in players], dtype=np.float64)
+        standing = np.fromiter(map(is_, height, repeat(None)), dtype=np.bool_, count=len(height))
+        heights = np.array(height, dtype=np.float64)  # None becomes NaN
         phases = np.array([p.phase for p in players], dtype=np.float64)
         override = [p.override for p in players]
-    else:
-        phases = np.array(at[0].arrays["phase"][at[1]])  # a copy: the stage writes the new phases there
-        override = at[0].arrays["override"][at[1]].tolist()
-    speeds = np.array(speed, dtype=np.float64)
-    standing = np.fromiter(map(is_, height, repeat(None)), dtype=np.bool_, count=len(height))
-    heights = np.array(height, dtype=np.float64)  # None becomes NaN
-    scales = np.array(scale, dtype=np.float64)
+    else:  # copies: the state machine writes the next requests there, and the stage the new phases
+        arrays, rows = at[0].arrays, at[1]
+        given = at[0].present["height"][rows]
+        speeds = np.array(arrays["speed"][rows])
+        standing = ~given
+        heights = np.where(given, arrays["height"][rows], np.nan)
+        phases = np.array(arrays["phase"][rows])
+        override = arrays["override"][rows].tolist()
     i, request_bad = _first_invalid(speeds, heights, standing, scales)
     if i >= 0:
+        bad = players[i]
         if request_bad:
             raise ValueError(
-                f"entity {entities[i]}: locomotion request speed={speed[i]!r}, height={height[i]!r} is invalid"
+                f"entity {entities[i]}: locomotion request speed={bad.speed!r}, height={bad.height!r} is invalid"
             )
-        raise ValueError(f"entity {entities[i]}: locomotion scale {scale[i]!r} must be positive")
+        raise ValueError(f"entity {entities[i]}: locomotion scale {bad.scale!r} must be positive")
     return Requests(speeds, heights, standing, scales, phases, override)
 
 

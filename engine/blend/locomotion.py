@@ -45,7 +45,7 @@ from engine.blend.pose_blend import crossfade, fade_weight
 from engine.blend.space import BlendSpace
 from engine.clip import Clip
 from engine.clips.contacts import foot_contacts
-from engine.columns import Column, Columns, columns
+from engine.columns import Column, Columns, assignment_mark, columns, unassigned_since
 from engine.components import LocalPose, Puppet, Transform
 from engine.ecs import World
 from engine.ik.foot_lock import FootLock
@@ -187,11 +187,14 @@ class LocomotionPlayer:
 
 
 # What the stage reads or writes of every player every step, kept in rows (:mod:`engine.rows`): one array
-# each over the crowd, so neither the set names, the phases and overrides read nor the four results written
-# cost a pass over a thousand player objects. A value a row cannot hold exactly (an ``int`` phase) unlinks the
-# batch back to plain objects, and the stage then takes them one by one, as before.
+# each over the crowd, so neither the requests (written by the state machine as arrays too), the set names,
+# the phases and overrides read nor the four results written cost a pass over a thousand player objects. A
+# value a row cannot hold exactly (an ``int`` phase) unlinks the batch back to plain objects, and the stage
+# then takes them one by one, as before.
 keep_in_rows(
     LocomotionPlayer,
+    speed=("float", (), False),
+    height=("float", (), True),
     library_key=("object", (), False),
     inside=("object", (), False),
     rate=("float", (), False),
@@ -228,6 +231,19 @@ def _override(player: LocomotionPlayer, loco: LocomotionSet, dt: float) -> tuple
         player.override, player.override_stopping, player.override_time = None, False, 0.0
         return None, 0.0, np.zeros(3)
     return clip, fade_weight(player.override_weight, 1.0), travel
+
+
+def _scales(group: _groups.Group) -> F:
+    """The group's players' scales: read from every player once, then kept (in the group) while no player's scale
+    was assigned (:func:`engine.columns.assignment_mark`; a puppet's size is set when it is made). Shared: read it,
+    never change it."""
+    kept = group.scaled
+    if kept is not None and unassigned_since(kept[1]):
+        return kept[0]
+    mark = assignment_mark(LocomotionPlayer, ("scale",))
+    scales = np.array([p.scale for p in group.players], dtype=np.float64)
+    group.scaled = (scales, mark)
+    return scales
 
 
 def _yaw(rotation: F) -> F:
@@ -344,7 +360,7 @@ def _animate_group(
     entities, players = group.entities, group.players
     count = len(players)
     alpha = 1.0 if loco.smoothing <= 0 else 1.0 - np.exp(-dt / loco.smoothing)
-    req = _requests.read(entities, players, at)
+    req = _requests.read(entities, players, at, _scales(group))
     answers = _requests.resolve(library.last_answers, key, loco, req)
     target = answers.points
     scale = req.scales
@@ -477,8 +493,16 @@ def _contacts(
     where they landed."""
     settle = speeds < _SETTLE_SPEED
     rows = group.ik_rows
-    for lock, flag in zip(locks, (settle if rows is None else settle[rows]).tolist(), strict=True):
-        lock.settle = flag
+    flags = settle if rows is None else settle[rows]
+    kept = group.settled
+    if kept is not None and kept[0] is locks and unassigned_since(kept[2]):
+        # The flags written last step are still in place (nobody assigned one since): only the changed are written.
+        for i in np.flatnonzero(flags != kept[1]).tolist():
+            locks[i].settle = bool(flags[i])
+    else:
+        for lock, flag in zip(locks, flags.tolist(), strict=True):
+            lock.settle = flag
+    group.settled = (locks, flags, assignment_mark(FootLock, ("settle",)))
     if votes is None:
         for lock in locks:
             lock.contacts = None

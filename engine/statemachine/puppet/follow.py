@@ -149,6 +149,7 @@ def follow_released(
     cols: Columns | None = None,
     block_rows: tuple[RowBlock, Rows | slice] | None = None,
     stand: bool = False,
+    player_rows: tuple[RowBlock, Rows | slice] | None = None,
 ) -> None:
     """:func:`follow_velocity` (``speed_scale`` 1) for puppets no stick holds, over arrays.
 
@@ -160,7 +161,9 @@ def follow_released(
     spring state, heading and stiffness are read and written in the block's arrays, no
     body touched; with ``cols`` the rotations of the puppets that stand are written as a
     column of :mod:`engine.columns`. ``stand`` also sets every player's ``height`` to ``None``
-    (standing tall) in the pass that sets its speed: one visit of each player."""
+    (standing tall) in the pass that sets its speed: one visit of each player. With ``player_rows``
+    (the players' rows in their row block) the speeds and heights are written there whole (see
+    :func:`set_requests`)."""
     n = len(bodies)
     if n == 0:
         return
@@ -197,27 +200,56 @@ def follow_released(
                 body.walk_velocity, body.walk_rate, body.recent = value[i], rate[i], recent[i]
         else:
             a["walk_velocity"][rows], a["walk_rate"][rows], a["recent"][rows] = value, rate, recent
-    speeds = speed.tolist()
     moving = speed > 1e-3
     turning = np.flatnonzero(moving).tolist()
     if stand:  # every player's speed now; a turning puppet's is set again by _face below
-        assign(players, "height", repeat(None))
-        assign(players, "speed", speeds)
+        set_requests(players, player_rows, speed, stand=True)
     for i in turning:
-        _face(transforms[i], bodies[i], players[i], speeds[i], dt, 1.0)
+        _face(transforms[i], bodies[i], players[i], float(speed[i]), dt, 1.0)
     if turning:
-        still = np.flatnonzero(~moving).tolist()
-        players = [players[i] for i in still]
-        speeds = [speeds[i] for i in still]
-        transforms = [transforms[i] for i in still]
+        still = np.flatnonzero(~moving)
+        players = [players[i] for i in still.tolist()]
+        speed = speed[still]
+        player_rows = rows_of(player_rows, still)
+        transforms = [transforms[i] for i in still.tolist()]
         rotation = rotation[still]
     if not stand:
-        assign(players, "speed", speeds)
+        set_requests(players, player_rows, speed)
     if cols is None or len(transforms) < n // 2:
         for tr, q in zip(transforms, rotation, strict=True):
             tr.rotation = q
     else:
         cols.get(Transform, "rotation").write(transforms, rotation)
+
+
+def set_requests(
+    players: Sequence[LocomotionPlayer], at: tuple[RowBlock, Rows | slice] | None, speeds: F, stand: bool = False
+) -> None:
+    """``players[i].speed = speeds[i]`` (a Python float, as ``tolist`` makes it) and, with ``stand``, ``height = None``.
+
+    ``at``: the players' rows in the row block they are linked to (:mod:`engine.rows`), where a crowd's requests are
+    written whole, no player touched; while that block is intact (an assignment the rows could not hold marks it
+    stale), else player by player (the loop in C, :func:`engine.batches.assign`)."""
+    if at is not None and not at[0].stale:
+        block, rows = at
+        if stand:
+            block.present["height"][rows] = False
+        block.arrays["speed"][rows] = speeds
+        return
+    if stand:
+        assign(players, "height", repeat(None))
+    assign(players, "speed", speeds.tolist())
+
+
+def rows_of(at: tuple[RowBlock, Rows | slice] | None, picked: Rows) -> tuple[RowBlock, Rows] | None:
+    """The rows ``picked`` of a batch at rows ``at`` of a row block (``picked`` indexes the batch)."""
+    if at is None:
+        return None
+    block, rows = at
+    return block, (picked if isinstance(rows, slice) and rows == _ALL else np.asarray(rows)[picked])
+
+
+_ALL = slice(None)
 
 
 def tuning_columns(block: RowBlock) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:

@@ -30,7 +30,7 @@ from engine.ik.system import IKRequest
 from engine.rows import RowBlock
 from engine.statemachine.machine import Brain, Rows
 from engine.statemachine.puppet.body import Handling, PuppetBody
-from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity, tuning_columns
+from engine.statemachine.puppet.follow import drag_reach, follow_released, follow_velocity, rows_of, tuning_columns
 from engine.statemachine.puppet.follow_legacy import follow_stick_legacy
 from engine.statemachine.puppet.names import PuppetState
 from engine.statemachine.puppet.spec import (
@@ -174,7 +174,17 @@ def update_locomotion_batch(world: World, columns: PuppetColumns, rows: Rows) ->
     fast_bodies = bodies if every else [bodies[i] for i in fast]
     linked = block is not None and not block.stale
     block_rows = (block, _ALL if every else np.asarray(fast, dtype=np.intp)) if linked and block is not None else None
-    follow_released(world.dt, fast_bodies, transforms, players, engine_columns(world), block_rows, stand=True)
+    player_rows = columns.player_rows if every else rows_of(columns.player_rows, np.asarray(fast, dtype=np.intp))
+    follow_released(
+        world.dt,
+        fast_bodies,
+        transforms,
+        players,
+        engine_columns(world),
+        block_rows,
+        stand=True,
+        player_rows=player_rows,
+    )
 
 
 _ALL = slice(None)

@@ -15,6 +15,7 @@ from engine.app import App
 from engine.batches import Batch, batch
 from engine.blend.locomotion import BlendLibrary, LocomotionPlayer
 from engine.blend.puppet import install_puppet_locomotion
+from engine.columns import Mark, assignment_mark, unassigned_since
 from engine.components import Grabbable, LocalPose, Name, Puppet, Transform
 from engine.ecs import Entity, World
 from engine.humanoid import humanoid_skeleton
@@ -43,6 +44,9 @@ class PuppetMachine:
 
     def __init__(self, machine: StateMachine[PuppetColumns] | None = None) -> None:
         self.machine = machine or puppet_machine()
+        self.overriding: tuple[tuple[PoseOverride, ...], Mark | None, list[int]] | None = None
+        """The pose overrides' batch, where their fields' assignment logs stood, and which rows of it had an
+        override to apply then (see :func:`apply_pose_overrides`)."""
 
 
 def brain_system(world: World) -> None:
@@ -56,6 +60,8 @@ def brain_system(world: World) -> None:
     bodies, brains, transforms, players, handling, ik = kept.lists
     columns = sense_all(world, kept.entities, bodies, None if kept.missing[2] else transforms)
     columns.players, columns.handling, columns.ik = players, handling, ik
+    if players and not kept.missing[3]:
+        columns.player_rows = row_store(world).rows(LocomotionPlayer, players)
     if handling and not kept.missing[4]:
         columns.handling_block = row_store(world).block(Handling, handling)
     step_machines(world, kept.entities, brains, columns)
@@ -69,11 +75,31 @@ def puppet_batch(world: World) -> Batch:
 
 
 def apply_pose_overrides(world: World) -> None:
-    """After blending: a state's pose override (get-up) replaces the animated pose."""
-    for _, override, pose in world.query(PoseOverride, LocalPose):
-        if override.weight > 0.0 and override.pose is not None:
-            pose.root = np.array(override.pose.root)
-            pose.rotations = np.array(override.pose.rotations)
+    """After blending: a state's pose override (get-up) replaces the animated pose.
+
+    Which puppets have one is decided by their ``weight`` and ``pose`` fields, which only a getting-up puppet's
+    states assign: the rows that had one are kept (in the :class:`PuppetMachine` resource) with where those fields'
+    assignment logs stood (:func:`engine.columns.assignment_mark`), so a crowd in which nobody gets up costs no pass
+    over its overrides; the kept rows' poses are copied every step, since the blend wrote over them."""
+    kept = batch(world, "pose overrides", (PoseOverride, LocalPose))
+    overrides, poses = kept.lists
+    machine = world.try_resource(PuppetMachine)
+    memo = None if machine is None else machine.overriding
+    if memo is not None and memo[0] is overrides and unassigned_since(memo[1]):
+        rows = memo[2]
+    else:
+        mark = assignment_mark(PoseOverride, _OVERRIDE_FIELDS)
+        rows = [i for i, o in enumerate(overrides) if o.weight > 0.0 and o.pose is not None]
+        if machine is not None:
+            machine.overriding = (overrides, mark, rows)
+    for i in rows:
+        held, pose = overrides[i].pose, poses[i]
+        assert held is not None  # a row is kept only while its pose is set (assigning it moves the mark)
+        pose.root = np.array(held.root)
+        pose.rotations = np.array(held.rotations)
+
+
+_OVERRIDE_FIELDS = ("weight", "pose")
 
 
 def install_puppets(app: App) -> None:

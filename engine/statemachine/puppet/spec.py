@@ -49,6 +49,9 @@ class PuppetColumns:
     """The row block the bodies are linked to, row ``i`` for ``bodies[i]`` (:mod:`engine.rows`), if they are."""
     handling_block: RowBlock | None = None
     """The row block ``handling`` is linked to, if every puppet has one and they are."""
+    player_rows: tuple[RowBlock, slice | NDArray[np.intp]] | None = None
+    """Where ``players`` are in the locomotion players' row block (every puppet has one and all are in it): the
+    requests an array update sets are written there whole (see :func:`player_rows`)."""
 
 
 PuppetStateDef = State[PuppetColumns]

@@ -232,3 +232,30 @@ def test_placing_the_crowd_compiled_is_the_numpy_sequence_bit_for_bit() -> None:
     _kernel.place(rotation, moved_b, travel, turn, roots, rots_b, headings_b, world_b)
     for x, y in ((moved_a, moved_b), (headings_a, headings_b), (world_a, world_b), (rots_a, rots_b)):
         assert np.array_equal(x, y)
+
+
+@pytest.mark.parametrize("longest", [_kernel.SERIES_UP_TO, 1.5])
+def test_the_kernels_slerp_between_frames_is_the_numpy_slerp_within_its_tolerance(longest: float) -> None:
+    """The kernel's slerp (:func:`_kernel._arc_point`: the sines by a series on short arcs, no division by
+    ``sin θ``) against :func:`engine.quat.slerp` on arcs up to the series' bound and on longer ones (``math.sin``),
+    nearly equal pairs included: every component within :data:`_kernel.SLERP_TOLERANCE`. Broken once by stopping
+    the series at ``x⁵`` (off by 1.7e-9 near the bound): it failed."""
+    from engine import quat
+
+    rng = np.random.default_rng(7)
+    a = _unit(rng, 600)
+    axis = rng.normal(size=(600, 3))
+    axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+    theta = rng.uniform(0.0, longest, 600)
+    theta[:40] = longest  # the bound itself, where the series is least exact
+    theta[40:80] = 1e-9 * rng.uniform(size=40)  # nearly equal: linear weights
+    turn = np.concatenate([np.cos(theta)[:, None], axis * np.sin(theta)[:, None]], axis=1)  # b = turn · a: arc theta
+    b = quat.mul(turn, a)
+    worst = 0.0
+    for qa, qb, t in zip(a, b, rng.uniform(0, 1, 600), strict=True):
+        ta, tb = tuple(qa.tolist()), tuple(qb.tolist())
+        far, arc, s = jit.qarc(ta, tb)
+        worst = max(
+            worst, float(np.abs(np.array(_kernel._arc_point(ta, far, arc, s, t)) - quat.slerp(qa, qb, t)).max())
+        )
+    assert worst <= _kernel.SLERP_TOLERANCE

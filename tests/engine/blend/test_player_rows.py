@@ -21,6 +21,7 @@ from engine.clip import Clip
 from engine.components import Puppet, Transform
 from engine.hashing import state_hash
 from engine.humanoid import humanoid_skeleton
+from engine.ik.system import IKRequest
 from engine.rows import RowBlock, row_store
 
 
@@ -103,3 +104,34 @@ def test_a_phase_the_rows_cannot_hold_is_taken_in_and_played_on(loco: Locomotion
     assert all(type(x) is float and 0.0 <= x < 1.0 for x in after)
     assert 0.0 < after[3] < 0.05  # played on from 0
     assert after[0] != before[0] and abs(after[0] - before[0]) < 0.05
+
+
+def test_a_scale_assigned_is_read_again_and_a_kept_one_is_not(loco: LocomotionSet) -> None:
+    """The stage keeps the players' scales while no scale is assigned, and reads them again after one is.
+    Broken once by keeping them whatever was assigned: it failed."""
+    app, es = _crowd(loco)
+    app.run_steps(2)
+    group = app.world.resource(BlendLibrary).groups.of(stage.batch(app.world, "locomotion", *_LOCOMOTION))[0]
+    kept = stage._scales(group)
+    assert stage._scales(group) is kept and kept.tolist() == [0.8 + 0.1 * i for i in (0, 2, 4)]
+    app.world.get(es[2], LocomotionPlayer).scale = 1.5
+    assert stage._scales(group).tolist() == [0.8, 1.5, 0.8 + 0.4]
+
+
+_LOCOMOTION = ((Transform, Puppet, LocomotionPlayer), (stage.LocalPose, IKRequest))
+
+
+def test_settle_flags_are_written_where_they_changed_or_someone_else_wrote_one(loco: LocomotionSet) -> None:
+    """Each foot lock's ``settle`` says whether its puppet is asked to stand (speed under 0.05 m/s); a flag
+    assigned by other code is set right again the next step. Broken once by writing only the flags that changed
+    since the stage's last write, whatever was assigned since: it failed."""
+    app, es = _crowd(loco)
+    for e in es:
+        app.world.add(e, IKRequest())
+    app.run_steps(3)
+    locks = [app.world.get(e, IKRequest).foot_lock for e in es]
+    assert [lock.settle for lock in locks] == [True] + [False] * 5
+    locks[2].settle = True
+    app.world.get(es[1], LocomotionPlayer).speed = 0.0
+    app.step()
+    assert [lock.settle for lock in locks] == [True, True] + [False] * 4

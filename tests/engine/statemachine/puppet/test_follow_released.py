@@ -16,12 +16,13 @@ import copy
 import numpy as np
 import pytest
 
+from engine.blend.locomotion import LocomotionPlayer
 from engine.columns import columns
 from engine.components import Transform
 from engine.ecs import World
 from engine.rows import row_store
 from engine.statemachine.puppet.body import PuppetBody
-from engine.statemachine.puppet.follow import follow_released, follow_velocity, tuning_columns
+from engine.statemachine.puppet.follow import follow_released, follow_velocity, set_requests, tuning_columns
 
 DT = 1.0 / 60.0
 
@@ -183,3 +184,36 @@ def test_the_rest_shortcut_takes_a_zero_step_but_not_an_infinite_one() -> None:
     assert _at_rest(z, z, h, w, 0.0)
     assert not _at_rest(z, z, h, w, float("inf"))
     assert _at_rest(z, z, h, np.zeros(2), 1 / 60)  # a stiffness of 0 still leaves 0 at 0
+
+
+@pytest.mark.parametrize("stand", [False, True])
+def test_requests_written_in_the_players_rows_read_as_the_plain_ones(stand: bool) -> None:
+    """With ``player_rows`` the speeds (and, standing, the heights) go straight into the players' row block
+    (:mod:`engine.rows`): every player then reads what the one-by-one path gives, a Python float speed and
+    ``None``, and no player left its block. Broken once by not clearing the heights' presence in the rows
+    (the heights stayed 0.7), and once by writing the still puppets' speeds to the batch's first rows: both failed."""
+    walks = _walks()
+    _, _, ref_players = _reference(walks)
+    world, made = _world(walks)
+    bodies = [world.get(e, PuppetBody) for e in made]
+    transforms = [world.get(e, Transform) for e in made]
+    players = tuple(LocomotionPlayer(speed=-1.0, height=0.7) for _ in made)
+    block = row_store(world).block(LocomotionPlayer, players)
+    assert not block.stale
+    standing = {"stand": True} if stand else {}
+    follow_released(DT, bodies, transforms, players, None, None, **standing, player_rows=(block, slice(None)))
+    assert not block.stale and all(p.__dict__.get("_row_link") is not None for p in players)
+    assert [p.speed for p in players] == [p.speed for p in ref_players]
+    assert all(type(p.speed) is float for p in players)
+    assert [p.height for p in players] == ([None] * len(players) if stand else [0.7] * len(players))
+
+
+def test_requests_go_player_by_player_once_the_rows_are_stale() -> None:
+    """A block marked stale (a value its rows could not hold was assigned) is not written: the players are, one by
+    one, the unlinked one included. Broken once by writing the stale block's arrays anyway: it failed."""
+    players = tuple(LocomotionPlayer(speed=0.5) for _ in range(3))
+    block = row_store(World()).block(LocomotionPlayer, players)
+    players[1].speed = 2  # an int: player 1 leaves the block, which goes stale
+    assert block.stale
+    set_requests(players, (block, slice(None)), np.array([0.25, 0.5, 0.75]), stand=True)
+    assert [p.speed for p in players] == [0.25, 0.5, 0.75] and [p.height for p in players] == [None] * 3
