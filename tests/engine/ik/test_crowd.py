@@ -9,9 +9,9 @@ and state hash must be equal bit for bit; against the pure-numpy path (numba off
 Broken once by skipping the foot locks in ``_ground_kernel.ground_crowd``: the rotations
 then differ from the general path's at the first served step. A replaced pose field (step 9)
 and a lock column relinked by another batch's read (step 13) must be taken in as well. A
-member's offsets replaced (step 7) or its lock retuned (step 12) must make the plan be checked
+member's offsets replaced (step 7) or its lock retuned (step 4) must make the plan be checked
 again although nothing else changed: broken once by leaving the puppets' fields out of the
-plan's assignment marks (step 7 then differs), once by leaving the locks' tuning out (step 12).
+plan's assignment marks (step 7 then differs), once by leaving the locks' tuning out (step 4).
 """
 
 from __future__ import annotations
@@ -78,6 +78,8 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch, n: int = N) ->
                 pass
             elif step == 3:
                 reqs[5].grounding = False  # a jump: the crowd goes on without it
+            elif step == 4:  # a member's lock retuned: it leaves the crowd's one tuning
+                reqs[3].foot_lock.max_stretch, reqs[3].foot_lock.release_time = 0.0, 0.02
             elif step == 6:
                 reqs[5].grounding = True
             elif step == 7:  # a member's bone lengths replaced: the plan's stacked offsets are out of date
@@ -91,8 +93,6 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch, n: int = N) ->
             elif step == 11:
                 reqs[9].sphere_centre = None
                 reqs[2].foot_lock.contacts = None
-            elif step == 12:  # a member's lock retuned: it leaves the crowd's one tuning
-                reqs[3].foot_lock.max_stretch = 0.02
             elif step == 13:  # another batch's read relinks a lock column: members past the tenth keep old views
                 cols.get(FootLock, "points", 2).read([*locks[:10], FootLock(points=np.ones((2, 3)))])
             app.step()
@@ -128,7 +128,7 @@ def test_the_crowd_pass_is_the_general_path_bit_for_bit(ground: Any, monkeypatch
     # one puppet is in the air (3-5: the crowd is not the animation's whole batch), when the
     # jumper rejoins with its reset lock (6), a lock field was replaced (8), a member has hands
     # on a sphere (10) or no contact votes (11 on). The step after each, it serves again. Once
-    # a member left for its own lock tuning (12), the lock column relinked by another batch's read
+    # a member left for its own lock tuning (4), the lock column relinked by another batch's read
     # at 13 holds the members at rows other than the rest of their lock state: step 13 goes to the
     # general path (as it did before plans were kept on assignment marks).
     assert none == [] and served == list(range(1, STEPS - 1))
