@@ -25,7 +25,18 @@ from numpy.typing import NDArray
 
 from engine.jit import njit, qaxis_angle, qbetween, qconj, qmul, qnormalize, qrot, qslerp, vcross, vdot, vnorm, vunit
 
-__all__ = ["BAD_GROUND", "BAD_WEIGHT", "DONE", "ground_crowd", "ground_crowd_on_plane", "legs_fk", "legs_solve", "legs_targets", "lock_group", "plane_query"]
+__all__ = [
+    "BAD_GROUND",
+    "BAD_WEIGHT",
+    "DONE",
+    "ground_crowd",
+    "ground_crowd_on_plane",
+    "legs_fk",
+    "legs_solve",
+    "legs_targets",
+    "lock_group",
+    "plane_query",
+]
 
 from engine.arrays import F64 as F
 from engine.arrays import I64 as I
