@@ -6,10 +6,13 @@ requests, stacking offsets, fitting and grouping the foot locks, reading their s
 the components, writing the pelvis shifts back. That cost several times the kernels. Here
 a :class:`CrowdPlan` is made once per membership: the puppets that only ask to have their
 feet planted (no effectors, no hands), share one skeleton and have live foot locks of one
-tuning — from one puppet up. Each step it checks, with a handful of C-level passes over the
-members (``map``/``all``, no Python frame per puppet), that nothing about them changed, then
-runs :func:`~engine.ik._ground_kernel.legs_fk`, the ground query, and
-:func:`~engine.ik._ground_kernel.ground_crowd` on the columns themselves, at the members'
+tuning — from one puppet up. The plan holds while none of the fields it was made from was
+assigned since (the fields' assignment logs, :func:`engine.columns.assignment_mark`: no look at
+the members at all); after an assignment it is checked with a handful of C-level passes over the
+members (``map``/``all``, no Python frame per puppet). Each step then runs
+:func:`~engine.ik._ground_kernel.legs_fk`, the ground query, and
+:func:`~engine.ik._ground_kernel.ground_crowd` (on flat ground the three in one compiled call,
+:func:`~engine.ik._ground_kernel.ground_crowd_on_plane`) on the columns themselves, at the members'
 rows (:meth:`engine.columns.Column.rows`: the crowd may be part of the animation's batch, with
 one puppet in the air or ten fallen): the local poses and the foot locks' state are updated
 in place.
