@@ -246,14 +246,16 @@ class _Watched:
     components some code replaced the field of among the few assigned since it last looked,
     instead of comparing every row each call. The log is cleared when it grows past
     :data:`_LOG_CAP` (a new :attr:`epoch`: a column that missed entries compares every row once);
-    it holds the components, so an id in it is never reused while it is there."""
+    it holds the components, so an id in it is never reused while it is there. :attr:`count` counts every assignment
+    ever (it never goes back, unlike the log's length): what a :class:`Mark` compares."""
 
-    __slots__ = ("name", "log", "epoch")
+    __slots__ = ("name", "log", "epoch", "count")
 
     def __init__(self, name: str) -> None:
         self.name = name
         self.log: list[Any] = []
         self.epoch = 0
+        self.count = 0
 
     def __set__(self, obj: Any, value: Any) -> None:
         obj.__dict__[self.name] = value
@@ -262,10 +264,12 @@ class _Watched:
             log.clear()
             self.epoch += 1
         log.append(obj)
+        self.count += 1
 
     def __delete__(self, obj: Any) -> None:
         del obj.__dict__[self.name]
         self.log.append(obj)
+        self.count += 1
 
 
 _LOG_CAP = 8192
@@ -282,8 +286,22 @@ def _watched(owners: Sequence[Any], attr: str) -> _Watched | None:
     return _field_log(cls, attr)
 
 
-Mark = tuple[tuple[_Watched, int, int], ...]
-"""Where the assignment logs of some fields stood (:func:`assignment_mark`)."""
+class Mark:
+    """Where the assignment logs of some fields stood (:func:`assignment_mark`): each log's :attr:`_Watched.count`,
+    kept as a tuple so that :func:`unassigned_since` compares them in C, without a Python step per field."""
+
+    __slots__ = ("_logs", "_at")
+
+    def __init__(self, logs: tuple[_Watched, ...]) -> None:
+        self._logs = logs
+        self._at = tuple(map(_COUNT, logs))
+
+    def unchanged(self) -> bool:
+        """Whether no log took an assignment since the mark was taken."""
+        return tuple(map(_COUNT, self._logs)) == self._at
+
+
+_COUNT = attrgetter("count")
 
 
 def assignment_mark(cls: type, attrs: Sequence[str]) -> Mark | None:
@@ -293,12 +311,12 @@ def assignment_mark(cls: type, attrs: Sequence[str]) -> Mark | None:
     logs = [_field_log(cls, attr) for attr in attrs]
     if any(log is None for log in logs):
         return None
-    return tuple((log, log.epoch, len(log.log)) for log in logs if log is not None)
+    return Mark(tuple(log for log in logs if log is not None))
 
 
 def unassigned_since(mark: Mark | None) -> bool:
     """Whether no component of the marked class had one of the marked fields assigned since the mark was taken."""
-    return mark is not None and all(log.epoch == epoch and len(log.log) == at for log, epoch, at in mark)
+    return mark is not None and mark.unchanged()
 
 
 def _field_log(cls: type, attr: str) -> _Watched | None:

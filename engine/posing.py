@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from engine import jit
 from engine.app import App
 from engine.arrays import F64 as F
-from engine.columns import Columns, columns
+from engine.columns import Columns, Mark, assignment_mark, columns, unassigned_since
 from engine.components import LocalPose, Puppet, WorldPose
 from engine.ecs import Entity, World
 from engine.fk import fk_rows, forward_kinematics
@@ -35,7 +35,8 @@ from engine.skeleton import Skeleton
 
 __all__ = ["FKPlan", "fk_system", "install_fk"]
 
-_PUPPET = attrgetter("skeleton", "offsets")
+_PUPPET_FIELDS = ("skeleton", "offsets")
+_PUPPET = attrgetter(*_PUPPET_FIELDS)
 
 
 @dataclass
@@ -58,7 +59,8 @@ class FKPlan:
 
     ``table``/``posed`` are the query results it was made for (``(Puppet, LocalPose)`` and the
     same with ``WorldPose``; kept so their ids are not reused); ``puppets`` the table's ``Puppet``
-    components and ``puppet_fields`` each one's ``(skeleton, offsets)`` objects then."""
+    components and ``puppet_fields`` each one's ``(skeleton, offsets)`` objects then; ``marks`` where the assignment
+    log of those two fields stood when the plan was last found to hold (:func:`_mark`)."""
 
     SIM_STATE: ClassVar[bool] = False
     table: list[tuple[Any, ...]] = field(default_factory=list)
@@ -66,15 +68,29 @@ class FKPlan:
     puppets: list[Puppet] = field(default_factory=list)
     puppet_fields: list[tuple[Any, ...]] = field(default_factory=list)
     groups: list[_Group] = field(default_factory=list)
+    marks: Mark | None = None
 
     def holds(self, table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> bool:
-        """Whether the plan still describes these query results (one C-level pass over the puppets)."""
+        """Whether the plan still describes these query results: at once while no puppet's skeleton or offsets
+        was assigned since it last held, else by one C-level pass over the puppets."""
         if table is not self.table or posed is not self.posed or len(posed) != len(table):
             return False
+        if unassigned_since(self.marks):
+            return True
         try:
-            return list(map(_PUPPET, self.puppets)) == self.puppet_fields
+            holds = list(map(_PUPPET, self.puppets)) == self.puppet_fields
         except ValueError:  # an offsets array compared with another: it was replaced
             return False
+        if holds:
+            self.marks = _mark(self.puppets)
+        return holds
+
+
+def _mark(puppets: list[Puppet]) -> Mark | None:
+    """Where the assignment log of the puppets' ``skeleton`` and ``offsets`` stands now
+    (:func:`engine.columns.assignment_mark`); ``None`` for puppets of several classes (then every step compares them)."""
+    kinds = set(map(type, puppets))
+    return assignment_mark(kinds.pop(), _PUPPET_FIELDS) if len(kinds) == 1 else None
 
 
 def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
@@ -98,7 +114,7 @@ def _plan(table: list[tuple[Any, ...]], posed: list[tuple[Any, ...]]) -> FKPlan:
             )
         )
     everyone = [row[1] for row in table]
-    return FKPlan(table, posed, everyone, list(map(_PUPPET, everyone)), groups)
+    return FKPlan(table, posed, everyone, list(map(_PUPPET, everyone)), groups, _mark(everyone))
 
 
 def _compiled(cols: Columns, group: _Group) -> bool:

@@ -25,12 +25,24 @@ from numpy.typing import NDArray
 
 from engine.jit import njit, qaxis_angle, qbetween, qconj, qmul, qnormalize, qrot, qslerp, vcross, vdot, vnorm, vunit
 
-__all__ = ["ground_crowd", "legs_fk", "legs_solve", "legs_targets", "lock_group", "plane_query"]
+__all__ = [
+    "BAD_GROUND",
+    "BAD_WEIGHT",
+    "DONE",
+    "ground_crowd",
+    "ground_crowd_on_plane",
+    "legs_fk",
+    "legs_solve",
+    "legs_targets",
+    "lock_group",
+    "plane_query",
+]
 
 from engine.arrays import F64 as F
 from engine.arrays import I64 as I
 
 _EPS = 1e-9
+DONE, BAD_WEIGHT, BAD_GROUND = 0, 1, 2  # what ground_crowd returns
 
 
 @njit
@@ -492,22 +504,26 @@ def ground_crowd(
     settle: NDArray[np.bool_],
     shift: F,
     kept: NDArray[np.bool_],
-) -> bool:
+) -> int:
     """After :func:`legs_fk` and the ground query, the rest of a crowd's grounding in one pass:
     per puppet ``p`` :func:`legs_targets`, :func:`lock_group` (every puppet locked, one ``settings``)
     and :func:`legs_solve`, in place on its pose, row ``rows[p]`` of ``roots``/``rots``, and its lock
     state, row ``lock_rows[p]`` of the lock arrays (its votes: row ``contact_rows[p]`` of ``contacts``).
     A puppet whose result is not finite keeps its given pose and is marked in ``kept [P]`` (its
-    ``shift`` and lock state still advance, as on the path in pieces). Returns ``False``, changing
-    nothing, if the ground's ``height``/``normal`` are not all finite."""
+    ``shift`` and lock state still advance, as on the path in pieces). Returns :data:`DONE`, or, changing
+    nothing, :data:`BAD_WEIGHT` if a ``weight`` is outside ``0..1`` (checked first) or :data:`BAD_GROUND` if the
+    ground's ``height``/``normal`` are not all finite."""
     count, n, nl = rows.shape[0], rots.shape[1], legs.shape[0]
+    for p in range(count):
+        if weight[p] < 0.0 or weight[p] > 1.0:
+            return BAD_WEIGHT
     for p in range(count):
         for k in range(nl):
             if not math.isfinite(height[p, k]):
-                return False
+                return BAD_GROUND
             for c in range(3):
                 if not math.isfinite(normal[p, k, c]):
-                    return False
+                    return BAD_GROUND
     targets, new_rot, floor = np.empty((count, nl, 3)), np.empty((count, nl, 4)), np.empty((count, nl, 3))
     pos, wrot, chain = np.empty((n, 3)), np.empty((n, 4)), np.empty(n, np.int64)
     toe = np.empty((nl, 3))
@@ -541,4 +557,53 @@ def ground_crowd(
         if not finite:
             roots[r] = given_root
             rots[r] = given_rot
-    return True
+    return DONE
+
+
+@njit
+def ground_crowd_on_plane(
+    parents: I,
+    rows: I,
+    roots: F,
+    rots: F,
+    offs: F,
+    legs: I,
+    soles: F,
+    tips: F,
+    heels: F,
+    knees: F,
+    point: F,
+    plane_normal: F,
+    weight: F,
+    align_height: float,
+    contact_height: float,
+    max_pelvis_shift: float,
+    dt: float,
+    settings: F,
+    lock_rows: I,
+    points: F,
+    weights: F,
+    planted: NDArray[np.bool_],
+    stepping: NDArray[np.bool_],
+    yaw: F,
+    animated: F,
+    contact_rows: I,
+    contacts: F,
+    settle: NDArray[np.bool_],
+    shift: F,
+    kept: NDArray[np.bool_],
+) -> int:
+    """:func:`legs_fk`, :func:`plane_query` (the plane through ``point`` with unit ``plane_normal``) and
+    :func:`ground_crowd` in one call: a crowd on flat ground grounded with one dispatch from Python and its
+    scratch arrays made here (the same functions, so the same operations). Returns what :func:`ground_crowd` does."""
+    count, nl = rows.shape[0], legs.shape[0]
+    ankles, hips, sole = np.empty((count, nl, 3)), np.empty((count, nl, 3)), np.empty((count, nl, 3))
+    qfeet = np.empty((count, nl, 4))
+    legs_fk(parents, rows, roots, rots, offs, legs, soles, ankles, qfeet, hips, sole)
+    height, normal = np.empty((count, nl)), np.empty((count, nl, 3))
+    plane_query(sole, point, plane_normal, height, normal)
+    return ground_crowd(
+        parents, rows, roots, rots, offs, legs, soles, tips, heels, knees, sole, qfeet, ankles, hips, height, normal,
+        weight, align_height, contact_height, max_pelvis_shift, dt, settings, lock_rows, points, weights, planted,
+        stepping, yaw, animated, contact_rows, contacts, settle, shift, kept,
+    )  # fmt: skip

@@ -6,10 +6,13 @@ requests, stacking offsets, fitting and grouping the foot locks, reading their s
 the components, writing the pelvis shifts back. That cost several times the kernels. Here
 a :class:`CrowdPlan` is made once per membership: the puppets that only ask to have their
 feet planted (no effectors, no hands), share one skeleton and have live foot locks of one
-tuning — from one puppet up. Each step it checks, with a handful of C-level passes over the
-members (``map``/``all``, no Python frame per puppet), that nothing about them changed, then
-runs :func:`~engine.ik._ground_kernel.legs_fk`, the ground query, and
-:func:`~engine.ik._ground_kernel.ground_crowd` on the columns themselves, at the members'
+tuning — from one puppet up. The plan holds while none of the fields it was made from was
+assigned since (the fields' assignment logs, :func:`engine.columns.assignment_mark`: no look at
+the members at all); after an assignment it is checked with a handful of C-level passes over the
+members (``map``/``all``, no Python frame per puppet). Each step then runs
+:func:`~engine.ik._ground_kernel.legs_fk`, the ground query, and
+:func:`~engine.ik._ground_kernel.ground_crowd` (on flat ground the three in one compiled call,
+:func:`~engine.ik._ground_kernel.ground_crowd_on_plane`) on the columns themselves, at the members'
 rows (:meth:`engine.columns.Column.rows`: the crowd may be part of the animation's batch, with
 one puppet in the air or ten fallen): the local poses and the foot locks' state are updated
 in place.
@@ -36,7 +39,7 @@ from numpy.typing import NDArray
 from engine import jit
 from engine.arrays import F64 as F
 from engine.arrays import I64
-from engine.columns import Columns
+from engine.columns import Columns, Mark, assignment_mark, unassigned_since
 from engine.components import LocalPose, Puppet
 from engine.fk import kernel_array
 from engine.ik import _ground_kernel as _kernel
@@ -59,9 +62,9 @@ _GROUNDING = attrgetter("grounding")
 _WEIGHT = attrgetter("grounding_weight")
 _SETTLE = attrgetter("settle")
 #: What a member's request, puppet and lock must keep for the plan to hold (compared as tuples, in C).
-_REQUEST = attrgetter("effectors", "sphere_centre", "foot_lock")
-_PUPPET = attrgetter("skeleton", "offsets")
-_TUNING = attrgetter(
+_REQUEST_FIELDS = ("grounding", "effectors", "sphere_centre", "foot_lock")
+_PUPPET_FIELDS = ("skeleton", "offsets")
+_TUNING_FIELDS = (
     "enabled",
     "release_time",
     "max_stretch",
@@ -72,6 +75,31 @@ _TUNING = attrgetter(
     "step_time",
     "step_height",
 )
+_REQUEST = attrgetter(*_REQUEST_FIELDS[1:])
+_PUPPET = attrgetter(*_PUPPET_FIELDS)
+_TUNING = attrgetter(*_TUNING_FIELDS)
+Marks = tuple[Mark | None, ...]
+
+
+def _mark(requests: list[Any]) -> Marks | None:
+    """Where the assignment logs (:func:`engine.columns.assignment_mark`) of every field :func:`_holds` reads stand
+    now: the requests' ``grounding``, ``effectors``, ``sphere_centre`` and ``foot_lock``, the puppets' ``skeleton``
+    and ``offsets``, the locks' tuning and ``contacts`` (what :func:`_plain` asks of an outsider); ``None`` when the
+    requests are of several classes or a field cannot have a log (then every step compares the members)."""
+    kinds = set(map(type, requests))
+    if len(kinds) != 1:
+        return None
+    marks = (
+        assignment_mark(kinds.pop(), _REQUEST_FIELDS),
+        assignment_mark(Puppet, _PUPPET_FIELDS),
+        assignment_mark(FootLock, (*_TUNING_FIELDS, "contacts")),
+    )
+    return None if None in marks else marks
+
+
+def _unassigned(marks: Marks | None) -> bool:
+    """Whether none of the fields marked by :func:`_mark` was assigned since."""
+    return marks is not None and all(map(unassigned_since, marks))
 
 
 def _plain(req: Any, settings: tuple[float, ...]) -> bool:
@@ -122,6 +150,8 @@ class CrowdPlan:
         settings, tuning, settings_array: the locks' tuning (:meth:`FootLock.settings`), one for all;
             ``tuning`` with ``enabled`` first, as each lock must still read.
         checked: the row arrays of the members' columns last found to agree (:func:`ground_crowd`).
+        marks: where the assignment logs of the fields the plan depends on stood when it was last found to hold
+            (:func:`_mark`): while none of them was assigned since, it still holds without a look at the members.
     """
 
     table: list[tuple[Any, ...]]
@@ -146,6 +176,7 @@ class CrowdPlan:
     heels: F
     knees: F
     checked: tuple[I64, ...] = ()
+    marks: Marks | None = None
 
 
 def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
@@ -199,26 +230,34 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> C
         tips=np.array([sk.tips[f] for _, _, f in idx] if sk else np.zeros((0, 3)), dtype=np.float64),
         heels=np.array([leg.heel for leg in legs], dtype=np.float64),
         knees=np.array([leg.knee_forward for leg in legs], dtype=np.float64),
+        marks=_mark(requests),
     )
 
 
 def _holds(plan: CrowdPlan, table: list[tuple[Any, ...]]) -> bool:
-    """Whether ``plan`` still describes ``table``'s crowd this step (C-level passes over the members;
-    Python only for the outsiders, the few unusual puppets of the group).
+    """Whether ``plan`` still describes ``table``'s crowd this step.
 
-    A puppet outside the group that becomes fit to join it without its ``grounding`` flag
-    changing (its effectors cleared, say) is noticed at the next change of membership; until
-    then it is served, correctly, by the general path."""
-    if table is not plan.table or list(map(_GROUNDING, plan.all_requests)) != plan.grounding:
+    While no field the plan depends on was assigned since it was last found to hold (:func:`_mark`), it holds with
+    no look at the members: a steady crowd costs no Python per puppet. Otherwise it is checked with C-level passes
+    over the members (Python only for the outsiders, the few unusual puppets of the group), and marked again if it
+    holds. A puppet outside the group that becomes fit to join it without its ``grounding`` flag changing (its
+    effectors cleared, say) is noticed at the next change of membership; until then it is served, correctly, by
+    the general path."""
+    if table is not plan.table:
         return False
-    if not plan.rows:
+    if _unassigned(plan.marks):
         return True
-    return (
+    if list(map(_GROUNDING, plan.all_requests)) != plan.grounding:
+        return False
+    holds = not plan.rows or (
         _unchanged(list(map(_REQUEST, plan.requests)), plan.request_fields)
         and _unchanged(list(map(_PUPPET, plan.puppets)), plan.puppet_fields)
         and list(map(_TUNING, plan.locks)).count(plan.tuning) == len(plan.locks)
         and not any(_plain(req, plan.settings) for req in plan.outsiders)
     )
+    if holds:
+        plan.marks = _mark(plan.all_requests)
+    return holds
 
 
 def current_plan(plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
@@ -276,28 +315,34 @@ def ground_crowd(plan: CrowdPlan, cols: Columns, ground: GroundQuery, dt: float)
         plan.checked = index
     count = len(reqs)
     weight = np.fromiter(map(_WEIGHT, reqs), dtype=np.float64, count=count)
-    if np.any((weight < 0.0) | (weight > 1.0)):
-        raise ValueError("weight must lie in 0..1")
     settle = np.fromiter(map(_SETTLE, locks), dtype=np.bool_, count=count)
-    ankles, hips, sole, qfeet = (np.empty((count, legs, 3)), np.empty((count, legs, 3)),
-                                 np.empty((count, legs, 3)), np.empty((count, legs, 4)))  # fmt: skip
     rows = roots[1]
-    _kernel.legs_fk(sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, ankles, qfeet, hips, sole)
-    if type(ground) is PlaneGround:  # the same heights as its call, without a dozen numpy calls
-        height, normal = np.empty((count, legs)), np.empty((count, legs, 3))
-        _kernel.plane_query(sole, *ground.frame, height, normal)
-    else:
-        height, normal = ground(sole[..., 0], sole[..., 2])
-        height, normal = kernel_array(height, (count, legs)), kernel_array(normal, (count, legs, 3))
     shift, kept = np.empty(count), np.empty(count, dtype=np.bool_)
     points, weights, planted, stepping, yaw, animated = (found[0] for found in state)
-    finite = _kernel.ground_crowd(
-        sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels, plan.knees,
-        sole, qfeet, ankles, hips, height, normal, weight,
-        ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT, dt, plan.settings_array,
-        state[0][1], points, weights, planted, stepping, yaw, animated, contacts[1], contacts[0], settle, shift, kept,
-    )  # fmt: skip
-    if not finite:
+    if type(ground) is PlaneGround:  # the same heights as its call, in the same dispatch as the rest
+        status = _kernel.ground_crowd_on_plane(
+            sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels,
+            plan.knees, *ground.frame, weight, ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT, dt,
+            plan.settings_array, state[0][1], points, weights, planted, stepping, yaw, animated, contacts[1],
+            contacts[0], settle, shift, kept,
+        )  # fmt: skip
+    else:
+        ankles, hips, sole, qfeet = (np.empty((count, legs, 3)), np.empty((count, legs, 3)),
+                                     np.empty((count, legs, 3)), np.empty((count, legs, 4)))  # fmt: skip
+        _kernel.legs_fk(sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, ankles, qfeet, hips,
+                        sole)  # fmt: skip
+        height, normal = ground(sole[..., 0], sole[..., 2])
+        height, normal = kernel_array(height, (count, legs)), kernel_array(normal, (count, legs, 3))
+        status = _kernel.ground_crowd(
+            sk.parents, rows, roots[0], rots[0], plan.offsets, plan.legs, plan.soles, plan.tips, plan.heels,
+            plan.knees, sole, qfeet, ankles, hips, height, normal, weight,
+            ALIGN_HEIGHT, CONTACT_HEIGHT, MAX_PELVIS_SHIFT, dt, plan.settings_array,
+            state[0][1], points, weights, planted, stepping, yaw, animated, contacts[1], contacts[0], settle, shift,
+            kept,
+        )  # fmt: skip
+    if status == _kernel.BAD_WEIGHT:
+        raise ValueError("weight must lie in 0..1")
+    if status == _kernel.BAD_GROUND:
         raise ValueError("ground query returned non-finite values")
     deque(map(setattr, reqs, repeat("pelvis_shift"), shift.tolist()), maxlen=0)
     return kept

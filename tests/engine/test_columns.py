@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from engine.columns import Column, Columns, Stacked, columns
+from engine.columns import Column, Columns, Stacked, assignment_mark, columns, unassigned_since
 from engine.ecs import World
 
 
@@ -227,3 +227,32 @@ def test_owners_without_a_log_are_compared_row_by_row(kind: str) -> None:
     assert col.linked(poses) is None
     assert np.array_equal(col.read(poses)[2], [4.0, 4.0, 4.0])
     assert col.linked(poses) is col.base
+
+
+@dataclass
+class _Tuned:
+    gain: float = 1.0
+    limit: float = 2.0
+
+
+def test_a_mark_sees_any_assignment_since_even_across_a_cleared_log() -> None:
+    """A mark (:func:`assignment_mark`) holds until one of its fields is assigned, whatever the value, and is not
+    fooled by a log cleared at its cap and refilled to the length it had. Broken once by comparing the logs' lengths
+    instead of their counts: the last assertion then fails."""
+    from engine import columns as module
+
+    tuned = _Tuned()
+    mark = assignment_mark(_Tuned, ("gain", "limit"))
+    assert unassigned_since(mark)
+    tuned.limit = 2.0  # the same value, still an assignment
+    assert not unassigned_since(mark)
+    tuned.gain = 3.0
+    mark = assignment_mark(_Tuned, ("gain", "limit"))
+    assert unassigned_since(mark) and not unassigned_since(None)
+    log = module._field_log(_Tuned, "gain")
+    assert log is not None
+    length = len(log.log)
+    for _ in range(module._LOG_CAP):  # the log cleared at its cap and refilled to the length it had
+        tuned.gain = 3.0
+    assert len(log.log) == length
+    assert not unassigned_since(mark)

@@ -8,7 +8,10 @@ contacts. With the crowd pass and with it switched off (every step on the genera
 and state hash must be equal bit for bit; against the pure-numpy path (numba off) to 1e-9.
 Broken once by skipping the foot locks in ``_ground_kernel.ground_crowd``: the rotations
 then differ from the general path's at the first served step. A replaced pose field (step 9)
-and a lock column relinked by another batch's read (step 13) must be taken in as well.
+and a lock column relinked by another batch's read (step 13) must be taken in as well. A
+member's offsets replaced (step 7) or its lock retuned (step 4) must make the plan be checked
+again although nothing else changed: broken once by leaving the puppets' fields out of the
+plan's assignment marks (step 7 then differs), once by leaving the locks' tuning out (step 4).
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch, n: int = N) ->
         ents.append(app.world.spawn(Puppet(sk, offsets), pose, IKRequest(grounding=True)))
     world = app.world
     reqs = [world.get(e, IKRequest) for e in ents]
+    puppets = [world.get(e, Puppet) for e in ents]
     poses = [world.get(e, LocalPose) for e in ents]
     out: list[Any] = []
     with jit.use(mode != "numpy"):
@@ -74,8 +78,12 @@ def _run(mode: str, ground: Any, monkeypatch: pytest.MonkeyPatch, n: int = N) ->
                 pass
             elif step == 3:
                 reqs[5].grounding = False  # a jump: the crowd goes on without it
+            elif step == 4:  # a member's lock retuned: it leaves the crowd's one tuning
+                reqs[3].foot_lock.max_stretch, reqs[3].foot_lock.release_time = 0.0, 0.02
             elif step == 6:
                 reqs[5].grounding = True
+            elif step == 7:  # a member's bone lengths replaced: the plan's stacked offsets are out of date
+                puppets[6].offsets = sk.offsets * 1.05
             elif step == 8:
                 reqs[7].foot_lock.yaw = np.array([0.3, -0.2])  # other code replaced a lock field
             elif step == 9:  # other code replaced a member's pose field after the animation wrote it
@@ -119,8 +127,11 @@ def test_the_crowd_pass_is_the_general_path_bit_for_bit(ground: Any, monkeypatch
     # Served but where it must stand aside: at the start (no lock state in columns yet), while
     # one puppet is in the air (3-5: the crowd is not the animation's whole batch), when the
     # jumper rejoins with its reset lock (6), a lock field was replaced (8), a member has hands
-    # on a sphere (10) or no contact votes (11 on). The step after each, it serves again.
-    assert none == [] and served == list(range(1, STEPS))
+    # on a sphere (10) or no contact votes (11 on). The step after each, it serves again. Once
+    # a member left for its own lock tuning (4), the lock column relinked by another batch's read
+    # at 13 holds the members at rows other than the rest of their lock state: step 13 goes to the
+    # general path (as it did before plans were kept on assignment marks).
+    assert none == [] and served == list(range(1, STEPS - 1))
     for a, b, c in zip(crowd, general, numpy_path, strict=True):
         for x, y in zip(a[:-1], b[:-1], strict=True):
             np.testing.assert_array_equal(x, y)
@@ -143,7 +154,7 @@ def test_a_small_crowd_is_served_as_the_one_puppet_path_did_bit_for_bit(
     ground = PlaneGround(normal=(0.1, 1.0, -0.2))
     crowd, served = _run("crowd", ground, monkeypatch, n)
     one_by_one, none = _run("general", ground, monkeypatch, n)
-    assert none == [] and served == list(range(1, STEPS))
+    assert none == [] and served == list(range(1, STEPS if n < 10 else STEPS - 1))  # 13: as in the test above
     for a, b in zip(crowd, one_by_one, strict=True):
         for x, y in zip(a[:-1], b[:-1], strict=True):
             np.testing.assert_array_equal(x, y)
