@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 import pytest
-from websockets.sync.client import connect
+from websockets.sync.client import ClientConnection, connect
 
 from engine.render.scene import RenderScene
 from input.web.cert import load_or_create
@@ -97,6 +97,16 @@ def _binary(message: str | bytes) -> bytes:
     return message
 
 
+def _watching_from_step_1(ws: ClientConnection, source: WebSource) -> SceneState:
+    """Past the page's hello: step 1 published, its whole scene received and acknowledged."""
+    ws.recv(timeout=5)
+    _wait(lambda: source.viewers == 1)
+    publish(source, 1)
+    _, state = read_scene_glb(_binary(ws.recv(timeout=5)))
+    ws.send(json.dumps({"ack": state.step}))
+    return state
+
+
 def test_a_frame_right_after_a_pong_is_not_held_for_the_pages_delayed_ack(source: WebSource) -> None:
     """The page pings once a second; the frame published just after the pong must go at once.
 
@@ -105,11 +115,7 @@ def test_a_frame_right_after_a_pong_is_not_held_for_the_pages_delayed_ack(source
     pong, which it delays by 40 ms: every wait is then 39-48 ms (tried); without it 1-16 ms.
     """
     with connect(f"wss://127.0.0.1:{source.port}/ws?t={source.token}", ssl=_tls(), open_timeout=10) as ws:
-        ws.recv(timeout=5)
-        _wait(lambda: source.viewers == 1)
-        publish(source, 1)
-        _, state = read_scene_glb(_binary(ws.recv(timeout=5)))
-        ws.send(json.dumps({"ack": state.step}))
+        state = _watching_from_step_1(ws, source)
         waits = []
         for step in range(2, 12):
             ws.send(json.dumps({"ping": 1.0}))
@@ -143,11 +149,7 @@ def test_a_page_that_keeps_up_gets_frames_coded_on_the_publishing_thread(
 
     monkeypatch.setattr(server, "encode_frame", spy)
     with connect(f"wss://127.0.0.1:{source.port}/ws?t={source.token}", ssl=_tls(), open_timeout=10) as ws:
-        ws.recv(timeout=5)
-        _wait(lambda: source.viewers == 1)
-        publish(source, 1)
-        _, state = read_scene_glb(_binary(ws.recv(timeout=5)))
-        ws.send(json.dumps({"ack": state.step}))
+        state = _watching_from_step_1(ws, source)
         for step in range(2, 8):
             publish(source, step)
             state = decode_frame(state, _binary(ws.recv(timeout=5)))
