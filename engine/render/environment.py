@@ -23,7 +23,16 @@ from engine.render import shaders_ground as G
 from engine.render.gpu import Instances, Releasable, mesh_buffers, set_uniform
 from engine.render.scene import PRINT_STRIDE, GroundMarks, RenderScene
 
-__all__ = ["Environment", "GROOVE", "ground_fills_view", "groove_shade", "marks_rect", "soften_marks"]
+__all__ = [
+    "Environment",
+    "GROOVE",
+    "SHADOW_STRENGTH",
+    "ground_fills_view",
+    "groove_shade",
+    "marks_rect",
+    "shadow_take",
+    "soften_marks",
+]
 
 _PRINT_FMT = ("2f 2f 2f 1f/i", "i_xz", "i_dir", "i_half", "i_strength")
 RIDGE_RADIUS = 130.0
@@ -73,6 +82,23 @@ def groove_shade(soft: NDArray[np.uint8], sun_dir: NDArray[np.float64]) -> NDArr
     out[..., :3] = np.minimum(k * 127.5 + 0.5, 255.0).astype(np.uint8)  # k > 0: no lower clip
     out[..., 3] = soft
     return out
+
+
+SHADOW_STRENGTH = 0.9
+"""How much of the sun's light the ground shadow takes away."""
+
+
+def shadow_take(common: dict[str, Any], strength: float = SHADOW_STRENGTH) -> tuple[float, float, float]:
+    """The share of the snow's light (per channel, linear) the ground shadow takes away: the sun's share
+    of it, ``sun / (sun + sky · ambient · 1.6)`` with ``sun`` its colour times its height, times
+    ``strength`` (``u_shadow_take`` of :data:`~engine.render.shaders_ground.SHADOW_DECAL_FS` and of the
+    ground's ``MASK``), from the frame's uniforms ``common`` (sun, sky, ambient)."""
+    height, ambient = float(common["u_sun_dir"][1]), float(common["u_ambient"])
+    out = []
+    for c, s in zip(common["u_sun_color"], common["u_sky_lin"], strict=True):
+        sun = float(c) * height
+        out.append(strength * sun / (sun + float(s) * ambient * 1.6))
+    return out[0], out[1], out[2]
 
 
 def marks_rect(marks: GroundMarks, threshold: float = 0.02) -> tuple[float, float, float, float] | None:
@@ -236,10 +262,15 @@ class Environment:
 
     def draw_ground(self, draws: list[tuple[str, int, int]], uniforms: dict[str, Any]) -> None:
         """The ground mesh in ``draws`` (:meth:`ground_draws`; ``uniforms``: centre, extent and the ground's colours)."""
+        take = (
+            shadow_take(self._common, float(uniforms["u_shadow_strength"])) if "u_shadow_strength" in uniforms else None
+        )
         for key, first, count in draws:
             prog = self._programs[key]
             for name, value in uniforms.items():
                 set_uniform(prog, name, value)
+            if take is not None:
+                set_uniform(prog, "u_shadow_take", take)
             self._vaos[key].render(moderngl.TRIANGLES, vertices=count, first=first)
 
     def draw_sky(self, scene: RenderScene, photo: bool, ground_height: float) -> None:
@@ -283,7 +314,7 @@ class Environment:
                 ("u_rect", shadow_rect),
                 ("u_height", height),
                 ("u_ground_mask", 4),
-                ("u_shadow_strength", 0.9),
+                ("u_shadow_take", shadow_take(self._common)),
             ):
                 set_uniform(prog, name, value)
             self._vaos["shadow"].render(moderngl.TRIANGLE_STRIP)

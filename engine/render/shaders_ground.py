@@ -78,6 +78,7 @@ uniform float u_grid_strength;
 uniform sampler2D u_ground_mask;    // MASK: the ground shadow is read here, not drawn as a decal
 uniform vec4 u_rect;
 uniform float u_shadow_strength;
+uniform vec3 u_shadow_take;         // MASK: the share of the light a shadow takes (see SHADOW_DECAL_FS)
 in vec3 v_pos;
 in vec3 v_lin;
 in vec3 v_color;
@@ -90,8 +91,7 @@ void main() {
 #ifdef MASK
     vec2 muv = (v_pos.xz - u_rect.xy) / u_rect.zw;
     if (u_shadow_strength > 0.0 && all(greaterThan(muv, vec2(0.0))) && all(lessThan(muv, vec2(1.0)))) {
-        vec3 sun = u_sun_color * u_sun_dir.y;
-        c *= 1.0 - texture(u_ground_mask, muv).r * u_shadow_strength * sun / (sun + u_sky_lin * u_ambient * 1.6);
+        c *= 1.0 - texture(u_ground_mask, muv).r * u_shadow_take;
     }
 #endif
 #ifdef NEAR
@@ -213,21 +213,22 @@ void main() {
 }
 """
 
+# The shadow takes away the sun's share of the snow's light, per channel (the blue sky light stays, so
+# shadows on snow are blue, not grey): u_shadow_take, that share times the shadow's strength, is the
+# same for every pixel and set once per frame (shadow_take in engine.render.environment): computed
+# here, its division per channel cost a quarter of the decal on llvmpipe, which does not hoist
+# uniform-only arithmetic out of the pixel loop. The fog then keeps 1 / (1 + d·density) of the
+# darkening: mix(1 - m·take, 1, fog_amount(d)) with fog_amount(d) = f / (1 + f), in one division.
 SHADOW_DECAL_FS = """
 uniform sampler2D u_ground_mask;
-uniform float u_shadow_strength;
+uniform vec3 u_shadow_take;
 in vec3 v_pos;
 in vec2 v_uv;
 out vec4 f_color;
 void main() {
     float m = texture(u_ground_mask, v_uv).r;
     if (m < 0.004) discard;
-    // The sun's share of the snow's light is what a shadow takes away.
-    // Per channel: the blue sky light stays, so shadows on snow are blue, not grey.
-    vec3 sun = u_sun_color * u_sun_dir.y;
-    vec3 lit = sun / (sun + u_sky_lin * u_ambient * 1.6);
-    vec3 keep = 1.0 - m * u_shadow_strength * lit;
-    keep = mix(keep, vec3(1.0), fog_amount(length(u_eye - v_pos)));
+    vec3 keep = 1.0 - m * u_shadow_take / (1.0 + length(u_eye - v_pos) * u_fog_density);
     f_color = vec4(0.5 * sqrt(keep), 1.0);   // sqrt: the picture is gamma 2
 }
 """
