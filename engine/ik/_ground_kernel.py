@@ -509,6 +509,8 @@ def ground_crowd(
     per puppet ``p`` :func:`legs_targets`, :func:`lock_group` (every puppet locked, one ``settings``)
     and :func:`legs_solve`, in place on its pose, row ``rows[p]`` of ``roots``/``rots``, and its lock
     state, row ``lock_rows[p]`` of the lock arrays (its votes: row ``contact_rows[p]`` of ``contacts``).
+    Toe tips are per puppet, ``tips [P, L, 3]``, as offsets are: puppets of one hierarchy with bones
+    of their own (the snowmen, each fitted to its balls) are one crowd.
     A puppet whose result is not finite keeps its given pose and is marked in ``kept [P]`` (its
     ``shift`` and lock state still advance, as on the path in pieces). Returns :data:`DONE`, or, changing
     nothing, :data:`BAD_WEIGHT` if a ``weight`` is outside ``0..1`` (checked first) or :data:`BAD_GROUND` if the
@@ -534,11 +536,11 @@ def ground_crowd(
         r = rows[p]
         for k in range(nl):
             _target_leg(
-                sole, qfeet, height, normal, weight[p], soles, tips, heels, align_height, contact_height,
+                sole, qfeet, height, normal, weight[p], soles, tips[p], heels, align_height, contact_height,
                 targets, new_rot, floor, p, k,
             )  # fmt: skip
         _lock_puppet(
-            lock_rows[p], p, contact_rows[p], settle[p], targets, new_rot, floor, tips, dt, settings, points, weights,
+            lock_rows[p], p, contact_rows[p], settle[p], targets, new_rot, floor, tips[p], dt, settings, points, weights,
             planted, stepping, yaw, animated, contacts, toe, twist, gap, start, still, misplaced,
         )  # fmt: skip
         given_root[:] = roots[r]
@@ -594,7 +596,7 @@ def ground_crowd_on_plane(
     kept: NDArray[np.bool_],
 ) -> int:
     """:func:`legs_fk`, :func:`plane_query` (the plane through ``point`` with unit ``plane_normal``) and
-    :func:`ground_crowd` in one call: a crowd on flat ground grounded with one dispatch from Python and its
+    :func:`ground_crowd` (``tips [P, L, 3]``) in one call: a crowd on flat ground grounded with one dispatch from Python and its
     scratch arrays made here (the same functions, so the same operations). Returns what :func:`ground_crowd` does."""
     count, nl = rows.shape[0], legs.shape[0]
     ankles, hips, sole = np.empty((count, nl, 3)), np.empty((count, nl, 3)), np.empty((count, nl, 3))

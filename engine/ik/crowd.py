@@ -5,8 +5,10 @@ compiled kernels, but around them the stage did Python per puppet every step: gr
 requests, stacking offsets, fitting and grouping the foot locks, reading their state from
 the components, writing the pelvis shifts back. That cost several times the kernels. Here
 a :class:`CrowdPlan` is made once per membership: the puppets that only ask to have their
-feet planted (no effectors, no hands), share one skeleton and have live foot locks of one
-tuning — from one puppet up. The plan holds while none of the fields it was made from was
+feet planted (no effectors, no hands), share one joint hierarchy and have live foot locks of one
+tuning — from one puppet up. Bone lengths and toe tips ride per member in the kernel's arrays, so
+puppets fitted to their own bones (the snowman game's snowmen, each rigged to its balls) share
+the pass with the default puppets. The plan holds while none of the fields it was made from was
 assigned since (the fields' assignment logs, :func:`engine.columns.assignment_mark`: no look at
 the members at all); after an assignment it is checked with a handful of C-level passes over the
 members (``map``/``all``, no Python frame per puppet). Each step then runs
@@ -27,7 +29,7 @@ puppet by puppet: the rest of the crowd stays on the pass.
 
 from __future__ import annotations
 
-from collections import deque
+from collections import Counter, deque
 from dataclasses import dataclass
 from itertools import repeat
 from operator import attrgetter, is_
@@ -142,8 +144,12 @@ class CrowdPlan:
         outsiders: the requests of the rest of the members' group (alike puppets that only ask
             to be grounded, but not plain: hands on a sphere, no contact votes); one that becomes
             plain changes the plan.
-        skeleton, puppets: their shared skeleton and their ``Puppet`` components; ``puppet_fields``
-            each member's ``(skeleton, offsets)`` objects, and ``offsets`` their stack ``[P, J, 3]``.
+        skeleton, puppets: their shared hierarchy (the first such skeleton seen) and their ``Puppet``
+            components; ``puppet_fields`` each member's ``(skeleton, offsets)`` objects, ``offsets`` their
+            stack ``[P, J, 3]`` and ``tips`` their own skeletons' toe tips ``[P, L, 3]``.
+        alike: per member, how many puppets of its very skeleton (``same_as``) ask to be grounded alike:
+            the path it would take off the pass (:data:`engine.ik.system.BATCH` or more: batched),
+            which says whether a non-finite result marks it unreached.
         locals_, requests, locks: the members' components, in row order (tuples: the columns
             remember their rows by the tuple); ``request_fields`` each request's
             ``(effectors, sphere_centre, foot_lock)``.
@@ -175,24 +181,28 @@ class CrowdPlan:
     tips: F
     heels: F
     knees: F
+    alike: I64
     checked: tuple[I64, ...] = ()
     marks: Marks | None = None
 
 
-def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
+def plan_crowd(table: list[tuple[Any, ...]], kin: Any, same_as: Any, crowd_from: int) -> CrowdPlan:
     """The crowd of ``table`` (rows ``(entity, Puppet, LocalPose, IKRequest)``).
 
-    It is the plain members of the largest of the groups that :func:`engine.ik.system.ik_system`
-    would ground alike (rows that ask for grounding and no effectors, of one skeleton — ``same_as``
-    maps a skeleton to its canonical equal): no hands on a sphere, a live foot lock, the first plain
-    member's lock tuning; at least ``crowd_from`` of them. Otherwise the plan has no members and
-    only remembers that there is no crowd."""
+    It is the plain members of the largest group of rows that ask for grounding and no effectors and
+    whose skeletons share one hierarchy (``kin`` maps a skeleton to the first seen with the same joints
+    and parents; their bone lengths and toe tips may differ): no hands on a sphere, a live foot lock,
+    the first plain member's lock tuning; at least ``crowd_from`` of them. Otherwise the plan has no
+    members and only remembers that there is no crowd. ``same_as`` (a skeleton's canonical equal)
+    counts each member's :attr:`CrowdPlan.alike`."""
     requests = [row[3] for row in table]
     groups: dict[int, list[int]] = {}
     for i, (_, puppet, _, req) in enumerate(table):
         if req.grounding and not req.effectors:
-            groups.setdefault(id(same_as(puppet.skeleton)), []).append(i)
+            groups.setdefault(id(kin(puppet.skeleton)), []).append(i)
     group = max(groups.values(), key=len) if groups else []
+    equal = {i: id(same_as(table[i][1].skeleton)) for i in group}
+    alike = Counter(equal.values())
     settings = next((t for i in group if (t := _own_tuning(table[i][3])) is not None), ())
     rows = [i for i in group if _plain(table[i][3], settings)]
     members_set = set(rows)
@@ -202,7 +212,7 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> C
     puppets: list[Puppet] = [table[i][1] for i in rows]
     members = [table[i][3] for i in rows]
     locks = tuple(req.foot_lock for req in members)
-    sk = same_as(puppets[0].skeleton) if puppets else None
+    sk = kin(puppets[0].skeleton) if puppets else None
     legs = HUMANOID_LEGS
     idx = np.array(
         [(sk.index(leg.upper), sk.index(leg.lower), sk.index(leg.foot)) for leg in legs] if sk else [],
@@ -227,9 +237,10 @@ def plan_crowd(table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> C
         settings_array=np.array(settings, dtype=np.float64),
         legs=idx,
         soles=np.array([leg.sole for leg in legs], dtype=np.float64),
-        tips=np.array([sk.tips[f] for _, _, f in idx] if sk else np.zeros((0, 3)), dtype=np.float64),
+        tips=np.array([p.skeleton.tips[idx[:, 2]] for p in puppets], dtype=np.float64).reshape(-1, len(legs), 3),
         heels=np.array([leg.heel for leg in legs], dtype=np.float64),
         knees=np.array([leg.knee_forward for leg in legs], dtype=np.float64),
+        alike=np.array([alike[equal[i]] for i in rows], dtype=np.int64),
         marks=_mark(requests),
     )
 
@@ -260,11 +271,13 @@ def _holds(plan: CrowdPlan, table: list[tuple[Any, ...]]) -> bool:
     return holds
 
 
-def current_plan(plan: CrowdPlan | None, table: list[tuple[Any, ...]], same_as: Any, crowd_from: int) -> CrowdPlan:
+def current_plan(
+    plan: CrowdPlan | None, table: list[tuple[Any, ...]], kin: Any, same_as: Any, crowd_from: int
+) -> CrowdPlan:
     """``plan`` if it still holds for ``table``, else a new one (:func:`plan_crowd`)."""
     if plan is not None and _holds(plan, table):
         return plan
-    return plan_crowd(table, same_as, crowd_from)
+    return plan_crowd(table, kin, same_as, crowd_from)
 
 
 def _place(cols: Columns, ctype: type, name: str, key: int, owners: tuple[Any, ...], shape: tuple[int, ...],

@@ -6,8 +6,9 @@ stage, after blending and before physics, and edits the puppet's
 :class:`~engine.components.LocalPose` in place. Order within a puppet: the
 optimisation IK's arbitrary targets first, then foot grounding (it moves the
 pelvis), then the hands (they follow the shoulders wherever the pelvis went).
-The largest group of alike puppets that only need their feet planted is served by the
-crowd pass (:mod:`engine.ik.crowd`) with no Python per puppet, from a single puppet up: its
+The largest group of puppets of one joint hierarchy that only need their feet planted is served
+by the crowd pass (:mod:`engine.ik.crowd`) with no Python per puppet, from a single puppet up (bone
+lengths may differ: the snowman game's puppet and its snowmen, each rigged to its balls, are one crowd): its
 compiled kernel is the per-puppet float path operation for operation, so even one puppet
 (the snowman game's) gains without changing a bit. What the pass cannot serve goes to the
 general path: groups of :data:`BATCH` or more alike puppets are grounded together as arrays
@@ -82,6 +83,7 @@ class IKRigCache:
     settings: IKSettings = field(default_factory=IKSettings)
     rigs: dict[int, IKRig] = field(default_factory=dict)
     canonical: dict[int, Skeleton] = field(default_factory=dict)
+    kindred: dict[int, Skeleton] = field(default_factory=dict)
     batch_from: int = BATCH  # alike puppets from which grounding is batched (benches raise it to compare)
     crowd_from: int = 1  # alike plain puppets from which the crowd pass serves them (benches raise it to compare)
     crowd: CrowdPlan | None = None  # who the crowd pass serves (engine.ik.crowd), remade when that changes
@@ -103,14 +105,22 @@ class IKRigCache:
             self.canonical[id(skeleton)] = found
         return found
 
+    def kin(self, skeleton: Skeleton) -> Skeleton:
+        """The first skeleton seen with ``skeleton``'s joints and parents (bone lengths and tips may differ):
+        the crowd pass takes offsets and tips per puppet, so these share it."""
+        found = self.kindred.get(id(skeleton))
+        if found is None:
+            found = next((s for s in self.kindred.values() if _kin(s, skeleton)), skeleton)
+            self.kindred[id(skeleton)] = found
+        return found
+
+
+def _kin(a: Skeleton, b: Skeleton) -> bool:
+    return a.names == b.names and np.array_equal(a.parents, b.parents)
+
 
 def _same(a: Skeleton, b: Skeleton) -> bool:
-    return (
-        a.names == b.names
-        and np.array_equal(a.parents, b.parents)
-        and np.array_equal(a.offsets, b.offsets)
-        and np.array_equal(a.tips, b.tips)
-    )
+    return _kin(a, b) and np.array_equal(a.offsets, b.offsets) and np.array_equal(a.tips, b.tips)
 
 
 def _ground_batches(world: World, rows: list[tuple[Puppet, LocalPose, IKRequest]], cache: IKRigCache) -> set[int]:
@@ -174,12 +184,12 @@ def ik_system(world: World) -> None:
         cache = IKRigCache()
         world.insert_resource(cache)
     table = world.query(Puppet, LocalPose, IKRequest)
-    cache.crowd = plan = current_plan(cache.crowd, table, cache.same_as, cache.crowd_from)
+    cache.crowd = plan = current_plan(cache.crowd, table, cache.kin, cache.same_as, cache.crowd_from)
     query = ground.query if ground is not None else PlaneGround()
     kept = ground_crowd(plan, columns(world), query, world.dt)
     if kept is not None:
-        if kept.any() and len(plan.rows) + len(plan.outsiders) < cache.batch_from:  # as the one-puppet path does
-            for i in np.flatnonzero(kept).tolist():
+        if kept.any():  # as the one-puppet path does, for a member that would not be batched
+            for i in np.flatnonzero(kept & (plan.alike < cache.batch_from)).tolist():
                 plan.requests[i].reached = False
         if len(plan.rows) == len(table):
             return

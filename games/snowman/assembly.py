@@ -53,15 +53,21 @@ def find_snowmen(balls: list[Ball], on_ground: float = 0.1) -> list[list[Ball]]:
     centers = np.array([b.center for b in balls], dtype=np.float64)
     radii = np.array([b.radius for b in balls], dtype=np.float64)
     on = resting_matrix(centers, radii) & (radii[:, None] < radii[None, :])
-    order = sorted(range(len(balls)), key=lambda i: (float(centers[i, 1]), balls[i].entity))
+    # Who rests on each ball, from one pass over the matrix (the rules ask every step, for every ball).
+    resting_on: dict[int, list[int]] = {}
+    for upper, lower in zip(*np.nonzero(on), strict=True):
+        resting_on.setdefault(int(lower), []).append(int(upper))
+    heights = centers[:, 1].tolist()
+    grounded = (~(centers[:, 1] - radii > on_ground)).tolist()
+    order = sorted(range(len(balls)), key=lambda i: (heights[i], balls[i].entity))
     used: set[int] = set()
     stacks: list[list[Ball]] = []
     for base in order:
-        if base in used or centers[base, 1] - radii[base] > on_ground:
+        if base in used or not grounded[base]:
             continue
         stack = [base]
         while len(stack) < 3:
-            above = [int(i) for i in np.nonzero(on[:, stack[-1]])[0] if i not in used and i not in stack]
+            above = [i for i in resting_on.get(stack[-1], ()) if i not in used and i not in stack]
             if not above:
                 break
             stack.append(min(above, key=lambda i: balls[i].entity))

@@ -14,6 +14,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from engine.blend.locomotion import LocomotionPlayer
@@ -97,11 +99,16 @@ def stick_stacked_balls(world: World) -> None:
     centers = np.array([balls[k][1].position for k in keys])
     radii = np.array([balls[k][0].radius for k in keys])
     on = resting_matrix(centers, radii, gap=0.1, off_axis=0.6) & (radii[:, None] < radii[None, :])
-    for i, e in enumerate(keys):
+    rows, cols = np.nonzero(on)  # row-major: each ball's candidates in order, balls resting on none skipped
+    candidates: dict[int, list[int]] = {}
+    for i, j in zip(rows.tolist(), cols.tolist(), strict=True):
+        candidates.setdefault(i, []).append(j)
+    for i, below in candidates.items():
+        e = keys[i]
         prop, tr = balls[e]
         if e in held or world.has(e, Stacked) or prop.carried or prop.velocity[1] >= 0.5:
             continue
-        for j in np.nonzero(on[i])[0]:
+        for j in below:
             o = keys[j]
             if o in held:
                 continue
@@ -116,8 +123,10 @@ def grow_snowballs(world: World) -> None:
     field = world.resource(SnowField)
     for _, ball, prop, tr, grab in world.query(Snowball, Prop, Transform, Grabbable):
         here = tr.position.copy()
-        rolling = np.isfinite(ball.last).all() and here[1] - prop.radius < 0.03 and prop.radius < MAX_RADIUS
-        if rolling and float(np.hypot(*(here - ball.last)[[0, 2]])) > 1e-4:
+        (x, y, z), (last_x, last_y, last_z) = here.tolist(), ball.last.tolist()  # floats: numpy's scalars cost more
+        finite = math.isfinite(last_x) and math.isfinite(last_y) and math.isfinite(last_z)
+        rolling = finite and y - prop.radius < 0.03 and prop.radius < MAX_RADIUS
+        if rolling and float(np.hypot(x - last_x, z - last_z)) > 1e-4:
             ball.snow = min(field.roll(ball.last, here, max(ball.snow, prop.radius)), MAX_RADIUS)
             if ball.snow - prop.radius >= GROWTH_STEP or ball.snow >= MAX_RADIUS:
                 prop.radius = ball.snow
@@ -136,7 +145,7 @@ def snow_drag(world: World) -> None:
     for e, _, prop, tr in world.query(Snowball, Prop, Transform):
         if prop.carried or e in held or tr.position[1] - prop.radius > 0.03:
             continue
-        speed = float(np.linalg.norm(prop.velocity[:3]))
+        speed = _speed(prop)
         if speed < 1e-4:
             continue
         keep = max(0.0, 1.0 - step / speed)
@@ -195,15 +204,14 @@ def assemble_snowmen(world: World) -> None:
     watch = world.resource(StackWatch)
     stats = world.resource(SnowmanStats)
     held = _held(world)
-    balls = [
+    still = [
         Ball(e, tr.position.copy(), prop.radius)
         for e, _, prop, tr in world.query(Snowball, Prop, Transform)
-        if e not in held and (not prop.carried or world.has(e, Stacked))
+        if e not in held and (not prop.carried or world.has(e, Stacked)) and _speed(prop) < 0.2
     ]
-    still = {b.entity for b in balls if float(np.linalg.norm(world.get(b.entity, Prop).velocity[:3])) < 0.2}
     seen: dict[tuple[int, ...], int] = {}
     watch.headless = 0
-    for stack in find_snowmen([b for b in balls if b.entity in still]):
+    for stack in find_snowmen(still):
         if len(stack) == 2 and stack[1].radius > HEAD_RATIO * stack[0].radius:
             watch.headless += 1
             continue
@@ -222,6 +230,13 @@ def assemble_snowmen(world: World) -> None:
             del seen[key]
             print(f"snowman {stats.built} came alive ({len(stack)} balls: {', '.join(f'{r:.2f}' for r in radii)} m)")
     watch.frames = seen
+
+
+def _speed(prop: Prop) -> float:
+    """A prop's speed: ``np.linalg.norm`` of its linear velocity to the bit (the square root of the same dot
+    product) without the call's checks, which cost more than the arithmetic for one ball."""
+    v = prop.velocity[:3]
+    return math.sqrt(v.dot(v))
 
 
 def snowmen_standing(world: World) -> int:
