@@ -11,7 +11,7 @@ from engine.components import Puppet, Stick, Transform, WorldPose
 from engine.ecs import Entity, World
 from engine.ragdoll.components import Prop
 from engine.render.components import Appearance
-from engine.render.extract import scene_from_world
+from engine.render.extract import pose_arrays, scene_from_world
 from engine.render.scene import RenderScene
 from input.motionstick import StickState
 
@@ -171,12 +171,23 @@ def height_cues(world: World, alpha: float) -> list[tuple[np.ndarray, float, flo
         surface = _surface_below(bottom[0], bottom[2], bottom[1], props[:i] + props[i + 1 :])
         if bottom[1] - surface > _PROP_LIFT:
             cues.append((bottom, surface, radius))
-    for _, _puppet, wp in world.query(Puppet, WorldPose):
-        pos, _ = wp.interpolated(alpha)
-        low = float(pos[:, 1].min())
-        if low > _PUPPET_LIFT:
-            point = np.array([pos[0, 0], low, pos[0, 2]])
+    # A crowd's joints in one array per run of puppets with as many joints (its columns, when FK keeps them):
+    # a thousand interpolations one puppet at a time cost more than drawing the crowd.
+    poses = [wp for _, _puppet, wp in world.query(Puppet, WorldPose)]
+    start = 0
+    while start < len(poses):
+        joints = len(poses[start].positions)
+        end = start + 1
+        while end < len(poses) and len(poses[end].positions) == joints:
+            end += 1
+        now, _, before, _ = pose_arrays(world, poses[start:end], joints)
+        lows = (before[:, :, 1] + alpha * (now[:, :, 1] - before[:, :, 1])).min(axis=1)
+        for k in np.nonzero(lows > _PUPPET_LIFT)[0]:
+            root = before[k, 0] + alpha * (now[k, 0] - before[k, 0])
+            low = float(lows[k])
+            point = np.array([root[0], low, root[2]])
             cues.append((point, _surface_below(point[0], point[2], low, props), _PUPPET_FOOTPRINT))
+        start = end
     return cues
 
 

@@ -16,6 +16,7 @@ not ``visible`` are skipped.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -23,13 +24,14 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.arrays import I64 as _Idx
+from engine.columns import Columns
 from engine.components import Puppet, Transform, WorldPose
 from engine.ecs import World
 from engine.render.components import Appearance, Shape
 from engine.render.scene import RenderScene
 from engine.skeleton import Skeleton
 
-__all__ = ["scene_from_world", "puppet_capsules"]
+__all__ = ["scene_from_world", "puppet_capsules", "pose_arrays"]
 
 _DEFAULT_PUPPET = Appearance()
 _DEFAULT_PROP = Appearance(color=(0.95, 0.96, 0.98))
@@ -58,8 +60,15 @@ def puppet_capsules(
     Several puppets of one skeleton at once: ``positions [P,J,3]``, ``rotations [P,J,4]``
     give ``a``, ``b`` as ``[P,B,3]`` and ``radius`` as ``[P,B]`` (``joint`` stays ``[B]``).
     """
+    leaves = _bones(skeleton.parents.tobytes(), skeleton.tips.tobytes())[3]
+    return _capsules(skeleton, np.asarray(positions, dtype=np.float64), np.asarray(rotations)[..., leaves, :])
+
+
+def _capsules(
+    skeleton: Skeleton, pos: NDArray[np.float64], leaf_rotations: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """:func:`puppet_capsules` given only the leaf joints' rotations (the only ones a capsule reads)."""
     parent, child, bone_owner, leaves = _bones(skeleton.parents.tobytes(), skeleton.tips.tobytes())
-    pos = np.asarray(positions, dtype=np.float64)
     lead = pos.shape[:-2]
     a = [pos[..., parent, :]]
     b = [pos[..., child, :]]
@@ -67,7 +76,7 @@ def puppet_capsules(
     owner = [bone_owner]
     if len(leaves):
         start = pos[..., leaves, :]
-        tip = quat.rotate(np.asarray(rotations, dtype=np.float64)[..., leaves, :], skeleton.tips[leaves])
+        tip = quat.rotate(np.asarray(leaf_rotations, dtype=np.float64), skeleton.tips[leaves])
         length = np.linalg.norm(tip, axis=-1, keepdims=True)
         rad = skeleton.radii[leaves]
         # End the capsule's surface at the tip rather than its core segment.
@@ -79,25 +88,46 @@ def puppet_capsules(
     return (np.concatenate(a, axis=-2), np.concatenate(b, axis=-2), np.concatenate(r, axis=-1), np.concatenate(owner))
 
 
+_WORLD_FIELDS = ("positions", "rotations", "prev_positions", "prev_rotations")
+
+
+def pose_arrays(world: World, poses: Sequence[WorldPose], joints: int) -> tuple[NDArray[np.float64], ...]:
+    """``positions, rotations, prev_positions, prev_rotations`` of ``poses`` (all of ``joints`` joints) as
+    ``[P,J,...]`` arrays, in that order. Read only: never change them.
+
+    When the poses are exactly a crowd's batch as FK keeps it (:mod:`engine.columns`, the same poses in
+    the same order, no field replaced since), these are the columns themselves: no per-puppet Python.
+    Otherwise (a puppet hidden, a skeleton of its own, a pose assigned by other code) they are stacked
+    from the components, as before."""
+    cols = world.try_resource(Columns)
+    linked = [] if cols is None else [cols.get(WorldPose, name, joints).linked(poses) for name in _WORLD_FIELDS]
+    if linked and all(base is not None and len(base) == len(poses) for base in linked):
+        return tuple(base for base in linked if base is not None)
+    return tuple(np.stack([getattr(w, name) for w in poses]) for name in _WORLD_FIELDS)
+
+
 def _add_puppets(
-    scene: RenderScene, skeleton: Skeleton, poses: list[WorldPose], looks: list[Appearance], alpha: float
+    scene: RenderScene, world: World, skeleton: Skeleton, poses: list[WorldPose], looks: list[Appearance], alpha: float
 ) -> None:
     """Capsules of puppets sharing ``skeleton``, posed and interpolated together, in one call.
 
     A crowd of a thousand cost half a second a frame puppet by puppet (an interpolation
-    and a capsule fill each, in small numpy calls); stacked, it is a few dozen calls.
+    and a capsule fill each, in small numpy calls); stacked, it is a few dozen calls, and a
+    crowd's poses are read straight from its columns (:func:`pose_arrays`). Rotations are
+    interpolated only at the leaf joints, the only ones a capsule reads (its tip's direction).
     """
-    stack = {
-        name: np.stack([getattr(w, name) for w in poses])
-        for name in ("positions", "rotations", "prev_positions", "prev_rotations")
-    }
-    pos = stack["prev_positions"] + alpha * (stack["positions"] - stack["prev_positions"])
-    rot = quat.nlerp(stack["prev_rotations"], stack["rotations"], alpha)
-    a, b, r, owner = puppet_capsules(skeleton, pos, rot)
+    positions, rotations, prev_positions, prev_rotations = pose_arrays(world, poses, skeleton.num_joints)
+    leaves = _bones(skeleton.parents.tobytes(), skeleton.tips.tobytes())[3]
+    pos = prev_positions + alpha * (positions - prev_positions)
+    rot = quat.nlerp(prev_rotations[:, leaves], rotations[:, leaves], alpha)
+    a, b, r, owner = _capsules(skeleton, pos, rot)
     bones = len(owner)
-    color = np.empty((len(poses), bones, 3))
-    for i, look in enumerate(looks):
-        color[i] = look.color if look.joint_colors is None else np.asarray(look.joint_colors)[owner]
+    if all(look.joint_colors is None for look in looks):
+        color = np.broadcast_to(np.array([look.color for look in looks])[:, None, :], (len(poses), bones, 3))
+    else:
+        color = np.empty((len(poses), bones, 3))
+        for i, look in enumerate(looks):
+            color[i] = look.color if look.joint_colors is None else np.asarray(look.joint_colors)[owner]
     outline = np.repeat([float(look.outline) for look in looks], bones)
     scene.add_capsules(a.reshape(-1, 3), b.reshape(-1, 3), r.reshape(-1), color.reshape(-1, 3), outline)
 
@@ -129,7 +159,7 @@ def scene_from_world(world: World, alpha: float, scene: RenderScene | None = Non
         runs[-1][1].append(wpose)
         runs[-1][2].append(look)
     for skeleton, poses, looks in runs:
-        _add_puppets(scene, skeleton, poses, looks, alpha)
+        _add_puppets(scene, world, skeleton, poses, looks, alpha)
     for e, tf, shape in world.query(Transform, Shape):
         look = world.try_get(e, Appearance) or _DEFAULT_PROP
         if not look.visible:

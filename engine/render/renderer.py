@@ -91,8 +91,14 @@ def _nearest_first(rows: NDArray[np.float32], eye: NDArray[np.float64]) -> NDArr
     """
     if len(rows) < 2:
         return rows
-    centre = 0.5 * (rows[:, 0:3] + rows[:, 3:6]) if rows.shape[1] != BOX_STRIDE else rows[:, 0:3]  # cones too
-    return rows[np.argsort(np.sum((centre - eye) ** 2, axis=1), kind="stable")]
+    # By columns: numpy sums a [N, 3] array along its rows slowly (a crowd's 21,000 capsules: 1.3 ms
+    # against 0.3), and the same sums in the same order give the same distances to the bit.
+    c = np.ascontiguousarray(rows[:, 0:6].T)
+    if rows.shape[1] != BOX_STRIDE:  # cones too
+        x, y, z = (0.5 * (c[k] + c[k + 3]) - eye[k] for k in range(3))
+    else:
+        x, y, z = (c[k] - eye[k] for k in range(3))
+    return rows[np.argsort(x * x + y * y + z * z, kind="stable")]
 
 
 def _in_view(rows: NDArray[np.float32], vp: NDArray[np.float64]) -> NDArray[np.intp]:
@@ -104,14 +110,17 @@ def _in_view(rows: NDArray[np.float32], vp: NDArray[np.float64]) -> NDArray[np.i
     """
     if len(rows) == 0:
         return np.arange(0)
-    a, b = rows[:, 0:3].astype(np.float64), rows[:, 3:6].astype(np.float64)
-    centre = 0.5 * (a + b)
-    radius = 0.5 * np.linalg.norm(b - a, axis=1) + rows[:, 6]
+    c = np.ascontiguousarray(rows[:, 0:7].T, dtype=np.float64)  # by columns, as in _nearest_first
+    centre = [0.5 * (c[k] + c[k + 3]) for k in range(3)]
+    half = [c[k + 3] - c[k] for k in range(3)]
+    reach = -(0.5 * np.sqrt(half[0] * half[0] + half[1] * half[1] + half[2] * half[2]) + c[6])
     m = np.asarray(vp, dtype=np.float64)
     planes = np.array([m[3] + m[0], m[3] - m[0], m[3] + m[1], m[3] - m[1], m[3] + m[2], m[3] - m[2]])
     planes /= np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
-    distance = centre @ planes[:, :3].T + planes[:, 3]
-    return np.nonzero(np.all(distance >= -radius[:, None], axis=1))[0]
+    inside = np.ones(len(rows), dtype=bool)
+    for p in planes:
+        inside &= centre[0] * p[0] + centre[1] * p[1] + centre[2] * p[2] + p[3] >= reach
+    return np.nonzero(inside)[0]
 
 
 def _shadow_key(
@@ -361,8 +370,13 @@ class Renderer:
         counts = {k: self._inst[k].upload(rows[k]) for k in ("boxes", "cones", "lines", "points")}
         # Coarser meshes where fewer pixels are drawn, or where the level allows a larger outline error.
         px_per_metre = h / (2.0 * math.tan(math.radians(camera.fov_y) / 2.0)) / self.quality.silhouette_px
-        levels = {kind: choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind]) for kind in self._lod}
         impostors = self.quality.impostors
+        levels = {  # impostors need no mesh level: a crowd's 21,000 rows are not measured for nothing
+            kind: np.zeros(len(rows[kind]), np.intp)
+            if impostors
+            else choose_levels(rows[kind], eye, px_per_metre, LIMITS[kind])
+            for kind in self._lod
+        }
         # The camera pass draws only what the view can see; the shadow map takes every caster (an
         # off-screen one may shade the ground in view).
         seen = {kind: _in_view(rows[kind], vp) for kind in self._lod}

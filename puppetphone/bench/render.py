@@ -14,6 +14,11 @@ of 3 repeats of several frames each (:func:`cpu_frame_time`):
   without a GPU falls to), against Panda3D drawing 100 walking skinned actors off-screen
   on the same llvmpipe (:mod:`puppetphone.bench.render_panda`, the ``[peers]`` extra), and the 30 fps
   goal; without Panda3D a line says the peer was skipped.
+- ``render_fps_1000_puppets_play``: a frame of ``play sandbox --puppets 1000`` as the window
+  draws it at ``low`` (:func:`played_crowd_frame`): the world's extract (capsules from the crowd's
+  columns, the height cues) and the drawing, after the crowd has spread into the sandbox
+  camera's view (about 60 puppets in it, the other 940 culled). Against 10 fps, the rate down to
+  which a window keeps game time; the steps are not in it (``crowd_step_ms_1000``).
 - ``render_fps_snowman_auto``: the snowman frame with the quality governor in the loop, as a
   player's ``auto`` has it (:class:`GovernedFrame`): it starts at ``medium`` and decides from each
   frame's CPU time; after its first 40 frames the frames are timed with it still deciding, in
@@ -73,6 +78,7 @@ __all__ = [
     "unloaded_frame_time",
     "cpu_frame_time",
     "quality_figures",
+    "played_crowd_frame",
     "GovernedFrame",
     "alternated",
 ]
@@ -81,6 +87,9 @@ WIDTH, HEIGHT = 1280, 720
 _ROW = 10  # puppets per row of the scene (seven stand in one row, a crowd of fifty in five)
 CROWD = 50
 BIG_CROWD = 100
+PLAY_CROWD = 1000
+SPREAD_STEPS = 600
+"""Steps the played crowd runs before it is timed: the wanderers leave their grid behind the camera and fill its view."""
 COLORS = (
     (0.85, 0.3, 0.25),
     (0.25, 0.5, 0.85),
@@ -143,6 +152,28 @@ def _thread_cpu() -> dict[str, float]:
             continue
         out[tid] = (int(fields[11]) + int(fields[12])) / tick  # utime + stime
     return out
+
+
+def played_crowd_frame(
+    draw: Callable[[RenderScene, Camera], None], puppets: int = PLAY_CROWD, spread: int = SPREAD_STEPS
+) -> Callable[[], None]:
+    """A frame of the sandbox with ``puppets`` puppets as ``play`` draws it, after ``spread`` steps: the
+    game's ``draw_world`` into a reused scene, then ``draw`` seen by the sandbox camera."""
+    from engine.render.scene import RenderScene
+    from games.common import draw_world
+    from games.sandbox import camera
+    from puppetphone.bench.crowd import crowd_app
+
+    app = crowd_app(puppets)
+    app.run_steps(spread)
+    scene, view = RenderScene(), camera()
+
+    def frame() -> None:
+        scene.clear()
+        draw_world(app.world, scene, 0.5)
+        draw(scene, view)
+
+    return frame
 
 
 def unloaded_frame_time(frame: Callable[[], object], frames: int = 40) -> float | None:
@@ -364,11 +395,22 @@ def quality_figures() -> list[Figure]:
         )
         renderer.set_quality(QUALITIES["low"])
         t_crowd = cpu_frame_time(lambda: draw(crowd, crowd_camera), frames=3)
+        t_play = cpu_frame_time(played_crowd_frame(draw), frames=3)
     finally:
         fill_vao.release()
         flat.release()
         renderer.release()
         target.close()
+    figures.append(
+        Figure(
+            "render",
+            f"render_fps_{PLAY_CROWD}_puppets_play",
+            1.0 / t_play,
+            "fps",
+            "10 fps: a window keeps game time down to it",
+            10.0,
+        )
+    )
     peer = panda3d_peer()
     if isinstance(peer, str):
         print(peer, file=sys.stderr)

@@ -102,3 +102,20 @@ def test_the_cue_shows_dark_on_the_snow_under_a_lifted_ball():
         darkest = patch[patch.sum(axis=1).argmin()]
         assert darkest.sum() < before[y, x].sum() - 300, (point, darkest, before[y, x])
         assert darkest[2] >= darkest[0]
+
+
+def test_in_a_crowd_only_the_lifted_puppets_get_a_cue_where_they_are_drawn():
+    """Cues read a crowd's joints as one array per run of puppets with as many joints; each lifted puppet's cue
+    stands under its own root, interpolated like its drawing (a row mix-up or a missed interpolation fails)."""
+    world = World()
+    sk = humanoid_skeleton()
+    for k in range(8):
+        lift = 0.6 if k in (2, 5) else 0.0
+        pos, rot = forward_kinematics(sk, sk.offsets[0] + np.array([k, lift, 0.0]), quat.identity(sk.num_joints))
+        prev = pos - np.array([0.0, 0.0, 0.4])
+        world.spawn(Puppet(sk), WorldPose(pos, rot, prev, rot.copy()))
+    world.flush()
+    cues = height_cues(world, 0.25)
+    assert [round(float(c[0][0])) for c in cues] == [2, 5]
+    for point, surface, _ in cues:
+        assert point[2] == pytest.approx(-0.3) and surface == 0.0 and point[1] > 0.5

@@ -111,3 +111,57 @@ def test_shape_and_appearance_validation():
     with pytest.raises(ValueError):
         s.radius = float("inf")
     assert s.radius == 0.2
+
+
+def _posed_crowd(n):
+    """``n`` puppets posed twice by the FK system, so their world poses live in its columns."""
+    from engine.components import LocalPose
+    from engine.posing import fk_system
+
+    world = World()
+    rng = np.random.default_rng(3)
+    locals_ = []
+    for k in range(n):
+        sk = humanoid_skeleton()  # each its own copy, as a crowd's puppets hold
+        rot = quat.normalize(quat.identity(sk.num_joints) + 0.2 * rng.normal(size=(sk.num_joints, 4)))
+        look = {"color": (0.1 * k, 0.5, 0.2)} if k % 2 else {}
+        lp = LocalPose(np.array([1.5 * k, 0.95, 0.0]), rot)
+        world.spawn(Puppet(sk), lp, *([Appearance(**look)] if look else []))
+        locals_.append(lp)
+    world.flush()
+    fk_system(world)
+    for lp in locals_:
+        lp.root = lp.root + np.array([0.0, 0.0, 0.3])
+    fk_system(world)
+    return world
+
+
+def _one_by_one(world, alpha):
+    """The capsules of every puppet drawn on its own, from its own interpolated pose (the old per-puppet way)."""
+    parts = [puppet_capsules(p.skeleton, *wp.interpolated(alpha)) for _, p, wp in world.query(Puppet, WorldPose)]
+    return np.concatenate([a for a, _, _, _ in parts]), np.concatenate([b for _, b, _, _ in parts])
+
+
+def test_a_crowd_is_drawn_from_its_columns_as_each_puppet_alone_would_be():
+    """The crowd's poses are the FK columns themselves (no gather), and the capsules match drawing each puppet
+    on its own. A pose some code replaced is not in the column: it must be read from the component (breaking
+    :func:`pose_arrays` to hand out the column without the ``linked`` check draws puppet 2 where it was)."""
+    from engine.columns import Columns
+    from engine.render.extract import pose_arrays
+
+    world = _posed_crowd(6)
+    poses = [wp for _, _, wp in world.query(Puppet, WorldPose)]
+    arrays = pose_arrays(world, poses, 17)
+    assert arrays[0] is world.resource(Columns).get(WorldPose, "positions", 17).base
+    assert all(np.shares_memory(a, getattr(poses[1], name)) for a, name in zip(arrays, ("positions", "rotations")))
+    a, b = _one_by_one(world, 0.3)
+    d = scene_from_world(world, 0.3).capsules.data
+    assert np.allclose(d[:, 0:3], a, atol=1e-6) and np.allclose(d[:, 3:6], b, atol=1e-6)
+    assert np.allclose(d[:21, 7:10], Appearance().color) and np.allclose(d[21:42, 7:10], (0.1, 0.5, 0.2))
+    before = d.copy()
+    poses[2].positions = poses[2].positions + np.array([0.0, 2.0, 0.0])  # other code replaced the field
+    a, b = _one_by_one(world, 0.3)
+    d = scene_from_world(world, 0.3).capsules.data
+    assert np.allclose(d[:, 0:3], a, atol=1e-6) and np.allclose(d[:, 3:6], b, atol=1e-6)
+    assert np.allclose(d[42:63, 1] - before[42:63, 1], 0.6, atol=1e-5)  # puppet 2 drawn raised, 0.3 of the way
+    assert np.array_equal(np.delete(d, np.s_[42:63], axis=0), np.delete(before, np.s_[42:63], axis=0))

@@ -80,6 +80,20 @@ def test_bounds_cover_every_caster():
     assert lo[0] <= -2.5 and hi[0] >= 3.5 - 1e-6 and hi[1] >= 2.1 - 1e-6 and lo[1] <= -0.1 + 1e-6
 
 
+def test_bounds_of_a_crowd_are_its_rows_reach_to_the_bit():
+    """Reduced by columns per kind, the bounds are exactly the row-by-row reach (a swapped end, a radius
+    added on the wrong side or a kind left out fails)."""
+    rng = np.random.default_rng(5)
+    s = RenderScene()
+    s.add_capsules(rng.normal(size=(3000, 3)) * 20, rng.normal(size=(3000, 3)) * 20, rng.uniform(0.01, 0.3, 3000))
+    s.add_spheres(rng.normal(size=(40, 3)) * 30, rng.uniform(0.1, 2.0, 40))
+    s.add_cones(rng.normal(size=(9, 3)) * 40, rng.normal(size=(9, 3)) * 40, rng.uniform(0.5, 3.0, 9))
+    rows = np.vstack([s.capsules.data, s.spheres.data, s.cones.data])
+    lo, hi = s.bounds()
+    assert np.array_equal(lo, (np.minimum(rows[:, 0:3], rows[:, 3:6]) - rows[:, 6:7]).min(axis=0))
+    assert np.array_equal(hi, (np.maximum(rows[:, 0:3], rows[:, 3:6]) + rows[:, 6:7]).max(axis=0))
+
+
 def test_background_validation_and_fade():
     s = RenderScene()
     img = np.zeros((4, 6, 3), dtype=np.uint8)

@@ -117,3 +117,16 @@ def test_alternated_figures_take_turns_and_keep_their_own_times() -> None:
     assert 0.002 <= times["a"] < 0.005 <= 0.006 <= times["b"] < 0.012
     runs = [order[0]] + [x for i, x in enumerate(order[1:], 1) if x != order[i - 1]]
     assert runs == ["a", "b", "a", "b"]  # a b | b a | a b
+
+
+def test_the_played_crowd_frame_draws_the_whole_crowd_each_frame_from_the_sandbox_camera() -> None:
+    """``render_fps_1000_puppets_play`` times the game's own extract and drawing: every puppet's capsules,
+    each frame anew in one reused scene (without the scene's clear the second frame holds two crowds)."""
+    from games.sandbox import camera
+    from puppetphone.bench.render import played_crowd_frame
+
+    drawn: list[tuple[int, float]] = []
+    frame = played_crowd_frame(lambda scene, cam: drawn.append((len(scene.capsules), cam.distance)), 4, 3)
+    frame()
+    frame()
+    assert drawn == [(4 * 21, camera().distance)] * 2
