@@ -29,11 +29,11 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike
 
-from engine import quat
+from engine import jit, quat
 from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.pose import Pose
-from engine.ragdoll._bounds import command_boxes, geom_boxes
+from engine.ragdoll._bounds import KindTable, command_boxes, geom_boxes, posed_boxes
 from engine.ragdoll._building import Building
 from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._control import apply_commands, place, project_twist
@@ -93,6 +93,7 @@ class PhysicsWorld(Readback, Building):
         self._new_data = False
         self._pool = RagdollPool()
         self._reach: dict[bytes, float] = {}
+        self._kinds = KindTable()  # the kinds' capsules for the compiled command boxes
         self.left_out = 0  # ragdolls that should have joined at the last change but the full pool had no room
         self._pool_layout: Layout | None = None
         self._digest = b""
@@ -483,6 +484,12 @@ class PhysicsWorld(Readback, Building):
             out[live] = geom_boxes(m, d, L.geom[order], own[order], len(live))
         rest = np.ones(len(rows), dtype=bool)
         rest[live] = False
+        if jit.enabled():  # every kind in one compiled pass
+            r = rows[rest]
+            slots = [self._ragdolls[k] for k in C.keys[r].tolist()]
+            ix = np.array([self._kinds.of(s.kind, s.spec) for s in slots], dtype=np.int64)
+            out[rest] = posed_boxes(self._kinds, ix, C.root[r], C.rot, C.starts[r])
+            return out
         kinds: dict[bytes, list[int]] = {}
         for i in np.nonzero(rest)[0].tolist():
             kinds.setdefault(self._ragdolls[int(C.keys[rows[i]])].kind, []).append(i)
