@@ -28,7 +28,7 @@ from engine.ragdoll._islands import capsule_boxes
 from engine.ragdoll.mjcf import RagdollSpec
 from engine.ragdoll.profile import bone_segments
 
-__all__ = ["KindTable", "command_boxes", "geom_boxes", "posed_boxes"]
+__all__ = ["KindTable", "command_boxes", "geom_boxes", "load", "posed_boxes"]
 
 
 _SEGMENTS: dict[bytes, tuple[_F, _F, _F]] = {}
@@ -150,3 +150,9 @@ def posed_boxes(table: KindTable, kinds: NDArray[np.int64], roots: _F, rot: _F, 
             kinds, table.start, table.parents, table.offsets, table.p0, table.p1, table.radius, roots, rot, first, out
         )
     return out
+
+
+def load() -> None:
+    """Load :func:`posed_boxes`' kernel now (see :func:`engine.ragdoll._drive_kernel.load`)."""
+    i, f2 = np.zeros(0, np.int64), np.zeros((0, 3))
+    _posed_boxes(i, np.zeros(2, np.int64), i, f2, f2, f2, np.zeros(0), f2, f2, i, np.zeros((0, 2, 3)))

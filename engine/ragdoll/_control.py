@@ -19,7 +19,7 @@ from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._contact_bits import set_contact_bits
-from engine.ragdoll._drive_kernel import drive_kernel, twist_kernel
+from engine.ragdoll._drive_kernel import drive_kernel, read_kernel, twist_kernel
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
 
@@ -238,6 +238,10 @@ def project_twist(L: Layout, d: mujoco.MjData) -> None:
 
 def read_poses(L: Layout, d: mujoco.MjData) -> tuple[_F, _F]:
     """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll."""
+    if jit.enabled():
+        roots, rot = np.empty((L.num_ragdolls, 3)), np.empty((int(L.starts[-1]), 4))
+        read_kernel(L.starts, L.root_q, L.ball_src, L.ball_q, L.hinge_src, L.hinge_q, L.hinge_axis, d.qpos, roots, rot)
+        return roots, rot
     roots = d.qpos[L.root_q[:, None] + np.arange(3)]
     rot = quat.identity(int(L.starts[-1]))
     rot[L.starts[:-1]] = d.qpos[L.root_q[:, None] + np.arange(3, 7)]

@@ -3,7 +3,8 @@
 A fall puts some twenty ragdolls in the model (ten fallers and their walking neighbours): 260 ball
 joints, 90 hinges, 400 actuators. Turning their commands into MuJoCo inputs was some sixty numpy
 passes over those few hundred rows (each a microsecond of dispatch for nanoseconds of arithmetic),
-2-3 ms of the fall's worst step; the twist projection after the step another twenty. Here each is
+2-3 ms of the fall's worst step; the twist projection after the step another twenty, reading the poses
+back ten more. Here each is
 one loop over the rows, written with the numpy path's operations in its order (the quaternion
 helpers of :mod:`engine.jit`, sums left to right as numpy sums three or four terms, ``sin``,
 ``cos``, ``atan2`` and ``sqrt`` from the same C library): the same numbers bit for bit, which
@@ -20,7 +21,7 @@ from numpy.typing import NDArray
 from engine import jit
 from engine.jit import qaxis_angle, qconj, qmul, qnormalize, qrot
 
-__all__ = ["drive_kernel", "twist_kernel"]
+__all__ = ["drive_kernel", "load", "read_kernel", "twist_kernel"]
 
 _Q = tuple[float, float, float, float]
 _V = tuple[float, float, float]
@@ -220,3 +221,49 @@ def twist_kernel(ball_q: _I, ball_d: _I, ball_axis: _F, ball_twist: _F, qpos: _F
         if np.sign(rate) == np.sign(ang):
             for c in range(3):
                 qvel[di + c] = qvel[di + c] - rate * axis[c]
+
+
+@jit.njit
+def read_kernel(
+    starts: _I,
+    root_q: _I,
+    ball_src: _I,
+    ball_q: _I,
+    hinge_src: _I,
+    hinge_q: _I,
+    hinge_axis: _F,
+    qpos: _F,
+    roots: _F,
+    rot: _F,
+) -> None:
+    """:func:`engine.ragdoll._control.read_poses` into ``roots [P,3]`` and ``rot [ΣJ,4]``: the roots, the
+    ball joints' rotations, the hinges' about their axes, the identity elsewhere, all normalised."""
+    for f in range(rot.shape[0]):
+        rot[f, 0], rot[f, 1], rot[f, 2], rot[f, 3] = 1.0, 0.0, 0.0, 0.0
+    for p in range(root_q.shape[0]):
+        q = root_q[p]
+        for c in range(3):
+            roots[p, c] = qpos[q + c]
+        for c in range(4):
+            rot[starts[p], c] = qpos[q + 3 + c]
+    for k in range(ball_src.shape[0]):
+        for c in range(4):
+            rot[ball_src[k], c] = qpos[ball_q[k] + c]
+    for k in range(hinge_src.shape[0]):
+        h = hinge_src[k]
+        rot[h, 0], rot[h, 1], rot[h, 2], rot[h, 3] = qaxis_angle(_row3(hinge_axis, k), qpos[hinge_q[k]])
+    for f in range(rot.shape[0]):
+        rot[f, 0], rot[f, 1], rot[f, 2], rot[f, 3] = qnormalize(_row4(rot, f))
+
+
+def load() -> None:
+    """Load the kernels now (from numba's disk cache, or compile them): called on zero rows, with arrays of
+    the real ones' types, they do nothing but load. The physics world calls this when it compiles its
+    model, so the first step that needs them (a crowd's first fall) does not pay the 20-50 ms."""
+    i, f, f2, b = np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 3)), np.zeros(0, np.bool_)
+    drive_kernel(
+        0.1, i, i, f2, f2, f2, f2, b, f, f, f, b, i, i, i, i, i, i, i, i, f, i, i, i, i, i, f2, f,
+        i, i, f, f, i, i, i, i, f, f, f2, f2, f2, b, f, f2, f2, f2, f, f,
+    )  # fmt: skip
+    twist_kernel(i, i, f2, f, f, f)
+    read_kernel(i, i, i, i, i, i, f2, f, f2, f2)

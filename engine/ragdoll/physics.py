@@ -34,10 +34,12 @@ from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.pose import Pose
 from engine.ragdoll._bounds import KindTable, command_boxes, geom_boxes, posed_boxes
+from engine.ragdoll._bounds import load as load_box_kernel
 from engine.ragdoll._building import Building
 from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._control import apply_commands, place, project_twist
 from engine.ragdoll._detail import Detail
+from engine.ragdoll._drive_kernel import load as load_drive_kernels
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
@@ -94,6 +96,7 @@ class PhysicsWorld(Readback, Building):
         self._pool = RagdollPool()
         self._reach: dict[bytes, float] = {}
         self._kinds = KindTable()  # the kinds' capsules for the compiled command boxes
+        self._loaded = False  # whether the compiled control kernels were loaded (ensure_built)
         self.left_out = 0  # ragdolls that should have joined at the last change but the full pool had no room
         self._pool_layout: Layout | None = None
         self._digest = b""
@@ -202,6 +205,10 @@ class PhysicsWorld(Readback, Building):
             self._size_pool()
         if self._dirty:
             self._compile()
+            if jit.enabled() and not self._loaded:  # the control kernels, at a step that compiles anyway
+                load_drive_kernels()
+                load_box_kernel()
+                self._loaded = True
         if self._moved:
             self._assign()
 

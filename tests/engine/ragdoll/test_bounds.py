@@ -3,6 +3,8 @@ one pass) are :func:`engine.ragdoll._bounds.command_boxes`' boxes, kind by kind,
 
 from __future__ import annotations
 
+from typing import Any, cast
+
 import numpy as np
 import pytest
 
@@ -41,3 +43,17 @@ def test_posed_boxes_are_the_command_boxes_of_each_kind(skeleton: Skeleton) -> N
             assert np.array_equal(got[mine], want), w
     assert table.of(kinds[1], specs[1]) == ix[which == 1][0]  # a kind seen before keeps its rows
     assert np.all(got[:, 1] - got[:, 0] > 0.1)  # boxes around whole bodies
+
+
+def test_load_compiles_the_signature_the_boxes_use(skeleton: Skeleton) -> None:
+    """:func:`~engine.ragdoll._bounds.load` gives the box kernel the argument types of a real call (one
+    signature after both). Broken by an ``int32`` kind array in ``load``: a second signature."""
+    from engine.ragdoll import _bounds as B
+
+    B.load()
+    profile = default_profile(skeleton)
+    spec = RagdollSpec(1, skeleton, profile, skeleton.offsets)
+    table = KindTable()
+    ix = np.array([table.of(kind_of(spec), spec)], dtype=np.int64)
+    posed_boxes(table, ix, np.zeros((1, 3)), quat.identity(skeleton.num_joints), np.zeros(1, dtype=np.int64))
+    assert len(cast(Any, B._posed_boxes).signatures) == 1  # numba's dispatcher

@@ -4,13 +4,14 @@ the numpy path of :mod:`engine.ragdoll._control` gives: the same MuJoCo inputs, 
 from __future__ import annotations
 
 import copy
+from typing import Any, cast
 
 import numpy as np
 import pytest
 
 from engine import jit, quat
 from engine.ragdoll import default_profile
-from engine.ragdoll._control import project_twist
+from engine.ragdoll._control import project_twist, read_poses
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
 
@@ -83,3 +84,42 @@ def test_twist_kernel_clamps_as_the_numpy_path(skeleton: Skeleton) -> None:
     assert 0 < changed.sum() < len(L.ball_q)  # some clamped, some within their range
     assert np.any(v0 != d.qvel)  # outward twist velocities removed
     assert np.any(v0[L.ball_d][changed] == d.qvel[L.ball_d][changed])  # inward ones kept
+
+
+def test_read_kernel_reads_the_poses_the_numpy_path_reads(skeleton: Skeleton) -> None:
+    """Joints in random, unnormalised rotations (hinges at random angles): both paths read the same roots
+    and rotations, bit for bit.
+
+    Broken in the kernel by leaving the rotations unnormalised, or by reading each hinge's angle from
+    the next hinge's ``qpos``: the arrays then differ."""
+    pw = _world(skeleton)
+    pw.step()
+    L, d = pw.layout, pw.data
+    assert L is not None and d is not None
+    rng = np.random.default_rng(4)
+    d.qpos[:] = rng.normal(0, 1, len(d.qpos))
+    with jit.use(False):
+        want = read_poses(L, d)
+    with jit.use(True):
+        got = read_poses(L, d)
+    assert np.array_equal(want[0], got[0]) and np.array_equal(want[1], got[1])
+    assert len(L.hinge_q) and not np.allclose(got[1][L.hinge_src], quat.identity(len(L.hinge_q)))
+
+
+def test_load_compiles_the_signatures_the_steps_use(skeleton: Skeleton) -> None:
+    """:func:`~engine.ragdoll._drive_kernel.load` (run when the world compiles its model) gives each kernel
+    the argument types of the real calls, so a step loads nothing more: one signature each after stepping.
+
+    Broken by a float array where the kernel gets MuJoCo's boolean ``eq_active`` (``f`` for the ``b`` in
+    ``load``): the first step then compiles a second signature of ``drive_kernel``."""
+    from engine.ragdoll import _drive_kernel as K
+
+    with jit.use(True):
+        pw = _world(skeleton)
+        pw.step()  # compiles the model: loads the kernels
+        pw.step()
+        L, d = pw.layout, pw.data
+        assert L is not None and d is not None
+        read_poses(L, d)
+    for kernel in (K.drive_kernel, K.twist_kernel, K.read_kernel):
+        assert len(cast(Any, kernel).signatures) == 1, kernel  # numba's dispatcher
