@@ -14,11 +14,12 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from engine import quat
+from engine import jit, quat
 from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._contact_bits import set_contact_bits
+from engine.ragdoll._drive_kernel import drive_kernel, read_kernel, twist_kernel
 from engine.ragdoll._layout import Layout
 from engine.ragdoll.mjcf import ANIMATED_BITS, GHOST_BITS, SIMULATED_BITS
 
@@ -28,6 +29,7 @@ GRAVITY = 9.81
 _PIN_STIFFNESS = 2500.0  # weld reference stiffness (1/s²) at pin weight 1
 _PIN_DAMPING = 100.0  # and damping (1/s): critically damped
 _MAX_LEAD = 0.5  # s: cap on the velocity lead at tiny weights
+_CONSTS = np.array([_PIN_STIFFNESS, _PIN_DAMPING, _MAX_LEAD, GRAVITY])  # drive_kernel's constants
 _HOLD_REACH = 0.5  # m: farthest the hold spring's anchor is from the held body (a stick flicked into the sky)
 
 
@@ -52,12 +54,53 @@ def apply_commands(
     if not len(rows):
         return
     j = joint_rows(C.starts, rows)
+    if jit.enabled():
+        drive_kernel(
+            dt, rows, j, C.root, C.rot, C.last_root, C.last_rot, C.has_last, C.muscle, C.pin, C.support,
+            C.kinematic, L.starts, L.root_q, L.root_d, L.ball_src, L.ball_owner, L.ball_q, L.ball_d, L.ball_c,
+            L.ball_lead, L.hinge_src, L.hinge_owner, L.hinge_q, L.hinge_d, L.hinge_c, L.hinge_axis, L.hinge_lead,
+            L.act, L.act_owner, L.act_kp, L.act_kv, L.body, L.body_owner, L.pin_eq, L.pin_mocap, _CONSTS,
+            m.body_mass, m.actuator_gainprm, m.actuator_biasprm, m.eq_solref, d.eq_active, d.ctrl,
+            d.mocap_pos, d.mocap_quat, d.xfrc_applied, d.qpos, d.qvel,
+        )  # fmt: skip
+    else:
+        _drive(L, m, d, C, rows, j, dt)
+    kin = C.kinematic[rows]
+    ghost = np.zeros(len(rows), dtype=bool) if ghost is None else ghost
+    # An animated (kinematic) ragdoll touches only simulated bodies and props: not the
+    # ground (neither can give way), not other animated bodies and not itself -- a
+    # crouching pose lays the arms into the legs, and the contact impulses inside the
+    # substeps would spin the arms and fling the ball in their hands. A ghost (deep in another
+    # ragdoll) touches only the ground and props until it is out (mjcf.GHOST_BITS).
+    kind = np.where(kin, 1, np.where(ghost, 2, 0))[L.geom_owner]
+    bits = np.array([SIMULATED_BITS, ANIMATED_BITS, GHOST_BITS])[kind]
+    set_contact_bits(m, L.geom, bits[:, 0], bits[:, 1])
+    # holds: every hold constraint off and every anchor on its target, then Python only for the held few
+    d.eq_active[L.hold_eqs] = 0
+    d.mocap_pos[L.hold_mocap] = C.hold_target[rows]
+    for p, i in enumerate(rows.tolist()):
+        hold = C.hold[i]
+        if hold is None:
+            continue
+        d.eq_active[L.hold_eq[p][hold]] = 1
+        target = C.hold_target[i]  # the spring pulls from at most _HOLD_REACH away: a bounded force
+        held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][hold]]]
+        gap = target - held
+        dist = float(np.linalg.norm(gap))
+        if dist > _HOLD_REACH:
+            target = held + gap * (_HOLD_REACH / dist)
+        d.mocap_pos[L.hold_mocap[p]] = target
+    C.roll(rows, keep_prev=False)
+
+
+def _drive(L: Layout, m: mujoco.MjModel, d: mujoco.MjData, C: Commands, rows: I64, j: I64, dt: float) -> None:
+    """The numpy path of :func:`engine.ragdoll._drive_kernel.drive_kernel` (its reference): servo targets
+    with their velocity lead, gains, pins, gravity support and the kinematic ragdolls' placements."""
     has = C.has_last[rows]
     root, rot = C.root[rows], C.rot[j]
     last_root = np.where(has[:, None], C.last_root[rows], root)
     last_rot = np.where(np.repeat(has, C.joints[rows])[:, None], C.last_rot[j], rot)
     muscle, pin, kin = C.muscle[rows], C.pin[rows], C.kinematic[rows]
-    ghost = np.zeros(len(rows), dtype=bool) if ghost is None else ghost
     r0 = L.starts[:-1]
     # target velocities from the previous target (zero after a placement)
     v_root = (root - last_root) / dt
@@ -87,30 +130,6 @@ def apply_commands(
     d.mocap_quat[L.pin_mocap] = quat.mul(quat.exp(w_root * pin_lead[:, None]), rot[r0])
     d.xfrc_applied[L.body] = 0.0
     d.xfrc_applied[L.body, 1] = m.body_mass[L.body] * GRAVITY * C.support[rows][L.body_owner]
-    # An animated (kinematic) ragdoll touches only simulated bodies and props: not the
-    # ground (neither can give way), not other animated bodies and not itself -- a
-    # crouching pose lays the arms into the legs, and the contact impulses inside the
-    # substeps would spin the arms and fling the ball in their hands. A ghost (deep in another
-    # ragdoll) touches only the ground and props until it is out (mjcf.GHOST_BITS).
-    kind = np.where(kin, 1, np.where(ghost, 2, 0))[L.geom_owner]
-    bits = np.array([SIMULATED_BITS, ANIMATED_BITS, GHOST_BITS])[kind]
-    set_contact_bits(m, L.geom, bits[:, 0], bits[:, 1])
-    # holds: every hold constraint off and every anchor on its target, then Python only for the held few
-    d.eq_active[L.hold_eqs] = 0
-    d.mocap_pos[L.hold_mocap] = C.hold_target[rows]
-    for p, i in enumerate(rows.tolist()):
-        hold = C.hold[i]
-        if hold is None:
-            continue
-        d.eq_active[L.hold_eq[p][hold]] = 1
-        target = C.hold_target[i]  # the spring pulls from at most _HOLD_REACH away: a bounded force
-        held = d.xpos[L.body[L.starts[p] + L.hold_joint[p][hold]]]
-        gap = target - held
-        dist = float(np.linalg.norm(gap))
-        if dist > _HOLD_REACH:
-            target = held + gap * (_HOLD_REACH / dist)
-        d.mocap_pos[L.hold_mocap[p]] = target
-    C.roll(rows, keep_prev=False)
     if kin.any():
         k = np.nonzero(kin)[0]
         d.qpos[L.root_q[k, None] + np.arange(3)] = root[k]
@@ -199,6 +218,9 @@ def project_twist(L: Layout, d: mujoco.MjData) -> None:
     """
     if len(L.ball_q) == 0:
         return
+    if jit.enabled():
+        twist_kernel(L.ball_q, L.ball_d, L.ball_axis, L.ball_twist, d.qpos, d.qvel)
+        return
     qi = L.ball_q[:, None] + np.arange(4)
     di = L.ball_d[:, None] + np.arange(3)
     swing, twist = quat.swing_twist(quat.align_hemisphere(d.qpos[qi]), L.ball_axis)
@@ -216,6 +238,10 @@ def project_twist(L: Layout, d: mujoco.MjData) -> None:
 
 def read_poses(L: Layout, d: mujoco.MjData) -> tuple[_F, _F]:
     """Roots ``[P,3]`` and flat local rotations ``[ΣJ,4]`` of every ragdoll."""
+    if jit.enabled():
+        roots, rot = np.empty((L.num_ragdolls, 3)), np.empty((int(L.starts[-1]), 4))
+        read_kernel(L.starts, L.root_q, L.ball_src, L.ball_q, L.hinge_src, L.hinge_q, L.hinge_axis, d.qpos, roots, rot)
+        return roots, rot
     roots = d.qpos[L.root_q[:, None] + np.arange(3)]
     rot = quat.identity(int(L.starts[-1]))
     rot[L.starts[:-1]] = d.qpos[L.root_q[:, None] + np.arange(3, 7)]

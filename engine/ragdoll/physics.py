@@ -29,15 +29,17 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike
 
-from engine import quat
+from engine import jit, quat
 from engine.arrays import F64 as _F
 from engine.arrays import I64
 from engine.pose import Pose
-from engine.ragdoll._bounds import command_boxes, geom_boxes
+from engine.ragdoll._bounds import KindTable, command_boxes, geom_boxes, posed_boxes
+from engine.ragdoll._bounds import load as load_box_kernel
 from engine.ragdoll._building import Building
 from engine.ragdoll._commands import Commands, joint_rows
 from engine.ragdoll._control import apply_commands, place, project_twist
 from engine.ragdoll._detail import Detail
+from engine.ragdoll._drive_kernel import load as load_drive_kernels
 from engine.ragdoll._guard import PhysicsRecovery, collect_warnings, guarded_step
 from engine.ragdoll._islands import LOOKAHEAD, ghosts, near_boxes, near_simulated, reach
 from engine.ragdoll._layout import Layout
@@ -93,6 +95,8 @@ class PhysicsWorld(Readback, Building):
         self._new_data = False
         self._pool = RagdollPool()
         self._reach: dict[bytes, float] = {}
+        self._kinds = KindTable()  # the kinds' capsules for the compiled command boxes
+        self._loaded = False  # whether the compiled control kernels were loaded (ensure_built)
         self.left_out = 0  # ragdolls that should have joined at the last change but the full pool had no room
         self._pool_layout: Layout | None = None
         self._digest = b""
@@ -201,6 +205,10 @@ class PhysicsWorld(Readback, Building):
             self._size_pool()
         if self._dirty:
             self._compile()
+            if jit.enabled() and not self._loaded:  # the control kernels, at a step that compiles anyway
+                load_drive_kernels()
+                load_box_kernel()
+                self._loaded = True
         if self._moved:
             self._assign()
 
@@ -483,6 +491,12 @@ class PhysicsWorld(Readback, Building):
             out[live] = geom_boxes(m, d, L.geom[order], own[order], len(live))
         rest = np.ones(len(rows), dtype=bool)
         rest[live] = False
+        if jit.enabled():  # every kind in one compiled pass
+            r = rows[rest]
+            slots = [self._ragdolls[k] for k in C.keys[r].tolist()]
+            ix = np.array([self._kinds.of(s.kind, s.spec) for s in slots], dtype=np.int64)
+            out[rest] = posed_boxes(self._kinds, ix, C.root[r], C.rot, C.starts[r])
+            return out
         kinds: dict[bytes, list[int]] = {}
         for i in np.nonzero(rest)[0].tolist():
             kinds.setdefault(self._ragdolls[int(C.keys[rows[i]])].kind, []).append(i)
