@@ -208,3 +208,40 @@ def test_membership_changes_run_no_forward(skeleton: Skeleton, monkeypatch: pyte
         _drive(pw, skeleton, falling)
         pw.step()
     assert calls == [] and len(gaps) == 4 and max(gaps) < 1e-9
+
+
+def test_a_slot_given_back_is_parked_at_rest_apart_and_inert(skeleton: Skeleton) -> None:
+    """A ragdoll that leaves after a fall leaves its slot under the field at rest, 4 m from every
+    other slot, with no contact bit, muscle, pin or hold left on, each joint checked one by one from
+    MuJoCo's own joint list (not from the slot table that parking reads). Broken once by writing the
+    parked roots without their slot's 4 m offset, once by a rest pose shifted by one qpos entry: both fail."""
+    pw = _crowd(skeleton, 3)
+    for _ in range(20):
+        _drive(pw, skeleton, {2, 3})
+        pw.step()
+    slot = int(pw.commands.pool[pw.commands.rows([3])[0]])
+    assert slot > 0  # (slot 0's offset is none)
+    _drive(pw, skeleton, {2})  # 3 leaves, 2 stays in the model
+    pw.step()
+    m, d = pw.model, pw.data
+    assert m is not None and d is not None and not pw.in_model(3) and pw.in_model(2)
+    b0 = int(m.body(f"rd{slot}_{skeleton.names[0]}").id)
+    t = int(m.body_treeid[b0])
+    nb, v0, nv = int(m.tree_bodynum[t]), int(m.tree_dofadr[t]), int(m.tree_dofnum[t])
+    assert int(d.tree_asleep[t]) >= 0  # asleep
+    for j in np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]:
+        q = int(m.jnt_qposadr[j])
+        if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+            np.testing.assert_array_equal(d.qpos[q : q + 7], [4.0 * slot, -50.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
+            np.testing.assert_array_equal(d.qpos[q : q + 4], [1.0, 0.0, 0.0, 0.0])
+        else:
+            assert d.qpos[q] == 0.0
+    assert not d.qvel[v0 : v0 + nv].any()
+    geoms = np.nonzero((m.geom_bodyid >= b0) & (m.geom_bodyid < b0 + nb))[0]
+    assert len(geoms) and not m.geom_contype[geoms].any() and not m.geom_conaffinity[geoms].any()
+    joints = np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]
+    acts = np.nonzero(np.isin(m.actuator_trnid[:, 0], joints))[0]
+    assert len(acts) and not m.actuator_gainprm[acts, 0].any()
+    eqs = [i for i in range(m.neq) if m.eq(i).name.startswith(f"rd{slot}_")]
+    assert eqs and not d.eq_active[eqs].any()
