@@ -172,7 +172,7 @@ class Building:
         if len(joined):  # joining from outside: where its animation was a step ago, moving as it moved then
             self._place_rows(joined)
             C.placed[joined] = True
-        settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], table)
+        settle(m, d, self._pool.free_slots(), table)
         # settle's kinematics (body and geom poses) is all that is read before the next step, whose
         # mj_step computes the rest from the state; a new MjData has no mass matrix yet (a kinetic
         # energy read before the first step): only then a whole mj_forward. (b32f saw the snowman demo

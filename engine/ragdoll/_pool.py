@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import heapq
 from dataclasses import dataclass
 
 import mujoco
@@ -93,19 +94,26 @@ class PoolSlot:
 
 
 class RagdollPool:
-    """The slots in compile order (slot ``i`` is named ``rd<i>_…`` in MuJoCo)."""
+    """The slots in compile order (slot ``i`` is named ``rd<i>_…`` in MuJoCo), with each kind's
+    slot count and free slots kept as they change (a fall asks for them once per joiner)."""
 
     def __init__(self) -> None:
         self.slots: list[PoolSlot] = []
         self._templates: dict[bytes, RagdollFragment] = {}
+        self._count: dict[bytes, int] = {}
+        self._free: dict[bytes, list[int]] = {}  # a heap per kind: the lowest free slot first
 
     def count(self, kind: bytes) -> int:
         """Slots of a kind."""
-        return sum(s.kind == kind for s in self.slots)
+        return self._count.get(kind, 0)
 
     def free(self, kind: bytes) -> int:
         """Free slots of a kind."""
-        return sum(s.kind == kind and s.owner is None for s in self.slots)
+        return len(self._free.get(kind, ()))
+
+    def free_slots(self) -> list[int]:
+        """Every free slot, ascending."""
+        return sorted(i for free in self._free.values() for i in free)
 
     def grow_to(self, spec: RagdollSpec, size: int) -> bool:
         """Make room for ``size`` slots of ``spec``'s kind (rounded up to :data:`CHUNK`); whether it grew."""
@@ -129,19 +137,25 @@ class RagdollPool:
                 dataclasses.replace(tpl.spec, key=i), body, contact, equality, actuator, tpl.kp, tpl.kv
             )
             self.slots.append(PoolSlot(kind, frag))
+            heapq.heappush(self._free.setdefault(kind, []), i)
+        self._count[kind] = want
         return True
 
     def take(self, kind: bytes, owner: int) -> int | None:
         """Lend the lowest free slot of a kind to ``owner`` (``None`` when the kind has none free)."""
-        for i, s in enumerate(self.slots):
-            if s.kind == kind and s.owner is None:
-                s.owner = owner
-                return i
-        return None
+        free = self._free.get(kind)
+        if not free:
+            return None
+        i = heapq.heappop(free)
+        self.slots[i].owner = owner
+        return i
 
     def release(self, i: int) -> None:
         """Give slot ``i`` back."""
-        self.slots[i].owner = None
+        s = self.slots[i]
+        if s.owner is not None:
+            s.owner = None
+            heapq.heappush(self._free[s.kind], i)
 
 
 def update_sleep(m: mujoco.MjModel, d: mujoco.MjData) -> None:

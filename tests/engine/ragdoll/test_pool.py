@@ -10,6 +10,7 @@ from engine import quat
 from engine.ragdoll import _building as building_module
 from engine.ragdoll import default_profile
 from engine.ragdoll import physics as physics_module
+from engine.ragdoll._pool import RagdollPool, kind_of
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
 
@@ -245,3 +246,22 @@ def test_a_slot_given_back_is_parked_at_rest_apart_and_inert(skeleton: Skeleton)
     assert len(acts) and not m.actuator_gainprm[acts, 0].any()
     eqs = [i for i in range(m.neq) if m.eq(i).name.startswith(f"rd{slot}_")]
     assert eqs and not d.eq_active[eqs].any()
+
+
+def test_the_pool_lends_the_lowest_free_slot_and_counts_what_it_holds(skeleton: Skeleton) -> None:
+    """The pool's counts and free slots are kept as slots are added, lent and given back (not
+    searched for): lending gives the lowest free slot of the kind, and a slot given back twice is
+    free once. Broken once by pushing a slot back on every release (the double one counted twice):
+    it fails; once by lending the newest free slot instead of the lowest: it fails."""
+    spec = _crowd(skeleton, 1)._ragdolls[1].spec
+    kind = kind_of(spec)
+    pool = RagdollPool()
+    assert pool.grow_to(spec, 5) and pool.count(kind) == 8 and pool.free(kind) == 8
+    assert [pool.take(kind, k) for k in (10, 11, 12)] == [0, 1, 2]
+    pool.release(1)
+    pool.release(1)
+    assert pool.free(kind) == 6 and pool.free_slots() == [1, 3, 4, 5, 6, 7]
+    assert pool.take(kind, 13) == 1 and pool.slots[1].owner == 13
+    assert not pool.grow_to(spec, 8) and pool.grow_to(spec, 9) and pool.count(kind) == 12
+    assert pool.free_slots() == list(range(3, 12)) and pool.take(kind, 14) == 3
+    assert pool.take(b"another kind", 15) is None and pool.count(b"another kind") == 0
