@@ -264,11 +264,12 @@ def settle(m: mujoco.MjModel, d: mujoco.MjData, free: list[int], table: SlotTabl
     """Put the free slots ``free`` to sleep where :func:`park` left them, everything else awake.
 
     MuJoCo wakes a sleeping tree whose body poses do not match its ``qpos`` (it takes that for a
-    push from outside), so the parked poses go through kinematics awake first, then sleep.
+    push from outside), so the poses of the slots parked since the last settle go through kinematics
+    awake first, then sleep. A slot already asleep stays asleep: its poses were made from the parked
+    state it still has, so waking it would only recompute the same numbers.
     """
     trees = table.tree[np.asarray(free, dtype=np.int64)]
-    asleep = np.asarray(d.tree_asleep)
-    asleep[trees[asleep[trees] >= 0]] = _AWAKE
+    trees = trees[np.asarray(d.tree_asleep)[trees] < 0]
     update_sleep(m, d)
     mujoco.mj_kinematics(m, d)
     d.tree_asleep[trees] = trees  # each a sleep cycle of one tree

@@ -265,3 +265,28 @@ def test_the_pool_lends_the_lowest_free_slot_and_counts_what_it_holds(skeleton: 
     assert not pool.grow_to(spec, 8) and pool.grow_to(spec, 9) and pool.count(kind) == 12
     assert pool.free_slots() == list(range(3, 12)) and pool.take(kind, 14) == 3
     assert pool.take(b"another kind", 15) is None and pool.count(b"another kind") == 0
+
+
+def test_a_membership_change_leaves_sleeping_slots_asleep(skeleton: Skeleton, monkeypatch: pytest.MonkeyPatch) -> None:
+    """When a ragdoll leaves, settling runs kinematics over the ragdolls in the model and the slot
+    just parked only: the slots parked earlier stay asleep (their poses already
+    match their parked state), and afterwards every free slot is asleep again. Broken by waking every
+    free slot before the kinematics again (as before): all 8 trees are awake there and it fails."""
+    pw = _crowd(skeleton, 6)
+    for _ in range(5):
+        _drive(pw, skeleton, {1, 2})
+        pw.step()
+    d = pw.data
+    assert d is not None and d.ntree_awake == 2
+    awake_at_kinematics: list[int] = []
+    kinematics = mujoco.mj_kinematics
+
+    def counted(m: mujoco.MjModel, data: mujoco.MjData) -> None:
+        awake_at_kinematics.append(int(data.ntree_awake))
+        kinematics(m, data)
+
+    monkeypatch.setattr(mujoco, "mj_kinematics", counted)
+    _drive(pw, skeleton, {2})  # 1 leaves
+    pw.step()
+    assert awake_at_kinematics == [2]  # 2 in the model, 1's slot parked this step
+    assert d.ntree_awake == 1 and pw.asleep() == 7
