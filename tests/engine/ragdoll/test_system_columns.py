@@ -37,7 +37,7 @@ def _run(skeleton: Skeleton, rows: bool, monkeypatch: pytest.MonkeyPatch) -> lis
     ]
     poses = tuple(world.get(e, LocalPose) for e in ents)
     rng = np.random.default_rng(5)
-    out: list[tuple[np.ndarray, np.ndarray]] = []
+    out = []
     for step in range(STEPS):
         # the animation stage: every pose written through the columns, as the crowd's animation does
         cols = columns(world)
