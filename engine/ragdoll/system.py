@@ -120,7 +120,7 @@ def physics_step(world: World) -> None:
             prop.placed = False
     pw.step()
     if targets is not None:
-        _write_simulated(world, pw, simulated, *targets)
+        _write_simulated(pw, simulated, *targets)
     for e, prop, tr in world.query(Prop, Transform):
         if not prop.carried:
             pos, rot, vel = pw.prop_state(e)
@@ -154,7 +154,6 @@ def _drive_simulated(
 
 
 def _write_simulated(
-    world: World,
     pw: PhysicsWorld,
     simulated: list[tuple[Entity, Ragdoll, LocalPose]],
     root: NDArray[np.float64],
@@ -168,35 +167,9 @@ def _write_simulated(
         update_settle(rd, float(ke[k]), float(np.linalg.norm(vel[k, :3])), float(rd.profile.masses.sum()))
     weights = np.array([rd.blend_weight for _, rd, _ in simulated], dtype=np.float64)
     out_root, out_rot = blend_rows(root, rot, sim_root, sim_rot, weights, sizes)
-    if _write_rows(world, simulated, out_root, out_rot, sizes):
-        return
     ends = np.cumsum(sizes).tolist()
     for k, (_, _, pose) in enumerate(simulated):
         pose.root, pose.rotations = out_root[k].copy(), out_rot[ends[k] - int(sizes[k]) : ends[k]].copy()
-
-
-def _write_rows(
-    world: World,
-    simulated: list[tuple[Entity, Ragdoll, LocalPose]],
-    root: NDArray[np.float64],
-    rot: NDArray[np.float64],
-    sizes: I64,
-) -> bool:
-    """Write the blended poses into the rows of the local-pose columns (:mod:`engine.columns`) the
-    poses view, when all have one joint count and are in those columns; whether it did. Assigning
-    new arrays instead would make the next reader of the columns (forward kinematics, right after)
-    take each one in and re-link it, per ragdoll in Python, every step of a fall."""
-    count = int(sizes[0])
-    if (sizes != count).any():
-        return False
-    cols, poses = columns(world), tuple(pose for _, _, pose in simulated)
-    roots = cols.get(LocalPose, "root", count).rows(poses)
-    rots = cols.get(LocalPose, "rotations", count).rows(poses) if roots is not None else None
-    if roots is None or rots is None:
-        return False
-    roots[0][roots[1]] = root
-    rots[0][rots[1]] = rot.reshape(len(poses), count, 4)
-    return True
 
 
 #: An animated ragdoll's settle state: not simulated, the body is its animation (no energy, nothing to settle).
