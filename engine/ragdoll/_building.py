@@ -21,7 +21,7 @@ from engine.ragdoll._commands import Commands
 from engine.ragdoll._detail import Detail
 from engine.ragdoll._guard import velocity_limits
 from engine.ragdoll._layout import Layout, build_layout, select
-from engine.ragdoll._pool import CHUNK, INITIAL, MAX_SLOTS, RagdollPool, park, settle, wake
+from engine.ragdoll._pool import CHUNK, INITIAL, MAX_SLOTS, RagdollPool, SlotTable, park, settle, slot_table, wake
 from engine.ragdoll._slots import PropSlot, RagdollSlot
 from engine.ragdoll.mjcf import build_mjcf, prop_name
 
@@ -43,6 +43,7 @@ class Building:
     _props: dict[int, PropSlot]
     _pool: RagdollPool
     _pool_layout: Layout | None
+    _slot_table: SlotTable | None = None  # what park and wake touch of each slot (with _pool_layout)
     _dirty: bool
     _sized: bool
     _moved: bool
@@ -78,7 +79,7 @@ class Building:
         old = snapshot(self.model, self.data)
         self._ke = self._read = None
         if not self._pool.slots and not self._props:
-            self.model = self.data = self.layout = self._pool_layout = None
+            self.model = self.data = self.layout = self._pool_layout = self._slot_table = None
             return
         rd = [s.fragment for s in self._pool.slots]
         pr = [self._props[k].spec for k in sorted(self._props)]
@@ -89,6 +90,7 @@ class Building:
         self._digest = hashlib.blake2b(xml.encode(), digest_size=16).digest()
         self.rebuilds += 1
         pool = self._pool_layout = build_layout(m, rd)
+        table = self._slot_table = slot_table(m, pool)
         for key, ps in self._props.items():
             n = prop_name(key)
             j = m.joint(n).id
@@ -105,9 +107,9 @@ class Building:
         m.tree_sleep_policy[:] = int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER)  # props and borrowed slots
         for i, ps_ in enumerate(self._pool.slots):
             if ps_.owner is None:
-                park(m, d, pool, i)
+                park(m, d, table, i)
             else:
-                wake(m, d, pool, i)
+                wake(m, d, table, i)
         for ps in self._props.values():
             if ps.init is not None:
                 pos, rot, vel = ps.init
@@ -153,16 +155,16 @@ class Building:
             self._compile()
             self._moved = False
         self._ke = self._read = None
-        if self.model is None or self.data is None or self._pool_layout is None:
+        if self.model is None or self.data is None or self._pool_layout is None or self._slot_table is None:
             self.layout = None
             return
-        m, d, pool = self.model, self.data, self._pool_layout
+        m, d, pool, table = self.model, self.data, self._pool_layout, self._slot_table
         for i in np.nonzero(C.in_model & (C.pool < 0))[0].tolist():
             key = int(C.keys[i])
             taken = self._pool.take(kind_of_row[i], key)
             assert taken is not None
             C.pool[i] = taken
-            wake(m, d, pool, taken)
+            wake(m, d, table, taken)
         rows = np.nonzero(C.pool >= 0)[0]
         keys = C.keys[rows].tolist()
         self.layout = select(pool, C.pool[rows].tolist(), keys)
@@ -170,7 +172,7 @@ class Building:
         if len(joined):  # joining from outside: where its animation was a step ago, moving as it moved then
             self._place_rows(joined)
             C.placed[joined] = True
-        settle(m, d, [i for i, ps in enumerate(self._pool.slots) if ps.owner is None], pool)
+        settle(m, d, self._pool.free_slots(), table)
         # settle's kinematics (body and geom poses) is all that is read before the next step, whose
         # mj_step computes the rest from the state; a new MjData has no mass matrix yet (a kinetic
         # energy read before the first step): only then a whole mj_forward. (b32f saw the snowman demo
@@ -183,8 +185,8 @@ class Building:
     def _give_back(self, row: int) -> None:
         """Return a ragdoll's pool slot (command row ``row``): parked, asleep, free for the next one of its kind."""
         C = self._cmds
-        if self.model is not None and self.data is not None and self._pool_layout is not None:
-            park(self.model, self.data, self._pool_layout, int(C.pool[row]))
+        if self.model is not None and self.data is not None and self._slot_table is not None:
+            park(self.model, self.data, self._slot_table, int(C.pool[row]))
         self._pool.release(int(C.pool[row]))
         C.pool[row] = -1
         self._moved = True

@@ -9,7 +9,7 @@ targets of ten ragdolls is then a handful of numpy calls, not ten Python loops.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import mujoco
@@ -64,6 +64,9 @@ class Layout:
     hold_eqs_owner: I
     hold_eq: list[dict[str, int]]
     hold_joint: list[dict[str, int]]  # holdable joint name -> its index in the ragdoll's skeleton
+    # per owner group (``_GROUPS``), each ragdoll's rows: what :func:`select` gathers (a pool's layout
+    # only; ``None`` in a selected one, which nothing selects from)
+    rows_of: dict[str, list[I]] | None = field(default=None, init=False, repr=False)
 
     def ordinal(self, key: int) -> int:
         """Position of ragdoll ``key`` in the flat layout."""
@@ -179,7 +182,7 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         "hold_eqs_owner",
     )
     floats = ("ball_twist", "ball_cone", "act_kp", "act_kv", "ball_lead", "hinge_lead")
-    return Layout(
+    layout = Layout(
         keys=[f.spec.key for f in fragments],
         starts=np.array(starts, dtype=np.int64),
         dofs=cat("dofs", np.int64, (2,)),
@@ -191,6 +194,13 @@ def build_layout(m: mujoco.MjModel, fragments: list[RagdollFragment]) -> Layout:
         **{n: cat(n, np.int64) for n in ints},
         **{n: cat(n, np.float64) for n in floats},
     )
+    ragdolls = np.arange(len(fragments))
+    layout.rows_of = {}
+    for owner in _GROUPS:
+        own = getattr(layout, owner)
+        lo, hi = np.searchsorted(own, ragdolls, "left"), np.searchsorted(own, ragdolls, "right")
+        layout.rows_of[owner] = [np.arange(a, b, dtype=np.int64) for a, b in zip(lo.tolist(), hi.tolist(), strict=True)]
+    return layout
 
 
 _PER_RAGDOLL = ("root_q", "root_d", "dofs", "pin_eq", "pin_mocap", "hold_mocap")
@@ -211,12 +221,11 @@ def select(pool: Layout, slots: list[int], keys: list[int]) -> Layout:
     sizes = np.diff(pool.starts)[idx]
     starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
     fields: dict[str, NDArray[Any]] = {n: getattr(pool, n)[idx] for n in _PER_RAGDOLL}  # int and float arrays
+    assert pool.rows_of is not None, "select from a pool's layout (build_layout), not a selected one"
     for owner, names in _GROUPS.items():
-        own = getattr(pool, owner)
-        lo, hi = np.searchsorted(own, idx, "left"), np.searchsorted(own, idx, "right")
-        counts = hi - lo  # each slot's rows lo..hi, end to end (one pass, not a range per slot)
-        rows = np.repeat(lo - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts) + np.arange(int(counts.sum()))
-        new_owner = np.repeat(np.arange(len(idx)), counts)
+        parts = [pool.rows_of[owner][s] for s in slots]
+        rows = np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+        new_owner = np.repeat(np.arange(len(idx)), list(map(len, parts)))
         fields[owner] = new_owner
         for n in names:
             fields[n] = getattr(pool, n)[rows]

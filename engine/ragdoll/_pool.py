@@ -28,10 +28,12 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import heapq
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+from numpy.typing import NDArray
 
 from engine.ragdoll._contact_bits import set_contact_bits
 from engine.ragdoll._layout import Layout
@@ -43,9 +45,11 @@ __all__ = [
     "MAX_SLOTS",
     "PoolSlot",
     "RagdollPool",
+    "SlotTable",
     "kind_of",
     "park",
     "settle",
+    "slot_table",
     "update_sleep",
     "wake",
 ]
@@ -90,19 +94,26 @@ class PoolSlot:
 
 
 class RagdollPool:
-    """The slots in compile order (slot ``i`` is named ``rd<i>_…`` in MuJoCo)."""
+    """The slots in compile order (slot ``i`` is named ``rd<i>_…`` in MuJoCo), with each kind's
+    slot count and free slots kept as they change (a fall asks for them once per joiner)."""
 
     def __init__(self) -> None:
         self.slots: list[PoolSlot] = []
         self._templates: dict[bytes, RagdollFragment] = {}
+        self._count: dict[bytes, int] = {}
+        self._free: dict[bytes, list[int]] = {}  # a heap per kind: the lowest free slot first
 
     def count(self, kind: bytes) -> int:
         """Slots of a kind."""
-        return sum(s.kind == kind for s in self.slots)
+        return self._count.get(kind, 0)
 
     def free(self, kind: bytes) -> int:
         """Free slots of a kind."""
-        return sum(s.kind == kind and s.owner is None for s in self.slots)
+        return len(self._free.get(kind, ()))
+
+    def free_slots(self) -> list[int]:
+        """Every free slot, ascending."""
+        return sorted(i for free in self._free.values() for i in free)
 
     def grow_to(self, spec: RagdollSpec, size: int) -> bool:
         """Make room for ``size`` slots of ``spec``'s kind (rounded up to :data:`CHUNK`); whether it grew."""
@@ -126,19 +137,25 @@ class RagdollPool:
                 dataclasses.replace(tpl.spec, key=i), body, contact, equality, actuator, tpl.kp, tpl.kv
             )
             self.slots.append(PoolSlot(kind, frag))
+            heapq.heappush(self._free.setdefault(kind, []), i)
+        self._count[kind] = want
         return True
 
     def take(self, kind: bytes, owner: int) -> int | None:
         """Lend the lowest free slot of a kind to ``owner`` (``None`` when the kind has none free)."""
-        for i, s in enumerate(self.slots):
-            if s.kind == kind and s.owner is None:
-                s.owner = owner
-                return i
-        return None
+        free = self._free.get(kind)
+        if not free:
+            return None
+        i = heapq.heappop(free)
+        self.slots[i].owner = owner
+        return i
 
     def release(self, i: int) -> None:
         """Give slot ``i`` back."""
-        self.slots[i].owner = None
+        s = self.slots[i]
+        if s.owner is not None:
+            s.owner = None
+            heapq.heappush(self._free[s.kind], i)
 
 
 def update_sleep(m: mujoco.MjModel, d: mujoco.MjData) -> None:
@@ -169,58 +186,90 @@ def update_sleep(m: mujoco.MjModel, d: mujoco.MjData) -> None:
     d.nv_awake = len(dofs)
 
 
-def _slot_ids(m: mujoco.MjModel, pool: Layout, slot: int) -> tuple[int, np.ndarray, np.ndarray]:
-    """The tree, actuators and equality constraints of pool slot ``slot`` (``pool``: the layout of every slot)."""
-    acts = pool.act[pool.act_owner == slot]
-    eqs = np.array([int(pool.pin_eq[slot]), *pool.hold_eq[slot].values()], dtype=np.int64)
-    return int(m.body_treeid[pool.body[pool.starts[slot]]]), acts, eqs
+@dataclass(frozen=True)
+class SlotTable:
+    """What parking and waking touch of each pool slot in one compiled model, found once per compile
+    (:func:`slot_table`), so that a slot leaving costs array writes, not searches over every body,
+    geom and joint of the model and a Python pass over its joints."""
+
+    tree: NDArray[np.int64]  # [S] MuJoCo tree of each slot
+    bodies: NDArray[np.int64]  # [S,2] body id range
+    dofs: NDArray[np.int64]  # [S,2] dof range
+    qpos: NDArray[np.int64]  # [S,2] qpos range (a tree's joints are contiguous)
+    rest: NDArray[np.float64]  # [nq] each slot's parked pose at its qpos range (elsewhere unused)
+    geoms: list[NDArray[np.int64]]  # per slot: its geoms
+    acts: list[NDArray[np.int64]]  # per slot: its actuators
+    eqs: list[NDArray[np.int64]]  # per slot: its pin and hold constraints
 
 
-def park(m: mujoco.MjModel, d: mujoco.MjData, pool: Layout, slot: int) -> None:
+def slot_table(m: mujoco.MjModel, pool: Layout) -> SlotTable:
+    """The :class:`SlotTable` of model ``m`` whose pool slots are laid out by ``pool``."""
+    slots = len(pool.keys)
+    tree = np.asarray(m.body_treeid)[pool.body[pool.starts[:slots]]].astype(np.int64)
+    b0 = np.asarray(m.tree_bodyadr)[tree].astype(np.int64)
+    v0 = np.asarray(m.tree_dofadr)[tree].astype(np.int64)
+    bodies = np.stack([b0, b0 + np.asarray(m.tree_bodynum)[tree]], axis=1)
+    dofs = np.stack([v0, v0 + np.asarray(m.tree_dofnum)[tree]], axis=1)
+    slot_of_tree = np.full(m.ntree, -1, dtype=np.int64)
+    slot_of_tree[tree] = np.arange(slots)
+    jtype, qadr = np.asarray(m.jnt_type), np.asarray(m.jnt_qposadr).astype(np.int64)
+    jslot = np.where(m.body_treeid[m.jnt_bodyid] >= 0, slot_of_tree[m.body_treeid[m.jnt_bodyid]], -1)
+    width = np.select([jtype == mujoco.mjtJoint.mjJNT_FREE, jtype == mujoco.mjtJoint.mjJNT_BALL], [7, 4], 1)
+    rest = np.zeros(m.nq)
+    free = np.nonzero((jtype == mujoco.mjtJoint.mjJNT_FREE) & (jslot >= 0))[0]
+    for k in range(3):  # under the field at rest, each slot apart from every other one
+        rest[qadr[free] + k] = _PARK[k] + (4.0 * jslot[free] if k == 0 else 0.0)
+    rest[qadr[free] + 3] = 1.0
+    rest[qadr[(jtype == mujoco.mjtJoint.mjJNT_BALL) & (jslot >= 0)]] = 1.0
+    qpos = np.zeros((slots, 2), dtype=np.int64)
+    for s in range(slots):
+        own = np.nonzero(jslot == s)[0]
+        qpos[s] = qadr[own].min(), qadr[own].max() + width[own[np.argmax(qadr[own])]]
+        assert qpos[s, 1] - qpos[s, 0] == width[own].sum(), "a pool slot's joints are not contiguous in qpos"
+    gbody = np.asarray(m.geom_bodyid)
+    geoms = [np.nonzero((gbody >= a) & (gbody < b))[0].astype(np.int64) for a, b in bodies]
+    acts = [pool.act[pool.act_owner == s] for s in range(slots)]
+    eqs = [np.array([int(pool.pin_eq[s]), *pool.hold_eq[s].values()], dtype=np.int64) for s in range(slots)]
+    return SlotTable(tree, bodies, dofs, qpos, rest, geoms, acts, eqs)
+
+
+def park(m: mujoco.MjModel, d: mujoco.MjData, table: SlotTable, slot: int) -> None:
     """Take slot ``slot`` out of the simulation: under the field at rest, nothing touching it,
     no muscle or constraint (:func:`settle` then puts it to sleep)."""
-    tree, acts, eqs = _slot_ids(m, pool, slot)
-    b0, nb = int(m.tree_bodyadr[tree]), int(m.tree_bodynum[tree])
-    v0, nv = int(m.tree_dofadr[tree]), int(m.tree_dofnum[tree])
-    geoms = np.nonzero((m.geom_bodyid >= b0) & (m.geom_bodyid < b0 + nb))[0]
-    set_contact_bits(m, geoms, 0, 0)
+    tree = int(table.tree[slot])
+    (b0, b1), (v0, v1), (q0, q1) = table.bodies[slot].tolist(), table.dofs[slot].tolist(), table.qpos[slot].tolist()
+    set_contact_bits(m, table.geoms[slot], 0, 0)
+    acts = table.acts[slot]
     m.actuator_gainprm[acts, 0] = 0.0
     m.actuator_biasprm[acts, :3] = 0.0
-    d.eq_active[eqs] = 0
-    d.xfrc_applied[b0 : b0 + nb] = 0.0
-    d.qfrc_applied[v0 : v0 + nv] = 0.0
-    jnts = np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]
-    for j in jnts:  # the rest pose, parked apart from every other slot
-        q = int(m.jnt_qposadr[j])
-        if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
-            d.qpos[q : q + 7] = [*(_PARK + [4.0 * slot, 0.0, 0.0]), 1.0, 0.0, 0.0, 0.0]
-        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
-            d.qpos[q : q + 4] = [1.0, 0.0, 0.0, 0.0]
-        else:
-            d.qpos[q] = 0.0
-    d.qvel[v0 : v0 + nv] = 0.0
-    d.qacc_warmstart[v0 : v0 + nv] = 0.0
+    d.eq_active[table.eqs[slot]] = 0
+    d.xfrc_applied[b0:b1] = 0.0
+    d.qfrc_applied[v0:v1] = 0.0
+    d.qpos[q0:q1] = table.rest[q0:q1]  # the rest pose, parked apart from every other slot
+    d.qvel[v0:v1] = 0.0
+    d.qacc_warmstart[v0:v1] = 0.0
     m.tree_sleep_policy[tree] = int(mujoco.mjtSleepPolicy.mjSLEEP_ALLOWED)
     d.tree_asleep[tree] = _AWAKE  # until :func:`settle` puts it to sleep where it now is
 
 
-def wake(m: mujoco.MjModel, d: mujoco.MjData, pool: Layout, slot: int) -> None:
+def wake(m: mujoco.MjModel, d: mujoco.MjData, table: SlotTable, slot: int) -> None:
     """Put slot ``slot`` back into the simulation (it never falls asleep by itself: a ragdoll lying
     still must still answer its muscles; :func:`settle` applies it)."""
-    tree, _, _ = _slot_ids(m, pool, slot)
+    tree = int(table.tree[slot])
     m.tree_sleep_policy[tree] = int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER)
     d.tree_asleep[tree] = _AWAKE
 
 
-def settle(m: mujoco.MjModel, d: mujoco.MjData, free: list[int], pool: Layout) -> None:
+def settle(m: mujoco.MjModel, d: mujoco.MjData, free: list[int], table: SlotTable) -> None:
     """Put the free slots ``free`` to sleep where :func:`park` left them, everything else awake.
 
     MuJoCo wakes a sleeping tree whose body poses do not match its ``qpos`` (it takes that for a
-    push from outside), so the parked poses go through kinematics awake first, then sleep.
+    push from outside), so the poses of the slots parked since the last settle go through kinematics
+    awake first, then sleep. A slot already asleep stays asleep: its poses were made from the parked
+    state it still has, so waking it would only recompute the same numbers.
     """
-    trees = np.array([int(m.body_treeid[pool.body[pool.starts[i]]]) for i in free], dtype=np.int64)
-    asleep = np.asarray(d.tree_asleep)
-    asleep[trees[asleep[trees] >= 0]] = _AWAKE
+    trees = table.tree[np.asarray(free, dtype=np.int64)]
+    trees = trees[np.asarray(d.tree_asleep)[trees] < 0]
     update_sleep(m, d)
     mujoco.mj_kinematics(m, d)
     d.tree_asleep[trees] = trees  # each a sleep cycle of one tree

@@ -10,6 +10,7 @@ from engine import quat
 from engine.ragdoll import _building as building_module
 from engine.ragdoll import default_profile
 from engine.ragdoll import physics as physics_module
+from engine.ragdoll._pool import RagdollPool, kind_of
 from engine.ragdoll.physics import PhysicsWorld
 from engine.skeleton import Skeleton
 
@@ -208,3 +209,84 @@ def test_membership_changes_run_no_forward(skeleton: Skeleton, monkeypatch: pyte
         _drive(pw, skeleton, falling)
         pw.step()
     assert calls == [] and len(gaps) == 4 and max(gaps) < 1e-9
+
+
+def test_a_slot_given_back_is_parked_at_rest_apart_and_inert(skeleton: Skeleton) -> None:
+    """A ragdoll that leaves after a fall leaves its slot under the field at rest, 4 m from every
+    other slot, with no contact bit, muscle, pin or hold left on, each joint checked one by one from
+    MuJoCo's own joint list (not from the slot table that parking reads). Broken once by writing the
+    parked roots without their slot's 4 m offset, once by a rest pose shifted by one qpos entry: both fail."""
+    pw = _crowd(skeleton, 3)
+    for _ in range(20):
+        _drive(pw, skeleton, {2, 3})
+        pw.step()
+    slot = int(pw.commands.pool[pw.commands.rows([3])[0]])
+    assert slot > 0  # (slot 0's offset is none)
+    _drive(pw, skeleton, {2})  # 3 leaves, 2 stays in the model
+    pw.step()
+    m, d = pw.model, pw.data
+    assert m is not None and d is not None and not pw.in_model(3) and pw.in_model(2)
+    b0 = int(m.body(f"rd{slot}_{skeleton.names[0]}").id)
+    t = int(m.body_treeid[b0])
+    nb, v0, nv = int(m.tree_bodynum[t]), int(m.tree_dofadr[t]), int(m.tree_dofnum[t])
+    assert int(d.tree_asleep[t]) >= 0  # asleep
+    for j in np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]:
+        q = int(m.jnt_qposadr[j])
+        if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+            np.testing.assert_array_equal(d.qpos[q : q + 7], [4.0 * slot, -50.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+        elif m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:
+            np.testing.assert_array_equal(d.qpos[q : q + 4], [1.0, 0.0, 0.0, 0.0])
+        else:
+            assert d.qpos[q] == 0.0
+    assert not d.qvel[v0 : v0 + nv].any()
+    geoms = np.nonzero((m.geom_bodyid >= b0) & (m.geom_bodyid < b0 + nb))[0]
+    assert len(geoms) and not m.geom_contype[geoms].any() and not m.geom_conaffinity[geoms].any()
+    joints = np.nonzero((m.jnt_bodyid >= b0) & (m.jnt_bodyid < b0 + nb))[0]
+    acts = np.nonzero(np.isin(m.actuator_trnid[:, 0], joints))[0]
+    assert len(acts) and not m.actuator_gainprm[acts, 0].any()
+    eqs = [i for i in range(m.neq) if m.eq(i).name.startswith(f"rd{slot}_")]
+    assert eqs and not d.eq_active[eqs].any()
+
+
+def test_the_pool_lends_the_lowest_free_slot_and_counts_what_it_holds(skeleton: Skeleton) -> None:
+    """The pool's counts and free slots are kept as slots are added, lent and given back (not
+    searched for): lending gives the lowest free slot of the kind, and a slot given back twice is
+    free once. Broken once by pushing a slot back on every release (the double one counted twice):
+    it fails; once by lending the newest free slot instead of the lowest: it fails."""
+    spec = _crowd(skeleton, 1)._ragdolls[1].spec
+    kind = kind_of(spec)
+    pool = RagdollPool()
+    assert pool.grow_to(spec, 5) and pool.count(kind) == 8 and pool.free(kind) == 8
+    assert [pool.take(kind, k) for k in (10, 11, 12)] == [0, 1, 2]
+    pool.release(1)
+    pool.release(1)
+    assert pool.free(kind) == 6 and pool.free_slots() == [1, 3, 4, 5, 6, 7]
+    assert pool.take(kind, 13) == 1 and pool.slots[1].owner == 13
+    assert not pool.grow_to(spec, 8) and pool.grow_to(spec, 9) and pool.count(kind) == 12
+    assert pool.free_slots() == list(range(3, 12)) and pool.take(kind, 14) == 3
+    assert pool.take(b"another kind", 15) is None and pool.count(b"another kind") == 0
+
+
+def test_a_membership_change_leaves_sleeping_slots_asleep(skeleton: Skeleton, monkeypatch: pytest.MonkeyPatch) -> None:
+    """When a ragdoll leaves, settling runs kinematics over the ragdolls in the model and the slot
+    just parked only: the slots parked earlier stay asleep (their poses already
+    match their parked state), and afterwards every free slot is asleep again. Broken by waking every
+    free slot before the kinematics again (as before): all 8 trees are awake there and it fails."""
+    pw = _crowd(skeleton, 6)
+    for _ in range(5):
+        _drive(pw, skeleton, {1, 2})
+        pw.step()
+    d = pw.data
+    assert d is not None and d.ntree_awake == 2
+    awake_at_kinematics: list[int] = []
+    kinematics = mujoco.mj_kinematics
+
+    def counted(m: mujoco.MjModel, data: mujoco.MjData) -> None:
+        awake_at_kinematics.append(int(data.ntree_awake))
+        kinematics(m, data)
+
+    monkeypatch.setattr(mujoco, "mj_kinematics", counted)
+    _drive(pw, skeleton, {2})  # 1 leaves
+    pw.step()
+    assert awake_at_kinematics == [2]  # 2 in the model, 1's slot parked this step
+    assert d.ntree_awake == 1 and pw.asleep() == 7
