@@ -102,6 +102,11 @@ def test_a_flood_loses_few_of_the_phones_readings_and_the_phone_still_steers():
     app = App(seed=0)
     install_input(app, hub)
     GAME.install(app)
+    # One step before the phone starts: the first imports numba and loads the cached kernels (0.9-2.3 s under load). A
+    # phone already sending through that stall lost every reading past the step's budget of 8 ("over budget":
+    # 36-66 of 900 beside two busy loops, the 107 short once in CI likely the same), a cost of the test's
+    # start-up, not of the flood; the kernel's receive buffer lost 0-28 of them meanwhile.
+    app.step()
     phone = subprocess.Popen(
         [sys.executable, "-c", PHONE, str(src.port), str(PHONE_READINGS)], stdout=subprocess.PIPE, text=True
     )
