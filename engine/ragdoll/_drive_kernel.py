@@ -16,17 +16,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
 
 from engine import jit
+from engine.arrays import F64, I64, Bool
 from engine.jit import qaxis_angle, qconj, qmul, qnormalize, qrot
 
 __all__ = ["drive_kernel", "load", "read_kernel", "twist_kernel"]
 
 _Q = tuple[float, float, float, float]
 _V = tuple[float, float, float]
-_F = NDArray[np.float64]
-_I = NDArray[np.int64]
 
 
 @jit.njit_inline
@@ -60,65 +58,65 @@ def _hinge_angle(q: _Q, axis: _V) -> float:
 
 
 @jit.njit_inline
-def _row4(a: _F, i: int) -> _Q:
+def _row4(a: F64, i: int) -> _Q:
     return (a[i, 0], a[i, 1], a[i, 2], a[i, 3])
 
 
 @jit.njit_inline
-def _row3(a: _F, i: int) -> _V:
+def _row3(a: F64, i: int) -> _V:
     return (a[i, 0], a[i, 1], a[i, 2])
 
 
 @jit.njit
 def drive_kernel(
     dt: float,
-    rows: _I,
-    j: _I,
-    c_root: _F,
-    c_rot: _F,
-    c_last_root: _F,
-    c_last_rot: _F,
-    c_has_last: NDArray[np.bool_],
-    c_muscle: _F,
-    c_pin: _F,
-    c_support: _F,
-    c_kin: NDArray[np.bool_],
-    starts: _I,
-    root_q: _I,
-    root_d: _I,
-    ball_src: _I,
-    ball_owner: _I,
-    ball_q: _I,
-    ball_d: _I,
-    ball_c: _I,
-    ball_lead: _F,
-    hinge_src: _I,
-    hinge_owner: _I,
-    hinge_q: _I,
-    hinge_d: _I,
-    hinge_c: _I,
-    hinge_axis: _F,
-    hinge_lead: _F,
-    act: _I,
-    act_owner: _I,
-    act_kp: _F,
-    act_kv: _F,
-    body: _I,
-    body_owner: _I,
-    pin_eq: _I,
-    pin_mocap: _I,
-    consts: _F,
-    body_mass: _F,
-    gainprm: _F,
-    biasprm: _F,
-    eq_solref: _F,
-    eq_active: NDArray[np.bool_],
-    ctrl: _F,
-    mocap_pos: _F,
-    mocap_quat: _F,
-    xfrc: _F,
-    qpos: _F,
-    qvel: _F,
+    rows: I64,
+    j: I64,
+    c_root: F64,
+    c_rot: F64,
+    c_last_root: F64,
+    c_last_rot: F64,
+    c_has_last: Bool,
+    c_muscle: F64,
+    c_pin: F64,
+    c_support: F64,
+    c_kin: Bool,
+    starts: I64,
+    root_q: I64,
+    root_d: I64,
+    ball_src: I64,
+    ball_owner: I64,
+    ball_q: I64,
+    ball_d: I64,
+    ball_c: I64,
+    ball_lead: F64,
+    hinge_src: I64,
+    hinge_owner: I64,
+    hinge_q: I64,
+    hinge_d: I64,
+    hinge_c: I64,
+    hinge_axis: F64,
+    hinge_lead: F64,
+    act: I64,
+    act_owner: I64,
+    act_kp: F64,
+    act_kv: F64,
+    body: I64,
+    body_owner: I64,
+    pin_eq: I64,
+    pin_mocap: I64,
+    consts: F64,
+    body_mass: F64,
+    gainprm: F64,
+    biasprm: F64,
+    eq_solref: F64,
+    eq_active: Bool,
+    ctrl: F64,
+    mocap_pos: F64,
+    mocap_quat: F64,
+    xfrc: F64,
+    qpos: F64,
+    qvel: F64,
 ) -> None:
     """The servo targets, gains, pins, gravity support and kinematic placements of
     :func:`engine.ragdoll._control.apply_commands` for ragdolls ``rows`` (the layout's, in its
@@ -197,7 +195,7 @@ def drive_kernel(
 
 
 @jit.njit
-def twist_kernel(ball_q: _I, ball_d: _I, ball_axis: _F, ball_twist: _F, qpos: _F, qvel: _F) -> None:
+def twist_kernel(ball_q: I64, ball_d: I64, ball_axis: F64, ball_twist: F64, qpos: F64, qvel: F64) -> None:
     """:func:`engine.ragdoll._control.project_twist` in place: each ball joint's twist about its bone
     clamped to ``±ball_twist``, and the twist velocity that pushes outwards removed."""
     for k in range(ball_q.shape[0]):
@@ -225,16 +223,16 @@ def twist_kernel(ball_q: _I, ball_d: _I, ball_axis: _F, ball_twist: _F, qpos: _F
 
 @jit.njit
 def read_kernel(
-    starts: _I,
-    root_q: _I,
-    ball_src: _I,
-    ball_q: _I,
-    hinge_src: _I,
-    hinge_q: _I,
-    hinge_axis: _F,
-    qpos: _F,
-    roots: _F,
-    rot: _F,
+    starts: I64,
+    root_q: I64,
+    ball_src: I64,
+    ball_q: I64,
+    hinge_src: I64,
+    hinge_q: I64,
+    hinge_axis: F64,
+    qpos: F64,
+    roots: F64,
+    rot: F64,
 ) -> None:
     """:func:`engine.ragdoll._control.read_poses` into ``roots [P,3]`` and ``rot [ΣJ,4]``: the roots, the
     ball joints' rotations, the hinges' about their axes, the identity elsewhere, all normalised."""
