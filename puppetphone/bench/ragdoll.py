@@ -4,8 +4,10 @@ Each active ragdoll tracks a walk (the library's ``walk`` clip, or a swinging st
 when the clip library is absent) with muscle and pin weight 1, on the ground. The
 baseline is the same number of *limp* ragdolls in the same kind of world, so the ratio
 is what muscles and pins cost (PuppetMaster quotes "1 puppet ≈ 2 normal ragdolls").
-Also reported: the cost of adding an eleventh ragdoll at run time (a model rebuild that
-carries every state over), and the active ragdoll's mean joint tracking error.
+Also reported: the cost of adding an eleventh to fifteenth ragdoll at run time, in thread CPU
+time (the pool grows in chunks of :data:`engine.ragdoll._pool.CHUNK` slots, so most joins take a
+free slot and only a chunk's first compiles the model again: ``ragdoll_add_rebuilds`` counts those
+compiles), and the active ragdoll's mean joint tracking error.
 """
 
 from __future__ import annotations
@@ -90,14 +92,14 @@ def run() -> list[Figure]:
         figures.append(Figure(BENCH, f"ragdoll_step_ms_{n}", t_active, "ms", f"{n} limp ragdoll(s)", t_limp))
     app, ents = _app(10, RagdollMode.ACTIVE, clip)
     pw = app.world.resource(PhysicsWorld)
-    rebuild = []
+    rebuilds_before, rebuild = pw.rebuilds, []
     for k in range(5):
         p = clip.sample(0.0)
         rd = Ragdoll(default_profile(clip.skeleton))
         app.world.spawn(Puppet(clip.skeleton), LocalPose(p.root + [-2.0 * (k + 1), 0.0, 0.0], p.rotations.copy()), rd)
-        t0 = time.perf_counter()
+        t0 = time.thread_time()
         app.step()
-        rebuild.append(time.perf_counter() - t0)
+        rebuild.append(time.thread_time() - t0)
     figures.append(
         Figure(
             BENCH,
@@ -108,6 +110,6 @@ def run() -> list[Figure]:
             figures[-1].value,
         )
     )
+    figures.append(Figure(BENCH, "ragdoll_add_rebuilds", float(pw.rebuilds - rebuilds_before), "count"))
     figures.append(Figure(BENCH, "ragdoll_track_error_deg", _tracking_error(clip), "deg"))
-    assert pw.rebuilds >= 6
     return figures
