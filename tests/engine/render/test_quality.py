@@ -6,7 +6,7 @@ import pytest
 from engine.camera import OrbitCamera
 from engine.render import RenderScene
 from engine.render.headless import egl_available
-from engine.render.quality import QUALITIES, QualityGovernor, parse_quality
+from engine.render.quality import QUALITIES, QUICK, QualityGovernor, parse_quality
 
 
 def test_auto_steps_down_while_frames_miss_the_budget_and_up_only_with_room_to_spare():
@@ -26,6 +26,19 @@ def test_auto_steps_down_while_frames_miss_the_budget_and_up_only_with_room_to_s
     for _ in range(fresh.window - 1):
         assert not fresh.frame(0.030)  # high at 30 ms still fits: no change
     assert fresh.level == "high"
+
+
+def test_frames_far_over_the_budget_leave_the_level_after_a_few_frames_and_one_fast_frame_keeps_it():
+    """A thousand puppets at medium: 300 ms frames. Waiting for the whole window was four seconds of slow
+    motion; after QUICK frames all over twice the budget the level goes down (fails without the quick rule).
+    A warm-up frame or two (shader compiles) among fast ones decides nothing."""
+    gov = QualityGovernor("auto")
+    changes = [gov.frame(0.300) for _ in range(QUICK)]
+    assert changes == [False] * (QUICK - 1) + [True]
+    assert gov.level == "low" and QUICK < gov.window
+    warm = QualityGovernor("auto")
+    assert not any(warm.frame(t) for t in (0.300, 0.250, *[0.020] * (warm.window - 3)))
+    assert warm.level == "medium"
 
 
 def test_a_step_up_scales_only_the_drawing_by_the_pixel_ratio_and_the_steps_count_as_they_are():
