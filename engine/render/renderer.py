@@ -356,6 +356,19 @@ class Renderer:
         return self._colour_only[1]
 
     # -- frame ------------------------------------------------------------------------
+    def draw_floor(self, scene: RenderScene, framebuffer: moderngl.Framebuffer) -> None:
+        """What every frame at this level pays before it draws anything: its 3-D buffer cleared to
+        ``scene``'s horizon colour and, below full size, scaled up over ``framebuffer``. The baseline
+        the sky and ground are judged against at each level (``puppetphone bench render``)."""
+        target, (w, h) = self._scene_target(framebuffer)
+        target.use()
+        target.viewport = (0, 0, w, h)
+        target.clear(*scene.horizon_color, 1.0, depth=1.0)
+        if target is not framebuffer:
+            self._upscale(framebuffer)
+            framebuffer.use()
+        self.ctx.enable_only(moderngl.NOTHING)
+
     def render(self, scene: RenderScene, camera: Camera, framebuffer: moderngl.Framebuffer) -> None:
         """Draw ``scene`` seen by ``camera`` into ``framebuffer`` (cleared first)."""
         ctx = self.ctx

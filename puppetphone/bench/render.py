@@ -33,7 +33,13 @@ of 3 repeats of several frames each (:func:`cpu_frame_time`):
   it, against a clear of the screen, measured in the same run (the floor of any frame);
   ``flat_fill_ms_1280x720``: a clear plus one flat-colour triangle over the screen, the
   least any per-pixel pass costs on this rasteriser (what a drawn sky and ground can
-  approach, not beat).
+  approach, not beat). ``sky_ground_added_ms_<quality>``: what the sky and ground add to a frame
+  at that level, against a clear of the screen: the empty frame less a frame at that level with
+  nothing drawn at all, sky and ground left out (:meth:`~engine.render.renderer.Renderer.draw_floor`:
+  the level's buffer cleared and, at ``low`` and ``medium``, scaled up over the screen; its time is in
+  the baseline's label). The scale-up is a per-pixel pass over 1280x720 (at least ``flat_fill``)
+  paid by every frame at those levels whatever it holds, so the empty frame at them cannot match a
+  clear of the screen; the sky and ground themselves can.
   At ``low`` and ``medium`` the camera stands still, as the snowman game's does, so the sky
   and ground are drawn once and copied into each frame (:mod:`engine.render.env_cache`: a
   memory copy of the smaller buffer's colour and depth, ~0.14 ms at 640x360 against ~0.6 ms
@@ -345,11 +351,20 @@ def quality_figures() -> list[Figure]:
         )
         game_fps: dict[str, float] = {}
         env_ms: dict[str, float] = {}
+        floor_ms: dict[str, float] = {}
+
+        def level_floor() -> None:
+            """A frame at the current level with nothing in it, not even the sky and ground (see the docstring)."""
+            renderer.draw_floor(empty, target.begin())
+            target.end()
+            ctx.finish()
+
         for name, quality in QUALITIES.items():
             renderer.set_quality(quality)
             if name != "low":  # low is measured with auto, below, in alternation
                 game_fps[name] = 1.0 / cpu_frame_time(game_frame)
             env_ms[name] = cpu_frame_time(lambda: draw(empty, camera)) * 1e3
+            floor_ms[name] = cpu_frame_time(level_floor) * 1e3
         renderer.set_quality(QUALITIES["low"])
         turning, frames_drawn = GAME.camera(), [0]
 
@@ -380,6 +395,16 @@ def quality_figures() -> list[Figure]:
             figures.append(Figure("render", f"render_fps_snowman_{name}", game_fps[name], "fps", "30 fps goal", 30.0))
             figures.append(
                 Figure("render", f"sky_ground_ms_{name}", env_ms[name], "ms", "clear of the screen", clear_ms)
+            )
+            figures.append(
+                Figure(
+                    "render",
+                    f"sky_ground_added_ms_{name}",
+                    env_ms[name] - floor_ms[name],
+                    "ms",
+                    f"clear of the screen (a {name} frame with nothing drawn: {floor_ms[name]:.3g} ms)",
+                    clear_ms,
+                )
             )
         for name, t in (("low", t_moving), ("high", t_moving_high)):
             figures.append(

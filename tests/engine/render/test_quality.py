@@ -102,3 +102,27 @@ def test_low_shades_a_quarter_of_the_pixels_and_keeps_the_text_sharp():
         assert abs(len(spots[0]) - len(spots[1])) < 0.2 * len(spots[1])
     finally:
         viewer.close()
+
+
+@pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
+def test_a_levels_floor_is_its_buffer_cleared_to_the_horizon_and_scaled_over_the_whole_frame():
+    """The baseline the sky and ground are judged against at a level: nothing but the horizon colour, on
+    every pixel of the frame (fails if the scale-up is left out: the frame keeps what it held before)."""
+    from engine.render import Viewer, make_target
+
+    viewer = Viewer(make_target(True, 320, 240, samples=0))
+    try:
+        scene = RenderScene()
+        viewer.camera = OrbitCamera(target=np.array([0.0, 0.9, 0.0]), pitch=0.2, distance=4.0)
+        viewer.draw(scene)  # a frame with sky and ground in it first
+        drawn = viewer.read_pixels().astype(np.int32)
+        with viewer.target.ctx:
+            viewer.renderer.set_quality(QUALITIES["low"])
+            viewer.renderer.draw_floor(scene, viewer.target.begin())
+            viewer.target.end()
+        floor = viewer.read_pixels().astype(np.int32)
+        horizon = np.round(np.asarray(scene.horizon_color) * 255.0)
+        assert np.abs(floor[..., :3] - horizon).max() <= 1
+        assert np.abs(drawn[..., :3] - horizon).max() > 20  # the sky and ground were not the horizon colour
+    finally:
+        viewer.close()
