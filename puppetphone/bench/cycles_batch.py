@@ -11,8 +11,11 @@ in a row, and takes that never repeat) go through:
   single-threaded worker processes started beforehand (skipped without the ``cluster`` extra).
 
 Each batch figure is the median over :data:`REPEATS` runs into a fresh library, start-up
-included (a user pays it). A "cycle" here is a take processed: looped or refused; the
-batch also searches every take for several activities, which the baseline does not.
+included (a user pays it). These rates are timed on the wall clock, as the latency figures are: a rate of
+takes through a pool of processes is what the pool is for, and CPU time would count its two
+workers' seconds as one user's wait (read them on a quiet machine: other load moves both sides).
+A "cycle" here is a take processed: looped or refused; the batch also searches every take for
+several activities, which the baseline does not.
 """
 
 from __future__ import annotations
