@@ -24,12 +24,14 @@ import importlib.util
 import math
 import os
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any, TypeVar, cast
 
 __all__ = [
     "AVAILABLE",
+    "compile_seconds",
     "enabled",
     "njit",
     "njit_inline",
@@ -83,8 +85,41 @@ def _numba() -> Any:
     if _numba_module is None:
         import numba
 
+        _time_compiles(numba)
         _numba_module = numba
     return _numba_module
+
+
+_compiling = {"seconds": 0.0, "depth": 0, "since": 0.0}
+
+
+def compile_seconds() -> float:
+    """Wall seconds this process has spent compiling kernels so far.
+
+    A kernel found in numba's disk cache is loaded, not compiled, so this stays near 0 except on a
+    first start after an install (every kernel: tens of seconds, inside the first steps) or after a
+    kernel's source changed. The window's time keeper leaves these seconds out of its verdict: a
+    one-off compile is not a game too slow to keep real time (:mod:`engine.runner`)."""
+    return _compiling["seconds"]
+
+
+def _time_compiles(numba: Any) -> None:
+    """Count the wall time of numba's compiles (its ``numba:compile`` events, outermost only: a kernel
+    compiles the kernels it calls inside its own)."""
+    from numba.core import event
+
+    class CompileTimer(event.Listener):
+        def on_start(self, _event: Any) -> None:
+            if _compiling["depth"] == 0:
+                _compiling["since"] = time.perf_counter()
+            _compiling["depth"] += 1
+
+        def on_end(self, _event: Any) -> None:
+            _compiling["depth"] -= 1
+            if _compiling["depth"] == 0:
+                _compiling["seconds"] += time.perf_counter() - _compiling["since"]
+
+    event.register("numba:compile", CompileTimer())
 
 
 class _Kernel:

@@ -62,3 +62,19 @@ def test_a_deferred_kernel_is_called_and_inlined_inside_a_compiled_one() -> None
     assert twice(4.0) == 8.0 and twice.py_func is _twice  # a dispatcher's attributes, through the stand-in
     (llvm,) = compiled.inspect_llvm().values()
     assert "_plus_one" not in llvm and "_twice" in llvm  # the inline helper was inlined, the other called
+
+
+def _cube(x: float) -> float:
+    return x * x * x
+
+
+@pytest.mark.skipif(not jit.AVAILABLE, reason="numba not installed: there are no compiled kernels")
+def test_compile_seconds_count_a_kernels_compile_once_and_not_its_calls() -> None:
+    """The window's time keeper leaves compiles out of its verdict: they must be counted when a kernel
+    compiles (an uncached one here), and not again when it runs."""
+    cube = jit._Kernel(_cube, {"nogil": True, "error_model": "numpy"})  # not cached: it always compiles
+    before = jit.compile_seconds()
+    assert cube(2.0) == 8.0
+    compiled = jit.compile_seconds()
+    assert compiled > before
+    assert cube(3.0) == 27.0 and jit.compile_seconds() == compiled
