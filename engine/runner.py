@@ -71,6 +71,7 @@ _STARTING = "starting: a first start after an install compiles the engine's kern
 frame follows at once; on a first start it stays while the first steps compile them."""
 _COMPILE_NOTE = 0.25
 """Seconds of compiling in one frame's steps from which the window says so."""
+_ONCE = "a first start after an install, once"
 
 
 class Activity(Protocol):
@@ -350,7 +351,7 @@ class Runner:
         last = self._wall()
         steps = 0
         meter = _RateMeter(last)
-        compiled_seen = jit.compile_seconds()
+        compiled_seen = compiled_at_start = jit.compile_seconds()
         self._note = (_STARTING, math.inf)  # on screen while the first step runs (see _STARTING)
         while not self._stopped and self._limit(steps) > 0 and not activity.finished():
             for event in self.viewer.poll_events():
@@ -381,8 +382,9 @@ class Runner:
                 # Kernels compiled in those steps (a first start) are a one-off wait, not a game too slow
                 # for real time: left out of the keeper's verdict, and named on screen instead.
                 self.keeper.frame(elapsed - compiling, max(0.0, lost - compiling))
-            if compiling >= _COMPILE_NOTE:
-                self._compiled_note(compiled_seen)
+            in_steps = jit.compile_seconds() - compiled_seen  # this frame's steps (the keeper counts it next frame)
+            if in_steps >= _COMPILE_NOTE:  # shown while the next steps may compile more
+                self._compiling_note(compiled_seen + in_steps - compiled_at_start)
             elif ran and self._note is not None and self._note[0] == _STARTING:
                 self._note = None
             drawing = self._wall()
@@ -398,13 +400,15 @@ class Runner:
             self.fps = meter.rate
         return steps
 
-    def _compiled_note(self, seconds: float) -> None:
-        """Say on screen, and once on stderr, that kernels were compiled (a first start after an install)."""
-        text = f"compiled the engine's kernels: {seconds:.0f} s (a first start after an install: once)"
-        self._note = (text, self._wall() + _NOTE_SECONDS)
+    def _compiling_note(self, seconds: float) -> None:
+        """Say on screen, and once on stderr, that the steps compile kernels (a first start after an install)."""
+        self._note = (f"compiling the engine's kernels: {seconds:.0f} s so far ({_ONCE})", self._wall() + _NOTE_SECONDS)
         if not self._compile_told:
             self._compile_told = True
-            print(f"puppetphone: {text}; they are cached for the next starts", file=sys.stderr)
+            print(
+                f"puppetphone: compiling the engine's kernels ({_ONCE}: they are cached for the next starts)",
+                file=sys.stderr,
+            )
 
     def draw(self, activity: Activity, complete: bool = False) -> None:
         """Draw the activity's current state into the target (and show it in a window).
