@@ -15,18 +15,19 @@ from pathlib import Path
 
 import pytest
 
-from puppetphone.simd_ceiling import ABOVE_CEILING, cap_numpy_dispatch
+from puppetphone.simd_ceiling import ABOVE_CEILING, BLAS_CORE, _cpu_flags, cap_numpy_dispatch
 
 ROOT = Path(__file__).resolve().parents[2]
 _RAGDOLL_RECORDING = "tests/data/puppet_jump_rise_again.rec"  # Locomotion, Jump@32, Ragdoll@74
 _PROBE = (
     "import os, puppetphone, numpy; from input.library_versions import numpy_simd_level; "
+    "print(os.environ.get('OPENBLAS_CORETYPE'), file=__import__('sys').stderr); "
     "print(os.environ.get('NPY_DISABLE_CPU_FEATURES')); print(numpy_simd_level())"
 )
 
 
 def _probe(**env: str) -> list[str]:
-    base = {k: v for k, v in os.environ.items() if k != "NPY_DISABLE_CPU_FEATURES"}
+    base = {k: v for k, v in os.environ.items() if k not in ("NPY_DISABLE_CPU_FEATURES", "OPENBLAS_CORETYPE")}
     done = subprocess.run(
         [sys.executable, "-W", "error", "-c", _PROBE],
         env={**base, **env},
@@ -58,6 +59,31 @@ def test_the_cap_adds_to_a_variable_and_repeats_nothing(monkeypatch: pytest.Monk
     assert env["NPY_DISABLE_CPU_FEATURES"].split() == ["AVX2", "X86_V4", "AVX512_ICL", "AVX512_SPR"]
     empty: dict[str, str] = {}
     assert cap_numpy_dispatch(empty) and empty["NPY_DISABLE_CPU_FEATURES"].split() == list(ABOVE_CEILING)
+
+
+def test_blas_kernels_are_held_at_avx2_where_the_cpu_runs_them_and_a_users_choice_is_kept(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """OpenBLAS's AVX-512 kernels parted every shipped recording from the AVX2 machine's at frame 18."""
+    monkeypatch.delitem(sys.modules, "numpy")
+    avx512 = frozenset({"avx2", "fma", "avx512f"})
+    env: dict[str, str] = {}
+    assert cap_numpy_dispatch(env, avx512) and env["OPENBLAS_CORETYPE"] == BLAS_CORE
+    mine = {"OPENBLAS_CORETYPE": "Zen"}
+    cap_numpy_dispatch(mine, avx512)
+    assert mine["OPENBLAS_CORETYPE"] == "Zen"
+    old: dict[str, str] = {}
+    cap_numpy_dispatch(old, frozenset({"sse4_2", "avx"}))  # no AVX2: Haswell kernels would not run
+    assert "OPENBLAS_CORETYPE" not in old
+
+
+def test_the_launcher_sets_the_blas_kernels_on_this_cpu_before_numpy_loads() -> None:
+    base = {k: v for k, v in os.environ.items() if k != "OPENBLAS_CORETYPE"}
+    done = subprocess.run(
+        [sys.executable, "-W", "error", "-c", _PROBE], env=base, cwd=ROOT, capture_output=True, text=True, check=True
+    )
+    expected = BLAS_CORE if {"avx2", "fma"} <= _cpu_flags() else "None"
+    assert done.stderr.split() == [expected]
 
 
 def test_once_numpy_is_imported_the_cap_says_it_cannot_help_and_changes_nothing() -> None:
