@@ -185,7 +185,7 @@ def run() -> list[Figure]:
                 ms, pct, e_mm, h_mm, n = _cell(config, dof, frames)
                 assert n == dof, f"{config} {dof}: {n} variables optimised"
                 name = f"curves_ms_{config}_{dof}dof_{frames}f"
-                figures.append(Figure("curves", name, ms, "ms", "thesis Table 4.3 (Mosek, i7-4930K)",
+                figures.append(Figure("curves", name, ms, "ms", "thesis Table 4.3 (Mosek, i7-4930K, 2013: straw man)",
                                       float(THESIS_MS[config][r][c])))  # fmt: skip
                 reach.append(pct)
                 err.append(e_mm)

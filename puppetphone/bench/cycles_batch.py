@@ -35,7 +35,7 @@ __all__ = ["TAKES", "run", "write_takes"]
 BENCH = "cycles-batch"
 TAKES = 40
 REPEATS = 3
-BASELINE = "one process per take (puppetphone cycle)"
+BASELINE = "one process per take, puppetphone cycle (straw man)"
 
 
 def write_takes(folder: Path, count: int = TAKES, seed: int = 0) -> list[Path]:

@@ -244,7 +244,7 @@ def run() -> list[Figure]:
         for pins in PINS:
             ms, err_mm, drift_mm, pct, cases, rig = _ours(dof, pins)
             tag = f"{dof}dof_{pins}pins"
-            base = f"thesis Table 4.3 (Mosek), {pins}-pin pairing, 2 frames"
+            base = f"thesis Table 4.3 (Mosek, 2013: straw man), {pins}-pin pairing, 2 frames"
             figures.append(Figure("ik", f"ik_ms_{tag}", ms, "ms", base, float(THESIS_MS[pins][i])))
             figures.append(Figure("ik", f"ik_error_mm_{tag}", err_mm, "mm", "tolerance", 0.1))
             if pins:

@@ -155,7 +155,9 @@ def run() -> list[Figure]:
     fps_loaded, free_loaded, level = _render_fps(loaded)
     fps_empty, free_empty, _ = _render_fps(empty, level)  # the empty field at the loaded field's level
     figures = [
-        Figure("snowman", "sim_step_ms", t_loaded * 1e3, "ms", "empty field", t_empty * 1e3),
+        Figure(
+            "snowman", "sim_step_ms", t_loaded * 1e3, "ms", "empty field (straw man: the fixed cost)", t_empty * 1e3
+        ),
         Figure("snowman", "sim_step_ms_vs_goal", t_loaded * 1e3, "ms", "goal", 8.0),
         Figure("snowman", "render_fps", fps_loaded, "fps", f"empty field (auto: both at {level})", fps_empty),
         Figure("snowman", "render_fps_vs_goal", fps_loaded, "fps", f"goal (auto: {level})", 30.0),
