@@ -125,7 +125,7 @@ def run() -> list[Figure]:
 
     factor = median_time(factorise, repeats=5, min_time=0.0) * 1e3
     return [
-        Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system", dense),
+        Figure("flow", "flow_solve_ms_40_objects", solve, "ms", "dense solve of the same system (straw man)", dense),
         Figure("flow", "flow_solve_cpu_ms_40_objects", cpu, "ms", "its wall time (shared cores)", solve),
         Figure("flow", "flow_factor_ms_40_objects", factor, "ms", "one prefactored solve", solve),
         *_scripted_edits(scene),
