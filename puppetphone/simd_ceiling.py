@@ -19,11 +19,13 @@ instruction).
 
 The cap works only through ``NPY_DISABLE_CPU_FEATURES``, which numpy reads once at import; so
 the launcher calls :func:`cap_numpy_dispatch` before anything imports numpy (OpenBLAS reads its
-variable when numpy loads it). A program that
-imported numpy first keeps its kernels (the recording header names them: ``numpy-simd``).
-The target names are numpy 2.4's, and numpy warns at import about a name it does not
-dispatch, so older numpy (the floor environment) is left alone: replays are promised only
-with constraints.txt's versions anyway. This module must not import numpy.
+variable when numpy loads it). A program that imported numpy first keeps its kernels (the
+recording header names them: ``numpy-simd``). numpy 2.4 names its targets by level; 1.26 to 2.3
+(the floor environment's 1.26 among them) by instruction set, and warn at import about a name they
+do not dispatch, so each gets its own list. Replays are promised only with constraints.txt's
+versions, but the compiled kernels' tests compare them with numpy bit for bit under every release
+(the floor's AVX-512 ``arccos`` parted a slerp from numba's in the last bit). This module must not
+import numpy.
 """
 
 from __future__ import annotations
@@ -37,8 +39,20 @@ __all__ = ["ABOVE_CEILING", "BLAS_CORE", "cap_numpy_dispatch"]
 
 #: numpy's dispatch targets above x86-64-v3, as numpy 2.4 names them.
 ABOVE_CEILING = ("X86_V4", "AVX512_ICL", "AVX512_SPR")
+#: The same before 2.4, named by instruction set: 1.26 to 2.2 dispatch up to Ice Lake, 2.3 adds Sapphire
+#: Rapids. A name the release does not dispatch makes numpy warn at import (an error under ``-W error``).
+_AVX512_BY_SET = (
+    "AVX512F",
+    "AVX512CD",
+    "AVX512_KNL",
+    "AVX512_KNM",
+    "AVX512_SKX",
+    "AVX512_CLX",
+    "AVX512_CNL",
+    "AVX512_ICL",
+)
 _VARIABLE = "NPY_DISABLE_CPU_FEATURES"
-_NAMED_FROM = (2, 4)  # the numpy release that names its x86 targets X86_V2..V4
+_NAMED_FROM = (2, 4)  # the numpy release that names its x86 targets X86_V2..V4 (ABOVE_CEILING)
 #: OpenBLAS's kernels for every x86-64 CPU with AVX2 and FMA (what an AVX2 machine picks itself).
 BLAS_CORE = "Haswell"
 _BLAS_VARIABLE = "OPENBLAS_CORETYPE"
@@ -57,28 +71,34 @@ def _cpu_flags() -> frozenset[str]:
     return frozenset()
 
 
-def _numpy_names_targets_by_level() -> bool:
+def _targets_above_ceiling() -> tuple[str, ...]:
+    """The installed numpy's dispatch targets above x86-64-v3 (none for a release older than 1.26, or none
+    installed: its dispatch is left alone)."""
     try:
-        major, minor = (int(p) for p in version("numpy").split(".")[:2])
+        release = tuple(int(p) for p in version("numpy").split(".")[:2])
     except (PackageNotFoundError, ValueError):
-        return False
-    return (major, minor) >= _NAMED_FROM
+        return ()
+    if release >= _NAMED_FROM:
+        return ABOVE_CEILING
+    if release >= (2, 3):
+        return (*_AVX512_BY_SET, "AVX512_SPR")
+    return _AVX512_BY_SET if release >= (1, 26) else ()
 
 
 def cap_numpy_dispatch(environ: MutableMapping[str, str] = os.environ, cpu_flags: frozenset[str] | None = None) -> bool:
     """Add :data:`ABOVE_CEILING` to ``NPY_DISABLE_CPU_FEATURES`` (keeping what is there), and set
     ``OPENBLAS_CORETYPE`` to :data:`BLAS_CORE` where the CPU (``cpu_flags``, read from the machine by
     default) has AVX2 and FMA and the user has not set it; ``False`` (nothing changed) when numpy is
-    already imported, so the cap would do nothing. numpy older than 2.4 names its targets otherwise:
-    its dispatch is left alone."""
+    already imported, so the cap would do nothing."""
     if "numpy" in sys.modules:
         return False
     flags = _cpu_flags() if cpu_flags is None else cpu_flags
     blas = _BLAS_VARIABLE not in environ and _BLAS_NEEDS.issubset(flags)
     if blas:
         environ[_BLAS_VARIABLE] = BLAS_CORE
-    if not _numpy_names_targets_by_level():
+    targets = _targets_above_ceiling()
+    if not targets:
         return blas
     present = environ.get(_VARIABLE, "").replace(",", " ").split()
-    environ[_VARIABLE] = " ".join(present + [f for f in ABOVE_CEILING if f not in present])
+    environ[_VARIABLE] = " ".join(present + [f for f in targets if f not in present])
     return True

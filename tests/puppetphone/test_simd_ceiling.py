@@ -86,6 +86,33 @@ def test_the_launcher_sets_the_blas_kernels_on_this_cpu_before_numpy_loads() -> 
     assert done.stderr.split() == [expected]
 
 
+@pytest.mark.parametrize(
+    ("release", "last"),
+    [
+        ("2.4.6", "AVX512_SPR"),
+        ("2.3.5", "AVX512_SPR"),
+        ("2.2.6", "AVX512_ICL"),
+        ("1.26.0", "AVX512_ICL"),
+        ("1.25.2", None),
+    ],
+)
+def test_each_numpy_release_gets_the_avx512_names_it_dispatches(monkeypatch: pytest.MonkeyPatch, release, last) -> None:
+    """numpy 1.26 with AVX512_SPR named warns at import (an error under -W error); unnamed, its AVX-512
+    arccos parted a compiled slerp from numpy's in the floor environment. Checked against each release's
+    ``__cpu_dispatch__``: 1.26, 2.0, 2.1, 2.2 end at AVX512_ICL, 2.3 adds AVX512_SPR, 2.4 names levels."""
+    import puppetphone.simd_ceiling as ceiling
+
+    monkeypatch.delitem(sys.modules, "numpy")
+    monkeypatch.setattr(ceiling, "version", lambda _name: release)
+    env: dict[str, str] = {}
+    ceiling.cap_numpy_dispatch(env, frozenset())
+    named = env.get("NPY_DISABLE_CPU_FEATURES", "").split()
+    assert (named[-1] if named else None) == last
+    assert ("X86_V4" in named) == release.startswith("2.4") and ("AVX512F" in named) == (
+        last is not None and not release.startswith("2.4")
+    )
+
+
 def test_once_numpy_is_imported_the_cap_says_it_cannot_help_and_changes_nothing() -> None:
     import numpy  # noqa: F401  (already loaded in this process)
 
