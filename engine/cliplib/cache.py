@@ -5,7 +5,10 @@ more with long mocap cycles); a set of authored clips is measured once and the r
 kept in ``$XDG_CACHE_HOME/puppetphone/lookup/<key>.npz``, so the next start with the
 same clips skips it. The key covers everything the numbers depend on: the clips'
 content hash, the probe grid and step, the source of the modules that play and
-measure a blend, and the numpy version — a cache written by other code is never read,
+measure a blend, the numpy version and the kernels it runs on this CPU (the SIMD targets and
+OpenBLAS core the launcher holds it at, :mod:`puppetphone.simd_ceiling`: a table measured before
+those caps, on an AVX-512 machine's kernels, parted every crowd's state from the capped one's) —
+a cache written by other code is never read,
 since a replay must measure exactly what the recorded session measured. Each file
 carries the SHA-256 of its key, probes and values; a cache file that is unreadable, does
 not match its probes or its checksum (damaged, or edited by hand) is ignored and
@@ -37,6 +40,7 @@ __all__ = [
     "MeasureCache",
     "cache_root",
     "code_fingerprint",
+    "kernel_choice",
     "default_cache_dir",
     "read_checked",
     "write_checked",
@@ -66,6 +70,7 @@ def default_cache_dir() -> Path:
 
 
 _SHA = "sha256"  # the member of a cache file that holds its checksum
+_KERNEL_CHOICE = ("NPY_DISABLE_CPU_FEATURES", "OPENBLAS_CORETYPE")  # read when numpy loads: its kernels
 #: Part of every key: a build that lays files out otherwise never reads (nor fights over) these.
 FILE_FORMAT = "puppetphone-cache/2"
 
@@ -108,9 +113,16 @@ def write_checked(path: Path, key: str, arrays: dict[str, NDArray[Any]]) -> bool
     return True
 
 
+def kernel_choice() -> str:
+    """The variables that chose numpy's and OpenBLAS's kernels when numpy loaded, as text for a cache key:
+    the same code and versions on other kernels round otherwise (see the module docstring)."""
+    return "".join(f"{variable}={os.environ.get(variable, '')};" for variable in _KERNEL_CHOICE)
+
+
 def code_fingerprint() -> str:
-    """Hash of the code that measures a blend, and numpy's version (see the module docstring)."""
-    h = hashlib.sha256(np.__version__.encode())
+    """Hash of the code that measures a blend, numpy's version and the kernels it was held at (see the
+    module docstring)."""
+    h = hashlib.sha256(np.__version__.encode() + kernel_choice().encode())
     for rel in _MEASURING:
         h.update(rel.encode() + (_ENGINE / rel).read_bytes())
     return h.hexdigest()

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from engine import jit
 from engine.clip import Clip, RootMotion
-from engine.cliplib.cache import FILE_FORMAT, cache_root, read_checked, write_checked
+from engine.cliplib.cache import FILE_FORMAT, cache_root, kernel_choice, read_checked, write_checked
 from engine.skeleton import Skeleton
 
 __all__ = ["BUILD_SOURCES", "build_key", "cached_clips", "default_folder", "decode", "encode"]
@@ -68,12 +68,13 @@ def _library_versions() -> dict[str, str]:
 
 
 def build_key() -> str:
-    """What the built clips depend on, hashed: the build's source, library versions, the kernel switch."""
+    """What the built clips depend on, hashed: the build's source, library versions, the kernel switch and
+    the kernels numpy was held at (:func:`engine.cliplib.cache.kernel_choice`)."""
     h = hashlib.sha256((FILE_FORMAT + _FORMAT).encode())
     sources = sorted(_ENGINE.joinpath("clips").glob("*.py")) + [_ENGINE / rel for rel in BUILD_SOURCES]
     for path in sources:
         h.update(path.relative_to(_ENGINE).as_posix().encode() + b"\0" + path.read_bytes())
-    h.update(json.dumps(_library_versions(), sort_keys=True).encode())
+    h.update(json.dumps(_library_versions(), sort_keys=True).encode() + kernel_choice().encode())
     return h.hexdigest()[:32]
 
 

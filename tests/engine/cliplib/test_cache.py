@@ -31,6 +31,17 @@ def test_other_clips_or_grid_get_another_key(tmp_path: Path) -> None:
     assert a.path != MeasureCache(tmp_path, "clips-b:9").path != MeasureCache(tmp_path, "clips-a:31").path
 
 
+def test_other_kernels_numpy_is_held_at_get_another_key(tmp_path: Path, monkeypatch) -> None:
+    """A table measured on an AVX-512 machine's OpenBLAS kernels parted a crowd's state from the one the
+    launcher's AVX2 cap measures: numbers from other kernels must not be read back."""
+    monkeypatch.delenv("OPENBLAS_CORETYPE", raising=False)
+    plain = MeasureCache(tmp_path, "clips-a:9").path
+    monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
+    capped = MeasureCache(tmp_path, "clips-a:9").path
+    monkeypatch.setenv("NPY_DISABLE_CPU_FEATURES", "X86_V3")
+    assert len({plain, capped, MeasureCache(tmp_path, "clips-a:9").path}) == 3
+
+
 def test_a_damaged_cache_file_is_measured_again(tmp_path: Path) -> None:
     probes = np.linspace(0.0, 1.0, 8).reshape(4, 2)
     cache = MeasureCache(tmp_path, "k")

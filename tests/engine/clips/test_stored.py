@@ -134,6 +134,14 @@ def test_the_key_follows_the_kernel_switch() -> None:
     assert compiled != plain
 
 
+def test_the_key_follows_the_kernels_numpy_is_held_at(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Built on an AVX-512 machine's OpenBLAS kernels the clips round otherwise than under the launcher's cap."""
+    monkeypatch.delenv("OPENBLAS_CORETYPE", raising=False)
+    plain = build_key()
+    monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
+    assert build_key() != plain
+
+
 def test_the_key_covers_every_engine_module_the_build_runs() -> None:
     """Built in a fresh process: each engine module it imported is hashed into the key (or it would go stale)."""
     code = (
