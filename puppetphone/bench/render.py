@@ -20,9 +20,10 @@ of 3 repeats of several frames each (:func:`cpu_frame_time`):
   its columns, the height cues) and the HUD overlay (its lines name what the 1000 puppets are
   doing) into a new scene, then the renderer through the window's own camera (the sandbox's) at
   1280x720, the 3-D scene at 640x360 scaled up. It is timed after :data:`PLAY_STEPS` steps of play,
-  when the crowd has walked into that view as a player sees it in the first half minute (about
-  200 puppets in it, drawn as impostors over one another towards the horizon; the other 800
-  culled), in process CPU time (the llvmpipe threads counted), the median of 3 repeats. The
+  when the crowd has walked into that view as a player sees it after 20 s (3,000 of the 21,000
+  capsules in it, about 140 puppets, drawn as impostors over one another towards the horizon; the
+  rest culled; the crowd goes on filling the view: 6,500 capsules at 2,400 steps), in process CPU
+  time (the llvmpipe threads counted), the median of 3 repeats of 4 frames. The
   shadows are drawn every frame, as they are while the crowd walks. Against 10 fps, the rate
   down to which a window keeps game time; the steps between two frames are not in it
   (``crowd_step_ms_1000``), nor the window's swap.
@@ -104,7 +105,7 @@ BIG_CROWD = 100
 PLAY_CROWD = 1000
 PLAY_STEPS = 1200
 """Steps of play before the window's frame is timed (20 s of game time): the wanderers have left their grid
-behind the camera and fill its view, about 200 of them in it, as the window shows them in its first half minute."""
+behind the camera and fill its view, about 140 of them in it, as the window shows them 20 s after it opens."""
 COLORS = (
     (0.85, 0.3, 0.25),
     (0.25, 0.5, 0.85),
