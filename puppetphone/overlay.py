@@ -19,12 +19,14 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 
+from engine.batches import batch
 from engine.components import Name
 from engine.ecs import World
 from engine.ragdoll import PhysicsWorld
 from engine.render.scene import RenderScene
 from engine.statemachine import Brain
-from engine.statemachine.puppet.words import describe_puppet
+from engine.statemachine.puppet.body import PuppetBody
+from engine.statemachine.puppet.words import describe_puppets
 from games.base import Game
 from games.common import Notice
 from input.hub import InputHub
@@ -166,15 +168,18 @@ def notice(world: World) -> tuple[str, float] | None:
 
 def _puppet_lines(world: World) -> list[str]:
     """What each puppet is doing; past :data:`MAX_PUPPET_LINES` the rest are counted by activity,
-    so a crowd does not bury the screen."""
-    lines, rest = [], Counter[str]()
-    for i, (e, brain) in enumerate(world.query(Brain)):
-        doing = describe_puppet(world, e, brain)
-        if i < MAX_PUPPET_LINES:
-            name = world.try_get(e, Name)
-            lines.append(f"{name.value if name is not None else f'#{e}'}: {doing}")
-        else:
-            rest[doing] += 1
+    so a crowd does not bury the screen.
+
+    The words of a whole crowd come at once from its arrays (:func:`describe_puppets`): one
+    :func:`describe_puppet` per puppet cost a thousand-puppet frame 5 ms of Python."""
+    kept = batch(world, "overlay words", (Brain,), (PuppetBody,))
+    brains, bodies = kept.lists
+    words = describe_puppets(world, kept.entities, brains, bodies)
+    lines = []
+    for e, doing in zip(kept.entities[:MAX_PUPPET_LINES], words, strict=False):
+        name = world.try_get(e, Name)
+        lines.append(f"{name.value if name is not None else f'#{e}'}: {doing}")
+    rest = Counter(words[MAX_PUPPET_LINES:])
     if rest:
         counts = ", ".join(f"{n} {doing}" for doing, n in sorted(rest.items(), key=lambda kv: (-kv[1], kv[0])))
         lines.append(f"and {sum(rest.values())} more: {counts}")

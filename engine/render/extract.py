@@ -16,6 +16,7 @@ not ``visible`` are skipped.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Sequence
 from functools import lru_cache
 
@@ -24,6 +25,7 @@ from numpy.typing import NDArray
 
 from engine import quat
 from engine.arrays import I64 as _Idx
+from engine.batches import batch
 from engine.columns import Columns
 from engine.components import Puppet, Transform, WorldPose
 from engine.ecs import World
@@ -31,7 +33,7 @@ from engine.render.components import Appearance, Shape
 from engine.render.scene import RenderScene
 from engine.skeleton import Skeleton
 
-__all__ = ["scene_from_world", "puppet_capsules", "pose_arrays"]
+__all__ = ["scene_from_world", "puppet_capsules", "pose_arrays", "DrawnRuns"]
 
 _DEFAULT_PUPPET = Appearance()
 _DEFAULT_PROP = Appearance(color=(0.95, 0.96, 0.98))
@@ -132,6 +134,64 @@ def _add_puppets(
     scene.add_capsules(a.reshape(-1, 3), b.reshape(-1, 3), r.reshape(-1), color.reshape(-1, 3), outline)
 
 
+class DrawnRuns:
+    """Resource: the runs :func:`_puppet_runs` found last, and the skeleton objects they were found for. Only
+    how the drawing groups the puppets: never hashed."""
+
+    SIM_STATE = False
+
+    def __init__(self) -> None:
+        self.skeletons: list[Skeleton] = []
+        self.bounds: list[tuple[int, int]] = []
+
+
+_SKELETON = operator.attrgetter("skeleton")
+_VISIBLE = operator.attrgetter("visible")
+
+
+def _look(appearance: Appearance | None) -> Appearance:
+    return _DEFAULT_PUPPET if appearance is None else appearance
+
+
+def _skeleton_key(sk: Skeleton) -> bytes:
+    return b"|".join((sk.parents.tobytes(), sk.tips.tobytes(), sk.radii.tobytes()))
+
+
+def _puppet_runs(world: World) -> list[tuple[Skeleton, list[WorldPose], list[Appearance]]]:
+    """The visible puppets in entity order, in runs of consecutive ones whose skeletons have the same bones and
+    radii (each puppet may hold its own copy): each run is drawn in one call.
+
+    The puppets are a kept batch (:mod:`engine.batches`), and their runs are kept with the skeleton objects they
+    were found for (:class:`DrawnRuns`): while every puppet holds the same skeleton and all are visible, a frame
+    finds them in a few C-level passes, where comparing the bytes of each puppet's skeleton, a thousand
+    puppets' every frame, cost more than their interpolation."""
+    kept = batch(world, "drawn puppets", (Puppet, WorldPose), (Appearance,))
+    puppets, poses, appearances = kept.lists
+    looks = list(map(_look, appearances))
+    if not all(map(_VISIBLE, looks)):
+        shown = [i for i, look in enumerate(looks) if look.visible]
+        skeletons = [puppets[i].skeleton for i in shown]
+        return [
+            (skeletons[a], [poses[shown[i]] for i in range(a, b)], [looks[shown[i]] for i in range(a, b)])
+            for a, b in _bounds(skeletons)
+        ]
+    skeletons = list(map(_SKELETON, puppets))
+    memo = world.try_resource(DrawnRuns)
+    if memo is None:
+        memo = DrawnRuns()
+        world.insert_resource(memo)
+    if len(memo.skeletons) != len(skeletons) or not all(map(operator.is_, memo.skeletons, skeletons)):
+        memo.skeletons, memo.bounds = skeletons, _bounds(skeletons)
+    return [(skeletons[a], list(poses[a:b]), looks[a:b]) for a, b in memo.bounds]
+
+
+def _bounds(skeletons: Sequence[Skeleton]) -> list[tuple[int, int]]:
+    """``[start, end)`` of each run of consecutive skeletons with the same bones and radii."""
+    keys = [_skeleton_key(sk) for sk in skeletons]
+    starts = [i for i in range(len(keys)) if i == 0 or keys[i] != keys[i - 1]]
+    return list(zip(starts, starts[1:] + [len(keys)] if keys else [], strict=True))
+
+
 def scene_from_world(world: World, alpha: float, scene: RenderScene | None = None) -> RenderScene:
     """Append every visible puppet and prop of ``world`` to ``scene`` (a new one if ``None``).
 
@@ -143,22 +203,7 @@ def scene_from_world(world: World, alpha: float, scene: RenderScene | None = Non
     if not 0.0 <= alpha <= 1.0:
         raise ValueError(f"alpha must be in [0, 1], got {alpha}")
     scene = RenderScene() if scene is None else scene
-    # Runs of consecutive puppets whose skeletons have the same bones and radii (each puppet may hold
-    # its own copy) are drawn together; the order of the rows is kept.
-    runs: list[tuple[Skeleton, list[WorldPose], list[Appearance]]] = []
-    run_key = b""
-    for e, puppet, wpose in world.query(Puppet, WorldPose):
-        look = world.try_get(e, Appearance) or _DEFAULT_PUPPET
-        if not look.visible:
-            continue
-        sk = puppet.skeleton
-        key = b"|".join((sk.parents.tobytes(), sk.tips.tobytes(), sk.radii.tobytes()))
-        if not runs or key != run_key:
-            runs.append((sk, [], []))
-            run_key = key
-        runs[-1][1].append(wpose)
-        runs[-1][2].append(look)
-    for skeleton, poses, looks in runs:
+    for skeleton, poses, looks in _puppet_runs(world):
         _add_puppets(scene, world, skeleton, poses, looks, alpha)
     for e, tf, shape in world.query(Transform, Shape):
         look = world.try_get(e, Appearance) or _DEFAULT_PROP

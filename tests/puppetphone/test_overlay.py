@@ -128,6 +128,30 @@ def test_a_crowd_is_summed_up_in_one_line():
     assert len(summary) == 1 and any(word in summary[0] for word in ("walking", "running", "standing"))
 
 
+def test_a_crowds_lines_are_those_of_one_description_per_puppet():
+    """The crowd's summary comes from its arrays (:func:`describe_puppets`); the text is what one
+    :func:`describe_puppet` per puppet gives, named lines and counts alike. Broken once by counting the last
+    named puppet too (``words[MAX_PUPPET_LINES - 1:]``): the summary said 997 more and it failed."""
+    from collections import Counter
+
+    from engine.components import Name
+    from engine.statemachine import Brain
+    from engine.statemachine.puppet.words import describe_puppet
+    from puppetphone.overlay import MAX_PUPPET_LINES
+
+    hub = InputHub()
+    app = make_app("sandbox", 0, hub, {"puppets": 1000})
+    app.run_steps(120)
+    world = app.world
+    doing = [(e, describe_puppet(world, e, brain)) for e, brain in world.query(Brain)]
+    named = [f"{world.get(e, Name).value}: {words}" for e, words in doing[:MAX_PUPPET_LINES]]
+    rest = Counter(words for _, words in doing[MAX_PUPPET_LINES:])
+    counts = ", ".join(f"{n} {w}" for w, n in sorted(rest.items(), key=lambda kv: (-kv[1], kv[0])))
+    lines = overlay_lines(world, GAME, hub, 60.0, False)
+    assert lines[1 : 2 + MAX_PUPPET_LINES] == [*named, f"and 996 more: {counts}"]
+    assert len(rest) >= 2  # walkers and runners: the counts are sorted, not one word
+
+
 def _help_drawn(source_kind: str, size: tuple[int, int] = (1280, 720)) -> tuple[list[str], RenderScene]:
     from input.factory import make_hub
 

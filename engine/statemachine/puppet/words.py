@@ -5,18 +5,27 @@ The overlay used to print the state's name and the last events the brain saw
 the puppet was back up. Here the words come from the state the brain is in *now*
 and, for a fall, from the transition that entered it, so the reason goes away with
 the state. Reads the world only.
+
+The overlay names a crowd's puppets every frame ("and 996 more: 587 walking, 395 running"):
+:func:`describe_puppets` gives the same words for all of them at once, the gaits of those
+walking or crouching (nearly all of a crowd) read from the row arrays their brains' states
+and their bodies' ground velocities live in (:mod:`engine.rows`), the few others one by one.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
+from engine.arrays import F64
 from engine.ecs import Entity, World
+from engine.rows import RowBlock, row_store
 from engine.statemachine.machine import Brain
 from engine.statemachine.puppet.body import Jumping, JumpPhase, PuppetBody
 from engine.statemachine.puppet.names import PuppetEvent, PuppetState
 
-__all__ = ["describe_puppet", "RUN_FRACTION"]
+__all__ = ["describe_puppet", "describe_puppets", "RUN_FRACTION"]
 
 RUN_FRACTION = 0.55
 """Ground speed, as a fraction of the puppet's top speed, from which it reads as running."""
@@ -64,3 +73,40 @@ def describe_puppet(world: World, entity: Entity, brain: Brain) -> str:
     if state == PuppetState.RAGDOLL:
         return _fall(brain, body, jump)
     return state.lower()
+
+
+def describe_puppets(
+    world: World, entities: Sequence[Entity], brains: tuple[Brain, ...], bodies: tuple[PuppetBody | None, ...]
+) -> list[str]:
+    """:func:`describe_puppet` of every ``entities[i]`` with ``brains[i]`` and ``bodies[i]``, in order.
+
+    Where the brains and bodies are in their row blocks (a crowd once the brain stage ran), the
+    puppets walking or crouching get their gait from the arrays, with the same comparisons on the
+    same numbers as :func:`_gait`; the others, and every puppet outside the blocks, one by one."""
+    store = row_store(world)
+    at_brains = store.rows(Brain, brains) if brains else None
+    at_bodies = None if at_brains is None or None in bodies else store.rows(PuppetBody, bodies)
+    if at_brains is None or at_bodies is None:
+        return [describe_puppet(world, e, brain) for e, brain in zip(entities, brains, strict=True)]
+    active = at_brains[0].arrays["active"][at_brains[1]]
+    block, rows = at_bodies
+    velocity = block.arrays["ground_velocity"][rows]
+    still, top = (limit[rows] for limit in _speed_limits(block))
+    speed = np.hypot(velocity[:, 0], velocity[:, 2])
+    crouched = active == PuppetState.CROUCH
+    moving = np.where(crouched, "crouch-walking", np.where(speed >= RUN_FRACTION * top, "running", "walking"))
+    gait = np.where(speed < still, np.where(crouched, "crouching", "standing"), moving).tolist()
+    on_feet = (crouched | (active == PuppetState.LOCOMOTION)).tolist()
+    return [gait[i] if on_feet[i] else describe_puppet(world, entities[i], brains[i]) for i in range(len(brains))]
+
+
+def _speed_limits(block: RowBlock) -> tuple[F64, F64]:
+    """Per row of a block of bodies: its tuning's ``still_speed`` and ``max_speed``, derived once and kept
+    with the block while no tuning is assigned (``RowBlock.objects_set``)."""
+    kept = block.memo.get("speed limits")
+    if kept is None or kept[0] != block.objects_set:
+        tunings = block.arrays["tuning"]
+        still = np.fromiter((t.still_speed for t in tunings), np.float64, len(tunings))
+        top = np.fromiter((t.max_speed for t in tunings), np.float64, len(tunings))
+        kept = block.memo["speed limits"] = (block.objects_set, still, top)
+    return kept[1], kept[2]

@@ -165,3 +165,18 @@ def test_a_crowd_is_drawn_from_its_columns_as_each_puppet_alone_would_be():
     assert np.allclose(d[:, 0:3], a, atol=1e-6) and np.allclose(d[:, 3:6], b, atol=1e-6)
     assert np.allclose(d[42:63, 1] - before[42:63, 1], 0.6, atol=1e-5)  # puppet 2 drawn raised, 0.3 of the way
     assert np.array_equal(np.delete(d, np.s_[42:63], axis=0), np.delete(before, np.s_[42:63], axis=0))
+
+
+def test_a_puppet_given_another_skeleton_is_drawn_with_it_on_the_next_frame():
+    """The crowd's runs of like skeletons are kept between frames (:class:`engine.render.extract.DrawnRuns`);
+    a skeleton assigned to one puppet, without any structural change, is seen on the next frame. Broken once
+    by keeping the runs whatever the skeletons: puppet 1 kept its old radii and it failed."""
+    import dataclasses
+
+    world = _posed_crowd(3)
+    before = scene_from_world(world, 0.5).capsules.data.copy()
+    puppet = world.query(Puppet, WorldPose)[1][1]
+    puppet.skeleton = dataclasses.replace(puppet.skeleton, radii=2.0 * puppet.skeleton.radii)
+    after = scene_from_world(world, 0.5).capsules.data
+    assert np.allclose(after[21:42, 6], 2.0 * before[21:42, 6])
+    assert np.array_equal(np.delete(after, np.s_[21:42], axis=0), np.delete(before, np.s_[21:42], axis=0))

@@ -119,14 +119,49 @@ def test_alternated_figures_take_turns_and_keep_their_own_times() -> None:
     assert runs == ["a", "b", "a", "b"]  # a b | b a | a b
 
 
-def test_the_played_crowd_frame_draws_the_whole_crowd_each_frame_from_the_sandbox_camera() -> None:
-    """``render_fps_1000_puppets_play`` times the game's own extract and drawing: every puppet's capsules,
-    each frame anew in one reused scene (without the scene's clear the second frame holds two crowds)."""
+def test_the_played_window_frame_is_the_runners_draw_of_the_session_after_its_steps() -> None:
+    """``render_fps_1000_puppets_play`` times what a window draws: the session's drawing (every puppet's
+    capsules and the HUD, whose lines name what the crowd is doing) into a new scene each frame, seen by
+    the session's camera, waited for; after the steps of play it was given. Broken once by drawing the game
+    without the overlay (the old figure's frame): the scene held no HUD line and it failed; once by reusing one scene without
+    clearing it: the second frame held two crowds."""
     from games.sandbox import camera
-    from puppetphone.bench.render import played_crowd_frame
+    from puppetphone.bench.render import played_window_frame
 
-    drawn: list[tuple[int, float]] = []
-    frame = played_crowd_frame(lambda scene, cam: drawn.append((len(scene.capsules), cam.distance)), 4, 3)
+    viewer = _Viewer()
+    frame = played_window_frame(viewer, 6, 5)  # type: ignore[arg-type]  # the stand-in has what it uses
     frame()
     frame()
-    assert drawn == [(4 * 21, camera().distance)] * 2
+    assert viewer.finished == 2
+    for capsules, distance, texts in viewer.drawn:
+        assert capsules == 6 * 21 and distance == camera().distance
+        assert "frame 5" in texts[0] and "and 2 more: " in "\n".join(texts)
+        assert any(line.startswith("[idle] mouse") for line in texts)  # the window's own source
+
+
+class _Viewer:
+    """A viewer stand-in: records what each frame drew and how often the frame was waited for."""
+
+    size = (1280, 720)
+
+    def __init__(self) -> None:
+        self.camera: object = None
+        self.drawn: list[tuple[int, float, list[str]]] = []
+        self.finished = 0
+        self.target = self
+
+    @property
+    def ctx(self) -> _Viewer:
+        return self
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def finish(self) -> None:
+        self.finished += 1
+
+    def draw(self, scene) -> None:  # type: ignore[no-untyped-def]  # a RenderScene
+        self.drawn.append((len(scene.capsules), self.camera.distance, [t.text for t in scene.texts]))  # type: ignore[attr-defined]  # an OrbitCamera
