@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from engine.clipfile import load_clip
 from input.recording import read_recording
 
@@ -18,7 +20,13 @@ def puppetphone(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     )
 
 
-def test_a_recorded_take_replays_to_the_same_loop_without_writing(tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def take(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, subprocess.CompletedProcess[str]]:
+    """One scripted take of the arm (``author record``, 600 steps), recorded once for the tests below that
+    need a real ``author-record`` recording: its own replay, a tempo edit of it and forged copies of it
+    (each of those used to record a take of its own, ~2 s of CPU each for the same command).
+    Its folder holds ``take.rec`` and the saved ``loop.ppclip``; the tests write their edits elsewhere."""
+    folder = tmp_path_factory.mktemp("take")
     done = puppetphone(
         "author",
         "record",
@@ -35,42 +43,36 @@ def test_a_recorded_take_replays_to_the_same_loop_without_writing(tmp_path: Path
         "take.rec",
         "-o",
         "loop.ppclip",
-        cwd=tmp_path,
+        cwd=folder,
     )
+    return folder, done
+
+
+def test_a_recorded_take_replays_to_the_same_loop_without_writing(
+    take: tuple[Path, subprocess.CompletedProcess[str]],
+) -> None:
+    folder, done = take
     assert done.returncode == 0, done.stderr
-    loop = load_clip(tmp_path / "loop.ppclip")
+    loop = load_clip(folder / "loop.ppclip")
     assert loop.loop and loop.num_frames > 10  # the scripted performer's take became a clean loop
-    header = read_recording(tmp_path / "take.rec").header
+    header = read_recording(folder / "take.rec").header
     assert header.game == "author-record" and header.setup["item"] == "r_upper_arm"
-    (tmp_path / "loop.ppclip").unlink()
-    done = puppetphone("replay", "take.rec", "--verify", "--headless", cwd=tmp_path)
+    (folder / "loop.ppclip").unlink()
+    done = puppetphone("replay", "take.rec", "--verify", "--headless", cwd=folder)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "replayed 600 frames, all 600 state hashes match" in done.stdout
-    assert not (tmp_path / "loop.ppclip").exists()  # a replay saves nothing
+    assert not (folder / "loop.ppclip").exists()  # a replay saves nothing
 
 
-def test_a_take_of_another_tempo_is_a_divergence(tmp_path: Path) -> None:
+def test_a_take_of_another_tempo_is_a_divergence(
+    take: tuple[Path, subprocess.CompletedProcess[str]], tmp_path: Path
+) -> None:
     """The recording pins the take: replayed with a shorter countdown the state differs, and says where."""
-    done = puppetphone(
-        "author",
-        "record",
-        "--script",
-        "loops",
-        "--headless",
-        "--frames",
-        "120",
-        "--countdown",
-        "1",
-        "--record",
-        "take.rec",
-        "-o",
-        "loop.ppclip",
-        cwd=tmp_path,
-    )
+    folder, done = take
     assert done.returncode == 0, done.stderr
     from input.recording import Recorder
 
-    rec = read_recording(tmp_path / "take.rec")
+    rec = read_recording(folder / "take.rec")
     rec.header.setup["countdown"] = 0.5
     with Recorder(tmp_path / "edited.rec", rec.header) as out:
         for frame, digest, parts in zip(rec.frames, rec.hashes, rec.parts, strict=True):
@@ -80,26 +82,15 @@ def test_a_take_of_another_tempo_is_a_divergence(tmp_path: Path) -> None:
     assert "differs at frame 0 in scene " in done.stdout  # the countdown timer is the first thing that differs
 
 
-def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(tmp_path: Path) -> None:
+def test_a_recording_with_a_malformed_tool_operation_is_refused_in_one_line(
+    take: tuple[Path, subprocess.CompletedProcess[str]], tmp_path: Path
+) -> None:
     from input.recording import Recorder
     from input.sample import TOOL, InputFrame
 
-    done = puppetphone(
-        "author",
-        "record",
-        "--script",
-        "loops",
-        "--headless",
-        "--frames",
-        "20",
-        "--record",
-        "take.rec",
-        "-o",
-        "loop.ppclip",
-        cwd=tmp_path,
-    )
+    folder, done = take
     assert done.returncode == 0, done.stderr
-    rec = read_recording(tmp_path / "take.rec")
+    rec = read_recording(folder / "take.rec")
     with Recorder(tmp_path / "forged.rec", rec.header) as out:
         for i, (frame, digest, parts) in enumerate(zip(rec.frames, rec.hashes, rec.parts, strict=True)):
             if i == 5:

@@ -144,6 +144,14 @@ def test_dask_local_cluster_of_two_workers(tmp_path: Path) -> None:
     still took 8787, and the test failed whenever that was in use (shown by holding 8787 while it ran)."""
     distributed = pytest.importorskip("distributed", reason="Dask's distributed is not installed (the 'cluster' extra)")
     write_takes(tmp_path / "takes", count=8)
+    # A scheduler nobody listens on: the command retries for its 20 s connect timeout before it gives up,
+    # a wait of nearly no CPU. Started first, it waits while the runs below work, instead of after them.
+    unreachable = subprocess.Popen(
+        [*CLI, str(tmp_path / "takes"), "-o", str(tmp_path / "x"), "--scheduler", "tcp://127.0.0.1:9"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     local = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "local"), "--jobs", "1")
     assert local.returncode == 0, local.stderr
     with distributed.LocalCluster(
@@ -155,8 +163,8 @@ def test_dask_local_cluster_of_two_workers(tmp_path: Path) -> None:
             assert r.returncode == 0, r.stderr
             assert SUMMARY.match(r.stdout.strip().splitlines()[-1])
             assert _content(lib) == _content(tmp_path / "local")
-    unreachable = _cycles(str(tmp_path / "takes"), "-o", str(tmp_path / "x"), "--scheduler", "tcp://127.0.0.1:9")
-    assert unreachable.returncode == 2 and "cannot reach the Dask scheduler" in unreachable.stderr
+    _, unreachable_err = unreachable.communicate(timeout=300)
+    assert unreachable.returncode == 2 and "cannot reach the Dask scheduler" in unreachable_err
 
 
 def test_retarget_puppet_writes_clips_on_the_puppet_skeleton(mocap_dir: Path, tmp_path: Path) -> None:

@@ -47,7 +47,9 @@ def test_the_play_command_devices_prints_listens_where_the_qr_code_points(tmp_pa
     address = urls[0][len("(osc.udp://") :].split(":")[0]
     command = next(line.strip() for line in shown.splitlines() if line.strip().startswith("puppetphone play"))
     assert "127.0.0.1 only" in shown
-    args = shlex.split(command)[1:] + ["--headless", "--frames", "900", "--record", "paired.rec"]
+    # 300 steps: five seconds of a live (paced) game, counted from its first step, so a slow start costs no
+    # packet that counts; the phone below sends one every ~0.03 s and ten must arrive. (900 waited 15 s.)
+    args = shlex.split(command)[1:] + ["--headless", "--frames", "300", "--record", "paired.rec"]
     game = subprocess.Popen(
         [sys.executable, "-m", "puppetphone", *args],
         cwd=tmp_path,
