@@ -36,9 +36,10 @@ import numpy as np
 __all__ = ["Quality", "QUALITIES", "QUALITY_NAMES", "QUICK", "QualityGovernor", "parse_quality"]
 
 QUICK = 4
-"""Frames after which a level whose every frame took over twice the budget is left, without waiting
-for the governor's whole window (the first frames at a level compile shaders: one or two slow ones
-must not decide)."""
+"""Frames after which a level whose last four frames each took over twice the budget is left, without
+waiting for the governor's whole window (the first frames at a level compile shaders: one or two slow
+ones must not decide; and a quick one, the window's first frame with nothing stepped yet, must not
+hold the level for the whole window: it did, for 12 frames of 0.3 s)."""
 
 
 @dataclass(frozen=True)
@@ -121,7 +122,8 @@ class QualityGovernor:
         self._fixed.append(fixed)
         i = self.ORDER.index(self.level)
         if len(self._times) < self.window:
-            far_over = len(self._times) >= QUICK and min(np.add(self._times, self._fixed)) > 2.0 * self.budget
+            recent = np.add(self._times, self._fixed)[-QUICK:]  # the last few: a quick first frame must not hold it
+            far_over = len(recent) == QUICK and recent.min() > 2.0 * self.budget
             if far_over and i > 0:
                 self._too_slow.add(self.level)
                 return self._set(self.ORDER[i - 1])

@@ -36,6 +36,9 @@ def test_frames_far_over_the_budget_leave_the_level_after_a_few_frames_and_one_f
     changes = [gov.frame(0.300) for _ in range(QUICK)]
     assert changes == [False] * (QUICK - 1) + [True]
     assert gov.level == "low" and gov.window > QUICK
+    first_quick = QualityGovernor("auto")  # the window's first frame: nothing stepped, drawn at once
+    changes = [first_quick.frame(t) for t in (0.040, *[0.300] * QUICK)]
+    assert changes == [False] * QUICK + [True] and first_quick.level == "low"
     warm = QualityGovernor("auto")
     assert not any(warm.frame(t) for t in (0.300, 0.250, *[0.020] * (warm.window - 3)))
     assert warm.level == "medium"
