@@ -95,13 +95,14 @@ class TimeKeeper:
     """How far a window's game time falls behind wall time, over the last few seconds.
 
     The runner tells it each frame's wall duration and how much of it was dropped (a
-    stall longer than the catch-up limit, or steps beyond the clock's cap). While the
-    game kept less than ``keep`` of the wall time of the last ``span`` seconds,
+    stall longer than the catch-up limit, or steps beyond the clock's cap). Once ``span``
+    seconds are judged, while the game kept less than ``keep`` of the wall time of the last ``span`` seconds,
     :meth:`behind` says so in words for the screen, and the first time it happens in a
     run a line goes to stderr; otherwise the window says nothing.
 
     The first ``grace`` seconds of a run are not judged: the first frames compile shaders
-    and fill caches, and a stall there says nothing about the game.
+    and fill caches, and a stall there says nothing about the game. Nor are the frames before a
+    change of the drawing level (:meth:`restart`).
 
     Args:
         max_frame: the runner's catch-up limit, named in the message.
@@ -112,6 +113,7 @@ class TimeKeeper:
 
     def __init__(self, max_frame: float, span: float = 2.0, keep: float = 0.98, grace: float = 1.0) -> None:
         self.max_frame, self.span, self.keep = max_frame, span, keep
+        self.grace = grace
         self._grace = grace
         self._frames: list[tuple[float, float]] = []
         self.dropped_total = 0.0
@@ -131,6 +133,13 @@ class TimeKeeper:
                 del self._frames[:i]
                 break
 
+    def restart(self) -> None:
+        """Judge afresh, after ``grace`` seconds again: the drawing level changed, and the frames drawn at the
+        level left (1000 puppets at ``medium`` on a laptop: 3 fps, the reason it was left) say nothing about
+        the new one, whose first frames compile its shaders. The terminal line is still said only once."""
+        self._frames.clear()
+        self._grace = self.grace
+
     def kept(self) -> float:
         """Share of the recent wall time the game kept (1 when nothing was dropped)."""
         wall = sum(e for e, _ in self._frames)
@@ -138,10 +147,12 @@ class TimeKeeper:
 
     def behind(self) -> str | None:
         """What to tell the player while the game runs slower than real time, else ``None``."""
+        wall = sum(e for e, _ in self._frames)
+        if wall < self.span:  # not yet a whole span judged (a run's start, or a level just changed)
+            return None
         kept = self.kept()
         if kept >= self.keep:
             return None
-        wall = sum(e for e, _ in self._frames)
         fps = len(self._frames) / wall if wall > 0 else 0.0
         text = (
             f"too slow to keep time: the game runs at {kept:.2f}x real time ({fps:.1f} fps, "

@@ -291,6 +291,7 @@ class Runner:
         """The quality key: the next of low, medium, high, auto, said on screen for a moment."""
         mode = self.quality.cycle()
         self._apply_quality()
+        self.keeper.restart()
         level = "" if mode != "auto" else f" (now {self.quality.level})"
         self._note = (f"quality: {mode}{level}", self._wall() + _NOTE_SECONDS)
 
@@ -396,6 +397,7 @@ class Runner:
             fixed = 0.0 if self.clock.paused else self._step_cost * self.quality.budget / activity.dt
             if self.quality.frame(self._wall() - drawing, fixed):
                 self._apply_quality()
+                self.keeper.restart()  # the verdict is on the level the governor chose, not the one it left
             meter.tick(now)
             self.fps = meter.rate
         return steps
