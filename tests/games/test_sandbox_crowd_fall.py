@@ -68,24 +68,16 @@ def test_a_hundred_of_a_thousand_go_limp_at_once_in_the_game(request: pytest.Fix
 
 def _draw_crowd(app) -> None:  # type: ignore[no-untyped-def]
     """The frame after the fall at ``low``: every puppet's capsules, finite, and the picture shows them."""
-    from engine.render import RenderScene, Viewer, make_target
-    from engine.render.quality import QUALITIES
+    from engine.render import RenderScene
     from games.sandbox import GAME
+    from tests.engine.render.drawn import drawn
 
     scene = RenderScene()
     GAME.draw(app.world, scene, 0.5)
     bones = len(app.world.query(Puppet)[0][1].skeleton.parents) - 1
     assert len(scene.capsules) >= PUPPETS * bones
     assert np.isfinite(scene.capsules.data).all()
-    viewer = Viewer(make_target(True, 320, 180, samples=0))
-    try:
-        with viewer.target.ctx:
-            viewer.renderer.set_quality(QUALITIES["low"])
-        viewer.camera = GAME.camera()
-        viewer.draw(scene)
-        img = viewer.read_pixels().astype(np.int32)
-    finally:
-        viewer.close()
+    img = drawn(scene, GAME.camera(), "low", (320, 180))
     blue = (img[..., 2] - img[..., 0]) > 40  # the crowd's blue puppets on the white field
     assert np.count_nonzero(blue) > 500
 

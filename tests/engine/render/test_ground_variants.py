@@ -15,8 +15,8 @@ from engine.camera import OrbitCamera
 from engine.render import RenderScene
 from engine.render.environment import Environment
 from engine.render.headless import egl_available
-from engine.render.quality import QUALITIES
 from engine.render.shaders_ground import NEAR_DETAIL
+from tests.engine.render.drawn import drawn
 
 _reason = egl_available()
 pytestmark = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
@@ -48,20 +48,10 @@ _SPLIT: Callable[..., list] = Environment.ground_draws
 
 
 def _frame(scene: RenderScene, camera: OrbitCamera, one_draw: bool) -> np.ndarray:
-    from engine.render import Viewer, make_target
-
-    viewer = Viewer(make_target(True, W, H, samples=0))
-    try:
-        with pytest.MonkeyPatch.context() as patch:
-            if one_draw:
-                patch.setattr(Environment, "ground_draws", _one_draw_with_everything)
-            with viewer.target.ctx:
-                viewer.renderer.set_quality(QUALITIES["high"])
-            viewer.camera = camera
-            viewer.draw(scene)
-            return viewer.read_pixels().astype(np.int32)
-    finally:
-        viewer.close()
+    with pytest.MonkeyPatch.context() as patch:
+        if one_draw:
+            patch.setattr(Environment, "ground_draws", _one_draw_with_everything)
+        return drawn(scene, camera, "high", (W, H))
 
 
 @pytest.mark.parametrize("shadow", [False, True])

@@ -19,7 +19,7 @@ from engine.camera import OrbitCamera
 from engine.render import RenderScene
 from engine.render.headless import egl_available
 from engine.render.impostors import quad_corners
-from engine.render.quality import QUALITIES
+from tests.engine.render.drawn import drawn
 
 _reason = egl_available()
 needs_gl = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
@@ -37,17 +37,7 @@ def test_the_quad_is_two_triangles_over_the_unit_square():
 def _render(
     scene: RenderScene, camera: OrbitCamera, size: tuple[int, int] = (320, 240), quality: str = "low"
 ) -> np.ndarray:
-    from engine.render import Viewer, make_target
-
-    viewer = Viewer(make_target(True, *size, samples=0))
-    try:
-        with viewer.target.ctx:
-            viewer.renderer.set_quality(QUALITIES[quality])
-        viewer.camera = camera
-        viewer.draw(scene)
-        return viewer.read_pixels().astype(np.int32)
-    finally:
-        viewer.close()
+    return drawn(scene, camera, quality, size)
 
 
 @needs_gl

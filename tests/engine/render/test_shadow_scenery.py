@@ -12,6 +12,7 @@ from engine.camera import OrbitCamera
 from engine.render import RenderScene
 from engine.render.headless import egl_available
 from engine.render.quality import QUALITIES
+from tests.engine.render.drawn import drawn
 
 _reason = egl_available()
 pytestmark = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
@@ -34,21 +35,7 @@ def _fresh(scene: RenderScene, level: str) -> np.ndarray:
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(shadows, "blit_depth", lambda *a: False)
-        return _draw(scene, level)
-
-
-def _draw(scene: RenderScene, level: str) -> np.ndarray:
-    from engine.render import Viewer, make_target
-
-    viewer = Viewer(make_target(True, 320, 240, samples=0))
-    try:
-        with viewer.target.ctx:
-            viewer.renderer.set_quality(QUALITIES[level])
-        viewer.camera = _CAMERA
-        viewer.draw(scene)
-        return viewer.read_pixels().copy()
-    finally:
-        viewer.close()
+        return drawn(scene, _CAMERA, level)
 
 
 @pytest.mark.parametrize("level", ["low", "high"])

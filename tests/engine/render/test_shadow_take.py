@@ -13,7 +13,7 @@ from engine.render import RenderScene
 from engine.render import shaders_ground as G
 from engine.render.environment import SHADOW_STRENGTH, shadow_take
 from engine.render.headless import egl_available
-from engine.render.quality import QUALITIES
+from tests.engine.render.drawn import drawn
 
 _reason = egl_available()
 needs_gl = pytest.mark.skipif(_reason is not None, reason=f"no headless EGL OpenGL 3.3 context: {_reason}")
@@ -53,23 +53,13 @@ def _field(shadows: bool = True) -> RenderScene:
 
 
 def _frame(scene: RenderScene, quality: str, per_pixel: bool) -> np.ndarray:
-    from engine.render import Viewer, make_target
-
     with pytest.MonkeyPatch.context() as patch:
         if per_pixel:
             patch.setattr(G, "SHADOW_DECAL_FS", _PER_PIXEL_DECAL)
             line = "        c *= 1.0 - texture(u_ground_mask, muv).r * u_shadow_take;"
             assert line in G.GROUND_MESH_FS
             patch.setattr(G, "GROUND_MESH_FS", G.GROUND_MESH_FS.replace(line, _PER_PIXEL_MASK))
-        viewer = Viewer(make_target(True, W, H, samples=0))
-        try:
-            with viewer.target.ctx:
-                viewer.renderer.set_quality(QUALITIES[quality])
-            viewer.camera = _CAMERA
-            viewer.draw(scene)
-            return viewer.read_pixels().astype(np.int32)
-        finally:
-            viewer.close()
+        return drawn(scene, _CAMERA, quality, (W, H))
 
 
 @needs_gl
