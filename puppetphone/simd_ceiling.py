@@ -92,8 +92,7 @@ def cap_numpy_dispatch(environ: MutableMapping[str, str] = os.environ, cpu_flags
     already imported, so the cap would do nothing."""
     if "numpy" in sys.modules:
         return False
-    flags = _cpu_flags() if cpu_flags is None else cpu_flags
-    blas = _BLAS_VARIABLE not in environ and _BLAS_NEEDS.issubset(flags)
+    blas = _BLAS_VARIABLE not in environ and _BLAS_NEEDS.issubset(_cpu_flags() if cpu_flags is None else cpu_flags)
     if blas:
         environ[_BLAS_VARIABLE] = BLAS_CORE
     targets = _targets_above_ceiling()
